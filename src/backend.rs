@@ -1,0 +1,115 @@
+//! Backend and precision choice shared by every command that computes.
+
+use crate::error::GpuError;
+use crate::gpu::contact::contact_gpu;
+use crate::gpu::GpuContext;
+use crate::kernels::contact::{contact, ContactBatch, ContactOutputs};
+use crate::physics::contact::ContactTerms;
+
+/// `--backend`: where the kernels run.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum BackendChoice {
+    /// The CPU twins (rayon over pairs / variants).
+    Cpu,
+    /// The WGSL kernels; an error if no adapter exists.
+    Gpu,
+    /// The GPU where an adapter exists, else the CPU with a one-line notice.
+    Auto,
+}
+
+/// `--precision`: the float type of the computation.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Precision {
+    /// 64-bit (the oracle's precision).
+    F64,
+    /// 32-bit.
+    F32,
+}
+
+/// A resolved backend.
+#[derive(Clone, Copy)]
+pub enum Backend {
+    /// CPU twins.
+    Cpu,
+    /// GPU kernels on the shared context.
+    Gpu(&'static GpuContext),
+}
+
+impl Backend {
+    /// Resolves `--backend` for a run at `precision`. `auto` falls back to the CPU, with a
+    /// one-line notice on stderr, when no adapter exists or it cannot run `precision`.
+    pub fn resolve(choice: BackendChoice, precision: Precision) -> Result<Backend, GpuError> {
+        match choice {
+            BackendChoice::Cpu => Ok(Backend::Cpu),
+            BackendChoice::Gpu => {
+                let ctx = GpuContext::shared()?;
+                if precision == Precision::F64 && !ctx.has_f64 {
+                    return Err(GpuError::Unsupported(format!(
+                        "adapter {} has no SHADER_F64; use --precision f32 or --backend cpu",
+                        ctx.info.name
+                    )));
+                }
+                Ok(Backend::Gpu(ctx))
+            }
+            BackendChoice::Auto => match GpuContext::shared() {
+                Ok(ctx) if precision == Precision::F32 || ctx.has_f64 => Ok(Backend::Gpu(ctx)),
+                Ok(ctx) => {
+                    eprintln!(
+                        "holewall: adapter {} has no SHADER_F64; using the CPU backend",
+                        ctx.info.name
+                    );
+                    Ok(Backend::Cpu)
+                }
+                Err(e) => {
+                    eprintln!("holewall: {e}; using the CPU backend");
+                    Ok(Backend::Cpu)
+                }
+            },
+        }
+    }
+
+    /// Name for reports.
+    pub fn describe(&self) -> String {
+        match self {
+            Backend::Cpu => "cpu".to_string(),
+            Backend::Gpu(ctx) => format!("gpu: {}", ctx.describe()),
+        }
+    }
+}
+
+/// Contact outputs at the precision that was asked for.
+#[derive(Clone, Debug)]
+pub enum ContactResults {
+    /// f64 run.
+    F64(ContactOutputs<f64>),
+    /// f32 run.
+    F32(ContactOutputs<f32>),
+}
+
+/// Evaluates the contact element for `batch` on `backend` at `precision`, with the kernel
+/// specialised to `terms`. An f32 run converts the inputs once and computes in f32
+/// throughout, on either backend.
+pub fn evaluate_contact(
+    backend: Backend,
+    precision: Precision,
+    terms: &ContactTerms,
+    batch: &ContactBatch<f64>,
+) -> Result<ContactResults, GpuError> {
+    Ok(match (backend, precision) {
+        (Backend::Cpu, Precision::F64) => {
+            let mut out = ContactOutputs::new(batch.num_pairs());
+            contact(terms, batch, &mut out);
+            ContactResults::F64(out)
+        }
+        (Backend::Cpu, Precision::F32) => {
+            let b32 = batch.cast::<f32>();
+            let mut out = ContactOutputs::new(b32.num_pairs());
+            contact(terms, &b32, &mut out);
+            ContactResults::F32(out)
+        }
+        (Backend::Gpu(ctx), Precision::F64) => ContactResults::F64(contact_gpu(ctx, terms, batch)?),
+        (Backend::Gpu(ctx), Precision::F32) => {
+            ContactResults::F32(contact_gpu(ctx, terms, &batch.cast::<f32>())?)
+        }
+    })
+}

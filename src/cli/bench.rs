@@ -1,0 +1,143 @@
+//! `holewall bench …`: throughput benchmarks. Medians over repeats; every ratio is formed
+//! from figures measured in the same run.
+
+use std::path::Path;
+
+use serde::Serialize;
+
+use crate::backend::{Backend, BackendChoice, Precision};
+use crate::error::Error;
+use crate::gpu::contact::GpuContactRun;
+use crate::kernels::contact::{contact as contact_twin, ContactOutputs};
+use crate::output::write_atomic;
+use crate::physics::contact::{ContactMode, ContactTerms, FrictionModel};
+use crate::selfcheck::{median_seconds, random_batch};
+
+#[derive(Serialize)]
+struct Row {
+    path: String,
+    median_s: f64,
+    evals_per_s: f64,
+    ratio_to_cpu_f64: f64,
+}
+
+#[derive(Serialize)]
+struct Report {
+    pairs: usize,
+    repeats: usize,
+    terms: String,
+    cpu_threads: usize,
+    adapter: String,
+    rows: Vec<Row>,
+}
+
+/// Contact evaluations per second for `pairs` (variant, site) pairs with the all-terms
+/// kernel (split friction, dynamic): CPU f64 and f32 twins on all cores; GPU f32 and f64
+/// with the data resident (kernel + wait) and end to end (upload + kernel + read-back).
+pub fn contact(
+    pairs: usize,
+    repeats: usize,
+    backend: BackendChoice,
+    json: Option<&Path>,
+) -> Result<(), Error> {
+    let terms = ContactTerms::all(FrictionModel::Split, ContactMode::Dynamic);
+    let num_variants = 1000.min(pairs.max(1));
+    let batch = random_batch(
+        42,
+        num_variants,
+        pairs.div_ceil(num_variants),
+        FrictionModel::Split,
+    );
+    let p = batch.num_pairs();
+    let mut rows: Vec<(String, f64)> = Vec::new();
+    let mut out64 = ContactOutputs::new(p);
+    let t = median_seconds::<Error>(repeats, || {
+        contact_twin(&terms, &batch, &mut out64);
+        Ok(())
+    })?;
+    rows.push(("CPU f64 (twin, rayon)".into(), t));
+    let b32 = batch.cast::<f32>();
+    let mut out32 = ContactOutputs::new(p);
+    let t = median_seconds::<Error>(repeats, || {
+        contact_twin(&terms, &b32, &mut out32);
+        Ok(())
+    })?;
+    rows.push(("CPU f32 (twin, rayon)".into(), t));
+    let mut adapter = "none".to_string();
+    let gpu = match backend {
+        BackendChoice::Cpu => None,
+        other => match Backend::resolve(other, Precision::F32)? {
+            Backend::Gpu(ctx) => Some(ctx),
+            Backend::Cpu => None,
+        },
+    };
+    if let Some(ctx) = gpu {
+        adapter = ctx.describe();
+        let run = GpuContactRun::new(ctx, &terms, &b32)?;
+        rows.push((
+            format!("GPU f32 resident ({} chunks)", run.num_chunks()),
+            median_seconds(repeats, || run.dispatch())?,
+        ));
+        rows.push((
+            "GPU f32 end to end".into(),
+            median_seconds(repeats, || {
+                let r = GpuContactRun::new(ctx, &terms, &b32)?;
+                r.dispatch()?;
+                r.read().map(|_| ())
+            })?,
+        ));
+        if ctx.has_f64 {
+            let run = GpuContactRun::new(ctx, &terms, &batch)?;
+            rows.push((
+                format!("GPU f64 resident ({} chunks)", run.num_chunks()),
+                median_seconds(repeats, || run.dispatch())?,
+            ));
+            rows.push((
+                "GPU f64 end to end".into(),
+                median_seconds(repeats, || {
+                    let r = GpuContactRun::new(ctx, &terms, &batch)?;
+                    r.dispatch()?;
+                    r.read().map(|_| ())
+                })?,
+            ));
+        }
+    }
+    let cpu64 = rows[0].1;
+    println!(
+        "contact evaluations, {p} pairs, all-terms kernel (split, dynamic), median of {repeats}"
+    );
+    println!(
+        "adapter: {adapter}; CPU threads: {}",
+        rayon::current_num_threads()
+    );
+    println!("| path | median time (s) | evaluations/s | ratio to CPU f64 |");
+    println!("|---|---|---|---|");
+    let rows: Vec<Row> = rows
+        .into_iter()
+        .map(|(path, t)| Row {
+            path,
+            median_s: t,
+            evals_per_s: p as f64 / t,
+            ratio_to_cpu_f64: cpu64 / t,
+        })
+        .collect();
+    for r in &rows {
+        println!(
+            "| {} | {:.4e} | {:.3e} | {:.2} |",
+            r.path, r.median_s, r.evals_per_s, r.ratio_to_cpu_f64
+        );
+    }
+    if let Some(path) = json {
+        let report = Report {
+            pairs: p,
+            repeats,
+            terms: format!("{terms:?}"),
+            cpu_threads: rayon::current_num_threads(),
+            adapter,
+            rows,
+        };
+        let text = serde_json::to_string_pretty(&report).map_err(std::io::Error::other)?;
+        write_atomic(path, text.as_bytes())?;
+    }
+    Ok(())
+}

@@ -1,0 +1,5 @@
+//! The commands behind the `holewall` binary (argument parsing stays in `src/main.rs`).
+
+pub mod bench;
+pub mod contact;
+pub mod gpu_info;

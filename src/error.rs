@@ -1,0 +1,58 @@
+//! The library's error types.
+
+use thiserror::Error;
+
+/// Errors of the GPU path.
+#[derive(Clone, Debug, Error)]
+pub enum GpuError {
+    /// No adapter could be opened (no Vulkan driver, or `WGPU_ADAPTER_NAME` matches none).
+    #[error("no GPU adapter: {0}")]
+    NoAdapter(String),
+    /// The device could not be created or was lost.
+    #[error("GPU device: {0}")]
+    Device(String),
+    /// A shader failed to compose, validate or compile.
+    #[error("shader: {0}")]
+    Shader(String),
+    /// The adapter lacks a feature the request needs.
+    #[error("GPU feature missing: {0}")]
+    Unsupported(String),
+}
+
+/// An input error: names the source, line, key and the allowed range. Exit code 2.
+#[derive(Clone, Debug, Error)]
+#[error("{source_name}:{line}: {key}: {message}")]
+pub struct InputError {
+    /// File name, or `<stdin>`.
+    pub source_name: String,
+    /// 1-based line number.
+    pub line: usize,
+    /// The offending key (or `-` where the line as a whole is wrong).
+    pub key: String,
+    /// What is wrong and what is allowed.
+    pub message: String,
+}
+
+/// Top-level error of a command.
+#[derive(Debug, Error)]
+pub enum Error {
+    /// Bad user input: exit code 2.
+    #[error(transparent)]
+    Input(#[from] InputError),
+    /// GPU failure.
+    #[error(transparent)]
+    Gpu(#[from] GpuError),
+    /// I/O failure.
+    #[error("{0}")]
+    Io(#[from] std::io::Error),
+}
+
+impl Error {
+    /// The process exit code for this error: 2 for bad input, 1 otherwise.
+    pub fn exit_code(&self) -> i32 {
+        match self {
+            Error::Input(_) => 2,
+            _ => 1,
+        }
+    }
+}

@@ -1,0 +1,354 @@
+//! Runs `shaders/contact.wgsl` (twin: `src/kernels/contact.rs`) on the GPU for a
+//! [`ContactBatch`], split into chunks that fit the adapter's binding limits.
+
+use std::collections::BTreeSet;
+use std::marker::PhantomData;
+use std::sync::Arc;
+
+use wgpu::util::DeviceExt;
+
+use crate::error::GpuError;
+use crate::gpu::compose::compose;
+use crate::gpu::layout::ContactDims;
+use crate::gpu::GpuContext;
+use crate::kernels::contact::{ContactBatch, ContactOutputs, OUTPUT_LEN, STATE_LEN};
+use crate::physics::contact::{ContactMode, ContactTerms, FrictionModel, SpringLaw, PARAMS_LEN};
+use crate::physics::Real;
+
+/// A float type a kernel can be compiled for.
+pub trait GpuReal: Real + bytemuck::Pod {
+    /// Whether this is `f64` (needs `SHADER_F64`).
+    const IS_F64: bool;
+}
+
+impl GpuReal for f32 {
+    const IS_F64: bool = false;
+}
+
+impl GpuReal for f64 {
+    const IS_F64: bool = true;
+}
+
+/// The composition flags of the contact kernel for a set of terms.
+pub fn contact_flags(terms: &ContactTerms) -> BTreeSet<&'static str> {
+    let mut flags = BTreeSet::new();
+    if terms.spring != SpringLaw::Linear {
+        flags.insert("POW");
+    }
+    if terms.spring == SpringLaw::PowerBlend {
+        flags.insert("BLEND");
+    }
+    let dynamic = terms.mode == ContactMode::Dynamic;
+    if dynamic {
+        flags.insert("DYNAMIC");
+    }
+    if dynamic && terms.damping {
+        flags.insert("DAMPING");
+    }
+    match terms.friction {
+        Some(FrictionModel::Split) => {
+            flags.insert("FRICTION");
+            flags.insert("SPLIT");
+        }
+        Some(FrictionModel::Coupled) => {
+            flags.insert("FRICTION");
+            flags.insert("COUPLED");
+        }
+        None => {}
+    }
+    flags
+}
+
+/// The WGSL text of the contact kernel specialised to `terms` and a precision.
+pub fn contact_wgsl(terms: &ContactTerms, f64: bool) -> Result<String, GpuError> {
+    let mut flags = contact_flags(terms);
+    if f64 {
+        flags.insert("F64");
+    }
+    compose("contact.wgsl", &flags, f64)
+}
+
+/// Invocations per workgroup in `shaders/contact.wgsl`.
+const WORKGROUP: usize = 64;
+
+struct Chunk {
+    offset: usize,
+    len: usize,
+    _params: wgpu::Buffer,
+    state: wgpu::Buffer,
+    values: wgpu::Buffer,
+    contact: wgpu::Buffer,
+    staging: wgpu::Buffer,
+    bind_group: wgpu::BindGroup,
+}
+
+/// A batch resident on the GPU: buffers and bind groups made once; [`Self::dispatch`] and
+/// [`Self::read`] can be repeated (benchmarks time them apart).
+pub struct GpuContactRun<T: GpuReal> {
+    ctx: &'static GpuContext,
+    pipeline: Arc<wgpu::ComputePipeline>,
+    chunks: Vec<Chunk>,
+    num_pairs: usize,
+    _real: PhantomData<T>,
+}
+
+fn bytes_of_len<T>(n: usize) -> u64 {
+    (n.max(1) * std::mem::size_of::<T>()) as u64
+}
+
+impl<T: GpuReal> GpuContactRun<T> {
+    /// Compiles (or fetches from the cache) the kernel for `terms` and uploads `batch`.
+    pub fn new(
+        ctx: &'static GpuContext,
+        terms: &ContactTerms,
+        batch: &ContactBatch<T>,
+    ) -> Result<Self, GpuError> {
+        if T::IS_F64 && !ctx.has_f64 {
+            return Err(GpuError::Unsupported(format!(
+                "adapter {} has no SHADER_F64; use --precision f32",
+                ctx.info.name
+            )));
+        }
+        let wgsl = contact_wgsl(terms, T::IS_F64)?;
+        let pipeline = ctx.pipeline("contact", &wgsl)?;
+        let device = &ctx.device;
+        let size = std::mem::size_of::<T>();
+        let max_binding = ctx.max_binding_bytes() as usize;
+        let max_groups = ctx.limits.max_compute_workgroups_per_dimension as usize;
+        let cap = (max_binding / (OUTPUT_LEN * size))
+            .min(max_groups * WORKGROUP)
+            .max(1);
+        let num_pairs = batch.num_pairs();
+        if batch.site_normals.len() * size > max_binding {
+            return Err(GpuError::Unsupported(
+                "too many sites for one binding".into(),
+            ));
+        }
+        let normals = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("site_normals"),
+            contents: bytemuck::cast_slice(if batch.site_normals.is_empty() {
+                &[0u32; 4][..]
+            } else {
+                bytemuck::cast_slice(&batch.site_normals)
+            }),
+            usage: wgpu::BufferUsages::STORAGE,
+        });
+        let layout = pipeline.get_bind_group_layout(0);
+        let mut chunks = Vec::new();
+        let mut offset = 0;
+        while offset < num_pairs {
+            let len = cap.min(num_pairs - offset);
+            let gather = |data: &[T], fields: usize| -> Vec<T> {
+                let mut out = Vec::with_capacity(fields * len);
+                for k in 0..fields {
+                    out.extend_from_slice(
+                        &data[k * num_pairs + offset..k * num_pairs + offset + len],
+                    );
+                }
+                out
+            };
+            let storage = |label: &str, contents: &[T]| {
+                device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                    label: Some(label),
+                    contents: bytemuck::cast_slice(contents),
+                    usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+                })
+            };
+            let params = storage("pair_params", &gather(&batch.pair_params, PARAMS_LEN));
+            let state = storage("pair_state", &gather(&batch.pair_state, STATE_LEN));
+            let values_bytes = bytes_of_len::<T>(OUTPUT_LEN * len);
+            let contact_bytes = bytes_of_len::<u32>(len);
+            let values = device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("out_values"),
+                size: values_bytes,
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+                mapped_at_creation: false,
+            });
+            let contact = device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("out_contact"),
+                size: contact_bytes,
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+                mapped_at_creation: false,
+            });
+            let staging = device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("contact_staging"),
+                size: values_bytes + contact_bytes,
+                usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            });
+            let dims = ContactDims {
+                num_pairs: len as u32,
+                num_variants: batch.num_variants as u32,
+                pair_offset: offset as u32,
+                _pad: 0,
+            };
+            let dims = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("contact_dims"),
+                contents: bytemuck::bytes_of(&dims),
+                usage: wgpu::BufferUsages::UNIFORM,
+            });
+            let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("contact"),
+                layout: &layout,
+                entries: &[
+                    wgpu::BindGroupEntry {
+                        binding: 0,
+                        resource: dims.as_entire_binding(),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 1,
+                        resource: normals.as_entire_binding(),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 2,
+                        resource: params.as_entire_binding(),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 3,
+                        resource: state.as_entire_binding(),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 4,
+                        resource: values.as_entire_binding(),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 5,
+                        resource: contact.as_entire_binding(),
+                    },
+                ],
+            });
+            chunks.push(Chunk {
+                offset,
+                len,
+                _params: params,
+                state,
+                values,
+                contact,
+                staging,
+                bind_group,
+            });
+            offset += len;
+        }
+        Ok(GpuContactRun {
+            ctx,
+            pipeline,
+            chunks,
+            num_pairs,
+            _real: PhantomData,
+        })
+    }
+
+    /// Number of chunks the batch was split into.
+    pub fn num_chunks(&self) -> usize {
+        self.chunks.len()
+    }
+
+    /// Re-uploads the state (`d`, `v`, `omega`) of every pair; parameters stay.
+    pub fn write_state(&self, batch: &ContactBatch<T>) {
+        let p = self.num_pairs;
+        for chunk in &self.chunks {
+            let mut data = Vec::with_capacity(STATE_LEN * chunk.len);
+            for k in 0..STATE_LEN {
+                data.extend_from_slice(
+                    &batch.pair_state[k * p + chunk.offset..k * p + chunk.offset + chunk.len],
+                );
+            }
+            self.ctx
+                .queue
+                .write_buffer(&chunk.state, 0, bytemuck::cast_slice(&data));
+        }
+    }
+
+    /// Runs the kernel over every chunk and waits for it to finish.
+    pub fn dispatch(&self) -> Result<(), GpuError> {
+        let mut encoder = self
+            .ctx
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("contact"),
+            });
+        {
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("contact"),
+                timestamp_writes: None,
+            });
+            pass.set_pipeline(&self.pipeline);
+            for chunk in &self.chunks {
+                pass.set_bind_group(0, &chunk.bind_group, &[]);
+                pass.dispatch_workgroups(chunk.len.div_ceil(WORKGROUP) as u32, 1, 1);
+            }
+        }
+        self.ctx.queue.submit([encoder.finish()]);
+        self.wait()
+    }
+
+    fn wait(&self) -> Result<(), GpuError> {
+        self.ctx
+            .device
+            .poll(wgpu::PollType::wait_indefinitely())
+            .map(|_| ())
+            .map_err(|e| GpuError::Device(e.to_string()))
+    }
+
+    /// Copies the results back into the CPU twin's layout.
+    pub fn read(&self) -> Result<ContactOutputs<T>, GpuError> {
+        let p = self.num_pairs;
+        let mut out = ContactOutputs::new(p);
+        let mut encoder = self
+            .ctx
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("contact_read"),
+            });
+        for chunk in &self.chunks {
+            let values_bytes = bytes_of_len::<T>(OUTPUT_LEN * chunk.len);
+            encoder.copy_buffer_to_buffer(&chunk.values, 0, &chunk.staging, 0, values_bytes);
+            encoder.copy_buffer_to_buffer(
+                &chunk.contact,
+                0,
+                &chunk.staging,
+                values_bytes,
+                bytes_of_len::<u32>(chunk.len),
+            );
+        }
+        self.ctx.queue.submit([encoder.finish()]);
+        for chunk in &self.chunks {
+            chunk
+                .staging
+                .slice(..)
+                .map_async(wgpu::MapMode::Read, |_| {});
+        }
+        self.wait()?;
+        for chunk in &self.chunks {
+            let values_bytes = bytes_of_len::<T>(OUTPUT_LEN * chunk.len) as usize;
+            {
+                let view = chunk
+                    .staging
+                    .slice(..)
+                    .get_mapped_range()
+                    .map_err(|e| GpuError::Device(format!("map: {e}")))?;
+                let values: &[T] = bytemuck::cast_slice(&view[..values_bytes]);
+                let flags: &[u32] = bytemuck::cast_slice(&view[values_bytes..]);
+                for k in 0..OUTPUT_LEN {
+                    out.values[k * p + chunk.offset..k * p + chunk.offset + chunk.len]
+                        .copy_from_slice(&values[k * chunk.len..(k + 1) * chunk.len]);
+                }
+                out.contact[chunk.offset..chunk.offset + chunk.len]
+                    .copy_from_slice(&flags[..chunk.len]);
+            }
+            chunk.staging.unmap();
+        }
+        Ok(out)
+    }
+}
+
+/// Evaluates `batch` on the GPU with the kernel specialised to `terms`.
+pub fn contact_gpu<T: GpuReal>(
+    ctx: &'static GpuContext,
+    terms: &ContactTerms,
+    batch: &ContactBatch<T>,
+) -> Result<ContactOutputs<T>, GpuError> {
+    let run = GpuContactRun::new(ctx, terms, batch)?;
+    run.dispatch()?;
+    run.read()
+}

@@ -1,0 +1,17 @@
+//! `#[repr(C)]` structs shared with WGSL. Keep in sync with `shaders/shared/layout.wgsl`.
+
+use bytemuck::{Pod, Zeroable};
+
+/// Dispatch dimensions of the contact kernel (uniform binding 0 of `shaders/contact.wgsl`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Pod, Zeroable)]
+pub struct ContactDims {
+    /// Pairs in this dispatch: the stride of every per-pair field array.
+    pub num_pairs: u32,
+    /// Variants per site in the whole batch: `site = (pair_offset + i) / num_variants`.
+    pub num_variants: u32,
+    /// Index of this dispatch's first pair in the whole batch.
+    pub pair_offset: u32,
+    /// Padding to 16 bytes.
+    pub _pad: u32,
+}

@@ -1,0 +1,8 @@
+//! The GPU path: wgpu context, shader composition, shared layouts, kernel runners.
+
+pub mod compose;
+pub mod contact;
+pub mod context;
+pub mod layout;
+
+pub use context::{list_adapters, AdapterSummary, GpuContext};

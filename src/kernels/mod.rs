@@ -1,0 +1,12 @@
+//! CPU twins of the WGSL kernels in `shaders/`: same names, same data layout, same loop
+//! index (`i` here where the shader has `gid.x`). They are the oracle the GPU results are
+//! tested against and the fallback where no adapter exists.
+//!
+//! | WGSL kernel | CPU twin |
+//! |---|---|
+//! | `shaders/contact.wgsl` | [`contact`] |
+
+pub mod contact;
+
+/// Every (shader, twin) pair; a test fails if a shader under `shaders/` is missing here.
+pub const TWINS: &[(&str, &str)] = &[("contact.wgsl", "src/kernels/contact.rs")];

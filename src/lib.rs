@@ -1,0 +1,20 @@
+//! holewall: a rotating drillstring touching the borehole wall, simulated for many
+//! parameter variants at once.
+//!
+//! The contact element of Le Phuoc Hao & Ta Quoc Dung (§2 of the seed paper, corrected as in
+//! `docs/contact-element.md`) is written once in [`physics::contact`], evaluated on the CPU
+//! by the twins in [`kernels`] (f64, the oracle) and on the GPU by the WGSL kernels in
+//! `shaders/` through [`gpu`], f32 or f64.
+
+#![warn(missing_docs)]
+
+pub mod backend;
+pub mod cli;
+pub mod error;
+pub mod gpu;
+pub mod kernels;
+pub mod output;
+pub mod physics;
+pub mod selfcheck;
+
+pub use error::{Error, GpuError, InputError};

@@ -1,0 +1,136 @@
+//! `holewall`: argument parsing only; the work is in the library.
+
+use std::io::Read;
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
+use holewall::backend::{Backend, BackendChoice, Precision};
+use holewall::cli;
+
+#[derive(Parser)]
+#[command(
+    name = "holewall",
+    version,
+    about = "Drillstring–holewall contact simulation for many variants at once"
+)]
+struct Args {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Contact-element calculator: JSON Lines in (FILE or stdin), JSON Lines out.
+    Contact {
+        /// Where to compute.
+        #[arg(long, value_enum, default_value_t = BackendChoice::Auto)]
+        backend: BackendChoice,
+        /// Float type of the computation.
+        #[arg(long, value_enum, default_value_t = Precision::F64)]
+        precision: Precision,
+        /// Input file (JSON Lines); stdin when absent.
+        file: Option<PathBuf>,
+    },
+    /// Lists GPU adapters and self-checks the contact kernel against its CPU twin.
+    GpuInfo {
+        /// (variant, site) pairs in the self-check.
+        #[arg(long, default_value_t = 20_000)]
+        pairs: usize,
+    },
+    /// Benchmarks (medians over repeats; GPU/CPU ratios from the same run).
+    Bench {
+        #[command(subcommand)]
+        what: BenchCommand,
+    },
+}
+
+#[derive(Subcommand)]
+enum BenchCommand {
+    /// Contact evaluations per second: CPU f64 (all cores), GPU f32 and f64.
+    Contact {
+        /// (variant, site) pairs per evaluation.
+        #[arg(long, default_value_t = 1_000_000)]
+        pairs: usize,
+        /// Timed repeats per path (the median is reported).
+        #[arg(long, default_value_t = 7)]
+        repeats: usize,
+        /// Where to compute the GPU paths (`cpu` benchmarks the CPU only).
+        #[arg(long, value_enum, default_value_t = BackendChoice::Auto)]
+        backend: BackendChoice,
+        /// Also write the results as JSON here.
+        #[arg(long)]
+        json: Option<PathBuf>,
+    },
+}
+
+fn fail(errors: &[holewall::Error]) -> ExitCode {
+    for e in errors {
+        eprintln!("holewall: {e}");
+    }
+    let code = errors.iter().map(|e| e.exit_code()).max().unwrap_or(1);
+    ExitCode::from(code as u8)
+}
+
+fn main() -> ExitCode {
+    let args = Args::parse();
+    match args.command {
+        Command::Contact {
+            backend,
+            precision,
+            file,
+        } => {
+            let (name, text) = match &file {
+                Some(path) => match std::fs::read_to_string(path) {
+                    Ok(t) => (path.display().to_string(), t),
+                    Err(e) => {
+                        eprintln!("holewall: {}: {e}", path.display());
+                        return ExitCode::from(2);
+                    }
+                },
+                None => {
+                    let mut t = String::new();
+                    if let Err(e) = std::io::stdin().read_to_string(&mut t) {
+                        eprintln!("holewall: <stdin>: {e}");
+                        return ExitCode::from(2);
+                    }
+                    ("<stdin>".to_string(), t)
+                }
+            };
+            // Validate before choosing a backend, so bad input never waits on a GPU.
+            if let Err(errs) = cli::contact::parse_all(&name, &text, precision == Precision::F32) {
+                return fail(
+                    &errs
+                        .into_iter()
+                        .map(holewall::Error::Input)
+                        .collect::<Vec<_>>(),
+                );
+            }
+            let backend = match Backend::resolve(backend, precision) {
+                Ok(b) => b,
+                Err(e) => return fail(&[e.into()]),
+            };
+            let stdout = std::io::stdout();
+            let mut lock = stdout.lock();
+            match cli::contact::run(backend, precision, &name, &text, &mut lock) {
+                Ok(()) => ExitCode::SUCCESS,
+                Err(errs) => fail(&errs),
+            }
+        }
+        Command::GpuInfo { pairs } => match cli::gpu_info::run(pairs) {
+            Ok(()) => ExitCode::SUCCESS,
+            Err(e) => fail(&[e]),
+        },
+        Command::Bench { what } => match what {
+            BenchCommand::Contact {
+                pairs,
+                repeats,
+                backend,
+                json,
+            } => match cli::bench::contact(pairs, repeats, backend, json.as_deref()) {
+                Ok(()) => ExitCode::SUCCESS,
+                Err(e) => fail(&[e]),
+            },
+        },
+    }
+}

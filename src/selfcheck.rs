@@ -1,0 +1,348 @@
+//! Random contact states spanning the element's regimes, and the error measures used to
+//! compare two evaluations (GPU against CPU twin, f32 against f64, analytic against finite
+//! differences). Used by the test suite, `holewall gpu-info` and the benchmarks.
+
+use rand::rngs::StdRng;
+use rand::{Rng, SeedableRng};
+
+use crate::kernels::contact::{ContactBatch, OUTPUT_LEN};
+use crate::physics::contact::{ContactParams, FrictionModel};
+use crate::physics::vec3::{add, cross, dot, scale, Vec3};
+
+/// The eight blocks of the output fields: (first, end) indices of g-force, g-moment,
+/// K-force rows, K-moment rows, C-force rows, C-moment rows, c_omega-force, c_omega-moment.
+pub const BLOCKS: [(usize, usize); 8] = [
+    (0, 3),
+    (3, 6),
+    (6, 15),
+    (15, 24),
+    (24, 33),
+    (33, 42),
+    (42, 45),
+    (45, 48),
+];
+
+/// Names of [`BLOCKS`].
+pub const BLOCK_NAMES: [&str; 8] = [
+    "g.f",
+    "g.m",
+    "K.f",
+    "K.m",
+    "C.f",
+    "C.m",
+    "c_omega.f",
+    "c_omega.m",
+];
+
+fn max_abs(x: &[f64]) -> f64 {
+    x.iter().fold(0.0, |m, v| m.max(v.abs()))
+}
+
+/// Relative error of `other` against `reference`, per block: `max|a − b| / max(max|b_block|,
+/// floor · max|b_quantity|)`, where the quantity is the block's force and moment halves
+/// together (so an all-but-zero moment block is judged against its force block). A block
+/// that is exactly zero in the reference and in the other gives 0; a zero reference with a
+/// non-zero other gives infinity.
+pub fn block_errors(
+    reference: &[f64; OUTPUT_LEN],
+    other: &[f64; OUTPUT_LEN],
+    floor: f64,
+) -> [f64; 8] {
+    let mut out = [0.0; 8];
+    for (b, &(lo, hi)) in BLOCKS.iter().enumerate() {
+        let pair = b - b % 2;
+        let quantity = max_abs(&reference[BLOCKS[pair].0..BLOCKS[pair + 1].1]);
+        let diff = (lo..hi).fold(0.0f64, |m, k| m.max((reference[k] - other[k]).abs()));
+        let denom = max_abs(&reference[lo..hi]).max(floor * quantity);
+        out[b] = if diff == 0.0 {
+            0.0
+        } else if denom == 0.0 {
+            f64::INFINITY
+        } else {
+            diff / denom
+        };
+    }
+    out
+}
+
+/// Which regime a sampled state is in (for reports and targeted checks).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Depth {
+    /// `delta < 0` (or `r = 0` at zero clearance).
+    Outside,
+    /// `delta ∈ [1e-9, 1e-5]` m.
+    JustPast,
+    /// `delta ∈ [1e-5, 1e-2]` m.
+    Deep,
+    /// `delta` within 1e-3 relative of `soft_blend`.
+    AtBlend,
+}
+
+/// Where the slip speed sits against `eps`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Slip {
+    /// `|s| < eps` (regularised branch).
+    Below,
+    /// `|s| = eps` (the C¹ seam).
+    At,
+    /// `|s| > eps`.
+    Above,
+    /// `s = 0` (rolling without slip, or no axial motion).
+    Zero,
+}
+
+/// One sampled contact state.
+#[derive(Clone, Debug)]
+pub struct Sample {
+    /// Displacement from the site reference point.
+    pub d: Vec3<f64>,
+    /// Velocity.
+    pub v: Vec3<f64>,
+    /// Spin rate.
+    pub omega: f64,
+    /// Law parameters.
+    pub params: ContactParams<f64>,
+    /// Depth regime.
+    pub depth: Depth,
+    /// Circumferential slip regime (for `coupled`: of the slip speed w).
+    pub slip_t: Slip,
+    /// Axial slip regime (split only).
+    pub slip_l: Slip,
+}
+
+fn log_uniform(rng: &mut StdRng, lo: f64, hi: f64) -> f64 {
+    10f64.powf(rng.random_range(lo.log10()..hi.log10()))
+}
+
+fn slip_speed(rng: &mut StdRng, regime: Slip, eps: f64) -> f64 {
+    let sign = if rng.random_bool(0.5) { 1.0 } else { -1.0 };
+    sign * match regime {
+        Slip::Below => rng.random_range(0.05..0.95) * eps,
+        Slip::At => eps,
+        Slip::Above => rng.random_range(1.05..100.0) * eps,
+        Slip::Zero => 0.0,
+    }
+}
+
+fn pick<T: Copy>(rng: &mut StdRng, items: &[T]) -> T {
+    items[rng.random_range(0..items.len())]
+}
+
+/// An orthonormal pair (u0, t0) perpendicular to the unit vector `n`.
+pub fn perpendicular_basis(n: &Vec3<f64>) -> (Vec3<f64>, Vec3<f64>) {
+    let helper = if n[0].abs() < 0.9 {
+        [1.0, 0.0, 0.0]
+    } else {
+        [0.0, 1.0, 0.0]
+    };
+    let a = cross(n, &helper);
+    let a = scale(&a, 1.0 / dot(&a, &a).sqrt());
+    (a, cross(n, &a))
+}
+
+/// Samples a state at a site with unit axis `n`, spanning: outside / just past contact
+/// (1e-9…1e-5 m) / deep / at the soft blend; slip below, at, above `eps` and zero; `m` in
+/// {2/3, 1, 3/2} or random in [0.5, 2]; `k_e` log-uniform up to 1e11; both signs of the
+/// normal velocity (so `N = 0` by damping also occurs).
+pub fn sample(rng: &mut StdRng, n: &Vec3<f64>, friction: FrictionModel) -> Sample {
+    let (u0, t0) = perpendicular_basis(n);
+    let theta = rng.random_range(0.0..std::f64::consts::TAU);
+    let u = add(&scale(&u0, theta.cos()), &scale(&t0, theta.sin()));
+    let t = cross(n, &u);
+
+    let clearance = if rng.random_bool(0.1) {
+        0.0
+    } else {
+        log_uniform(rng, 1e-3, 5e-2)
+    };
+    let random_m = rng.random_range(0.5..2.0);
+    let m = pick(rng, &[2.0 / 3.0, 1.0, 1.5, random_m]);
+    let soft_blend = log_uniform(rng, 1e-6, 1e-4);
+    let depth = pick(
+        rng,
+        &[
+            Depth::Outside,
+            Depth::JustPast,
+            Depth::JustPast,
+            Depth::Deep,
+            Depth::Deep,
+            Depth::AtBlend,
+        ],
+    );
+    let delta = match depth {
+        Depth::Outside => -rng.random_range(0.0..1.0) * clearance,
+        Depth::JustPast => log_uniform(rng, 1e-9, 1e-5),
+        Depth::Deep => log_uniform(rng, 1e-5, 1e-2),
+        Depth::AtBlend => soft_blend * (1.0 + rng.random_range(-1e-3..1e-3)),
+    };
+    let r = clearance + delta;
+    let axial = rng.random_range(-0.1..0.1);
+    let d = add(&scale(&u, r), &scale(n, axial));
+
+    let eps = log_uniform(rng, 1e-4, 1e-2);
+    let disk_radius = rng.random_range(0.03..0.15);
+    let slips = [Slip::Below, Slip::At, Slip::Above, Slip::Zero];
+    let slip_t = pick(rng, &slips);
+    let slip_l = pick(rng, &slips);
+    let (s_t, s_l) = match friction {
+        FrictionModel::Split => (slip_speed(rng, slip_t, eps), slip_speed(rng, slip_l, eps)),
+        FrictionModel::Coupled => {
+            let w = slip_speed(rng, slip_t, eps).abs();
+            let phi = rng.random_range(0.0..std::f64::consts::TAU);
+            (w * phi.cos(), w * phi.sin())
+        }
+    };
+    let v_u = log_uniform(rng, 1e-4, 3.0) * if rng.random_bool(0.5) { 1.0 } else { -1.0 };
+    let v_t = log_uniform(rng, 1e-4, 3.0) * if rng.random_bool(0.5) { 1.0 } else { -1.0 };
+    let v = add(&add(&scale(&u, v_u), &scale(&t, v_t)), &scale(n, s_l));
+    // omega sets the circumferential slip s_t = v·t + R_d·omega.
+    let omega = (s_t - dot(&v, &t)) / disk_radius;
+
+    let mu = |rng: &mut StdRng| {
+        if rng.random_bool(0.1) {
+            0.0
+        } else {
+            rng.random_range(0.0..1.0)
+        }
+    };
+    let params = ContactParams {
+        clearance,
+        disk_radius,
+        wall_stiffness: log_uniform(rng, 1e5, 1e11),
+        spring_exponent: m,
+        wall_damping: if rng.random_bool(0.2) {
+            0.0
+        } else {
+            log_uniform(rng, 10.0, 1e5)
+        },
+        mu_t: mu(rng),
+        mu_l: mu(rng),
+        eps,
+        soft_blend,
+    };
+    Sample {
+        d,
+        v,
+        omega,
+        params,
+        depth,
+        slip_t,
+        slip_l,
+    }
+}
+
+/// A random unit vector.
+pub fn random_unit(rng: &mut StdRng) -> Vec3<f64> {
+    loop {
+        let a: Vec3<f64> = [
+            rng.random_range(-1.0..1.0),
+            rng.random_range(-1.0..1.0),
+            rng.random_range(-1.0..1.0),
+        ];
+        let len = dot(&a, &a).sqrt();
+        if len > 0.1 && len <= 1.0 {
+            return scale(&a, 1.0 / len);
+        }
+    }
+}
+
+/// A random batch of V variants × S sites (random axes per site, [`sample`] per pair).
+pub fn random_batch(
+    seed: u64,
+    num_variants: usize,
+    num_sites: usize,
+    friction: FrictionModel,
+) -> ContactBatch<f64> {
+    let mut rng = StdRng::seed_from_u64(seed);
+    let mut batch = ContactBatch::new(num_variants, num_sites);
+    for site in 0..num_sites {
+        let n = random_unit(&mut rng);
+        batch.set_site_normal(site, n);
+        let n = batch.site_normal(site);
+        for variant in 0..num_variants {
+            let s = sample(&mut rng, &n, friction);
+            let i = batch.pair_index(variant, site);
+            batch.set_params(i, &s.params);
+            batch.set_state(i, s.d, s.v, s.omega);
+        }
+    }
+    batch
+}
+
+/// Median wall time (s) of `repeats` calls of `f`, after one warm-up call.
+pub fn median_seconds<E>(repeats: usize, mut f: impl FnMut() -> Result<(), E>) -> Result<f64, E> {
+    f()?;
+    let mut times = Vec::with_capacity(repeats.max(1));
+    for _ in 0..repeats.max(1) {
+        let start = std::time::Instant::now();
+        f()?;
+        times.push(start.elapsed().as_secs_f64());
+    }
+    times.sort_by(|a, b| a.total_cmp(b));
+    Ok(times[times.len() / 2])
+}
+
+/// Result of [`contact_comparison`].
+#[derive(Clone, Debug)]
+pub struct ContactComparison {
+    /// Largest per-block relative error of GPU f64 against CPU f64 (None without SHADER_F64).
+    pub max_rel_f64: Option<f64>,
+    /// Largest per-block relative error of GPU f32 against CPU f64.
+    pub max_rel_f32: f64,
+    /// Median evaluations per second, CPU f64 twin on all cores.
+    pub evals_per_s_cpu_f64: f64,
+    /// Median evaluations per second, GPU f32 (data resident, kernel and wait).
+    pub evals_per_s_gpu_f32: f64,
+    /// Median evaluations per second, GPU f64.
+    pub evals_per_s_gpu_f64: Option<f64>,
+}
+
+/// Evaluates `pairs` random pairs with `terms` on the CPU twin (f64) and on the GPU (f32,
+/// and f64 where the adapter has it); reports the largest per-block relative errors
+/// (floor 1e-12 of the block's quantity, see [`block_errors`]) and evaluation rates.
+pub fn contact_comparison(
+    ctx: &'static crate::gpu::GpuContext,
+    terms: &crate::physics::contact::ContactTerms,
+    pairs: usize,
+    repeats: usize,
+) -> Result<ContactComparison, crate::error::GpuError> {
+    use crate::gpu::contact::GpuContactRun;
+    use crate::kernels::contact::{contact, ContactOutputs};
+    let num_variants = 100.min(pairs.max(1));
+    let num_sites = pairs.div_ceil(num_variants);
+    let friction = terms.friction.unwrap_or(FrictionModel::Split);
+    let batch = random_batch(0x5eed ^ pairs as u64, num_variants, num_sites, friction);
+    let p = batch.num_pairs();
+    let mut reference = ContactOutputs::new(p);
+    let cpu_time = median_seconds::<std::convert::Infallible>(repeats, || {
+        contact(terms, &batch, &mut reference);
+        Ok(())
+    })
+    .unwrap_or(f64::NAN);
+    let max_err = |other: &dyn Fn(usize) -> [f64; OUTPUT_LEN]| {
+        (0..p).fold(0.0f64, |m, i| {
+            let e = block_errors(&reference.fields(i), &other(i), 1e-12);
+            e.iter().fold(m, |m, x| m.max(*x))
+        })
+    };
+    let b32 = batch.cast::<f32>();
+    let run32 = GpuContactRun::new(ctx, terms, &b32)?;
+    let t32 = median_seconds(repeats, || run32.dispatch())?;
+    let o32 = run32.read()?;
+    let max_rel_f32 = max_err(&|i| o32.fields(i).map(|x| x as f64));
+    let (max_rel_f64, t64) = if ctx.has_f64 {
+        let run64 = GpuContactRun::new(ctx, terms, &batch)?;
+        let t = median_seconds(repeats, || run64.dispatch())?;
+        let o64 = run64.read()?;
+        (Some(max_err(&|i| o64.fields(i))), Some(t))
+    } else {
+        (None, None)
+    };
+    Ok(ContactComparison {
+        max_rel_f64,
+        max_rel_f32,
+        evals_per_s_cpu_f64: p as f64 / cpu_time,
+        evals_per_s_gpu_f32: p as f64 / t32,
+        evals_per_s_gpu_f64: t64.map(|t| p as f64 / t),
+    })
+}
