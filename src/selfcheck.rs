@@ -39,30 +39,26 @@ fn max_abs(x: &[f64]) -> f64 {
 }
 
 /// Relative error of `other` against `reference`, per block: `max|a − b| / max(max|b_block|,
-/// floor · max|b_quantity|)`, where the quantity is the block's force and moment halves
-/// together (so an all-but-zero moment block is judged against its force block). A block
-/// that is exactly zero in the reference and in the other gives 0; a zero reference with a
-/// non-zero other gives infinity.
+/// floor_q)`, with an absolute floor per quantity (g, K, C, c_omega) for blocks that vanish
+/// by cancellation (e.g. `C` without damping where the regularised sign is flat). A block
+/// exactly equal in both gives 0; a non-zero difference over a zero denominator, infinity.
 pub fn block_errors(
     reference: &[f64; OUTPUT_LEN],
     other: &[f64; OUTPUT_LEN],
-    floor: f64,
+    floors: &[f64; 4],
 ) -> [f64; 8] {
-    let mut out = [0.0; 8];
-    for (b, &(lo, hi)) in BLOCKS.iter().enumerate() {
-        let pair = b - b % 2;
-        let quantity = max_abs(&reference[BLOCKS[pair].0..BLOCKS[pair + 1].1]);
+    std::array::from_fn(|b| {
+        let (lo, hi) = BLOCKS[b];
         let diff = (lo..hi).fold(0.0f64, |m, k| m.max((reference[k] - other[k]).abs()));
-        let denom = max_abs(&reference[lo..hi]).max(floor * quantity);
-        out[b] = if diff == 0.0 {
+        let denom = max_abs(&reference[lo..hi]).max(floors[b / 2]);
+        if diff == 0.0 {
             0.0
         } else if denom == 0.0 {
             f64::INFINITY
         } else {
             diff / denom
-        };
-    }
-    out
+        }
+    })
 }
 
 /// Which regime a sampled state is in (for reports and targeted checks).
@@ -158,7 +154,7 @@ pub fn sample(rng: &mut StdRng, n: &Vec3<f64>, friction: FrictionModel) -> Sampl
     let random_m = rng.random_range(0.5..2.0);
     let m = pick(rng, &[2.0 / 3.0, 1.0, 1.5, random_m]);
     let soft_blend = log_uniform(rng, 1e-6, 1e-4);
-    let depth = pick(
+    let mut depth = pick(
         rng,
         &[
             Depth::Outside,
@@ -169,6 +165,10 @@ pub fn sample(rng: &mut StdRng, n: &Vec3<f64>, friction: FrictionModel) -> Sampl
             Depth::AtBlend,
         ],
     );
+    if clearance == 0.0 && depth == Depth::Outside {
+        // At zero clearance only the axis itself is outside, where u is undefined.
+        depth = Depth::JustPast;
+    }
     let delta = match depth {
         Depth::Outside => -rng.random_range(0.0..1.0) * clearance,
         Depth::JustPast => log_uniform(rng, 1e-9, 1e-5),
@@ -321,7 +321,7 @@ pub fn contact_comparison(
     .unwrap_or(f64::NAN);
     let max_err = |other: &dyn Fn(usize) -> [f64; OUTPUT_LEN]| {
         (0..p).fold(0.0f64, |m, i| {
-            let e = block_errors(&reference.fields(i), &other(i), 1e-12);
+            let e = quantity_errors(&reference.fields(i), &other(i));
             e.iter().fold(m, |m, x| m.max(*x))
         })
     };
@@ -344,5 +344,150 @@ pub fn contact_comparison(
         evals_per_s_cpu_f64: p as f64 / cpu_time,
         evals_per_s_gpu_f32: p as f64 / t32,
         evals_per_s_gpu_f64: t64.map(|t| p as f64 / t),
+    })
+}
+
+/// The four output quantities as (first, end) field indices: g, K, C, c_omega.
+pub const QUANTITIES: [(usize, usize); 4] = [(0, 6), (6, 24), (24, 42), (42, 48)];
+
+/// Names of [`QUANTITIES`].
+pub const QUANTITY_NAMES: [&str; 4] = ["g", "K", "C", "c_omega"];
+
+/// Normwise relative error of `other` against `reference` per quantity (g, K, C,
+/// c_omega): `max|a − b| / max|b|` over the quantity's entries; 0 where both are zero,
+/// infinity where only the reference is.
+pub fn quantity_errors(reference: &[f64; OUTPUT_LEN], other: &[f64; OUTPUT_LEN]) -> [f64; 4] {
+    QUANTITIES.map(|(lo, hi)| {
+        let diff = (lo..hi).fold(0.0f64, |m, k| m.max((reference[k] - other[k]).abs()));
+        let scale = max_abs(&reference[lo..hi]);
+        if diff == 0.0 {
+            0.0
+        } else if scale == 0.0 {
+            f64::INFINITY
+        } else {
+            diff / scale
+        }
+    })
+}
+
+/// First-order condition number of the element's outputs for one pair: how much a
+/// relative perturbation `u` of the inputs (and of each operation) can grow in the
+/// outputs, normwise. Terms (docs/contact-element.md, "Accuracy"):
+/// - `|d|/r`: forming `d_t = d − (d·n)n` cancels the axial part, so `u` and `t` carry a
+///   relative error `u·|d|/r`;
+/// - `(1 + m)·r/delta`: `delta = r − ΔR` cancels, and `f_e`, `df_e` inherit it;
+/// - `(f_e·(1 + m)·r/delta + |f_d| + c·|v|·(1 + |d|/r))/N`: the cancellation of the elastic
+///   and damping parts in `N = f_e + f_d`;
+/// - with friction, `(μ_t + μ_l)·S/eps · (1 + |v_u|/eps)` with `S = |v|(1 + |d|/r) + R_d|ω|`
+///   the scale of the slip speeds: the regularised sign has slope `2/eps`, and `∂φ/∂s`
+///   (in `K`, `C`) slope `2/eps²`.
+///
+/// Returns `None` where the pair has no contact force (all outputs are exactly zero on
+/// every path, or the contact flag itself sits within rounding of `delta = 0`).
+pub fn condition_number(
+    n: &Vec3<f64>,
+    d: &Vec3<f64>,
+    v: &Vec3<f64>,
+    omega: f64,
+    p: &ContactParams<f64>,
+    friction: bool,
+    damping: bool,
+) -> Option<f64> {
+    use crate::physics::contact::{elastic_force, SpringLaw};
+    use crate::physics::vec3::sub;
+    let d_t = sub(d, &scale(n, dot(d, n)));
+    let r = dot(&d_t, &d_t).sqrt();
+    let delta = r - p.clearance;
+    if !(delta > 0.0) {
+        return None;
+    }
+    let u = scale(&d_t, 1.0 / r);
+    let (f_e, _) = elastic_force(delta, p, SpringLaw::PowerBlend);
+    let v_u = dot(v, &u);
+    let f_d = if damping { p.wall_damping * v_u } else { 0.0 };
+    let normal = f_e + f_d;
+    if !(normal > 0.0) {
+        return None;
+    }
+    let speed = dot(v, v).sqrt();
+    let d_len = dot(d, d).sqrt();
+    let axial = d_len / r;
+    let delta_cond = (1.0 + p.spring_exponent) * r / delta;
+    let mut kappa = 1.0 + axial + delta_cond + (f_e * delta_cond + f_d.abs()) / normal;
+    if damping {
+        kappa += p.wall_damping * speed * (1.0 + axial) / normal;
+    }
+    if friction {
+        let slip_scale = speed * (1.0 + axial) + p.disk_radius * omega.abs();
+        kappa += (p.mu_t + p.mu_l) * slip_scale / p.eps * (1.0 + v_u.abs() / p.eps);
+    }
+    Some(kappa)
+}
+
+/// Natural magnitude of each output quantity (g, K, C, c_omega) for one pair: the sum of
+/// the magnitudes of the terms that build it (docs/contact-element.md, "Accuracy"). An
+/// error is judged against this scale rather than against the quantity's own norm, which
+/// can vanish by cancellation (a Jacobian of the regularised sign at its seam, a moment of
+/// a nearly pure rolling contact) while its terms, and so its rounding errors, do not.
+/// `None` where [`condition_number`] is `None`.
+pub fn term_scales(
+    n: &Vec3<f64>,
+    d: &Vec3<f64>,
+    v: &Vec3<f64>,
+    p: &ContactParams<f64>,
+    friction: bool,
+    dynamic: bool,
+    damping: bool,
+) -> Option<[f64; 4]> {
+    use crate::physics::contact::{elastic_force, SpringLaw};
+    use crate::physics::vec3::sub;
+    let d_t = sub(d, &scale(n, dot(d, n)));
+    let r = dot(&d_t, &d_t).sqrt();
+    let delta = r - p.clearance;
+    if !(delta > 0.0) {
+        return None;
+    }
+    let u = scale(&d_t, 1.0 / r);
+    let (f_e, df_e) = elastic_force(delta, p, SpringLaw::PowerBlend);
+    let c = if damping { p.wall_damping } else { 0.0 };
+    let v_u = dot(v, &u);
+    let normal = f_e + c * v_u;
+    if !(normal > 0.0) {
+        return None;
+    }
+    let speed = dot(v, v).sqrt();
+    let mu = if friction { p.mu_t + p.mu_l } else { 0.0 };
+    let arm = 1.0 + p.disk_radius;
+    let slope = 2.0 / p.eps;
+    let g = normal * (1.0 + mu) * arm;
+    let k = (df_e.abs() + normal / r + c * speed / r) * (1.0 + mu) * arm
+        + normal * mu * arm * (1.0 + v_u.abs() * slope) / r;
+    let (cs, cw) = if dynamic {
+        (
+            (c + normal * mu * slope) * (1.0 + mu) * arm,
+            normal * mu * p.disk_radius * slope * arm,
+        )
+    } else {
+        (0.0, 0.0)
+    };
+    Some([g, k, cs, cw])
+}
+
+/// Error of `other` against `reference` per quantity, relative to [`term_scales`].
+pub fn scaled_errors(
+    reference: &[f64; OUTPUT_LEN],
+    other: &[f64; OUTPUT_LEN],
+    scales: &[f64; 4],
+) -> [f64; 4] {
+    std::array::from_fn(|q| {
+        let (lo, hi) = QUANTITIES[q];
+        let diff = (lo..hi).fold(0.0f64, |m, k| m.max((reference[k] - other[k]).abs()));
+        if diff == 0.0 {
+            0.0
+        } else if scales[q] == 0.0 {
+            f64::INFINITY
+        } else {
+            diff / scales[q]
+        }
     })
 }

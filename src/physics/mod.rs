@@ -8,7 +8,30 @@ pub mod vec3;
 
 /// Float type the physics is generic over: `f32` (what a GPU f32 run computes) or `f64`
 /// (the oracle).
-pub trait Real: num_traits::Float + Default + Send + Sync + std::fmt::Debug + 'static {
+pub trait Real:
+    Copy
+    + Default
+    + Send
+    + Sync
+    + std::fmt::Debug
+    + PartialOrd
+    + std::ops::Add<Output = Self>
+    + std::ops::Sub<Output = Self>
+    + std::ops::Mul<Output = Self>
+    + std::ops::Div<Output = Self>
+    + std::ops::Neg<Output = Self>
+    + 'static
+{
+    /// 0.
+    fn zero() -> Self;
+    /// 1.
+    fn one() -> Self;
+    /// |x|.
+    fn abs(self) -> Self;
+    /// √x.
+    fn sqrt(self) -> Self;
+    /// x^e for x > 0.
+    fn powf(self, e: Self) -> Self;
     /// Rounds an `f64` to this type.
     fn from_f64_lossy(x: f64) -> Self;
     /// Widens (or keeps) this value as `f64`.
@@ -20,6 +43,21 @@ pub trait Real: num_traits::Float + Default + Send + Sync + std::fmt::Debug + 's
 }
 
 impl Real for f32 {
+    fn zero() -> Self {
+        0.0
+    }
+    fn one() -> Self {
+        1.0
+    }
+    fn abs(self) -> Self {
+        f32::abs(self)
+    }
+    fn sqrt(self) -> Self {
+        f32::sqrt(self)
+    }
+    fn powf(self, e: Self) -> Self {
+        f32::powf(self, e)
+    }
     fn from_f64_lossy(x: f64) -> Self {
         x as f32
     }
@@ -31,6 +69,21 @@ impl Real for f32 {
 }
 
 impl Real for f64 {
+    fn zero() -> Self {
+        0.0
+    }
+    fn one() -> Self {
+        1.0
+    }
+    fn abs(self) -> Self {
+        f64::abs(self)
+    }
+    fn sqrt(self) -> Self {
+        f64::sqrt(self)
+    }
+    fn powf(self, e: Self) -> Self {
+        f64::powf(self, e)
+    }
     fn from_f64_lossy(x: f64) -> Self {
         x
     }
@@ -40,3 +93,8 @@ impl Real for f64 {
     const UNIT_ROUNDOFF: f64 = f64::EPSILON / 2.0;
     const NAME: &'static str = "f64";
 }
+
+#[cfg(test)]
+mod contact_tests;
+#[cfg(test)]
+mod double_double;
