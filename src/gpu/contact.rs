@@ -97,11 +97,23 @@ fn bytes_of_len<T>(n: usize) -> u64 {
 }
 
 impl<T: GpuReal> GpuContactRun<T> {
-    /// Compiles (or fetches from the cache) the kernel for `terms` and uploads `batch`.
+    /// Compiles (or fetches from the cache) the kernel for `terms` and uploads `batch`, in
+    /// chunks as large as the adapter's binding limits allow.
     pub fn new(
         ctx: &'static GpuContext,
         terms: &ContactTerms,
         batch: &ContactBatch<T>,
+    ) -> Result<Self, GpuError> {
+        Self::with_chunk_limit(ctx, terms, batch, usize::MAX)
+    }
+
+    /// As [`Self::new`], with at most `max_chunk_pairs` pairs per chunk (tests use it to put
+    /// chunk boundaries inside a site).
+    pub fn with_chunk_limit(
+        ctx: &'static GpuContext,
+        terms: &ContactTerms,
+        batch: &ContactBatch<T>,
+        max_chunk_pairs: usize,
     ) -> Result<Self, GpuError> {
         if T::IS_F64 && !ctx.has_f64 {
             return Err(GpuError::Unsupported(format!(
@@ -117,6 +129,7 @@ impl<T: GpuReal> GpuContactRun<T> {
         let max_groups = ctx.limits.max_compute_workgroups_per_dimension as usize;
         let cap = (max_binding / (OUTPUT_LEN * size))
             .min(max_groups * WORKGROUP)
+            .min(max_chunk_pairs)
             .max(1);
         let num_pairs = batch.num_pairs();
         if batch.site_normals.len() * size > max_binding {

@@ -1,0 +1,416 @@
+//! The contact kernel (`shaders/contact.wgsl`) against its CPU twin (`src/kernels/contact.rs`).
+//!
+//! Error measures (docs/contact-element.md, "Accuracy"): per pair and output quantity,
+//! the normwise relative error, and the error relative to the quantity's natural scale
+//! (`term_scales`), bounded by `C·u·κ` with `κ` the first-order condition number.
+
+mod common;
+
+use holewall::gpu::contact::{contact_gpu, contact_wgsl};
+use holewall::kernels::contact::{contact, ContactBatch, ContactOutputs};
+use holewall::physics::contact::{ContactMode, ContactTerms, FrictionModel, SpringLaw};
+use holewall::selfcheck::{
+    condition_number, quantity_errors, random_batch, scaled_errors, term_scales,
+};
+
+const CONFIGS: [(FrictionModel, ContactMode); 4] = [
+    (FrictionModel::Split, ContactMode::Dynamic),
+    (FrictionModel::Split, ContactMode::Static),
+    (FrictionModel::Coupled, ContactMode::Dynamic),
+    (FrictionModel::Coupled, ContactMode::Static),
+];
+
+/// 50 variants × 200 sites = 10,000 (variant, site) pairs per configuration.
+fn batch(friction: FrictionModel, seed: u64) -> ContactBatch<f64> {
+    random_batch(seed, 50, 200, friction)
+}
+
+struct Report {
+    pairs: usize,
+    checked: usize,
+    max_plain: f64,
+    max_plain_well: f64,
+    max_ratio: f64,
+    scaled: Vec<f64>,
+}
+
+/// Compares `other` with the f64 reference; `bound_u` is the unit roundoff of `other`'s
+/// precision; pairs with `u·κ > 1e-3` (or no force) are counted but not bounded.
+fn compare(
+    batch: &ContactBatch<f64>,
+    terms: &ContactTerms,
+    reference: &ContactOutputs<f64>,
+    other: &dyn Fn(usize) -> ([f64; 48], u32),
+    bound_u: f64,
+    c: f64,
+    what: &str,
+) -> Report {
+    let mut rep = Report {
+        pairs: batch.num_pairs(),
+        checked: 0,
+        max_plain: 0.0,
+        max_plain_well: 0.0,
+        max_ratio: 0.0,
+        scaled: Vec::new(),
+    };
+    let dynamic = terms.mode == ContactMode::Dynamic;
+    for i in 0..batch.num_pairs() {
+        let (d, v, omega) = batch.state(i);
+        let p = batch.params(i);
+        let n = batch.site_normal(i / batch.num_variants);
+        let (fields, flag) = other(i);
+        let kappa = condition_number(
+            &n,
+            &d,
+            &v,
+            omega,
+            &p,
+            terms.friction.is_some(),
+            terms.damping && dynamic,
+        );
+        let Some(kappa) = kappa.filter(|k| bound_u * k <= 1e-3) else {
+            continue;
+        };
+        rep.checked += 1;
+        assert_eq!(
+            flag, reference.contact[i],
+            "{what}: contact flag differs at pair {i}"
+        );
+        let scales = term_scales(
+            &n,
+            &d,
+            &v,
+            &p,
+            terms.friction.is_some(),
+            dynamic,
+            terms.damping && dynamic,
+        )
+        .unwrap();
+        let scaled = scaled_errors(&reference.fields(i), &fields, &scales);
+        let plain = quantity_errors(&reference.fields(i), &fields);
+        for q in 0..4 {
+            let ratio = scaled[q] / (bound_u * kappa);
+            assert!(
+                ratio <= c,
+                "{what}: pair {i} quantity {q}: error {:.3e} > {c}·u·κ (κ = {kappa:.3e})",
+                scaled[q]
+            );
+            rep.max_ratio = rep.max_ratio.max(ratio);
+            rep.scaled.push(scaled[q]);
+            rep.max_plain = rep.max_plain.max(plain[q]);
+            if kappa <= 1e3 {
+                rep.max_plain_well = rep.max_plain_well.max(plain[q]);
+            }
+        }
+    }
+    rep
+}
+
+#[test]
+fn f64_kernel_matches_its_twin() {
+    let Some(ctx) = common::gpu() else { return };
+    assert!(
+        ctx.has_f64,
+        "the adapter {} lacks SHADER_F64",
+        ctx.info.name
+    );
+    for (k, (friction, mode)) in CONFIGS.into_iter().enumerate() {
+        let terms = ContactTerms::all(friction, mode);
+        let batch = batch(friction, 100 + k as u64);
+        let mut reference = ContactOutputs::new(batch.num_pairs());
+        contact(&terms, &batch, &mut reference);
+        let gpu = contact_gpu(ctx, &terms, &batch).unwrap();
+        // Every pair: flags equal, and where the reference has no force the GPU has none.
+        for i in 0..batch.num_pairs() {
+            assert_eq!(
+                gpu.contact[i], reference.contact[i],
+                "contact flag at pair {i}"
+            );
+            if reference.fields(i).iter().all(|x| *x == 0.0) && reference.contact[i] == 0 {
+                assert!(gpu.fields(i).iter().all(|x| *x == 0.0));
+            }
+        }
+        let rep = compare(
+            &batch,
+            &terms,
+            &reference,
+            &|i| (gpu.fields(i), gpu.contact[i]),
+            f64::EPSILON / 2.0,
+            8.0,
+            "GPU f64",
+        );
+        // The figure: 1e-12 relative, normwise per quantity, wherever the state
+        // itself is not ill-conditioned beyond κ = 1e3.
+        assert!(
+            rep.max_plain_well <= 1e-12,
+            "f64 normwise error {:.3e} > 1e-12 at κ ≤ 1e3",
+            rep.max_plain_well
+        );
+        assert!(
+            rep.checked * 10 >= rep.pairs * 6,
+            "too few pairs in contact: {}",
+            rep.checked
+        );
+        eprintln!(
+            "GPU f64 {friction:?}/{mode:?}: {} pairs, {} in contact; max normwise rel. error {:.2e} (κ ≤ 1e3: {:.2e}); max error/(u·κ) {:.2}",
+            rep.pairs, rep.checked, rep.max_plain, rep.max_plain_well, rep.max_ratio
+        );
+    }
+}
+
+#[test]
+fn f32_kernel_within_its_condition_bound() {
+    let Some(ctx) = common::gpu() else { return };
+    let u32_ = f32::EPSILON as f64 / 2.0;
+    for (k, (friction, mode)) in CONFIGS.into_iter().enumerate() {
+        let terms = ContactTerms::all(friction, mode);
+        let batch = batch(friction, 200 + k as u64);
+        let mut reference = ContactOutputs::new(batch.num_pairs());
+        contact(&terms, &batch, &mut reference);
+        let b32 = batch.cast::<f32>();
+        let gpu = contact_gpu(ctx, &terms, &b32).unwrap();
+        let to64 =
+            |o: &ContactOutputs<f32>, i: usize| (o.fields(i).map(|x| x as f64), o.contact[i]);
+        // GPU f32 against the f64 oracle: first-order bound C·u·κ with C = 32.
+        let rep = compare(
+            &batch,
+            &terms,
+            &reference,
+            &|i| to64(&gpu, i),
+            u32_,
+            32.0,
+            "GPU f32 vs f64",
+        );
+        // And against its own twin run in f32 (same bound: both are f32 roundings).
+        let mut twin32 = ContactOutputs::new(batch.num_pairs());
+        contact(&terms, &b32, &mut twin32);
+        let twin_rep = compare(
+            &batch,
+            &terms,
+            &reference,
+            &|i| to64(&twin32, i),
+            u32_,
+            32.0,
+            "CPU f32 vs f64",
+        );
+        // The sampler spans deliberately ill-conditioned states (1e-9 m past contact at up to
+        // 5 cm radius: κ ≈ 1e8), where f32 resolves nothing; a fifth must remain.
+        assert!(
+            rep.checked * 10 >= rep.pairs * 2,
+            "too few well-conditioned pairs: {}",
+            rep.checked
+        );
+        let mut scaled = rep.scaled.clone();
+        scaled.sort_by(|a, b| a.total_cmp(b));
+        let pct = |q: f64| scaled[((scaled.len() - 1) as f64 * q) as usize];
+        eprintln!(
+            "GPU f32 {friction:?}/{mode:?}: {} pairs, {} with u·κ ≤ 1e-3: max error/(u·κ) {:.2} (CPU f32 twin: {:.2}); error / natural scale: median {:.1e}, 99th pct {:.1e}, max {:.1e}",
+            rep.pairs, rep.checked, rep.max_ratio, twin_rep.max_ratio, pct(0.5), pct(0.99), pct(1.0)
+        );
+    }
+}
+
+#[test]
+fn frictionless_undamped_linear_scene_compiles_lean_kernel_with_same_numbers() {
+    // Scene: μ = 0, c = 0, m = 1 everywhere.
+    let mut batch = random_batch(7, 40, 50, FrictionModel::Split);
+    for i in 0..batch.num_pairs() {
+        let mut p = batch.params(i);
+        p.mu_t = 0.0;
+        p.mu_l = 0.0;
+        p.wall_damping = 0.0;
+        p.spring_exponent = 1.0;
+        batch.set_params(i, &p);
+    }
+    for mode in [ContactMode::Dynamic, ContactMode::Static] {
+        let lean = batch.required_terms(FrictionModel::Coupled, mode);
+        assert_eq!(
+            lean,
+            ContactTerms {
+                spring: SpringLaw::Linear,
+                damping: false,
+                friction: None,
+                mode
+            }
+        );
+        for f64 in [false, true] {
+            // Code only: comments name every parameter.
+            let code = |w: String| {
+                w.lines()
+                    .map(|l| l.split("//").next().unwrap_or(""))
+                    .collect::<Vec<_>>()
+                    .join("\n")
+            };
+            let wgsl = code(contact_wgsl(&lean, f64).unwrap());
+            for absent in [
+                "regularised_sign",
+                "friction_factors",
+                "mu_t",
+                "mu_l",
+                "c_wall",
+                "pow",
+                "exp_f64",
+                "ln_f64",
+                "soft_blend",
+                "param(8u",
+            ] {
+                assert!(!wgsl.contains(absent), "lean kernel contains {absent:?}");
+            }
+            let full =
+                code(contact_wgsl(&ContactTerms::all(FrictionModel::Coupled, mode), f64).unwrap());
+            for present in ["regularised_sign", "mu_t", "pow_pos"] {
+                assert!(full.contains(present), "all-terms kernel lacks {present:?}");
+            }
+            // Wall damping acts only in dynamic analysis.
+            assert_eq!(full.contains("c_wall"), mode == ContactMode::Dynamic);
+            assert!(wgsl.len() < full.len());
+            eprintln!(
+                "contact kernel, {mode:?}, f64 = {f64}: lean {} bytes of code, all terms {} bytes",
+                wgsl.len(),
+                full.len()
+            );
+        }
+        // Same numbers: CPU twin lean vs all terms, and on the GPU.
+        let all = ContactTerms::all(FrictionModel::Coupled, mode);
+        let mut a = ContactOutputs::new(batch.num_pairs());
+        let mut b = ContactOutputs::new(batch.num_pairs());
+        contact(&lean, &batch, &mut a);
+        contact(&all, &batch, &mut b);
+        assert_eq!(a, b);
+        if let Some(ctx) = common::gpu() {
+            let ga = contact_gpu(ctx, &lean, &batch).unwrap();
+            let gb = contact_gpu(ctx, &all, &batch).unwrap();
+            assert_eq!(ga.contact, gb.contact);
+            for i in 0..batch.num_pairs() {
+                let e = quantity_errors(&ga.fields(i), &gb.fields(i));
+                assert!(
+                    e.iter().all(|x| *x <= 1e-15),
+                    "lean vs all-terms GPU kernel at pair {i}: {e:?}"
+                );
+            }
+            let b32 = batch.cast::<f32>();
+            let ga = contact_gpu(ctx, &lean, &b32).unwrap();
+            let gb = contact_gpu(ctx, &all, &b32).unwrap();
+            for i in 0..batch.num_pairs() {
+                let e = quantity_errors(
+                    &ga.fields(i).map(|x| x as f64),
+                    &gb.fields(i).map(|x| x as f64),
+                );
+                assert!(
+                    e.iter().all(|x| *x <= 1e-6),
+                    "lean vs all-terms GPU f32 kernel at pair {i}: {e:?}"
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn f64_pow_ln_exp_match_the_cpu_over_the_whole_range() {
+    use wgpu::util::DeviceExt;
+    let Some(ctx) = common::gpu() else { return };
+    let math = holewall::gpu::compose::source("shared/math_f64.wgsl").unwrap();
+    let wgsl = format!(
+        "{math}\n@group(0) @binding(0) var<storage, read> xs: array<f64>;\n@group(0) @binding(1) var<storage, read_write> out: array<f64>;\n@compute @workgroup_size(64)\nfn main(@builtin(global_invocation_id) gid: vec3<u32>) {{\n  let i = gid.x;\n  if (i >= arrayLength(&xs) / 2u) {{ return; }}\n  let x = xs[2u * i];\n  let m = xs[2u * i + 1u];\n  out[3u * i] = pow_pos(x, m);\n  out[3u * i + 1u] = ln_f64(x);\n  out[3u * i + 2u] = exp_f64(m * 10.0lf);\n}}\n"
+    );
+    let pipeline = ctx.pipeline("math_f64_test", &wgsl).unwrap();
+    let count = 4096;
+    let mut inputs = Vec::with_capacity(2 * count);
+    for k in 0..count {
+        // x log-uniform over 1e-300 … 1e300, m over 0.3 … 3 (the spring exponents of use),
+        // m·10 over 3 … 30 for exp, and exact powers of two.
+        let x = if k % 64 == 0 {
+            2f64.powi((k as i32 / 64) - 32)
+        } else {
+            10f64.powf(-300.0 + 600.0 * (k as f64 * 0.618_033_988_75).fract())
+        };
+        let m = 0.3 + 2.7 * (k as f64 * 0.414_213_562_37).fract();
+        inputs.push(x);
+        inputs.push(m);
+    }
+    let xs = ctx
+        .device
+        .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: None,
+            contents: bytemuck::cast_slice(&inputs),
+            usage: wgpu::BufferUsages::STORAGE,
+        });
+    let size = (3 * count * 8) as u64;
+    let out = ctx.device.create_buffer(&wgpu::BufferDescriptor {
+        label: None,
+        size,
+        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+        mapped_at_creation: false,
+    });
+    let staging = ctx.device.create_buffer(&wgpu::BufferDescriptor {
+        label: None,
+        size,
+        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    });
+    let bg = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: None,
+        layout: &pipeline.get_bind_group_layout(0),
+        entries: &[
+            wgpu::BindGroupEntry {
+                binding: 0,
+                resource: xs.as_entire_binding(),
+            },
+            wgpu::BindGroupEntry {
+                binding: 1,
+                resource: out.as_entire_binding(),
+            },
+        ],
+    });
+    let mut enc = ctx.device.create_command_encoder(&Default::default());
+    {
+        let mut pass = enc.begin_compute_pass(&Default::default());
+        pass.set_pipeline(&pipeline);
+        pass.set_bind_group(0, &bg, &[]);
+        pass.dispatch_workgroups((count as u32).div_ceil(64), 1, 1);
+    }
+    enc.copy_buffer_to_buffer(&out, 0, &staging, 0, size);
+    ctx.queue.submit([enc.finish()]);
+    staging.slice(..).map_async(wgpu::MapMode::Read, |_| {});
+    ctx.device
+        .poll(wgpu::PollType::wait_indefinitely())
+        .unwrap();
+    let view = staging.slice(..).get_mapped_range().unwrap();
+    let got: &[f64] = bytemuck::cast_slice(&view);
+    let (mut worst_pow, mut worst_ln, mut worst_exp) = (0.0f64, 0.0f64, 0.0f64);
+    for k in 0..count {
+        let (x, m) = (inputs[2 * k], inputs[2 * k + 1]);
+        let want = x.powf(m);
+        if want.is_normal() {
+            // Relative error of exp(m·ln x) grows with |m·ln x| (the absolute error of the
+            // exponent becomes a relative error of the result).
+            let e = ((got[3 * k] - want) / want).abs() / (1.0 + (m * x.ln()).abs());
+            worst_pow = worst_pow.max(e);
+        }
+        let ln_want = x.ln();
+        worst_ln = worst_ln.max((got[3 * k + 1] - ln_want).abs() / ln_want.abs().max(1.0));
+        let exp_want = (m * 10.0).exp();
+        worst_exp = worst_exp.max(((got[3 * k + 2] - exp_want) / exp_want).abs());
+    }
+    eprintln!("f64 WGSL math: pow rel/(1+|m ln x|) {worst_pow:.2e}, ln {worst_ln:.2e}, exp {worst_exp:.2e}");
+    assert!(worst_pow <= 4.0 * f64::EPSILON, "pow {worst_pow:e}");
+    assert!(worst_ln <= 4.0 * f64::EPSILON, "ln {worst_ln:e}");
+    assert!(worst_exp <= 8.0 * f64::EPSILON, "exp {worst_exp:e}");
+}
+
+#[test]
+fn batches_larger_than_one_binding_are_chunked_and_exact() {
+    let Some(ctx) = common::gpu() else { return };
+    // Force several chunks by a batch above the per-binding capacity? That needs > 128 MiB
+    // here; instead check the chunk arithmetic on a batch whose pairs do not divide evenly
+    // by the variants (a chunk boundary inside a site) with the real kernel.
+    let terms = ContactTerms::all(FrictionModel::Split, ContactMode::Dynamic);
+    let batch = random_batch(11, 7, 13, FrictionModel::Split);
+    let run =
+        holewall::gpu::contact::GpuContactRun::with_chunk_limit(ctx, &terms, &batch, 10).unwrap();
+    assert_eq!(run.num_chunks(), 10);
+    run.dispatch().unwrap();
+    let chunked = run.read().unwrap();
+    let whole = contact_gpu(ctx, &terms, &batch).unwrap();
+    assert_eq!(chunked, whole);
+}
