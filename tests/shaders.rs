@@ -1,0 +1,123 @@
+//! Every WGSL kernel has a CPU twin, names it on its first line, and validates with naga in
+//! every specialisation (no GPU needed).
+
+use std::collections::BTreeSet;
+
+use holewall::gpu::compose::{compose, validate, SHADERS};
+use holewall::gpu::contact::contact_wgsl;
+use holewall::kernels::TWINS;
+use holewall::physics::contact::{ContactMode, ContactTerms, FrictionModel, SpringLaw};
+
+#[test]
+fn every_shader_has_a_twin_named_on_its_first_line() {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let mut on_disk = BTreeSet::new();
+    for entry in std::fs::read_dir(root.join("shaders")).unwrap() {
+        let path = entry.unwrap().path();
+        if path.extension().is_some_and(|e| e == "wgsl") {
+            on_disk.insert(path.file_name().unwrap().to_string_lossy().to_string());
+        }
+    }
+    assert!(!on_disk.is_empty());
+    for name in &on_disk {
+        let (_, twin) = TWINS
+            .iter()
+            .find(|(s, _)| s == name)
+            .unwrap_or_else(|| panic!("shaders/{name} has no CPU twin in kernels::TWINS"));
+        assert!(
+            root.join(twin).is_file(),
+            "twin {twin} of {name} is missing"
+        );
+        let text = std::fs::read_to_string(root.join("shaders").join(name)).unwrap();
+        let first = text.lines().next().unwrap_or("");
+        assert!(
+            first.contains(twin),
+            "first line of shaders/{name} must name its twin {twin}: {first:?}"
+        );
+        let twin_text = std::fs::read_to_string(root.join(twin)).unwrap();
+        assert!(
+            twin_text
+                .lines()
+                .next()
+                .unwrap_or("")
+                .contains(&format!("shaders/{name}")),
+            "first line of {twin} must name shaders/{name}"
+        );
+        // The embedded copy is the file on disk.
+        assert!(
+            SHADERS.iter().any(|(n, s)| n == name && *s == text),
+            "{name} not embedded"
+        );
+    }
+    for (name, _) in TWINS {
+        assert!(
+            on_disk.contains(*name),
+            "kernels::TWINS lists {name}, which is not in shaders/"
+        );
+    }
+    // Every shared file is embedded too.
+    for entry in std::fs::read_dir(root.join("shaders/shared")).unwrap() {
+        let path = entry.unwrap().path();
+        let rel = format!("shared/{}", path.file_name().unwrap().to_string_lossy());
+        let text = std::fs::read_to_string(&path).unwrap();
+        assert!(
+            SHADERS.iter().any(|(n, s)| *n == rel && *s == text),
+            "{rel} not embedded"
+        );
+    }
+}
+
+#[test]
+fn every_contact_specialisation_validates() {
+    let mut count = 0;
+    for spring in [SpringLaw::Linear, SpringLaw::Power, SpringLaw::PowerBlend] {
+        for damping in [false, true] {
+            for friction in [
+                None,
+                Some(FrictionModel::Split),
+                Some(FrictionModel::Coupled),
+            ] {
+                for mode in [ContactMode::Dynamic, ContactMode::Static] {
+                    for f64 in [false, true] {
+                        let terms = ContactTerms {
+                            spring,
+                            damping,
+                            friction,
+                            mode,
+                        };
+                        let wgsl = contact_wgsl(&terms, f64).unwrap();
+                        validate(&wgsl).unwrap_or_else(|e| panic!("{terms:?} f64={f64}: {e}"));
+                        assert_eq!(
+                            wgsl.contains("f64"),
+                            f64,
+                            "precision leak in {terms:?} f64={f64}"
+                        );
+                        count += 1;
+                    }
+                }
+            }
+        }
+    }
+    assert_eq!(count, 72);
+}
+
+#[test]
+fn composer_handles_nesting_else_and_errors() {
+    let flags: BTreeSet<&str> = ["F64", "POW"].into_iter().collect();
+    let text = compose("contact.wgsl", &flags, true).unwrap();
+    assert!(text.starts_with("alias real = f64;"));
+    assert!(
+        text.contains("fn pow_pos(x: f64, m: f64) -> f64"),
+        "f64 pow comes from math_f64"
+    );
+    assert!(
+        !text.contains("return pow(x, m)"),
+        "the f32 builtin pow must not reach an f64 kernel"
+    );
+    let flags32: BTreeSet<&str> = ["POW"].into_iter().collect();
+    let text32 = compose("contact.wgsl", &flags32, false).unwrap();
+    assert!(text32.contains("return pow(x, m)"));
+    assert!(!text32.contains("exp_f64"));
+    assert!(!text.contains("#if") && !text.contains("#endif") && !text.contains("#include"));
+    assert!(compose("no_such.wgsl", &flags, false).is_err());
+}
