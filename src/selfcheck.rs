@@ -384,6 +384,7 @@ pub fn quantity_errors(reference: &[f64; OUTPUT_LEN], other: &[f64; OUTPUT_LEN])
 ///
 /// Returns `None` where the pair has no contact force (all outputs are exactly zero on
 /// every path, or the contact flag itself sits within rounding of `delta = 0`).
+#[allow(clippy::neg_cmp_op_on_partial_ord)]
 pub fn condition_number(
     n: &Vec3<f64>,
     d: &Vec3<f64>,
@@ -430,6 +431,7 @@ pub fn condition_number(
 /// can vanish by cancellation (a Jacobian of the regularised sign at its seam, a moment of
 /// a nearly pure rolling contact) while its terms, and so its rounding errors, do not.
 /// `None` where [`condition_number`] is `None`.
+#[allow(clippy::neg_cmp_op_on_partial_ord)]
 pub fn term_scales(
     n: &Vec3<f64>,
     d: &Vec3<f64>,

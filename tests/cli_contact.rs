@@ -136,7 +136,8 @@ fn reads_a_file_argument() {
 /// message naming line 2 and the key.
 #[test]
 fn bad_input_is_rejected_with_line_and_key() {
-    let cases: Vec<(&str, Box<dyn Fn(&mut Value)>, &str)> = vec![
+    type Edit = Box<dyn Fn(&mut Value)>;
+    let cases: Vec<(&str, Edit, &str)> = vec![
         (
             "disk_radius",
             Box::new(|v| v["disk_radius"] = json!(0.2)),

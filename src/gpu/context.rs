@@ -132,7 +132,9 @@ impl GpuContext {
 
     /// The largest storage binding, in bytes, that a kernel may use on this device.
     pub fn max_binding_bytes(&self) -> u64 {
-        (self.limits.max_storage_buffer_binding_size as u64).min(self.limits.max_buffer_size)
+        self.limits
+            .max_storage_buffer_binding_size
+            .min(self.limits.max_buffer_size)
     }
 
     /// The compute pipeline for `wgsl` (entry point `main`), compiled once per distinct

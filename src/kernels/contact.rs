@@ -66,8 +66,8 @@ impl<T: Real> ContactBatch<T> {
     /// Sets the hole axis of a site (normalised here).
     pub fn set_site_normal(&mut self, site: usize, n: [T; 3]) {
         let len = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
-        for k in 0..3 {
-            self.site_normals[3 * site + k] = n[k] / len;
+        for (slot, x) in self.site_normals[3 * site..3 * site + 3].iter_mut().zip(n) {
+            *slot = x / len;
         }
     }
 
@@ -199,6 +199,9 @@ pub fn response_fields<T: Real>(r: &ContactResponse<T>) -> [T; OUTPUT_LEN] {
     out
 }
 
+/// One parallel task: first pair, its contact flags, and one slice per output field.
+type Block<'a, T> = (usize, &'a mut [u32], Vec<&'a mut [T]>);
+
 /// Pairs per parallel task.
 const BLOCK: usize = 2048;
 
@@ -217,7 +220,7 @@ pub fn contact<T: Real>(
         .chunks_mut(p.max(1))
         .map(|f| f.chunks_mut(BLOCK))
         .collect();
-    let mut blocks: Vec<(usize, &mut [u32], Vec<&mut [T]>)> = Vec::new();
+    let mut blocks: Vec<Block<'_, T>> = Vec::new();
     for (b, flags) in out.contact.chunks_mut(BLOCK).enumerate() {
         let fields: Vec<&mut [T]> = field_blocks
             .iter_mut()

@@ -284,6 +284,9 @@ pub fn friction_factors<T: Real>(
 /// `u = d_t/r`, `t = n × u`. Since `u, t, n` are orthonormal, `∂u/∂x = (I − nnᵀ − uuᵀ)/r
 /// = t tᵀ/r` and `∂t/∂x = n × ∂u/∂x = −u tᵀ/r`; every x-derivative is a column vector
 /// times `tᵀ` or `uᵀ`.
+///
+/// A NaN penetration or normal force counts as no contact (the negated comparisons).
+#[allow(clippy::neg_cmp_op_on_partial_ord)]
 pub fn evaluate<T: Real>(
     n: &Vec3<T>,
     d: &Vec3<T>,

@@ -29,6 +29,7 @@ fn g_dd(
     evaluate(&dd3(n), d, v, omega, &p.cast::<Dd>(), terms).g
 }
 
+#[allow(clippy::too_many_arguments)]
 /// K, C, c_omega by central differences of g in double-double, in output-field layout.
 fn finite_difference(
     n: &Vec3<f64>,
@@ -334,7 +335,9 @@ fn zero_outside_contact() {
 }
 
 /// Random in-contact states for the property checks.
-fn contact_states(seed: u64, count: usize) -> Vec<(Vec3<f64>, Vec3<f64>, f64, ContactParams<f64>)> {
+type State = (Vec3<f64>, Vec3<f64>, f64, ContactParams<f64>);
+
+fn contact_states(seed: u64, count: usize) -> Vec<State> {
     let mut rng = StdRng::seed_from_u64(seed);
     (0..count)
         .map(|_| {
