@@ -43,6 +43,13 @@ fn put(field: u32, i: u32, x: real) {
     out_values[field * dims.num_pairs + i] = x;
 }
 
+// Zero outputs (no contact, or no force). Every output is written exactly once per pair.
+fn clear(i: u32) {
+    for (var k = 0u; k < 48u; k = k + 1u) {
+        put(k, i, real(0.0));
+    }
+}
+
 fn cross3(a: vec3<real>, b: vec3<real>) -> vec3<real> {
     return vec3<real>(a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x);
 }
@@ -102,9 +109,6 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     if (i >= dims.num_pairs) {
         return;
     }
-    for (var k = 0u; k < 48u; k = k + 1u) {
-        put(k, i, real(0.0));
-    }
     out_contact[i] = 0u;
 
     let site = (dims.pair_offset + i) / dims.num_variants;
@@ -120,6 +124,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let r = sqrt(dot(d_t, d_t));
     let delta = r - clearance;
     if (!(delta > real(0.0))) {
+        clear(i);
         return;
     }
     out_contact[i] = 1u;
@@ -169,6 +174,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     dn_dv_u = c_wall;
 #endif
     if (!(n_raw > real(0.0))) {
+        clear(i);
         return;
     }
     let normal = n_raw;
@@ -225,13 +231,22 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
             let dn_dv = dn_dv_u * u[col];
             put(24u + 3u * row + col, i, dir_f[row] * dn_dv + normal * (cf_t[row] * t[col] + cf_n[row] * n[col]));
             put(24u + 3u * (row + 3u) + col, i, dir_m[row] * dn_dv + normal * (cm_t[row] * t[col] + cm_n[row] * n[col]));
+#else
+            put(24u + 3u * row + col, i, real(0.0));
+            put(24u + 3u * (row + 3u) + col, i, real(0.0));
 #endif
         }
 #if DYNAMIC
 #if FRICTION
         put(42u + row, i, normal * rd * cf_t[row]);
         put(45u + row, i, normal * rd * cm_t[row]);
+#else
+        put(42u + row, i, real(0.0));
+        put(45u + row, i, real(0.0));
 #endif
+#else
+        put(42u + row, i, real(0.0));
+        put(45u + row, i, real(0.0));
 #endif
     }
 }
