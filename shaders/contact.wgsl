@@ -43,6 +43,12 @@ fn put(field: u32, i: u32, x: real) {
     out_values[field * dims.num_pairs + i] = x;
 }
 
+fn put3(field: u32, i: u32, x: vec3<real>) {
+    put(field, i, x.x);
+    put(field + 1u, i, x.y);
+    put(field + 2u, i, x.z);
+}
+
 // Zero outputs (no contact, or no force). Every output is written exactly once per pair.
 fn clear(i: u32) {
     for (var k = 0u; k < 48u; k = k + 1u) {
@@ -220,33 +226,34 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
 #endif
 #endif
 
-    for (var row = 0u; row < 3u; row = row + 1u) {
-        put(row, i, normal * dir_f[row]);
-        put(row + 3u, i, normal * dir_m[row]);
-        for (var col = 0u; col < 3u; col = col + 1u) {
-            let dn_dx = dn_dx_u * u[col] + dn_dx_t * t[col];
-            put(6u + 3u * row + col, i, dir_f[row] * dn_dx + kf_t[row] * t[col]);
-            put(6u + 3u * (row + 3u) + col, i, dir_m[row] * dn_dx + km_t[row] * t[col]);
+    // Rows written as vectors (no dynamic indexing): K row r = dir[r]·∂N/∂x + kf_t[r]·tᵀ.
+    put3(0u, i, dir_f * normal);
+    put3(3u, i, dir_m * normal);
+    let dn_dx = u * dn_dx_u + t * dn_dx_t;
+    put3(6u, i, dn_dx * dir_f.x + t * kf_t.x);
+    put3(9u, i, dn_dx * dir_f.y + t * kf_t.y);
+    put3(12u, i, dn_dx * dir_f.z + t * kf_t.z);
+    put3(15u, i, dn_dx * dir_m.x + t * km_t.x);
+    put3(18u, i, dn_dx * dir_m.y + t * km_t.y);
+    put3(21u, i, dn_dx * dir_m.z + t * km_t.z);
 #if DYNAMIC
-            let dn_dv = dn_dv_u * u[col];
-            put(24u + 3u * row + col, i, dir_f[row] * dn_dv + normal * (cf_t[row] * t[col] + cf_n[row] * n[col]));
-            put(24u + 3u * (row + 3u) + col, i, dir_m[row] * dn_dv + normal * (cm_t[row] * t[col] + cm_n[row] * n[col]));
-#else
-            put(24u + 3u * row + col, i, real(0.0));
-            put(24u + 3u * (row + 3u) + col, i, real(0.0));
-#endif
-        }
-#if DYNAMIC
+    let dn_dv = u * dn_dv_u;
+    put3(24u, i, dn_dv * dir_f.x + (t * cf_t.x + n * cf_n.x) * normal);
+    put3(27u, i, dn_dv * dir_f.y + (t * cf_t.y + n * cf_n.y) * normal);
+    put3(30u, i, dn_dv * dir_f.z + (t * cf_t.z + n * cf_n.z) * normal);
+    put3(33u, i, dn_dv * dir_m.x + (t * cm_t.x + n * cm_n.x) * normal);
+    put3(36u, i, dn_dv * dir_m.y + (t * cm_t.y + n * cm_n.y) * normal);
+    put3(39u, i, dn_dv * dir_m.z + (t * cm_t.z + n * cm_n.z) * normal);
 #if FRICTION
-        put(42u + row, i, normal * rd * cf_t[row]);
-        put(45u + row, i, normal * rd * cm_t[row]);
+    put3(42u, i, cf_t * (normal * rd));
+    put3(45u, i, cm_t * (normal * rd));
 #else
-        put(42u + row, i, real(0.0));
-        put(45u + row, i, real(0.0));
+    put3(42u, i, vec3<real>(real(0.0)));
+    put3(45u, i, vec3<real>(real(0.0)));
 #endif
 #else
-        put(42u + row, i, real(0.0));
-        put(45u + row, i, real(0.0));
-#endif
+    for (var k = 24u; k < 48u; k = k + 1u) {
+        put(k, i, real(0.0));
     }
+#endif
 }
