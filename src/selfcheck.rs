@@ -282,71 +282,6 @@ pub fn median_seconds<E>(repeats: usize, mut f: impl FnMut() -> Result<(), E>) -
     Ok(times[times.len() / 2])
 }
 
-/// Result of [`contact_comparison`].
-#[derive(Clone, Debug)]
-pub struct ContactComparison {
-    /// Largest per-block relative error of GPU f64 against CPU f64 (None without SHADER_F64).
-    pub max_rel_f64: Option<f64>,
-    /// Largest per-block relative error of GPU f32 against CPU f64.
-    pub max_rel_f32: f64,
-    /// Median evaluations per second, CPU f64 twin on all cores.
-    pub evals_per_s_cpu_f64: f64,
-    /// Median evaluations per second, GPU f32 (data resident, kernel and wait).
-    pub evals_per_s_gpu_f32: f64,
-    /// Median evaluations per second, GPU f64.
-    pub evals_per_s_gpu_f64: Option<f64>,
-}
-
-/// Evaluates `pairs` random pairs with `terms` on the CPU twin (f64) and on the GPU (f32,
-/// and f64 where the adapter has it); reports the largest per-block relative errors
-/// (floor 1e-12 of the block's quantity, see [`block_errors`]) and evaluation rates.
-pub fn contact_comparison(
-    ctx: &'static crate::gpu::GpuContext,
-    terms: &crate::physics::contact::ContactTerms,
-    pairs: usize,
-    repeats: usize,
-) -> Result<ContactComparison, crate::error::GpuError> {
-    use crate::gpu::contact::GpuContactRun;
-    use crate::kernels::contact::{contact, ContactOutputs};
-    let num_variants = 100.min(pairs.max(1));
-    let num_sites = pairs.div_ceil(num_variants);
-    let friction = terms.friction.unwrap_or(FrictionModel::Split);
-    let batch = random_batch(0x5eed ^ pairs as u64, num_variants, num_sites, friction);
-    let p = batch.num_pairs();
-    let mut reference = ContactOutputs::new(p);
-    let cpu_time = median_seconds::<std::convert::Infallible>(repeats, || {
-        contact(terms, &batch, &mut reference);
-        Ok(())
-    })
-    .unwrap_or(f64::NAN);
-    let max_err = |other: &dyn Fn(usize) -> [f64; OUTPUT_LEN]| {
-        (0..p).fold(0.0f64, |m, i| {
-            let e = quantity_errors(&reference.fields(i), &other(i));
-            e.iter().fold(m, |m, x| m.max(*x))
-        })
-    };
-    let b32 = batch.cast::<f32>();
-    let run32 = GpuContactRun::new(ctx, terms, &b32)?;
-    let t32 = median_seconds(repeats, || run32.dispatch())?;
-    let o32 = run32.read()?;
-    let max_rel_f32 = max_err(&|i| o32.fields(i).map(|x| x as f64));
-    let (max_rel_f64, t64) = if ctx.has_f64 {
-        let run64 = GpuContactRun::new(ctx, terms, &batch)?;
-        let t = median_seconds(repeats, || run64.dispatch())?;
-        let o64 = run64.read()?;
-        (Some(max_err(&|i| o64.fields(i))), Some(t))
-    } else {
-        (None, None)
-    };
-    Ok(ContactComparison {
-        max_rel_f64,
-        max_rel_f32,
-        evals_per_s_cpu_f64: p as f64 / cpu_time,
-        evals_per_s_gpu_f32: p as f64 / t32,
-        evals_per_s_gpu_f64: t64.map(|t| p as f64 / t),
-    })
-}
-
 /// The four output quantities as (first, end) field indices: g, K, C, c_omega.
 pub const QUANTITIES: [(usize, usize); 4] = [(0, 6), (6, 24), (24, 42), (42, 48)];
 
@@ -375,8 +310,9 @@ pub fn quantity_errors(reference: &[f64; OUTPUT_LEN], other: &[f64; OUTPUT_LEN])
 /// outputs, normwise. Terms (docs/contact-element.md, "Accuracy"):
 /// - `|d|/r`: forming `d_t = d − (d·n)n` cancels the axial part, so `u` and `t` carry a
 ///   relative error `u·|d|/r`;
-/// - `(1 + m)·r/delta`: `delta = r − ΔR` cancels, and `f_e`, `df_e` inherit it;
-/// - `(f_e·(1 + m)·r/delta + |f_d| + c·|v|·(1 + |d|/r))/N`: the cancellation of the elastic
+/// - `(1 + m)·|d|/delta`: `delta = r − ΔR` cancels, the rounding of `d` (≈ `u·|d|`, axial part
+///   included) moves it, and `f_e`, `df_e` inherit it;
+/// - `(f_e·(1 + m)·|d|/delta + |f_d| + c·|v|·(1 + |d|/r))/N`: the cancellation of the elastic
 ///   and damping parts in `N = f_e + f_d`;
 /// - with friction, `(μ_t + μ_l)·S/eps · (1 + |v_u|/eps)` with `S = |v|(1 + |d|/r) + R_d|ω|`
 ///   the scale of the slip speeds: the regularised sign has slope `2/eps`, and `∂φ/∂s`
@@ -413,7 +349,8 @@ pub fn condition_number(
     let speed = dot(v, v).sqrt();
     let d_len = dot(d, d).sqrt();
     let axial = d_len / r;
-    let delta_cond = (1.0 + p.spring_exponent) * r / delta;
+    // The rounding of d itself (≈ u·|d| in each component) moves delta: |d|/delta, not r/delta.
+    let delta_cond = (1.0 + p.spring_exponent) * d_len / delta;
     let mut kappa = 1.0 + axial + delta_cond + (f_e * delta_cond + f_d.abs()) / normal;
     if damping {
         kappa += p.wall_damping * speed * (1.0 + axial) / normal;
@@ -491,5 +428,175 @@ pub fn scaled_errors(
         } else {
             diff / scales[q]
         }
+    })
+}
+
+/// Statistics of one output set against the f64 reference, from [`compare_outputs`].
+#[derive(Clone, Debug, Default)]
+pub struct ErrorStats {
+    /// Pairs compared.
+    pub pairs: usize,
+    /// Pairs with a contact force and `u·κ ≤ 1e-3`, where the bound is applied.
+    pub checked: usize,
+    /// Largest normwise relative error per quantity over the checked pairs.
+    pub max_normwise: f64,
+    /// The same over checked pairs with `κ ≤ 1e3`.
+    pub max_normwise_well: f64,
+    /// Largest (error / natural scale) / (u·κ) over the checked pairs.
+    pub max_ratio: f64,
+    /// Every (error / natural scale) of the checked pairs, for percentiles.
+    pub scaled: Vec<f64>,
+    /// Pairs whose contact flag differs from the reference.
+    pub flag_mismatches: usize,
+    /// Checked pairs whose error exceeds `bound·u·κ` (bound given to [`compare_outputs`]).
+    pub over_bound: usize,
+}
+
+impl ErrorStats {
+    /// The `q`-quantile (0…1) of the scaled errors; 0 when none.
+    pub fn scaled_quantile(&self, q: f64) -> f64 {
+        if self.scaled.is_empty() {
+            return 0.0;
+        }
+        let mut v = self.scaled.clone();
+        v.sort_by(|a, b| a.total_cmp(b));
+        v[((v.len() - 1) as f64 * q.clamp(0.0, 1.0)) as usize]
+    }
+}
+
+/// Compares `other` (its fields and contact flag per pair, at unit roundoff `u`) with the
+/// f64 `reference` of the same batch. Pairs with a contact force and `u·κ ≤ 1e-3` are
+/// checked: their error relative to the quantity's natural scale ([`term_scales`]) is
+/// compared with `bound·u·κ` ([`condition_number`]); the rest sit within rounding of a
+/// corner (contact onset, `N = 0`) at this precision and are only counted.
+pub fn compare_outputs(
+    batch: &ContactBatch<f64>,
+    terms: &crate::physics::contact::ContactTerms,
+    reference: &crate::kernels::contact::ContactOutputs<f64>,
+    other: &dyn Fn(usize) -> ([f64; OUTPUT_LEN], u32),
+    unit_roundoff: f64,
+    bound: f64,
+) -> ErrorStats {
+    use crate::physics::contact::ContactMode;
+    let dynamic = terms.mode == ContactMode::Dynamic;
+    let friction = terms.friction.is_some();
+    let damping = terms.damping && dynamic;
+    let mut st = ErrorStats {
+        pairs: batch.num_pairs(),
+        ..Default::default()
+    };
+    for i in 0..batch.num_pairs() {
+        let (d, v, omega) = batch.state(i);
+        let p = batch.params(i);
+        let n = batch.site_normal(i / batch.num_variants);
+        let (fields, flag) = other(i);
+        let Some(kappa) = condition_number(&n, &d, &v, omega, &p, friction, damping)
+            .filter(|k| unit_roundoff * k <= 1e-3)
+        else {
+            continue;
+        };
+        st.checked += 1;
+        if flag != reference.contact[i] {
+            st.flag_mismatches += 1;
+        }
+        let Some(scales) = term_scales(&n, &d, &v, &p, friction, dynamic, damping) else {
+            continue;
+        };
+        let scaled = scaled_errors(&reference.fields(i), &fields, &scales);
+        let plain = quantity_errors(&reference.fields(i), &fields);
+        let mut over = false;
+        for q in 0..4 {
+            let ratio = scaled[q] / (unit_roundoff * kappa);
+            over |= ratio > bound;
+            st.max_ratio = st.max_ratio.max(ratio);
+            st.max_normwise = st.max_normwise.max(plain[q]);
+            if kappa <= 1e3 {
+                st.max_normwise_well = st.max_normwise_well.max(plain[q]);
+            }
+            st.scaled.push(scaled[q]);
+        }
+        st.over_bound += usize::from(over);
+    }
+    st
+}
+
+/// Result of [`contact_comparison`].
+#[derive(Clone, Debug)]
+pub struct ContactComparison {
+    /// GPU f64 against the CPU f64 twin (None without SHADER_F64).
+    pub f64_stats: Option<ErrorStats>,
+    /// GPU f32 against the CPU f64 twin.
+    pub f32_stats: ErrorStats,
+    /// Median evaluations per second, CPU f64 twin on all cores.
+    pub evals_per_s_cpu_f64: f64,
+    /// Median evaluations per second, GPU f32 (data resident, kernel and wait).
+    pub evals_per_s_gpu_f32: f64,
+    /// Median evaluations per second, GPU f64.
+    pub evals_per_s_gpu_f64: Option<f64>,
+}
+
+/// The f32 error bound constant: f32 results are within `F32_BOUND·u·κ` (see
+/// docs/contact-element.md, "Accuracy").
+pub const F32_BOUND: f64 = 8.0;
+/// The f64 error bound constant (GPU against the CPU twin).
+pub const F64_BOUND: f64 = 8.0;
+
+/// Evaluates `pairs` random pairs with `terms` on the CPU twin (f64) and on the GPU (f32,
+/// and f64 where the adapter has it): error statistics and evaluation rates.
+pub fn contact_comparison(
+    ctx: &'static crate::gpu::GpuContext,
+    terms: &crate::physics::contact::ContactTerms,
+    pairs: usize,
+    repeats: usize,
+) -> Result<ContactComparison, crate::error::GpuError> {
+    use crate::gpu::contact::GpuContactRun;
+    use crate::kernels::contact::{contact, ContactOutputs};
+    let num_variants = 100.min(pairs.max(1));
+    let num_sites = pairs.div_ceil(num_variants);
+    let friction = terms.friction.unwrap_or(FrictionModel::Split);
+    let batch = random_batch(0x5eed ^ pairs as u64, num_variants, num_sites, friction);
+    let p = batch.num_pairs();
+    let mut reference = ContactOutputs::new(p);
+    let cpu_time = median_seconds::<std::convert::Infallible>(repeats, || {
+        contact(terms, &batch, &mut reference);
+        Ok(())
+    })
+    .unwrap_or(f64::NAN);
+    let b32 = batch.cast::<f32>();
+    let run32 = GpuContactRun::new(ctx, terms, &b32)?;
+    let t32 = median_seconds(repeats, || run32.dispatch())?;
+    let o32 = run32.read()?;
+    let f32_stats = compare_outputs(
+        &batch,
+        terms,
+        &reference,
+        &|i| (o32.fields(i).map(f64::from), o32.contact[i]),
+        f32::EPSILON as f64 / 2.0,
+        F32_BOUND,
+    );
+    let (f64_stats, t64) = if ctx.has_f64 {
+        let run64 = GpuContactRun::new(ctx, terms, &batch)?;
+        let t = median_seconds(repeats, || run64.dispatch())?;
+        let o64 = run64.read()?;
+        (
+            Some(compare_outputs(
+                &batch,
+                terms,
+                &reference,
+                &|i| (o64.fields(i), o64.contact[i]),
+                f64::EPSILON / 2.0,
+                F64_BOUND,
+            )),
+            Some(t),
+        )
+    } else {
+        (None, None)
+    };
+    Ok(ContactComparison {
+        f64_stats,
+        f32_stats,
+        evals_per_s_cpu_f64: p as f64 / cpu_time,
+        evals_per_s_gpu_f32: p as f64 / t32,
+        evals_per_s_gpu_f64: t64.map(|t| p as f64 / t),
     })
 }
