@@ -38,6 +38,24 @@ fn max_abs(x: &[f64]) -> f64 {
     x.iter().fold(0.0, |m, v| m.max(v.abs()))
 }
 
+/// `max|a − b|` over `lo..hi`, divided by `denom`: 0 where equal, infinity over a zero
+/// denominator.
+fn relative_difference(
+    reference: &[f64; OUTPUT_LEN],
+    other: &[f64; OUTPUT_LEN],
+    (lo, hi): (usize, usize),
+    denom: f64,
+) -> f64 {
+    let diff = (lo..hi).fold(0.0f64, |m, k| m.max((reference[k] - other[k]).abs()));
+    if diff == 0.0 {
+        0.0
+    } else if denom == 0.0 {
+        f64::INFINITY
+    } else {
+        diff / denom
+    }
+}
+
 /// Relative error of `other` against `reference`, per block: `max|a − b| / max(max|b_block|,
 /// floor_q)`, with an absolute floor per quantity (g, K, C, c_omega) for blocks that vanish
 /// by cancellation (e.g. `C` without damping where the regularised sign is flat). A block
@@ -49,15 +67,12 @@ pub fn block_errors(
 ) -> [f64; 8] {
     std::array::from_fn(|b| {
         let (lo, hi) = BLOCKS[b];
-        let diff = (lo..hi).fold(0.0f64, |m, k| m.max((reference[k] - other[k]).abs()));
-        let denom = max_abs(&reference[lo..hi]).max(floors[b / 2]);
-        if diff == 0.0 {
-            0.0
-        } else if denom == 0.0 {
-            f64::INFINITY
-        } else {
-            diff / denom
-        }
+        relative_difference(
+            reference,
+            other,
+            BLOCKS[b],
+            max_abs(&reference[lo..hi]).max(floors[b / 2]),
+        )
     })
 }
 
@@ -293,15 +308,7 @@ pub const QUANTITY_NAMES: [&str; 4] = ["g", "K", "C", "c_omega"];
 /// infinity where only the reference is.
 pub fn quantity_errors(reference: &[f64; OUTPUT_LEN], other: &[f64; OUTPUT_LEN]) -> [f64; 4] {
     QUANTITIES.map(|(lo, hi)| {
-        let diff = (lo..hi).fold(0.0f64, |m, k| m.max((reference[k] - other[k]).abs()));
-        let scale = max_abs(&reference[lo..hi]);
-        if diff == 0.0 {
-            0.0
-        } else if scale == 0.0 {
-            f64::INFINITY
-        } else {
-            diff / scale
-        }
+        relative_difference(reference, other, (lo, hi), max_abs(&reference[lo..hi]))
     })
 }
 
@@ -418,17 +425,7 @@ pub fn scaled_errors(
     other: &[f64; OUTPUT_LEN],
     scales: &[f64; 4],
 ) -> [f64; 4] {
-    std::array::from_fn(|q| {
-        let (lo, hi) = QUANTITIES[q];
-        let diff = (lo..hi).fold(0.0f64, |m, k| m.max((reference[k] - other[k]).abs()));
-        if diff == 0.0 {
-            0.0
-        } else if scales[q] == 0.0 {
-            f64::INFINITY
-        } else {
-            diff / scales[q]
-        }
-    })
+    std::array::from_fn(|q| relative_difference(reference, other, QUANTITIES[q], scales[q]))
 }
 
 /// Statistics of one output set against the f64 reference, from [`compare_outputs`].

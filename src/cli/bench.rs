@@ -7,8 +7,9 @@ use serde::Serialize;
 
 use crate::backend::{Backend, BackendChoice, Precision};
 use crate::error::Error;
-use crate::gpu::contact::GpuContactRun;
-use crate::kernels::contact::{contact as contact_twin, ContactOutputs};
+use crate::gpu::contact::{GpuContactRun, GpuReal};
+use crate::gpu::GpuContext;
+use crate::kernels::contact::{contact as contact_twin, ContactBatch, ContactOutputs};
 use crate::output::write_atomic;
 use crate::physics::contact::{ContactMode, ContactTerms, FrictionModel};
 use crate::selfcheck::{median_seconds, random_batch};
@@ -73,33 +74,9 @@ pub fn contact(
     };
     if let Some(ctx) = gpu {
         adapter = ctx.describe();
-        let run = GpuContactRun::new(ctx, &terms, &b32)?;
-        rows.push((
-            format!("GPU f32 resident ({} chunks)", run.num_chunks()),
-            median_seconds(repeats, || run.dispatch())?,
-        ));
-        rows.push((
-            "GPU f32 end to end".into(),
-            median_seconds(repeats, || {
-                let r = GpuContactRun::new(ctx, &terms, &b32)?;
-                r.dispatch()?;
-                r.read().map(|_| ())
-            })?,
-        ));
+        gpu_rows(ctx, &terms, &b32, repeats, &mut rows)?;
         if ctx.has_f64 {
-            let run = GpuContactRun::new(ctx, &terms, &batch)?;
-            rows.push((
-                format!("GPU f64 resident ({} chunks)", run.num_chunks()),
-                median_seconds(repeats, || run.dispatch())?,
-            ));
-            rows.push((
-                "GPU f64 end to end".into(),
-                median_seconds(repeats, || {
-                    let r = GpuContactRun::new(ctx, &terms, &batch)?;
-                    r.dispatch()?;
-                    r.read().map(|_| ())
-                })?,
-            ));
+            gpu_rows(ctx, &terms, &batch, repeats, &mut rows)?;
         }
     }
     let cpu64 = rows[0].1;
@@ -139,5 +116,30 @@ pub fn contact(
         let text = serde_json::to_string_pretty(&report).map_err(std::io::Error::other)?;
         write_atomic(path, text.as_bytes())?;
     }
+    Ok(())
+}
+
+/// Resident (kernel + wait) and end-to-end (upload, kernel, read-back) rows for one precision.
+fn gpu_rows<T: GpuReal>(
+    ctx: &'static GpuContext,
+    terms: &ContactTerms,
+    batch: &ContactBatch<T>,
+    repeats: usize,
+    rows: &mut Vec<(String, f64)>,
+) -> Result<(), Error> {
+    let run = GpuContactRun::new(ctx, terms, batch)?;
+    let name = T::NAME;
+    rows.push((
+        format!("GPU {name} resident ({} chunks)", run.num_chunks()),
+        median_seconds(repeats, || run.dispatch())?,
+    ));
+    rows.push((
+        format!("GPU {name} end to end"),
+        median_seconds(repeats, || {
+            let r = GpuContactRun::new(ctx, terms, batch)?;
+            r.dispatch()?;
+            r.read().map(|_| ())
+        })?,
+    ));
     Ok(())
 }

@@ -65,27 +65,27 @@ fn finite_difference(
             }
         })
     };
+    let dynamic = terms.mode == ContactMode::Dynamic;
+    let h = |x: f64| Dd::from(x);
     for j in 0..3 {
-        let mut dp = base_d;
-        let mut dm = base_d;
-        dp[j] = dp[j] + Dd::from(h_x);
-        dm[j] = dm[j] - Dd::from(h_x);
+        let shift = |a: &Vec3<Dd>, by: Dd| {
+            let mut b = *a;
+            b[j] = b[j] + by;
+            b
+        };
+        // Column j of K (x_j) and, in dynamic mode, of C (v_j).
         let col = diff(
-            g_dd(n, &dp, &base_v, w, p, terms),
-            g_dd(n, &dm, &base_v, w, p, terms),
+            g_dd(n, &shift(&base_d, h(h_x)), &base_v, w, p, terms),
+            g_dd(n, &shift(&base_d, -h(h_x)), &base_v, w, p, terms),
             h_x,
         );
         for r in 0..6 {
             out[6 + 3 * r + j] = col[r];
         }
-        if terms.mode == ContactMode::Dynamic {
-            let mut vp = base_v;
-            let mut vm = base_v;
-            vp[j] = vp[j] + Dd::from(h_v);
-            vm[j] = vm[j] - Dd::from(h_v);
+        if dynamic {
             let col = diff(
-                g_dd(n, &base_d, &vp, w, p, terms),
-                g_dd(n, &base_d, &vm, w, p, terms),
+                g_dd(n, &base_d, &shift(&base_v, h(h_v)), w, p, terms),
+                g_dd(n, &base_d, &shift(&base_v, -h(h_v)), w, p, terms),
                 h_v,
             );
             for r in 0..6 {
@@ -93,11 +93,10 @@ fn finite_difference(
             }
         }
     }
-    if terms.mode == ContactMode::Dynamic {
-        let hw = Dd::from(h_w);
+    if dynamic {
         let col = diff(
-            g_dd(n, &base_d, &base_v, w + hw, p, terms),
-            g_dd(n, &base_d, &base_v, w - hw, p, terms),
+            g_dd(n, &base_d, &base_v, w + h(h_w), p, terms),
+            g_dd(n, &base_d, &base_v, w - h(h_w), p, terms),
             h_w,
         );
         out[42..48].copy_from_slice(&col);
