@@ -245,3 +245,52 @@ fn bad_input_is_rejected_with_line_and_key() {
     assert_eq!(code, 2);
     assert!(stderr.contains("<stdin>:1:"));
 }
+
+fn run_env(args: &[&str], env: &[(&str, &str)]) -> (i32, String, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_holewall"))
+        .args(args)
+        .envs(env.iter().copied())
+        .env_remove("HOLEWALL_REQUIRE_GPU")
+        .output()
+        .unwrap();
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stdout).to_string(),
+        String::from_utf8_lossy(&out.stderr).to_string(),
+    )
+}
+
+#[test]
+fn adapter_choice_follows_the_environment() {
+    let case = concat!(env!("CARGO_MANIFEST_DIR"), "/cases/contact_examples.jsonl");
+    let lines = std::fs::read_to_string(case).unwrap().lines().count();
+    // No backend that can open an adapter: auto falls back to the CPU with one notice.
+    let (code, stdout, stderr) = run_env(&["contact", case], &[("WGPU_BACKEND", "metal")]);
+    assert_eq!(code, 0, "{stderr}");
+    assert_eq!(stdout.lines().count(), lines);
+    let notices: Vec<&str> = stderr
+        .lines()
+        .filter(|l| l.contains("using the CPU backend"))
+        .collect();
+    assert_eq!(notices.len(), 1, "{stderr}");
+    // --backend gpu does not fall back.
+    let (code, stdout, stderr) = run_env(
+        &["contact", "--backend", "gpu", case],
+        &[("WGPU_BACKEND", "metal")],
+    );
+    assert_eq!(code, 1);
+    assert!(
+        stdout.is_empty() && stderr.contains("no GPU adapter"),
+        "{stderr}"
+    );
+    // WGPU_ADAPTER_NAME that matches no adapter is an error naming the adapters seen.
+    let (code, stdout, stderr) = run_env(
+        &["contact", "--backend", "gpu", case],
+        &[("WGPU_ADAPTER_NAME", "no-such-adapter-xyz")],
+    );
+    assert_eq!(code, 1);
+    assert!(
+        stdout.is_empty() && stderr.contains("no-such-adapter-xyz"),
+        "{stderr}"
+    );
+}
