@@ -16,5 +16,6 @@ pub mod kernels;
 pub mod output;
 pub mod physics;
 pub mod selfcheck;
+pub mod well;
 
 pub use error::{Error, GpuError, InputError};
