@@ -16,6 +16,7 @@ pub mod kernels;
 pub mod output;
 pub mod physics;
 pub mod selfcheck;
+pub mod units;
 pub mod well;
 
 pub use error::{Error, GpuError, InputError};

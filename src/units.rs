@@ -1,0 +1,328 @@
+//! Quantities with units, as engineers write them in case files: a bare number is SI; a
+//! string is `"<number> <unit>"` (`"6.5 in"`, `"20 klbf"`, `"10 ppg"`, `"120 rpm"`,
+//! `"1500 ft"`). The unit must fit the key's dimension.
+
+use thiserror::Error;
+
+/// Physical dimension of a case-file key.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Dimension {
+    /// m
+    Length,
+    /// N
+    Force,
+    /// kg/m³
+    Density,
+    /// rad/s
+    AngularSpeed,
+    /// m/s
+    Speed,
+    /// Pa
+    Pressure,
+    /// N·m
+    Torque,
+    /// rad (case files speak degrees by default: see [`parse_angle_deg`])
+    Angle,
+    /// N/m
+    Stiffness,
+    /// N·s/m
+    Damping,
+    /// s
+    Time,
+    /// dimensionless
+    Ratio,
+}
+
+impl Dimension {
+    /// SI unit name, for messages.
+    pub fn si(&self) -> &'static str {
+        match self {
+            Dimension::Length => "m",
+            Dimension::Force => "N",
+            Dimension::Density => "kg/m3",
+            Dimension::AngularSpeed => "rad/s",
+            Dimension::Speed => "m/s",
+            Dimension::Pressure => "Pa",
+            Dimension::Torque => "N.m",
+            Dimension::Angle => "rad",
+            Dimension::Stiffness => "N/m",
+            Dimension::Damping => "N.s/m",
+            Dimension::Time => "s",
+            Dimension::Ratio => "1",
+        }
+    }
+}
+
+const LBF: f64 = 4.448_221_615_260_5;
+const FT: f64 = 0.3048;
+const INCH: f64 = 0.0254;
+
+/// Known units: (name, dimension, factor to SI).
+const UNITS: &[(&str, Dimension, f64)] = &[
+    ("m", Dimension::Length, 1.0),
+    ("mm", Dimension::Length, 1e-3),
+    ("cm", Dimension::Length, 1e-2),
+    ("km", Dimension::Length, 1e3),
+    ("in", Dimension::Length, INCH),
+    ("ft", Dimension::Length, FT),
+    ("N", Dimension::Force, 1.0),
+    ("kN", Dimension::Force, 1e3),
+    ("MN", Dimension::Force, 1e6),
+    ("lbf", Dimension::Force, LBF),
+    ("klbf", Dimension::Force, 1e3 * LBF),
+    ("kgf", Dimension::Force, 9.806_65),
+    ("tf", Dimension::Force, 9806.65),
+    ("kg/m3", Dimension::Density, 1.0),
+    ("g/cm3", Dimension::Density, 1e3),
+    ("sg", Dimension::Density, 1e3),
+    ("ppg", Dimension::Density, 119.826_427),
+    ("lb/gal", Dimension::Density, 119.826_427),
+    ("rad/s", Dimension::AngularSpeed, 1.0),
+    ("rpm", Dimension::AngularSpeed, std::f64::consts::TAU / 60.0),
+    ("m/s", Dimension::Speed, 1.0),
+    ("m/h", Dimension::Speed, 1.0 / 3600.0),
+    ("m/min", Dimension::Speed, 1.0 / 60.0),
+    ("ft/h", Dimension::Speed, FT / 3600.0),
+    ("ft/min", Dimension::Speed, FT / 60.0),
+    ("Pa", Dimension::Pressure, 1.0),
+    ("kPa", Dimension::Pressure, 1e3),
+    ("MPa", Dimension::Pressure, 1e6),
+    ("GPa", Dimension::Pressure, 1e9),
+    ("psi", Dimension::Pressure, LBF / (INCH * INCH)),
+    ("ksi", Dimension::Pressure, 1e3 * LBF / (INCH * INCH)),
+    ("Mpsi", Dimension::Pressure, 1e6 * LBF / (INCH * INCH)),
+    ("N.m", Dimension::Torque, 1.0),
+    ("Nm", Dimension::Torque, 1.0),
+    ("kN.m", Dimension::Torque, 1e3),
+    ("ft.lbf", Dimension::Torque, FT * LBF),
+    ("kft.lbf", Dimension::Torque, 1e3 * FT * LBF),
+    ("rad", Dimension::Angle, 1.0),
+    ("deg", Dimension::Angle, std::f64::consts::PI / 180.0),
+    ("N/m", Dimension::Stiffness, 1.0),
+    ("kN/m", Dimension::Stiffness, 1e3),
+    ("MN/m", Dimension::Stiffness, 1e6),
+    ("lbf/in", Dimension::Stiffness, LBF / INCH),
+    ("N.s/m", Dimension::Damping, 1.0),
+    ("kN.s/m", Dimension::Damping, 1e3),
+    ("s", Dimension::Time, 1.0),
+    ("ms", Dimension::Time, 1e-3),
+    ("min", Dimension::Time, 60.0),
+    ("h", Dimension::Time, 3600.0),
+    ("%", Dimension::Ratio, 1e-2),
+];
+
+/// A quantity that cannot be read.
+#[derive(Clone, Debug, Error, PartialEq)]
+pub enum UnitError {
+    /// Not `<number> <unit>`.
+    #[error("cannot read {text:?} as \"<number> <unit>\"")]
+    Malformed {
+        /// The text.
+        text: String,
+    },
+    /// Unknown unit.
+    #[error("unknown unit {unit:?} (units of {dimension:?}: {known})")]
+    Unknown {
+        /// The unit.
+        unit: String,
+        /// The key's dimension.
+        dimension: Dimension,
+        /// Units that would fit.
+        known: String,
+    },
+    /// Unit of another dimension.
+    #[error("unit {unit:?} is a {found:?}, but this key is a {expected:?} (e.g. {example})")]
+    WrongDimension {
+        /// The unit.
+        unit: String,
+        /// Its dimension.
+        found: Dimension,
+        /// The key's dimension.
+        expected: Dimension,
+        /// A unit that fits.
+        example: String,
+    },
+    /// NaN or infinite.
+    #[error("{text:?} is not a finite number")]
+    NotFinite {
+        /// The text.
+        text: String,
+    },
+}
+
+fn units_of(dimension: Dimension) -> String {
+    UNITS
+        .iter()
+        .filter(|(_, d, _)| *d == dimension)
+        .map(|(n, _, _)| *n)
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+/// Normalises the spellings engineers use: `N·m`, `N-m`, `N m` → `N.m`; `deg/30m` stays.
+fn normalise(unit: &str) -> String {
+    unit.trim()
+        .replace(['·', '-', '*'], ".")
+        .replace("ft.lb", "ft.lbf")
+        .replace("ft.lbff", "ft.lbf")
+        .replace("kg/m^3", "kg/m3")
+        .replace("g/cc", "g/cm3")
+}
+
+/// Parses `"<number> <unit>"` (or a bare number, in SI) into SI units of `dimension`.
+pub fn parse_quantity(text: &str, dimension: Dimension) -> Result<f64, UnitError> {
+    let t = text.trim();
+    let split = t
+        .find(|c: char| !(c.is_ascii_digit() || matches!(c, '.' | '-' | '+' | 'e' | 'E')))
+        .unwrap_or(t.len());
+    // "1e3 m": the number may contain 'e'; a unit never starts right after a digit with 'e'
+    // followed by a digit, so take the longest prefix that parses.
+    let (mut number, mut unit) = (&t[..split], t[split..].trim());
+    if number.parse::<f64>().is_err() {
+        // e.g. "5 ft" splits fine; "2e" from "2 each" does not: back off one char at a time.
+        let mut k = split;
+        while k > 0 && t[..k].parse::<f64>().is_err() {
+            k -= 1;
+        }
+        number = &t[..k];
+        unit = t[k..].trim();
+    }
+    let value: f64 = number.parse().map_err(|_| UnitError::Malformed {
+        text: text.to_string(),
+    })?;
+    if !value.is_finite() {
+        return Err(UnitError::NotFinite {
+            text: text.to_string(),
+        });
+    }
+    if unit.is_empty() {
+        return Ok(value);
+    }
+    let unit_n = normalise(unit);
+    match UNITS.iter().find(|(n, _, _)| *n == unit_n) {
+        Some((_, d, f)) if *d == dimension => Ok(value * f),
+        Some((_, d, _)) => Err(UnitError::WrongDimension {
+            unit: unit.to_string(),
+            found: *d,
+            expected: dimension,
+            example: units_of(dimension),
+        }),
+        None => Err(UnitError::Unknown {
+            unit: unit.to_string(),
+            dimension,
+            known: units_of(dimension),
+        }),
+    }
+}
+
+/// Parses an angle; a bare number is in **degrees** (the drilling convention for
+/// inclination and azimuth). Returns degrees.
+pub fn parse_angle_deg(text: &str) -> Result<f64, UnitError> {
+    let t = text.trim();
+    if let Ok(v) = t.parse::<f64>() {
+        return if v.is_finite() {
+            Ok(v)
+        } else {
+            Err(UnitError::NotFinite {
+                text: text.to_string(),
+            })
+        };
+    }
+    parse_quantity(text, Dimension::Angle).map(f64::to_degrees)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn close(a: f64, b: f64) -> bool {
+        (a - b).abs() <= 1e-12 * b.abs().max(1.0)
+    }
+
+    #[test]
+    fn field_units_convert_to_si() {
+        assert!(close(
+            parse_quantity("6.5 in", Dimension::Length).unwrap(),
+            0.1651
+        ));
+        assert!(close(
+            parse_quantity("1500 ft", Dimension::Length).unwrap(),
+            457.2
+        ));
+        assert!(close(
+            parse_quantity("20 klbf", Dimension::Force).unwrap(),
+            88_964.432_305_21
+        ));
+        assert!(close(
+            parse_quantity("10 ppg", Dimension::Density).unwrap(),
+            1198.26427
+        ));
+        assert!(close(
+            parse_quantity("1.2 sg", Dimension::Density).unwrap(),
+            1200.0
+        ));
+        assert!(close(
+            parse_quantity("120 rpm", Dimension::AngularSpeed).unwrap(),
+            4.0 * std::f64::consts::PI
+        ));
+        assert!(close(
+            parse_quantity("30e6 psi", Dimension::Pressure).unwrap(),
+            206_842_718_795.05
+        ));
+        assert!(close(
+            parse_quantity("10 kft·lbf", Dimension::Torque).unwrap(),
+            13_558.179_483_314
+        ));
+        assert!(close(
+            parse_quantity("10 kft-lbf", Dimension::Torque).unwrap(),
+            13_558.179_483_314
+        ));
+        assert!(close(
+            parse_quantity("24.5 m/h", Dimension::Speed).unwrap(),
+            24.5 / 3600.0
+        ));
+        assert!(close(
+            parse_quantity("2.5e-3", Dimension::Length).unwrap(),
+            2.5e-3
+        ));
+        assert!(close(
+            parse_quantity("1e3 N", Dimension::Force).unwrap(),
+            1e3
+        ));
+        assert!(close(parse_angle_deg("12").unwrap(), 12.0));
+        assert!(close(
+            parse_angle_deg("0.5 rad").unwrap(),
+            0.5f64.to_degrees()
+        ));
+    }
+
+    #[test]
+    fn wrong_units_are_named() {
+        let e = parse_quantity("20 klbf", Dimension::Length).unwrap_err();
+        assert!(matches!(
+            e,
+            UnitError::WrongDimension {
+                found: Dimension::Force,
+                expected: Dimension::Length,
+                ..
+            }
+        ));
+        assert!(e.to_string().contains("in, ft"));
+        assert!(matches!(
+            parse_quantity("3 furlongs", Dimension::Length),
+            Err(UnitError::Unknown { .. })
+        ));
+        assert!(matches!(
+            parse_quantity("inch 3", Dimension::Length),
+            Err(UnitError::Malformed { .. })
+        ));
+        assert!(matches!(
+            parse_quantity("inf m", Dimension::Length),
+            Err(UnitError::Malformed { .. }) | Err(UnitError::NotFinite { .. })
+        ));
+        assert!(matches!(
+            parse_quantity("1e999 m", Dimension::Length),
+            Err(UnitError::NotFinite { .. })
+        ));
+    }
+}
