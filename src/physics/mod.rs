@@ -3,7 +3,9 @@
 //! The CPU twins in `src/kernels/` call these functions; the WGSL kernels in `shaders/`
 //! write the same formulas.
 
+pub mod beam;
 pub mod contact;
+pub mod hyperdual;
 pub mod vec3;
 
 /// Float type the physics is generic over: `f32` (what a GPU f32 run computes) or `f64`
