@@ -283,6 +283,7 @@ fn perturb(
 
 /// Internal force (12) and consistent tangent (12×12) of the element: `f_j = ∂E/∂δ_j`,
 /// `K_jk = ∂f_j/∂Δ_k` with rotations updated multiplicatively (`exp(δ)·exp(Δ)·R`).
+#[allow(clippy::needless_range_loop)]
 pub fn force_and_tangent(
     state: &ElementState,
     section: &BeamSection,
