@@ -13,9 +13,11 @@ pub mod cli;
 pub mod error;
 pub mod gpu;
 pub mod kernels;
+pub mod model;
 pub mod output;
 pub mod physics;
 pub mod selfcheck;
+pub mod solve;
 pub mod units;
 pub mod well;
 

@@ -1,0 +1,203 @@
+//! The immutable model of one drillstring in one well: nodes along the well path, beam
+//! elements between them, contact sites, loads and boundary conditions (paper §3.1).
+//!
+//! Nodes are numbered from the surface (node 0, MD 0) to the bit (last node). The string is
+//! meshed on the hole axis, so each node's initial position is its contact site's
+//! reference point `x0`.
+
+use crate::physics::beam::{BeamSection, Mat3};
+use crate::physics::contact::{ContactParams, FrictionModel};
+use crate::physics::vec3::{cross, dot, scale, sub, Vec3};
+use crate::well::WellPath;
+
+/// Standard gravity (m/s²).
+pub const GRAVITY: f64 = 9.806_65;
+
+/// One node.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Node {
+    /// Measured depth (m).
+    pub md: f64,
+    /// Initial position (on the hole axis).
+    pub position: Vec3<f64>,
+    /// Unit hole axis at the node, pointing down-hole.
+    pub hole_axis: Vec3<f64>,
+}
+
+/// One beam element between nodes `i` and `i + 1`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Element {
+    /// Section and material.
+    pub section: BeamSection,
+    /// Initial length (m).
+    pub length0: f64,
+    /// Initial frame, columns `e1` (node i → i+1), `e2`, `e3`.
+    pub frame0: Mat3<f64>,
+    /// Buoyed weight per length (N/m): `ρ_steel A g (1 − ρ_mud/ρ_steel)`.
+    pub buoyed_weight_per_length: f64,
+    /// Air weight per length (N/m).
+    pub air_weight_per_length: f64,
+    /// Outer diameter (m), for stresses and the soft-string torque arm.
+    pub outer_diameter: f64,
+    /// Index of the string component the element belongs to.
+    pub component: usize,
+}
+
+/// A contact element at a node (paper §2).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Site {
+    /// Node index.
+    pub node: usize,
+    /// Hole radius `R_h` (m).
+    pub hole_radius: f64,
+    /// Law parameters; `clearance = R_h − R_d`, `disk_radius = R_d`.
+    pub params: ContactParams<f64>,
+    /// Whether the site is a stabilizer (as opposed to pipe body contact).
+    pub stabilizer: bool,
+}
+
+/// Top boundary condition.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum TopBoundary {
+    /// Clamped to the rotary table: all displacements and rotations zero (§3.1).
+    Clamped,
+    /// Pinned: displacements and the rotation about the hole axis zero, bending rotations
+    /// free (closed-form checks: pinned columns).
+    Pinned,
+}
+
+/// Everything a static or dynamic solve needs.
+#[derive(Clone, Debug)]
+pub struct Model {
+    /// Nodes, surface first.
+    pub nodes: Vec<Node>,
+    /// Elements, element `i` between nodes `i` and `i + 1`.
+    pub elements: Vec<Element>,
+    /// Contact sites.
+    pub sites: Vec<Site>,
+    /// Friction model of every site.
+    pub friction: FrictionModel,
+    /// Weight on bit (N, compressive force of the rock on the bit).
+    pub weight_on_bit: f64,
+    /// Torque on bit (N·m, resisting the rotation).
+    pub torque_on_bit: f64,
+    /// Axial speed of the operation along the hole axis, positive down-hole (m/s): the
+    /// friction direction in static analysis (tripping in > 0, out < 0).
+    pub axial_speed: f64,
+    /// Rotation speed of the operation (rad/s, positive clockwise seen from above).
+    pub rotation_speed: f64,
+    /// Top boundary condition.
+    pub top: TopBoundary,
+    /// Whether the bit's displacements perpendicular to the hole axis are held at zero.
+    pub bit_lateral_fixed: bool,
+    /// Further nodal loads (node, [force (N); moment (N·m)]), scaled with the load factor.
+    pub point_loads: Vec<(usize, [f64; 6])>,
+}
+
+/// An orthonormal frame whose first column is `e1`.
+pub fn frame_from_axis(e1: &Vec3<f64>) -> Mat3<f64> {
+    let helper = if e1[2].abs() < 0.9 {
+        [0.0, 0.0, 1.0]
+    } else {
+        [1.0, 0.0, 0.0]
+    };
+    let e2 = cross(&helper, e1);
+    let e2 = scale(&e2, 1.0 / dot(&e2, &e2).sqrt());
+    let e3 = cross(e1, &e2);
+    [
+        [e1[0], e2[0], e3[0]],
+        [e1[1], e2[1], e3[1]],
+        [e1[2], e2[2], e3[2]],
+    ]
+}
+
+/// One tubular of the string: the mesh builder's input.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Tubular {
+    /// Name for reports (e.g. "drill collar").
+    pub name: String,
+    /// Length (m).
+    pub length: f64,
+    /// Outer diameter (m).
+    pub outer_diameter: f64,
+    /// Inner diameter (m).
+    pub inner_diameter: f64,
+    /// Young's modulus (Pa).
+    pub youngs_modulus: f64,
+    /// Poisson ratio.
+    pub poisson_ratio: f64,
+    /// Steel density (kg/m³).
+    pub density: f64,
+    /// Target element length in this tubular (m).
+    pub element_length: f64,
+}
+
+/// Meshes tubulars listed **from the bit up** along `well`, the bit at `bit_md`. Returns
+/// nodes (surface first) and elements, with buoyancy factor `1 − ρ_mud/ρ_steel`.
+pub fn mesh_string(
+    well: &WellPath,
+    tubulars_from_bit: &[Tubular],
+    bit_md: f64,
+    mud_density: f64,
+) -> (Vec<Node>, Vec<Element>) {
+    // MD breakpoints from the top down.
+    let mut pieces: Vec<(usize, f64, f64)> = Vec::new(); // (component, top md, bottom md)
+    let mut bottom = bit_md;
+    for (k, t) in tubulars_from_bit.iter().enumerate() {
+        let top = (bottom - t.length).max(0.0);
+        pieces.push((k, top, bottom));
+        bottom = top;
+        if top <= 0.0 {
+            break;
+        }
+    }
+    pieces.reverse();
+    let mut mds = vec![pieces.first().map(|p| p.1).unwrap_or(0.0)];
+    let mut owner = Vec::new();
+    for &(k, top, bot) in &pieces {
+        let n = ((bot - top) / tubulars_from_bit[k].element_length)
+            .ceil()
+            .max(1.0) as usize;
+        for j in 1..=n {
+            mds.push(top + (bot - top) * j as f64 / n as f64);
+            owner.push(k);
+        }
+    }
+    let nodes: Vec<Node> = mds
+        .iter()
+        .map(|&md| {
+            let (p, t) = well.at(md);
+            Node {
+                md,
+                position: p,
+                hole_axis: t,
+            }
+        })
+        .collect();
+    let elements = owner
+        .iter()
+        .enumerate()
+        .map(|(i, &k)| {
+            let t = &tubulars_from_bit[k];
+            let d = sub(&nodes[i + 1].position, &nodes[i].position);
+            let l0 = dot(&d, &d).sqrt();
+            let section = BeamSection::tube(
+                t.outer_diameter,
+                t.inner_diameter,
+                t.youngs_modulus,
+                t.poisson_ratio,
+            );
+            let air = t.density * section.area * GRAVITY;
+            Element {
+                section,
+                length0: l0,
+                frame0: frame_from_axis(&scale(&d, 1.0 / l0)),
+                buoyed_weight_per_length: air * (1.0 - mud_density / t.density),
+                air_weight_per_length: air,
+                outer_diameter: t.outer_diameter,
+                component: k,
+            }
+        })
+        .collect();
+    (nodes, elements)
+}

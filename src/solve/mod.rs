@@ -1,0 +1,4 @@
+//! Solvers: the chain linear algebra and the static equilibrium.
+
+pub mod chain;
+pub mod statics;

@@ -1,0 +1,580 @@
+//! Static equilibrium of the drillstring (paper §3.1): Newton on the global tangent with
+//! load stepping and a backtracking line search. Rotations are updated multiplicatively
+//! (`R ← exp([Δθ]×) R`). Contact elements act in `static` mode, their friction direction
+//! set by the operation's virtual velocities.
+//!
+//! Boundary conditions: top clamped (all six DOFs); bit held laterally (the two
+//! translations perpendicular to the hole axis), loaded by the weight on bit `−WOB·t` and
+//! the torque on bit `−TOB·t` (`t` the down-hole axis); buoyed self-weight as consistent
+//! nodal loads. All external loads are scaled by the load factor `λ ∈ [0, 1]`.
+
+use thiserror::Error;
+
+use crate::model::{Model, TopBoundary};
+use crate::physics::beam::{
+    force_and_tangent, internal_force, local_deformation, rotation_exp, section_forces,
+    ElementState, Mat3, SectionForces,
+};
+use crate::physics::contact::{evaluate, ContactMode, ContactTerms, SpringLaw};
+use crate::physics::vec3::{cross, dot, scale, sub, Vec3};
+use crate::solve::chain::{BlockTridiagonal, ChainSolver, LinearSolveError};
+
+/// Solver settings.
+#[derive(Clone, Copy, Debug)]
+pub struct StaticOptions {
+    /// Load steps to start with (grown after easy steps, cut on failure).
+    pub initial_steps: usize,
+    /// Newton iterations per load step.
+    pub max_iterations: usize,
+    /// Converged when the largest residual force is below `tolerance` × the reference
+    /// force (largest of total weight and WOB) and the largest moment below `tolerance` ×
+    /// reference force × 1 m.
+    pub tolerance: f64,
+    /// Smallest load-step size before giving up.
+    pub min_step: f64,
+}
+
+impl Default for StaticOptions {
+    fn default() -> Self {
+        StaticOptions {
+            initial_steps: 4,
+            max_iterations: 40,
+            tolerance: 1e-9,
+            min_step: 1e-4,
+        }
+    }
+}
+
+/// Why a static solve failed.
+#[derive(Clone, Debug, Error)]
+pub enum StaticError {
+    /// A load step could not be completed even at the smallest step size.
+    #[error("load step from λ = {from:.6} failed at step {step:.2e} (below the minimum {min:.2e}): {reason}")]
+    LoadStep {
+        /// Load factor reached.
+        from: f64,
+        /// Step tried last.
+        step: f64,
+        /// Minimum step.
+        min: f64,
+        /// The last failure.
+        reason: String,
+    },
+}
+
+/// Nodal configuration.
+#[derive(Clone, Debug)]
+pub struct StaticState {
+    /// Node positions.
+    pub x: Vec<Vec3<f64>>,
+    /// Nodal rotations (from the initial configuration).
+    pub rot: Vec<Mat3<f64>>,
+}
+
+impl StaticState {
+    /// The undeformed configuration.
+    pub fn initial(model: &Model) -> StaticState {
+        let eye = rotation_exp(&[0.0; 3]);
+        StaticState {
+            x: model.nodes.iter().map(|n| n.position).collect(),
+            rot: vec![eye; model.nodes.len()],
+        }
+    }
+}
+
+/// A converged static solution.
+#[derive(Clone, Debug)]
+pub struct StaticSolution {
+    /// Configuration.
+    pub state: StaticState,
+    /// Section forces per element.
+    pub section_forces: Vec<SectionForces>,
+    /// Per contact site: (in contact, normal force N (N), internal generalised force g).
+    pub contact: Vec<(bool, f64, [f64; 6])>,
+    /// Newton iterations per completed load step.
+    pub iterations: Vec<usize>,
+    /// Messages: step cuts and why.
+    pub log: Vec<String>,
+    /// Force and moment the top support exerts on the string (N, N·m): the hook load is
+    /// `−reaction[2]` in a vertical well.
+    pub top_reaction: [f64; 6],
+}
+
+fn mat_mul(a: &Mat3<f64>, b: &Mat3<f64>) -> Mat3<f64> {
+    std::array::from_fn(|r| std::array::from_fn(|c| (0..3).map(|k| a[r][k] * b[k][c]).sum()))
+}
+
+/// Constraint data: per node the translation basis (columns) and fixed flags in it.
+struct Constraints {
+    basis: Vec<Option<Mat3<f64>>>,
+    fixed: Vec<[bool; 6]>,
+}
+
+fn constraints(model: &Model) -> Constraints {
+    let n = model.nodes.len();
+    let mut basis = vec![None; n];
+    let mut fixed = vec![[false; 6]; n];
+    fixed[0] = match model.top {
+        TopBoundary::Clamped => [true; 6],
+        TopBoundary::Pinned => [true, true, true, false, false, false],
+    };
+    if model.top == TopBoundary::Pinned {
+        // The twist is held about global z: a well's top is vertical.
+        fixed[0][5] = true;
+    }
+    if model.bit_lateral_fixed {
+        let bit = n - 1;
+        let t = model.nodes[bit].hole_axis;
+        // Columns a, b ⊥ t, then t: fix the first two.
+        let f = crate::model::frame_from_axis(&t);
+        let b: Mat3<f64> = std::array::from_fn(|r| [f[r][1], f[r][2], f[r][0]]);
+        basis[bit] = Some(b);
+        fixed[bit][0] = true;
+        fixed[bit][1] = true;
+    }
+    Constraints { basis, fixed }
+}
+
+/// External loads at load factor 1 (6 per node).
+pub fn external_loads(model: &Model) -> Vec<f64> {
+    let n = model.nodes.len();
+    let mut f = vec![0.0; 6 * n];
+    for (i, e) in model.elements.iter().enumerate() {
+        let q = [0.0, 0.0, e.buoyed_weight_per_length];
+        let l = e.length0;
+        let e1 = [e.frame0[0][0], e.frame0[1][0], e.frame0[2][0]];
+        let m = scale(&cross(&e1, &q), l * l / 12.0);
+        for k in 0..3 {
+            f[6 * i + k] += q[k] * l / 2.0;
+            f[6 * (i + 1) + k] += q[k] * l / 2.0;
+            f[6 * i + 3 + k] += m[k];
+            f[6 * (i + 1) + 3 + k] -= m[k];
+        }
+    }
+    let bit = n - 1;
+    let t = model.nodes[bit].hole_axis;
+    for k in 0..3 {
+        f[6 * bit + k] -= model.weight_on_bit * t[k];
+        f[6 * bit + 3 + k] -= model.torque_on_bit * t[k];
+    }
+    for (node, load) in &model.point_loads {
+        for k in 0..6 {
+            f[6 * node + k] += load[k];
+        }
+    }
+    f
+}
+
+/// Residual `f_int + g_contact − λ f_ext` and (if `tangent` is given) the tangent, before
+/// constraints.
+fn assemble(
+    model: &Model,
+    state: &StaticState,
+    lambda: f64,
+    f_ext: &[f64],
+    residual: &mut [f64],
+    mut tangent: Option<&mut BlockTridiagonal>,
+) {
+    if let Some(t) = tangent.as_deref_mut() {
+        t.clear();
+    }
+    for (r, f) in residual.iter_mut().zip(f_ext) {
+        *r = -lambda * f;
+    }
+    for (i, e) in model.elements.iter().enumerate() {
+        let es = ElementState {
+            x: [state.x[i], state.x[i + 1]],
+            triad: [
+                mat_mul(&state.rot[i], &e.frame0),
+                mat_mul(&state.rot[i + 1], &e.frame0),
+            ],
+        };
+        let f = match tangent.as_deref_mut() {
+            Some(t) => {
+                let (f, k) = force_and_tangent(&es, &e.section, e.length0);
+                t.add_element(i, &k);
+                f
+            }
+            None => internal_force(&es, &e.section, e.length0),
+        };
+        for j in 0..12 {
+            residual[6 * i + j] += f[j];
+        }
+    }
+    let terms = ContactTerms {
+        spring: SpringLaw::PowerBlend,
+        damping: false,
+        friction: Some(model.friction),
+        mode: ContactMode::Static,
+    };
+    for site in &model.sites {
+        let node = &model.nodes[site.node];
+        let d = sub(&state.x[site.node], &node.position);
+        let v = scale(&node.hole_axis, model.axial_speed);
+        let out = evaluate(
+            &node.hole_axis,
+            &d,
+            &v,
+            model.rotation_speed,
+            &site.params,
+            &terms,
+        );
+        if !out.contact {
+            continue;
+        }
+        for r in 0..6 {
+            residual[6 * site.node + r] += out.g[r];
+            if let Some(t) = tangent.as_deref_mut() {
+                for c in 0..3 {
+                    t.diag[site.node][r][c] += out.k[r][c];
+                }
+            }
+        }
+    }
+}
+
+/// Applies the translation bases and fixed DOFs to a residual (only).
+fn constrain_residual(c: &Constraints, residual: &mut [f64]) {
+    for (i, b) in c.basis.iter().enumerate() {
+        if let Some(b) = b {
+            let v: [f64; 3] = std::array::from_fn(|k| residual[6 * i + k]);
+            for r in 0..3 {
+                residual[6 * i + r] = (0..3).map(|k| b[k][r] * v[k]).sum();
+            }
+        }
+    }
+    for (i, fixed) in c.fixed.iter().enumerate() {
+        for (d, &is_fixed) in fixed.iter().enumerate() {
+            if is_fixed {
+                residual[6 * i + d] = 0.0;
+            }
+        }
+    }
+}
+
+/// Applies the translation bases and fixed DOFs to a residual and tangent.
+fn constrain(c: &Constraints, residual: &mut [f64], tangent: &mut BlockTridiagonal) {
+    let n = tangent.nodes();
+    for (i, b) in c.basis.iter().enumerate() {
+        let Some(b) = b else { continue };
+        // Rows of node i: Bᵀ·; columns of node i: ·B (translations only).
+        let rot_rows = |blk: &mut [[f64; 6]; 6]| {
+            let v: [[f64; 6]; 3] = [blk[0], blk[1], blk[2]];
+            for (r, row) in blk.iter_mut().take(3).enumerate() {
+                for (col, x) in row.iter_mut().enumerate() {
+                    *x = (0..3).map(|k| b[k][r] * v[k][col]).sum();
+                }
+            }
+        };
+        let rot_cols = |blk: &mut [[f64; 6]; 6]| {
+            for row in blk.iter_mut() {
+                let v: [f64; 3] = [row[0], row[1], row[2]];
+                for c in 0..3 {
+                    row[c] = (0..3).map(|k| v[k] * b[k][c]).sum();
+                }
+            }
+        };
+        rot_rows(&mut tangent.diag[i]);
+        rot_cols(&mut tangent.diag[i]);
+        if i > 0 {
+            rot_rows(&mut tangent.lower[i - 1]);
+            rot_cols(&mut tangent.upper[i - 1]);
+        }
+        if i + 1 < n {
+            rot_rows(&mut tangent.upper[i]);
+            rot_cols(&mut tangent.lower[i]);
+        }
+        let v: [f64; 3] = std::array::from_fn(|k| residual[6 * i + k]);
+        for r in 0..3 {
+            residual[6 * i + r] = (0..3).map(|k| b[k][r] * v[k]).sum();
+        }
+    }
+    for (i, fixed) in c.fixed.iter().enumerate() {
+        for (d, &is_fixed) in fixed.iter().enumerate() {
+            if !is_fixed {
+                continue;
+            }
+            residual[6 * i + d] = 0.0;
+            for c2 in 0..6 {
+                tangent.diag[i][d][c2] = 0.0;
+                tangent.diag[i][c2][d] = 0.0;
+                if i > 0 {
+                    tangent.lower[i - 1][d][c2] = 0.0;
+                    tangent.upper[i - 1][c2][d] = 0.0;
+                }
+                if i + 1 < n {
+                    tangent.upper[i][d][c2] = 0.0;
+                    tangent.lower[i][c2][d] = 0.0;
+                }
+            }
+            tangent.diag[i][d][d] = 1.0;
+        }
+    }
+}
+
+/// Applies `α·Δ` (constrained coordinates) to a state.
+fn update(c: &Constraints, state: &StaticState, delta: &[f64], alpha: f64) -> StaticState {
+    let mut s = state.clone();
+    for i in 0..s.x.len() {
+        let mut du: Vec3<f64> = std::array::from_fn(|k| alpha * delta[6 * i + k]);
+        if let Some(b) = &c.basis[i] {
+            du = std::array::from_fn(|r| (0..3).map(|k| b[r][k] * du[k]).sum());
+        }
+        for (x, d) in s.x[i].iter_mut().zip(du) {
+            *x += d;
+        }
+        let dth: Vec3<f64> = std::array::from_fn(|k| alpha * delta[6 * i + 3 + k]);
+        s.rot[i] = mat_mul(&rotation_exp(&dth), &s.rot[i]);
+    }
+    s
+}
+
+/// Residual measure: max(|force| / F_ref, |moment| / (F_ref·1 m)).
+fn residual_measure(r: &[f64], f_ref: f64) -> f64 {
+    r.iter().fold(0.0f64, |m, x| m.max(x.abs())) / f_ref
+}
+
+/// Total weight and WOB scale: the reference force of the convergence test.
+pub fn reference_force(model: &Model) -> f64 {
+    let weight: f64 = model
+        .elements
+        .iter()
+        .map(|e| e.buoyed_weight_per_length.abs() * e.length0)
+        .sum();
+    let point = model
+        .point_loads
+        .iter()
+        .flat_map(|(_, l)| l.iter())
+        .fold(0.0f64, |m, x| m.max(x.abs()));
+    weight
+        .max(model.weight_on_bit.abs())
+        .max(model.torque_on_bit.abs())
+        .max(point)
+        .max(1.0)
+}
+
+/// Solves for static equilibrium at full load, from the undeformed configuration.
+pub fn solve_static(model: &Model, options: &StaticOptions) -> Result<StaticSolution, StaticError> {
+    solve_static_from(model, StaticState::initial(model), options)
+}
+
+/// The constrained tangent at a configuration and load factor (for stability checks:
+/// it is positive definite exactly while the equilibrium is stable).
+pub fn constrained_tangent(model: &Model, state: &StaticState, lambda: f64) -> BlockTridiagonal {
+    let c = constraints(model);
+    let f_ext = external_loads(model);
+    let n = model.nodes.len();
+    let mut residual = vec![0.0; 6 * n];
+    let mut tangent = BlockTridiagonal::zeros(n);
+    assemble(
+        model,
+        state,
+        lambda,
+        &f_ext,
+        &mut residual,
+        Some(&mut tangent),
+    );
+    constrain(&c, &mut residual, &mut tangent);
+    tangent
+}
+
+/// Internal force vector (elements and contacts) at a configuration, unconstrained.
+pub fn internal_forces(model: &Model, state: &StaticState) -> Vec<f64> {
+    let n = model.nodes.len();
+    let mut residual = vec![0.0; 6 * n];
+    assemble(model, state, 0.0, &vec![0.0; 6 * n], &mut residual, None);
+    residual
+}
+
+/// As [`solve_static`], from a given starting configuration (e.g. a string laid on the
+/// low side of the hole).
+pub fn solve_static_from(
+    model: &Model,
+    start: StaticState,
+    options: &StaticOptions,
+) -> Result<StaticSolution, StaticError> {
+    let c = constraints(model);
+    let f_ext = external_loads(model);
+    let f_ref = reference_force(model);
+    let n = model.nodes.len();
+    let mut residual = vec![0.0; 6 * n];
+    let mut tangent = BlockTridiagonal::zeros(n);
+    let mut solver = ChainSolver::new();
+    let mut state = start;
+    let mut lambda = 0.0;
+    let mut step = 1.0 / options.initial_steps.max(1) as f64;
+    let mut iterations = Vec::new();
+    let mut log = Vec::new();
+    while lambda < 1.0 {
+        let target = (lambda + step).min(1.0);
+        match newton(
+            model,
+            &c,
+            &state,
+            target,
+            &f_ext,
+            f_ref,
+            options,
+            &mut solver,
+            &mut residual,
+            &mut tangent,
+        ) {
+            Ok((s, its)) => {
+                state = s;
+                lambda = target;
+                iterations.push(its);
+                if its <= 6 {
+                    step = (step * 1.5).min(1.0);
+                }
+            }
+            Err(reason) => {
+                if step / 2.0 < options.min_step {
+                    return Err(StaticError::LoadStep {
+                        from: lambda,
+                        step,
+                        min: options.min_step,
+                        reason,
+                    });
+                }
+                log.push(format!(
+                    "load step λ {lambda:.6} → {target:.6} failed ({reason}); step cut to {:.3e}",
+                    step / 2.0
+                ));
+                step /= 2.0;
+            }
+        }
+    }
+    Ok(finish(model, state, iterations, log))
+}
+
+#[allow(clippy::too_many_arguments)]
+fn newton(
+    model: &Model,
+    c: &Constraints,
+    start: &StaticState,
+    lambda: f64,
+    f_ext: &[f64],
+    f_ref: f64,
+    options: &StaticOptions,
+    solver: &mut ChainSolver,
+    residual: &mut [f64],
+    tangent: &mut BlockTridiagonal,
+) -> Result<(StaticState, usize), String> {
+    let mut state = start.clone();
+    let length_scale = 1.0 + start.x.iter().flatten().fold(0.0f64, |m, x| m.max(x.abs()));
+    assemble(model, &state, lambda, f_ext, residual, Some(tangent));
+    constrain(c, residual, tangent);
+    let mut measure = residual_measure(residual, f_ref);
+    let mut trial = vec![0.0; residual.len()];
+    for it in 1..=options.max_iterations {
+        let rhs: Vec<f64> = residual.iter().map(|x| -x).collect();
+        let delta = solver
+            .solve(tangent, &rhs)
+            .map_err(|e: LinearSolveError| e.to_string())?;
+        // Line search on the energy slope s(α) = Δ·r(α): the full step is taken unless
+        // it overshoots (|s(1)| > |s(0)|), then halved until it does not (at most 6 times).
+        let s0 = delta
+            .iter()
+            .zip(residual.iter())
+            .map(|(d, r)| d * r)
+            .sum::<f64>();
+        let mut alpha = 1.0;
+        let mut trial_state;
+        loop {
+            trial_state = update(c, &state, &delta, alpha);
+            assemble(model, &trial_state, lambda, f_ext, &mut trial, None);
+            constrain_residual(c, &mut trial);
+            let s = delta.iter().zip(&trial).map(|(d, r)| d * r).sum::<f64>();
+            let finite = trial.iter().all(|x| x.is_finite());
+            if (finite && s.abs() <= s0.abs()) || alpha < 1.0 / 32.0 {
+                break;
+            }
+            alpha *= 0.5;
+        }
+        if !trial.iter().all(|x| x.is_finite()) {
+            return Err("residual is not finite".into());
+        }
+        state = trial_state;
+        assemble(model, &state, lambda, f_ext, residual, Some(tangent));
+        constrain(c, residual, tangent);
+        measure = residual_measure(residual, f_ref);
+        let step_size = delta.iter().fold(0.0f64, |m, x| m.max(x.abs())) * alpha;
+        if std::env::var("HOLEWALL_DEBUG_NEWTON").is_ok() {
+            eprintln!("  newton λ {lambda:.4} it {it}: α {alpha} step {step_size:.3e} residual {measure:.3e}");
+        }
+        // Converged: residual below tolerance with a small last step, or the step down at
+        // rounding level (positions carry ≈1e-16·|x| of noise, which a stiff string turns
+        // into residual forces above a tight tolerance) with the residual small anyway.
+        if (measure <= options.tolerance && step_size <= 1e-6)
+            || (step_size <= 1e-12 * length_scale && measure <= 1e-6)
+        {
+            return Ok((state, it));
+        }
+    }
+    Err(format!(
+        "Newton did not converge in {} iterations (residual {measure:.3e} of the reference force)",
+        options.max_iterations
+    ))
+}
+
+fn finish(
+    model: &Model,
+    state: StaticState,
+    iterations: Vec<usize>,
+    log: Vec<String>,
+) -> StaticSolution {
+    let section_forces = model
+        .elements
+        .iter()
+        .enumerate()
+        .map(|(i, e)| {
+            let t1 = mat_mul(&state.rot[i], &e.frame0);
+            let t2 = mat_mul(&state.rot[i + 1], &e.frame0);
+            let def = local_deformation(&state.x[i], &state.x[i + 1], &t1, &t2, e.length0);
+            section_forces(&def, &e.section, e.length0)
+        })
+        .collect();
+    let terms = ContactTerms {
+        spring: SpringLaw::PowerBlend,
+        damping: false,
+        friction: Some(model.friction),
+        mode: ContactMode::Static,
+    };
+    let contact = model
+        .sites
+        .iter()
+        .map(|site| {
+            let node = &model.nodes[site.node];
+            let d = sub(&state.x[site.node], &node.position);
+            let v = scale(&node.hole_axis, model.axial_speed);
+            let out = evaluate(
+                &node.hole_axis,
+                &d,
+                &v,
+                model.rotation_speed,
+                &site.params,
+                &terms,
+            );
+            // Normal force: the radial part of the internal force.
+            let d_t = sub(&d, &scale(&node.hole_axis, dot(&d, &node.hole_axis)));
+            let r = dot(&d_t, &d_t).sqrt();
+            let normal = if r > 0.0 {
+                dot(&[out.g[0], out.g[1], out.g[2]], &d_t) / r
+            } else {
+                0.0
+            };
+            (out.contact, normal, out.g)
+        })
+        .collect();
+    let f_int = internal_forces(model, &state);
+    let f_ext = external_loads(model);
+    let top_reaction = std::array::from_fn(|k| f_int[k] - f_ext[k]);
+    StaticSolution {
+        state,
+        section_forces,
+        contact,
+        iterations,
+        log,
+        top_reaction,
+    }
+}
