@@ -6,6 +6,7 @@
 pub mod beam;
 pub mod contact;
 pub mod hyperdual;
+pub mod soft_string;
 pub mod vec3;
 
 /// Float type the physics is generic over: `f32` (what a GPU f32 run computes) or `f64`
