@@ -201,3 +201,68 @@ pub fn mesh_string(
         .collect();
     (nodes, elements)
 }
+
+/// Contact law settings shared by the sites of a model (paper Table 1 defaults in the case
+/// files).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ContactSettings {
+    /// Wall stiffness `k_e` (N/m^m).
+    pub wall_stiffness: f64,
+    /// Spring exponent `m`.
+    pub spring_exponent: f64,
+    /// Wall damping `c` (N·s/m).
+    pub wall_damping: f64,
+    /// Friction regularisation speed `eps` (m/s).
+    pub eps: f64,
+    /// Soft-spring blend depth (m).
+    pub soft_blend: f64,
+}
+
+/// Adds a contact site at every node listed, with hole radius `hole_radius(md)` and disk
+/// radius `disk_radius(node)`, friction `mu` (both directions).
+pub fn add_sites(
+    model: &mut Model,
+    nodes: &[usize],
+    hole_radius: impl Fn(f64) -> f64,
+    disk_radius: impl Fn(usize) -> f64,
+    mu: impl Fn(f64) -> f64,
+    settings: &ContactSettings,
+    stabilizer: bool,
+) {
+    for &i in nodes {
+        let md = model.nodes[i].md;
+        let rh = hole_radius(md);
+        let rd = disk_radius(i);
+        let mu = mu(md);
+        model.sites.push(Site {
+            node: i,
+            hole_radius: rh,
+            params: ContactParams {
+                clearance: rh - rd,
+                disk_radius: rd,
+                wall_stiffness: settings.wall_stiffness,
+                spring_exponent: settings.spring_exponent,
+                wall_damping: settings.wall_damping,
+                mu_t: mu,
+                mu_l: mu,
+                eps: settings.eps,
+                soft_blend: settings.soft_blend,
+            },
+            stabilizer,
+        });
+    }
+}
+
+impl Model {
+    /// Outer radius of the pipe at node `i` (largest of its elements).
+    pub fn pipe_radius_at(&self, i: usize) -> f64 {
+        let mut r: f64 = 0.0;
+        if i > 0 {
+            r = r.max(0.5 * self.elements[i - 1].outer_diameter);
+        }
+        if i < self.elements.len() {
+            r = r.max(0.5 * self.elements[i].outer_diameter);
+        }
+        r
+    }
+}

@@ -72,6 +72,30 @@ pub struct StaticState {
 }
 
 impl StaticState {
+    /// A first guess with every contact node on the low side of its hole (where gravity
+    /// has a component normal to the hole axis), just touching the wall: the usual start of
+    /// a torque-and-drag solve, which a string hanging in the middle of a deviated hole is
+    /// far from (its lateral stiffness before contact is that of a 1 km cable).
+    pub fn on_low_side(model: &Model) -> StaticState {
+        let mut s = StaticState::initial(model);
+        for site in &model.sites {
+            let node = &model.nodes[site.node];
+            let t = node.hole_axis;
+            let g = [0.0, 0.0, 1.0];
+            let g_perp = sub(&g, &scale(&t, dot(&g, &t)));
+            let len = dot(&g_perp, &g_perp).sqrt();
+            let held =
+                site.node == 0 || (model.bit_lateral_fixed && site.node + 1 == model.nodes.len());
+            if len > 1e-3 && !held {
+                let depth = site.params.clearance + 1e-6;
+                for (x, g) in s.x[site.node].iter_mut().zip(g_perp) {
+                    *x += depth * g / len;
+                }
+            }
+        }
+        s
+    }
+
     /// The undeformed configuration.
     pub fn initial(model: &Model) -> StaticState {
         let eye = rotation_exp(&[0.0; 3]);
@@ -353,9 +377,15 @@ pub fn reference_force(model: &Model) -> f64 {
         .max(1.0)
 }
 
-/// Solves for static equilibrium at full load, from the undeformed configuration.
+/// Solves for static equilibrium at full load, from the undeformed configuration, or with
+/// contact sites from [`StaticState::on_low_side`].
 pub fn solve_static(model: &Model, options: &StaticOptions) -> Result<StaticSolution, StaticError> {
-    solve_static_from(model, StaticState::initial(model), options)
+    let start = if model.sites.is_empty() {
+        StaticState::initial(model)
+    } else {
+        StaticState::on_low_side(model)
+    };
+    solve_static_from(model, start, options)
 }
 
 /// The constrained tangent at a configuration and load factor (for stability checks:
@@ -394,25 +424,41 @@ pub fn solve_static_from(
     options: &StaticOptions,
 ) -> Result<StaticSolution, StaticError> {
     let c = constraints(model);
-    let f_ext = external_loads(model);
+    let (f_gravity, f_other) = split_loads(model);
     let f_ref = reference_force(model);
     let n = model.nodes.len();
     let mut residual = vec![0.0; 6 * n];
     let mut tangent = BlockTridiagonal::zeros(n);
     let mut solver = ChainSolver::new();
     let mut state = start;
+    // With contact, gravity acts in full from the start (the string lies on the wall, as
+    // the starting guess has it) and λ ramps the bit loads, point loads and friction;
+    // without contact every load ramps.
+    let full_gravity = !model.sites.is_empty();
     let mut lambda = 0.0;
+    let mut pending_zero = full_gravity;
     let mut step = 1.0 / options.initial_steps.max(1) as f64;
     let mut iterations = Vec::new();
     let mut log = Vec::new();
-    while lambda < 1.0 {
-        let target = (lambda + step).min(1.0);
+    while lambda < 1.0 || pending_zero {
+        let target = if pending_zero {
+            0.0
+        } else {
+            (lambda + step).min(1.0)
+        };
+        let gamma = if full_gravity { 1.0 } else { target };
+        let f_step: Vec<f64> = f_gravity
+            .iter()
+            .zip(&f_other)
+            .map(|(g, o)| gamma * g + target * o)
+            .collect();
+        let scaled = scale_friction(model, target);
         match newton(
-            model,
+            &scaled,
             &c,
             &state,
-            target,
-            &f_ext,
+            1.0,
+            &f_step,
             f_ref,
             options,
             &mut solver,
@@ -421,14 +467,18 @@ pub fn solve_static_from(
         ) {
             Ok((s, its)) => {
                 state = s;
-                lambda = target;
                 iterations.push(its);
+                if pending_zero {
+                    pending_zero = false;
+                    continue;
+                }
+                lambda = target;
                 if its <= 6 {
                     step = (step * 1.5).min(1.0);
                 }
             }
             Err(reason) => {
-                if step / 2.0 < options.min_step {
+                if pending_zero || step / 2.0 < options.min_step {
                     return Err(StaticError::LoadStep {
                         from: lambda,
                         step,
@@ -445,6 +495,28 @@ pub fn solve_static_from(
         }
     }
     Ok(finish(model, state, iterations, log))
+}
+
+/// Gravity loads and the other external loads (bit, point loads), at full value.
+fn split_loads(model: &Model) -> (Vec<f64>, Vec<f64>) {
+    let mut bare = model.clone();
+    bare.weight_on_bit = 0.0;
+    bare.torque_on_bit = 0.0;
+    bare.point_loads.clear();
+    let gravity = external_loads(&bare);
+    let all = external_loads(model);
+    let other = all.iter().zip(&gravity).map(|(a, g)| a - g).collect();
+    (gravity, other)
+}
+
+/// The model with every friction coefficient scaled by `factor`.
+fn scale_friction(model: &Model, factor: f64) -> Model {
+    let mut m = model.clone();
+    for site in &mut m.sites {
+        site.params.mu_t *= factor;
+        site.params.mu_l *= factor;
+    }
+    m
 }
 
 #[allow(clippy::too_many_arguments)]
@@ -473,11 +545,14 @@ fn newton(
             .map_err(|e: LinearSolveError| e.to_string())?;
         // Line search on the energy slope s(α) = Δ·r(α): the full step is taken unless
         // it overshoots (|s(1)| > |s(0)|), then halved until it does not (at most 6 times).
+        // Also accepted: a step that lowers the residual's 2-norm (friction makes the
+        // tangent unsymmetric, and the energy slope alone then rejects good steps).
         let s0 = delta
             .iter()
             .zip(residual.iter())
             .map(|(d, r)| d * r)
             .sum::<f64>();
+        let norm0 = residual.iter().map(|r| r * r).sum::<f64>().sqrt();
         let mut alpha = 1.0;
         let mut trial_state;
         loop {
@@ -485,8 +560,11 @@ fn newton(
             assemble(model, &trial_state, lambda, f_ext, &mut trial, None);
             constrain_residual(c, &mut trial);
             let s = delta.iter().zip(&trial).map(|(d, r)| d * r).sum::<f64>();
+            let norm = trial.iter().map(|r| r * r).sum::<f64>().sqrt();
             let finite = trial.iter().all(|x| x.is_finite());
-            if (finite && s.abs() <= s0.abs()) || alpha < 1.0 / 32.0 {
+            if (finite && (s.abs() <= s0.abs() || norm <= (1.0 - 1e-4 * alpha) * norm0))
+                || alpha < 1.0 / 32.0
+            {
                 break;
             }
             alpha *= 0.5;
