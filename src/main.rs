@@ -38,6 +38,17 @@ enum Command {
         #[arg(long, default_value_t = 20_000)]
         pairs: usize,
     },
+    /// Static analysis: torque & drag, neutral point, side forces (CSV, JSON).
+    Static {
+        /// Case file (TOML; see cases/README.md).
+        case: PathBuf,
+        /// Finite elements (stiff string) or soft-string torque & drag.
+        #[arg(long, value_enum, default_value_t = cli::static_cmd::StaticModel::Fe)]
+        model: cli::static_cmd::StaticModel,
+        /// Output folder.
+        #[arg(long)]
+        out: PathBuf,
+    },
     /// Benchmarks (medians over repeats; GPU/CPU ratios from the same run).
     Bench {
         #[command(subcommand)]
@@ -117,6 +128,16 @@ fn main() -> ExitCode {
                 Err(errs) => fail(&errs),
             }
         }
+        Command::Static { case, model, out } => match cli::static_cmd::run(&case, model, &out) {
+            Ok(summary) => {
+                println!(
+                    "{}",
+                    serde_json::to_string_pretty(&summary).unwrap_or_default()
+                );
+                ExitCode::SUCCESS
+            }
+            Err(e) => fail(&[e]),
+        },
         Command::GpuInfo { pairs } => match cli::gpu_info::run(pairs) {
             Ok(()) => ExitCode::SUCCESS,
             Err(e) => fail(&[e]),

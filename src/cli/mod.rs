@@ -3,3 +3,4 @@
 pub mod bench;
 pub mod contact;
 pub mod gpu_info;
+pub mod static_cmd;

@@ -1,0 +1,833 @@
+//! Case files (TOML): well, hole sections, mud, the string from the bit up, the operation,
+//! contact and mesh settings. Numbers are SI; a string `"<number> <unit>"` is accepted where
+//! engineers think in field units (`src/units.rs`). Every key is documented in
+//! `cases/README.md`. Unknown keys and bad values are rejected naming the file, line, key
+//! and allowed range.
+
+use std::path::{Path, PathBuf};
+
+use serde::Deserialize;
+use toml::Spanned;
+
+use crate::error::InputError;
+use crate::model::{add_sites, mesh_string, ContactSettings, Model, TopBoundary, Tubular};
+use crate::physics::contact::FrictionModel;
+use crate::units::{parse_angle_deg, parse_quantity, Dimension};
+use crate::well::{SurveyStation, WellPath};
+
+/// A number (SI) or `"<number> <unit>"`.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(untagged)]
+pub enum Quantity {
+    /// SI number.
+    Number(f64),
+    /// Text with a unit.
+    Text(String),
+}
+
+type Q = Spanned<Quantity>;
+
+/// `[well]`.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct WellSpec {
+    /// `"vertical"`, `"build_and_hold"` or `"survey"`.
+    pub profile: Spanned<String>,
+    /// Total measured depth of the hole (bit depth).
+    pub total_md: Q,
+    /// Survey CSV (`md, inclination, azimuth`; MD in m unless the header says ft), relative
+    /// to the case file.
+    pub survey: Option<Spanned<String>>,
+    /// Kick-off MD (build_and_hold).
+    pub kickoff_md: Option<Q>,
+    /// Build rate in degrees per 30 m (build_and_hold).
+    pub build_rate_deg_per_30m: Option<Spanned<f64>>,
+    /// Hold inclination in degrees (build_and_hold).
+    pub hold_inclination: Option<Q>,
+    /// Azimuth in degrees (build_and_hold).
+    pub azimuth: Option<Q>,
+}
+
+/// `[[hole]]`: a hole section from the previous section's bottom (or the surface).
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct HoleSpec {
+    /// Bottom of the section (MD).
+    pub bottom_md: Q,
+    /// Hole (or casing inner) diameter.
+    pub diameter: Q,
+    /// Cased or open hole (for reports).
+    #[serde(default)]
+    pub cased: bool,
+    /// Friction coefficient in the section.
+    pub friction: Spanned<f64>,
+}
+
+/// `[mud]`.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MudSpec {
+    /// Mud density.
+    pub density: Q,
+}
+
+/// `[[string]]`: one component, listed from the bit up.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ComponentSpec {
+    /// `bit`, `collar`, `stabilizer`, `hwdp`, `drill_pipe`, or any name.
+    pub kind: Spanned<String>,
+    /// Length.
+    pub length: Q,
+    /// Outer diameter (body).
+    pub od: Q,
+    /// Inner diameter.
+    pub id: Q,
+    /// Stabilizer blade diameter (makes the component a contact site).
+    pub blade_diameter: Option<Q>,
+    /// Young's modulus (default 207 GPa).
+    pub youngs_modulus: Option<Q>,
+    /// Poisson ratio (default 0.3).
+    pub poisson_ratio: Option<Spanned<f64>>,
+    /// Steel density (default 7850 kg/m³).
+    pub density: Option<Q>,
+}
+
+/// `[operation]`.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct OperationSpec {
+    /// `rotating`, `tripping_in`, `tripping_out`, `sliding`.
+    pub mode: Spanned<String>,
+    /// Weight on bit (default 0).
+    pub weight_on_bit: Option<Q>,
+    /// Torque on bit (default 0).
+    pub torque_on_bit: Option<Q>,
+    /// Rotation speed (default 0; `rotating` needs it).
+    pub rpm: Option<Q>,
+    /// Tripping speed (default 0.5 m/s for tripping modes).
+    pub axial_speed: Option<Q>,
+}
+
+/// `[contact]`.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ContactSpec {
+    /// `stabilizers` (the paper) or `all_nodes` (deviated wells).
+    pub sites: Option<Spanned<String>>,
+    /// Wall stiffness (default 6e7 N/m, Table 1).
+    pub wall_stiffness: Option<Q>,
+    /// Spring exponent (default 1).
+    pub exponent: Option<Spanned<f64>>,
+    /// Wall damping (default 8e3 N·s/m, Table 1).
+    pub damping: Option<Q>,
+    /// Friction regularisation speed (default 1e-3 m/s).
+    pub eps: Option<Q>,
+    /// Soft-spring blend depth (default 1e-5 m).
+    pub soft_blend: Option<Q>,
+    /// `split` (default) or `coupled`.
+    pub friction_model: Option<Spanned<String>>,
+}
+
+/// `[mesh]`.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MeshSpec {
+    /// Element length in the drill pipe (default 10 m).
+    pub element_length: Option<Q>,
+    /// Element length in the BHA (collars, stabilizers, HWDP, bit; default 1 m).
+    pub bha_element_length: Option<Q>,
+}
+
+/// A whole case file.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CaseSpec {
+    /// Free text.
+    pub title: Option<String>,
+    /// Well path.
+    pub well: WellSpec,
+    /// Hole sections.
+    pub hole: Vec<HoleSpec>,
+    /// Mud.
+    pub mud: MudSpec,
+    /// String from the bit up.
+    pub string: Vec<ComponentSpec>,
+    /// Operation.
+    pub operation: OperationSpec,
+    /// Contact settings.
+    pub contact: Option<ContactSpec>,
+    /// Mesh settings.
+    pub mesh: Option<MeshSpec>,
+}
+
+/// A case read and checked, ready to build a model.
+#[derive(Clone, Debug)]
+pub struct Case {
+    /// Title.
+    pub title: String,
+    /// The file it came from.
+    pub path: PathBuf,
+    /// Model (mesh, sites, loads, boundary conditions).
+    pub model: Model,
+    /// Hole sections: (bottom MD, diameter, friction).
+    pub hole: Vec<(f64, f64, f64)>,
+    /// Bit depth (m).
+    pub bit_md: f64,
+    /// Mud density (kg/m³).
+    pub mud_density: f64,
+}
+
+struct Ctx<'a> {
+    path: &'a Path,
+    text: &'a str,
+}
+
+impl Ctx<'_> {
+    fn line(&self, offset: usize) -> usize {
+        self.text[..offset.min(self.text.len())]
+            .matches('\n')
+            .count()
+            + 1
+    }
+
+    fn err(
+        &self,
+        span: std::ops::Range<usize>,
+        key: &str,
+        message: impl Into<String>,
+    ) -> InputError {
+        InputError {
+            source_name: self.path.display().to_string(),
+            line: self.line(span.start),
+            key: key.into(),
+            message: message.into(),
+        }
+    }
+
+    fn quantity(
+        &self,
+        q: &Q,
+        key: &str,
+        dim: Dimension,
+        ok: impl Fn(f64) -> bool,
+        range: &str,
+    ) -> Result<f64, InputError> {
+        let v = match q.get_ref() {
+            Quantity::Number(x) if x.is_finite() => *x,
+            Quantity::Number(x) => {
+                return Err(self.err(
+                    q.span(),
+                    key,
+                    format!("{x} is not finite; allowed: {range}"),
+                ))
+            }
+            Quantity::Text(t) => parse_quantity(t, dim)
+                .map_err(|e| self.err(q.span(), key, format!("{e}; allowed: {range}")))?,
+        };
+        if ok(v) {
+            Ok(v)
+        } else {
+            Err(self.err(
+                q.span(),
+                key,
+                format!("{v} {} is out of range; allowed: {range}", dim.si()),
+            ))
+        }
+    }
+
+    fn angle(
+        &self,
+        q: &Q,
+        key: &str,
+        ok: impl Fn(f64) -> bool,
+        range: &str,
+    ) -> Result<f64, InputError> {
+        let v = match q.get_ref() {
+            Quantity::Number(x) => *x,
+            Quantity::Text(t) => parse_angle_deg(t)
+                .map_err(|e| self.err(q.span(), key, format!("{e}; allowed: {range}")))?,
+        };
+        if v.is_finite() && ok(v) {
+            Ok(v)
+        } else {
+            Err(self.err(
+                q.span(),
+                key,
+                format!("{v}° is out of range; allowed: {range}"),
+            ))
+        }
+    }
+
+    fn number(
+        &self,
+        q: &Spanned<f64>,
+        key: &str,
+        ok: impl Fn(f64) -> bool,
+        range: &str,
+    ) -> Result<f64, InputError> {
+        let v = *q.get_ref();
+        if v.is_finite() && ok(v) {
+            Ok(v)
+        } else {
+            Err(self.err(
+                q.span(),
+                key,
+                format!("{v} is out of range; allowed: {range}"),
+            ))
+        }
+    }
+}
+
+fn read_survey(
+    path: &Path,
+    ctx: &Ctx,
+    span: std::ops::Range<usize>,
+) -> Result<Vec<SurveyStation>, InputError> {
+    let text = std::fs::read_to_string(path).map_err(|e| {
+        ctx.err(
+            span.clone(),
+            "well.survey",
+            format!("{}: {e}", path.display()),
+        )
+    })?;
+    let mut out = Vec::new();
+    let mut md_factor = 1.0;
+    for (k, line) in text.lines().enumerate() {
+        let fields: Vec<&str> = line.split(',').map(str::trim).collect();
+        if line.trim().is_empty() {
+            continue;
+        }
+        let bad = |msg: String| InputError {
+            source_name: path.display().to_string(),
+            line: k + 1,
+            key: "survey".into(),
+            message: msg,
+        };
+        if fields.len() != 3 {
+            return Err(bad(format!(
+                "expected 3 columns (md, inclination, azimuth), got {}",
+                fields.len()
+            )));
+        }
+        if fields[0].parse::<f64>().is_err() {
+            if k == 0 {
+                if fields[0].to_ascii_lowercase().contains("ft") {
+                    md_factor = 0.3048;
+                }
+                continue;
+            }
+            return Err(bad(format!("md {:?} is not a number", fields[0])));
+        }
+        let parse = |s: &str, what: &str| {
+            s.parse::<f64>()
+                .map_err(|_| bad(format!("{what} {s:?} is not a number")))
+        };
+        out.push(SurveyStation {
+            md: parse(fields[0], "md")? * md_factor,
+            inclination_deg: parse(fields[1], "inclination")?,
+            azimuth_deg: parse(fields[2], "azimuth")?,
+        });
+    }
+    Ok(out)
+}
+
+/// Reads, validates and meshes a case file.
+pub fn load_case(path: &Path) -> Result<Case, InputError> {
+    let text = std::fs::read_to_string(path).map_err(|e| InputError {
+        source_name: path.display().to_string(),
+        line: 0,
+        key: "-".into(),
+        message: e.to_string(),
+    })?;
+    parse_case(path, &text)
+}
+
+/// Parses a case from its text (`path` names it in messages and anchors relative paths).
+pub fn parse_case(path: &Path, text: &str) -> Result<Case, InputError> {
+    let ctx = Ctx { path, text };
+    let spec: CaseSpec = toml::from_str(text).map_err(|e| {
+        let line = e.span().map(|s| ctx.line(s.start)).unwrap_or(0);
+        InputError {
+            source_name: path.display().to_string(),
+            line,
+            key: "-".into(),
+            message: e.message().to_string(),
+        }
+    })?;
+    let pos = |x: f64| x > 0.0;
+    let bit_md = ctx.quantity(
+        &spec.well.total_md,
+        "well.total_md",
+        Dimension::Length,
+        pos,
+        "> 0",
+    )?;
+    let well = match spec.well.profile.get_ref().as_str() {
+        "vertical" => WellPath::vertical(bit_md),
+        "build_and_hold" => {
+            let need = |q: &Option<Q>, key: &str| {
+                q.clone().ok_or_else(|| {
+                    ctx.err(
+                        spec.well.profile.span(),
+                        key,
+                        "required by profile = \"build_and_hold\"",
+                    )
+                })
+            };
+            let kop = ctx.quantity(
+                &need(&spec.well.kickoff_md, "well.kickoff_md")?,
+                "well.kickoff_md",
+                Dimension::Length,
+                |x| (0.0..bit_md).contains(&x),
+                "0 ≤ kickoff_md < total_md",
+            )?;
+            let rate = spec.well.build_rate_deg_per_30m.as_ref().ok_or_else(|| {
+                ctx.err(
+                    spec.well.profile.span(),
+                    "well.build_rate_deg_per_30m",
+                    "required by profile = \"build_and_hold\"",
+                )
+            })?;
+            let rate = ctx.number(
+                rate,
+                "well.build_rate_deg_per_30m",
+                |x| x > 0.0 && x <= 30.0,
+                "0 < rate ≤ 30 °/30 m",
+            )?;
+            let inc = ctx.angle(
+                &need(&spec.well.hold_inclination, "well.hold_inclination")?,
+                "well.hold_inclination",
+                |x| (0.0..=180.0).contains(&x),
+                "0° … 180°",
+            )?;
+            let azi = ctx.angle(
+                &need(&spec.well.azimuth, "well.azimuth")?,
+                "well.azimuth",
+                |_| true,
+                "any angle",
+            )?;
+            WellPath::build_and_hold(kop, rate, inc, azi, bit_md)
+                .map_err(|e| ctx.err(spec.well.profile.span(), "well", e.to_string()))?
+        }
+        "survey" => {
+            let file = spec.well.survey.as_ref().ok_or_else(|| {
+                ctx.err(
+                    spec.well.profile.span(),
+                    "well.survey",
+                    "required by profile = \"survey\"",
+                )
+            })?;
+            let survey_path = path.parent().unwrap_or(Path::new(".")).join(file.get_ref());
+            let stations = read_survey(&survey_path, &ctx, file.span())?;
+            let survey_path_s = survey_path.display().to_string();
+            WellPath::from_survey(&stations, [0.0; 3]).map_err(|e| InputError {
+                source_name: survey_path_s,
+                line: 0,
+                key: "survey".into(),
+                message: e.to_string(),
+            })?
+        }
+        other => {
+            return Err(ctx.err(
+                spec.well.profile.span(),
+                "well.profile",
+                format!("unknown profile {other:?}; allowed: vertical, build_and_hold, survey"),
+            ))
+        }
+    };
+    // Below a survey's last station the path goes on along its last tangent.
+
+    // Hole sections.
+    let mut hole = Vec::new();
+    let mut previous = 0.0;
+    for h in &spec.hole {
+        let bottom = ctx.quantity(
+            &h.bottom_md,
+            "hole.bottom_md",
+            Dimension::Length,
+            |x| x > previous,
+            &format!("> the previous section's bottom ({previous} m)"),
+        )?;
+        let d = ctx.quantity(
+            &h.diameter,
+            "hole.diameter",
+            Dimension::Length,
+            |x| x > 0.0 && x < 2.0,
+            "0 < diameter < 2 m",
+        )?;
+        let mu = ctx.number(
+            &h.friction,
+            "hole.friction",
+            |x| (0.0..=2.0).contains(&x),
+            "0 ≤ friction ≤ 2",
+        )?;
+        hole.push((bottom, d, mu));
+        previous = bottom;
+    }
+    if hole.is_empty() {
+        return Err(InputError {
+            source_name: path.display().to_string(),
+            line: 1,
+            key: "hole".into(),
+            message: "at least one [[hole]] section is required".into(),
+        });
+    }
+    if previous + 1e-9 < bit_md {
+        let last = spec.hole.last().map(|h| h.bottom_md.span()).unwrap_or(0..0);
+        return Err(ctx.err(
+            last,
+            "hole.bottom_md",
+            format!("the last hole section ends at {previous} m, above the bit at {bit_md} m"),
+        ));
+    }
+    let hole_at = |md: f64| {
+        *hole
+            .iter()
+            .find(|(b, _, _)| md <= *b + 1e-9)
+            .unwrap_or(hole.last().unwrap_or(&(0.0, 0.2159, 0.25)))
+    };
+
+    let mud = ctx.quantity(
+        &spec.mud.density,
+        "mud.density",
+        Dimension::Density,
+        |x| (0.0..5000.0).contains(&x),
+        "0 ≤ density < 5000 kg/m3",
+    )?;
+    let mesh = spec.mesh.clone();
+    let el_pipe = match mesh.as_ref().and_then(|m| m.element_length.clone()) {
+        Some(q) => ctx.quantity(
+            &q,
+            "mesh.element_length",
+            Dimension::Length,
+            |x| x > 0.0 && x <= 100.0,
+            "0 < length ≤ 100 m",
+        )?,
+        None => 10.0,
+    };
+    let el_bha = match mesh.as_ref().and_then(|m| m.bha_element_length.clone()) {
+        Some(q) => ctx.quantity(
+            &q,
+            "mesh.bha_element_length",
+            Dimension::Length,
+            |x| x > 0.0 && x <= 100.0,
+            "0 < length ≤ 100 m",
+        )?,
+        None => 1.0,
+    };
+
+    // String, from the bit up.
+    if spec.string.is_empty() {
+        return Err(InputError {
+            source_name: path.display().to_string(),
+            line: 1,
+            key: "string".into(),
+            message: "at least one [[string]] component is required".into(),
+        });
+    }
+    let mut tubulars = Vec::new();
+    let mut blades = Vec::new();
+    for c in &spec.string {
+        let kind = c.kind.get_ref().clone();
+        let length = ctx.quantity(&c.length, "string.length", Dimension::Length, pos, "> 0")?;
+        let od = ctx.quantity(
+            &c.od,
+            "string.od",
+            Dimension::Length,
+            |x| x > 0.0 && x < 1.0,
+            "0 < od < 1 m",
+        )?;
+        let id = ctx.quantity(
+            &c.id,
+            "string.id",
+            Dimension::Length,
+            |x| (0.0..od).contains(&x),
+            &format!("0 ≤ id < od ({od} m)"),
+        )?;
+        let e = match &c.youngs_modulus {
+            Some(q) => ctx.quantity(
+                q,
+                "string.youngs_modulus",
+                Dimension::Pressure,
+                |x| x > 1e9 && x < 1e12,
+                "1 GPa … 1000 GPa",
+            )?,
+            None => 207e9,
+        };
+        let nu = match &c.poisson_ratio {
+            Some(q) => ctx.number(
+                q,
+                "string.poisson_ratio",
+                |x| (0.0..0.5).contains(&x),
+                "0 ≤ ν < 0.5",
+            )?,
+            None => 0.3,
+        };
+        let rho = match &c.density {
+            Some(q) => ctx.quantity(
+                q,
+                "string.density",
+                Dimension::Density,
+                |x| x > 1000.0 && x < 20000.0,
+                "1000 … 20000 kg/m3",
+            )?,
+            None => 7850.0,
+        };
+        let blade = match &c.blade_diameter {
+            Some(q) => {
+                let md_here = bit_md - tubulars.iter().map(|t: &Tubular| t.length).sum::<f64>();
+                let hole_d = hole_at(md_here).1;
+                Some(ctx.quantity(q, "string.blade_diameter", Dimension::Length, |x| x >= od && x <= hole_d, &format!("od ≤ blade diameter ≤ hole diameter ({hole_d} m): the disk must fit the hole"))?)
+            }
+            None => None,
+        };
+        if od > hole_at(bit_md - tubulars.iter().map(|t: &Tubular| t.length).sum::<f64>()).1 {
+            return Err(ctx.err(
+                c.od.span(),
+                "string.od",
+                format!("{od} m is wider than the hole"),
+            ));
+        }
+        let bha = kind != "drill_pipe";
+        blades.push(blade);
+        tubulars.push(Tubular {
+            name: kind,
+            length,
+            outer_diameter: od,
+            inner_diameter: id,
+            youngs_modulus: e,
+            poisson_ratio: nu,
+            density: rho,
+            element_length: if bha { el_bha } else { el_pipe },
+        });
+    }
+    let string_length: f64 = tubulars.iter().map(|t| t.length).sum();
+    if string_length + 1e-9 < bit_md {
+        let last = spec.string.last().map(|c| c.length.span()).unwrap_or(0..0);
+        return Err(ctx.err(last, "string.length", format!("the string is {string_length} m long, shorter than the bit depth {bit_md} m: it must reach the surface")));
+    }
+
+    // Operation.
+    let op = &spec.operation;
+    let wob = op
+        .weight_on_bit
+        .as_ref()
+        .map(|q| {
+            ctx.quantity(
+                q,
+                "operation.weight_on_bit",
+                Dimension::Force,
+                |x| x >= 0.0,
+                "≥ 0",
+            )
+        })
+        .transpose()?
+        .unwrap_or(0.0);
+    let tob = op
+        .torque_on_bit
+        .as_ref()
+        .map(|q| {
+            ctx.quantity(
+                q,
+                "operation.torque_on_bit",
+                Dimension::Torque,
+                |x| x >= 0.0,
+                "≥ 0",
+            )
+        })
+        .transpose()?
+        .unwrap_or(0.0);
+    let rpm = op
+        .rpm
+        .as_ref()
+        .map(|q| {
+            ctx.quantity(
+                q,
+                "operation.rpm",
+                Dimension::AngularSpeed,
+                |x| (0.0..100.0).contains(&x),
+                "0 … 955 rpm",
+            )
+        })
+        .transpose()?
+        .unwrap_or(0.0);
+    let speed = op
+        .axial_speed
+        .as_ref()
+        .map(|q| {
+            ctx.quantity(
+                q,
+                "operation.axial_speed",
+                Dimension::Speed,
+                |x| (0.0..10.0).contains(&x),
+                "0 ≤ speed < 10 m/s",
+            )
+        })
+        .transpose()?
+        .unwrap_or(0.5);
+    let (axial_speed, rotation_speed) = match op.mode.get_ref().as_str() {
+        "rotating" => (0.0, rpm),
+        "tripping_in" => (speed, 0.0),
+        "tripping_out" => (-speed, 0.0),
+        "sliding" => (speed, 0.0),
+        other => {
+            return Err(ctx.err(
+                op.mode.span(),
+                "operation.mode",
+                format!(
+                    "unknown mode {other:?}; allowed: rotating, tripping_in, tripping_out, sliding"
+                ),
+            ))
+        }
+    };
+
+    // Contact.
+    let cs = spec.contact.clone();
+    let q_or = |q: Option<Q>,
+                key: &str,
+                dim: Dimension,
+                default: f64,
+                ok: &dyn Fn(f64) -> bool,
+                range: &str|
+     -> Result<f64, InputError> {
+        match q {
+            Some(q) => ctx.quantity(&q, key, dim, ok, range),
+            None => Ok(default),
+        }
+    };
+    let settings = ContactSettings {
+        wall_stiffness: q_or(
+            cs.as_ref().and_then(|c| c.wall_stiffness.clone()),
+            "contact.wall_stiffness",
+            Dimension::Stiffness,
+            6e7,
+            &|x| x > 0.0 && x <= 1e12,
+            "0 < k_e ≤ 1e12 N/m",
+        )?,
+        spring_exponent: match cs.as_ref().and_then(|c| c.exponent.clone()) {
+            Some(q) => ctx.number(&q, "contact.exponent", |x| x > 0.0 && x <= 3.0, "0 < m ≤ 3")?,
+            None => 1.0,
+        },
+        wall_damping: q_or(
+            cs.as_ref().and_then(|c| c.damping.clone()),
+            "contact.damping",
+            Dimension::Damping,
+            8e3,
+            &|x| x >= 0.0,
+            "≥ 0",
+        )?,
+        eps: q_or(
+            cs.as_ref().and_then(|c| c.eps.clone()),
+            "contact.eps",
+            Dimension::Speed,
+            1e-3,
+            &|x| x > 0.0,
+            "> 0",
+        )?,
+        soft_blend: q_or(
+            cs.as_ref().and_then(|c| c.soft_blend.clone()),
+            "contact.soft_blend",
+            Dimension::Length,
+            1e-5,
+            &|x| x > 0.0,
+            "> 0",
+        )?,
+    };
+    let friction = match cs.as_ref().and_then(|c| c.friction_model.clone()) {
+        None => FrictionModel::Split,
+        Some(s) => match s.get_ref().as_str() {
+            "split" => FrictionModel::Split,
+            "coupled" => FrictionModel::Coupled,
+            other => {
+                return Err(ctx.err(
+                    s.span(),
+                    "contact.friction_model",
+                    format!("unknown model {other:?}; allowed: split, coupled"),
+                ))
+            }
+        },
+    };
+    let all_nodes = match cs.as_ref().and_then(|c| c.sites.clone()) {
+        None => false,
+        Some(s) => match s.get_ref().as_str() {
+            "stabilizers" => false,
+            "all_nodes" => true,
+            other => {
+                return Err(ctx.err(
+                    s.span(),
+                    "contact.sites",
+                    format!("unknown value {other:?}; allowed: stabilizers, all_nodes"),
+                ))
+            }
+        },
+    };
+
+    let (nodes, elements) = mesh_string(&well, &tubulars, bit_md, mud);
+    let n = nodes.len();
+    let mut model = Model {
+        nodes,
+        elements,
+        sites: vec![],
+        friction,
+        weight_on_bit: wob,
+        torque_on_bit: tob,
+        axial_speed,
+        rotation_speed,
+        top: TopBoundary::Clamped,
+        bit_lateral_fixed: true,
+        point_loads: vec![],
+    };
+    // Stabilizers: a site at the node nearest each stabilizer's middle.
+    let mut stab_nodes = Vec::new();
+    let mut bottom = bit_md;
+    for (t, blade) in tubulars.iter().zip(&blades) {
+        if let Some(b) = blade {
+            let mid = bottom - 0.5 * t.length;
+            let node = (0..n)
+                .min_by(|&a, &c| {
+                    (model.nodes[a].md - mid)
+                        .abs()
+                        .total_cmp(&(model.nodes[c].md - mid).abs())
+                })
+                .unwrap_or(n - 1);
+            stab_nodes.push((node, 0.5 * b));
+        }
+        bottom -= t.length;
+    }
+    for (node, radius) in &stab_nodes {
+        add_sites(
+            &mut model,
+            &[*node],
+            |md| 0.5 * hole_at(md).1,
+            |_| *radius,
+            |md| hole_at(md).2,
+            &settings,
+            true,
+        );
+    }
+    if all_nodes {
+        let others: Vec<usize> = (1..n)
+            .filter(|i| !stab_nodes.iter().any(|(s, _)| s == i))
+            .collect();
+        let radii: Vec<f64> = (0..n).map(|i| model.pipe_radius_at(i)).collect();
+        add_sites(
+            &mut model,
+            &others,
+            |md| 0.5 * hole_at(md).1,
+            |i| radii[i],
+            |md| hole_at(md).2,
+            &settings,
+            false,
+        );
+    }
+    model.sites.sort_by_key(|s| s.node);
+    Ok(Case {
+        title: spec.title.unwrap_or_default(),
+        path: path.to_path_buf(),
+        model,
+        hole,
+        bit_md,
+        mud_density: mud,
+    })
+}

@@ -1,0 +1,270 @@
+//! `holewall static CASE [--model fe|soft-string] --out DIR`: torque & drag, neutral point,
+//! side forces (paper §3, Table 2, Figs 8, 10, 11).
+
+use std::path::Path;
+
+use serde::Serialize;
+
+use crate::case::{load_case, Case};
+use crate::error::Error;
+use crate::model::Model;
+use crate::output::write_atomic;
+use crate::physics::soft_string::{soft_string, Operation};
+use crate::physics::vec3::{dot, scale, sub};
+use crate::solve::statics::{solve_static, StaticOptions};
+
+/// Which model computes the profile.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum StaticModel {
+    /// Finite elements: co-rotational beams, contact elements (stiff string).
+    Fe,
+    /// Johancsik soft-string torque & drag.
+    SoftString,
+}
+
+/// One row of `profile.csv`.
+#[derive(Clone, Debug, Serialize)]
+pub struct ProfileRow {
+    /// Measured depth (m).
+    pub md_m: f64,
+    /// Position (m): north, east, TVD.
+    pub x_m: f64,
+    /// See `x_m`.
+    pub y_m: f64,
+    /// See `x_m`.
+    pub z_m: f64,
+    /// Effective axial force, tension positive (N).
+    pub axial_force_n: f64,
+    /// Axial stress `F/A` (Pa).
+    pub axial_stress_pa: f64,
+    /// Torque (N·m).
+    pub torque_nm: f64,
+    /// Bending moment (N·m).
+    pub bending_moment_nm: f64,
+    /// Side (contact normal) force (N).
+    pub side_force_n: f64,
+    /// Lateral displacement from the hole axis (m).
+    pub lateral_displacement_m: f64,
+    /// In contact with the wall.
+    pub in_contact: bool,
+}
+
+/// `summary.json`.
+#[derive(Clone, Debug, Serialize)]
+pub struct Summary {
+    /// Case title.
+    pub title: String,
+    /// `fe` or `soft-string`.
+    pub model: String,
+    /// Neutral point (effective axial force zero), from the bit (m); null if none.
+    pub neutral_point_from_bit_m: Option<f64>,
+    /// Neutral point from the surface (MD, m).
+    pub neutral_point_from_surface_m: Option<f64>,
+    /// Hook load (N).
+    pub hook_load_n: f64,
+    /// Surface torque (N·m).
+    pub surface_torque_nm: f64,
+    /// Largest side force (N).
+    pub max_side_force_n: f64,
+    /// Where it acts (MD, m).
+    pub max_side_force_md_m: f64,
+    /// Compression beyond the sinusoidal-buckling load somewhere (Dawson–Paslay; vertical:
+    /// Lubinski's 2.55·(EI w²)^(1/3)).
+    pub sinusoidal_buckling: bool,
+    /// Compression beyond √2 × that (helical buckling).
+    pub helical_buckling: bool,
+    /// Load steps and Newton iterations (FE).
+    pub newton_iterations: Vec<usize>,
+}
+
+/// Neutral point: the first MD, going up from the bit, where the axial force turns from
+/// compression to tension (linear interpolation between nodes).
+pub fn neutral_point(rows: &[ProfileRow]) -> Option<f64> {
+    for k in (1..rows.len()).rev() {
+        let (lo, hi) = (&rows[k], &rows[k - 1]);
+        if lo.axial_force_n <= 0.0 && hi.axial_force_n > 0.0 {
+            let f = lo.axial_force_n / (lo.axial_force_n - hi.axial_force_n);
+            return Some(lo.md_m + f * (hi.md_m - lo.md_m));
+        }
+    }
+    None
+}
+
+fn buckling(model: &Model, rows: &[ProfileRow], case: &Case) -> (bool, bool) {
+    let mut sinusoidal = false;
+    let mut helical = false;
+    for (i, e) in model.elements.iter().enumerate() {
+        let f = -(0.5 * (rows[i].axial_force_n + rows[i + 1].axial_force_n));
+        if f <= 0.0 {
+            continue;
+        }
+        let md = 0.5 * (model.nodes[i].md + model.nodes[i + 1].md);
+        let hole_d = case
+            .hole
+            .iter()
+            .find(|h| md <= h.0 + 1e-9)
+            .map(|h| h.1)
+            .unwrap_or(case.hole[0].1);
+        let r = 0.5 * (hole_d - e.outer_diameter);
+        let ei = e.section.bending_stiffness();
+        let w = e.buoyed_weight_per_length.max(0.0);
+        let sin_i = {
+            let t = model.nodes[i].hole_axis;
+            (1.0 - t[2] * t[2]).max(0.0).sqrt()
+        };
+        let dp = if r > 0.0 {
+            2.0 * (ei * w * sin_i / r).sqrt()
+        } else {
+            f64::INFINITY
+        };
+        let lubinski = 2.55 * (ei * w * w).cbrt();
+        let critical = dp.max(lubinski);
+        sinusoidal |= f > critical;
+        helical |= f > std::f64::consts::SQRT_2 * critical;
+    }
+    (sinusoidal, helical)
+}
+
+/// Runs the command; returns the summary.
+pub fn run(case_path: &Path, which: StaticModel, out: &Path) -> Result<Summary, Error> {
+    let case = load_case(case_path)?;
+    let model = &case.model;
+    let n = model.nodes.len();
+    let (rows, hook, torque, its) = match which {
+        StaticModel::Fe => {
+            let sol = solve_static(model, &StaticOptions::default())
+                .map_err(|e| Error::Io(std::io::Error::other(e.to_string())))?;
+            let mut side = vec![0.0; n];
+            let mut in_contact = vec![false; n];
+            for (site, (c, normal, _)) in model.sites.iter().zip(&sol.contact) {
+                side[site.node] = *normal;
+                in_contact[site.node] = *c && *normal > 0.0;
+            }
+            let rows: Vec<ProfileRow> = (0..n)
+                .map(|i| {
+                    let adj: Vec<usize> = [i.checked_sub(1), (i < n - 1).then_some(i)]
+                        .into_iter()
+                        .flatten()
+                        .collect();
+                    let avg = |f: &dyn Fn(usize) -> f64| {
+                        adj.iter().map(|&e| f(e)).sum::<f64>() / adj.len() as f64
+                    };
+                    let axial = avg(&|e| sol.section_forces[e].axial);
+                    let area = avg(&|e| model.elements[e].section.area);
+                    let d = sub(&sol.state.x[i], &model.nodes[i].position);
+                    let t = model.nodes[i].hole_axis;
+                    let d_t = sub(&d, &scale(&t, dot(&d, &t)));
+                    ProfileRow {
+                        md_m: model.nodes[i].md,
+                        x_m: sol.state.x[i][0],
+                        y_m: sol.state.x[i][1],
+                        z_m: sol.state.x[i][2],
+                        axial_force_n: axial,
+                        axial_stress_pa: axial / area,
+                        torque_nm: avg(&|e| sol.section_forces[e].torque).abs(),
+                        bending_moment_nm: avg(&|e| {
+                            sol.section_forces[e].bending[if e < i { 1 } else { 0 }]
+                        }),
+                        side_force_n: side[i],
+                        lateral_displacement_m: dot(&d_t, &d_t).sqrt(),
+                        in_contact: in_contact[i],
+                    }
+                })
+                .collect();
+            let t0 = model.nodes[0].hole_axis;
+            let hook = -dot(
+                &[
+                    sol.top_reaction[0],
+                    sol.top_reaction[1],
+                    sol.top_reaction[2],
+                ],
+                &t0,
+            );
+            let torque = dot(
+                &[
+                    sol.top_reaction[3],
+                    sol.top_reaction[4],
+                    sol.top_reaction[5],
+                ],
+                &t0,
+            )
+            .abs();
+            (rows, hook, torque, sol.iterations)
+        }
+        StaticModel::SoftString => {
+            let mu = case.hole.first().map(|h| h.2).unwrap_or(0.25);
+            let prof = soft_string(
+                model,
+                &Operation {
+                    axial_speed: model.axial_speed,
+                    rotation_speed: model.rotation_speed,
+                    weight_on_bit: model.weight_on_bit,
+                    torque_on_bit: model.torque_on_bit,
+                    friction: mu,
+                },
+            );
+            let rows: Vec<ProfileRow> = (0..n)
+                .map(|i| {
+                    let e = i.min(n - 2);
+                    let area = model.elements[e].section.area;
+                    let side = if i < n - 1 { prof.side_force[i] } else { 0.0 };
+                    ProfileRow {
+                        md_m: model.nodes[i].md,
+                        x_m: model.nodes[i].position[0],
+                        y_m: model.nodes[i].position[1],
+                        z_m: model.nodes[i].position[2],
+                        axial_force_n: prof.tension[i],
+                        axial_stress_pa: prof.tension[i] / area,
+                        torque_nm: prof.torque[i],
+                        bending_moment_nm: 0.0,
+                        side_force_n: side,
+                        lateral_displacement_m: 0.0,
+                        in_contact: side > 0.0,
+                    }
+                })
+                .collect();
+            (rows, prof.hook_load(), prof.surface_torque(), vec![])
+        }
+    };
+    let np = neutral_point(&rows);
+    let (k_max, max_side) = rows
+        .iter()
+        .enumerate()
+        .fold((0, 0.0f64), |(bk, bv), (k, r)| {
+            if r.side_force_n > bv {
+                (k, r.side_force_n)
+            } else {
+                (bk, bv)
+            }
+        });
+    let (sinusoidal, helical) = buckling(model, &rows, &case);
+    let summary = Summary {
+        title: case.title.clone(),
+        model: match which {
+            StaticModel::Fe => "fe".into(),
+            StaticModel::SoftString => "soft-string".into(),
+        },
+        neutral_point_from_bit_m: np.map(|md| case.bit_md - md),
+        neutral_point_from_surface_m: np,
+        hook_load_n: hook,
+        surface_torque_nm: torque,
+        max_side_force_n: max_side,
+        max_side_force_md_m: rows[k_max].md_m,
+        sinusoidal_buckling: sinusoidal,
+        helical_buckling: helical,
+        newton_iterations: its,
+    };
+    std::fs::create_dir_all(out)?;
+    let mut w = csv::Writer::from_writer(Vec::new());
+    for r in &rows {
+        w.serialize(r)
+            .map_err(|e| Error::Io(std::io::Error::other(e)))?;
+    }
+    let bytes = w
+        .into_inner()
+        .map_err(|e| Error::Io(std::io::Error::other(e.to_string())))?;
+    write_atomic(&out.join("profile.csv"), &bytes)?;
+    let json = serde_json::to_string_pretty(&summary).map_err(std::io::Error::other)?;
+    write_atomic(&out.join("summary.json"), json.as_bytes())?;
+    Ok(summary)
+}

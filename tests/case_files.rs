@@ -1,0 +1,234 @@
+//! Case files: the paper cases run end to end; bad input is rejected with file, line, key
+//! and allowed range, exit code 2, nothing written.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+fn holewall(args: &[&str]) -> (i32, String, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_holewall"))
+        .args(args)
+        .output()
+        .unwrap();
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stdout).to_string(),
+        String::from_utf8_lossy(&out.stderr).to_string(),
+    )
+}
+
+fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("holewall-case-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+#[test]
+fn paper_cases_run_end_to_end_with_both_models() {
+    for case in ["paper_one_stabilizer.toml", "paper_three_stabilizers.toml"] {
+        let path = root().join("cases").join(case);
+        let mut hooks = Vec::new();
+        for model in ["fe", "soft-string"] {
+            let out = scratch(&format!("{case}-{model}"));
+            let (code, stdout, stderr) = holewall(&[
+                "static",
+                path.to_str().unwrap(),
+                "--model",
+                model,
+                "--out",
+                out.to_str().unwrap(),
+            ]);
+            assert_eq!(code, 0, "{case} {model}: {stderr}");
+            let summary: serde_json::Value =
+                serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap())
+                    .unwrap();
+            assert_eq!(
+                serde_json::from_str::<serde_json::Value>(&stdout).unwrap(),
+                summary
+            );
+            let np = summary["neutral_point_from_bit_m"].as_f64().unwrap();
+            let from_surface = summary["neutral_point_from_surface_m"].as_f64().unwrap();
+            assert!((np + from_surface - 4300.0).abs() < 1e-6);
+            hooks.push(summary["hook_load_n"].as_f64().unwrap());
+            let csv = std::fs::read_to_string(out.join("profile.csv")).unwrap();
+            let header = csv.lines().next().unwrap();
+            assert_eq!(header, "md_m,x_m,y_m,z_m,axial_force_n,axial_stress_pa,torque_nm,bending_moment_nm,side_force_n,lateral_displacement_m,in_contact");
+            assert!(csv.lines().count() > 100);
+        }
+        // Vertical well: both models give buoyed weight − WOB.
+        assert!((hooks[0] / hooks[1] - 1.0).abs() < 1e-3, "{hooks:?}");
+    }
+}
+
+fn write_case(dir: &Path, text: &str) -> PathBuf {
+    let p = dir.join("case.toml");
+    std::fs::write(&p, text).unwrap();
+    p
+}
+
+const GOOD: &str = r#"title = "test"
+[well]
+profile = "vertical"
+total_md = "300 m"
+
+[[hole]]
+bottom_md = "300 m"
+diameter = "8.5 in"
+friction = 0.3
+
+[mud]
+density = "10 ppg"
+
+[[string]]
+kind = "collar"
+length = "30 m"
+od = "6.5 in"
+id = "2.8125 in"
+
+[[string]]
+kind = "stabilizer"
+length = "1.5 m"
+od = "6.5 in"
+id = "2.8125 in"
+blade_diameter = "8.25 in"
+
+[[string]]
+kind = "drill_pipe"
+length = "1000 ft"
+od = "5 in"
+id = "4.276 in"
+
+[operation]
+mode = "rotating"
+weight_on_bit = "20 klbf"
+rpm = "120 rpm"
+"#;
+
+#[test]
+fn field_units_are_accepted() {
+    let dir = scratch("good");
+    let case = write_case(&dir, GOOD);
+    let out = dir.join("out");
+    let (code, _, stderr) = holewall(&[
+        "static",
+        case.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{stderr}");
+    let c = holewall::case::load_case(&case).unwrap();
+    assert!((c.model.weight_on_bit - 88_964.432_305_21).abs() < 1e-6);
+    assert!((c.model.rotation_speed - 4.0 * std::f64::consts::PI).abs() < 1e-12);
+    assert!((c.mud_density - 1198.264_27).abs() < 1e-3);
+    assert_eq!(c.model.sites.len(), 1);
+    assert!((c.model.sites[0].params.disk_radius - 0.5 * 8.25 * 0.0254).abs() < 1e-12);
+}
+
+#[test]
+fn bad_input_names_file_line_key_and_range() {
+    // (what, case text, key named, the text on the line named)
+    let cases: Vec<(&str, String, &str, &str)> = vec![
+        (
+            "negative length",
+            GOOD.replace("length = \"30 m\"", "length = \"-30 m\""),
+            "string.length",
+            "length = \"-30 m\"",
+        ),
+        (
+            "ID ≥ OD",
+            GOOD.replacen("id = \"2.8125 in\"", "id = \"7 in\"", 1),
+            "string.id",
+            "id = \"7 in\"",
+        ),
+        (
+            "disk wider than the hole",
+            GOOD.replace("blade_diameter = \"8.25 in\"", "blade_diameter = \"9 in\""),
+            "string.blade_diameter",
+            "blade_diameter = \"9 in\"",
+        ),
+        (
+            "unit that does not fit",
+            GOOD.replace("weight_on_bit = \"20 klbf\"", "weight_on_bit = \"20 ft\""),
+            "operation.weight_on_bit",
+            "weight_on_bit = \"20 ft\"",
+        ),
+        (
+            "unknown key",
+            GOOD.replace("friction = 0.3", "friction = 0.3\nroughness = 2"),
+            "roughness",
+            "roughness = 2",
+        ),
+        (
+            "unknown mode",
+            GOOD.replace("mode = \"rotating\"", "mode = \"spinning\""),
+            "operation.mode",
+            "mode = \"spinning\"",
+        ),
+        (
+            "string too short",
+            GOOD.replace("length = \"1000 ft\"", "length = \"100 ft\""),
+            "string.length",
+            "length = \"100 ft\"",
+        ),
+    ];
+    for (what, text, key, marker) in cases {
+        let line = 1 + text[..text.find(marker).unwrap()].matches('\n').count();
+        let dir = scratch(&what.replace(' ', "_").replace('≥', "ge"));
+        let case = write_case(&dir, &text);
+        let out = dir.join("out");
+        let (code, stdout, stderr) = holewall(&[
+            "static",
+            case.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        assert_eq!(code, 2, "{what}: {stderr}");
+        assert!(stdout.is_empty(), "{what}");
+        assert!(!out.exists(), "{what}: output written");
+        assert!(
+            stderr.contains(&format!("case.toml:{line}:")),
+            "{what}: line {line} not named: {stderr}"
+        );
+        assert!(
+            stderr.contains(key),
+            "{what}: key {key} not named: {stderr}"
+        );
+        assert!(!stderr.contains("panicked"), "{what}: {stderr}");
+    }
+    // Surveys: MD not increasing, inclination outside [0°, 180°].
+    for (what, survey, words) in [
+        (
+            "md",
+            "md,inclination,azimuth\n0,0,0\n100,5,10\n100,6,10\n",
+            "MD must increase",
+        ),
+        (
+            "inclination",
+            "md,inclination,azimuth\n0,0,0\n100,190,10\n",
+            "outside [0°, 180°]",
+        ),
+    ] {
+        let dir = scratch(&format!("survey-{what}"));
+        std::fs::write(dir.join("survey.csv"), survey).unwrap();
+        let text = GOOD.replace(
+            "profile = \"vertical\"",
+            "profile = \"survey\"\nsurvey = \"survey.csv\"",
+        );
+        let case = write_case(&dir, &text);
+        let (code, _, stderr) = holewall(&[
+            "static",
+            case.to_str().unwrap(),
+            "--out",
+            dir.join("out").to_str().unwrap(),
+        ]);
+        assert_eq!(code, 2, "{what}: {stderr}");
+        assert!(
+            stderr.contains(words) && stderr.contains("survey"),
+            "{what}: {stderr}"
+        );
+    }
+}
