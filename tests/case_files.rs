@@ -123,7 +123,7 @@ fn field_units_are_accepted() {
     let c = holewall::case::load_case(&case).unwrap();
     assert!((c.model.weight_on_bit - 88_964.432_305_21).abs() < 1e-6);
     assert!((c.model.rotation_speed - 4.0 * std::f64::consts::PI).abs() < 1e-12);
-    assert!((c.mud_density - 1198.264_27).abs() < 1e-3);
+    assert!((c.mud_density - 1198.26427).abs() < 1e-3);
     assert_eq!(c.model.sites.len(), 1);
     assert!((c.model.sites[0].params.disk_radius - 0.5 * 8.25 * 0.0254).abs() < 1e-12);
 }
