@@ -17,6 +17,7 @@ pub mod kernels;
 pub mod model;
 pub mod output;
 pub mod physics;
+pub mod plots;
 pub mod selfcheck;
 pub mod solve;
 pub mod units;

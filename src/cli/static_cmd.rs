@@ -266,5 +266,127 @@ pub fn run(case_path: &Path, which: StaticModel, out: &Path) -> Result<Summary, 
     write_atomic(&out.join("profile.csv"), &bytes)?;
     let json = serde_json::to_string_pretty(&summary).map_err(std::io::Error::other)?;
     write_atomic(&out.join("summary.json"), json.as_bytes())?;
+    write_plots(&case, which, &rows, np, out)?;
     Ok(summary)
+}
+
+fn write_plots(
+    case: &Case,
+    which: StaticModel,
+    rows: &[ProfileRow],
+    np: Option<f64>,
+    out: &Path,
+) -> std::io::Result<()> {
+    use crate::plots::{line_plot, Marker, Series};
+    let name = match which {
+        StaticModel::Fe => "FE",
+        StaticModel::SoftString => "soft string",
+    };
+    let col = |f: &dyn Fn(&ProfileRow) -> f64| -> Vec<(f64, f64)> {
+        rows.iter().map(|r| (r.md_m, f(r))).collect()
+    };
+    let np_marker: Vec<Marker> = np
+        .map(|md| Marker {
+            label: "neutral point",
+            x: md,
+            y: 0.0,
+        })
+        .into_iter()
+        .collect();
+    line_plot(
+        &out.join("axial_force.png"),
+        &format!("{}: axial force ({name})", case.title),
+        "MD (m)",
+        "effective axial force, tension + (N)",
+        &[Series {
+            name,
+            points: col(&|r| r.axial_force_n),
+        }],
+        &np_marker,
+    )?;
+    line_plot(
+        &out.join("axial_stress.png"),
+        &format!("{}: axial stress ({name})", case.title),
+        "MD (m)",
+        "axial stress (Pa)",
+        &[Series {
+            name,
+            points: col(&|r| r.axial_stress_pa),
+        }],
+        &np_marker,
+    )?;
+    line_plot(
+        &out.join("side_force.png"),
+        &format!("{}: side force ({name})", case.title),
+        "MD (m)",
+        "side force (N)",
+        &[Series {
+            name,
+            points: col(&|r| r.side_force_n),
+        }],
+        &[],
+    )?;
+    line_plot(
+        &out.join("torque.png"),
+        &format!("{}: torque ({name})", case.title),
+        "MD (m)",
+        "torque (N·m)",
+        &[Series {
+            name,
+            points: col(&|r| r.torque_nm),
+        }],
+        &[],
+    )?;
+    let bha_top = case.bit_md - 200.0;
+    let bha: Vec<(f64, f64)> = rows
+        .iter()
+        .filter(|r| r.md_m >= bha_top)
+        .map(|r| (r.md_m, r.lateral_displacement_m))
+        .collect();
+    line_plot(
+        &out.join("bha_deflection.png"),
+        &format!("{}: BHA lateral deflection ({name})", case.title),
+        "MD (m)",
+        "lateral displacement from the hole axis (m)",
+        &[Series { name, points: bha }],
+        &[],
+    )?;
+    if which == StaticModel::Fe {
+        let model = &case.model;
+        let mu = case.hole.first().map(|h| h.2).unwrap_or(0.25);
+        let ss = soft_string(
+            model,
+            &Operation {
+                axial_speed: model.axial_speed,
+                rotation_speed: model.rotation_speed,
+                weight_on_bit: model.weight_on_bit,
+                torque_on_bit: model.torque_on_bit,
+                friction: mu,
+            },
+        );
+        let ss_pts: Vec<(f64, f64)> = model
+            .nodes
+            .iter()
+            .zip(&ss.tension)
+            .map(|(n, t)| (n.md, *t))
+            .collect();
+        line_plot(
+            &out.join("fe_vs_soft_string.png"),
+            &format!("{}: axial force, FE vs soft string", case.title),
+            "MD (m)",
+            "effective axial force (N)",
+            &[
+                Series {
+                    name: "FE",
+                    points: col(&|r| r.axial_force_n),
+                },
+                Series {
+                    name: "soft string",
+                    points: ss_pts,
+                },
+            ],
+            &np_marker,
+        )?;
+    }
+    Ok(())
 }
