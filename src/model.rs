@@ -22,6 +22,11 @@ pub struct Node {
     pub position: Vec3<f64>,
     /// Unit hole axis at the node, pointing down-hole.
     pub hole_axis: Vec3<f64>,
+    /// Reference triad of the node in the natural (straight, unstressed) string: first axis
+    /// along the hole axis, the others carried along the well by parallel transport (no
+    /// twist). Element triads are `R_i · frame0`: a string meshed into a curved hole is bent
+    /// there (moment ≈ EI·κ), as a straight pipe forced into the hole is.
+    pub frame0: Mat3<f64>,
 }
 
 /// One beam element between nodes `i` and `i + 1`.
@@ -111,6 +116,24 @@ pub fn frame_from_axis(e1: &Vec3<f64>) -> Mat3<f64> {
     ]
 }
 
+/// Parallel transport of a frame from tangent `t1` to `t2`: the minimal rotation taking
+/// `t1` to `t2`, applied to `frame`.
+pub fn transport(frame: &Mat3<f64>, t1: &Vec3<f64>, t2: &Vec3<f64>) -> Mat3<f64> {
+    let axis = cross(t1, t2);
+    let s = dot(&axis, &axis).sqrt();
+    let c = dot(t1, t2);
+    let angle = s.atan2(c);
+    let theta = if s > 0.0 {
+        scale(&axis, angle / s)
+    } else {
+        [0.0; 3]
+    };
+    let r = crate::physics::beam::rotation_exp(&theta);
+    std::array::from_fn(|row| {
+        std::array::from_fn(|col| (0..3).map(|k| r[row][k] * frame[k][col]).sum())
+    })
+}
+
 /// One tubular of the string: the mesh builder's input.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Tubular {
@@ -163,7 +186,7 @@ pub fn mesh_string(
             owner.push(k);
         }
     }
-    let nodes: Vec<Node> = mds
+    let mut nodes: Vec<Node> = mds
         .iter()
         .map(|&md| {
             let (p, t) = well.at(md);
@@ -171,9 +194,17 @@ pub fn mesh_string(
                 md,
                 position: p,
                 hole_axis: t,
+                frame0: frame_from_axis(&t),
             }
         })
         .collect();
+    for i in 1..nodes.len() {
+        nodes[i].frame0 = transport(
+            &nodes[i - 1].frame0,
+            &nodes[i - 1].hole_axis,
+            &nodes[i].hole_axis,
+        );
+    }
     let elements = owner
         .iter()
         .enumerate()

@@ -72,24 +72,54 @@ pub struct StaticState {
 }
 
 impl StaticState {
-    /// A first guess with every contact node on the low side of its hole (where gravity
-    /// has a component normal to the hole axis), just touching the wall: the usual start of
-    /// a torque-and-drag solve, which a string hanging in the middle of a deviated hole is
-    /// far from (its lateral stiffness before contact is that of a 1 km cable).
+    /// A first guess with every contact node against the wall on the side a cable would
+    /// lie: along the lateral load `q = F·dt/ds + w·g_⊥` of the frictionless soft-string
+    /// solution (tension `F` pulls the string to the inside of a bend, weight to the low
+    /// side). A string hanging in the middle of a deviated hole is far from equilibrium
+    /// (its lateral stiffness before contact is that of a cable kilometres long); this start
+    /// is close to it.
     pub fn on_low_side(model: &Model) -> StaticState {
+        use crate::physics::soft_string::{soft_string, Operation};
         let mut s = StaticState::initial(model);
+        let n = model.nodes.len();
+        let cable = soft_string(
+            model,
+            &Operation {
+                axial_speed: 0.0,
+                rotation_speed: 0.0,
+                weight_on_bit: model.weight_on_bit,
+                torque_on_bit: 0.0,
+                friction: 0.0,
+            },
+        );
         for site in &model.sites {
-            let node = &model.nodes[site.node];
-            let t = node.hole_axis;
+            let i = site.node;
+            let held = i == 0 || (model.bit_lateral_fixed && i + 1 == n);
+            if held {
+                continue;
+            }
+            let (a, b) = (i.saturating_sub(1), (i + 1).min(n - 1));
+            let ds = model.nodes[b].md - model.nodes[a].md;
+            let dt = scale(
+                &sub(&model.nodes[b].hole_axis, &model.nodes[a].hole_axis),
+                1.0 / ds,
+            );
+            let t = model.nodes[i].hole_axis;
             let g = [0.0, 0.0, 1.0];
             let g_perp = sub(&g, &scale(&t, dot(&g, &t)));
-            let len = dot(&g_perp, &g_perp).sqrt();
-            let held =
-                site.node == 0 || (model.bit_lateral_fixed && site.node + 1 == model.nodes.len());
-            if len > 1e-3 && !held {
+            let w = model.elements[i.min(n - 2)].buoyed_weight_per_length;
+            let q = [
+                cable.tension[i] * dt[0] + w * g_perp[0],
+                cable.tension[i] * dt[1] + w * g_perp[1],
+                cable.tension[i] * dt[2] + w * g_perp[2],
+            ];
+            // Lateral part only.
+            let q = sub(&q, &scale(&t, dot(&q, &t)));
+            let len = dot(&q, &q).sqrt();
+            if len > 1e-3 * w.abs().max(1e-12) {
                 let depth = site.params.clearance + 1e-6;
-                for (x, g) in s.x[site.node].iter_mut().zip(g_perp) {
-                    *x += depth * g / len;
+                for (x, qk) in s.x[i].iter_mut().zip(q) {
+                    *x += depth * qk / len;
                 }
             }
         }
@@ -209,8 +239,8 @@ fn assemble(
         let es = ElementState {
             x: [state.x[i], state.x[i + 1]],
             triad: [
-                mat_mul(&state.rot[i], &e.frame0),
-                mat_mul(&state.rot[i + 1], &e.frame0),
+                mat_mul(&state.rot[i], &model.nodes[i].frame0),
+                mat_mul(&state.rot[i + 1], &model.nodes[i + 1].frame0),
             ],
         };
         let f = match tangent.as_deref_mut() {
@@ -606,8 +636,8 @@ fn finish(
         .iter()
         .enumerate()
         .map(|(i, e)| {
-            let t1 = mat_mul(&state.rot[i], &e.frame0);
-            let t2 = mat_mul(&state.rot[i + 1], &e.frame0);
+            let t1 = mat_mul(&state.rot[i], &model.nodes[i].frame0);
+            let t2 = mat_mul(&state.rot[i + 1], &model.nodes[i + 1].frame0);
             let def = local_deformation(&state.x[i], &state.x[i + 1], &t1, &t2, e.length0);
             section_forces(&def, &e.section, e.length0)
         })
