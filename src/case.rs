@@ -107,6 +107,9 @@ pub struct OperationSpec {
     pub rpm: Option<Q>,
     /// Tripping speed (default 0.5 m/s for tripping modes).
     pub axial_speed: Option<Q>,
+    /// Hook load: given instead of the weight on bit (the bit then rests on bottom and the
+    /// weight on bit is what the hook load leaves).
+    pub hook_load: Option<Q>,
 }
 
 /// `[contact]`.
@@ -666,6 +669,26 @@ pub fn parse_case(path: &Path, text: &str) -> Result<Case, InputError> {
         })
         .transpose()?
         .unwrap_or(0.5);
+    let hook = op
+        .hook_load
+        .as_ref()
+        .map(|q| {
+            ctx.quantity(
+                q,
+                "operation.hook_load",
+                Dimension::Force,
+                |x| x > 0.0,
+                "> 0",
+            )
+        })
+        .transpose()?;
+    if let (Some(_), Some(w)) = (hook, &op.weight_on_bit) {
+        return Err(ctx.err(
+            w.span(),
+            "operation.weight_on_bit",
+            "give either weight_on_bit (top clamped) or hook_load (bit on bottom), not both",
+        ));
+    }
     let (axial_speed, rotation_speed) = match op.mode.get_ref().as_str() {
         "rotating" => (0.0, rpm),
         "tripping_in" => (speed, 0.0),
@@ -774,7 +797,10 @@ pub fn parse_case(path: &Path, text: &str) -> Result<Case, InputError> {
         torque_on_bit: tob,
         axial_speed,
         rotation_speed,
-        top: TopBoundary::Clamped,
+        top: match hook {
+            Some(h) => TopBoundary::HookLoad(h),
+            None => TopBoundary::Clamped,
+        },
         bit_lateral_fixed: true,
         point_loads: vec![],
     };

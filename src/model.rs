@@ -69,6 +69,10 @@ pub enum TopBoundary {
     /// Pinned: displacements and the rotation about the hole axis zero, bending rotations
     /// free (closed-form checks: pinned columns).
     Pinned,
+    /// Hook load given (N): the top is held laterally and in rotation but free to move
+    /// along the (vertical) hole axis, pulled up by the hook load; the bit then rests on
+    /// bottom (axially held) and the weight on bit is the reaction there.
+    HookLoad(f64),
 }
 
 /// Everything a static or dynamic solve needs.

@@ -242,3 +242,28 @@ fn rigid_spin_of_1000_rad_leaves_no_internal_force() {
         f.iter().fold(0.0f64, |a, b| a.max(b.abs()))
     );
 }
+
+#[test]
+fn hook_load_given_puts_the_rest_on_the_bit() {
+    let well = WellPath::vertical(1000.0);
+    let mud = 1200.0;
+    let tubs = [
+        tubular("collar", 150.0, 0.165, 0.071, 2.0),
+        tubular("pipe", 850.0, 0.127, 0.108, 10.0),
+    ];
+    let mut m = model(&well, &tubs, 1000.0, mud, 0.0);
+    let bf = 1.0 - mud / STEEL;
+    let air_weight = STEEL * GRAVITY * (150.0 * area(0.165, 0.071) + 850.0 * area(0.127, 0.108));
+    let hook = bf * air_weight - 50e3;
+    m.top = TopBoundary::HookLoad(hook);
+    let sol = solve_static(&m, &StaticOptions::default()).unwrap();
+    let wob = -sol.bit_reaction[2];
+    assert!((wob - 50e3).abs() <= 5e-3 * 50e3, "WOB {wob}");
+    let axial: Vec<f64> = sol.section_forces.iter().map(|s| s.axial).collect();
+    let np_from_bit = 1000.0 - neutral_point_md(&m, &axial);
+    let expected_np = 50e3 / (bf * STEEL * area(0.165, 0.071) * GRAVITY);
+    assert!(
+        (np_from_bit - expected_np).abs() <= 5e-3 * expected_np,
+        "{np_from_bit} vs {expected_np}"
+    );
+}

@@ -64,6 +64,8 @@ pub struct Summary {
     pub hook_load_n: f64,
     /// Surface torque (N·m).
     pub surface_torque_nm: f64,
+    /// Weight on bit (N): as given, or the bit's reaction when the hook load is given.
+    pub weight_on_bit_n: f64,
     /// Largest side force (N).
     pub max_side_force_n: f64,
     /// Where it acts (MD, m).
@@ -130,6 +132,7 @@ pub fn run(case_path: &Path, which: StaticModel, out: &Path) -> Result<Summary, 
     let case = load_case(case_path)?;
     let model = &case.model;
     let n = model.nodes.len();
+    let mut wob = model.weight_on_bit;
     let (rows, hook, torque, its) = match which {
         StaticModel::Fe => {
             let sol = solve_static(model, &StaticOptions::default())
@@ -172,7 +175,7 @@ pub fn run(case_path: &Path, which: StaticModel, out: &Path) -> Result<Summary, 
                 })
                 .collect();
             let t0 = model.nodes[0].hole_axis;
-            let hook = -dot(
+            let mut hook = -dot(
                 &[
                     sol.top_reaction[0],
                     sol.top_reaction[1],
@@ -180,6 +183,18 @@ pub fn run(case_path: &Path, which: StaticModel, out: &Path) -> Result<Summary, 
                 ],
                 &t0,
             );
+            if let crate::model::TopBoundary::HookLoad(h) = model.top {
+                hook = h;
+                let tb = model.nodes[n - 1].hole_axis;
+                wob = -dot(
+                    &[
+                        sol.bit_reaction[0],
+                        sol.bit_reaction[1],
+                        sol.bit_reaction[2],
+                    ],
+                    &tb,
+                );
+            }
             let torque = dot(
                 &[
                     sol.top_reaction[3],
@@ -192,6 +207,9 @@ pub fn run(case_path: &Path, which: StaticModel, out: &Path) -> Result<Summary, 
             (rows, hook, torque, sol.iterations)
         }
         StaticModel::SoftString => {
+            if let crate::model::TopBoundary::HookLoad(_) = model.top {
+                return Err(Error::Io(std::io::Error::other("the soft-string model needs the weight on bit; give operation.weight_on_bit instead of hook_load")));
+            }
             let mu = case.hole.first().map(|h| h.2).unwrap_or(0.25);
             let prof = soft_string(
                 model,
@@ -248,6 +266,7 @@ pub fn run(case_path: &Path, which: StaticModel, out: &Path) -> Result<Summary, 
         neutral_point_from_surface_m: np,
         hook_load_n: hook,
         surface_torque_nm: torque,
+        weight_on_bit_n: wob,
         max_side_force_n: max_side,
         max_side_force_md_m: rows[k_max].md_m,
         sinusoidal_buckling: sinusoidal,

@@ -152,6 +152,8 @@ pub struct StaticSolution {
     /// Force and moment the top support exerts on the string (N, N·m): the hook load is
     /// `−reaction[2]` in a vertical well.
     pub top_reaction: [f64; 6],
+    /// Force and moment the bit's supports (and contact) exert on the string (N, N·m).
+    pub bit_reaction: [f64; 6],
 }
 
 fn mat_mul(a: &Mat3<f64>, b: &Mat3<f64>) -> Mat3<f64> {
@@ -171,6 +173,8 @@ fn constraints(model: &Model) -> Constraints {
     fixed[0] = match model.top {
         TopBoundary::Clamped => [true; 6],
         TopBoundary::Pinned => [true, true, true, false, false, false],
+        // Free along global z: a well's top is vertical.
+        TopBoundary::HookLoad(_) => [true, true, false, true, true, true],
     };
     if model.top == TopBoundary::Pinned {
         // The twist is held about global z: a well's top is vertical.
@@ -185,6 +189,9 @@ fn constraints(model: &Model) -> Constraints {
         basis[bit] = Some(b);
         fixed[bit][0] = true;
         fixed[bit][1] = true;
+        if matches!(model.top, TopBoundary::HookLoad(_)) {
+            fixed[bit][2] = true;
+        }
     }
     Constraints { basis, fixed }
 }
@@ -207,9 +214,20 @@ pub fn external_loads(model: &Model) -> Vec<f64> {
     }
     let bit = n - 1;
     let t = model.nodes[bit].hole_axis;
+    let wob = if matches!(model.top, TopBoundary::HookLoad(_)) {
+        0.0
+    } else {
+        model.weight_on_bit
+    };
     for k in 0..3 {
-        f[6 * bit + k] -= model.weight_on_bit * t[k];
+        f[6 * bit + k] -= wob * t[k];
         f[6 * bit + 3 + k] -= model.torque_on_bit * t[k];
+    }
+    if let TopBoundary::HookLoad(hook) = model.top {
+        let t0 = model.nodes[0].hole_axis;
+        for k in 0..3 {
+            f[k] -= hook * t0[k];
+        }
     }
     for (node, load) in &model.point_loads {
         for k in 0..6 {
@@ -677,6 +695,8 @@ fn finish(
     let f_int = internal_forces(model, &state);
     let f_ext = external_loads(model);
     let top_reaction = std::array::from_fn(|k| f_int[k] - f_ext[k]);
+    let b = 6 * (model.nodes.len() - 1);
+    let bit_reaction = std::array::from_fn(|k| f_int[b + k] - f_ext[b + k]);
     StaticSolution {
         state,
         section_forces,
@@ -684,5 +704,6 @@ fn finish(
         iterations,
         log,
         top_reaction,
+        bit_reaction,
     }
 }
