@@ -33,18 +33,43 @@ fn deviated_case_runs_and_models_agree_on_hook_load() {
     let mut summaries = Vec::new();
     for model in ["fe", "soft-string"] {
         let out = scratch(&format!("bh-{model}"));
-        let (code, _, stderr) = holewall(&["static", path.to_str().unwrap(), "--model", model, "--out", out.to_str().unwrap()]);
+        let (code, _, stderr) = holewall(&[
+            "static",
+            path.to_str().unwrap(),
+            "--model",
+            model,
+            "--out",
+            out.to_str().unwrap(),
+        ]);
         assert_eq!(code, 0, "{model}: {stderr}");
-        for f in ["profile.csv", "summary.json", "axial_force.png", "axial_stress.png", "side_force.png", "torque.png", "bha_deflection.png"] {
+        for f in [
+            "profile.csv",
+            "summary.json",
+            "axial_force.png",
+            "axial_stress.png",
+            "side_force.png",
+            "torque.png",
+            "bha_deflection.png",
+        ] {
             assert!(out.join(f).is_file(), "{model}: {f} missing");
         }
         if model == "fe" {
             assert!(out.join("fe_vs_soft_string.png").is_file());
         }
-        summaries.push(serde_json::from_str::<serde_json::Value>(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap());
+        summaries.push(
+            serde_json::from_str::<serde_json::Value>(
+                &std::fs::read_to_string(out.join("summary.json")).unwrap(),
+            )
+            .unwrap(),
+        );
     }
     let hook = |k: usize| summaries[k]["hook_load_n"].as_f64().unwrap();
-    assert!((hook(0) / hook(1) - 1.0).abs() < 0.05, "FE {} vs soft string {}", hook(0), hook(1));
+    assert!(
+        (hook(0) / hook(1) - 1.0).abs() < 0.05,
+        "FE {} vs soft string {}",
+        hook(0),
+        hook(1)
+    );
     // The near-bit stabilizer carries the largest side force.
     assert!(summaries[0]["max_side_force_md_m"].as_f64().unwrap() > 1495.0);
 }

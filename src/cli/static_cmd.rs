@@ -9,7 +9,7 @@ use crate::case::{load_case, Case};
 use crate::error::Error;
 use crate::model::Model;
 use crate::output::write_atomic;
-use crate::physics::soft_string::{soft_string, Operation};
+use crate::physics::soft_string::{soft_string_with, Operation};
 use crate::physics::vec3::{dot, scale, sub};
 use crate::solve::statics::{solve_static, StaticOptions};
 
@@ -75,8 +75,10 @@ pub struct Summary {
     pub sinusoidal_buckling: bool,
     /// Compression beyond √2 × that (helical buckling).
     pub helical_buckling: bool,
-    /// Load steps and Newton iterations (FE).
+    /// Newton iterations per completed load step (FE).
     pub newton_iterations: Vec<usize>,
+    /// Load-step cuts and why (FE).
+    pub solver_log: Vec<String>,
 }
 
 /// Neutral point: the first MD, going up from the bit, where the axial force turns from
@@ -133,6 +135,7 @@ pub fn run(case_path: &Path, which: StaticModel, out: &Path) -> Result<Summary, 
     let model = &case.model;
     let n = model.nodes.len();
     let mut wob = model.weight_on_bit;
+    let mut solver_log = Vec::new();
     let (rows, hook, torque, its) = match which {
         StaticModel::Fe => {
             let sol = solve_static(model, &StaticOptions::default())
@@ -204,23 +207,14 @@ pub fn run(case_path: &Path, which: StaticModel, out: &Path) -> Result<Summary, 
                 &t0,
             )
             .abs();
+            solver_log = sol.log.clone();
             (rows, hook, torque, sol.iterations)
         }
         StaticModel::SoftString => {
             if let crate::model::TopBoundary::HookLoad(_) = model.top {
                 return Err(Error::Io(std::io::Error::other("the soft-string model needs the weight on bit; give operation.weight_on_bit instead of hook_load")));
             }
-            let mu = case.hole.first().map(|h| h.2).unwrap_or(0.25);
-            let prof = soft_string(
-                model,
-                &Operation {
-                    axial_speed: model.axial_speed,
-                    rotation_speed: model.rotation_speed,
-                    weight_on_bit: model.weight_on_bit,
-                    torque_on_bit: model.torque_on_bit,
-                    friction: mu,
-                },
-            );
+            let prof = soft_string_for_case(&case);
             let rows: Vec<ProfileRow> = (0..n)
                 .map(|i| {
                     let e = i.min(n - 2);
@@ -272,6 +266,7 @@ pub fn run(case_path: &Path, which: StaticModel, out: &Path) -> Result<Summary, 
         sinusoidal_buckling: sinusoidal,
         helical_buckling: helical,
         newton_iterations: its,
+        solver_log,
     };
     std::fs::create_dir_all(out)?;
     let mut w = csv::Writer::from_writer(Vec::new());
@@ -372,17 +367,7 @@ fn write_plots(
     )?;
     if which == StaticModel::Fe {
         let model = &case.model;
-        let mu = case.hole.first().map(|h| h.2).unwrap_or(0.25);
-        let ss = soft_string(
-            model,
-            &Operation {
-                axial_speed: model.axial_speed,
-                rotation_speed: model.rotation_speed,
-                weight_on_bit: model.weight_on_bit,
-                torque_on_bit: model.torque_on_bit,
-                friction: mu,
-            },
-        );
+        let ss = soft_string_for_case(case);
         let ss_pts: Vec<(f64, f64)> = model
             .nodes
             .iter()
@@ -408,4 +393,28 @@ fn write_plots(
         )?;
     }
     Ok(())
+}
+
+/// The soft-string profile of a case's operation, with each hole section's friction.
+pub fn soft_string_for_case(case: &Case) -> crate::physics::soft_string::SoftStringProfile {
+    let model = &case.model;
+    let friction_at = |md: f64| {
+        case.hole
+            .iter()
+            .find(|h| md <= h.0 + 1e-9)
+            .or(case.hole.last())
+            .map(|h| h.2)
+            .unwrap_or(0.25)
+    };
+    soft_string_with(
+        model,
+        &Operation {
+            axial_speed: model.axial_speed,
+            rotation_speed: model.rotation_speed,
+            weight_on_bit: model.weight_on_bit,
+            torque_on_bit: model.torque_on_bit,
+            friction: friction_at(0.0),
+        },
+        &friction_at,
+    )
 }

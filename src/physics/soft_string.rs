@@ -52,8 +52,18 @@ impl SoftStringProfile {
     }
 }
 
-/// Runs the soft-string model over the model's mesh for one operation.
+/// Runs the soft-string model over the model's mesh for one operation, with one friction
+/// coefficient (`op.friction`) everywhere.
 pub fn soft_string(model: &Model, op: &Operation) -> SoftStringProfile {
+    soft_string_with(model, op, &|_| op.friction)
+}
+
+/// As [`soft_string`], with the friction coefficient a function of MD (hole sections).
+pub fn soft_string_with(
+    model: &Model,
+    op: &Operation,
+    friction_at: &dyn Fn(f64) -> f64,
+) -> SoftStringProfile {
     let n = model.nodes.len();
     let mut tension = vec![0.0; n];
     let mut torque = vec![0.0; n];
@@ -85,8 +95,9 @@ pub fn soft_string(model: &Model, op: &Operation) -> SoftStringProfile {
                 (0.0, 0.0)
             }
         };
-        tension[i] = f + weight * dot(&g, &mean) + op.friction * normal * axial_share;
-        torque[i] = torque[i + 1] + op.friction * normal * radius * torque_share;
+        let mu = friction_at(0.5 * (model.nodes[i].md + model.nodes[i + 1].md));
+        tension[i] = f + weight * dot(&g, &mean) + mu * normal * axial_share;
+        torque[i] = torque[i + 1] + mu * normal * radius * torque_share;
     }
     SoftStringProfile {
         tension,
