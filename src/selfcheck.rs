@@ -312,6 +312,55 @@ pub fn quantity_errors(reference: &[f64; OUTPUT_LEN], other: &[f64; OUTPUT_LEN])
     })
 }
 
+/// The quantities of one pair in contact that the error measures need (f64 reference).
+struct PairState {
+    r: f64,
+    delta: f64,
+    f_e: f64,
+    df_e: f64,
+    f_d: f64,
+    v_u: f64,
+    normal: f64,
+    speed: f64,
+}
+
+/// `None` where the pair carries no contact force.
+#[allow(clippy::neg_cmp_op_on_partial_ord)]
+fn pair_state(
+    n: &Vec3<f64>,
+    d: &Vec3<f64>,
+    v: &Vec3<f64>,
+    p: &ContactParams<f64>,
+    damping: bool,
+) -> Option<PairState> {
+    use crate::physics::contact::{elastic_force, SpringLaw};
+    use crate::physics::vec3::sub;
+    let d_t = sub(d, &scale(n, dot(d, n)));
+    let r = dot(&d_t, &d_t).sqrt();
+    let delta = r - p.clearance;
+    if !(delta > 0.0) {
+        return None;
+    }
+    let u = scale(&d_t, 1.0 / r);
+    let (f_e, df_e) = elastic_force(delta, p, SpringLaw::PowerBlend);
+    let v_u = dot(v, &u);
+    let f_d = if damping { p.wall_damping * v_u } else { 0.0 };
+    let normal = f_e + f_d;
+    if !(normal > 0.0) {
+        return None;
+    }
+    Some(PairState {
+        r,
+        delta,
+        f_e,
+        df_e,
+        f_d,
+        v_u,
+        normal,
+        speed: dot(v, v).sqrt(),
+    })
+}
+
 /// First-order condition number of the element's outputs for one pair: how much a
 /// relative perturbation `u` of the inputs (and of each operation) can grow in the
 /// outputs, normwise. Terms (docs/contact-element.md, "Accuracy"):
@@ -337,23 +386,16 @@ pub fn condition_number(
     friction: bool,
     damping: bool,
 ) -> Option<f64> {
-    use crate::physics::contact::{elastic_force, SpringLaw};
-    use crate::physics::vec3::sub;
-    let d_t = sub(d, &scale(n, dot(d, n)));
-    let r = dot(&d_t, &d_t).sqrt();
-    let delta = r - p.clearance;
-    if !(delta > 0.0) {
-        return None;
-    }
-    let u = scale(&d_t, 1.0 / r);
-    let (f_e, _) = elastic_force(delta, p, SpringLaw::PowerBlend);
-    let v_u = dot(v, &u);
-    let f_d = if damping { p.wall_damping * v_u } else { 0.0 };
-    let normal = f_e + f_d;
-    if !(normal > 0.0) {
-        return None;
-    }
-    let speed = dot(v, v).sqrt();
+    let PairState {
+        r,
+        delta,
+        f_e,
+        f_d,
+        v_u,
+        normal,
+        speed,
+        ..
+    } = pair_state(n, d, v, p, damping)?;
     let d_len = dot(d, d).sqrt();
     let axial = d_len / r;
     // The rounding of d itself (≈ u·|d| in each component) moves delta: |d|/delta, not r/delta.
@@ -385,23 +427,15 @@ pub fn term_scales(
     dynamic: bool,
     damping: bool,
 ) -> Option<[f64; 4]> {
-    use crate::physics::contact::{elastic_force, SpringLaw};
-    use crate::physics::vec3::sub;
-    let d_t = sub(d, &scale(n, dot(d, n)));
-    let r = dot(&d_t, &d_t).sqrt();
-    let delta = r - p.clearance;
-    if !(delta > 0.0) {
-        return None;
-    }
-    let u = scale(&d_t, 1.0 / r);
-    let (f_e, df_e) = elastic_force(delta, p, SpringLaw::PowerBlend);
+    let PairState {
+        r,
+        df_e,
+        v_u,
+        normal,
+        speed,
+        ..
+    } = pair_state(n, d, v, p, damping)?;
     let c = if damping { p.wall_damping } else { 0.0 };
-    let v_u = dot(v, &u);
-    let normal = f_e + c * v_u;
-    if !(normal > 0.0) {
-        return None;
-    }
-    let speed = dot(v, v).sqrt();
     let mu = if friction { p.mu_t + p.mu_l } else { 0.0 };
     let arm = 1.0 + p.disk_radius;
     let slope = 2.0 / p.eps;

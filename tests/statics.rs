@@ -98,23 +98,8 @@ fn vertical_well_neutral_point_and_hook_load() {
     );
 }
 
-/// Dense symmetric part of a constrained tangent, and whether it is positive definite.
 fn positive_definite(t: &BlockTridiagonal) -> bool {
-    let n = 6 * t.nodes();
-    let mut a = nalgebra::DMatrix::<f64>::zeros(n, n);
-    for i in 0..t.nodes() {
-        for r in 0..6 {
-            for c in 0..6 {
-                a[(6 * i + r, 6 * i + c)] += t.diag[i][r][c];
-                if i + 1 < t.nodes() {
-                    a[(6 * i + r, 6 * (i + 1) + c)] += t.upper[i][r][c];
-                    a[(6 * (i + 1) + r, 6 * i + c)] += t.lower[i][r][c];
-                }
-            }
-        }
-    }
-    let sym = (&a + a.transpose()) * 0.5;
-    nalgebra::linalg::Cholesky::new(sym).is_some()
+    t.symmetric_part_positive_definite()
 }
 
 #[test]

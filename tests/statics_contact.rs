@@ -70,20 +70,7 @@ fn model_with_contact(well: &WellPath, md: f64, element_length: f64, mu: f64) ->
 }
 
 fn positive_definite(t: &BlockTridiagonal) -> bool {
-    let n = 6 * t.nodes();
-    let mut a = nalgebra::DMatrix::<f64>::zeros(n, n);
-    for i in 0..t.nodes() {
-        for r in 0..6 {
-            for c in 0..6 {
-                a[(6 * i + r, 6 * i + c)] += t.diag[i][r][c];
-                if i + 1 < t.nodes() {
-                    a[(6 * i + r, 6 * (i + 1) + c)] += t.upper[i][r][c];
-                    a[(6 * (i + 1) + r, 6 * i + c)] += t.lower[i][r][c];
-                }
-            }
-        }
-    }
-    nalgebra::linalg::Cholesky::new((&a + a.transpose()) * 0.5).is_some()
+    t.symmetric_part_positive_definite()
 }
 
 fn dawson_paslay_sinusoidal_buckling(inclination_deg: f64, length: f64) -> f64 {

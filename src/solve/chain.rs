@@ -83,6 +83,31 @@ impl BlockTridiagonal {
         y
     }
 
+    /// Dense copy (small systems: stability checks, tests).
+    pub fn to_dense(&self) -> nalgebra::DMatrix<f64> {
+        let n = self.nodes();
+        let mut a = nalgebra::DMatrix::<f64>::zeros(6 * n, 6 * n);
+        for i in 0..n {
+            for r in 0..6 {
+                for c in 0..6 {
+                    a[(6 * i + r, 6 * i + c)] += self.diag[i][r][c];
+                    if i + 1 < n {
+                        a[(6 * i + r, 6 * (i + 1) + c)] += self.upper[i][r][c];
+                        a[(6 * (i + 1) + r, 6 * i + c)] += self.lower[i][r][c];
+                    }
+                }
+            }
+        }
+        a
+    }
+
+    /// Whether the symmetric part is positive definite (a stable equilibrium when this is
+    /// a constrained tangent).
+    pub fn symmetric_part_positive_definite(&self) -> bool {
+        let a = self.to_dense();
+        nalgebra::linalg::Cholesky::new((&a + a.transpose()) * 0.5).is_some()
+    }
+
     fn triplets(&self) -> Vec<Triplet<usize, usize, f64>> {
         let n = self.nodes();
         let mut t = Vec::with_capacity(36 * (3 * n));

@@ -15,7 +15,7 @@ use crate::physics::beam::{
     force_and_tangent, internal_force, local_deformation, rotation_exp, section_forces,
     ElementState, Mat3, SectionForces,
 };
-use crate::physics::contact::{evaluate, ContactMode, ContactTerms, SpringLaw};
+use crate::physics::contact::{evaluate, ContactMode, ContactResponse, ContactTerms, SpringLaw};
 use crate::physics::vec3::{cross, dot, scale, sub, Vec3};
 use crate::solve::chain::{BlockTridiagonal, ChainSolver, LinearSolveError};
 
@@ -237,6 +237,32 @@ pub fn external_loads(model: &Model) -> Vec<f64> {
     f
 }
 
+/// The static contact element at a site for a configuration (friction direction from the
+/// operation's virtual velocities).
+fn site_response(
+    model: &Model,
+    state: &StaticState,
+    site: &crate::model::Site,
+) -> ContactResponse<f64> {
+    let terms = ContactTerms {
+        spring: SpringLaw::PowerBlend,
+        damping: false,
+        friction: Some(model.friction),
+        mode: ContactMode::Static,
+    };
+    let node = &model.nodes[site.node];
+    let d = sub(&state.x[site.node], &node.position);
+    let v = scale(&node.hole_axis, model.axial_speed);
+    evaluate(
+        &node.hole_axis,
+        &d,
+        &v,
+        model.rotation_speed,
+        &site.params,
+        &terms,
+    )
+}
+
 /// Residual `f_int + g_contact − λ f_ext` and (if `tangent` is given) the tangent, before
 /// constraints.
 fn assemble(
@@ -273,24 +299,8 @@ fn assemble(
             residual[6 * i + j] += f[j];
         }
     }
-    let terms = ContactTerms {
-        spring: SpringLaw::PowerBlend,
-        damping: false,
-        friction: Some(model.friction),
-        mode: ContactMode::Static,
-    };
     for site in &model.sites {
-        let node = &model.nodes[site.node];
-        let d = sub(&state.x[site.node], &node.position);
-        let v = scale(&node.hole_axis, model.axial_speed);
-        let out = evaluate(
-            &node.hole_axis,
-            &d,
-            &v,
-            model.rotation_speed,
-            &site.params,
-            &terms,
-        );
+        let out = site_response(model, state, site);
         if !out.contact {
             continue;
         }
@@ -660,27 +670,13 @@ fn finish(
             section_forces(&def, &e.section, e.length0)
         })
         .collect();
-    let terms = ContactTerms {
-        spring: SpringLaw::PowerBlend,
-        damping: false,
-        friction: Some(model.friction),
-        mode: ContactMode::Static,
-    };
     let contact = model
         .sites
         .iter()
         .map(|site| {
             let node = &model.nodes[site.node];
             let d = sub(&state.x[site.node], &node.position);
-            let v = scale(&node.hole_axis, model.axial_speed);
-            let out = evaluate(
-                &node.hole_axis,
-                &d,
-                &v,
-                model.rotation_speed,
-                &site.params,
-                &terms,
-            );
+            let out = site_response(model, &state, site);
             // Normal force: the radial part of the internal force.
             let d_t = sub(&d, &scale(&node.hole_axis, dot(&d, &node.hole_axis)));
             let r = dot(&d_t, &d_t).sqrt();
