@@ -6,6 +6,7 @@
 pub mod beam;
 pub mod contact;
 pub mod hyperdual;
+pub mod mass;
 pub mod soft_string;
 pub mod vec3;
 

@@ -1,4 +1,5 @@
 //! Solvers: the chain linear algebra and the static equilibrium.
 
 pub mod chain;
+pub mod modal;
 pub mod statics;

@@ -161,12 +161,12 @@ fn mat_mul(a: &Mat3<f64>, b: &Mat3<f64>) -> Mat3<f64> {
 }
 
 /// Constraint data: per node the translation basis (columns) and fixed flags in it.
-struct Constraints {
+pub(crate) struct Constraints {
     basis: Vec<Option<Mat3<f64>>>,
-    fixed: Vec<[bool; 6]>,
+    pub(crate) fixed: Vec<[bool; 6]>,
 }
 
-fn constraints(model: &Model) -> Constraints {
+pub(crate) fn constraints(model: &Model) -> Constraints {
     let n = model.nodes.len();
     let mut basis = vec![None; n];
     let mut fixed = vec![[false; 6]; n];
@@ -335,7 +335,7 @@ fn constrain_residual(c: &Constraints, residual: &mut [f64]) {
 }
 
 /// Applies the translation bases and fixed DOFs to a residual and tangent.
-fn constrain(c: &Constraints, residual: &mut [f64], tangent: &mut BlockTridiagonal) {
+pub(crate) fn constrain(c: &Constraints, residual: &mut [f64], tangent: &mut BlockTridiagonal) {
     let n = tangent.nodes();
     for (i, b) in c.basis.iter().enumerate() {
         let Some(b) = b else { continue };

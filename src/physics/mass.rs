@@ -1,0 +1,146 @@
+//! Mass of a beam element: consistent (Euler–Bernoulli cubic bending, linear axial and
+//! torsional shape functions, with rotary inertia) or lumped (half the mass and rotary
+//! inertia to each node), in the element frame, then rotated to global axes.
+
+use super::beam::{BeamSection, Mat3};
+
+/// Mass matrix kind.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum MassKind {
+    /// Consistent: the shape functions of the stiffness.
+    Consistent,
+    /// Lumped: `ρAl/2` and `ρI_p l/2`, `ρI l/2` at each node (diagonal).
+    Lumped,
+}
+
+/// Element mass matrix (12×12, DOFs `[u1, θ1, u2, θ2]`) in the element frame `e1` (axis),
+/// `e2`, `e3`. `density` in kg/m³; `added_mass_per_length` (kg/m, e.g. mud inside the pipe
+/// and entrained outside) adds to the translational mass only.
+pub fn local_mass(
+    section: &BeamSection,
+    density: f64,
+    added_mass_per_length: f64,
+    l: f64,
+    kind: MassKind,
+) -> [[f64; 12]; 12] {
+    let mut m = [[0.0; 12]; 12];
+    let mt = density * section.area + added_mass_per_length; // kg/m, translational
+    let ip = density * section.polar_moment; // kg·m, torsional
+    let ib = density * section.second_moment; // kg·m, rotary (bending)
+    match kind {
+        MassKind::Lumped => {
+            for node in 0..2 {
+                let o = 6 * node;
+                for k in 0..3 {
+                    m[o + k][o + k] = 0.5 * mt * l;
+                }
+                m[o + 3][o + 3] = 0.5 * ip * l;
+                m[o + 4][o + 4] = 0.5 * ib * l;
+                m[o + 5][o + 5] = 0.5 * ib * l;
+            }
+        }
+        MassKind::Consistent => {
+            // Axial (u_x) and torsion (θ_x): linear shape functions, (l/6)[2 1; 1 2].
+            for (dof, rho) in [(0usize, mt), (3usize, ip)] {
+                m[dof][dof] = rho * l / 3.0;
+                m[dof + 6][dof + 6] = rho * l / 3.0;
+                m[dof][dof + 6] = rho * l / 6.0;
+                m[dof + 6][dof] = rho * l / 6.0;
+            }
+            // Bending: translation w with rotation θ, for (w, θ) = (u_y, θ_z) and (u_z, −θ_y).
+            for (w, th, sign) in [(1usize, 5usize, 1.0), (2usize, 4usize, -1.0)] {
+                let c = mt * l / 420.0;
+                let idx = [w, th, w + 6, th + 6];
+                let s = [1.0, sign, 1.0, sign];
+                let base = [
+                    [156.0, 22.0 * l, 54.0, -13.0 * l],
+                    [22.0 * l, 4.0 * l * l, 13.0 * l, -3.0 * l * l],
+                    [54.0, 13.0 * l, 156.0, -22.0 * l],
+                    [-13.0 * l, -3.0 * l * l, -22.0 * l, 4.0 * l * l],
+                ];
+                // Rotary inertia (ρI/(30 l)).
+                let r = ib / (30.0 * l);
+                let rot = [
+                    [36.0, 3.0 * l, -36.0, 3.0 * l],
+                    [3.0 * l, 4.0 * l * l, -3.0 * l, -l * l],
+                    [-36.0, -3.0 * l, 36.0, -3.0 * l],
+                    [3.0 * l, -l * l, -3.0 * l, 4.0 * l * l],
+                ];
+                for a in 0..4 {
+                    for b in 0..4 {
+                        m[idx[a]][idx[b]] += s[a] * s[b] * (c * base[a][b] + r * rot[a][b]);
+                    }
+                }
+            }
+        }
+    }
+    m
+}
+
+/// Rotates a 12×12 element matrix from the element frame (columns of `frame`) to global axes.
+pub fn to_global(local: &[[f64; 12]; 12], frame: &Mat3<f64>) -> [[f64; 12]; 12] {
+    // T = blockdiag(Q, Q, Q, Q), global = T · local · Tᵀ.
+    let q = |r: usize, c: usize| -> f64 {
+        if r / 3 == c / 3 {
+            frame[r % 3][c % 3]
+        } else {
+            0.0
+        }
+    };
+    let mut tmp = [[0.0; 12]; 12];
+    for r in 0..12 {
+        for c in 0..12 {
+            tmp[r][c] = (0..12).map(|k| q(r, k) * local[k][c]).sum();
+        }
+    }
+    let mut out = [[0.0; 12]; 12];
+    for r in 0..12 {
+        for c in 0..12 {
+            out[r][c] = (0..12).map(|k| tmp[r][k] * q(c, k)).sum();
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn total_mass_and_rigid_body_kinetic_energy() {
+        let s = BeamSection::tube(0.165, 0.071, 2.1e11, 0.3);
+        let l = 3.0;
+        for kind in [MassKind::Consistent, MassKind::Lumped] {
+            let m = local_mass(&s, 7850.0, 0.0, l, kind);
+            // A rigid translation along each axis carries the element's whole mass.
+            let mass = 7850.0 * s.area * l;
+            for axis in 0..3 {
+                let mut v = [0.0; 12];
+                v[axis] = 1.0;
+                v[axis + 6] = 1.0;
+                let ke: f64 = (0..12)
+                    .map(|r| (0..12).map(|c| v[r] * m[r][c] * v[c]).sum::<f64>())
+                    .sum();
+                assert!(
+                    (ke - mass).abs() < 1e-9 * mass,
+                    "{kind:?} axis {axis}: {ke} vs {mass}"
+                );
+            }
+            // A rigid spin about the axis carries ρ I_p l.
+            let mut v = [0.0; 12];
+            v[3] = 1.0;
+            v[9] = 1.0;
+            let ke: f64 = (0..12)
+                .map(|r| (0..12).map(|c| v[r] * m[r][c] * v[c]).sum::<f64>())
+                .sum();
+            let ip = 7850.0 * s.polar_moment * l;
+            assert!((ke - ip).abs() < 1e-9 * ip);
+            // Symmetric.
+            for r in 0..12 {
+                for c in 0..12 {
+                    assert!((m[r][c] - m[c][r]).abs() < 1e-12 * mass);
+                }
+            }
+        }
+    }
+}
