@@ -87,18 +87,12 @@ pub fn to_global(local: &[[f64; 12]; 12], frame: &Mat3<f64>) -> [[f64; 12]; 12] 
             0.0
         }
     };
-    let mut tmp = [[0.0; 12]; 12];
-    for r in 0..12 {
-        for c in 0..12 {
-            tmp[r][c] = (0..12).map(|k| q(r, k) * local[k][c]).sum();
-        }
-    }
-    let mut out = [[0.0; 12]; 12];
-    for r in 0..12 {
-        for c in 0..12 {
-            out[r][c] = (0..12).map(|k| tmp[r][k] * q(c, k)).sum();
-        }
-    }
+    let tmp: [[f64; 12]; 12] = std::array::from_fn(|r| {
+        std::array::from_fn(|c| (0..12).map(|k| q(r, k) * local[k][c]).sum())
+    });
+    let out: [[f64; 12]; 12] = std::array::from_fn(|r| {
+        std::array::from_fn(|c| (0..12).map(|k| tmp[r][k] * q(c, k)).sum())
+    });
     out
 }
 
