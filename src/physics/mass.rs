@@ -97,6 +97,7 @@ pub fn to_global(local: &[[f64; 12]; 12], frame: &Mat3<f64>) -> [[f64; 12]; 12] 
 }
 
 #[cfg(test)]
+#[allow(clippy::needless_range_loop)]
 mod tests {
     use super::*;
 
