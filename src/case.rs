@@ -142,6 +142,59 @@ pub struct MeshSpec {
     pub bha_element_length: Option<Q>,
 }
 
+/// `[dynamics]`: the time integration (`holewall run`).
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DynamicsSpec {
+    /// Simulated time.
+    pub duration: Q,
+    /// Time step (default 1e-3 s).
+    pub time_step: Option<Q>,
+    /// Output interval (default 0.01 s).
+    pub output_interval: Option<Q>,
+    /// Rotary-table ramp time from rest to the operation's rpm (default 0: at speed).
+    pub ramp_time: Option<Q>,
+    /// Spectral radius at infinity ρ∞ ∈ [0, 1] (default 0.8).
+    pub rho_inf: Option<Spanned<f64>>,
+    /// Rayleigh damping `a0` (1/s, mass-proportional; default 0).
+    pub rayleigh_mass: Option<Spanned<f64>>,
+    /// Rayleigh damping `a1` (s, stiffness-proportional; default 0).
+    pub rayleigh_stiffness: Option<Spanned<f64>>,
+    /// Outputs to record: `bit_displacement`, `lateral`, `contact_forces`, `spin`,
+    /// `surface_torque`, `axial_stress`, `energy` (default: all).
+    pub outputs: Option<Vec<Spanned<String>>>,
+}
+
+/// Checked `[dynamics]` settings.
+#[derive(Clone, Debug)]
+pub struct DynamicsSettings {
+    /// Simulated time (s).
+    pub duration: f64,
+    /// Time step (s).
+    pub time_step: f64,
+    /// Output interval (s).
+    pub output_interval: f64,
+    /// Table ramp time (s).
+    pub ramp_time: f64,
+    /// ρ∞.
+    pub rho_inf: f64,
+    /// Rayleigh (a0, a1).
+    pub rayleigh: (f64, f64),
+    /// Outputs requested.
+    pub outputs: Vec<String>,
+}
+
+/// Every output `holewall run` can record.
+pub const DYNAMIC_OUTPUTS: &[&str] = &[
+    "bit_displacement",
+    "lateral",
+    "contact_forces",
+    "spin",
+    "surface_torque",
+    "axial_stress",
+    "energy",
+];
+
 /// A whole case file.
 #[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -162,6 +215,8 @@ pub struct CaseSpec {
     pub contact: Option<ContactSpec>,
     /// Mesh settings.
     pub mesh: Option<MeshSpec>,
+    /// Time integration (`holewall run`).
+    pub dynamics: Option<DynamicsSpec>,
 }
 
 /// A case read and checked, ready to build a model.
@@ -179,6 +234,10 @@ pub struct Case {
     pub bit_md: f64,
     /// Mud density (kg/m³).
     pub mud_density: f64,
+    /// Steel density per element (kg/m³).
+    pub element_density: Vec<f64>,
+    /// `[dynamics]`, if given.
+    pub dynamics: Option<DynamicsSettings>,
 }
 
 struct Ctx<'a> {
@@ -848,6 +907,15 @@ pub fn parse_case(path: &Path, text: &str) -> Result<Case, InputError> {
         );
     }
     model.sites.sort_by_key(|s| s.node);
+    let element_density = model
+        .elements
+        .iter()
+        .map(|e| tubulars[e.component].density)
+        .collect();
+    let dynamics = match &spec.dynamics {
+        None => None,
+        Some(d) => Some(dynamics_settings(&ctx, d)?),
+    };
     Ok(Case {
         title: spec.title.unwrap_or_default(),
         path: path.to_path_buf(),
@@ -855,5 +923,96 @@ pub fn parse_case(path: &Path, text: &str) -> Result<Case, InputError> {
         hole,
         bit_md,
         mud_density: mud,
+        element_density,
+        dynamics,
+    })
+}
+
+fn dynamics_settings(ctx: &Ctx, d: &DynamicsSpec) -> Result<DynamicsSettings, InputError> {
+    let duration = ctx.quantity(
+        &d.duration,
+        "dynamics.duration",
+        Dimension::Time,
+        |x| x > 0.0 && x <= 1e5,
+        "0 < duration ≤ 1e5 s",
+    )?;
+    let opt = |q: &Option<Q>,
+               key: &str,
+               default: f64,
+               ok: &dyn Fn(f64) -> bool,
+               range: &str|
+     -> Result<f64, InputError> {
+        match q {
+            Some(q) => ctx.quantity(q, key, Dimension::Time, ok, range),
+            None => Ok(default),
+        }
+    };
+    let time_step = opt(
+        &d.time_step,
+        "dynamics.time_step",
+        1e-3,
+        &|x| x > 0.0 && x <= duration,
+        "0 < time_step ≤ duration",
+    )?;
+    let output_interval = opt(
+        &d.output_interval,
+        "dynamics.output_interval",
+        1e-2_f64.max(time_step),
+        &|x| x >= time_step && x <= duration,
+        "time_step ≤ interval ≤ duration",
+    )?;
+    let ramp_time = opt(
+        &d.ramp_time,
+        "dynamics.ramp_time",
+        0.0,
+        &|x| x >= 0.0,
+        "≥ 0",
+    )?;
+    let rho_inf = match &d.rho_inf {
+        Some(q) => ctx.number(
+            q,
+            "dynamics.rho_inf",
+            |x| (0.0..=1.0).contains(&x),
+            "0 ≤ ρ∞ ≤ 1",
+        )?,
+        None => 0.8,
+    };
+    let a0 = match &d.rayleigh_mass {
+        Some(q) => ctx.number(q, "dynamics.rayleigh_mass", |x| x >= 0.0, "≥ 0 (1/s)")?,
+        None => 0.0,
+    };
+    let a1 = match &d.rayleigh_stiffness {
+        Some(q) => ctx.number(q, "dynamics.rayleigh_stiffness", |x| x >= 0.0, "≥ 0 (s)")?,
+        None => 0.0,
+    };
+    let outputs = match &d.outputs {
+        None => DYNAMIC_OUTPUTS.iter().map(|s| s.to_string()).collect(),
+        Some(list) => {
+            let mut out = Vec::new();
+            for o in list {
+                if !DYNAMIC_OUTPUTS.contains(&o.get_ref().as_str()) {
+                    return Err(ctx.err(
+                        o.span(),
+                        "dynamics.outputs",
+                        format!(
+                            "unknown output {:?}; allowed: {}",
+                            o.get_ref(),
+                            DYNAMIC_OUTPUTS.join(", ")
+                        ),
+                    ));
+                }
+                out.push(o.get_ref().clone());
+            }
+            out
+        }
+    };
+    Ok(DynamicsSettings {
+        duration,
+        time_step,
+        output_interval,
+        ramp_time,
+        rho_inf,
+        rayleigh: (a0, a1),
+        outputs,
     })
 }

@@ -49,6 +49,18 @@ enum Command {
         #[arg(long)]
         out: PathBuf,
     },
+    /// Dynamic analysis: spin-up from the static equilibrium, implicit time integration
+    /// (time series CSV and plots).
+    Run {
+        /// Case file with a [dynamics] table.
+        case: PathBuf,
+        /// Output folder.
+        #[arg(long)]
+        out: PathBuf,
+        /// No progress bar.
+        #[arg(long)]
+        quiet: bool,
+    },
     /// Benchmarks (medians over repeats; GPU/CPU ratios from the same run).
     Bench {
         #[command(subcommand)]
@@ -129,6 +141,16 @@ fn main() -> ExitCode {
             }
         }
         Command::Static { case, model, out } => match cli::static_cmd::run(&case, model, &out) {
+            Ok(summary) => {
+                println!(
+                    "{}",
+                    serde_json::to_string_pretty(&summary).unwrap_or_default()
+                );
+                ExitCode::SUCCESS
+            }
+            Err(e) => fail(&[e]),
+        },
+        Command::Run { case, out, quiet } => match cli::run_cmd::run(&case, &out, !quiet) {
             Ok(summary) => {
                 println!(
                     "{}",

@@ -279,3 +279,97 @@ fn bad_input_names_file_line_key_and_range() {
         );
     }
 }
+
+#[test]
+fn run_writes_the_requested_time_series_and_plots() {
+    let path = root().join("cases/spinup_short.toml");
+    let out = scratch("run-all");
+    let (code, stdout, stderr) = holewall(&[
+        "run",
+        path.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--quiet",
+    ]);
+    assert_eq!(code, 0, "{stderr}");
+    let summary: serde_json::Value = serde_json::from_str(&stdout).unwrap();
+    assert_eq!(summary["steps"].as_u64(), Some(500));
+    for f in [
+        "timeseries.csv",
+        "contact_sites.csv",
+        "axial_stress.csv",
+        "bit_displacement.png",
+        "orbit_site0.png",
+        "spin_site0.png",
+        "energy.png",
+    ] {
+        assert!(out.join(f).is_file(), "{f} missing");
+    }
+    // The stabilizer spins up with the table: its mean spin over the last 0.3 s is near 120 rpm.
+    let sites = std::fs::read_to_string(out.join("contact_sites.csv")).unwrap();
+    let spins: Vec<f64> = sites
+        .lines()
+        .skip(1)
+        .filter_map(|l| {
+            let f: Vec<f64> = l.split(',').map(|x| x.parse().unwrap()).collect();
+            (f[0] >= 0.7).then_some(f[7])
+        })
+        .collect();
+    let mean = spins.iter().sum::<f64>() / spins.len() as f64;
+    assert!(
+        (mean / (4.0 * std::f64::consts::PI) - 1.0).abs() < 0.1,
+        "mean spin {mean}"
+    );
+
+    // Only what the case asks for.
+    let text = std::fs::read_to_string(&path)
+        .unwrap()
+        .replace(
+            "rho_inf = 0.8",
+            "rho_inf = 0.8\noutputs = [\"bit_displacement\"]",
+        )
+        .replace("duration = \"1 s\"", "duration = \"0.1 s\"");
+    let dir = scratch("run-some");
+    let case = write_case(&dir, &text);
+    let out = dir.join("out");
+    let (code, _, stderr) = holewall(&[
+        "run",
+        case.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--quiet",
+    ]);
+    assert_eq!(code, 0, "{stderr}");
+    assert!(out.join("bit_displacement.png").is_file());
+    assert!(
+        !out.join("contact_sites.csv").exists()
+            && !out.join("axial_stress.csv").exists()
+            && !out.join("energy.png").exists()
+    );
+    let header = std::fs::read_to_string(out.join("timeseries.csv"))
+        .unwrap()
+        .lines()
+        .next()
+        .unwrap()
+        .to_string();
+    assert_eq!(header, "t_s,bit_axial_displacement_m");
+
+    // An unknown output is an input error.
+    let bad = text.replace(
+        "outputs = [\"bit_displacement\"]",
+        "outputs = [\"bit_displacement\", \"vibes\"]",
+    );
+    let case = write_case(&dir, &bad);
+    let (code, _, stderr) = holewall(&[
+        "run",
+        case.to_str().unwrap(),
+        "--out",
+        dir.join("out2").to_str().unwrap(),
+        "--quiet",
+    ]);
+    assert_eq!(code, 2, "{stderr}");
+    assert!(
+        stderr.contains("dynamics.outputs") && stderr.contains("vibes"),
+        "{stderr}"
+    );
+}

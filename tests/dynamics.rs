@@ -169,9 +169,16 @@ fn damped_run_settles_to_the_static_solution() {
     m.point_loads = vec![(bit, [2000.0, 0.0, 0.0, 0.0, 0.0, 0.0])];
     let static_tip = solve_static(&m, &StaticOptions::default()).unwrap().state.x[bit][0];
     // Mass-proportional Rayleigh damping, about 30 % of critical in the first mode (1.29 Hz).
-    let options = DynamicOptions { dt: 0.01, rayleigh: (2.0 * 0.3 * 8.1, 0.0), alpha: AlphaParams::chung_hulbert(0.8), ..Default::default() };
+    let options = DynamicOptions {
+        dt: 0.01,
+        rayleigh: (2.0 * 0.3 * 8.1, 0.0),
+        alpha: AlphaParams::chung_hulbert(0.8),
+        ..Default::default()
+    };
     let mut dynamics = Dynamics::new(&m, options, &|_| RHO);
-    let mut s = dynamics.initial_state(holewall::solve::statics::StaticState::initial(&m)).unwrap();
+    let mut s = dynamics
+        .initial_state(holewall::solve::statics::StaticState::initial(&m))
+        .unwrap();
     let mut peak: f64 = 0.0;
     dynamics
         .run(&mut s, 12.0, &mut |_, st| {
@@ -180,7 +187,10 @@ fn damped_run_settles_to_the_static_solution() {
         .unwrap();
     let tip = s.q.x[bit][0];
     eprintln!("settled tip {tip:.6e} m vs static {static_tip:.6e} m (overshoot peak {peak:.4e} m)");
-    assert!(peak > 1.2 * static_tip, "the load was applied suddenly: it must overshoot");
+    assert!(
+        peak > 1.2 * static_tip,
+        "the load was applied suddenly: it must overshoot"
+    );
     assert!((tip / static_tip - 1.0).abs() <= 1e-4);
     let v: f64 = s.v.iter().fold(0.0, |m, x| m.max(x.abs()));
     assert!(v < 1e-5, "still moving: {v:e}");
@@ -192,7 +202,12 @@ fn hht_is_second_order_and_dissipative() {
     assert!((p.gamma - 0.6).abs() < 1e-15 && (p.beta - 0.3025).abs() < 1e-15 && p.alpha_m == 0.0);
     let m = cantilever(10.0, 10);
     let (m, start) = released(&m, 50.0);
-    let options = DynamicOptions { dt: 2e-3, alpha: p, tolerance: 1e-10, ..Default::default() };
+    let options = DynamicOptions {
+        dt: 2e-3,
+        alpha: p,
+        tolerance: 1e-10,
+        ..Default::default()
+    };
     let mut dynamics = Dynamics::new(&m, options, &|_| RHO);
     let mut s = dynamics.initial_state(start).unwrap();
     let e0 = dynamics.kinetic_energy(&s) + strain_energy(&m, &s.q);
@@ -200,5 +215,8 @@ fn hht_is_second_order_and_dissipative() {
         dynamics.step(&mut s, 2e-3).unwrap();
     }
     let e1 = dynamics.kinetic_energy(&s) + strain_energy(&m, &s.q);
-    assert!(e1 < e0 && e1 > 0.5 * e0, "HHT dissipates, mildly at low frequency: {e0} → {e1}");
+    assert!(
+        e1 < e0 && e1 > 0.5 * e0,
+        "HHT dissipates, mildly at low frequency: {e0} → {e1}"
+    );
 }

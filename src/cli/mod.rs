@@ -3,4 +3,5 @@
 pub mod bench;
 pub mod contact;
 pub mod gpu_info;
+pub mod run_cmd;
 pub mod static_cmd;

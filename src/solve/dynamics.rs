@@ -17,7 +17,6 @@
 //! The top node is clamped to the rotary table, whose rotation about the (vertical) axis is
 //! prescribed: a ramp from rest to the operation's speed over `ramp_time`.
 
-
 // Index loops over 3×3 and 6×6 blocks read like the formulas.
 #![allow(clippy::needless_range_loop)]
 use crate::model::Model;
@@ -390,6 +389,45 @@ impl<'a> Dynamics<'a> {
             add_scaled(&mut s_mat, &k_t, hhb);
         }
         (r, s_mat)
+    }
+
+    /// Force and moment the rotary table exerts on the string's top node (N, N·m).
+    pub fn top_reaction(&mut self, s: &DynamicState) -> [f64; 6] {
+        let (r, _) = self.residual_and_matrix(s, 0.0, 0.0, false);
+        std::array::from_fn(|k| r[k])
+    }
+
+    /// The contact response of each site at a state (dynamic mode).
+    pub fn contact_forces(
+        &self,
+        s: &DynamicState,
+    ) -> Vec<crate::physics::contact::ContactResponse<f64>> {
+        let model = self.model;
+        let terms = ContactTerms {
+            spring: SpringLaw::PowerBlend,
+            damping: true,
+            friction: Some(model.friction),
+            mode: ContactMode::Dynamic,
+        };
+        model
+            .sites
+            .iter()
+            .map(|site| {
+                let i = site.node;
+                let node = &model.nodes[i];
+                let d = sub(&s.q.x[i], &node.position);
+                let v: Vec3<f64> = std::array::from_fn(|k| s.v[6 * i + k]);
+                let w: Vec3<f64> = std::array::from_fn(|k| s.v[6 * i + 3 + k]);
+                evaluate(
+                    &node.hole_axis,
+                    &d,
+                    &v,
+                    dot(&node.hole_axis, &w),
+                    &site.params,
+                    &terms,
+                )
+            })
+            .collect()
     }
 
     /// Advances `s` by one step of size `h`; on failure `s` is unchanged.

@@ -1,0 +1,417 @@
+//! `holewall run CASE --out DIR`: the string spun up from its static equilibrium and
+//! integrated in time (paper §3.1, Figs 5–10), with a progress bar. Writes only the outputs
+//! the case's `[dynamics].outputs` asks for.
+
+use std::path::Path;
+
+use serde::Serialize;
+
+use crate::case::{load_case, Case};
+use crate::error::{Error, InputError};
+use crate::output::write_atomic;
+use crate::physics::beam::{local_deformation, section_forces, Mat3};
+use crate::physics::vec3::{dot, scale, sub};
+use crate::plots::{line_plot, Series};
+use crate::solve::dynamics::{strain_energy, AlphaParams, DynamicOptions, DynamicState, Dynamics};
+use crate::solve::statics::{solve_static, StaticOptions};
+
+/// `summary.json` of a run.
+#[derive(Clone, Debug, Serialize)]
+pub struct RunSummary {
+    /// Case title.
+    pub title: String,
+    /// Simulated time (s).
+    pub duration_s: f64,
+    /// Completed steps.
+    pub steps: usize,
+    /// Mean Newton iterations per step.
+    pub mean_newton_iterations: f64,
+    /// Step cuts and regrowth.
+    pub log: Vec<String>,
+    /// Outputs written.
+    pub outputs: Vec<String>,
+}
+
+fn mat_mul(a: &Mat3<f64>, b: &Mat3<f64>) -> Mat3<f64> {
+    std::array::from_fn(|r| std::array::from_fn(|c| (0..3).map(|k| a[r][k] * b[k][c]).sum()))
+}
+
+struct Recorder {
+    series: Vec<[f64; 6]>, // t, bit axial displacement, surface torque, KE, SE, KE+SE
+    sites: Vec<(f64, usize, [f64; 5])>, // t, site, [lateral x, lateral y, radius, normal force, spin]
+    stress: Vec<(f64, f64, f64)>,       // t, md, axial stress
+}
+
+fn record(
+    case: &Case,
+    dynamics: &Dynamics,
+    s: &DynamicState,
+    rec: &mut Recorder,
+    want: &dyn Fn(&str) -> bool,
+) {
+    let model = &case.model;
+    let n = model.nodes.len();
+    let bit = n - 1;
+    let tb = model.nodes[bit].hole_axis;
+    let bit_axial = dot(&sub(&s.q.x[bit], &model.nodes[bit].position), &tb);
+    let forces = |i: usize| {
+        let e = &model.elements[i];
+        let t1 = mat_mul(&s.q.rot[i], &model.nodes[i].frame0);
+        let t2 = mat_mul(&s.q.rot[i + 1], &model.nodes[i + 1].frame0);
+        section_forces(
+            &local_deformation(&s.q.x[i], &s.q.x[i + 1], &t1, &t2, e.length0),
+            &e.section,
+            e.length0,
+        )
+    };
+    let torque = forces(0).torque.abs();
+    let ke = if want("energy") {
+        dynamics.kinetic_energy(s)
+    } else {
+        0.0
+    };
+    let se = if want("energy") {
+        strain_energy(model, &s.q)
+    } else {
+        0.0
+    };
+    rec.series.push([s.t, bit_axial, torque, ke, se, ke + se]);
+    if want("lateral") || want("contact_forces") || want("spin") {
+        let contact = dynamics.contact_forces(s);
+        for (k, (site, out)) in model.sites.iter().zip(contact).enumerate() {
+            let node = &model.nodes[site.node];
+            let d = sub(&s.q.x[site.node], &node.position);
+            let d_t = sub(&d, &scale(&node.hole_axis, dot(&d, &node.hole_axis)));
+            let f = &node.frame0;
+            let (ex, ey) = ([f[0][1], f[1][1], f[2][1]], [f[0][2], f[1][2], f[2][2]]);
+            let r = dot(&d_t, &d_t).sqrt();
+            let normal = if r > 0.0 {
+                dot(&[out.g[0], out.g[1], out.g[2]], &d_t) / r
+            } else {
+                0.0
+            };
+            let w: [f64; 3] = std::array::from_fn(|j| s.v[6 * site.node + 3 + j]);
+            rec.sites.push((
+                s.t,
+                k,
+                [
+                    dot(&d_t, &ex),
+                    dot(&d_t, &ey),
+                    r,
+                    normal,
+                    dot(&node.hole_axis, &w),
+                ],
+            ));
+        }
+    }
+    if want("axial_stress") {
+        for i in 0..model.elements.len() {
+            let md = 0.5 * (model.nodes[i].md + model.nodes[i + 1].md);
+            rec.stress
+                .push((s.t, md, forces(i).axial / model.elements[i].section.area));
+        }
+    }
+}
+
+fn csv_bytes(header: &[&str], rows: impl Iterator<Item = Vec<f64>>) -> Result<Vec<u8>, Error> {
+    let mut w = csv::Writer::from_writer(Vec::new());
+    w.write_record(header)
+        .map_err(|e| Error::Io(std::io::Error::other(e)))?;
+    for r in rows {
+        w.write_record(r.iter().map(|x| x.to_string()))
+            .map_err(|e| Error::Io(std::io::Error::other(e)))?;
+    }
+    w.into_inner()
+        .map_err(|e| Error::Io(std::io::Error::other(e.to_string())))
+}
+
+/// Runs the command.
+pub fn run(case_path: &Path, out: &Path, show_progress: bool) -> Result<RunSummary, Error> {
+    let case = load_case(case_path)?;
+    let settings = case.dynamics.clone().ok_or_else(|| {
+        Error::Input(InputError { source_name: case_path.display().to_string(), line: 1, key: "dynamics".into(), message: "holewall run needs a [dynamics] table (duration, time_step, …); see cases/README.md".into() })
+    })?;
+    let model = &case.model;
+    let start = solve_static(model, &StaticOptions::default())
+        .map_err(|e| Error::Io(std::io::Error::other(format!("static start: {e}"))))?;
+    let options = DynamicOptions {
+        dt: settings.time_step,
+        alpha: AlphaParams::chung_hulbert(settings.rho_inf),
+        rayleigh: settings.rayleigh,
+        ramp_time: settings.ramp_time,
+        ..Default::default()
+    };
+    let density = case.element_density.clone();
+    let mut dynamics = Dynamics::new(model, options, &|e| density[e]);
+    let mut s = dynamics
+        .initial_state(start.state)
+        .map_err(|e| Error::Io(std::io::Error::other(e)))?;
+    let want = |name: &str| settings.outputs.iter().any(|o| o == name);
+    let mut rec = Recorder {
+        series: Vec::new(),
+        sites: Vec::new(),
+        stress: Vec::new(),
+    };
+    record(&case, &dynamics, &s, &mut rec, &want);
+    let bar = if show_progress {
+        indicatif::ProgressBar::new(1000)
+    } else {
+        indicatif::ProgressBar::hidden()
+    };
+    bar.set_style(
+        indicatif::ProgressStyle::with_template(
+            "{bar:40} {percent:>3}% t = {msg} s, {elapsed} elapsed, eta {eta}",
+        )
+        .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+    );
+    let mut next_output = settings.output_interval;
+    let mut pending: Vec<DynamicState> = Vec::new();
+    dynamics
+        .run(&mut s, settings.duration, &mut |_, st| {
+            bar.set_position((1000.0 * st.t / settings.duration) as u64);
+            bar.set_message(format!("{:.3}", st.t));
+            if st.t >= next_output - 1e-9 {
+                pending.push(st.clone());
+                next_output += settings.output_interval;
+            }
+        })
+        .map_err(|e| Error::Io(std::io::Error::other(e)))?;
+    bar.finish_and_clear();
+    for st in &pending {
+        record(&case, &dynamics, st, &mut rec, &want);
+    }
+
+    std::fs::create_dir_all(out)?;
+    let mut written = Vec::new();
+    let t: Vec<f64> = rec.series.iter().map(|r| r[0]).collect();
+    let col = |k: usize| -> Vec<(f64, f64)> { rec.series.iter().map(|r| (r[0], r[k])).collect() };
+    let mut header = vec!["t_s"];
+    let mut cols = vec![0usize];
+    for (name, h, k) in [
+        ("bit_displacement", "bit_axial_displacement_m", 1),
+        ("surface_torque", "surface_torque_nm", 2),
+    ] {
+        if want(name) {
+            header.push(h);
+            cols.push(k);
+        }
+    }
+    if want("energy") {
+        header.extend(["kinetic_energy_j", "strain_energy_j", "mechanical_energy_j"]);
+        cols.extend([3, 4, 5]);
+    }
+    write_atomic(
+        &out.join("timeseries.csv"),
+        &csv_bytes(
+            &header,
+            rec.series
+                .iter()
+                .map(|r| cols.iter().map(|&k| r[k]).collect()),
+        )?,
+    )?;
+    written.push("timeseries.csv".to_string());
+    let title = &case.title;
+    if want("bit_displacement") {
+        line_plot(
+            &out.join("bit_displacement.png"),
+            &format!("{title}: bit axial displacement (Fig 5)"),
+            "t (s)",
+            "displacement along the hole axis, down + (m)",
+            &[Series {
+                name: "bit",
+                points: col(1),
+            }],
+            &[],
+        )?;
+        written.push("bit_displacement.png".into());
+    }
+    if want("surface_torque") {
+        line_plot(
+            &out.join("surface_torque.png"),
+            &format!("{title}: surface torque"),
+            "t (s)",
+            "torque (N·m)",
+            &[Series {
+                name: "top",
+                points: col(2),
+            }],
+            &[],
+        )?;
+        written.push("surface_torque.png".into());
+    }
+    if want("energy") {
+        line_plot(
+            &out.join("energy.png"),
+            &format!("{title}: energy"),
+            "t (s)",
+            "energy (J)",
+            &[
+                Series {
+                    name: "kinetic",
+                    points: col(3),
+                },
+                Series {
+                    name: "strain",
+                    points: col(4),
+                },
+                Series {
+                    name: "kinetic + strain",
+                    points: col(5),
+                },
+            ],
+            &[],
+        )?;
+        written.push("energy.png".into());
+    }
+    if !rec.sites.is_empty() {
+        let header = [
+            "t_s",
+            "site",
+            "md_m",
+            "lateral_x_m",
+            "lateral_y_m",
+            "lateral_radius_m",
+            "normal_force_n",
+            "spin_rate_rad_s",
+        ];
+        let rows = rec.sites.iter().map(|(t, k, v)| {
+            vec![
+                *t,
+                *k as f64,
+                model.nodes[model.sites[*k].node].md,
+                v[0],
+                v[1],
+                v[2],
+                v[3],
+                v[4],
+            ]
+        });
+        write_atomic(&out.join("contact_sites.csv"), &csv_bytes(&header, rows)?)?;
+        written.push("contact_sites.csv".into());
+        for (k, site) in model.sites.iter().enumerate().filter(|(_, s)| s.stabilizer) {
+            let pts = |j: usize| -> Vec<(f64, f64)> {
+                rec.sites
+                    .iter()
+                    .filter(|r| r.1 == k)
+                    .map(|r| (r.0, r.2[j]))
+                    .collect()
+            };
+            let md = model.nodes[site.node].md;
+            if want("lateral") {
+                line_plot(
+                    &out.join(format!("lateral_site{k}.png")),
+                    &format!("{title}: lateral displacement at MD {md:.1} m (Fig 6)"),
+                    "t (s)",
+                    "radial displacement (m)",
+                    &[Series {
+                        name: "radius",
+                        points: pts(2),
+                    }],
+                    &[],
+                )?;
+                let orbit: Vec<(f64, f64)> = rec
+                    .sites
+                    .iter()
+                    .filter(|r| r.1 == k)
+                    .map(|r| (r.2[0], r.2[1]))
+                    .collect();
+                line_plot(
+                    &out.join(format!("orbit_site{k}.png")),
+                    &format!("{title}: orbit at MD {md:.1} m (Fig 7)"),
+                    "x (m)",
+                    "y (m)",
+                    &[Series {
+                        name: "orbit",
+                        points: orbit,
+                    }],
+                    &[],
+                )?;
+                written.push(format!("lateral_site{k}.png"));
+                written.push(format!("orbit_site{k}.png"));
+            }
+            if want("contact_forces") {
+                line_plot(
+                    &out.join(format!("contact_force_site{k}.png")),
+                    &format!("{title}: contact force at MD {md:.1} m"),
+                    "t (s)",
+                    "normal force (N)",
+                    &[Series {
+                        name: "N",
+                        points: pts(3),
+                    }],
+                    &[],
+                )?;
+                written.push(format!("contact_force_site{k}.png"));
+            }
+            if want("spin") {
+                line_plot(
+                    &out.join(format!("spin_site{k}.png")),
+                    &format!("{title}: stabilizer spin rate at MD {md:.1} m"),
+                    "t (s)",
+                    "spin rate (rad/s)",
+                    &[Series {
+                        name: "spin",
+                        points: pts(4),
+                    }],
+                    &[],
+                )?;
+                written.push(format!("spin_site{k}.png"));
+            }
+        }
+    }
+    if want("axial_stress") {
+        let rows = rec.stress.iter().map(|(t, md, s)| vec![*t, *md, *s]);
+        write_atomic(
+            &out.join("axial_stress.csv"),
+            &csv_bytes(&["t_s", "md_m", "axial_stress_pa"], rows)?,
+        )?;
+        written.push("axial_stress.csv".into());
+        // Stress along MD at the start and at the end (Figs 8, 10).
+        let at = |time: f64| -> Vec<(f64, f64)> {
+            rec.stress
+                .iter()
+                .filter(|r| (r.0 - time).abs() < 1e-12)
+                .map(|r| (r.1, r.2))
+                .collect()
+        };
+        let (t0, t1) = (
+            t.first().copied().unwrap_or(0.0),
+            t.last().copied().unwrap_or(0.0),
+        );
+        line_plot(
+            &out.join("axial_stress.png"),
+            &format!("{title}: axial stress along the string (Figs 8, 10)"),
+            "MD (m)",
+            "axial stress (Pa)",
+            &[
+                Series {
+                    name: &format!("t = {t0:.2} s"),
+                    points: at(t0),
+                },
+                Series {
+                    name: &format!("t = {t1:.2} s"),
+                    points: at(t1),
+                },
+            ],
+            &[],
+        )?;
+        written.push("axial_stress.png".into());
+    }
+    let steps = dynamics.iterations.len();
+    let summary = RunSummary {
+        title: case.title.clone(),
+        duration_s: s.t,
+        steps,
+        mean_newton_iterations: dynamics.iterations.iter().sum::<usize>() as f64
+            / steps.max(1) as f64,
+        log: dynamics.log.clone(),
+        outputs: written,
+    };
+    write_atomic(
+        &out.join("summary.json"),
+        serde_json::to_string_pretty(&summary)
+            .map_err(std::io::Error::other)?
+            .as_bytes(),
+    )?;
+    Ok(summary)
+}
