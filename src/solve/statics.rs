@@ -117,7 +117,11 @@ impl StaticState {
             let q = sub(&q, &scale(&t, dot(&q, &t)));
             let len = dot(&q, &q).sqrt();
             if len > 1e-3 * w.abs().max(1e-12) {
-                let depth = site.params.clearance + 1e-6;
+                // Penetration at which the wall carries the node's share of the lateral
+                // load (bisection on the spring law): a fixed guess would be far too deep for
+                // a stiff wall (k_e = 1e11 with a soft spring) and far too shallow for a soft one.
+                let share = len * 0.5 * ds;
+                let depth = site.params.clearance + penetration_for(share, &site.params);
                 for (x, qk) in s.x[i].iter_mut().zip(q) {
                     *x += depth * qk / len;
                 }
@@ -126,7 +130,7 @@ impl StaticState {
         s
     }
 
-    /// The undeformed configuration.
+    /// The undeformed configuration (every node on the hole axis, no rotation).
     pub fn initial(model: &Model) -> StaticState {
         let eye = rotation_exp(&[0.0; 3]);
         StaticState {
@@ -702,4 +706,25 @@ fn finish(
         top_reaction,
         bit_reaction,
     }
+}
+
+/// Penetration `delta ≥ 0` at which the elastic wall force equals `force` (bisection).
+fn penetration_for(force: f64, p: &crate::physics::contact::ContactParams<f64>) -> f64 {
+    use crate::physics::contact::{elastic_force, SpringLaw};
+    if force <= 0.0 {
+        return 0.0;
+    }
+    let (mut lo, mut hi) = (0.0, 1e-12);
+    while elastic_force(hi, p, SpringLaw::PowerBlend).0 < force && hi < 1.0 {
+        hi *= 10.0;
+    }
+    for _ in 0..100 {
+        let mid = 0.5 * (lo + hi);
+        if elastic_force(mid, p, SpringLaw::PowerBlend).0 < force {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    hi
 }
