@@ -289,6 +289,24 @@ pub fn add_sites(
 }
 
 impl Model {
+    /// A model of the mesh with no contact sites or loads: top clamped, bit held laterally,
+    /// split friction, no operation.
+    pub fn bare(nodes: Vec<Node>, elements: Vec<Element>) -> Model {
+        Model {
+            nodes,
+            elements,
+            sites: vec![],
+            friction: FrictionModel::Split,
+            weight_on_bit: 0.0,
+            torque_on_bit: 0.0,
+            axial_speed: 0.0,
+            rotation_speed: 0.0,
+            top: TopBoundary::Clamped,
+            bit_lateral_fixed: true,
+            point_loads: vec![],
+        }
+    }
+
     /// Outer radius of the pipe at node `i` (largest of its elements).
     pub fn pipe_radius_at(&self, i: usize) -> f64 {
         let mut r: f64 = 0.0;

@@ -1,7 +1,6 @@
 //! Implicit dynamics (generalised-α on the rotation group) against closed forms.
 
-use holewall::model::{mesh_string, Model, TopBoundary, Tubular};
-use holewall::physics::contact::FrictionModel;
+use holewall::model::{mesh_string, Model, Tubular};
 use holewall::physics::mass::MassKind;
 use holewall::solve::dynamics::{
     strain_energy, AlphaParams, DynamicOptions, DynamicState, Dynamics,
@@ -27,17 +26,8 @@ fn cantilever(l: f64, elements: usize) -> Model {
     };
     let (nodes, elements) = mesh_string(&well, &[t], l, RHO);
     Model {
-        nodes,
-        elements,
-        sites: vec![],
-        friction: FrictionModel::Split,
-        weight_on_bit: 0.0,
-        torque_on_bit: 0.0,
-        axial_speed: 0.0,
-        rotation_speed: 0.0,
-        top: TopBoundary::Clamped,
         bit_lateral_fixed: false,
-        point_loads: vec![],
+        ..Model::bare(nodes, elements)
     }
 }
 

@@ -2,7 +2,6 @@
 //! of axial load on the lateral ones.
 
 use holewall::model::{mesh_string, Model, TopBoundary, Tubular};
-use holewall::physics::contact::FrictionModel;
 use holewall::physics::mass::MassKind;
 use holewall::solve::modal::{mass_matrix, modes, participation, Mode};
 use holewall::solve::statics::{solve_static, StaticOptions};
@@ -35,17 +34,10 @@ fn column(
     // Weightless: mud as dense as steel.
     let (nodes, elements) = mesh_string(&well, &[t], length, RHO);
     Model {
-        nodes,
-        elements,
-        sites: vec![],
-        friction: FrictionModel::Split,
         weight_on_bit: wob,
-        torque_on_bit: 0.0,
-        axial_speed: 0.0,
-        rotation_speed: 0.0,
         top,
         bit_lateral_fixed,
-        point_loads: vec![],
+        ..Model::bare(nodes, elements)
     }
 }
 

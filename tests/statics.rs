@@ -2,7 +2,6 @@
 
 use holewall::model::{mesh_string, Model, TopBoundary, Tubular, GRAVITY};
 use holewall::physics::beam::rotation_exp;
-use holewall::physics::contact::FrictionModel;
 use holewall::solve::chain::BlockTridiagonal;
 use holewall::solve::statics::{
     constrained_tangent, internal_forces, solve_static, StaticOptions, StaticState,
@@ -28,17 +27,8 @@ fn tubular(name: &str, length: f64, od: f64, id: f64, element_length: f64) -> Tu
 fn model(well: &WellPath, tubulars: &[Tubular], bit_md: f64, mud: f64, wob: f64) -> Model {
     let (nodes, elements) = mesh_string(well, tubulars, bit_md, mud);
     Model {
-        nodes,
-        elements,
-        sites: vec![],
-        friction: FrictionModel::Split,
         weight_on_bit: wob,
-        torque_on_bit: 0.0,
-        axial_speed: 0.0,
-        rotation_speed: 0.0,
-        top: TopBoundary::Clamped,
-        bit_lateral_fixed: true,
-        point_loads: vec![],
+        ..Model::bare(nodes, elements)
     }
 }
 

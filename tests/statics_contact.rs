@@ -1,8 +1,7 @@
 //! Static solver with contact at every node: Dawson–Paslay buckling, and the FE model
 //! against soft-string torque & drag.
 
-use holewall::model::{add_sites, mesh_string, ContactSettings, Model, TopBoundary, Tubular};
-use holewall::physics::contact::FrictionModel;
+use holewall::model::{add_sites, mesh_string, ContactSettings, Model, Tubular};
 use holewall::physics::soft_string::{soft_string, Operation};
 use holewall::solve::chain::BlockTridiagonal;
 use holewall::solve::statics::{
@@ -44,17 +43,8 @@ fn model_with_contact(well: &WellPath, md: f64, element_length: f64, mu: f64) ->
     let (nodes, elements) = mesh_string(well, &[pipe(md, element_length)], md, MUD);
     let n = nodes.len();
     let mut m = Model {
-        nodes,
-        elements,
-        sites: vec![],
-        friction: FrictionModel::Split,
-        weight_on_bit: 0.0,
-        torque_on_bit: 0.0,
-        axial_speed: 0.0,
-        rotation_speed: 0.0,
-        top: TopBoundary::Clamped,
         bit_lateral_fixed: false,
-        point_loads: vec![],
+        ..Model::bare(nodes, elements)
     };
     let all: Vec<usize> = (1..n).collect();
     add_sites(

@@ -109,8 +109,8 @@ pub fn soft_string_with(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::model::{mesh_string, Model, TopBoundary, Tubular};
-    use crate::physics::contact::FrictionModel;
+    use crate::model::{mesh_string, Model, Tubular};
+
     use crate::well::{SurveyStation, WellPath};
 
     fn model_for(well: &WellPath, md: f64, element_length: f64) -> Model {
@@ -125,19 +125,7 @@ mod tests {
             element_length,
         };
         let (nodes, elements) = mesh_string(well, &[t], md, 1200.0);
-        Model {
-            nodes,
-            elements,
-            sites: vec![],
-            friction: FrictionModel::Split,
-            weight_on_bit: 0.0,
-            torque_on_bit: 0.0,
-            axial_speed: 0.0,
-            rotation_speed: 0.0,
-            top: TopBoundary::Clamped,
-            bit_lateral_fixed: true,
-            point_loads: vec![],
-        }
+        Model::bare(nodes, elements)
     }
 
     #[test]
