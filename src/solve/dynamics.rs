@@ -231,10 +231,21 @@ impl<'a> Dynamics<'a> {
     /// consistent accelerations.
     pub fn initial_state(&mut self, q: StaticState) -> Result<DynamicState, String> {
         let n = self.model.nodes.len();
+        self.initial_state_moving(q, vec![0.0; 6 * n])
+    }
+
+    /// The initial state in configuration `q` with velocities `v` (6 per node: ẋ, spatial
+    /// ω), with consistent accelerations.
+    pub fn initial_state_moving(
+        &mut self,
+        q: StaticState,
+        v: Vec<f64>,
+    ) -> Result<DynamicState, String> {
+        let n = self.model.nodes.len();
         let mut s = DynamicState {
             t: 0.0,
             q,
-            v: vec![0.0; 6 * n],
+            v,
             vdot: vec![0.0; 6 * n],
             a: vec![0.0; 6 * n],
         };
@@ -469,23 +480,42 @@ impl<'a> Dynamics<'a> {
         };
         let mut vdot = s.vdot.clone();
         // The table: prescribed spin about z at the top node.
+        // The rotary table drives the top node (clamped or hook-load tops); a pinned top
+        // only holds its displacements and twist.
+        let driven = !matches!(self.model.top, crate::model::TopBoundary::Pinned);
+        let fixed_top = c.fixed[0];
         let top_prescribed = |vd: &mut Vec<f64>| {
             for k in 0..6 {
-                vd[k] = 0.0;
+                if fixed_top[k] {
+                    vd[k] = 0.0;
+                }
             }
-            vd[5] = phiddot;
+            if driven {
+                vd[5] = phiddot;
+            }
+        };
+        let table = |tr: &mut DynamicState| {
+            if driven {
+                tr.q.rot[0] = rotation_exp(&[0.0, 0.0, phi]);
+                tr.v[3] = 0.0;
+                tr.v[4] = 0.0;
+                tr.v[5] = phidot;
+            }
         };
         top_prescribed(&mut vdot);
         for it in 1..=self.options.max_iterations {
             apply(&mut trial, &vdot);
             // Exact table kinematics at the top node.
-            trial.q.rot[0] = rotation_exp(&[0.0, 0.0, phi]);
-            trial.v[3] = 0.0;
-            trial.v[4] = 0.0;
-            trial.v[5] = phidot;
+            table(&mut trial);
             let (mut r, mut mat) = self.residual_and_matrix(&trial, hg, hhb, true);
             constrain(&c, &mut r, &mut mat);
-            let measure = r.iter().fold(0.0f64, |m, x| m.max(x.abs())) / self.f_ref;
+            // Scale: the loads, or the inertial forces if larger (a whirling string).
+            let inertial = (0..n).fold(0.0f64, |m, i| {
+                (0..3).fold(m, |m, k| {
+                    m.max((self.mass[i] * trial.vdot[6 * i + k]).abs())
+                })
+            });
+            let measure = r.iter().fold(0.0f64, |m, x| m.max(x.abs())) / self.f_ref.max(inertial);
             if !measure.is_finite() {
                 return Err("residual is not finite".into());
             }
@@ -506,10 +536,7 @@ impl<'a> Dynamics<'a> {
                 || (step_norm <= 1e-12 * length_scale && measure <= 1e-6)
             {
                 apply(&mut trial, &vdot);
-                trial.q.rot[0] = rotation_exp(&[0.0, 0.0, phi]);
-                trial.v[3] = 0.0;
-                trial.v[4] = 0.0;
-                trial.v[5] = phidot;
+                table(&mut trial);
                 *s = trial;
                 return Ok(it);
             }
