@@ -95,6 +95,20 @@ fn fail(errors: &[holewall::Error]) -> ExitCode {
     ExitCode::from(code as u8)
 }
 
+/// Prints a command's JSON summary on success; reports the error otherwise.
+fn print_summary<T: serde::Serialize>(result: Result<T, holewall::Error>) -> ExitCode {
+    match result {
+        Ok(summary) => {
+            println!(
+                "{}",
+                serde_json::to_string_pretty(&summary).unwrap_or_default()
+            );
+            ExitCode::SUCCESS
+        }
+        Err(e) => fail(&[e]),
+    }
+}
+
 fn main() -> ExitCode {
     let args = Args::parse();
     match args.command {
@@ -140,26 +154,10 @@ fn main() -> ExitCode {
                 Err(errs) => fail(&errs),
             }
         }
-        Command::Static { case, model, out } => match cli::static_cmd::run(&case, model, &out) {
-            Ok(summary) => {
-                println!(
-                    "{}",
-                    serde_json::to_string_pretty(&summary).unwrap_or_default()
-                );
-                ExitCode::SUCCESS
-            }
-            Err(e) => fail(&[e]),
-        },
-        Command::Run { case, out, quiet } => match cli::run_cmd::run(&case, &out, !quiet) {
-            Ok(summary) => {
-                println!(
-                    "{}",
-                    serde_json::to_string_pretty(&summary).unwrap_or_default()
-                );
-                ExitCode::SUCCESS
-            }
-            Err(e) => fail(&[e]),
-        },
+        Command::Static { case, model, out } => {
+            print_summary(cli::static_cmd::run(&case, model, &out))
+        }
+        Command::Run { case, out, quiet } => print_summary(cli::run_cmd::run(&case, &out, !quiet)),
         Command::GpuInfo { pairs } => match cli::gpu_info::run(pairs) {
             Ok(()) => ExitCode::SUCCESS,
             Err(e) => fail(&[e]),

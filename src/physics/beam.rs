@@ -281,27 +281,40 @@ fn perturb(
     }
 }
 
+/// ε₁ (the virtual variation δ) and ε₂ (the Newton increment Δ) as hyper-dual units.
+const EPS1: HyperDual = HyperDual {
+    re: 0.0,
+    e1: 1.0,
+    e2: 0.0,
+    e12: 0.0,
+};
+const EPS2: HyperDual = HyperDual {
+    re: 0.0,
+    e1: 0.0,
+    e2: 1.0,
+    e12: 0.0,
+};
+
+type LiftedState = ([[HyperDual; 3]; 2], [Mat3<HyperDual>; 2]);
+
+fn lift(state: &ElementState) -> LiftedState {
+    let x = state.x.map(|p| p.map(HyperDual::constant));
+    let t = state.triad.map(|m| m.map(|r| r.map(HyperDual::constant)));
+    (x, t)
+}
+
+/// Strain energy with DOF `j` varied along ε₁ from a (possibly ε₂-perturbed) state.
+fn energy_varied(base: &LiftedState, j: usize, section: &BeamSection, length0: f64) -> HyperDual {
+    let (mut x, mut t) = *base;
+    perturb(&mut x, &mut t, j, EPS1);
+    let def = local_deformation(&x[0], &x[1], &t[0], &t[1], length0);
+    strain_energy(&def, section, length0)
+}
+
 /// Internal force (12) only: 12 evaluations of `E` instead of 144 (line searches).
 pub fn internal_force(state: &ElementState, section: &BeamSection, length0: f64) -> [f64; 12] {
-    let lift = |x: &[f64; 3]| x.map(HyperDual::constant);
-    let lift_m = |m: &Mat3<f64>| m.map(|r| r.map(HyperDual::constant));
-    std::array::from_fn(|j| {
-        let mut x = [lift(&state.x[0]), lift(&state.x[1])];
-        let mut t = [lift_m(&state.triad[0]), lift_m(&state.triad[1])];
-        perturb(
-            &mut x,
-            &mut t,
-            j,
-            HyperDual {
-                re: 0.0,
-                e1: 1.0,
-                e2: 0.0,
-                e12: 0.0,
-            },
-        );
-        let def = local_deformation(&x[0], &x[1], &t[0], &t[1], length0);
-        strain_energy(&def, section, length0).e1
-    })
+    let base = lift(state);
+    std::array::from_fn(|j| energy_varied(&base, j, section, length0).e1)
 }
 
 /// Internal force (12) and consistent tangent (12×12) of the element: `f_j = ∂E/∂δ_j`,
@@ -312,43 +325,14 @@ pub fn force_and_tangent(
     section: &BeamSection,
     length0: f64,
 ) -> ([f64; 12], [[f64; 12]; 12]) {
-    let lift = |x: &[f64; 3]| x.map(HyperDual::constant);
-    let lift_m = |m: &Mat3<f64>| m.map(|r| r.map(HyperDual::constant));
-    let base_x = [lift(&state.x[0]), lift(&state.x[1])];
-    let base_t = [lift_m(&state.triad[0]), lift_m(&state.triad[1])];
     let mut force = [0.0; 12];
     let mut tangent = [[0.0; 12]; 12];
     for k in 0..12 {
         // Δ_k (ε₂) applied first, then δ_j (ε₁) on top.
-        let mut xk = base_x;
-        let mut tk = base_t;
-        perturb(
-            &mut xk,
-            &mut tk,
-            k,
-            HyperDual {
-                re: 0.0,
-                e1: 0.0,
-                e2: 1.0,
-                e12: 0.0,
-            },
-        );
+        let mut base = lift(state);
+        perturb(&mut base.0, &mut base.1, k, EPS2);
         for j in 0..12 {
-            let mut x = xk;
-            let mut t = tk;
-            perturb(
-                &mut x,
-                &mut t,
-                j,
-                HyperDual {
-                    re: 0.0,
-                    e1: 1.0,
-                    e2: 0.0,
-                    e12: 0.0,
-                },
-            );
-            let def = local_deformation(&x[0], &x[1], &t[0], &t[1], length0);
-            let e = strain_energy(&def, section, length0);
+            let e = energy_varied(&base, j, section, length0);
             tangent[j][k] = e.e12;
             if k == 0 {
                 force[j] = e.e1;
