@@ -73,6 +73,9 @@ pub enum TopBoundary {
     /// along the (vertical) hole axis, pulled up by the hook load; the bit then rests on
     /// bottom (axially held) and the weight on bit is the reaction there.
     HookLoad(f64),
+    /// Nothing held: a free-flying string (closed-form checks of the dynamics: energy of a
+    /// spinning, bent string). Statics need another support.
+    Free,
 }
 
 /// Everything a static or dynamic solve needs.

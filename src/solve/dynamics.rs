@@ -209,6 +209,15 @@ impl<'a> Dynamics<'a> {
         }
     }
 
+    /// Whether the rotary table drives the top node (clamped or hook-load tops; a pinned top
+    /// only holds its displacements and twist, a free one nothing).
+    fn table_driven(&self) -> bool {
+        matches!(
+            self.model.top,
+            crate::model::TopBoundary::Clamped | crate::model::TopBoundary::HookLoad(_)
+        )
+    }
+
     /// Kinetic energy (translational + rotational).
     pub fn kinetic_energy(&self, s: &DynamicState) -> f64 {
         let mut e = 0.0;
@@ -249,8 +258,9 @@ impl<'a> Dynamics<'a> {
             vdot: vec![0.0; 6 * n],
             a: vec![0.0; 6 * n],
         };
-        let (_, _, acc) = self.table(0.0);
-        s.vdot[5] = acc;
+        if self.table_driven() {
+            s.vdot[5] = self.table(0.0).2;
+        }
         // M v̇ = f_ext − f_int − g: one linear solve with the mass as the matrix.
         let (r, _) = self.residual_and_matrix(&s, 0.0, 0.0, false);
         // Convergence is judged against the larger of the loads and the initial internal
@@ -480,9 +490,7 @@ impl<'a> Dynamics<'a> {
         };
         let mut vdot = s.vdot.clone();
         // The table: prescribed spin about z at the top node.
-        // The rotary table drives the top node (clamped or hook-load tops); a pinned top
-        // only holds its displacements and twist.
-        let driven = !matches!(self.model.top, crate::model::TopBoundary::Pinned);
+        let driven = self.table_driven();
         let fixed_top = c.fixed[0];
         let top_prescribed = |vd: &mut Vec<f64>| {
             for k in 0..6 {

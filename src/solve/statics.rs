@@ -179,6 +179,7 @@ pub(crate) fn constraints(model: &Model) -> Constraints {
         TopBoundary::Pinned => [true, true, true, false, false, false],
         // Free along global z: a well's top is vertical.
         TopBoundary::HookLoad(_) => [true, true, false, true, true, true],
+        TopBoundary::Free => [false; 6],
     };
     if model.top == TopBoundary::Pinned {
         // The twist is held about global z: a well's top is vertical.
