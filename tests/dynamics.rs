@@ -370,3 +370,92 @@ fn high_modes_lose_energy_at_the_rate_theory_gives() {
         assert!((spectral_radius(p, 1e6) - rho_inf.max(1e-300)).abs() < 1e-3);
     }
 }
+
+/// A 10 m collar hanging from the rotary table (weightless), a stabilizer at its free end
+/// pressed to the wall by whirling faster than the string's first natural frequency
+/// (8.1 rad/s). Returns (measured whirl rate of the stabilizer centre, its own spin rate,
+/// slip speed at the contact point / Ω·R_d), averaged over the second half of the run.
+fn whirl(mu: f64, t_end: f64) -> (f64, f64, f64) {
+    use holewall::model::{add_sites, ContactSettings};
+    let (r_d, clearance, spin) = (0.1, 0.02, 4.0);
+    let mut m = cantilever(10.0, 10);
+    m.rotation_speed = spin;
+    let bit = m.nodes.len() - 1;
+    let settings = ContactSettings {
+        wall_stiffness: 1e8,
+        spring_exponent: 1.0,
+        wall_damping: 2e3,
+        eps: 1e-3,
+        soft_blend: 1e-4,
+    };
+    add_sites(&mut m, &[bit], |_| r_d + clearance, |_| r_d, |_| mu, &settings, true);
+    // Start: the tip pushed to the wall (static shape under a tip load), whirling backward
+    // at 0.7 times the rolling rate, the whole string spinning with the table.
+    let mut pushed = m.clone();
+    pushed.sites.clear();
+    pushed.point_loads = vec![(bit, [22_100.0 * (clearance + 2e-5), 0.0, 0.0, 0.0, 0.0, 0.0])];
+    let start = solve_static(&pushed, &StaticOptions::default()).unwrap().state;
+    let w0 = -0.7 * spin * r_d / clearance;
+    let n = m.nodes.len();
+    let mut v = vec![0.0; 6 * n];
+    for i in 0..n {
+        let d = [start.x[i][0] - m.nodes[i].position[0], start.x[i][1] - m.nodes[i].position[1]];
+        v[6 * i] = -w0 * d[1];
+        v[6 * i + 1] = w0 * d[0];
+        v[6 * i + 5] = spin;
+    }
+    let options = DynamicOptions {
+        dt: 1e-3,
+        alpha: AlphaParams::chung_hulbert(0.8),
+        ..Default::default()
+    };
+    let mut dynamics = Dynamics::new(&m, options, &|_| RHO);
+    let mut s = dynamics.initial_state_moving(start, v).unwrap();
+    let (mut angle, mut last) = (Vec::new(), None::<f64>);
+    let (mut spins, mut slips) = (Vec::new(), Vec::new());
+    let mut unwrapped = 0.0;
+    dynamics
+        .run(&mut s, t_end, &mut |_, st| {
+            let d = [st.q.x[bit][0], st.q.x[bit][1]];
+            let a = d[1].atan2(d[0]);
+            if let Some(l) = last {
+                let mut da = a - l;
+                da -= std::f64::consts::TAU * (da / std::f64::consts::TAU).round();
+                unwrapped += da;
+            }
+            last = Some(a);
+            if st.t > 0.5 * t_end {
+                angle.push((st.t, unwrapped));
+                let r = d[0].hypot(d[1]);
+                let tangential = (d[0] * st.v[6 * bit + 1] - d[1] * st.v[6 * bit]) / r;
+                let w = st.v[6 * bit + 5];
+                spins.push(w);
+                slips.push((tangential + w * r_d) / (spin * r_d));
+                assert!(r > clearance * 0.99, "left the wall: r = {r}");
+            }
+        })
+        .unwrap();
+    let nm = angle.len() as f64;
+    let (mt, ma) = angle
+        .iter()
+        .fold((0.0, 0.0), |(a, b), (t, x)| (a + t / nm, b + x / nm));
+    let rate = angle.iter().map(|(t, x)| (t - mt) * (x - ma)).sum::<f64>()
+        / angle.iter().map(|(t, _)| (t - mt).powi(2)).sum::<f64>();
+    let mean = |x: &[f64]| x.iter().sum::<f64>() / x.len() as f64;
+    (rate, mean(&spins), mean(&slips))
+}
+
+#[test]
+fn stabilizer_rolling_on_the_wall_whirls_backward_and_slips_with_low_friction() {
+    let (r_d, clearance) = (0.1, 0.02);
+    let (rate, spin, slip) = whirl(0.5, 1.5);
+    let expected = -spin * r_d / clearance;
+    eprintln!("μ = 0.5: whirl {rate:.4} rad/s vs −Ω·R_d/ΔR = {expected:.4} rad/s (spin {spin:.4}); slip {slip:.2e}");
+    assert!((rate / expected - 1.0).abs() <= 0.02, "rolling whirl {rate} vs {expected}");
+    assert!(slip.abs() < 0.02);
+    let (rate, spin, slip) = whirl(0.01, 1.5);
+    let expected = -spin * r_d / clearance;
+    eprintln!("μ = 0.01: whirl {rate:.4} rad/s vs −Ω·R_d/ΔR = {expected:.4} rad/s; slip {slip:.2e}");
+    assert!(rate < 0.0 && rate > 0.8 * expected, "slipping: {rate} vs {expected}");
+    assert!(slip > 0.2, "slipping: {slip}");
+}
