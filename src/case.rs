@@ -163,6 +163,11 @@ pub struct DynamicsSpec {
     /// Outputs to record: `bit_displacement`, `lateral`, `contact_forces`, `spin`,
     /// `surface_torque`, `axial_stress`, `energy` (default: all).
     pub outputs: Option<Vec<Spanned<String>>>,
+    /// Mass matrix: `"lumped"` (default) or `"consistent"`.
+    pub mass: Option<Spanned<String>>,
+    /// Rate at which the hook (the clamped top) is lowered, e.g. `"30 m/h"` (default 0:
+    /// hook fixed); ramped with the table.
+    pub rop: Option<Q>,
 }
 
 /// Checked `[dynamics]` settings.
@@ -182,6 +187,10 @@ pub struct DynamicsSettings {
     pub rayleigh: (f64, f64),
     /// Outputs requested.
     pub outputs: Vec<String>,
+    /// Mass matrix kind.
+    pub mass: crate::physics::mass::MassKind,
+    /// Hook lowering rate (m/s).
+    pub rop: f64,
 }
 
 /// Every output `holewall run` can record.
@@ -1006,6 +1015,30 @@ fn dynamics_settings(ctx: &Ctx, d: &DynamicsSpec) -> Result<DynamicsSettings, In
             out
         }
     };
+    let mass = match &d.mass {
+        None => crate::physics::mass::MassKind::Lumped,
+        Some(m) => match m.get_ref().as_str() {
+            "lumped" => crate::physics::mass::MassKind::Lumped,
+            "consistent" => crate::physics::mass::MassKind::Consistent,
+            other => {
+                return Err(ctx.err(
+                    m.span(),
+                    "dynamics.mass",
+                    format!("unknown mass {other:?}; allowed: lumped, consistent"),
+                ))
+            }
+        },
+    };
+    let rop = match &d.rop {
+        Some(q) => ctx.quantity(
+            q,
+            "dynamics.rop",
+            Dimension::Speed,
+            |x| (0.0..=0.1).contains(&x),
+            "0 ≤ rop ≤ 0.1 m/s (360 m/h)",
+        )?,
+        None => 0.0,
+    };
     Ok(DynamicsSettings {
         duration,
         time_step,
@@ -1014,5 +1047,7 @@ fn dynamics_settings(ctx: &Ctx, d: &DynamicsSpec) -> Result<DynamicsSettings, In
         rho_inf,
         rayleigh: (a0, a1),
         outputs,
+        mass,
+        rop,
     })
 }

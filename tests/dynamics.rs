@@ -47,10 +47,22 @@ fn run(
     steps: usize,
     rho_inf: f64,
 ) -> (Vec<f64>, Vec<f64>) {
+    run_with(m, start, dt, steps, rho_inf, MassKind::Lumped)
+}
+
+fn run_with(
+    m: &Model,
+    start: &holewall::solve::statics::StaticState,
+    dt: f64,
+    steps: usize,
+    rho_inf: f64,
+    mass: MassKind,
+) -> (Vec<f64>, Vec<f64>) {
     let options = DynamicOptions {
         dt,
         alpha: AlphaParams::chung_hulbert(rho_inf),
         tolerance: 1e-10,
+        mass,
         ..Default::default()
     };
     let mut dynamics = Dynamics::new(m, options, &|_| RHO);
@@ -84,26 +96,73 @@ fn small_free_vibration_keeps_its_energy_with_rho_inf_one() {
 
 #[test]
 fn free_vibration_period_matches_the_first_mode() {
-    let m = cantilever(10.0, 10);
-    let sol = solve_static(&m, &StaticOptions::default()).unwrap();
-    let mass = mass_matrix(&m, MassKind::Lumped, &|_| RHO);
-    let f1 = modes(&m, &sol.state, &mass)
-        .into_iter()
-        .find(|md| participation(md, 0) > 0.9)
-        .unwrap()
-        .frequency_hz;
-    let (m, start) = released(&m, 50.0);
-    let dt = 1.0 / (f1 * 400.0);
-    let (tip, _) = run(&m, &start, dt, 1200, 1.0);
-    // Zero crossings → period.
-    let crossings: Vec<f64> = (1..tip.len())
-        .filter(|&k| tip[k - 1] > 0.0 && tip[k] <= 0.0)
-        .map(|k| (k as f64 - 1.0 + tip[k - 1] / (tip[k - 1] - tip[k])) * dt)
-        .collect();
-    assert!(crossings.len() >= 2);
-    let period = crossings[1] - crossings[0];
-    eprintln!("period {period:.6} s vs 1/f1 {:.6} s", 1.0 / f1);
-    assert!((period * f1 - 1.0).abs() <= 0.01);
+    // Lumped and consistent mass, each against the modal solution with the same mass; the
+    // consistent run must also keep its energy.
+    for kind in [MassKind::Lumped, MassKind::Consistent] {
+        let m = cantilever(10.0, 4);
+        let sol = solve_static(&m, &StaticOptions::default()).unwrap();
+        let mass = mass_matrix(&m, kind, &|_| RHO);
+        let mode = modes(&m, &sol.state, &mass)
+            .into_iter()
+            .find(|md| participation(md, 0) > 0.5)
+            .unwrap();
+        let f1 = mode.frequency_hz;
+        // Released from the mode shape (2 mm at the tip): only that mode vibrates.
+        let start = from_mode(&sol.state, &mode.shape, 2e-3);
+        let dt = 1.0 / (f1 * 400.0);
+        let (tip, energy) = run_with(&m, &start, dt, 1200, 1.0, kind);
+        // Zero crossings → period.
+        let crossings: Vec<f64> = (1..tip.len())
+            .filter(|&k| tip[k - 1] > 0.0 && tip[k] <= 0.0)
+            .map(|k| (k as f64 - 1.0 + tip[k - 1] / (tip[k - 1] - tip[k])) * dt)
+            .collect();
+        assert!(crossings.len() >= 2);
+        let period = (crossings[crossings.len() - 1] - crossings[0]) / (crossings.len() - 1) as f64;
+        let drift = energy
+            .iter()
+            .fold(0.0f64, |d, e| d.max((e / energy[0] - 1.0).abs()));
+        eprintln!(
+            "{kind:?} mass: period {period:.6} s vs 1/f1 {:.6} s; energy drift {drift:.1e}",
+            1.0 / f1
+        );
+        // Trapezoidal period error at 400 steps per period: (ωh)²/12 ≈ 2e-5.
+        assert!((period * f1 - 1.0).abs() <= 1e-4, "{kind:?}");
+        assert!(drift <= 1e-6, "{kind:?}: energy drift {drift:e}");
+    }
+}
+
+#[test]
+fn hook_lowered_at_rop_carries_the_string_down() {
+    let mut m = cantilever(10.0, 5);
+    m.bit_lateral_fixed = false;
+    let (rop, ramp) = (0.01, 0.2);
+    let options = DynamicOptions {
+        dt: 1e-3,
+        rop,
+        ramp_time: ramp,
+        ..Default::default()
+    };
+    let mut dynamics = Dynamics::new(&m, options, &|_| RHO);
+    let mut s = dynamics
+        .initial_state(holewall::solve::statics::StaticState::initial(&m))
+        .unwrap();
+    dynamics.run(&mut s, 1.0, &mut |_, _| {}).unwrap();
+    let expected = 0.5 * rop * ramp + rop * (1.0 - ramp);
+    let bit = m.nodes.len() - 1;
+    // The top follows the hook exactly; the bit with it, up to the axial vibration the
+    // ramp's kinks excite (inertia ≈ 70 N over EA/L: about 1e-7 m, ±1e-4 m/s).
+    for (i, tol_x, tol_v) in [(0, 1e-12, 1e-12), (bit, 1e-6, 0.02 * rop)] {
+        let dz = s.q.x[i][2] - m.nodes[i].position[2];
+        eprintln!(
+            "node {i}: lowered {dz:.9} m vs {expected:.9} m, at {:.6} m/s",
+            s.v[6 * i + 2]
+        );
+        assert!(
+            (dz - expected).abs() <= tol_x,
+            "node {i}: {dz} vs {expected}"
+        );
+        assert!((s.v[6 * i + 2] - rop).abs() <= tol_v);
+    }
 }
 
 /// sin²(πt/0.2): a smooth load from rest (no shock to excite the high modes).
@@ -274,6 +333,24 @@ fn spinning_bent_string_keeps_its_energy_at_second_order() {
     assert!(orders.iter().all(|o| *o >= 1.8), "second order: {orders:?}");
 }
 
+/// `state` displaced along a mode shape, scaled to `amplitude` at its largest entry.
+fn from_mode(
+    state: &holewall::solve::statics::StaticState,
+    shape: &[f64],
+    amplitude: f64,
+) -> holewall::solve::statics::StaticState {
+    let eps = amplitude / shape.iter().fold(0.0f64, |a, x| a.max(x.abs()));
+    let mut start = state.clone();
+    for i in 0..start.x.len() {
+        for k in 0..3 {
+            start.x[i][k] += eps * shape[6 * i + k];
+        }
+        let th: [f64; 3] = std::array::from_fn(|k| eps * shape[6 * i + 3 + k]);
+        start.rot[i] = holewall::physics::beam::rotation_exp(&th);
+    }
+    start
+}
+
 /// Spectral radius of the scheme's amplification matrix for `ẍ + ω²x = 0` at `ωh`
 /// (state `(x, v, a)`; the equation of motion holds at `t_{n+1}`, as in the integrator).
 fn spectral_radius(p: AlphaParams, wh: f64) -> f64 {
@@ -307,7 +384,6 @@ fn high_modes_lose_energy_at_the_rate_theory_gives() {
     let mass = mass_matrix(&m, MassKind::Lumped, &|_| RHO);
     let all = modes(&m, &sol.state, &mass);
     let lateral: Vec<_> = all.iter().filter(|md| participation(md, 0) > 0.3).collect();
-    let bit = m.nodes.len() - 1;
     for rho_inf in [0.5, 0.0] {
         let p = AlphaParams::chung_hulbert(rho_inf);
         // A mid-range mode at ωh = 1.5 and the highest lateral mode at the same step.
@@ -317,16 +393,7 @@ fn high_modes_lose_energy_at_the_rate_theory_gives() {
         for mode in [mid, *lateral.last().unwrap()] {
             let wh = std::f64::consts::TAU * mode.frequency_hz * dt;
             // Released at rest from the mode shape, 0.1 mm amplitude (linear range).
-            let amp = mode.shape.iter().fold(0.0f64, |a, x| a.max(x.abs()));
-            let eps = 1e-4 / amp;
-            let mut start = sol.state.clone();
-            for i in 0..=bit {
-                for k in 0..3 {
-                    start.x[i][k] += eps * mode.shape[6 * i + k];
-                }
-                let th: [f64; 3] = std::array::from_fn(|k| eps * mode.shape[6 * i + 3 + k]);
-                start.rot[i] = holewall::physics::beam::rotation_exp(&th);
-            }
+            let start = from_mode(&sol.state, &mode.shape, 1e-4);
             let options = DynamicOptions {
                 dt,
                 alpha: p,
@@ -388,18 +455,34 @@ fn whirl(mu: f64, t_end: f64) -> (f64, f64, f64) {
         eps: 1e-3,
         soft_blend: 1e-4,
     };
-    add_sites(&mut m, &[bit], |_| r_d + clearance, |_| r_d, |_| mu, &settings, true);
+    add_sites(
+        &mut m,
+        &[bit],
+        |_| r_d + clearance,
+        |_| r_d,
+        |_| mu,
+        &settings,
+        true,
+    );
     // Start: the tip pushed to the wall (static shape under a tip load), whirling backward
     // at 0.7 times the rolling rate, the whole string spinning with the table.
     let mut pushed = m.clone();
     pushed.sites.clear();
-    pushed.point_loads = vec![(bit, [22_100.0 * (clearance + 2e-5), 0.0, 0.0, 0.0, 0.0, 0.0])];
-    let start = solve_static(&pushed, &StaticOptions::default()).unwrap().state;
+    pushed.point_loads = vec![(
+        bit,
+        [22_100.0 * (clearance + 2e-5), 0.0, 0.0, 0.0, 0.0, 0.0],
+    )];
+    let start = solve_static(&pushed, &StaticOptions::default())
+        .unwrap()
+        .state;
     let w0 = -0.7 * spin * r_d / clearance;
     let n = m.nodes.len();
     let mut v = vec![0.0; 6 * n];
     for i in 0..n {
-        let d = [start.x[i][0] - m.nodes[i].position[0], start.x[i][1] - m.nodes[i].position[1]];
+        let d = [
+            start.x[i][0] - m.nodes[i].position[0],
+            start.x[i][1] - m.nodes[i].position[1],
+        ];
         v[6 * i] = -w0 * d[1];
         v[6 * i + 1] = w0 * d[0];
         v[6 * i + 5] = spin;
@@ -451,11 +534,19 @@ fn stabilizer_rolling_on_the_wall_whirls_backward_and_slips_with_low_friction() 
     let (rate, spin, slip) = whirl(0.5, 1.5);
     let expected = -spin * r_d / clearance;
     eprintln!("μ = 0.5: whirl {rate:.4} rad/s vs −Ω·R_d/ΔR = {expected:.4} rad/s (spin {spin:.4}); slip {slip:.2e}");
-    assert!((rate / expected - 1.0).abs() <= 0.02, "rolling whirl {rate} vs {expected}");
+    assert!(
+        (rate / expected - 1.0).abs() <= 0.02,
+        "rolling whirl {rate} vs {expected}"
+    );
     assert!(slip.abs() < 0.02);
     let (rate, spin, slip) = whirl(0.01, 1.5);
     let expected = -spin * r_d / clearance;
-    eprintln!("μ = 0.01: whirl {rate:.4} rad/s vs −Ω·R_d/ΔR = {expected:.4} rad/s; slip {slip:.2e}");
-    assert!(rate < 0.0 && rate > 0.8 * expected, "slipping: {rate} vs {expected}");
+    eprintln!(
+        "μ = 0.01: whirl {rate:.4} rad/s vs −Ω·R_d/ΔR = {expected:.4} rad/s; slip {slip:.2e}"
+    );
+    assert!(
+        rate < 0.0 && rate > 0.8 * expected,
+        "slipping: {rate} vs {expected}"
+    );
     assert!(slip > 0.2, "slipping: {slip}");
 }

@@ -139,6 +139,8 @@ pub fn run(case_path: &Path, out: &Path, show_progress: bool) -> Result<RunSumma
         alpha: AlphaParams::chung_hulbert(settings.rho_inf),
         rayleigh: settings.rayleigh,
         ramp_time: settings.ramp_time,
+        mass: settings.mass,
+        rop: settings.rop,
         ..Default::default()
     };
     let density = case.element_density.clone();

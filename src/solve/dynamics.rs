@@ -12,16 +12,19 @@
 //! `S = M + hγ' C_t + h²β' K_t` (`β' = β(1 − α_f)/(1 − α_m)`, `γ' = γ(1 − α_f)/(1 − α_m)`),
 //! where `K_t` holds the beam and contact stiffness and `C_t` the gyroscopic, Rayleigh and
 //! contact damping (`C` on ẋ, `c_omega nᵀ` on ω: the spin is the node's own angular velocity
-//! about the hole axis). Mass: lumped, with rotary inertia (`J = R J₀ Rᵀ`).
+//! about the hole axis). Mass: lumped, with rotary inertia (`J = R J₀ Rᵀ`), or consistent
+//! (see [`DynamicOptions::mass`]).
 //!
 //! The top node is clamped to the rotary table, whose rotation about the (vertical) axis is
-//! prescribed: a ramp from rest to the operation's speed over `ramp_time`.
+//! prescribed: a ramp from rest to the operation's speed over `ramp_time`; the hook holds it
+//! or lowers it at the ROP (ramped the same way).
 
 // Index loops over 3×3 and 6×6 blocks read like the formulas.
 #![allow(clippy::needless_range_loop)]
 use crate::model::Model;
 use crate::physics::beam::{force_and_tangent, rotation_exp, ElementState, Mat3};
 use crate::physics::contact::{evaluate, ContactMode, ContactTerms, SpringLaw};
+use crate::physics::mass::MassKind;
 use crate::physics::vec3::{cross, dot, sub, Vec3};
 use crate::solve::chain::{BlockTridiagonal, ChainSolver};
 use crate::solve::statics::{constrain, constraints, external_loads, reference_force, StaticState};
@@ -84,6 +87,16 @@ pub struct DynamicOptions {
     pub ramp_time: f64,
     /// Factor on the external loads as a function of time (default: 1).
     pub load_factor: Option<fn(f64) -> f64>,
+    /// Lumped (diagonal, rotary inertia rotated with each node) or consistent mass. The
+    /// consistent matrix is assembled once in the initial element frames: exact for the
+    /// spin about the pipe axis (axisymmetric sections), first order in the bending
+    /// rotations, which stay small in a hole. Gyroscopic moments come from the nodal
+    /// rotary inertia in both cases (they do no work, so the energy stays that of the
+    /// chosen mass).
+    pub mass: MassKind,
+    /// Rate at which the hook lowers a clamped top along the hole axis (m/s, ROP), ramped
+    /// like the table; 0: hook fixed.
+    pub rop: f64,
 }
 
 impl Default for DynamicOptions {
@@ -97,6 +110,8 @@ impl Default for DynamicOptions {
             rayleigh: (0.0, 0.0),
             ramp_time: 0.0,
             load_factor: None,
+            mass: MassKind::Lumped,
+            rop: 0.0,
         }
     }
 }
@@ -168,6 +183,8 @@ pub struct Dynamics<'a> {
     options: DynamicOptions,
     solver: ChainSolver,
     k0: Option<BlockTridiagonal>,
+    /// The consistent mass matrix (global, initial frames) when asked for.
+    consistent: Option<BlockTridiagonal>,
     /// Messages: step cuts and regrowth.
     pub log: Vec<String>,
     /// Newton iterations of every completed step.
@@ -182,7 +199,10 @@ impl<'a> Dynamics<'a> {
         density_of: &dyn Fn(usize) -> f64,
     ) -> Self {
         let (mass, inertia0) = lumped_mass(model, density_of);
+        let consistent = (options.mass == MassKind::Consistent)
+            .then(|| crate::solve::modal::mass_matrix(model, MassKind::Consistent, density_of));
         Dynamics {
+            consistent,
             model,
             mass,
             inertia0,
@@ -198,14 +218,16 @@ impl<'a> Dynamics<'a> {
 
     /// Rotary-table angle, speed and acceleration at `t` (ramp from rest).
     pub fn table(&self, t: f64) -> (f64, f64, f64) {
-        let w = self.model.rotation_speed;
-        let tr = self.options.ramp_time;
-        if tr <= 0.0 {
-            (w * t, w, 0.0)
-        } else if t < tr {
-            (0.5 * w * t * t / tr, w * t / tr, w / tr)
+        ramp(self.model.rotation_speed, self.options.ramp_time, t)
+    }
+
+    /// Hook travel down the hole axis, its speed and acceleration at `t` (lowered at the
+    /// ROP, ramped like the table; zero unless the top is clamped).
+    pub fn hook(&self, t: f64) -> (f64, f64, f64) {
+        if matches!(self.model.top, crate::model::TopBoundary::Clamped) {
+            ramp(self.options.rop, self.options.ramp_time, t)
         } else {
-            (0.5 * w * tr + w * (t - tr), w, 0.0)
+            (0.0, 0.0, 0.0)
         }
     }
 
@@ -220,6 +242,9 @@ impl<'a> Dynamics<'a> {
 
     /// Kinetic energy (translational + rotational).
     pub fn kinetic_energy(&self, s: &DynamicState) -> f64 {
+        if let Some(mc) = &self.consistent {
+            return 0.5 * dot_n(&s.v, &mc.mul(&s.v));
+        }
         let mut e = 0.0;
         for i in 0..self.model.nodes.len() {
             let v: Vec3<f64> = std::array::from_fn(|k| s.v[6 * i + k]);
@@ -261,6 +286,7 @@ impl<'a> Dynamics<'a> {
         if self.table_driven() {
             s.vdot[5] = self.table(0.0).2;
         }
+        s.vdot[2] = self.hook(0.0).2;
         // M v̇ = f_ext − f_int − g: one linear solve with the mass as the matrix.
         let (r, _) = self.residual_and_matrix(&s, 0.0, 0.0, false);
         // Convergence is judged against the larger of the loads and the initial internal
@@ -272,12 +298,16 @@ impl<'a> Dynamics<'a> {
             .fold(0.0f64, |m, (ri, fe)| m.max((ri + lambda * fe).abs()));
         self.f_ref = self.f_ref.max(f_int);
         let mut mass = BlockTridiagonal::zeros(n);
-        for i in 0..n {
-            let j = self.spatial_inertia(&s.q, i);
-            for k in 0..3 {
-                mass.diag[i][k][k] = self.mass[i];
-                for c in 0..3 {
-                    mass.diag[i][3 + k][3 + c] = j[k][c];
+        if let Some(mc) = &self.consistent {
+            mass = mc.clone();
+        } else {
+            for i in 0..n {
+                let j = self.spatial_inertia(&s.q, i);
+                for k in 0..3 {
+                    mass.diag[i][k][k] = self.mass[i];
+                    for c in 0..3 {
+                        mass.diag[i][3 + k][3 + c] = j[k][c];
+                    }
                 }
             }
         }
@@ -325,6 +355,15 @@ impl<'a> Dynamics<'a> {
             self.k0 = Some(k_t.clone());
         }
         // Inertia and gyroscopic moments.
+        if let Some(mc) = &self.consistent {
+            for (ri, fi) in r.iter_mut().zip(mc.mul(&s.vdot)) {
+                *ri += fi;
+            }
+            if with_matrix {
+                add_scaled(&mut s_mat, mc, 1.0);
+            }
+        }
+        let lumped = self.consistent.is_none();
         for i in 0..n {
             let j = self.spatial_inertia(&s.q, i);
             let w: Vec3<f64> = std::array::from_fn(|k| s.v[6 * i + 3 + k]);
@@ -333,17 +372,23 @@ impl<'a> Dynamics<'a> {
             let gyro = cross(&w, &jw);
             let jwd = mat_vec(&j, &wdot);
             for k in 0..3 {
-                r[6 * i + k] += self.mass[i] * s.vdot[6 * i + k];
-                r[6 * i + 3 + k] += jwd[k] + gyro[k];
+                if lumped {
+                    r[6 * i + k] += self.mass[i] * s.vdot[6 * i + k];
+                    r[6 * i + 3 + k] += jwd[k];
+                }
+                r[6 * i + 3 + k] += gyro[k];
             }
             if with_matrix {
                 // ∂(ω × Jω)/∂ω = [ω]× J − [Jω]×.
                 let sw = mat_mul(&skew(&w), &j);
                 let sjw = skew(&jw);
                 for a in 0..3 {
-                    s_mat.diag[i][a][a] += self.mass[i];
+                    if lumped {
+                        s_mat.diag[i][a][a] += self.mass[i];
+                    }
                     for b in 0..3 {
-                        s_mat.diag[i][3 + a][3 + b] += j[a][b] + hg * (sw[a][b] - sjw[a][b]);
+                        let inertia = if lumped { j[a][b] } else { 0.0 };
+                        s_mat.diag[i][3 + a][3 + b] += inertia + hg * (sw[a][b] - sjw[a][b]);
                     }
                 }
             }
@@ -356,18 +401,51 @@ impl<'a> Dynamics<'a> {
                 .as_ref()
                 .map(|k0| k0.mul(&s.v))
                 .unwrap_or_else(|| vec![0.0; 6 * n]);
-            for i in 0..n {
-                for k in 0..6 {
-                    let m = if k < 3 {
-                        self.mass[i] * s.v[6 * i + k]
-                    } else {
-                        0.0
-                    };
-                    r[6 * i + k] += a0 * m + a1 * k0v[6 * i + k];
+            // Mass-proportional part on the translations (a rigid spin is not damped).
+            let mut mv = vec![0.0; 6 * n];
+            match &self.consistent {
+                Some(mc) => {
+                    let mut vt = s.v.clone();
+                    for i in 0..n {
+                        vt[6 * i + 3..6 * i + 6].fill(0.0);
+                    }
+                    mv = mc.mul(&vt);
+                    for i in 0..n {
+                        mv[6 * i + 3..6 * i + 6].fill(0.0);
+                    }
                 }
-                if with_matrix {
-                    for k in 0..3 {
-                        s_mat.diag[i][k][k] += hg * a0 * self.mass[i];
+                None => {
+                    for d in 0..6 * n {
+                        if d % 6 < 3 {
+                            mv[d] = self.mass[d / 6] * s.v[d];
+                        }
+                    }
+                }
+            }
+            for d in 0..6 * n {
+                r[d] += a0 * mv[d] + a1 * k0v[d];
+            }
+            if with_matrix {
+                match &self.consistent {
+                    Some(mc) => {
+                        let mut mt = mc.clone();
+                        for blk in mt.diag.iter_mut().chain(&mut mt.upper).chain(&mut mt.lower) {
+                            for r in 0..6 {
+                                for c in 0..6 {
+                                    if r >= 3 || c >= 3 {
+                                        blk[r][c] = 0.0;
+                                    }
+                                }
+                            }
+                        }
+                        add_scaled(&mut s_mat, &mt, hg * a0);
+                    }
+                    None => {
+                        for i in 0..n {
+                            for k in 0..3 {
+                                s_mat.diag[i][k][k] += hg * a0 * self.mass[i];
+                            }
+                        }
                     }
                 }
             }
@@ -461,6 +539,10 @@ impl<'a> Dynamics<'a> {
         let hhb = h * h * p.beta * ratio;
         let t1 = s.t + h;
         let (phi, phidot, phiddot) = self.table(t1);
+        let (zh, zhdot, zhddot) = self.hook(t1);
+        let lowered =
+            self.options.rop != 0.0 && matches!(self.model.top, crate::model::TopBoundary::Clamped);
+        let top_z = self.model.nodes[0].position[2];
         let mut trial = s.clone();
         trial.t = t1;
         // Predictor: v̇_{n+1} = v̇_n.
@@ -501,6 +583,9 @@ impl<'a> Dynamics<'a> {
             if driven {
                 vd[5] = phiddot;
             }
+            if lowered {
+                vd[2] = zhddot;
+            }
         };
         let table = |tr: &mut DynamicState| {
             if driven {
@@ -508,6 +593,10 @@ impl<'a> Dynamics<'a> {
                 tr.v[3] = 0.0;
                 tr.v[4] = 0.0;
                 tr.v[5] = phidot;
+            }
+            if lowered {
+                tr.q.x[0][2] = top_z + zh;
+                tr.v[2] = zhdot;
             }
         };
         top_prescribed(&mut vdot);
@@ -590,6 +679,26 @@ impl<'a> Dynamics<'a> {
         }
         Ok(())
     }
+}
+
+/// Position, rate and acceleration of a motion ramped linearly from rest to `rate` over
+/// `ramp_time`.
+fn ramp(rate: f64, ramp_time: f64, t: f64) -> (f64, f64, f64) {
+    if ramp_time <= 0.0 {
+        (rate * t, rate, 0.0)
+    } else if t < ramp_time {
+        (
+            0.5 * rate * t * t / ramp_time,
+            rate * t / ramp_time,
+            rate / ramp_time,
+        )
+    } else {
+        (0.5 * rate * ramp_time + rate * (t - ramp_time), rate, 0.0)
+    }
+}
+
+fn dot_n(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| x * y).sum()
 }
 
 fn add_scaled(a: &mut BlockTridiagonal, b: &BlockTridiagonal, s: f64) {
