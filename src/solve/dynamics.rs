@@ -22,12 +22,14 @@
 // Index loops over 3×3 and 6×6 blocks read like the formulas.
 #![allow(clippy::needless_range_loop)]
 use crate::model::Model;
-use crate::physics::beam::{force_and_tangent, rotation_exp, ElementState, Mat3};
+use crate::physics::beam::{force_and_tangent, internal_force, rotation_exp, ElementState, Mat3};
 use crate::physics::contact::{evaluate, ContactMode, ContactTerms, SpringLaw};
 use crate::physics::mass::MassKind;
 use crate::physics::vec3::{cross, dot, sub, Vec3};
 use crate::solve::chain::{BlockTridiagonal, ChainSolver};
-use crate::solve::statics::{constrain, constraints, external_loads, reference_force, StaticState};
+use crate::solve::statics::{
+    constrain, constrain_residual, constraints, external_loads, reference_force, StaticState,
+};
 
 /// Generalised-α parameters.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -345,11 +347,18 @@ impl<'a> Dynamics<'a> {
                     mat_mul(&s.q.rot[i + 1], &model.nodes[i + 1].frame0),
                 ],
             };
-            let (f, k) = force_and_tangent(&es, &e.section, e.length0);
-            for j in 0..12 {
-                r[6 * i + j] += f[j];
+            if with_matrix || self.k0.is_none() {
+                let (f, k) = force_and_tangent(&es, &e.section, e.length0);
+                for j in 0..12 {
+                    r[6 * i + j] += f[j];
+                }
+                k_t.add_element(i, &k);
+            } else {
+                let f = internal_force(&es, &e.section, e.length0);
+                for j in 0..12 {
+                    r[6 * i + j] += f[j];
+                }
             }
-            k_t.add_element(i, &k);
         }
         if self.k0.is_none() {
             self.k0 = Some(k_t.clone());
@@ -619,19 +628,47 @@ impl<'a> Dynamics<'a> {
             let rhs: Vec<f64> = r.iter().map(|x| -x).collect();
             let dv = self.solver.solve(&mat, &rhs).map_err(|e| e.to_string())?;
             let step_norm = dv.iter().fold(0.0f64, |m, x| m.max(x.abs())) * hhb;
+            let length_scale = 1.0 + s.q.x.iter().flatten().fold(0.0f64, |m, x| m.max(x.abs()));
+            let converged = measure <= self.options.tolerance
+                || (step_norm <= 1e-12 * length_scale && measure <= 1e-6);
+            // Backtracking on the residual's 2-norm: a regularised sign with a tiny `eps`
+            // (or a contact switching on and off) makes full Newton steps jump across the
+            // narrow transition and cycle; a shorter step lands in it. Full steps are kept
+            // when nothing shorter lowers the residual.
+            let mut alpha = 1.0;
+            if !converged {
+                let norm0 = r.iter().map(|x| x * x).sum::<f64>().sqrt();
+                let mut probe = trial.clone();
+                let mut accepted = false;
+                for _ in 0..24 {
+                    let mut cand: Vec<f64> =
+                        vdot.iter().zip(&dv).map(|(x, d)| x + alpha * d).collect();
+                    top_prescribed(&mut cand);
+                    apply(&mut probe, &cand);
+                    table(&mut probe);
+                    let (mut rc, _) = self.residual_and_matrix(&probe, hg, hhb, false);
+                    constrain_residual(&c, &mut rc);
+                    let norm = rc.iter().map(|x| x * x).sum::<f64>().sqrt();
+                    if norm.is_finite() && norm <= (1.0 - 1e-4 * alpha) * norm0 {
+                        accepted = true;
+                        break;
+                    }
+                    alpha *= 0.5;
+                }
+                if !accepted {
+                    alpha = 1.0;
+                }
+            }
             for (x, d) in vdot.iter_mut().zip(&dv) {
-                *x += d;
+                *x += alpha * d;
             }
             top_prescribed(&mut vdot);
             if std::env::var("HOLEWALL_DEBUG_NEWTON").is_ok() {
                 eprintln!(
-                    "  dyn t {t1:.6} it {it}: residual {measure:.3e} correction {step_norm:.3e}"
+                    "  dyn t {t1:.6} it {it}: residual {measure:.3e} correction {step_norm:.3e} α {alpha}"
                 );
             }
-            let length_scale = 1.0 + s.q.x.iter().flatten().fold(0.0f64, |m, x| m.max(x.abs()));
-            if measure <= self.options.tolerance
-                || (step_norm <= 1e-12 * length_scale && measure <= 1e-6)
-            {
+            if converged {
                 apply(&mut trial, &vdot);
                 table(&mut trial);
                 *s = trial;

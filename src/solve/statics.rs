@@ -321,7 +321,7 @@ fn assemble(
 }
 
 /// Applies the translation bases and fixed DOFs to a residual (only).
-fn constrain_residual(c: &Constraints, residual: &mut [f64]) {
+pub(crate) fn constrain_residual(c: &Constraints, residual: &mut [f64]) {
     for (i, b) in c.basis.iter().enumerate() {
         if let Some(b) = b {
             let v: [f64; 3] = std::array::from_fn(|k| residual[6 * i + k]);
@@ -540,8 +540,43 @@ pub fn solve_static_from(
                     step = (step * 1.5).min(1.0);
                 }
             }
+            Err(reason) if pending_zero => {
+                // Gravity alone failed from the low-side start: continue from the linear
+                // spring law to the case's exponent (a soft law's onset stiffness is huge
+                // and contacts cycle in and out); every stage is logged.
+                let continued = exponent_continuation(
+                    model,
+                    &c,
+                    &state,
+                    &f_gravity,
+                    f_ref,
+                    options,
+                    &mut solver,
+                    &mut residual,
+                    &mut tangent,
+                    &mut log,
+                );
+                match continued {
+                    Some((s, its)) => {
+                        log.push(format!(
+                            "gravity step failed directly ({reason}); reached by continuation of the spring exponent"
+                        ));
+                        state = s;
+                        iterations.extend(its);
+                        pending_zero = false;
+                    }
+                    None => {
+                        return Err(StaticError::LoadStep {
+                            from: lambda,
+                            step,
+                            min: options.min_step,
+                            reason,
+                        })
+                    }
+                }
+            }
             Err(reason) => {
-                if pending_zero || step / 2.0 < options.min_step {
+                if step / 2.0 < options.min_step {
                     return Err(StaticError::LoadStep {
                         from: lambda,
                         step,
@@ -558,6 +593,78 @@ pub fn solve_static_from(
         }
     }
     Ok(finish(model, state, iterations, log))
+}
+
+/// Equilibrium under gravity (no bit loads, no friction) reached by continuation of every
+/// site's spring exponent from 1 (linear) to its own value, with adaptive steps. `None`
+/// when the law is linear everywhere or a stage fails below the minimum step.
+#[allow(clippy::too_many_arguments)]
+fn exponent_continuation(
+    model: &Model,
+    c: &Constraints,
+    start: &StaticState,
+    f_gravity: &[f64],
+    f_ref: f64,
+    options: &StaticOptions,
+    solver: &mut ChainSolver,
+    residual: &mut [f64],
+    tangent: &mut BlockTridiagonal,
+    log: &mut Vec<String>,
+) -> Option<(StaticState, Vec<usize>)> {
+    if model.sites.iter().all(|s| s.params.spring_exponent == 1.0) {
+        return None;
+    }
+    let frictionless = scale_friction(model, 0.0);
+    let at = |s: f64| {
+        let mut m = frictionless.clone();
+        for site in &mut m.sites {
+            let target = site.params.spring_exponent;
+            site.params.spring_exponent = 1.0 + s * (target - 1.0);
+        }
+        m
+    };
+    let mut state = start.clone();
+    let mut its = Vec::new();
+    let (mut s, mut step) = (0.0f64, 1.0f64);
+    let mut first = true;
+    while first || s < 1.0 {
+        let target = if first { 0.0 } else { (s + step).min(1.0) };
+        match newton(
+            &at(target),
+            c,
+            &state,
+            1.0,
+            f_gravity,
+            f_ref,
+            options,
+            solver,
+            residual,
+            tangent,
+        ) {
+            Ok((next, k)) => {
+                state = next;
+                its.push(k);
+                first = false;
+                s = target;
+                if k <= 6 {
+                    step = (1.5 * step).min(1.0);
+                }
+            }
+            Err(reason) => {
+                if first || step / 2.0 < options.min_step {
+                    log.push(format!(
+                        "exponent continuation failed at s = {s:.4}: {reason}"
+                    ));
+                    return None;
+                }
+                step /= 2.0;
+                log.push(format!(
+                    "exponent continuation {s:.4} → {target:.4} failed ({reason}); step cut to {step:.3e}"
+                ));
+            }
+        }
+    }
+    Some((state, its))
 }
 
 /// Gravity loads and the other external loads (bit, point loads), at full value.
