@@ -85,6 +85,20 @@ enum BenchCommand {
         #[arg(long)]
         json: Option<PathBuf>,
     },
+    /// Time steps per second and Newton iterations per step of `holewall run` (CPU f64).
+    Dynamics {
+        /// Case file with a `[dynamics]` table.
+        case: PathBuf,
+        /// Steps per repeat (at the case's time step, from the static equilibrium).
+        #[arg(long, default_value_t = 200)]
+        steps: usize,
+        /// Timed repeats (the median is reported).
+        #[arg(long, default_value_t = 5)]
+        repeats: usize,
+        /// Also write the results as JSON here.
+        #[arg(long)]
+        json: Option<PathBuf>,
+    },
 }
 
 fn fail(errors: &[holewall::Error]) -> ExitCode {
@@ -169,6 +183,15 @@ fn main() -> ExitCode {
                 backend,
                 json,
             } => match cli::bench::contact(pairs, repeats, backend, json.as_deref()) {
+                Ok(()) => ExitCode::SUCCESS,
+                Err(e) => fail(&[e]),
+            },
+            BenchCommand::Dynamics {
+                case,
+                steps,
+                repeats,
+                json,
+            } => match cli::bench::dynamics(&case, steps, repeats, json.as_deref()) {
                 Ok(()) => ExitCode::SUCCESS,
                 Err(e) => fail(&[e]),
             },

@@ -143,3 +143,79 @@ fn gpu_rows<T: GpuReal>(
     ));
     Ok(())
 }
+
+#[derive(Serialize)]
+struct DynamicsReport {
+    case: String,
+    nodes: usize,
+    elements: usize,
+    contact_sites: usize,
+    time_step_s: f64,
+    steps: usize,
+    repeats: usize,
+    median_s: f64,
+    steps_per_s: f64,
+    newton_iterations_per_step: f64,
+    ms_per_newton_iteration: f64,
+    step_cuts: usize,
+}
+
+/// Steps per second and Newton iterations per step of the CPU f64 integrator on a case
+/// with a `[dynamics]` table: `steps` steps from the static equilibrium, timed `repeats`
+/// times (median).
+pub fn dynamics(
+    case_path: &Path,
+    steps: usize,
+    repeats: usize,
+    json: Option<&Path>,
+) -> Result<(), Error> {
+    use crate::solve::dynamics::Dynamics;
+    use crate::solve::statics::{solve_static, StaticOptions};
+    let case = crate::case::load_case(case_path)?;
+    let settings = case.dynamics.clone().ok_or_else(|| {
+        Error::Io(std::io::Error::other(format!(
+            "{}: bench dynamics needs a [dynamics] table",
+            case_path.display()
+        )))
+    })?;
+    let model = &case.model;
+    let start = solve_static(model, &StaticOptions::default())
+        .map_err(|e| Error::Io(std::io::Error::other(format!("static start: {e}"))))?;
+    let options = super::run_cmd::options_for(&settings);
+    let density = case.element_density.clone();
+    let mut its = (0usize, 0usize, 0usize);
+    let t = median_seconds::<Error>(repeats, || {
+        let mut d = Dynamics::new(model, options, &|e| density[e]);
+        let mut s = d
+            .initial_state(start.state.clone())
+            .map_err(|e| Error::Io(std::io::Error::other(e)))?;
+        d.run(&mut s, steps as f64 * options.dt, &mut |_, _| {})
+            .map_err(|e| Error::Io(std::io::Error::other(e)))?;
+        its = (
+            d.iterations.len(),
+            d.iterations.iter().sum(),
+            d.log.iter().filter(|l| l.contains("cut to")).count(),
+        );
+        Ok(())
+    })?;
+    let report = DynamicsReport {
+        case: case_path.display().to_string(),
+        nodes: model.nodes.len(),
+        elements: model.elements.len(),
+        contact_sites: model.sites.len(),
+        time_step_s: options.dt,
+        steps: its.0,
+        repeats,
+        median_s: t,
+        steps_per_s: its.0 as f64 / t,
+        newton_iterations_per_step: its.1 as f64 / its.0.max(1) as f64,
+        ms_per_newton_iteration: 1e3 * t / its.1.max(1) as f64,
+        step_cuts: its.2,
+    };
+    let text = serde_json::to_string_pretty(&report).unwrap_or_default();
+    println!("{text}");
+    if let Some(path) = json {
+        write_atomic(path, text.as_bytes())?;
+    }
+    Ok(())
+}

@@ -125,6 +125,19 @@ fn csv_bytes(header: &[&str], rows: impl Iterator<Item = Vec<f64>>) -> Result<Ve
         .map_err(|e| Error::Io(std::io::Error::other(e.to_string())))
 }
 
+/// Integrator options of a case's `[dynamics]` table.
+pub fn options_for(settings: &crate::case::DynamicsSettings) -> DynamicOptions {
+    DynamicOptions {
+        dt: settings.time_step,
+        alpha: AlphaParams::chung_hulbert(settings.rho_inf),
+        rayleigh: settings.rayleigh,
+        ramp_time: settings.ramp_time,
+        mass: settings.mass,
+        rop: settings.rop,
+        ..Default::default()
+    }
+}
+
 /// Runs the command.
 pub fn run(case_path: &Path, out: &Path, show_progress: bool) -> Result<RunSummary, Error> {
     let case = load_case(case_path)?;
@@ -134,15 +147,7 @@ pub fn run(case_path: &Path, out: &Path, show_progress: bool) -> Result<RunSumma
     let model = &case.model;
     let start = solve_static(model, &StaticOptions::default())
         .map_err(|e| Error::Io(std::io::Error::other(format!("static start: {e}"))))?;
-    let options = DynamicOptions {
-        dt: settings.time_step,
-        alpha: AlphaParams::chung_hulbert(settings.rho_inf),
-        rayleigh: settings.rayleigh,
-        ramp_time: settings.ramp_time,
-        mass: settings.mass,
-        rop: settings.rop,
-        ..Default::default()
-    };
+    let options = options_for(&settings);
     let density = case.element_density.clone();
     let mut dynamics = Dynamics::new(model, options, &|e| density[e]);
     let mut s = dynamics
