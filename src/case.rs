@@ -226,6 +226,42 @@ pub struct CaseSpec {
     pub mesh: Option<MeshSpec>,
     /// Time integration (`holewall run`).
     pub dynamics: Option<DynamicsSpec>,
+    /// Variants (`holewall ensemble`).
+    pub ensemble: Option<EnsembleSpec>,
+}
+
+/// `[ensemble]`: what each variant runs, the grid of variants, the variants whose full
+/// time series are written.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct EnsembleSpec {
+    /// `"static"` (default) or `"dynamic"` (needs `[dynamics]`).
+    pub analysis: Option<Spanned<String>>,
+    /// Key → values; every combination is a variant (see `src/ensemble.rs` for the keys).
+    pub grid: Option<std::collections::BTreeMap<String, Spanned<Vec<Quantity>>>>,
+    /// Names of the variants whose full time series are written (grid variants are named
+    /// by their index).
+    pub series: Option<Vec<String>>,
+}
+
+/// What an ensemble runs per variant.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Analysis {
+    /// Static equilibrium.
+    Static,
+    /// The `[dynamics]` run from the static equilibrium.
+    Dynamic,
+}
+
+/// Checked `[ensemble]`.
+#[derive(Clone, Debug)]
+pub struct EnsembleSettings {
+    /// What each variant runs.
+    pub analysis: Analysis,
+    /// Grid (key, values), in key order.
+    pub grid: Vec<(crate::ensemble::Key, Vec<f64>)>,
+    /// Variants with full time series.
+    pub series: Vec<String>,
 }
 
 /// A case read and checked, ready to build a model.
@@ -247,6 +283,8 @@ pub struct Case {
     pub element_density: Vec<f64>,
     /// `[dynamics]`, if given.
     pub dynamics: Option<DynamicsSettings>,
+    /// `[ensemble]`, if given.
+    pub ensemble: Option<EnsembleSettings>,
 }
 
 struct Ctx<'a> {
@@ -925,7 +963,12 @@ pub fn parse_case(path: &Path, text: &str) -> Result<Case, InputError> {
         None => None,
         Some(d) => Some(dynamics_settings(&ctx, d)?),
     };
+    let ensemble = match &spec.ensemble {
+        None => None,
+        Some(e) => Some(ensemble_settings(&ctx, e, dynamics.is_some())?),
+    };
     Ok(Case {
+        ensemble,
         title: spec.title.unwrap_or_default(),
         path: path.to_path_buf(),
         model,
@@ -934,6 +977,60 @@ pub fn parse_case(path: &Path, text: &str) -> Result<Case, InputError> {
         mud_density: mud,
         element_density,
         dynamics,
+    })
+}
+
+fn ensemble_settings(
+    ctx: &Ctx,
+    e: &EnsembleSpec,
+    has_dynamics: bool,
+) -> Result<EnsembleSettings, InputError> {
+    let analysis = match &e.analysis {
+        None => Analysis::Static,
+        Some(a) => match a.get_ref().as_str() {
+            "static" => Analysis::Static,
+            "dynamic" if has_dynamics => Analysis::Dynamic,
+            "dynamic" => {
+                return Err(ctx.err(
+                    a.span(),
+                    "ensemble.analysis",
+                    "\"dynamic\" needs a [dynamics] table",
+                ))
+            }
+            other => {
+                return Err(ctx.err(
+                    a.span(),
+                    "ensemble.analysis",
+                    format!("unknown analysis {other:?}; allowed: static, dynamic"),
+                ))
+            }
+        },
+    };
+    let mut grid = Vec::new();
+    for (name, values) in e.grid.iter().flatten() {
+        let key_name = format!("ensemble.grid.{name}");
+        let key = crate::ensemble::Key::parse(name)
+            .map_err(|m| ctx.err(values.span(), &key_name, m))?;
+        if values.get_ref().is_empty() {
+            return Err(ctx.err(values.span(), &key_name, "no values"));
+        }
+        let mut list = Vec::new();
+        for q in values.get_ref() {
+            let text = match q {
+                Quantity::Number(x) => x.to_string(),
+                Quantity::Text(t) => t.clone(),
+            };
+            list.push(
+                key.value(&text)
+                    .map_err(|m| ctx.err(values.span(), &key_name, m))?,
+            );
+        }
+        grid.push((key, list));
+    }
+    Ok(EnsembleSettings {
+        analysis,
+        grid,
+        series: e.series.clone().unwrap_or_default(),
     })
 }
 

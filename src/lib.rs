@@ -10,6 +10,7 @@
 
 pub mod backend;
 pub mod case;
+pub mod ensemble;
 pub mod cli;
 pub mod error;
 pub mod gpu;
