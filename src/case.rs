@@ -1009,8 +1009,8 @@ fn ensemble_settings(
     let mut grid = Vec::new();
     for (name, values) in e.grid.iter().flatten() {
         let key_name = format!("ensemble.grid.{name}");
-        let key = crate::ensemble::Key::parse(name)
-            .map_err(|m| ctx.err(values.span(), &key_name, m))?;
+        let key =
+            crate::ensemble::Key::parse(name).map_err(|m| ctx.err(values.span(), &key_name, m))?;
         if values.get_ref().is_empty() {
             return Err(ctx.err(values.span(), &key_name, "no values"));
         }

@@ -118,16 +118,36 @@ impl Key {
             Param::WallStiffness => (None, |x| x > 0.0 && x <= 1e12, "0 < k_e ≤ 1e12 N/m^m"),
             Param::WallDamping => (Some(Dimension::Damping), |x| x >= 0.0, "≥ 0 N·s/m"),
             Param::Exponent => (None, |x| x > 0.0 && x <= 3.0, "0 < m ≤ 3"),
-            Param::Eps => (Some(Dimension::Speed), |x| x > 0.0 && x <= 10.0, "0 < eps ≤ 10 m/s"),
+            Param::Eps => (
+                Some(Dimension::Speed),
+                |x| x > 0.0 && x <= 10.0,
+                "0 < eps ≤ 10 m/s",
+            ),
             Param::Rpm => (
                 Some(Dimension::AngularSpeed),
                 |x| (0.0..=1000.0 * std::f64::consts::TAU / 60.0).contains(&x),
                 "0 … 1000 rpm",
             ),
-            Param::Wob => (Some(Dimension::Force), |x| (0.0..=1e7).contains(&x), "0 … 1e7 N"),
-            Param::Tob => (Some(Dimension::Torque), |x| (0.0..=1e6).contains(&x), "0 … 1e6 N·m"),
-            Param::Blade => (Some(Dimension::Length), |x| x > 0.0 && x < 2.0, "0 < blade < 2 m"),
-            Param::FromBit => (Some(Dimension::Length), |x| x > 0.0 && x < 2e4, "0 < from_bit < 20 km"),
+            Param::Wob => (
+                Some(Dimension::Force),
+                |x| (0.0..=1e7).contains(&x),
+                "0 … 1e7 N",
+            ),
+            Param::Tob => (
+                Some(Dimension::Torque),
+                |x| (0.0..=1e6).contains(&x),
+                "0 … 1e6 N·m",
+            ),
+            Param::Blade => (
+                Some(Dimension::Length),
+                |x| x > 0.0 && x < 2.0,
+                "0 < blade < 2 m",
+            ),
+            Param::FromBit => (
+                Some(Dimension::Length),
+                |x| x > 0.0 && x < 2e4,
+                "0 < from_bit < 20 km",
+            ),
         };
         let t = text.trim();
         let v = match (t.parse::<f64>(), dim) {
@@ -164,7 +184,8 @@ fn input_error(source: &str, line: usize, key: &str, message: impl Into<String>)
 /// variant. Every cell is checked; the first error names the file, line and key.
 pub fn variants_from_csv(path: &Path) -> Result<Vec<Variant>, InputError> {
     let source = path.display().to_string();
-    let text = std::fs::read_to_string(path).map_err(|e| input_error(&source, 0, "-", e.to_string()))?;
+    let text =
+        std::fs::read_to_string(path).map_err(|e| input_error(&source, 0, "-", e.to_string()))?;
     variants_from_csv_text(&source, &text)
 }
 
@@ -191,7 +212,12 @@ pub fn variants_from_csv_text(source: &str, text: &str) -> Result<Vec<Variant>, 
         }
     }
     if keys.iter().all(|k| k.is_none()) {
-        return Err(input_error(source, 1, "-", format!("no parameter columns; allowed: {KEY_FORMS}")));
+        return Err(input_error(
+            source,
+            1,
+            "-",
+            format!("no parameter columns; allowed: {KEY_FORMS}"),
+        ));
     }
     let mut out = Vec::new();
     for (row, record) in reader.records().enumerate() {
@@ -217,7 +243,9 @@ pub fn variants_from_csv_text(source: &str, text: &str) -> Result<Vec<Variant>, 
             match key {
                 None => v.name = cell.to_string(),
                 Some(k) => {
-                    let x = k.value(cell).map_err(|m| input_error(source, line, &k.name, m))?;
+                    let x = k
+                        .value(cell)
+                        .map_err(|m| input_error(source, line, &k.name, m))?;
                     v.overrides.push((k.clone(), x));
                 }
             }
@@ -266,12 +294,10 @@ pub fn apply(case: &Case, variant: &Variant) -> Result<Model, String> {
     let mut model = case.model.clone();
     let stabs = stabilizer_sites(&case.model);
     let stab = |k: usize| -> Result<usize, String> {
-        stabs.get(k - 1).copied().ok_or_else(|| {
-            format!(
-                "stab{k}: the case has {} stabilizer site(s)",
-                stabs.len()
-            )
-        })
+        stabs
+            .get(k - 1)
+            .copied()
+            .ok_or_else(|| format!("stab{k}: the case has {} stabilizer site(s)", stabs.len()))
     };
     let hole_radius_at = |md: f64| {
         0.5 * case
@@ -303,10 +329,15 @@ pub fn apply(case: &Case, variant: &Variant) -> Result<Model, String> {
         }
         if let Some(j) = (0..model.sites.len()).find(|&j| j != k && model.sites[j].node == node) {
             if model.sites[j].stabilizer {
-                return Err(format!("{}: two stabilizers at MD {:.2} m", key.name, model.nodes[node].md));
+                return Err(format!(
+                    "{}: two stabilizers at MD {:.2} m",
+                    key.name, model.nodes[node].md
+                ));
             }
-            let (pipe_radius, hole_radius) =
-                (model.pipe_radius_at(old), hole_radius_at(model.nodes[old].md));
+            let (pipe_radius, hole_radius) = (
+                model.pipe_radius_at(old),
+                hole_radius_at(model.nodes[old].md),
+            );
             let other = &mut model.sites[j];
             other.node = old;
             other.hole_radius = hole_radius;
@@ -318,7 +349,10 @@ pub fn apply(case: &Case, variant: &Variant) -> Result<Model, String> {
         site.hole_radius = hole_radius_at(model.nodes[node].md);
         site.params.clearance = site.hole_radius - site.params.disk_radius;
         if site.params.clearance < 0.0 {
-            return Err(format!("{}: the blade is wider than the hole there", key.name));
+            return Err(format!(
+                "{}: the blade is wider than the hole there",
+                key.name
+            ));
         }
     }
     for (key, value) in &variant.overrides {
@@ -384,7 +418,13 @@ mod tests {
         let k = Key::parse("stab1.from_bit").unwrap();
         assert_eq!((k.param, k.stabilizer), (Param::FromBit, Some(1)));
         assert_eq!(Key::parse("rpm").unwrap().param, Param::Rpm);
-        for bad in ["rpm.stab1", "stab0.blade", "kappa", "mu.stabx", "stab1.width"] {
+        for bad in [
+            "rpm.stab1",
+            "stab0.blade",
+            "kappa",
+            "mu.stabx",
+            "stab1.width",
+        ] {
             assert!(Key::parse(bad).is_err(), "{bad}");
         }
         let rpm = Key::parse("rpm").unwrap();
@@ -412,7 +452,8 @@ mod tests {
 
     #[test]
     fn csv_errors_name_line_and_key() {
-        let e = variants_from_csv_text("v.csv", "name,mu,wob\na,0.2,10 kN\nb,3,10 kN\n").unwrap_err();
+        let e =
+            variants_from_csv_text("v.csv", "name,mu,wob\na,0.2,10 kN\nb,3,10 kN\n").unwrap_err();
         assert_eq!((e.line, e.key.as_str()), (3, "mu"));
         let e = variants_from_csv_text("v.csv", "mu,speed\n0.2,1\n").unwrap_err();
         assert_eq!((e.line, e.key.as_str()), (1, "speed"));

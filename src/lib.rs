@@ -10,8 +10,8 @@
 
 pub mod backend;
 pub mod case;
-pub mod ensemble;
 pub mod cli;
+pub mod ensemble;
 pub mod error;
 pub mod gpu;
 pub mod kernels;

@@ -61,6 +61,27 @@ enum Command {
         #[arg(long)]
         quiet: bool,
     },
+    /// One case, many variants (CSV of overrides or the case's [ensemble] grid): statics
+    /// or dynamics per variant, quantities of interest and status in variants.csv.
+    Ensemble {
+        /// Case file (with an [ensemble] table for a grid, analysis and series).
+        case: PathBuf,
+        /// CSV of variants: a header of keys (mu, k_e, rpm, wob, stab1.blade, …), a row each.
+        #[arg(long)]
+        variants: Option<PathBuf>,
+        /// Where the variants run.
+        #[arg(long, value_enum, default_value_t = BackendChoice::Auto)]
+        backend: BackendChoice,
+        /// Float type.
+        #[arg(long, value_enum, default_value_t = Precision::F64)]
+        precision: Precision,
+        /// Output folder.
+        #[arg(long)]
+        out: PathBuf,
+        /// No progress bar.
+        #[arg(long)]
+        quiet: bool,
+    },
     /// Benchmarks (medians over repeats; GPU/CPU ratios from the same run).
     Bench {
         #[command(subcommand)]
@@ -172,6 +193,21 @@ fn main() -> ExitCode {
             print_summary(cli::static_cmd::run(&case, model, &out))
         }
         Command::Run { case, out, quiet } => print_summary(cli::run_cmd::run(&case, &out, !quiet)),
+        Command::Ensemble {
+            case,
+            variants,
+            backend,
+            precision,
+            out,
+            quiet,
+        } => print_summary(cli::ensemble_cmd::run(
+            &case,
+            variants.as_deref(),
+            backend,
+            precision,
+            &out,
+            !quiet,
+        )),
         Command::GpuInfo { pairs } => match cli::gpu_info::run(pairs) {
             Ok(()) => ExitCode::SUCCESS,
             Err(e) => fail(&[e]),

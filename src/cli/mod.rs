@@ -2,6 +2,7 @@
 
 pub mod bench;
 pub mod contact;
+pub mod ensemble_cmd;
 pub mod gpu_info;
 pub mod run_cmd;
 pub mod static_cmd;

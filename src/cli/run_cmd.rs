@@ -141,6 +141,12 @@ pub fn options_for(settings: &crate::case::DynamicsSettings) -> DynamicOptions {
 /// Runs the command.
 pub fn run(case_path: &Path, out: &Path, show_progress: bool) -> Result<RunSummary, Error> {
     let case = load_case(case_path)?;
+    run_case(&case, out, show_progress)
+}
+
+/// Runs a loaded case (its model may carry an ensemble variant's overrides).
+pub fn run_case(case: &Case, out: &Path, show_progress: bool) -> Result<RunSummary, Error> {
+    let case_path = &case.path;
     let settings = case.dynamics.clone().ok_or_else(|| {
         Error::Input(InputError { source_name: case_path.display().to_string(), line: 1, key: "dynamics".into(), message: "holewall run needs a [dynamics] table (duration, time_step, …); see cases/README.md".into() })
     })?;
@@ -159,7 +165,7 @@ pub fn run(case_path: &Path, out: &Path, show_progress: bool) -> Result<RunSumma
         sites: Vec::new(),
         stress: Vec::new(),
     };
-    record(&case, &dynamics, &s, &mut rec, &want);
+    record(case, &dynamics, &s, &mut rec, &want);
     let bar = if show_progress {
         indicatif::ProgressBar::new(1000)
     } else {
@@ -185,7 +191,7 @@ pub fn run(case_path: &Path, out: &Path, show_progress: bool) -> Result<RunSumma
         .map_err(|e| Error::Io(std::io::Error::other(e)))?;
     bar.finish_and_clear();
     for st in &pending {
-        record(&case, &dynamics, st, &mut rec, &want);
+        record(case, &dynamics, st, &mut rec, &want);
     }
 
     std::fs::create_dir_all(out)?;

@@ -84,14 +84,36 @@ pub struct Summary {
 /// Neutral point: the first MD, going up from the bit, where the axial force turns from
 /// compression to tension (linear interpolation between nodes).
 pub fn neutral_point(rows: &[ProfileRow]) -> Option<f64> {
-    for k in (1..rows.len()).rev() {
-        let (lo, hi) = (&rows[k], &rows[k - 1]);
-        if lo.axial_force_n <= 0.0 && hi.axial_force_n > 0.0 {
-            let f = lo.axial_force_n / (lo.axial_force_n - hi.axial_force_n);
-            return Some(lo.md_m + f * (hi.md_m - lo.md_m));
+    let md: Vec<f64> = rows.iter().map(|r| r.md_m).collect();
+    let axial: Vec<f64> = rows.iter().map(|r| r.axial_force_n).collect();
+    neutral_point_of(&md, &axial)
+}
+
+/// [`neutral_point`] from nodal MDs and axial forces (tension +).
+pub fn neutral_point_of(md: &[f64], axial: &[f64]) -> Option<f64> {
+    for k in (1..md.len()).rev() {
+        let (lo, hi) = (axial[k], axial[k - 1]);
+        if lo <= 0.0 && hi > 0.0 {
+            let f = lo / (lo - hi);
+            return Some(md[k] + f * (md[k - 1] - md[k]));
         }
     }
     None
+}
+
+/// Nodal axial forces: the mean of the adjacent elements' (as in `profile.csv`).
+pub fn nodal_axial_forces(element_axial: &[f64]) -> Vec<f64> {
+    let n = element_axial.len() + 1;
+    (0..n)
+        .map(|i| {
+            let adj: Vec<f64> = [i.checked_sub(1), (i < n - 1).then_some(i)]
+                .into_iter()
+                .flatten()
+                .map(|e| element_axial[e])
+                .collect();
+            adj.iter().sum::<f64>() / adj.len() as f64
+        })
+        .collect()
 }
 
 fn buckling(model: &Model, rows: &[ProfileRow], case: &Case) -> (bool, bool) {
@@ -129,6 +151,83 @@ fn buckling(model: &Model, rows: &[ProfileRow], case: &Case) -> (bool, bool) {
     (sinusoidal, helical)
 }
 
+/// Profile rows, hook load, surface torque and weight on bit of an FE static solution.
+pub fn fe_rows(
+    model: &Model,
+    sol: &crate::solve::statics::StaticSolution,
+) -> (Vec<ProfileRow>, f64, f64, f64) {
+    let n = model.nodes.len();
+    let mut wob = model.weight_on_bit;
+    let mut side = vec![0.0; n];
+    let mut in_contact = vec![false; n];
+    for (site, (c, normal, _)) in model.sites.iter().zip(&sol.contact) {
+        side[site.node] = *normal;
+        in_contact[site.node] = *c && *normal > 0.0;
+    }
+    let rows: Vec<ProfileRow> = (0..n)
+        .map(|i| {
+            let adj: Vec<usize> = [i.checked_sub(1), (i < n - 1).then_some(i)]
+                .into_iter()
+                .flatten()
+                .collect();
+            let avg = |f: &dyn Fn(usize) -> f64| {
+                adj.iter().map(|&e| f(e)).sum::<f64>() / adj.len() as f64
+            };
+            let axial = avg(&|e| sol.section_forces[e].axial);
+            let area = avg(&|e| model.elements[e].section.area);
+            let d = sub(&sol.state.x[i], &model.nodes[i].position);
+            let t = model.nodes[i].hole_axis;
+            let d_t = sub(&d, &scale(&t, dot(&d, &t)));
+            ProfileRow {
+                md_m: model.nodes[i].md,
+                x_m: sol.state.x[i][0],
+                y_m: sol.state.x[i][1],
+                z_m: sol.state.x[i][2],
+                axial_force_n: axial,
+                axial_stress_pa: axial / area,
+                torque_nm: avg(&|e| sol.section_forces[e].torque).abs(),
+                bending_moment_nm: avg(&|e| {
+                    sol.section_forces[e].bending[if e < i { 1 } else { 0 }]
+                }),
+                side_force_n: side[i],
+                lateral_displacement_m: dot(&d_t, &d_t).sqrt(),
+                in_contact: in_contact[i],
+            }
+        })
+        .collect();
+    let t0 = model.nodes[0].hole_axis;
+    let mut hook = -dot(
+        &[
+            sol.top_reaction[0],
+            sol.top_reaction[1],
+            sol.top_reaction[2],
+        ],
+        &t0,
+    );
+    if let crate::model::TopBoundary::HookLoad(h) = model.top {
+        hook = h;
+        let tb = model.nodes[n - 1].hole_axis;
+        wob = -dot(
+            &[
+                sol.bit_reaction[0],
+                sol.bit_reaction[1],
+                sol.bit_reaction[2],
+            ],
+            &tb,
+        );
+    }
+    let torque = dot(
+        &[
+            sol.top_reaction[3],
+            sol.top_reaction[4],
+            sol.top_reaction[5],
+        ],
+        &t0,
+    )
+    .abs();
+    (rows, hook, torque, wob)
+}
+
 /// Runs the command; returns the summary.
 pub fn run(case_path: &Path, which: StaticModel, out: &Path) -> Result<Summary, Error> {
     let case = load_case(case_path)?;
@@ -140,73 +239,8 @@ pub fn run(case_path: &Path, which: StaticModel, out: &Path) -> Result<Summary, 
         StaticModel::Fe => {
             let sol = solve_static(model, &StaticOptions::default())
                 .map_err(|e| Error::Io(std::io::Error::other(e.to_string())))?;
-            let mut side = vec![0.0; n];
-            let mut in_contact = vec![false; n];
-            for (site, (c, normal, _)) in model.sites.iter().zip(&sol.contact) {
-                side[site.node] = *normal;
-                in_contact[site.node] = *c && *normal > 0.0;
-            }
-            let rows: Vec<ProfileRow> = (0..n)
-                .map(|i| {
-                    let adj: Vec<usize> = [i.checked_sub(1), (i < n - 1).then_some(i)]
-                        .into_iter()
-                        .flatten()
-                        .collect();
-                    let avg = |f: &dyn Fn(usize) -> f64| {
-                        adj.iter().map(|&e| f(e)).sum::<f64>() / adj.len() as f64
-                    };
-                    let axial = avg(&|e| sol.section_forces[e].axial);
-                    let area = avg(&|e| model.elements[e].section.area);
-                    let d = sub(&sol.state.x[i], &model.nodes[i].position);
-                    let t = model.nodes[i].hole_axis;
-                    let d_t = sub(&d, &scale(&t, dot(&d, &t)));
-                    ProfileRow {
-                        md_m: model.nodes[i].md,
-                        x_m: sol.state.x[i][0],
-                        y_m: sol.state.x[i][1],
-                        z_m: sol.state.x[i][2],
-                        axial_force_n: axial,
-                        axial_stress_pa: axial / area,
-                        torque_nm: avg(&|e| sol.section_forces[e].torque).abs(),
-                        bending_moment_nm: avg(&|e| {
-                            sol.section_forces[e].bending[if e < i { 1 } else { 0 }]
-                        }),
-                        side_force_n: side[i],
-                        lateral_displacement_m: dot(&d_t, &d_t).sqrt(),
-                        in_contact: in_contact[i],
-                    }
-                })
-                .collect();
-            let t0 = model.nodes[0].hole_axis;
-            let mut hook = -dot(
-                &[
-                    sol.top_reaction[0],
-                    sol.top_reaction[1],
-                    sol.top_reaction[2],
-                ],
-                &t0,
-            );
-            if let crate::model::TopBoundary::HookLoad(h) = model.top {
-                hook = h;
-                let tb = model.nodes[n - 1].hole_axis;
-                wob = -dot(
-                    &[
-                        sol.bit_reaction[0],
-                        sol.bit_reaction[1],
-                        sol.bit_reaction[2],
-                    ],
-                    &tb,
-                );
-            }
-            let torque = dot(
-                &[
-                    sol.top_reaction[3],
-                    sol.top_reaction[4],
-                    sol.top_reaction[5],
-                ],
-                &t0,
-            )
-            .abs();
+            let (rows, hook, torque, w) = fe_rows(model, &sol);
+            wob = w;
             solver_log = sol.log.clone();
             (rows, hook, torque, sol.iterations)
         }

@@ -1,0 +1,595 @@
+//! `holewall ensemble CASE [--variants FILE] --out DIR`: one case, many variants (issue 5).
+//!
+//! Each variant is the case with its overrides (`src/ensemble.rs`), solved statically or
+//! run dynamically from its static equilibrium. The CPU backend runs the variants in
+//! parallel (rayon), each with the f64 solvers (faer for the global solves); a variant that
+//! fails is reported with its reason and never touches another's numbers.
+//!
+//! Output: `DIR/variants.csv` (overrides, quantities of interest, status per variant),
+//! `DIR/summary.json`, plots of the quantities of interest over the variants, and for the
+//! variants the case names in `ensemble.series` the full `holewall run` output under
+//! `DIR/series/<name>/`.
+
+use std::path::Path;
+
+use rayon::prelude::*;
+use serde::Serialize;
+
+use crate::backend::{BackendChoice, Precision};
+use crate::case::{load_case, Analysis, Case};
+use crate::cli::static_cmd::{fe_rows, neutral_point, neutral_point_of, nodal_axial_forces};
+use crate::ensemble::{apply, stabilizer_sites, variants_from_csv, variants_from_grid, Variant};
+use crate::error::{Error, GpuError, InputError};
+use crate::model::Model;
+use crate::output::write_atomic;
+use crate::physics::beam::{local_deformation, section_forces, Mat3};
+use crate::physics::vec3::{dot, scale, sub};
+use crate::plots::{line_plot, Series};
+use crate::solve::dynamics::{DynamicState, Dynamics};
+use crate::solve::statics::{solve_static, StaticOptions};
+
+/// Per-stabilizer quantities of interest.
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct StabilizerQoi {
+    /// Largest normal (side) force (N).
+    pub max_side_force_n: f64,
+    /// Largest lateral displacement from the hole axis (m).
+    pub max_lateral_m: f64,
+    /// Whirl frequency over the second half of a dynamic run (Hz), signed: + forward (with
+    /// the rotation), − backward; `None` for static runs or a stabilizer that stays put.
+    pub whirl_hz: Option<f64>,
+}
+
+/// How a variant ended.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Status {
+    /// Converged at the requested steps.
+    Converged,
+    /// Converged, with load or time steps cut on the way (see the reason column).
+    StepCut,
+    /// Failed (NaN, Newton divergence, step below the minimum): see the reason.
+    Failed,
+}
+
+/// One variant's result.
+#[derive(Clone, Debug, Serialize)]
+pub struct VariantResult {
+    /// Variant name.
+    pub name: String,
+    /// Status.
+    pub status: Status,
+    /// Why it failed, or the first step cut.
+    pub reason: String,
+    /// Neutral point from the bit (m): static solution, or the last state of a dynamic run.
+    pub neutral_point_from_bit_m: Option<f64>,
+    /// Largest surface torque (N·m).
+    pub max_surface_torque_nm: f64,
+    /// Per stabilizer, nearest the bit first.
+    pub stabilizers: Vec<StabilizerQoi>,
+    /// Mean Newton iterations per load or time step.
+    pub newton_iterations_per_step: f64,
+    /// Step cuts.
+    pub step_cuts: usize,
+}
+
+/// The command's summary.
+#[derive(Clone, Debug, Serialize)]
+pub struct EnsembleSummary {
+    /// Case title.
+    pub title: String,
+    /// `static` or `dynamic`.
+    pub analysis: String,
+    /// Where it ran.
+    pub backend: String,
+    /// Variants run.
+    pub variants: usize,
+    /// Converged without cuts.
+    pub converged: usize,
+    /// Converged with step cuts.
+    pub step_cut: usize,
+    /// Failed.
+    pub failed: usize,
+    /// Names and reasons of the failed variants.
+    pub failures: Vec<(String, String)>,
+    /// Wall time of the variant runs (s).
+    pub seconds: f64,
+    /// Files written.
+    pub outputs: Vec<String>,
+}
+
+fn mat_mul(a: &Mat3<f64>, b: &Mat3<f64>) -> Mat3<f64> {
+    std::array::from_fn(|r| std::array::from_fn(|c| (0..3).map(|k| a[r][k] * b[k][c]).sum()))
+}
+
+fn element_axial(model: &Model, q: &crate::solve::statics::StaticState, i: usize) -> (f64, f64) {
+    let e = &model.elements[i];
+    let t1 = mat_mul(&q.rot[i], &model.nodes[i].frame0);
+    let t2 = mat_mul(&q.rot[i + 1], &model.nodes[i + 1].frame0);
+    let f = section_forces(
+        &local_deformation(&q.x[i], &q.x[i + 1], &t1, &t2, e.length0),
+        &e.section,
+        e.length0,
+    );
+    (f.axial, f.torque)
+}
+
+/// Lateral offset of a site's node from the hole axis, in the node's frame (x, y).
+fn lateral(model: &Model, q: &crate::solve::statics::StaticState, node: usize) -> (f64, f64) {
+    let nd = &model.nodes[node];
+    let d = sub(&q.x[node], &nd.position);
+    let d_t = sub(&d, &scale(&nd.hole_axis, dot(&d, &nd.hole_axis)));
+    let f = &nd.frame0;
+    (
+        dot(&d_t, &[f[0][1], f[1][1], f[2][1]]),
+        dot(&d_t, &[f[0][2], f[1][2], f[2][2]]),
+    )
+}
+
+fn failed(name: &str, reason: String, stabs: usize) -> VariantResult {
+    VariantResult {
+        name: name.to_string(),
+        status: Status::Failed,
+        reason,
+        neutral_point_from_bit_m: None,
+        max_surface_torque_nm: f64::NAN,
+        stabilizers: vec![StabilizerQoi::default(); stabs],
+        newton_iterations_per_step: f64::NAN,
+        step_cuts: 0,
+    }
+}
+
+/// Static equilibrium of one variant's model.
+pub fn static_variant(case: &Case, name: &str, model: &Model) -> VariantResult {
+    let stabs = stabilizer_sites(model);
+    let sol = match solve_static(model, &StaticOptions::default()) {
+        Ok(s) => s,
+        Err(e) => return failed(name, e.to_string(), stabs.len()),
+    };
+    let (rows, _hook, torque, _wob) = fe_rows(model, &sol);
+    let stabilizers = stabs
+        .iter()
+        .map(|&k| {
+            let (x, y) = lateral(model, &sol.state, model.sites[k].node);
+            StabilizerQoi {
+                max_side_force_n: sol.contact[k].1.max(0.0),
+                max_lateral_m: x.hypot(y),
+                whirl_hz: None,
+            }
+        })
+        .collect();
+    let cuts = sol.log.iter().filter(|l| l.contains("cut")).count();
+    VariantResult {
+        name: name.to_string(),
+        status: if cuts > 0 {
+            Status::StepCut
+        } else {
+            Status::Converged
+        },
+        reason: sol.log.first().cloned().unwrap_or_default(),
+        neutral_point_from_bit_m: neutral_point(&rows).map(|md| case.bit_md - md),
+        max_surface_torque_nm: torque,
+        stabilizers,
+        newton_iterations_per_step: sol.iterations.iter().sum::<usize>() as f64
+            / sol.iterations.len().max(1) as f64,
+        step_cuts: cuts,
+    }
+}
+
+/// The `[dynamics]` run of one variant's model from its static equilibrium.
+pub fn dynamic_variant(case: &Case, name: &str, model: &Model) -> VariantResult {
+    let stabs = stabilizer_sites(model);
+    let Some(settings) = case.dynamics.clone() else {
+        return failed(name, "no [dynamics] table".into(), stabs.len());
+    };
+    let start = match solve_static(model, &StaticOptions::default()) {
+        Ok(s) => s,
+        Err(e) => return failed(name, format!("static start: {e}"), stabs.len()),
+    };
+    let options = super::run_cmd::options_for(&settings);
+    let density = &case.element_density;
+    let mut dynamics = Dynamics::new(model, options, &|e| density[e]);
+    let mut s = match dynamics.initial_state(start.state) {
+        Ok(s) => s,
+        Err(e) => return failed(name, format!("initial state: {e}"), stabs.len()),
+    };
+    let mut qoi = vec![StabilizerQoi::default(); stabs.len()];
+    let mut angles: Vec<Vec<(f64, f64)>> = vec![Vec::new(); stabs.len()];
+    let mut last_angle: Vec<Option<f64>> = vec![None; stabs.len()];
+    let mut unwrapped = vec![0.0; stabs.len()];
+    let mut max_torque: f64 = 0.0;
+    let half = 0.5 * settings.duration;
+    let mut observe = |d: &Dynamics, st: &DynamicState| {
+        max_torque = max_torque.max(element_axial(model, &st.q, 0).1.abs());
+        let contact = d.contact_forces(st);
+        for (j, &k) in stabs.iter().enumerate() {
+            let node = model.sites[k].node;
+            let (x, y) = lateral(model, &st.q, node);
+            let r = x.hypot(y);
+            qoi[j].max_lateral_m = qoi[j].max_lateral_m.max(r);
+            if r > 0.0 {
+                let g = &contact[k].g;
+                let nd = &model.nodes[node];
+                let d = sub(&st.q.x[node], &nd.position);
+                let d_t = sub(&d, &scale(&nd.hole_axis, dot(&d, &nd.hole_axis)));
+                let normal = dot(&[g[0], g[1], g[2]], &d_t) / r;
+                qoi[j].max_side_force_n = qoi[j].max_side_force_n.max(normal);
+            }
+            let a = y.atan2(x);
+            if let Some(l) = last_angle[j] {
+                let mut da = a - l;
+                da -= std::f64::consts::TAU * (da / std::f64::consts::TAU).round();
+                unwrapped[j] += da;
+            }
+            last_angle[j] = Some(a);
+            if st.t >= half && r > 1e-6 {
+                angles[j].push((st.t, unwrapped[j]));
+            }
+        }
+    };
+    observe(&dynamics, &s);
+    let result = dynamics.run(&mut s, settings.duration, &mut observe);
+    let cuts = dynamics.log.iter().filter(|l| l.contains("cut to")).count();
+    if let Err(reason) = result {
+        let mut f = failed(name, reason, stabs.len());
+        f.step_cuts = cuts;
+        return f;
+    }
+    if s.v.iter().any(|x| !x.is_finite()) {
+        return failed(name, "state is not finite".into(), stabs.len());
+    }
+    let sign = if model.rotation_speed < 0.0 {
+        -1.0
+    } else {
+        1.0
+    };
+    for (j, pts) in angles.iter().enumerate() {
+        if pts.len() >= 3 {
+            let nm = pts.len() as f64;
+            let (mt, ma) = pts
+                .iter()
+                .fold((0.0, 0.0), |(a, b), (t, x)| (a + t / nm, b + x / nm));
+            let den: f64 = pts.iter().map(|(t, _)| (t - mt).powi(2)).sum();
+            if den > 0.0 {
+                let rate = pts.iter().map(|(t, x)| (t - mt) * (x - ma)).sum::<f64>() / den;
+                // Lateral angles are measured about the node's frame0 (e2, e3) = about
+                // the hole axis, the direction of a positive rotation speed.
+                qoi[j].whirl_hz = Some(sign * rate / std::f64::consts::TAU);
+            }
+        }
+    }
+    let axial: Vec<f64> = (0..model.elements.len())
+        .map(|i| element_axial(model, &s.q, i).0)
+        .collect();
+    let md: Vec<f64> = model.nodes.iter().map(|n| n.md).collect();
+    let np = neutral_point_of(&md, &nodal_axial_forces(&axial));
+    VariantResult {
+        name: name.to_string(),
+        status: if cuts > 0 {
+            Status::StepCut
+        } else {
+            Status::Converged
+        },
+        reason: dynamics.log.first().cloned().unwrap_or_default(),
+        neutral_point_from_bit_m: np.map(|x| case.bit_md - x),
+        max_surface_torque_nm: max_torque,
+        stabilizers: qoi,
+        newton_iterations_per_step: dynamics.iterations.iter().sum::<usize>() as f64
+            / dynamics.iterations.len().max(1) as f64,
+        step_cuts: cuts,
+    }
+}
+
+/// Runs every variant on the CPU (rayon over variants); results in variant order.
+pub fn run_variants_cpu(
+    case: &Case,
+    analysis: Analysis,
+    variants: &[Variant],
+    bar: &indicatif::ProgressBar,
+) -> Vec<VariantResult> {
+    variants
+        .par_iter()
+        .map(|v| {
+            let stabs = stabilizer_sites(&case.model).len();
+            let r = match apply(case, v) {
+                Err(e) => failed(&v.name, format!("variant: {e}"), stabs),
+                Ok(model) => match analysis {
+                    Analysis::Static => static_variant(case, &v.name, &model),
+                    Analysis::Dynamic => dynamic_variant(case, &v.name, &model),
+                },
+            };
+            bar.inc(1);
+            r
+        })
+        .collect()
+}
+
+fn fmt(x: f64) -> String {
+    if x.is_finite() {
+        format!("{x}")
+    } else {
+        String::new()
+    }
+}
+
+fn variants_csv(
+    variants: &[Variant],
+    results: &[VariantResult],
+    stabs: usize,
+    dynamic: bool,
+) -> Result<Vec<u8>, Error> {
+    let io = |e: csv::Error| Error::Io(std::io::Error::other(e));
+    let mut keys: Vec<String> = Vec::new();
+    for v in variants {
+        for (k, _) in &v.overrides {
+            if !keys.contains(&k.name) {
+                keys.push(k.name.clone());
+            }
+        }
+    }
+    let mut header: Vec<String> = vec!["index".into(), "name".into()];
+    header.extend(keys.iter().cloned());
+    header.extend(
+        [
+            "status",
+            "reason",
+            "neutral_point_from_bit_m",
+            "max_surface_torque_nm",
+        ]
+        .map(String::from),
+    );
+    for k in 1..=stabs {
+        header.push(format!("stab{k}_max_side_force_n"));
+        header.push(format!("stab{k}_max_lateral_m"));
+        if dynamic {
+            header.push(format!("stab{k}_whirl_hz"));
+            header.push(format!("stab{k}_whirl"));
+        }
+    }
+    header.extend(["newton_iterations_per_step", "step_cuts"].map(String::from));
+    let mut w = csv::Writer::from_writer(Vec::new());
+    w.write_record(&header).map_err(io)?;
+    for (i, (v, r)) in variants.iter().zip(results).enumerate() {
+        let mut row = vec![i.to_string(), v.name.clone()];
+        for k in &keys {
+            row.push(
+                v.overrides
+                    .iter()
+                    .find(|(key, _)| &key.name == k)
+                    .map(|(_, x)| fmt(*x))
+                    .unwrap_or_default(),
+            );
+        }
+        row.push(
+            match r.status {
+                Status::Converged => "converged",
+                Status::StepCut => "step_cut",
+                Status::Failed => "failed",
+            }
+            .into(),
+        );
+        row.push(r.reason.clone());
+        row.push(r.neutral_point_from_bit_m.map(fmt).unwrap_or_default());
+        row.push(fmt(r.max_surface_torque_nm));
+        for q in &r.stabilizers {
+            row.push(fmt(q.max_side_force_n));
+            row.push(fmt(q.max_lateral_m));
+            if dynamic {
+                row.push(q.whirl_hz.map(fmt).unwrap_or_default());
+                row.push(
+                    match q.whirl_hz {
+                        Some(h) if h > 0.0 => "forward",
+                        Some(h) if h < 0.0 => "backward",
+                        _ => "",
+                    }
+                    .into(),
+                );
+            }
+        }
+        row.push(fmt(r.newton_iterations_per_step));
+        row.push(r.step_cuts.to_string());
+        w.write_record(&row).map_err(io)?;
+    }
+    w.into_inner()
+        .map_err(|e| Error::Io(std::io::Error::other(e.to_string())))
+}
+
+/// Runs the command.
+pub fn run(
+    case_path: &Path,
+    variants_file: Option<&Path>,
+    backend: BackendChoice,
+    precision: Precision,
+    out: &Path,
+    show_progress: bool,
+) -> Result<EnsembleSummary, Error> {
+    let case = load_case(case_path)?;
+    let settings = case.ensemble.clone();
+    let variants = match (variants_file, &settings) {
+        (Some(f), _) => variants_from_csv(f)?,
+        (None, Some(s)) if !s.grid.is_empty() => variants_from_grid(&s.grid),
+        _ => {
+            return Err(InputError {
+                source_name: case_path.display().to_string(),
+                line: 1,
+                key: "ensemble.grid".into(),
+                message: "no variants: give --variants FILE or an [ensemble.grid] table".into(),
+            }
+            .into())
+        }
+    };
+    let analysis = settings
+        .as_ref()
+        .map(|s| s.analysis)
+        .unwrap_or(Analysis::Static);
+    let series: Vec<String> = settings
+        .as_ref()
+        .map(|s| s.series.clone())
+        .unwrap_or_default();
+    for name in &series {
+        if !variants.iter().any(|v| &v.name == name) {
+            return Err(InputError {
+                source_name: case_path.display().to_string(),
+                line: 1,
+                key: "ensemble.series".into(),
+                message: format!("no variant named {name:?}"),
+            }
+            .into());
+        }
+        if analysis == Analysis::Static {
+            return Err(InputError {
+                source_name: case_path.display().to_string(),
+                line: 1,
+                key: "ensemble.series".into(),
+                message: "time series need analysis = \"dynamic\"".into(),
+            }
+            .into());
+        }
+    }
+    if precision == Precision::F32 {
+        return Err(InputError {
+            source_name: "--precision".into(),
+            line: 0,
+            key: "precision".into(),
+            message: "the CPU ensemble computes in f64 (the oracle); f32 needs the GPU engine, which is not built yet".into(),
+        }
+        .into());
+    }
+    let backend_name = match backend {
+        BackendChoice::Cpu => "cpu",
+        BackendChoice::Auto => {
+            eprintln!("holewall: the GPU ensemble engine is not built yet; running the variants on the CPU (f64)");
+            "cpu"
+        }
+        BackendChoice::Gpu => return Err(GpuError::Unsupported(
+            "the GPU ensemble engine (the Newton step in WGSL) is not built yet; use --backend cpu"
+                .into(),
+        )
+        .into()),
+    };
+    // Check every variant against the case before any work.
+    for v in &variants {
+        if let Err(e) = apply(&case, v) {
+            return Err(InputError {
+                source_name: variants_file
+                    .map(|p| p.display().to_string())
+                    .unwrap_or_else(|| case_path.display().to_string()),
+                line: 0,
+                key: format!("variant {}", v.name),
+                message: e,
+            }
+            .into());
+        }
+    }
+    let bar = if show_progress {
+        indicatif::ProgressBar::new(variants.len() as u64)
+    } else {
+        indicatif::ProgressBar::hidden()
+    };
+    bar.set_style(
+        indicatif::ProgressStyle::with_template(
+            "{bar:40} {pos}/{len} variants, {elapsed} elapsed, eta {eta}",
+        )
+        .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+    );
+    let start = std::time::Instant::now();
+    let results = run_variants_cpu(&case, analysis, &variants, &bar);
+    let seconds = start.elapsed().as_secs_f64();
+    bar.finish_and_clear();
+
+    std::fs::create_dir_all(out)?;
+    let stabs = stabilizer_sites(&case.model).len();
+    let dynamic = analysis == Analysis::Dynamic;
+    let mut outputs = vec!["variants.csv".to_string()];
+    write_atomic(
+        &out.join("variants.csv"),
+        &variants_csv(&variants, &results, stabs, dynamic)?,
+    )?;
+    let idx = |f: &dyn Fn(&VariantResult) -> Option<f64>| -> Vec<(f64, f64)> {
+        results
+            .iter()
+            .enumerate()
+            .filter_map(|(i, r)| f(r).filter(|x| x.is_finite()).map(|y| (i as f64, y)))
+            .collect()
+    };
+    line_plot(
+        &out.join("neutral_point.png"),
+        &format!("{}: neutral point over the variants", case.title),
+        "variant",
+        "neutral point from the bit (m)",
+        &[Series {
+            name: "neutral point",
+            points: idx(&|r| r.neutral_point_from_bit_m),
+        }],
+        &[],
+    )?;
+    outputs.push("neutral_point.png".into());
+    let names: Vec<String> = (1..=stabs).map(|k| format!("stab{k}")).collect();
+    let side: Vec<Series> = (0..stabs)
+        .map(|k| Series {
+            name: &names[k],
+            points: idx(&|r| r.stabilizers.get(k).map(|q| q.max_side_force_n)),
+        })
+        .collect();
+    line_plot(
+        &out.join("side_force.png"),
+        &format!("{}: largest side force per stabilizer", case.title),
+        "variant",
+        "side force (N)",
+        &side,
+        &[],
+    )?;
+    outputs.push("side_force.png".into());
+    if dynamic {
+        let whirl: Vec<Series> = (0..stabs)
+            .map(|k| Series {
+                name: &names[k],
+                points: idx(&|r| r.stabilizers.get(k).and_then(|q| q.whirl_hz)),
+            })
+            .collect();
+        line_plot(
+            &out.join("whirl.png"),
+            &format!("{}: whirl frequency (+ forward, − backward)", case.title),
+            "variant",
+            "whirl (Hz)",
+            &whirl,
+            &[],
+        )?;
+        outputs.push("whirl.png".into());
+        for name in &series {
+            let v = variants
+                .iter()
+                .find(|v| &v.name == name)
+                .ok_or_else(|| Error::Io(std::io::Error::other(format!("no variant {name}"))))?;
+            let mut c = case.clone();
+            c.model = apply(&case, v).map_err(|e| Error::Io(std::io::Error::other(e)))?;
+            let dir = out.join("series").join(name);
+            super::run_cmd::run_case(&c, &dir, false)?;
+            outputs.push(format!("series/{name}/"));
+        }
+    }
+    let count = |s: Status| results.iter().filter(|r| r.status == s).count();
+    let summary = EnsembleSummary {
+        title: case.title.clone(),
+        analysis: if dynamic { "dynamic" } else { "static" }.into(),
+        backend: backend_name.into(),
+        variants: variants.len(),
+        converged: count(Status::Converged),
+        step_cut: count(Status::StepCut),
+        failed: count(Status::Failed),
+        failures: results
+            .iter()
+            .filter(|r| r.status == Status::Failed)
+            .map(|r| (r.name.clone(), r.reason.clone()))
+            .collect(),
+        seconds,
+        outputs,
+    };
+    write_atomic(
+        &out.join("summary.json"),
+        serde_json::to_string_pretty(&summary)
+            .unwrap_or_default()
+            .as_bytes(),
+    )?;
+    Ok(summary)
+}

@@ -1,0 +1,206 @@
+//! Ensembles on the CPU backend: a variant's results equal a single run of the case with
+//! the same values written into it; a failing variant fails alone; bad variant files are
+//! refused with file, line and key.
+
+use holewall::backend::{BackendChoice, Precision};
+use holewall::case::{parse_case, Analysis};
+use holewall::cli::ensemble_cmd::{run, run_variants_cpu, static_variant, Status};
+use holewall::ensemble::{apply, variants_from_csv_text};
+
+/// The 60 m test bed of `tests/extreme.rs` with Table 1 values, written out.
+fn bed(mu: &str, wob: &str) -> String {
+    std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/tests/data/extreme_base.toml"
+    ))
+    .unwrap()
+    .replace("MU", mu)
+    .replace("BLADE", "8.25 in")
+    .replace("KE", "6e7")
+    .replace("EXP", "1")
+    .replace("EPS", "1e-3")
+    .replace(
+        "weight_on_bit = \"20 kN\"",
+        &format!("weight_on_bit = \"{wob}\""),
+    )
+}
+
+fn tmp(name: &str) -> std::path::PathBuf {
+    let d = std::env::temp_dir().join(format!("holewall-ens-{}-{name}", std::process::id()));
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+#[test]
+fn a_variant_equals_the_case_with_its_values_written_in() {
+    let dir = tmp("equal");
+    let base = parse_case(&dir.join("base.toml"), &bed("0.3", "20 kN")).unwrap();
+    let variants =
+        variants_from_csv_text("v.csv", "name,mu,wob\nlow,0.1,10 kN\nhigh,0.5,35 kN\n").unwrap();
+    let bar = indicatif::ProgressBar::hidden();
+    let results = run_variants_cpu(&base, Analysis::Static, &variants, &bar);
+    for (v, r, (mu, wob)) in [
+        (&variants[0], &results[0], ("0.1", "10 kN")),
+        (&variants[1], &results[1], ("0.5", "35 kN")),
+    ] {
+        let written = parse_case(&dir.join("w.toml"), &bed(mu, wob)).unwrap();
+        let single = static_variant(&written, &v.name, &written.model);
+        assert_ne!(r.status, Status::Failed, "{}: {}", v.name, r.reason);
+        let np = r.neutral_point_from_bit_m;
+        eprintln!(
+            "{}: neutral point {np:?} m, surface torque {:.1} N·m, stab1 side force {:.1} N",
+            v.name, r.max_surface_torque_nm, r.stabilizers[0].max_side_force_n
+        );
+        // Same model, same solver: the same numbers.
+        assert_eq!(r.neutral_point_from_bit_m, single.neutral_point_from_bit_m);
+        assert_eq!(r.max_surface_torque_nm, single.max_surface_torque_nm);
+        assert_eq!(
+            r.stabilizers[0].max_side_force_n,
+            single.stabilizers[0].max_side_force_n
+        );
+    }
+    // The overrides did something: with 35 kN the whole 60 m string is in compression (no
+    // neutral point), and five times the friction gives far more surface torque.
+    assert!(results[1].neutral_point_from_bit_m.is_none());
+    assert!(results[1].max_surface_torque_nm > 2.0 * results[0].max_surface_torque_nm);
+}
+
+#[test]
+fn a_failing_variant_fails_alone_and_the_others_are_bit_identical() {
+    let dir = tmp("fail");
+    let case = parse_case(&dir.join("base.toml"), &bed("0.3", "20 kN")).unwrap();
+    let good = variants_from_csv_text("v.csv", "name,mu,wob\na,0.2,15 kN\nb,0.4,25 kN\n").unwrap();
+    // An absurd spring: k_e at the top of its range with m = 3 and a soft start cannot be
+    // brought to equilibrium.
+    let with_bad = variants_from_csv_text(
+        "v.csv",
+        "name,mu,wob,k_e,m\na,0.2,15 kN,6e7,1\nbad,0.3,9000 kN,1e12,3\nb,0.4,25 kN,6e7,1\n",
+    )
+    .unwrap();
+    let bar = indicatif::ProgressBar::hidden();
+    let alone = run_variants_cpu(&case, Analysis::Static, &good, &bar);
+    let mixed = run_variants_cpu(&case, Analysis::Static, &with_bad, &bar);
+    assert_eq!(mixed[1].status, Status::Failed);
+    eprintln!("failed variant: {}", mixed[1].reason);
+    assert!(!mixed[1].reason.is_empty());
+    for (a, m) in [(&alone[0], &mixed[0]), (&alone[1], &mixed[2])] {
+        assert_eq!(a.status, Status::Converged);
+        assert_eq!(
+            a.neutral_point_from_bit_m.map(f64::to_bits),
+            m.neutral_point_from_bit_m.map(f64::to_bits)
+        );
+        assert_eq!(
+            a.max_surface_torque_nm.to_bits(),
+            m.max_surface_torque_nm.to_bits()
+        );
+        assert_eq!(
+            a.stabilizers[0].max_side_force_n.to_bits(),
+            m.stabilizers[0].max_side_force_n.to_bits()
+        );
+    }
+}
+
+#[test]
+fn stabilizer_layout_moves_the_site() {
+    let dir = tmp("layout");
+    let case = parse_case(&dir.join("base.toml"), &bed("0.3", "20 kN")).unwrap();
+    let v = variants_from_csv_text("v.csv", "stab1.from_bit,stab1.blade\n20 m,8 in\n").unwrap();
+    let m = apply(&case, &v[0]).unwrap();
+    let stab = m.sites.iter().find(|s| s.stabilizer).unwrap();
+    let md = m.nodes[stab.node].md;
+    assert!((case.bit_md - md - 20.0).abs() <= 1.5, "stabilizer at {md}");
+    assert!((stab.params.disk_radius - 0.1016).abs() < 1e-12);
+    assert!((stab.params.clearance - (stab.hole_radius - 0.1016)).abs() < 1e-12);
+    // Every node still carries exactly one site (the pipe-body site took the old node).
+    let mut nodes: Vec<usize> = m.sites.iter().map(|s| s.node).collect();
+    nodes.dedup();
+    assert_eq!(nodes.len(), case.model.sites.len());
+    let too_wide = variants_from_csv_text("v.csv", "stab1.blade\n9 in\n").unwrap();
+    assert!(apply(&case, &too_wide[0])
+        .unwrap_err()
+        .contains("wider than the hole"));
+}
+
+#[test]
+fn grid_dynamic_ensemble_writes_variants_and_series() {
+    let dir = tmp("grid");
+    let text = bed("0.3", "20 kN").replace("duration = \"0.1 s\"", "duration = \"0.06 s\"")
+        + "\n[ensemble]\nanalysis = \"dynamic\"\nseries = [\"1\"]\n\n[ensemble.grid]\nrpm = [\"60 rpm\", \"120 rpm\"]\n";
+    let path = dir.join("grid.toml");
+    std::fs::write(&path, text).unwrap();
+    let out = dir.join("out");
+    let s = run(&path, None, BackendChoice::Cpu, Precision::F64, &out, false).unwrap();
+    assert_eq!((s.variants, s.failed), (2, 0));
+    let csv = std::fs::read_to_string(out.join("variants.csv")).unwrap();
+    assert!(csv.lines().next().unwrap().contains("stab1_whirl_hz"));
+    assert_eq!(csv.lines().count(), 3);
+    assert!(out.join("series/1/timeseries.csv").exists());
+    assert!(out.join("whirl.png").exists());
+    // f32 and the GPU engine are refused plainly (not built yet), before any output.
+    let out2 = dir.join("out2");
+    let e = run(
+        &path,
+        None,
+        BackendChoice::Cpu,
+        Precision::F32,
+        &out2,
+        false,
+    )
+    .unwrap_err();
+    assert_eq!(e.exit_code(), 2);
+    assert!(run(
+        &path,
+        None,
+        BackendChoice::Gpu,
+        Precision::F64,
+        &out2,
+        false
+    )
+    .is_err());
+    assert!(!out2.exists());
+}
+
+#[test]
+fn bad_variant_files_name_file_line_and_key() {
+    let dir = tmp("bad");
+    let case = dir.join("c.toml");
+    std::fs::write(&case, bed("0.3", "20 kN")).unwrap();
+    for (body, line, key) in [
+        ("mu,wob\n0.2,10 kN\n0.3,-5 kN\n", 3, "wob"),
+        ("mu,torque\n0.2,1\n", 1, "torque"),
+        ("k_e.stab0\n1e8\n", 1, "k_e.stab0"),
+        ("m\n0\n", 2, "m"),
+    ] {
+        let f = dir.join("v.csv");
+        std::fs::write(&f, body).unwrap();
+        let out = dir.join("o");
+        let e = run(
+            &case,
+            Some(&f),
+            BackendChoice::Cpu,
+            Precision::F64,
+            &out,
+            false,
+        )
+        .unwrap_err();
+        let msg = e.to_string();
+        eprintln!("{msg}");
+        assert_eq!(e.exit_code(), 2);
+        assert!(msg.contains(&format!("v.csv:{line}: {key}")), "{msg}");
+        assert!(!out.exists());
+    }
+    // A stabilizer the case does not have.
+    let f = dir.join("v.csv");
+    std::fs::write(&f, "mu.stab3\n0.2\n").unwrap();
+    let e = run(
+        &case,
+        Some(&f),
+        BackendChoice::Cpu,
+        Precision::F64,
+        &dir.join("o"),
+        false,
+    )
+    .unwrap_err();
+    assert_eq!(e.exit_code(), 2);
+    assert!(e.to_string().contains("stab3"), "{e}");
+}
