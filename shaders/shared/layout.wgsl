@@ -8,3 +8,13 @@ struct ContactDims {
     pair_offset: u32,
     _pad: u32,
 }
+
+// Keep in sync with src/gpu/layout.rs (ChainDims).
+struct ChainDims {
+    // Variants in this dispatch (the stride of every field array).
+    num_variants: u32,
+    // Nodes of the chain.
+    num_nodes: u32,
+    _pad0: u32,
+    _pad1: u32,
+}

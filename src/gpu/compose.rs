@@ -16,6 +16,7 @@ use crate::error::GpuError;
 /// The shader sources, embedded at build time.
 pub const SHADERS: &[(&str, &str)] = &[
     ("contact.wgsl", include_str!("../../shaders/contact.wgsl")),
+    ("block_lu.wgsl", include_str!("../../shaders/block_lu.wgsl")),
     (
         "shared/math_f64.wgsl",
         include_str!("../../shaders/shared/math_f64.wgsl"),

@@ -15,3 +15,18 @@ pub struct ContactDims {
     /// Padding to 16 bytes.
     pub _pad: u32,
 }
+
+/// Dispatch dimensions of the block-tridiagonal solve (uniform binding 0 of
+/// `shaders/block_lu.wgsl`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Pod, Zeroable)]
+pub struct ChainDims {
+    /// Variants in this dispatch: the stride of every field array.
+    pub num_variants: u32,
+    /// Nodes of the chain.
+    pub num_nodes: u32,
+    /// Padding to 16 bytes.
+    pub _pad0: u32,
+    /// Padding.
+    pub _pad1: u32,
+}

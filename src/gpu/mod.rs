@@ -1,5 +1,6 @@
 //! The GPU path: wgpu context, shader composition, shared layouts, kernel runners.
 
+pub mod block_lu;
 pub mod compose;
 pub mod contact;
 pub mod context;

@@ -5,8 +5,13 @@
 //! | WGSL kernel | CPU twin |
 //! |---|---|
 //! | `shaders/contact.wgsl` | [`contact`] |
+//! | `shaders/block_lu.wgsl` | [`block_lu`] |
 
+pub mod block_lu;
 pub mod contact;
 
 /// Every (shader, twin) pair; a test fails if a shader under `shaders/` is missing here.
-pub const TWINS: &[(&str, &str)] = &[("contact.wgsl", "src/kernels/contact.rs")];
+pub const TWINS: &[(&str, &str)] = &[
+    ("contact.wgsl", "src/kernels/contact.rs"),
+    ("block_lu.wgsl", "src/kernels/block_lu.rs"),
+];

@@ -1,0 +1,233 @@
+//! The block-tridiagonal solve (`shaders/block_lu.wgsl`, twin `src/kernels/block_lu.rs`)
+//! against faer's sparse LU on real tangents of the paper cases and on random
+//! block-diagonally-dominant systems; GPU against the twin; a singular variant fails alone.
+
+mod common;
+
+use holewall::gpu::block_lu::{block_lu_gpu, block_lu_gpu_chunked};
+use holewall::kernels::block_lu::{block_lu, ChainBatch, SINGULAR, SOLVED};
+use holewall::solve::chain::{BlockTridiagonal, ChainSolver};
+use rand::{Rng, SeedableRng};
+
+fn random_system(
+    rng: &mut rand::rngs::StdRng,
+    n: usize,
+    decades: i32,
+) -> (BlockTridiagonal, Vec<f64>) {
+    let mut a = BlockTridiagonal::zeros(n);
+    for blocks in [&mut a.upper, &mut a.lower] {
+        for b in blocks.iter_mut() {
+            for row in b.iter_mut() {
+                for x in row.iter_mut() {
+                    *x = rng.random_range(-1.0..1.0);
+                }
+            }
+        }
+    }
+    for (i, b) in a.diag.iter_mut().enumerate() {
+        for (r, row) in b.iter_mut().enumerate() {
+            for (c, x) in row.iter_mut().enumerate() {
+                *x = rng.random_range(-1.0..1.0);
+                if r == c {
+                    // Dominant: beyond the row sums of the three blocks, scaled per node so
+                    // the entries span `2·decades` orders of magnitude.
+                    *x += 20.0 * scale(i, decades);
+                }
+            }
+        }
+        let s = scale(i, decades);
+        for (r, row) in b.iter_mut().enumerate() {
+            for (c, x) in row.iter_mut().enumerate() {
+                if r != c {
+                    *x *= s;
+                }
+            }
+        }
+        if i > 0 {
+            for row in a.lower[i - 1].iter_mut() {
+                for x in row.iter_mut() {
+                    *x *= s;
+                }
+            }
+        }
+        if i + 1 < n {
+            for row in a.upper[i].iter_mut() {
+                for x in row.iter_mut() {
+                    *x *= s;
+                }
+            }
+        }
+    }
+    let b = (0..6 * n).map(|_| rng.random_range(-1.0..1.0)).collect();
+    (a, b)
+}
+
+fn scale(i: usize, decades: i32) -> f64 {
+    if decades == 0 {
+        1.0
+    } else {
+        10f64.powi((i as i32 % (2 * decades + 1)) - decades)
+    }
+}
+
+fn norm(x: &[f64]) -> f64 {
+    x.iter().map(|v| v * v).sum::<f64>().sqrt()
+}
+
+fn relative_residual(a: &BlockTridiagonal, x: &[f64], b: &[f64]) -> f64 {
+    let ax = a.mul(x);
+    let r: Vec<f64> = ax.iter().zip(b).map(|(p, q)| p - q).collect();
+    norm(&r) / norm(b)
+}
+
+fn relative_error(x: &[f64], reference: &[f64]) -> f64 {
+    let d: Vec<f64> = x.iter().zip(reference).map(|(p, q)| p - q).collect();
+    norm(&d) / norm(reference)
+}
+
+/// Constrained static tangents of the paper cases at their equilibria.
+fn paper_tangents() -> Vec<(String, BlockTridiagonal)> {
+    use holewall::solve::statics::{constrained_tangent, solve_static, StaticOptions};
+    ["paper_one_stabilizer.toml", "paper_three_stabilizers.toml"]
+        .iter()
+        .map(|name| {
+            let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+                .join("cases")
+                .join(name);
+            let case = holewall::case::load_case(&path).unwrap();
+            let sol = solve_static(&case.model, &StaticOptions::default()).unwrap();
+            (
+                name.to_string(),
+                constrained_tangent(&case.model, &sol.state, 1.0),
+            )
+        })
+        .collect()
+}
+
+#[test]
+fn twin_matches_faer_on_paper_tangents_and_random_systems() {
+    let mut rng = rand::rngs::StdRng::seed_from_u64(7);
+    let mut systems: Vec<(String, BlockTridiagonal, Vec<f64>)> = paper_tangents()
+        .into_iter()
+        .map(|(name, a)| {
+            let b = (0..6 * a.nodes())
+                .map(|_| rng.random_range(-1e4..1e4))
+                .collect();
+            (name, a, b)
+        })
+        .collect();
+    for k in 0..8 {
+        let (a, b) = random_system(&mut rng, 40, 3);
+        systems.push((format!("random {k}"), a, b));
+    }
+    for (name, a, b) in &systems {
+        let reference = ChainSolver::new().solve(a, b).unwrap();
+        let batch = ChainBatch::<f64>::from_systems(&[(a, b.as_slice())]);
+        let (x, status) = block_lu(&batch);
+        assert_eq!(status, vec![SOLVED]);
+        let res = relative_residual(a, &x, b);
+        let res_faer = relative_residual(a, &reference, b);
+        let err = relative_error(&x, &reference);
+        eprintln!(
+            "{name}: {} nodes, relative residual {res:.2e} (faer {res_faer:.2e}), difference from faer {err:.2e}",
+            a.nodes()
+        );
+        assert!(res <= 1e-10, "{name}: residual {res:e}");
+        assert!(err <= 1e-8, "{name}: differs from faer by {err:e}");
+    }
+}
+
+#[test]
+fn gpu_matches_the_twin_and_a_singular_variant_fails_alone() {
+    let Some(ctx) = common::gpu() else { return };
+    let mut rng = rand::rngs::StdRng::seed_from_u64(11);
+    let n = 30;
+    let sys: Vec<(BlockTridiagonal, Vec<f64>)> =
+        (0..64).map(|_| random_system(&mut rng, n, 0)).collect();
+    let refs: Vec<(&BlockTridiagonal, &[f64])> =
+        sys.iter().map(|(a, b)| (a, b.as_slice())).collect();
+    let b64 = ChainBatch::<f64>::from_systems(&refs);
+    let (cpu, st) = block_lu(&b64);
+    assert!(st.iter().all(|&s| s == SOLVED));
+    if ctx.has_f64 {
+        let (gpu, gst) = block_lu_gpu(ctx, &b64).unwrap();
+        assert_eq!(gst, st);
+        let mut worst: f64 = 0.0;
+        for j in 0..64 {
+            worst = worst.max(relative_error(&b64.unpack(&gpu, j), &b64.unpack(&cpu, j)));
+        }
+        eprintln!("GPU f64 vs twin: worst relative difference {worst:.2e}");
+        assert!(worst <= 1e-12);
+        // Chunked dispatches (7 variants each) give the same numbers.
+        let (chunked, _) = block_lu_gpu_chunked(ctx, &b64, 7).unwrap();
+        assert_eq!(chunked, gpu);
+    }
+    // f32: error against the f64 solution, bounded by the conditioning.
+    let b32 = ChainBatch::<f32>::from_systems(&refs);
+    let (gpu32, st32) = block_lu_gpu(ctx, &b32).unwrap();
+    let (cpu32, _) = block_lu(&b32);
+    assert!(st32.iter().all(|&s| s == SOLVED));
+    let mut worst_gpu: f64 = 0.0;
+    let mut worst_cpu: f64 = 0.0;
+    let mut worst_bound: f64 = 0.0;
+    for j in 0..64 {
+        let exact = b64.unpack(&cpu, j);
+        let g: Vec<f64> = b32.unpack(&gpu32, j).iter().map(|&x| x as f64).collect();
+        let c: Vec<f64> = b32.unpack(&cpu32, j).iter().map(|&x| x as f64).collect();
+        let dense = sys[j].0.to_dense();
+        let kappa = dense.norm() * dense.clone().try_inverse().unwrap().norm();
+        let bound = 8.0 * f32::EPSILON as f64 * kappa;
+        let eg = relative_error(&g, &exact);
+        worst_gpu = worst_gpu.max(eg / bound);
+        worst_cpu = worst_cpu.max(relative_error(&c, &exact) / bound);
+        worst_bound = worst_bound.max(bound);
+        assert!(
+            eg <= bound,
+            "variant {j}: f32 error {eg:e} beyond 8·u·κ_F = {bound:e}"
+        );
+    }
+    eprintln!(
+        "f32: worst error / (8·u₃₂·κ_F): GPU {worst_gpu:.2e}, CPU twin {worst_cpu:.2e} (largest bound {worst_bound:.2e})"
+    );
+    // A singular variant (a zero diagonal block row) and a NaN one fail alone.
+    let mut bad = sys.clone();
+    bad[5].0.diag[3] = [[0.0; 6]; 6];
+    bad[5].0.upper[3] = [[0.0; 6]; 6];
+    bad[5].0.lower[2] = [[0.0; 6]; 6];
+    bad[9].0.diag[0][0][0] = f64::NAN;
+    let refs_bad: Vec<(&BlockTridiagonal, &[f64])> =
+        bad.iter().map(|(a, b)| (a, b.as_slice())).collect();
+    let bb = ChainBatch::<f64>::from_systems(&refs_bad);
+    let (cpu_bad, st_bad) = block_lu(&bb);
+    assert_eq!((st_bad[5], st_bad[9]), (SINGULAR, SINGULAR));
+    for j in (0..64).filter(|j| *j != 5 && *j != 9) {
+        assert_eq!(st_bad[j], SOLVED);
+        assert_eq!(
+            bb.unpack(&cpu_bad, j),
+            b64.unpack(&cpu, j),
+            "twin variant {j}"
+        );
+    }
+    if ctx.has_f64 {
+        let (gpu_bad64, gst64) = block_lu_gpu(ctx, &bb).unwrap();
+        assert_eq!(gst64, st_bad, "GPU f64 flags the same variants");
+        for j in (0..64).filter(|j| *j != 5 && *j != 9) {
+            assert_eq!(
+                bb.unpack(&gpu_bad64, j),
+                bb.unpack(&cpu_bad, j),
+                "GPU f64 variant {j}"
+            );
+        }
+    }
+    let bb32 = ChainBatch::<f32>::from_systems(&refs_bad);
+    let (gpu_bad, gst_bad) = block_lu_gpu(ctx, &bb32).unwrap();
+    assert_eq!((gst_bad[5], gst_bad[9]), (SINGULAR, SINGULAR));
+    for j in (0..64).filter(|j| *j != 5 && *j != 9) {
+        assert_eq!(gst_bad[j], SOLVED);
+        assert_eq!(
+            bb32.unpack(&gpu_bad, j),
+            b32.unpack(&gpu32, j),
+            "GPU variant {j}"
+        );
+    }
+}
