@@ -170,11 +170,11 @@ fn gpu_matches_the_twin_and_a_singular_variant_fails_alone() {
     let mut worst_gpu: f64 = 0.0;
     let mut worst_cpu: f64 = 0.0;
     let mut worst_bound: f64 = 0.0;
-    for j in 0..64 {
+    for (j, (a, _)) in sys.iter().enumerate() {
         let exact = b64.unpack(&cpu, j);
         let g: Vec<f64> = b32.unpack(&gpu32, j).iter().map(|&x| x as f64).collect();
         let c: Vec<f64> = b32.unpack(&cpu32, j).iter().map(|&x| x as f64).collect();
-        let dense = sys[j].0.to_dense();
+        let dense = a.to_dense();
         let kappa = dense.norm() * dense.clone().try_inverse().unwrap().norm();
         let bound = 8.0 * f32::EPSILON as f64 * kappa;
         let eg = relative_error(&g, &exact);
