@@ -123,10 +123,14 @@ fn composer_handles_nesting_else_and_errors() {
 }
 
 #[test]
-fn block_lu_validates_in_both_precisions() {
+fn block_lu_and_assembly_validate_in_both_precisions() {
     for f64 in [false, true] {
-        let wgsl = holewall::gpu::block_lu::block_lu_wgsl(f64).unwrap();
-        validate(&wgsl).unwrap_or_else(|e| panic!("f64={f64}: {e}"));
-        assert_eq!(wgsl.contains("f64"), f64, "precision leak, f64={f64}");
+        for wgsl in [
+            holewall::gpu::block_lu::block_lu_wgsl(f64).unwrap(),
+            holewall::gpu::assemble::assemble_wgsl(f64).unwrap(),
+        ] {
+            validate(&wgsl).unwrap_or_else(|e| panic!("f64={f64}: {e}"));
+            assert_eq!(wgsl.contains("f64"), f64, "precision leak, f64={f64}");
+        }
     }
 }

@@ -18,3 +18,11 @@ struct ChainDims {
     _pad0: u32,
     _pad1: u32,
 }
+
+// Keep in sync with src/gpu/layout.rs (AssembleDims).
+struct AssembleDims {
+    num_variants: u32,
+    num_nodes: u32,
+    num_sites: u32,
+    _pad: u32,
+}

@@ -17,6 +17,7 @@ use crate::error::GpuError;
 pub const SHADERS: &[(&str, &str)] = &[
     ("contact.wgsl", include_str!("../../shaders/contact.wgsl")),
     ("block_lu.wgsl", include_str!("../../shaders/block_lu.wgsl")),
+    ("assemble.wgsl", include_str!("../../shaders/assemble.wgsl")),
     (
         "shared/math_f64.wgsl",
         include_str!("../../shaders/shared/math_f64.wgsl"),

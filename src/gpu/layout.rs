@@ -30,3 +30,17 @@ pub struct ChainDims {
     /// Padding.
     pub _pad1: u32,
 }
+
+/// Dispatch dimensions of the assembly (uniform binding 0 of `shaders/assemble.wgsl`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Pod, Zeroable)]
+pub struct AssembleDims {
+    /// Variants V.
+    pub num_variants: u32,
+    /// Nodes n.
+    pub num_nodes: u32,
+    /// Contact sites S per variant.
+    pub num_sites: u32,
+    /// Padding to 16 bytes.
+    pub _pad: u32,
+}

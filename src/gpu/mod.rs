@@ -1,9 +1,11 @@
 //! The GPU path: wgpu context, shader composition, shared layouts, kernel runners.
 
+pub mod assemble;
 pub mod block_lu;
 pub mod compose;
 pub mod contact;
 pub mod context;
+pub mod dispatch;
 pub mod layout;
 
 pub use context::{list_adapters, AdapterSummary, GpuContext};

@@ -6,7 +6,9 @@
 //! |---|---|
 //! | `shaders/contact.wgsl` | [`contact`] |
 //! | `shaders/block_lu.wgsl` | [`block_lu`] |
+//! | `shaders/assemble.wgsl` | [`assemble`] |
 
+pub mod assemble;
 pub mod block_lu;
 pub mod contact;
 
@@ -14,4 +16,5 @@ pub mod contact;
 pub const TWINS: &[(&str, &str)] = &[
     ("contact.wgsl", "src/kernels/contact.rs"),
     ("block_lu.wgsl", "src/kernels/block_lu.rs"),
+    ("assemble.wgsl", "src/kernels/assemble.rs"),
 ];

@@ -244,7 +244,8 @@ pub fn external_loads(model: &Model) -> Vec<f64> {
 
 /// The static contact element at a site for a configuration (friction direction from the
 /// operation's virtual velocities).
-fn site_response(
+/// A site's contact response in static mode (friction direction from the operation).
+pub fn site_response(
     model: &Model,
     state: &StaticState,
     site: &crate::model::Site,
@@ -469,6 +470,24 @@ pub fn constrained_tangent(model: &Model, state: &StaticState, lambda: f64) -> B
     );
     constrain(&c, &mut residual, &mut tangent);
     tangent
+}
+
+/// Residual `f_int + g − λ f_ext` and tangent at a configuration, before constraints (the
+/// oracle of `shaders/assemble.wgsl`).
+pub fn assembled(model: &Model, state: &StaticState, lambda: f64) -> (Vec<f64>, BlockTridiagonal) {
+    let n = model.nodes.len();
+    let mut residual = vec![0.0; 6 * n];
+    let mut tangent = BlockTridiagonal::zeros(n);
+    let f_ext = external_loads(model);
+    assemble(
+        model,
+        state,
+        lambda,
+        &f_ext,
+        &mut residual,
+        Some(&mut tangent),
+    );
+    (residual, tangent)
 }
 
 /// Internal force vector (elements and contacts) at a configuration, unconstrained.

@@ -1,0 +1,84 @@
+//! Runs `shaders/assemble.wgsl` (twin: `src/kernels/assemble.rs`).
+
+use std::collections::BTreeSet;
+
+use crate::error::GpuError;
+use crate::gpu::compose::compose;
+use crate::gpu::contact::GpuReal;
+use crate::gpu::dispatch::run_once;
+use crate::gpu::layout::AssembleDims;
+use crate::gpu::GpuContext;
+use crate::kernels::assemble::AssemblyInputs;
+use crate::kernels::block_lu::ChainBatch;
+
+/// The WGSL text of the assembly at a precision.
+pub fn assemble_wgsl(f64: bool) -> Result<String, GpuError> {
+    let mut flags = BTreeSet::new();
+    if f64 {
+        flags.insert("F64");
+    }
+    compose("assemble.wgsl", &flags, f64)
+}
+
+/// Assembles every variant on the GPU; the result is laid out as the twin's.
+pub fn assemble_gpu<T: GpuReal>(
+    ctx: &'static GpuContext,
+    a: &AssemblyInputs<T>,
+) -> Result<ChainBatch<T>, GpuError> {
+    if T::IS_F64 && !ctx.has_f64 {
+        return Err(GpuError::Unsupported(format!(
+            "adapter {} has no SHADER_F64; use --precision f32",
+            ctx.info.name
+        )));
+    }
+    let (n, nv) = (a.num_nodes, a.num_variants);
+    let m = n.saturating_sub(1);
+    let size = std::mem::size_of::<T>();
+    let largest = [a.elem_tangent.len() * size, a.contact.len() * size]
+        .into_iter()
+        .max()
+        .unwrap_or(0);
+    if largest as u64 > ctx.max_binding_bytes() {
+        return Err(GpuError::Unsupported(format!(
+            "{largest} bytes in one binding exceed the adapter's {}; split the variants",
+            ctx.max_binding_bytes()
+        )));
+    }
+    let pipeline = ctx.pipeline("assemble", &assemble_wgsl(T::IS_F64)?)?;
+    let dims = AssembleDims {
+        num_variants: nv as u32,
+        num_nodes: n as u32,
+        num_sites: a.num_sites as u32,
+        _pad: 0,
+    };
+    let out = run_once(
+        ctx,
+        &pipeline,
+        "assemble",
+        bytemuck::bytes_of(&dims),
+        &[
+            bytemuck::cast_slice(&a.elem_force),
+            bytemuck::cast_slice(&a.elem_tangent),
+            bytemuck::cast_slice(&a.contact),
+            bytemuck::cast_slice(&a.contact_flag),
+            bytemuck::cast_slice(&a.node_site),
+            bytemuck::cast_slice(&a.f_ext),
+        ],
+        &[
+            36 * n * nv * size,
+            36 * m * nv * size,
+            36 * m * nv * size,
+            6 * n * nv * size,
+        ],
+        n * nv,
+    )?;
+    let cast = |b: &Vec<u8>| -> Vec<T> { bytemuck::cast_slice(b).to_vec() };
+    Ok(ChainBatch {
+        num_variants: nv,
+        num_nodes: n,
+        diag: cast(&out[0]),
+        upper: cast(&out[1]),
+        lower: cast(&out[2]),
+        rhs: cast(&out[3]),
+    })
+}

@@ -1,0 +1,109 @@
+//! One-shot dispatch of a kernel whose bindings are: a uniform (binding 0), read-only
+//! storage inputs, then read-write storage outputs, in that order. Buffers are made, the
+//! kernel runs once over `invocations` (workgroups of 64), and every output is read back.
+
+use wgpu::util::DeviceExt;
+
+use crate::error::GpuError;
+use crate::gpu::GpuContext;
+
+/// Invocations per workgroup of every kernel dispatched here.
+pub const WORKGROUP: usize = 64;
+
+/// Runs `pipeline` once; returns the bytes of each output, in order.
+pub fn run_once(
+    ctx: &GpuContext,
+    pipeline: &wgpu::ComputePipeline,
+    label: &str,
+    uniform: &[u8],
+    inputs: &[&[u8]],
+    output_bytes: &[usize],
+    invocations: usize,
+) -> Result<Vec<Vec<u8>>, GpuError> {
+    let device = &ctx.device;
+    let dims = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some(label),
+        contents: uniform,
+        usage: wgpu::BufferUsages::UNIFORM,
+    });
+    let inputs: Vec<wgpu::Buffer> = inputs
+        .iter()
+        .map(|bytes| {
+            // Empty bindings are not allowed: pad to one word.
+            let padded: &[u8] = if bytes.is_empty() { &[0u8; 4] } else { bytes };
+            device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some(label),
+                contents: padded,
+                usage: wgpu::BufferUsages::STORAGE,
+            })
+        })
+        .collect();
+    let outputs: Vec<wgpu::Buffer> = output_bytes
+        .iter()
+        .map(|&bytes| {
+            device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size: bytes.max(4) as u64,
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+                mapped_at_creation: false,
+            })
+        })
+        .collect();
+    let total: usize = output_bytes.iter().map(|b| b.max(&4)).sum();
+    let staging = device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some(label),
+        size: total as u64,
+        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    });
+    let entries: Vec<wgpu::BindGroupEntry> = std::iter::once(&dims)
+        .chain(inputs.iter())
+        .chain(outputs.iter())
+        .enumerate()
+        .map(|(k, b)| wgpu::BindGroupEntry {
+            binding: k as u32,
+            resource: b.as_entire_binding(),
+        })
+        .collect();
+    let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some(label),
+        layout: &pipeline.get_bind_group_layout(0),
+        entries: &entries,
+    });
+    let mut encoder =
+        device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(label) });
+    {
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some(label),
+            timestamp_writes: None,
+        });
+        pass.set_pipeline(pipeline);
+        pass.set_bind_group(0, &bind_group, &[]);
+        pass.dispatch_workgroups(invocations.div_ceil(WORKGROUP) as u32, 1, 1);
+    }
+    let mut offset = 0u64;
+    for (b, &bytes) in outputs.iter().zip(output_bytes) {
+        let size = bytes.max(4) as u64;
+        encoder.copy_buffer_to_buffer(b, 0, &staging, offset, size);
+        offset += size;
+    }
+    ctx.queue.submit([encoder.finish()]);
+    staging.slice(..).map_async(wgpu::MapMode::Read, |_| {});
+    device
+        .poll(wgpu::PollType::wait_indefinitely())
+        .map_err(|e| GpuError::Device(e.to_string()))?;
+    let mut result = Vec::new();
+    {
+        let view = staging
+            .slice(..)
+            .get_mapped_range()
+            .map_err(|e| GpuError::Device(format!("map: {e}")))?;
+        let mut offset = 0usize;
+        for &bytes in output_bytes {
+            result.push(view[offset..offset + bytes].to_vec());
+            offset += bytes.max(4);
+        }
+    }
+    staging.unmap();
+    Ok(result)
+}

@@ -1,0 +1,137 @@
+//! Twin of `shaders/assemble.wgsl`: the static residual and block-tridiagonal tangent of
+//! every variant, gathered per node (one invocation per (node, variant), no atomics).
+//!
+//! Node `i` of variant `v` sums the halves of its two elements and its contact site:
+//!
+//! ```text
+//! r_i   = f_{i−1}[6..12] + f_i[0..6] + g_site − f_ext,i
+//! D_i   = K_{i−1}[6..12][6..12] + K_i[0..6][0..6] + [K_site | 0]
+//! U_i   = K_i[0..6][6..12],   L_i = K_i[6..12][0..6]      (i < n − 1)
+//! ```
+//!
+//! Inputs are the beam kernel's element force (12) and tangent (144) per (element, variant)
+//! and the contact kernel's outputs per (site, variant), in their layouts; outputs are in
+//! the [`crate::kernels::block_lu::ChainBatch`] layout, ready for the block solve. Layout:
+//! element field `j` of element `e`, variant `v` at `[(12 e + j) V + v]` (force) and
+//! `[(144 e + j) V + v]` (tangent, row-major); contact field `k` of pair `s·V + v` at
+//! `[k · S V + s V + v]`; `node_site[i V + v]` is the site at node `i` or `u32::MAX`.
+
+// Index loops mirror the WGSL kernel line for line.
+#![allow(clippy::needless_range_loop)]
+use rayon::prelude::*;
+
+use crate::kernels::block_lu::ChainBatch;
+use crate::kernels::contact::{OUT_G, OUT_K};
+use crate::physics::Real;
+
+/// No contact site at a node.
+pub const NO_SITE: u32 = u32::MAX;
+
+/// Everything the assembly reads, for V variants on a chain of n nodes.
+#[derive(Clone, Debug, PartialEq)]
+pub struct AssemblyInputs<T> {
+    /// Variants V.
+    pub num_variants: usize,
+    /// Nodes n.
+    pub num_nodes: usize,
+    /// Contact sites S per variant.
+    pub num_sites: usize,
+    /// Element internal forces, `12 (n−1) V`.
+    pub elem_force: Vec<T>,
+    /// Element tangents, `144 (n−1) V`.
+    pub elem_tangent: Vec<T>,
+    /// Contact outputs (the contact kernel's `values`), `48 S V`.
+    pub contact: Vec<T>,
+    /// Contact flags per pair, `S V`.
+    pub contact_flag: Vec<u32>,
+    /// Site at each node per variant, `n V` ([`NO_SITE`] where none).
+    pub node_site: Vec<u32>,
+    /// External loads (already scaled by the load factor), `6 n V`.
+    pub f_ext: Vec<T>,
+}
+
+/// One (node, variant) invocation: residual (6), diagonal (36), and, below the last node,
+/// upper and lower (36 each).
+fn node_blocks<T: Real>(
+    a: &AssemblyInputs<T>,
+    i: usize,
+    v: usize,
+) -> ([T; 6], [T; 36], [T; 36], [T; 36]) {
+    let nv = a.num_variants;
+    let n = a.num_nodes;
+    let pairs = a.num_sites * nv;
+    let mut r = [T::zero(); 6];
+    let mut d = [T::zero(); 36];
+    let mut u = [T::zero(); 36];
+    let mut l = [T::zero(); 36];
+    for k in 0..6 {
+        r[k] = T::zero() - a.f_ext[(6 * i + k) * nv + v];
+    }
+    if i > 0 {
+        let e = i - 1;
+        for k in 0..6 {
+            r[k] = r[k] + a.elem_force[(12 * e + 6 + k) * nv + v];
+            for c in 0..6 {
+                d[6 * k + c] =
+                    d[6 * k + c] + a.elem_tangent[(144 * e + 12 * (6 + k) + 6 + c) * nv + v];
+            }
+        }
+    }
+    if i + 1 < n {
+        let e = i;
+        for k in 0..6 {
+            r[k] = r[k] + a.elem_force[(12 * e + k) * nv + v];
+            for c in 0..6 {
+                d[6 * k + c] = d[6 * k + c] + a.elem_tangent[(144 * e + 12 * k + c) * nv + v];
+                u[6 * k + c] = a.elem_tangent[(144 * e + 12 * k + 6 + c) * nv + v];
+                l[6 * k + c] = a.elem_tangent[(144 * e + 12 * (6 + k) + c) * nv + v];
+            }
+        }
+    }
+    let s = a.node_site[i * nv + v];
+    if s != NO_SITE {
+        let p = s as usize * nv + v;
+        if a.contact_flag[p] != 0 {
+            for k in 0..6 {
+                r[k] = r[k] + a.contact[(OUT_G + k) * pairs + p];
+                for c in 0..3 {
+                    d[6 * k + c] = d[6 * k + c] + a.contact[(OUT_K + 3 * k + c) * pairs + p];
+                }
+            }
+        }
+    }
+    (r, d, u, l)
+}
+
+/// Assembles every variant (rayon over nodes × variants). Returns the tangents with the
+/// residuals as right-hand sides (`rhs = r`; the Newton step solves `K Δ = −r`).
+pub fn assemble<T: Real + Send + Sync>(a: &AssemblyInputs<T>) -> ChainBatch<T> {
+    let (n, nv) = (a.num_nodes, a.num_variants);
+    let per: Vec<_> = (0..n * nv)
+        .into_par_iter()
+        .map(|idx| node_blocks(a, idx / nv, idx % nv))
+        .collect();
+    let m = n.saturating_sub(1);
+    let mut out = ChainBatch {
+        num_variants: nv,
+        num_nodes: n,
+        diag: vec![T::zero(); 36 * n * nv],
+        upper: vec![T::zero(); 36 * m * nv],
+        lower: vec![T::zero(); 36 * m * nv],
+        rhs: vec![T::zero(); 6 * n * nv],
+    };
+    for (idx, (r, d, u, l)) in per.into_iter().enumerate() {
+        let (i, v) = (idx / nv, idx % nv);
+        for k in 0..6 {
+            out.rhs[(6 * i + k) * nv + v] = r[k];
+        }
+        for k in 0..36 {
+            out.diag[(36 * i + k) * nv + v] = d[k];
+            if i + 1 < n {
+                out.upper[(36 * i + k) * nv + v] = u[k];
+                out.lower[(36 * i + k) * nv + v] = l[k];
+            }
+        }
+    }
+    out
+}

@@ -1,0 +1,177 @@
+//! The assembly kernel (`shaders/assemble.wgsl`, twin `src/kernels/assemble.rs`) gathers
+//! exactly what the static solver scatters; the GPU equals the twin.
+
+mod common;
+
+use holewall::gpu::assemble::assemble_gpu;
+use holewall::kernels::assemble::{assemble, AssemblyInputs, NO_SITE};
+use holewall::kernels::contact::{response_fields, OUTPUT_LEN};
+use holewall::physics::beam::{force_and_tangent, ElementState};
+use holewall::solve::statics::{assembled, external_loads, site_response, StaticState};
+use rand::{Rng, SeedableRng};
+
+fn mat_mul(a: &[[f64; 3]; 3], b: &[[f64; 3]; 3]) -> [[f64; 3]; 3] {
+    std::array::from_fn(|r| std::array::from_fn(|c| (0..3).map(|k| a[r][k] * b[k][c]).sum()))
+}
+
+/// The 60 m test bed of `tests/extreme.rs` (contact at every node) at V perturbed states.
+fn inputs(
+    v: usize,
+) -> (
+    holewall::model::Model,
+    Vec<StaticState>,
+    AssemblyInputs<f64>,
+) {
+    let text = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/tests/data/extreme_base.toml"
+    ))
+    .unwrap()
+    .replace("MU", "0.3")
+    .replace("BLADE", "8.25 in")
+    .replace("KE", "6e7")
+    .replace("EXP", "1.5")
+    .replace("EPS", "1e-3");
+    let case = holewall::case::parse_case(std::path::Path::new("bed.toml"), &text).unwrap();
+    let model = case.model;
+    let base = StaticState::on_low_side(&model);
+    let mut rng = rand::rngs::StdRng::seed_from_u64(3);
+    let states: Vec<StaticState> = (0..v)
+        .map(|_| {
+            let mut s = base.clone();
+            for x in s.x.iter_mut().skip(1) {
+                for c in x.iter_mut() {
+                    *c += rng.random_range(-2e-3..2e-3);
+                }
+            }
+            s
+        })
+        .collect();
+    let n = model.nodes.len();
+    let e = n - 1;
+    let sites = model.sites.len();
+    let mut a = AssemblyInputs {
+        num_variants: v,
+        num_nodes: n,
+        num_sites: sites,
+        elem_force: vec![0.0; 12 * e * v],
+        elem_tangent: vec![0.0; 144 * e * v],
+        contact: vec![0.0; OUTPUT_LEN * sites * v],
+        contact_flag: vec![0; sites * v],
+        node_site: vec![NO_SITE; n * v],
+        f_ext: vec![0.0; 6 * n * v],
+    };
+    let f_ext = external_loads(&model);
+    let lambda = 0.7;
+    for (j, s) in states.iter().enumerate() {
+        for (i, el) in model.elements.iter().enumerate() {
+            let es = ElementState {
+                x: [s.x[i], s.x[i + 1]],
+                triad: [
+                    mat_mul(&s.rot[i], &model.nodes[i].frame0),
+                    mat_mul(&s.rot[i + 1], &model.nodes[i + 1].frame0),
+                ],
+            };
+            let (f, k) = force_and_tangent(&es, &el.section, el.length0);
+            for r in 0..12 {
+                a.elem_force[(12 * i + r) * v + j] = f[r];
+                for c in 0..12 {
+                    a.elem_tangent[(144 * i + 12 * r + c) * v + j] = k[r][c];
+                }
+            }
+        }
+        for (k, site) in model.sites.iter().enumerate() {
+            let out = site_response(&model, s, site);
+            let p = k * v + j;
+            a.contact_flag[p] = out.contact as u32;
+            for (field, x) in response_fields(&out).into_iter().enumerate() {
+                a.contact[field * sites * v + p] = x;
+            }
+            a.node_site[site.node * v + j] = k as u32;
+        }
+        for d in 0..6 * n {
+            a.f_ext[d * v + j] = lambda * f_ext[d];
+        }
+    }
+    (model, states, a)
+}
+
+#[test]
+fn twin_gathers_what_the_solver_scatters_and_the_gpu_agrees() {
+    let v = 6;
+    let (model, states, a) = inputs(v);
+    let twin = assemble(&a);
+    let in_contact = a.contact_flag.iter().filter(|&&f| f != 0).count();
+    assert!(in_contact > 10, "the bed must have contacts: {in_contact}");
+    for (j, s) in states.iter().enumerate() {
+        let (r, k) = assembled(&model, s, 0.7);
+        let n = model.nodes.len();
+        for i in 0..n {
+            for row in 0..6 {
+                assert_eq!(
+                    twin.rhs[(6 * i + row) * v + j],
+                    r[6 * i + row],
+                    "rhs {i} {row}"
+                );
+                for c in 0..6 {
+                    assert_eq!(twin.diag[(36 * i + 6 * row + c) * v + j], k.diag[i][row][c]);
+                    if i + 1 < n {
+                        assert_eq!(
+                            twin.upper[(36 * i + 6 * row + c) * v + j],
+                            k.upper[i][row][c]
+                        );
+                        assert_eq!(
+                            twin.lower[(36 * i + 6 * row + c) * v + j],
+                            k.lower[i][row][c]
+                        );
+                    }
+                }
+            }
+        }
+    }
+    let Some(ctx) = common::gpu() else { return };
+    let rel = |x: &[f64], y: &[f64]| {
+        let num: f64 = x
+            .iter()
+            .zip(y)
+            .map(|(p, q)| (p - q).powi(2))
+            .sum::<f64>()
+            .sqrt();
+        let den: f64 = y.iter().map(|q| q * q).sum::<f64>().sqrt();
+        num / den
+    };
+    if ctx.has_f64 {
+        let gpu = assemble_gpu(ctx, &a).unwrap();
+        let worst = [
+            rel(&gpu.rhs, &twin.rhs),
+            rel(&gpu.diag, &twin.diag),
+            rel(&gpu.upper, &twin.upper),
+            rel(&gpu.lower, &twin.lower),
+        ];
+        eprintln!("GPU f64 vs twin (rhs, diag, upper, lower): {worst:?}");
+        assert!(worst.iter().all(|w| *w <= 1e-15));
+    }
+    // f32: the inputs rounded to f32, summed in f32; against the f64 twin.
+    let a32 = AssemblyInputs::<f32> {
+        num_variants: a.num_variants,
+        num_nodes: a.num_nodes,
+        num_sites: a.num_sites,
+        elem_force: a.elem_force.iter().map(|&x| x as f32).collect(),
+        elem_tangent: a.elem_tangent.iter().map(|&x| x as f32).collect(),
+        contact: a.contact.iter().map(|&x| x as f32).collect(),
+        contact_flag: a.contact_flag.clone(),
+        node_site: a.node_site.clone(),
+        f_ext: a.f_ext.iter().map(|&x| x as f32).collect(),
+    };
+    let gpu32 = assemble_gpu(ctx, &a32).unwrap();
+    let twin32 = assemble(&a32);
+    let up = |x: &[f32]| x.iter().map(|&y| y as f64).collect::<Vec<f64>>();
+    assert_eq!(
+        gpu32.diag, twin32.diag,
+        "f32 GPU = f32 twin (same sums in the same order)"
+    );
+    let e_diag = rel(&up(&gpu32.diag), &twin.diag);
+    let e_rhs = rel(&up(&gpu32.rhs), &twin.rhs);
+    eprintln!("f32 vs f64 twin: diag {e_diag:.2e}, rhs {e_rhs:.2e} (u32 = 6.0e-8)");
+    assert!(e_diag <= 4.0 * f32::EPSILON as f64);
+}
