@@ -1,6 +1,6 @@
 //! The assembly kernel (`shaders/assemble.wgsl`, twin `src/kernels/assemble.rs`) gathers
-#![allow(clippy::needless_range_loop)]
 //! exactly what the static solver scatters; the GPU equals the twin.
+#![allow(clippy::needless_range_loop)]
 
 mod common;
 
