@@ -525,35 +525,41 @@ pub fn run(
     )?;
     outputs.push("neutral_point.png".into());
     let names: Vec<String> = (1..=stabs).map(|k| format!("stab{k}")).collect();
-    let side: Vec<Series> = (0..stabs)
-        .map(|k| Series {
-            name: &names[k],
-            points: idx(&|r| r.stabilizers.get(k).map(|q| q.max_side_force_n)),
-        })
-        .collect();
-    line_plot(
-        &out.join("side_force.png"),
-        &format!("{}: largest side force per stabilizer", case.title),
-        "variant",
-        "side force (N)",
-        &side,
-        &[],
-    )?;
-    outputs.push("side_force.png".into());
-    if dynamic {
-        let whirl: Vec<Series> = (0..stabs)
+    // One line per stabilizer of a per-stabilizer quantity over the variants.
+    let per_stabilizer = |file: &str,
+                          title: &str,
+                          y_label: &str,
+                          f: &dyn Fn(&StabilizerQoi) -> Option<f64>|
+     -> Result<(), Error> {
+        let series: Vec<Series> = (0..stabs)
             .map(|k| Series {
                 name: &names[k],
-                points: idx(&|r| r.stabilizers.get(k).and_then(|q| q.whirl_hz)),
+                points: idx(&|r| r.stabilizers.get(k).and_then(f)),
             })
             .collect();
         line_plot(
-            &out.join("whirl.png"),
-            &format!("{}: whirl frequency (+ forward, − backward)", case.title),
+            &out.join(file),
+            &format!("{}: {title}", case.title),
             "variant",
-            "whirl (Hz)",
-            &whirl,
+            y_label,
+            &series,
             &[],
+        )?;
+        Ok(())
+    };
+    per_stabilizer(
+        "side_force.png",
+        "largest side force per stabilizer",
+        "side force (N)",
+        &|q| Some(q.max_side_force_n),
+    )?;
+    outputs.push("side_force.png".into());
+    if dynamic {
+        per_stabilizer(
+            "whirl.png",
+            "whirl frequency (+ forward, − backward)",
+            "whirl (Hz)",
+            &|q| q.whirl_hz,
         )?;
         outputs.push("whirl.png".into());
         for name in &series {

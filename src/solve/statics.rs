@@ -455,20 +455,8 @@ pub fn solve_static(model: &Model, options: &StaticOptions) -> Result<StaticSolu
 /// The constrained tangent at a configuration and load factor (for stability checks:
 /// it is positive definite exactly while the equilibrium is stable).
 pub fn constrained_tangent(model: &Model, state: &StaticState, lambda: f64) -> BlockTridiagonal {
-    let c = constraints(model);
-    let f_ext = external_loads(model);
-    let n = model.nodes.len();
-    let mut residual = vec![0.0; 6 * n];
-    let mut tangent = BlockTridiagonal::zeros(n);
-    assemble(
-        model,
-        state,
-        lambda,
-        &f_ext,
-        &mut residual,
-        Some(&mut tangent),
-    );
-    constrain(&c, &mut residual, &mut tangent);
+    let (mut residual, mut tangent) = assembled(model, state, lambda);
+    constrain(&constraints(model), &mut residual, &mut tangent);
     tangent
 }
 
