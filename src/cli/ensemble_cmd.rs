@@ -139,6 +139,33 @@ fn failed(name: &str, reason: String, stabs: usize) -> VariantResult {
     }
 }
 
+/// A variant that finished: converged, or with the step cuts its solver log records.
+fn finished(
+    name: &str,
+    log: &[String],
+    iterations: &[usize],
+    neutral_point_from_bit_m: Option<f64>,
+    max_surface_torque_nm: f64,
+    stabilizers: Vec<StabilizerQoi>,
+) -> VariantResult {
+    let cuts = log.iter().filter(|l| l.contains("cut")).count();
+    VariantResult {
+        name: name.to_string(),
+        status: if cuts > 0 {
+            Status::StepCut
+        } else {
+            Status::Converged
+        },
+        reason: log.first().cloned().unwrap_or_default(),
+        neutral_point_from_bit_m,
+        max_surface_torque_nm,
+        stabilizers,
+        newton_iterations_per_step: iterations.iter().sum::<usize>() as f64
+            / iterations.len().max(1) as f64,
+        step_cuts: cuts,
+    }
+}
+
 /// Static equilibrium of one variant's model.
 pub fn static_variant(case: &Case, name: &str, model: &Model) -> VariantResult {
     let stabs = stabilizer_sites(model);
@@ -158,22 +185,14 @@ pub fn static_variant(case: &Case, name: &str, model: &Model) -> VariantResult {
             }
         })
         .collect();
-    let cuts = sol.log.iter().filter(|l| l.contains("cut")).count();
-    VariantResult {
-        name: name.to_string(),
-        status: if cuts > 0 {
-            Status::StepCut
-        } else {
-            Status::Converged
-        },
-        reason: sol.log.first().cloned().unwrap_or_default(),
-        neutral_point_from_bit_m: neutral_point(&rows).map(|md| case.bit_md - md),
-        max_surface_torque_nm: torque,
+    finished(
+        name,
+        &sol.log,
+        &sol.iterations,
+        neutral_point(&rows).map(|md| case.bit_md - md),
+        torque,
         stabilizers,
-        newton_iterations_per_step: sol.iterations.iter().sum::<usize>() as f64
-            / sol.iterations.len().max(1) as f64,
-        step_cuts: cuts,
-    }
+    )
 }
 
 /// The `[dynamics]` run of one variant's model from its static equilibrium.
@@ -263,21 +282,14 @@ pub fn dynamic_variant(case: &Case, name: &str, model: &Model) -> VariantResult 
         .collect();
     let md: Vec<f64> = model.nodes.iter().map(|n| n.md).collect();
     let np = neutral_point_of(&md, &nodal_axial_forces(&axial));
-    VariantResult {
-        name: name.to_string(),
-        status: if cuts > 0 {
-            Status::StepCut
-        } else {
-            Status::Converged
-        },
-        reason: dynamics.log.first().cloned().unwrap_or_default(),
-        neutral_point_from_bit_m: np.map(|x| case.bit_md - x),
-        max_surface_torque_nm: max_torque,
-        stabilizers: qoi,
-        newton_iterations_per_step: dynamics.iterations.iter().sum::<usize>() as f64
-            / dynamics.iterations.len().max(1) as f64,
-        step_cuts: cuts,
-    }
+    finished(
+        name,
+        &dynamics.log,
+        &dynamics.iterations,
+        np.map(|x| case.bit_md - x),
+        max_torque,
+        qoi,
+    )
 }
 
 /// Runs every variant on the CPU (rayon over variants); results in variant order.
