@@ -22,13 +22,14 @@
 // Index loops over 3×3 and 6×6 blocks read like the formulas.
 #![allow(clippy::needless_range_loop)]
 use crate::model::Model;
-use crate::physics::beam::{force_and_tangent, internal_force, rotation_exp, ElementState, Mat3};
+use crate::physics::beam::{rotation_exp, Mat3};
 use crate::physics::contact::{evaluate, ContactMode, ContactTerms, SpringLaw};
 use crate::physics::mass::MassKind;
 use crate::physics::vec3::{cross, dot, sub, Vec3};
 use crate::solve::chain::{BlockTridiagonal, ChainSolver};
 use crate::solve::statics::{
-    constrain, constrain_residual, constraints, external_loads, reference_force, StaticState,
+    constrain, constrain_residual, constraints, element_responses, external_loads, reference_force,
+    StaticState,
 };
 
 /// Generalised-α parameters.
@@ -339,25 +340,16 @@ impl<'a> Dynamics<'a> {
         let mut r: Vec<f64> = self.f_ext.iter().map(|f| -lambda * f).collect();
         let mut k_t = BlockTridiagonal::zeros(n);
         let mut s_mat = BlockTridiagonal::zeros(n);
-        for (i, e) in model.elements.iter().enumerate() {
-            let es = ElementState {
-                x: [s.q.x[i], s.q.x[i + 1]],
-                triad: [
-                    mat_mul(&s.q.rot[i], &model.nodes[i].frame0),
-                    mat_mul(&s.q.rot[i + 1], &model.nodes[i + 1].frame0),
-                ],
-            };
-            if with_matrix || self.k0.is_none() {
-                let (f, k) = force_and_tangent(&es, &e.section, e.length0);
-                for j in 0..12 {
-                    r[6 * i + j] += f[j];
-                }
+        let with_tangent = with_matrix || self.k0.is_none();
+        for (i, (f, k)) in element_responses(model, &s.q, with_tangent)
+            .into_iter()
+            .enumerate()
+        {
+            for j in 0..12 {
+                r[6 * i + j] += f[j];
+            }
+            if let Some(k) = k {
                 k_t.add_element(i, &k);
-            } else {
-                let f = internal_force(&es, &e.section, e.length0);
-                for j in 0..12 {
-                    r[6 * i + j] += f[j];
-                }
             }
         }
         if self.k0.is_none() {

@@ -285,22 +285,14 @@ fn assemble(
     for (r, f) in residual.iter_mut().zip(f_ext) {
         *r = -lambda * f;
     }
-    for (i, e) in model.elements.iter().enumerate() {
-        let es = ElementState {
-            x: [state.x[i], state.x[i + 1]],
-            triad: [
-                mat_mul(&state.rot[i], &model.nodes[i].frame0),
-                mat_mul(&state.rot[i + 1], &model.nodes[i + 1].frame0),
-            ],
-        };
-        let f = match tangent.as_deref_mut() {
-            Some(t) => {
-                let (f, k) = force_and_tangent(&es, &e.section, e.length0);
-                t.add_element(i, &k);
-                f
-            }
-            None => internal_force(&es, &e.section, e.length0),
-        };
+    let with_tangent = tangent.is_some();
+    for (i, (f, k)) in element_responses(model, state, with_tangent)
+        .into_iter()
+        .enumerate()
+    {
+        if let (Some(t), Some(k)) = (tangent.as_deref_mut(), k) {
+            t.add_element(i, &k);
+        }
         for j in 0..12 {
             residual[6 * i + j] += f[j];
         }
@@ -319,6 +311,40 @@ fn assemble(
             }
         }
     }
+}
+
+/// An element's internal force and, if asked for, its tangent.
+pub(crate) type ElementResponse = ([f64; 12], Option<[[f64; 12]; 12]>);
+
+/// Internal force (12) and, if asked, tangent (12×12) of every element at a
+/// configuration, computed in parallel over elements (rayon); summed by the caller in
+/// element order, so the result does not depend on the thread count.
+pub(crate) fn element_responses(
+    model: &Model,
+    state: &StaticState,
+    with_tangent: bool,
+) -> Vec<ElementResponse> {
+    use rayon::prelude::*;
+    model
+        .elements
+        .par_iter()
+        .enumerate()
+        .map(|(i, e)| {
+            let es = ElementState {
+                x: [state.x[i], state.x[i + 1]],
+                triad: [
+                    mat_mul(&state.rot[i], &model.nodes[i].frame0),
+                    mat_mul(&state.rot[i + 1], &model.nodes[i + 1].frame0),
+                ],
+            };
+            if with_tangent {
+                let (f, k) = force_and_tangent(&es, &e.section, e.length0);
+                (f, Some(k))
+            } else {
+                (internal_force(&es, &e.section, e.length0), None)
+            }
+        })
+        .collect()
 }
 
 /// Applies the translation bases and fixed DOFs to a residual (only).
