@@ -123,11 +123,13 @@ fn composer_handles_nesting_else_and_errors() {
 }
 
 #[test]
-fn block_lu_and_assembly_validate_in_both_precisions() {
+fn engine_kernels_validate_in_both_precisions() {
     for f64 in [false, true] {
         for wgsl in [
             holewall::gpu::block_lu::block_lu_wgsl(f64).unwrap(),
             holewall::gpu::assemble::assemble_wgsl(f64).unwrap(),
+            holewall::gpu::update::update_wgsl(false, f64).unwrap(),
+            holewall::gpu::update::update_wgsl(true, f64).unwrap(),
         ] {
             validate(&wgsl).unwrap_or_else(|e| panic!("f64={f64}: {e}"));
             assert_eq!(wgsl.contains("f64"), f64, "precision leak, f64={f64}");

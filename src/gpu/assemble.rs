@@ -5,7 +5,7 @@ use std::collections::BTreeSet;
 use crate::error::GpuError;
 use crate::gpu::compose::compose;
 use crate::gpu::contact::GpuReal;
-use crate::gpu::dispatch::run_once;
+use crate::gpu::dispatch::{run_once, Out};
 use crate::gpu::layout::AssembleDims;
 use crate::gpu::GpuContext;
 use crate::kernels::assemble::AssemblyInputs;
@@ -65,10 +65,10 @@ pub fn assemble_gpu<T: GpuReal>(
             bytemuck::cast_slice(&a.f_ext),
         ],
         &[
-            36 * n * nv * size,
-            36 * m * nv * size,
-            36 * m * nv * size,
-            6 * n * nv * size,
+            Out::Empty(36 * n * nv * size),
+            Out::Empty(36 * m * nv * size),
+            Out::Empty(36 * m * nv * size),
+            Out::Empty(6 * n * nv * size),
         ],
         n * nv,
     )?;

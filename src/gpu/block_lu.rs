@@ -7,7 +7,7 @@ use std::collections::BTreeSet;
 use crate::error::GpuError;
 use crate::gpu::compose::compose;
 use crate::gpu::contact::GpuReal;
-use crate::gpu::dispatch::{run_once, WORKGROUP};
+use crate::gpu::dispatch::{run_once, Out, WORKGROUP};
 use crate::gpu::layout::ChainDims;
 use crate::gpu::GpuContext;
 use crate::kernels::block_lu::ChainBatch;
@@ -100,10 +100,10 @@ pub fn block_lu_gpu_chunked<T: GpuReal>(
                 bytemuck::cast_slice(&rhs),
             ],
             &[
-                36 * m.max(1) * len * size,
-                6 * n * len * size,
-                x_bytes,
-                4 * len,
+                Out::Empty(36 * m.max(1) * len * size),
+                Out::Empty(6 * n * len * size),
+                Out::Empty(x_bytes),
+                Out::Empty(4 * len),
             ],
             len,
         )?;

@@ -18,6 +18,7 @@ pub const SHADERS: &[(&str, &str)] = &[
     ("contact.wgsl", include_str!("../../shaders/contact.wgsl")),
     ("block_lu.wgsl", include_str!("../../shaders/block_lu.wgsl")),
     ("assemble.wgsl", include_str!("../../shaders/assemble.wgsl")),
+    ("update.wgsl", include_str!("../../shaders/update.wgsl")),
     (
         "shared/math_f64.wgsl",
         include_str!("../../shaders/shared/math_f64.wgsl"),

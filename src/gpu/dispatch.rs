@@ -10,6 +10,24 @@ use crate::gpu::GpuContext;
 /// Invocations per workgroup of every kernel dispatched here.
 pub const WORKGROUP: usize = 64;
 
+/// A read-write binding: its size, or its initial contents.
+#[derive(Clone, Copy, Debug)]
+pub enum Out<'a> {
+    /// Uninitialised, this many bytes.
+    Empty(usize),
+    /// Starts with these bytes (updated in place by the kernel).
+    From(&'a [u8]),
+}
+
+impl Out<'_> {
+    fn bytes(&self) -> usize {
+        match self {
+            Out::Empty(n) => *n,
+            Out::From(b) => b.len(),
+        }
+    }
+}
+
 /// Runs `pipeline` once; returns the bytes of each output, in order.
 pub fn run_once(
     ctx: &GpuContext,
@@ -17,9 +35,10 @@ pub fn run_once(
     label: &str,
     uniform: &[u8],
     inputs: &[&[u8]],
-    output_bytes: &[usize],
+    outputs: &[Out],
     invocations: usize,
 ) -> Result<Vec<Vec<u8>>, GpuError> {
+    let output_bytes: Vec<usize> = outputs.iter().map(Out::bytes).collect();
     let device = &ctx.device;
     let dims = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
         label: Some(label),
@@ -38,15 +57,23 @@ pub fn run_once(
             })
         })
         .collect();
-    let outputs: Vec<wgpu::Buffer> = output_bytes
+    let usage = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC;
+    let outputs: Vec<wgpu::Buffer> = outputs
         .iter()
-        .map(|&bytes| {
-            device.create_buffer(&wgpu::BufferDescriptor {
+        .map(|out| match out {
+            Out::From(bytes) if !bytes.is_empty() => {
+                device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                    label: Some(label),
+                    contents: bytes,
+                    usage,
+                })
+            }
+            _ => device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some(label),
-                size: bytes.max(4) as u64,
-                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+                size: out.bytes().max(4) as u64,
+                usage,
                 mapped_at_creation: false,
-            })
+            }),
         })
         .collect();
     let total: usize = output_bytes.iter().map(|b| b.max(&4)).sum();
@@ -82,7 +109,7 @@ pub fn run_once(
         pass.dispatch_workgroups(invocations.div_ceil(WORKGROUP) as u32, 1, 1);
     }
     let mut offset = 0u64;
-    for (b, &bytes) in outputs.iter().zip(output_bytes) {
+    for (b, &bytes) in outputs.iter().zip(&output_bytes) {
         let size = bytes.max(4) as u64;
         encoder.copy_buffer_to_buffer(b, 0, &staging, offset, size);
         offset += size;
@@ -99,7 +126,7 @@ pub fn run_once(
             .get_mapped_range()
             .map_err(|e| GpuError::Device(format!("map: {e}")))?;
         let mut offset = 0usize;
-        for &bytes in output_bytes {
+        for &bytes in &output_bytes {
             result.push(view[offset..offset + bytes].to_vec());
             offset += bytes.max(4);
         }

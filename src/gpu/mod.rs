@@ -7,5 +7,6 @@ pub mod contact;
 pub mod context;
 pub mod dispatch;
 pub mod layout;
+pub mod update;
 
 pub use context::{list_adapters, AdapterSummary, GpuContext};

@@ -7,14 +7,17 @@
 //! | `shaders/contact.wgsl` | [`contact`] |
 //! | `shaders/block_lu.wgsl` | [`block_lu`] |
 //! | `shaders/assemble.wgsl` | [`assemble`] |
+//! | `shaders/update.wgsl` | [`update`] |
 
 pub mod assemble;
 pub mod block_lu;
 pub mod contact;
+pub mod update;
 
 /// Every (shader, twin) pair; a test fails if a shader under `shaders/` is missing here.
 pub const TWINS: &[(&str, &str)] = &[
     ("contact.wgsl", "src/kernels/contact.rs"),
     ("block_lu.wgsl", "src/kernels/block_lu.rs"),
     ("assemble.wgsl", "src/kernels/assemble.rs"),
+    ("update.wgsl", "src/kernels/update.rs"),
 ];

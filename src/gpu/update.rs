@@ -1,0 +1,106 @@
+//! Runs `shaders/update.wgsl` (twin: `src/kernels/update.rs`): the update and the norms.
+
+use std::collections::BTreeSet;
+
+use crate::error::GpuError;
+use crate::gpu::compose::compose;
+use crate::gpu::contact::GpuReal;
+use crate::gpu::dispatch::{run_once, Out};
+use crate::gpu::layout::ChainDims;
+use crate::gpu::GpuContext;
+use crate::kernels::update::ConfigBatch;
+
+/// The WGSL text of the update (`norms = false`) or of the norms, at a precision.
+pub fn update_wgsl(norms: bool, f64: bool) -> Result<String, GpuError> {
+    let mut flags = BTreeSet::new();
+    if f64 {
+        flags.insert("F64");
+    }
+    if norms {
+        flags.insert("NORMS");
+    }
+    compose("update.wgsl", &flags, f64)
+}
+
+fn check<T: GpuReal>(ctx: &GpuContext) -> Result<(), GpuError> {
+    if T::IS_F64 && !ctx.has_f64 {
+        return Err(GpuError::Unsupported(format!(
+            "adapter {} has no SHADER_F64; use --precision f32",
+            ctx.info.name
+        )));
+    }
+    Ok(())
+}
+
+fn dims(b_nodes: usize, nv: usize) -> ChainDims {
+    ChainDims {
+        num_variants: nv as u32,
+        num_nodes: b_nodes as u32,
+        _pad0: 0,
+        _pad1: 0,
+    }
+}
+
+/// Applies `α_v Δ_v` to every variant on the GPU, as [`crate::kernels::update::update`].
+pub fn update_gpu<T: GpuReal>(
+    ctx: &'static GpuContext,
+    b: &mut ConfigBatch<T>,
+    delta: &[T],
+    alpha: &[T],
+) -> Result<(), GpuError> {
+    check::<T>(ctx)?;
+    let pipeline = ctx.pipeline("update", &update_wgsl(false, T::IS_F64)?)?;
+    let d = dims(b.num_nodes, b.num_variants);
+    let out = run_once(
+        ctx,
+        &pipeline,
+        "update",
+        bytemuck::bytes_of(&d),
+        &[
+            bytemuck::cast_slice(delta),
+            bytemuck::cast_slice(alpha),
+            bytemuck::cast_slice(&b.basis),
+        ],
+        &[
+            Out::From(bytemuck::cast_slice(&b.x)),
+            Out::From(bytemuck::cast_slice(&b.rot)),
+        ],
+        b.num_nodes * b.num_variants,
+    )?;
+    b.x = bytemuck::cast_slice(&out[0]).to_vec();
+    b.rot = bytemuck::cast_slice(&out[1]).to_vec();
+    Ok(())
+}
+
+/// Per variant the largest `|r|` and `|α Δ|` on the GPU, as [`crate::kernels::update::norms`].
+pub fn norms_gpu<T: GpuReal>(
+    ctx: &'static GpuContext,
+    residual: &[T],
+    delta: &[T],
+    alpha: &[T],
+    num_nodes: usize,
+    num_variants: usize,
+) -> Result<(Vec<T>, Vec<T>), GpuError> {
+    check::<T>(ctx)?;
+    let pipeline = ctx.pipeline("norms", &update_wgsl(true, T::IS_F64)?)?;
+    let d = dims(num_nodes, num_variants);
+    let size = std::mem::size_of::<T>();
+    let out = run_once(
+        ctx,
+        &pipeline,
+        "norms",
+        bytemuck::bytes_of(&d),
+        &[
+            bytemuck::cast_slice(delta),
+            bytemuck::cast_slice(alpha),
+            bytemuck::cast_slice(residual),
+        ],
+        &[Out::Empty(2 * num_variants * size)],
+        num_variants,
+    )?;
+    let pairs: &[T] = bytemuck::cast_slice(&out[0]);
+    Ok((
+        pairs.iter().step_by(2).copied().collect(),
+        pairs.iter().skip(1).step_by(2).copied().collect(),
+    ))
+}

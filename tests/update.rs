@@ -1,0 +1,139 @@
+//! The update kernel (`shaders/update.wgsl`, twin `src/kernels/update.rs`): the twin moves
+//! a configuration as the static solver does; the GPU equals the twin; NaN shows in the
+//! norms of its own variant only.
+#![allow(clippy::needless_range_loop)]
+
+mod common;
+
+use holewall::gpu::update::{norms_gpu, update_gpu};
+use holewall::kernels::update::{norms, update, ConfigBatch};
+use holewall::physics::beam::rotation_exp;
+use rand::{Rng, SeedableRng};
+
+fn batch(
+    v: usize,
+    n: usize,
+    rng: &mut rand::rngs::StdRng,
+) -> (ConfigBatch<f64>, Vec<f64>, Vec<f64>) {
+    let mut b = ConfigBatch {
+        num_variants: v,
+        num_nodes: n,
+        x: (0..3 * n * v)
+            .map(|_| rng.random_range(-100.0..100.0))
+            .collect(),
+        rot: vec![0.0; 9 * n * v],
+        basis: vec![0.0; 9 * n],
+    };
+    for i in 0..n {
+        // A rotated basis at the last node (the bit held in the hole frame), identity elsewhere.
+        let basis = if i + 1 == n {
+            rotation_exp(&[0.3, -0.2, 0.5])
+        } else {
+            rotation_exp(&[0.0; 3])
+        };
+        for r in 0..3 {
+            for c in 0..3 {
+                b.basis[9 * i + 3 * r + c] = basis[r][c];
+            }
+        }
+        for j in 0..v {
+            let th: [f64; 3] = std::array::from_fn(|_| rng.random_range(-2.0..2.0));
+            let rot = rotation_exp(&th);
+            for r in 0..3 {
+                for c in 0..3 {
+                    b.rot[(9 * i + 3 * r + c) * v + j] = rot[r][c];
+                }
+            }
+        }
+    }
+    let delta: Vec<f64> = (0..6 * n * v)
+        .map(|_| rng.random_range(-0.05..0.05))
+        .collect();
+    let alpha: Vec<f64> = (0..v).map(|_| rng.random_range(0.1..1.0)).collect();
+    (b, delta, alpha)
+}
+
+#[test]
+fn update_matches_rodrigues_and_gpu_matches_twin() {
+    let mut rng = rand::rngs::StdRng::seed_from_u64(9);
+    let (v, n) = (16, 20);
+    let (b0, delta, alpha) = batch(v, n, &mut rng);
+    let mut twin = b0.clone();
+    update(&mut twin, &delta, &alpha);
+    // Against the formulas with std trigonometry (the static solver's update).
+    let mut worst: f64 = 0.0;
+    for j in 0..v {
+        for i in 0..n {
+            let du: [f64; 3] = std::array::from_fn(|k| alpha[j] * delta[(6 * i + k) * v + j]);
+            let th: [f64; 3] = std::array::from_fn(|k| alpha[j] * delta[(6 * i + 3 + k) * v + j]);
+            let e = rotation_exp(&th);
+            for r in 0..3 {
+                let bx: f64 = (0..3).map(|k| b0.basis[9 * i + 3 * r + k] * du[k]).sum();
+                let x = b0.x[(3 * i + r) * v + j] + bx;
+                worst = worst.max((twin.x[(3 * i + r) * v + j] - x).abs() / x.abs().max(1.0));
+                for c in 0..3 {
+                    let rc: f64 = (0..3)
+                        .map(|m| e[r][m] * b0.rot[(9 * i + 3 * m + c) * v + j])
+                        .sum();
+                    worst = worst.max((twin.rot[(9 * i + 3 * r + c) * v + j] - rc).abs());
+                }
+            }
+        }
+    }
+    eprintln!("twin vs std-trig update: {worst:.2e}");
+    assert!(worst <= 1e-15);
+    let residual: Vec<f64> = (0..6 * n * v)
+        .map(|_| rng.random_range(-1e3..1e3))
+        .collect();
+    let (r_twin, d_twin) = norms(&residual, &delta, &alpha, n, v);
+    let Some(ctx) = common::gpu() else { return };
+    if ctx.has_f64 {
+        let mut gpu = b0.clone();
+        update_gpu(ctx, &mut gpu, &delta, &alpha).unwrap();
+        let diff = gpu
+            .x
+            .iter()
+            .zip(&twin.x)
+            .chain(gpu.rot.iter().zip(&twin.rot))
+            .fold(0.0f64, |m, (a, b)| m.max((a - b).abs() / b.abs().max(1.0)));
+        eprintln!("GPU f64 vs twin: {diff:.2e}");
+        assert!(diff <= 1e-15);
+        let (r_gpu, d_gpu) = norms_gpu(ctx, &residual, &delta, &alpha, n, v).unwrap();
+        assert_eq!((r_gpu, d_gpu), (r_twin.clone(), d_twin.clone()));
+    }
+    // f32: against the f64 twin.
+    let cast = |x: &[f64]| x.iter().map(|&y| y as f32).collect::<Vec<f32>>();
+    let mut b32 = ConfigBatch {
+        num_variants: v,
+        num_nodes: n,
+        x: cast(&b0.x),
+        rot: cast(&b0.rot),
+        basis: cast(&b0.basis),
+    };
+    update_gpu(ctx, &mut b32, &cast(&delta), &cast(&alpha)).unwrap();
+    let rot_err = b32
+        .rot
+        .iter()
+        .zip(&twin.rot)
+        .fold(0.0f64, |m, (a, b)| m.max((*a as f64 - b).abs()));
+    eprintln!("GPU f32 rotations vs f64 twin: {rot_err:.2e} (u32 = 6.0e-8)");
+    assert!(rot_err <= 16.0 * f32::EPSILON as f64);
+    // NaN in one variant's residual shows in its norm only.
+    let mut bad = residual.clone();
+    bad[7 * v + 3] = f64::NAN;
+    let (r_bad, _) = norms(&bad, &delta, &alpha, n, v);
+    assert!(r_bad[3].is_nan());
+    for j in (0..v).filter(|&j| j != 3) {
+        assert_eq!(r_bad[j], r_twin[j]);
+    }
+    let (r_bad32, _) = norms_gpu(ctx, &cast(&bad), &cast(&delta), &cast(&alpha), n, v).unwrap();
+    assert!(
+        !r_bad32[3].is_finite(),
+        "GPU f32 norm of the NaN variant: {}",
+        r_bad32[3]
+    );
+    assert!(r_bad32
+        .iter()
+        .enumerate()
+        .all(|(j, x)| j == 3 || x.is_finite()));
+}
