@@ -26,3 +26,11 @@ struct AssembleDims {
     num_sites: u32,
     _pad: u32,
 }
+
+// Keep in sync with src/gpu/layout.rs (BeamDims).
+struct BeamDims {
+    num_variants: u32,
+    num_elements: u32,
+    _pad0: u32,
+    _pad1: u32,
+}

@@ -19,6 +19,7 @@ pub const SHADERS: &[(&str, &str)] = &[
     ("block_lu.wgsl", include_str!("../../shaders/block_lu.wgsl")),
     ("assemble.wgsl", include_str!("../../shaders/assemble.wgsl")),
     ("update.wgsl", include_str!("../../shaders/update.wgsl")),
+    ("beam.wgsl", include_str!("../../shaders/beam.wgsl")),
     (
         "shared/math_f64.wgsl",
         include_str!("../../shaders/shared/math_f64.wgsl"),

@@ -44,3 +44,17 @@ pub struct AssembleDims {
     /// Padding to 16 bytes.
     pub _pad: u32,
 }
+
+/// Dispatch dimensions of the beam kernel (uniform binding 0 of `shaders/beam.wgsl`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Pod, Zeroable)]
+pub struct BeamDims {
+    /// Variants V.
+    pub num_variants: u32,
+    /// Elements of the chain.
+    pub num_elements: u32,
+    /// Padding to 16 bytes.
+    pub _pad0: u32,
+    /// Padding.
+    pub _pad1: u32,
+}

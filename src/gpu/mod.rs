@@ -1,6 +1,7 @@
 //! The GPU path: wgpu context, shader composition, shared layouts, kernel runners.
 
 pub mod assemble;
+pub mod beam;
 pub mod block_lu;
 pub mod compose;
 pub mod contact;

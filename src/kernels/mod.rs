@@ -8,8 +8,10 @@
 //! | `shaders/block_lu.wgsl` | [`block_lu`] |
 //! | `shaders/assemble.wgsl` | [`assemble`] |
 //! | `shaders/update.wgsl` | [`update`] |
+//! | `shaders/beam.wgsl` | [`beam`] |
 
 pub mod assemble;
+pub mod beam;
 pub mod block_lu;
 pub mod contact;
 pub mod update;
@@ -20,4 +22,5 @@ pub const TWINS: &[(&str, &str)] = &[
     ("block_lu.wgsl", "src/kernels/block_lu.rs"),
     ("assemble.wgsl", "src/kernels/assemble.rs"),
     ("update.wgsl", "src/kernels/update.rs"),
+    ("beam.wgsl", "src/kernels/beam.rs"),
 ];

@@ -1,0 +1,75 @@
+//! Runs `shaders/beam.wgsl` (twin: `src/kernels/beam.rs`).
+
+use std::collections::BTreeSet;
+
+use crate::error::GpuError;
+use crate::gpu::compose::compose;
+use crate::gpu::contact::GpuReal;
+use crate::gpu::dispatch::{run_once, Out};
+use crate::gpu::layout::BeamDims;
+use crate::gpu::GpuContext;
+use crate::kernels::beam::{frame_table, section_table};
+use crate::model::Model;
+
+/// The WGSL text of the beam kernel at a precision.
+pub fn beam_wgsl(f64: bool) -> Result<String, GpuError> {
+    let mut flags = BTreeSet::new();
+    if f64 {
+        flags.insert("F64");
+    }
+    compose("beam.wgsl", &flags, f64)
+}
+
+/// Element forces and tangents of V variants on the GPU, laid out as the twin's.
+pub fn beam_gpu<T: GpuReal>(
+    ctx: &'static GpuContext,
+    model: &Model,
+    num_variants: usize,
+    x: &[T],
+    rot: &[T],
+) -> Result<(Vec<T>, Vec<T>), GpuError> {
+    if T::IS_F64 && !ctx.has_f64 {
+        return Err(GpuError::Unsupported(format!(
+            "adapter {} has no SHADER_F64; use --precision f32",
+            ctx.info.name
+        )));
+    }
+    let ne = model.elements.len();
+    let size = std::mem::size_of::<T>();
+    if (144 * ne * num_variants * size) as u64 > ctx.max_binding_bytes() {
+        return Err(GpuError::Unsupported(
+            "element tangents exceed one binding; split the variants".into(),
+        ));
+    }
+    let pipeline = ctx.pipeline("beam", &beam_wgsl(T::IS_F64)?)?;
+    let cast = |v: Vec<f64>| -> Vec<T> { v.into_iter().map(T::from_f64_lossy).collect() };
+    let sections = cast(section_table(model));
+    let frames = cast(frame_table(model));
+    let dims = BeamDims {
+        num_variants: num_variants as u32,
+        num_elements: ne as u32,
+        _pad0: 0,
+        _pad1: 0,
+    };
+    let out = run_once(
+        ctx,
+        &pipeline,
+        "beam",
+        bytemuck::bytes_of(&dims),
+        &[
+            bytemuck::cast_slice(x),
+            bytemuck::cast_slice(rot),
+            bytemuck::cast_slice(&frames),
+            bytemuck::cast_slice(&sections),
+        ],
+        &[
+            Out::Empty(12 * ne * num_variants * size),
+            Out::Empty(144 * ne * num_variants * size),
+        ],
+        ne * num_variants,
+    )?;
+    Ok((
+        bytemuck::cast_slice(&out[0]).to_vec(),
+        bytemuck::cast_slice(&out[1]).to_vec(),
+    ))
+}

@@ -1,0 +1,98 @@
+//! The beam kernel (`shaders/beam.wgsl`, twin `src/kernels/beam.rs`): GPU against the twin
+//! on perturbed configurations of a real string (bent, twisted, stretched).
+#![allow(clippy::needless_range_loop)]
+
+mod common;
+
+use holewall::gpu::beam::beam_gpu;
+use holewall::kernels::beam::beam;
+use holewall::physics::beam::rotation_exp;
+use holewall::solve::statics::StaticState;
+use rand::{Rng, SeedableRng};
+
+#[test]
+fn gpu_beam_matches_the_twin() {
+    let text = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/tests/data/extreme_base.toml"
+    ))
+    .unwrap()
+    .replace("MU", "0.3")
+    .replace("BLADE", "8.25 in")
+    .replace("KE", "6e7")
+    .replace("EXP", "1")
+    .replace("EPS", "1e-3");
+    let case = holewall::case::parse_case(std::path::Path::new("bed.toml"), &text).unwrap();
+    let model = case.model;
+    let n = model.nodes.len();
+    let v = 8;
+    let base = StaticState::on_low_side(&model);
+    let mut rng = rand::rngs::StdRng::seed_from_u64(21);
+    let mut x = vec![0.0; 3 * n * v];
+    let mut rot = vec![0.0; 9 * n * v];
+    for j in 0..v {
+        // A rigid spin of up to 50 rad about the vertical (large rotation) on top of small
+        // deformations.
+        let spin = rotation_exp(&[0.0, 0.0, rng.random_range(-50.0..50.0)]);
+        for i in 0..n {
+            let p: [f64; 3] = std::array::from_fn(|k| base.x[i][k] + rng.random_range(-3e-3..3e-3));
+            let th: [f64; 3] = std::array::from_fn(|_| rng.random_range(-0.02..0.02));
+            let r = rotation_exp(&th);
+            for a in 0..3 {
+                x[(3 * i + a) * v + j] = (0..3).map(|b| spin[a][b] * p[b]).sum();
+                for c in 0..3 {
+                    rot[(9 * i + 3 * a + c) * v + j] = (0..3).map(|m| spin[a][m] * r[m][c]).sum();
+                }
+            }
+        }
+    }
+    let (f_exact, k_exact) = beam(&model, v, &x, &rot);
+    let Some(ctx) = common::gpu() else { return };
+    let ne = model.elements.len();
+    // Normwise relative difference per (element, variant), worst over all.
+    let worst = |f: &[f64], k: &[f64], f_twin: &[f64], k_twin: &[f64]| {
+        let mut w: (f64, f64) = (0.0, 0.0);
+        for e in 0..ne {
+            for j in 0..v {
+                let (mut df, mut nf, mut dk, mut nk) = (0.0, 0.0, 0.0, 0.0);
+                for a in 0..12 {
+                    let i = (12 * e + a) * v + j;
+                    df += (f[i] - f_twin[i]).powi(2);
+                    nf += f_twin[i].powi(2);
+                    for b in 0..12 {
+                        let i = (144 * e + 12 * a + b) * v + j;
+                        dk += (k[i] - k_twin[i]).powi(2);
+                        nk += k_twin[i].powi(2);
+                    }
+                }
+                w.0 = w.0.max((df / nf.max(1e-300)).sqrt());
+                w.1 = w.1.max((dk / nk).sqrt());
+            }
+        }
+        w
+    };
+    if ctx.has_f64 {
+        let (f, k) = beam_gpu(ctx, &model, v, &x, &rot).unwrap();
+        let (wf, wk) = worst(&f, &k, &f_exact, &k_exact);
+        eprintln!("GPU f64 vs twin: force {wf:.2e}, tangent {wk:.2e}");
+        assert!(wf <= 1e-9 && wk <= 1e-12, "force {wf:e}, tangent {wk:e}");
+    }
+    let x32: Vec<f32> = x.iter().map(|&a| a as f32).collect();
+    let r32: Vec<f32> = rot.iter().map(|&a| a as f32).collect();
+    let up = |a: &[f32]| a.iter().map(|&b| b as f64).collect::<Vec<f64>>();
+    let (f, k) = beam_gpu(ctx, &model, v, &x32, &r32).unwrap();
+    // Two parts: rounding the inputs to f32 (positions ≈ 60 m carry 4e-6 m, against
+    // deformations of a few mm: the internal force, a difference, loses ≈ 3 digits), and the
+    // kernel's f32 arithmetic (against the twin fed the same rounded inputs).
+    let (f_rounded, k_rounded) = beam(&model, v, &up(&x32), &up(&r32));
+    let (input_f, input_k) = worst(&f_rounded, &k_rounded, &f_exact, &k_exact);
+    let (kernel_f, kernel_k) = worst(&up(&f), &up(&k), &f_rounded, &k_rounded);
+    eprintln!(
+        "f32: input rounding → force {input_f:.2e}, tangent {input_k:.2e}; kernel arithmetic → force {kernel_f:.2e}, tangent {kernel_k:.2e}"
+    );
+    assert!(kernel_k <= 1e-4, "f32 tangent {kernel_k:e}");
+    assert!(
+        kernel_f <= 4.0 * input_f.max(1e-4),
+        "f32 force {kernel_f:e}"
+    );
+}
