@@ -1,8 +1,8 @@
 // Twin: src/kernels/assemble.rs (static residual and block-tridiagonal tangent per variant).
 //
 // One invocation per (node, variant), index = node · V + variant; each gathers the halves of
-// its two elements and its contact site, so no two invocations write the same entry. Layouts
-// as in the twin's module documentation.
+// its two elements and its contact site, so no two invocations write the same entry, then
+// applies the constraints to the blocks it owns. Layouts as in the twin's documentation.
 #include "shared/layout.wgsl"
 
 @group(0) @binding(0) var<uniform> dims: AssembleDims;
@@ -12,15 +12,58 @@
 @group(0) @binding(4) var<storage, read> contact_flag: array<u32>;
 @group(0) @binding(5) var<storage, read> node_site: array<u32>;
 @group(0) @binding(6) var<storage, read> f_ext: array<real>;
-@group(0) @binding(7) var<storage, read_write> out_diag: array<real>;
-@group(0) @binding(8) var<storage, read_write> out_upper: array<real>;
-@group(0) @binding(9) var<storage, read_write> out_lower: array<real>;
-@group(0) @binding(10) var<storage, read_write> out_rhs: array<real>;
+// Translation basis per node (row-major, identity where none) and fixed-DOF masks.
+@group(0) @binding(7) var<storage, read> basis: array<real>;
+@group(0) @binding(8) var<storage, read> fixed: array<u32>;
+@group(0) @binding(9) var<storage, read_write> out_diag: array<real>;
+@group(0) @binding(10) var<storage, read_write> out_upper: array<real>;
+@group(0) @binding(11) var<storage, read_write> out_lower: array<real>;
+@group(0) @binding(12) var<storage, read_write> out_rhs: array<real>;
 
 // Field offsets of the contact kernel's outputs (src/kernels/contact.rs OUT_G, OUT_K).
 const OUT_G: u32 = 0u;
 const OUT_K: u32 = 6u;
 const NO_SITE: u32 = 0xffffffffu;
+
+// block ← diag(B_a, I)ᵀ · block · diag(B_b, I): rows of node a, then columns of node b.
+fn transform(blk: ptr<function, array<real, 36>>, a: u32, b: u32) {
+    var rows: array<real, 18>;
+    for (var k = 0u; k < 18u; k = k + 1u) {
+        rows[k] = (*blk)[k];
+    }
+    for (var r = 0u; r < 3u; r = r + 1u) {
+        for (var c = 0u; c < 6u; c = c + 1u) {
+            var s = real(0.0);
+            for (var k = 0u; k < 3u; k = k + 1u) {
+                s = s + basis[9u * a + 3u * k + r] * rows[6u * k + c];
+            }
+            (*blk)[6u * r + c] = s;
+        }
+    }
+    for (var r = 0u; r < 6u; r = r + 1u) {
+        let v = vec3<real>((*blk)[6u * r], (*blk)[6u * r + 1u], (*blk)[6u * r + 2u]);
+        for (var c = 0u; c < 3u; c = c + 1u) {
+            var s = real(0.0);
+            for (var k = 0u; k < 3u; k = k + 1u) {
+                s = s + v[k] * basis[9u * b + 3u * k + c];
+            }
+            (*blk)[6u * r + c] = s;
+        }
+    }
+}
+
+fn clear_fixed(blk: ptr<function, array<real, 36>>, row_mask: u32, col_mask: u32) {
+    for (var d = 0u; d < 6u; d = d + 1u) {
+        for (var c = 0u; c < 6u; c = c + 1u) {
+            if ((row_mask & (1u << d)) != 0u) {
+                (*blk)[6u * d + c] = real(0.0);
+            }
+            if ((col_mask & (1u << d)) != 0u) {
+                (*blk)[6u * c + d] = real(0.0);
+            }
+        }
+    }
+}
 
 @compute @workgroup_size(64)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
@@ -34,6 +77,8 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let pairs = dims.num_sites * nv;
     var r: array<real, 6>;
     var d: array<real, 36>;
+    var u: array<real, 36>;
+    var l: array<real, 36>;
     for (var k = 0u; k < 6u; k = k + 1u) {
         r[k] = -f_ext[(6u * i + k) * nv + v];
     }
@@ -55,8 +100,8 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
             r[k] = r[k] + elem_force[(12u * e + k) * nv + v];
             for (var c = 0u; c < 6u; c = c + 1u) {
                 d[6u * k + c] = d[6u * k + c] + elem_tangent[(144u * e + 12u * k + c) * nv + v];
-                out_upper[(36u * i + 6u * k + c) * nv + v] = elem_tangent[(144u * e + 12u * k + 6u + c) * nv + v];
-                out_lower[(36u * i + 6u * k + c) * nv + v] = elem_tangent[(144u * e + 12u * (6u + k) + c) * nv + v];
+                u[6u * k + c] = elem_tangent[(144u * e + 12u * k + 6u + c) * nv + v];
+                l[6u * k + c] = elem_tangent[(144u * e + 12u * (6u + k) + c) * nv + v];
             }
         }
     }
@@ -72,10 +117,39 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
             }
         }
     }
+    // Constraints (as statics::constrain): bases, then fixed DOFs.
+    transform(&d, i, i);
+    let rv = vec3<real>(r[0], r[1], r[2]);
+    for (var row = 0u; row < 3u; row = row + 1u) {
+        var s = real(0.0);
+        for (var k = 0u; k < 3u; k = k + 1u) {
+            s = s + basis[9u * i + 3u * k + row] * rv[k];
+        }
+        r[row] = s;
+    }
+    let f_i = fixed[i];
+    clear_fixed(&d, f_i, f_i);
+    for (var k = 0u; k < 6u; k = k + 1u) {
+        if ((f_i & (1u << k)) != 0u) {
+            r[k] = real(0.0);
+            d[6u * k + k] = real(1.0);
+        }
+    }
     for (var k = 0u; k < 6u; k = k + 1u) {
         out_rhs[(6u * i + k) * nv + v] = r[k];
     }
     for (var k = 0u; k < 36u; k = k + 1u) {
         out_diag[(36u * i + k) * nv + v] = d[k];
+    }
+    if (i + 1u < n) {
+        transform(&u, i, i + 1u);
+        transform(&l, i + 1u, i);
+        let f_j = fixed[i + 1u];
+        clear_fixed(&u, f_i, f_j);
+        clear_fixed(&l, f_j, f_i);
+        for (var k = 0u; k < 36u; k = k + 1u) {
+            out_upper[(36u * i + k) * nv + v] = u[k];
+            out_lower[(36u * i + k) * nv + v] = l[k];
+        }
     }
 }

@@ -1,5 +1,5 @@
 //! The assembly kernel (`shaders/assemble.wgsl`, twin `src/kernels/assemble.rs`) gathers
-//! exactly what the static solver scatters; the GPU equals the twin.
+//! exactly what the static solver scatters, constraints included; the GPU equals the twin.
 #![allow(clippy::needless_range_loop)]
 
 mod common;
@@ -8,7 +8,9 @@ use holewall::gpu::assemble::assemble_gpu;
 use holewall::kernels::assemble::{assemble, AssemblyInputs, NO_SITE};
 use holewall::kernels::contact::{response_fields, OUTPUT_LEN};
 use holewall::physics::beam::{force_and_tangent, ElementState};
-use holewall::solve::statics::{assembled, external_loads, site_response, StaticState};
+use holewall::solve::statics::{
+    assembled, constrained_system, constraint_tables, external_loads, site_response, StaticState,
+};
 use rand::{Rng, SeedableRng};
 
 fn mat_mul(a: &[[f64; 3]; 3], b: &[[f64; 3]; 3]) -> [[f64; 3]; 3] {
@@ -18,6 +20,7 @@ fn mat_mul(a: &[[f64; 3]; 3], b: &[[f64; 3]; 3]) -> [[f64; 3]; 3] {
 /// The 60 m test bed of `tests/extreme.rs` (contact at every node) at V perturbed states.
 fn inputs(
     v: usize,
+    constrained: bool,
 ) -> (
     holewall::model::Model,
     Vec<StaticState>,
@@ -61,7 +64,20 @@ fn inputs(
         contact_flag: vec![0; sites * v],
         node_site: vec![NO_SITE; n * v],
         f_ext: vec![0.0; 6 * n * v],
+        basis: (0..n)
+            .flat_map(|_| [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0])
+            .collect(),
+        fixed: vec![0; n],
     };
+    if constrained {
+        let (basis, fixed) = constraint_tables(&model);
+        a.basis = basis;
+        a.fixed = fixed;
+        assert!(
+            a.fixed[0] != 0 && a.fixed[n - 1] != 0,
+            "top and bit are held"
+        );
+    }
     let f_ext = external_loads(&model);
     let lambda = 0.7;
     for (j, s) in states.iter().enumerate() {
@@ -100,12 +116,29 @@ fn inputs(
 #[test]
 fn twin_gathers_what_the_solver_scatters_and_the_gpu_agrees() {
     let v = 6;
-    let (model, states, a) = inputs(v);
+    // The constrained system against statics::constrain; the unconstrained one first.
+    let (model, states, a0) = inputs(v, false);
+    let twin0 = assemble(&a0);
+    for (j, s) in states.iter().enumerate() {
+        let (r, k) = assembled(&model, s, 0.7);
+        for i in 0..model.nodes.len() {
+            for row in 0..6 {
+                assert_eq!(twin0.rhs[(6 * i + row) * v + j], r[6 * i + row]);
+                for c in 0..6 {
+                    assert_eq!(
+                        twin0.diag[(36 * i + 6 * row + c) * v + j],
+                        k.diag[i][row][c]
+                    );
+                }
+            }
+        }
+    }
+    let (model, states, a) = inputs(v, true);
     let twin = assemble(&a);
     let in_contact = a.contact_flag.iter().filter(|&&f| f != 0).count();
     assert!(in_contact > 10, "the bed must have contacts: {in_contact}");
     for (j, s) in states.iter().enumerate() {
-        let (r, k) = assembled(&model, s, 0.7);
+        let (r, k) = constrained_system(&model, s, 0.7);
         let n = model.nodes.len();
         for i in 0..n {
             for row in 0..6 {
@@ -163,6 +196,8 @@ fn twin_gathers_what_the_solver_scatters_and_the_gpu_agrees() {
         contact_flag: a.contact_flag.clone(),
         node_site: a.node_site.clone(),
         f_ext: a.f_ext.iter().map(|&x| x as f32).collect(),
+        basis: a.basis.iter().map(|&x| x as f32).collect(),
+        fixed: a.fixed.clone(),
     };
     let gpu32 = assemble_gpu(ctx, &a32).unwrap();
     let twin32 = assemble(&a32);

@@ -63,6 +63,8 @@ pub fn assemble_gpu<T: GpuReal>(
             bytemuck::cast_slice(&a.contact_flag),
             bytemuck::cast_slice(&a.node_site),
             bytemuck::cast_slice(&a.f_ext),
+            bytemuck::cast_slice(&a.basis),
+            bytemuck::cast_slice(&a.fixed),
         ],
         &[
             Out::Empty(36 * n * nv * size),

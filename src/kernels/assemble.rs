@@ -1,7 +1,10 @@
 //! Twin of `shaders/assemble.wgsl`: the static residual and block-tridiagonal tangent of
 //! every variant, gathered per node (one invocation per (node, variant), no atomics).
 //!
-//! Node `i` of variant `v` sums the halves of its two elements and its contact site:
+//! Node `i` of variant `v` sums the halves of its two elements and its contact site, then
+//! applies the constraints to the blocks it owns (as `statics::constrain`: each block
+//! `(a, b)` becomes `diag(B_a, I)ᵀ · block · diag(B_b, I)`, then fixed DOFs get zero rows
+//! and columns, 1 on the diagonal and a zero right-hand side):
 //!
 //! ```text
 //! r_i   = f_{i−1}[6..12] + f_i[0..6] + g_site − f_ext,i
@@ -48,6 +51,48 @@ pub struct AssemblyInputs<T> {
     pub node_site: Vec<u32>,
     /// External loads (already scaled by the load factor), `6 n V`.
     pub f_ext: Vec<T>,
+    /// Translation basis per node (row-major, identity where none), `9 n`, shared.
+    pub basis: Vec<T>,
+    /// Fixed-DOF bit mask per node (bit `d`: DOF `d` in the basis), `n`, shared.
+    pub fixed: Vec<u32>,
+}
+
+/// `block ← diag(B_a, I)ᵀ · block · diag(B_b, I)`: rows of node `a`, then columns of node `b`.
+fn transform<T: Real>(blk: &mut [T; 36], ba: &[T], bb: &[T]) {
+    let rows: [[T; 6]; 3] = std::array::from_fn(|r| std::array::from_fn(|c| blk[6 * r + c]));
+    for r in 0..3 {
+        for c in 0..6 {
+            let mut s = T::zero();
+            for k in 0..3 {
+                s = s + ba[3 * k + r] * rows[k][c];
+            }
+            blk[6 * r + c] = s;
+        }
+    }
+    for r in 0..6 {
+        let v: [T; 3] = std::array::from_fn(|k| blk[6 * r + k]);
+        for c in 0..3 {
+            let mut s = T::zero();
+            for k in 0..3 {
+                s = s + v[k] * bb[3 * k + c];
+            }
+            blk[6 * r + c] = s;
+        }
+    }
+}
+
+/// Zeroes the rows of `blk` fixed in `row_mask` and the columns fixed in `col_mask`.
+fn clear_fixed<T: Real>(blk: &mut [T; 36], row_mask: u32, col_mask: u32) {
+    for d in 0..6 {
+        for c in 0..6 {
+            if row_mask & (1 << d) != 0 {
+                blk[6 * d + c] = T::zero();
+            }
+            if col_mask & (1 << d) != 0 {
+                blk[6 * c + d] = T::zero();
+            }
+        }
+    }
 }
 
 /// One (node, variant) invocation: residual (6), diagonal (36), and, below the last node,
@@ -99,6 +144,33 @@ fn node_blocks<T: Real>(
                 }
             }
         }
+    }
+    // Constraints (as statics::constrain): bases, then fixed DOFs.
+    let b_i = &a.basis[9 * i..9 * i + 9];
+    transform(&mut d, b_i, b_i);
+    let rv = r;
+    for row in 0..3 {
+        let mut s = T::zero();
+        for k in 0..3 {
+            s = s + b_i[3 * k + row] * rv[k];
+        }
+        r[row] = s;
+    }
+    let f_i = a.fixed[i];
+    clear_fixed(&mut d, f_i, f_i);
+    for k in 0..6 {
+        if f_i & (1 << k) != 0 {
+            r[k] = T::zero();
+            d[6 * k + k] = T::one();
+        }
+    }
+    if i + 1 < n {
+        let b_j = &a.basis[9 * (i + 1)..9 * (i + 1) + 9];
+        transform(&mut u, b_i, b_j);
+        transform(&mut l, b_j, b_i);
+        let f_j = a.fixed[i + 1];
+        clear_fixed(&mut u, f_i, f_j);
+        clear_fixed(&mut l, f_j, f_i);
     }
     (r, d, u, l)
 }

@@ -481,9 +481,37 @@ pub fn solve_static(model: &Model, options: &StaticOptions) -> Result<StaticSolu
 /// The constrained tangent at a configuration and load factor (for stability checks:
 /// it is positive definite exactly while the equilibrium is stable).
 pub fn constrained_tangent(model: &Model, state: &StaticState, lambda: f64) -> BlockTridiagonal {
+    constrained_system(model, state, lambda).1
+}
+
+/// The constraints as tables for the GPU assembly: per node the translation basis
+/// (row-major, identity where the node has none) and a bit mask of fixed DOFs (bit `d` for
+/// DOF `d` in that basis).
+pub fn constraint_tables(model: &Model) -> (Vec<f64>, Vec<u32>) {
+    let c = constraints(model);
+    let mut basis = Vec::with_capacity(9 * model.nodes.len());
+    for b in &c.basis {
+        let m = b.unwrap_or_else(|| rotation_exp(&[0.0; 3]));
+        basis.extend(m.iter().flatten());
+    }
+    let fixed = c
+        .fixed
+        .iter()
+        .map(|f| (0..6).filter(|&d| f[d]).fold(0u32, |m, d| m | (1 << d)))
+        .collect();
+    (basis, fixed)
+}
+
+/// Residual and tangent with the constraints applied (the Newton system), at a
+/// configuration and load factor.
+pub fn constrained_system(
+    model: &Model,
+    state: &StaticState,
+    lambda: f64,
+) -> (Vec<f64>, BlockTridiagonal) {
     let (mut residual, mut tangent) = assembled(model, state, lambda);
     constrain(&constraints(model), &mut residual, &mut tangent);
-    tangent
+    (residual, tangent)
 }
 
 /// Residual `f_int + g − λ f_ext` and tangent at a configuration, before constraints (the
