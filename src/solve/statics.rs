@@ -729,7 +729,7 @@ fn exponent_continuation(
 }
 
 /// Gravity loads and the other external loads (bit, point loads), at full value.
-fn split_loads(model: &Model) -> (Vec<f64>, Vec<f64>) {
+pub fn split_loads(model: &Model) -> (Vec<f64>, Vec<f64>) {
     let mut bare = model.clone();
     bare.weight_on_bit = 0.0;
     bare.torque_on_bit = 0.0;
@@ -824,6 +824,11 @@ fn newton(
         "Newton did not converge in {} iterations (residual {measure:.3e} of the reference force)",
         options.max_iterations
     ))
+}
+
+/// The solution (section forces, contact, reactions) at a converged configuration.
+pub fn solution_at(model: &Model, state: StaticState) -> StaticSolution {
+    finish(model, state, vec![], vec![])
 }
 
 fn finish(

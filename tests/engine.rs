@@ -1,0 +1,80 @@
+//! The static ensemble through the kernels (beam, contact, assembly, block LU, norms,
+//! update) against `solve_static` per variant; the GPU path against the twin path.
+
+mod common;
+
+use holewall::cli::static_cmd::{fe_rows, neutral_point};
+use holewall::engine::{solve_static_ensemble, EngineStatus, GpuPath, TwinPath};
+use holewall::ensemble::{apply, variants_from_csv_text};
+use holewall::solve::statics::{solution_at, solve_static, StaticOptions};
+
+fn qoi(
+    model: &holewall::model::Model,
+    sol: &holewall::solve::statics::StaticSolution,
+    bit_md: f64,
+) -> [f64; 3] {
+    let (rows, _, torque, _) = fe_rows(model, sol);
+    let side = sol.contact.iter().map(|c| c.1).fold(0.0f64, f64::max);
+    [
+        neutral_point(&rows)
+            .map(|md| bit_md - md)
+            .unwrap_or(f64::NAN),
+        torque,
+        side,
+    ]
+}
+
+#[test]
+fn kernel_chain_static_ensemble_matches_single_cpu_runs() {
+    let text = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/tests/data/extreme_base.toml"
+    ))
+    .unwrap()
+    .replace("MU", "0.3")
+    .replace("BLADE", "8.25 in")
+    .replace("KE", "6e7")
+    .replace("EXP", "1")
+    .replace("EPS", "1e-3");
+    let case = holewall::case::parse_case(std::path::Path::new("bed.toml"), &text).unwrap();
+    let variants = variants_from_csv_text(
+        "v.csv",
+        "mu,wob,k_e\n0.1,5 kN,6e7\n0.2,8 kN,1e8\n0.3,10 kN,6e7\n0.4,12 kN,3e7\n0.15,6 kN,6e7\n0.25,9 kN,2e8\n",
+    )
+    .unwrap();
+    let models: Vec<_> = variants.iter().map(|v| apply(&case, v).unwrap()).collect();
+    let options = StaticOptions::default();
+    let twin = solve_static_ensemble(&models, &mut TwinPath, &options).unwrap();
+    let mut worst: f64 = 0.0;
+    for (j, (m, r)) in models.iter().zip(&twin).enumerate() {
+        assert_eq!(r.status, EngineStatus::Converged, "variant {j}");
+        let cpu = solve_static(m, &options).unwrap();
+        let a = qoi(m, &solution_at(m, r.state.clone()), case.bit_md);
+        let b = qoi(m, &cpu, case.bit_md);
+        for k in 0..3 {
+            let rel = (a[k] - b[k]).abs() / b[k].abs().max(1e-300);
+            worst = worst.max(rel);
+        }
+        eprintln!(
+            "variant {j}: kernels {a:.6?} vs solve_static {b:.6?}; iterations per step {:?}",
+            r.iterations
+        );
+    }
+    eprintln!("twin path vs solve_static: worst relative QoI difference {worst:.2e}");
+    assert!(worst <= 1e-9, "{worst:e}");
+    let Some(ctx) = common::gpu() else { return };
+    if ctx.has_f64 {
+        let gpu = solve_static_ensemble::<f64, _>(&models, &mut GpuPath(ctx), &options).unwrap();
+        let mut diff: f64 = 0.0;
+        for (g, t) in gpu.iter().zip(&twin) {
+            assert_eq!(g.status, t.status);
+            for (xg, xt) in g.state.x.iter().zip(&t.state.x) {
+                for k in 0..3 {
+                    diff = diff.max((xg[k] - xt[k]).abs());
+                }
+            }
+        }
+        eprintln!("GPU f64 path vs twin path: largest position difference {diff:.2e} m");
+        assert!(diff <= 1e-9);
+    }
+}
