@@ -78,3 +78,50 @@ fn kernel_chain_static_ensemble_matches_single_cpu_runs() {
         assert!(diff <= 1e-9);
     }
 }
+
+#[test]
+fn a_failing_variant_fails_alone_in_the_engine() {
+    let text = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/tests/data/extreme_base.toml"
+    ))
+    .unwrap()
+    .replace("MU", "0.3")
+    .replace("BLADE", "8.25 in")
+    .replace("KE", "6e7")
+    .replace("EXP", "1")
+    .replace("EPS", "1e-3");
+    let case = holewall::case::parse_case(std::path::Path::new("bed.toml"), &text).unwrap();
+    let good =
+        variants_from_csv_text("v.csv", "mu,wob,k_e,m\n0.2,8 kN,6e7,1\n0.3,10 kN,6e7,1\n").unwrap();
+    let mixed = variants_from_csv_text(
+        "v.csv",
+        "mu,wob,k_e,m\n0.2,8 kN,6e7,1\n0.3,9000 kN,1e12,3\n0.3,10 kN,6e7,1\n",
+    )
+    .unwrap();
+    let models = |v: &[holewall::ensemble::Variant]| {
+        v.iter()
+            .map(|x| apply(&case, x).unwrap())
+            .collect::<Vec<_>>()
+    };
+    let options = StaticOptions::default();
+    let alone = solve_static_ensemble(&models(&good), &mut TwinPath, &options).unwrap();
+    let with_bad = solve_static_ensemble(&models(&mixed), &mut TwinPath, &options).unwrap();
+    eprintln!("bad variant: {:?}", with_bad[1].status);
+    assert!(matches!(with_bad[1].status, EngineStatus::Failed(_)));
+    let bits = |r: &holewall::engine::EngineResult| -> Vec<u64> {
+        r.state.x.iter().flatten().map(|x| x.to_bits()).collect()
+    };
+    assert_eq!(bits(&alone[0]), bits(&with_bad[0]));
+    assert_eq!(bits(&alone[1]), bits(&with_bad[2]));
+    let Some(ctx) = common::gpu() else { return };
+    if ctx.has_f64 {
+        let alone =
+            solve_static_ensemble::<f64, _>(&models(&good), &mut GpuPath(ctx), &options).unwrap();
+        let with_bad =
+            solve_static_ensemble::<f64, _>(&models(&mixed), &mut GpuPath(ctx), &options).unwrap();
+        assert!(matches!(with_bad[1].status, EngineStatus::Failed(_)));
+        assert_eq!(bits(&alone[0]), bits(&with_bad[0]));
+        assert_eq!(bits(&alone[1]), bits(&with_bad[2]));
+    }
+}

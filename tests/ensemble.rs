@@ -2,6 +2,8 @@
 //! the same values written into it; a failing variant fails alone; bad variant files are
 //! refused with file, line and key.
 
+mod common;
+
 use holewall::backend::{BackendChoice, Precision};
 use holewall::case::{parse_case, Analysis};
 use holewall::cli::ensemble_cmd::{run, run_variants_cpu, static_variant, Status};
@@ -203,4 +205,87 @@ fn bad_variant_files_name_file_line_and_key() {
     .unwrap_err();
     assert_eq!(e.exit_code(), 2);
     assert!(e.to_string().contains("stab3"), "{e}");
+}
+
+#[test]
+fn sixty_four_variant_static_ensemble_on_the_gpu_matches_the_cpu_runs() {
+    if common::gpu().is_none() {
+        return;
+    }
+    let dir = tmp("gpu64");
+    let case = dir.join("c.toml");
+    std::fs::write(&case, bed("0.3", "20 kN")).unwrap();
+    let mut csv = String::from("name,mu,wob,k_e.stab1\n");
+    for a in 0..8 {
+        for b in 0..8 {
+            csv += &format!(
+                "v{a}{b},{},{} kN,{}\n",
+                0.1 + 0.05 * a as f64,
+                4.0 + 1.5 * b as f64,
+                [3e7, 6e7, 1e8, 2e8][(a + b) % 4]
+            );
+        }
+    }
+    let f = dir.join("v.csv");
+    std::fs::write(&f, csv).unwrap();
+    let t0 = std::time::Instant::now();
+    let gpu = run(
+        &case,
+        Some(&f),
+        BackendChoice::Gpu,
+        Precision::F64,
+        &dir.join("gpu"),
+        false,
+    )
+    .unwrap();
+    let t_gpu = t0.elapsed().as_secs_f64();
+    let t0 = std::time::Instant::now();
+    let cpu = run(
+        &case,
+        Some(&f),
+        BackendChoice::Cpu,
+        Precision::F64,
+        &dir.join("cpu"),
+        false,
+    )
+    .unwrap();
+    let t_cpu = t0.elapsed().as_secs_f64();
+    assert_eq!((gpu.backend.as_str(), cpu.backend.as_str()), ("gpu", "cpu"));
+    assert_eq!(gpu.variants, 64);
+    let read = |p: &std::path::Path| -> Vec<Vec<String>> {
+        std::fs::read_to_string(p.join("variants.csv"))
+            .unwrap()
+            .lines()
+            .map(|l| l.split(',').map(String::from).collect())
+            .collect()
+    };
+    let (g, c) = (read(&dir.join("gpu")), read(&dir.join("cpu")));
+    let header = &g[0];
+    let cols: Vec<usize> = [
+        "neutral_point_from_bit_m",
+        "max_surface_torque_nm",
+        "stab1_max_side_force_n",
+        "stab1_max_lateral_m",
+    ]
+    .iter()
+    .map(|name| header.iter().position(|h| h == name).unwrap())
+    .collect();
+    let mut worst: f64 = 0.0;
+    let mut compared = 0;
+    for (rg, rc) in g.iter().zip(&c).skip(1) {
+        for &k in &cols {
+            match (rg[k].parse::<f64>(), rc[k].parse::<f64>()) {
+                (Ok(a), Ok(b)) => {
+                    worst = worst.max((a - b).abs() / b.abs().max(1e-12));
+                    compared += 1;
+                }
+                _ => assert_eq!(rg[k], rc[k], "one side empty"),
+            }
+        }
+    }
+    eprintln!(
+        "64 variants: GPU {t_gpu:.1} s ({} re-run on the CPU), CPU {t_cpu:.1} s; {compared} quantities, worst relative difference {worst:.2e}",
+        gpu.step_cut
+    );
+    assert!(worst <= 1e-9, "{worst:e}");
 }

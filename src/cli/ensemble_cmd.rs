@@ -168,12 +168,21 @@ fn finished(
 
 /// Static equilibrium of one variant's model.
 pub fn static_variant(case: &Case, name: &str, model: &Model) -> VariantResult {
+    match solve_static(model, &StaticOptions::default()) {
+        Ok(sol) => static_result(case, name, model, &sol),
+        Err(e) => failed(name, e.to_string(), stabilizer_sites(model).len()),
+    }
+}
+
+/// Quantities of interest of a converged static solution.
+pub fn static_result(
+    case: &Case,
+    name: &str,
+    model: &Model,
+    sol: &crate::solve::statics::StaticSolution,
+) -> VariantResult {
     let stabs = stabilizer_sites(model);
-    let sol = match solve_static(model, &StaticOptions::default()) {
-        Ok(s) => s,
-        Err(e) => return failed(name, e.to_string(), stabs.len()),
-    };
-    let (rows, _hook, torque, _wob) = fe_rows(model, &sol);
+    let (rows, _hook, torque, _wob) = fe_rows(model, sol);
     let stabilizers = stabs
         .iter()
         .map(|&k| {
@@ -193,6 +202,56 @@ pub fn static_variant(case: &Case, name: &str, model: &Model) -> VariantResult {
         torque,
         stabilizers,
     )
+}
+
+/// Static equilibria of every variant through the GPU kernels (f64), the variants that
+/// fail there re-run on the CPU with step control (their reason says so). `None` when
+/// the variants do not share one site layout (stabilizer moves): the caller runs the CPU.
+pub fn run_static_gpu(
+    case: &Case,
+    variants: &[Variant],
+    ctx: &'static crate::gpu::GpuContext,
+) -> Result<Option<Vec<VariantResult>>, Error> {
+    use crate::engine::{solve_static_ensemble, EngineStatus, GpuPath};
+    let models: Vec<Model> = variants
+        .iter()
+        .map(|v| apply(case, v))
+        .collect::<Result<_, _>>()
+        .map_err(|e| Error::Io(std::io::Error::other(e)))?;
+    let shared = models.iter().all(|m| {
+        m.sites.len() == case.model.sites.len()
+            && m.sites
+                .iter()
+                .zip(&case.model.sites)
+                .all(|(a, b)| a.node == b.node)
+    });
+    if !shared {
+        return Ok(None);
+    }
+    let results =
+        solve_static_ensemble::<f64, _>(&models, &mut GpuPath(ctx), &StaticOptions::default())
+            .map_err(|e| Error::Io(std::io::Error::other(format!("GPU engine: {e}"))))?;
+    Ok(Some(
+        results
+            .into_par_iter()
+            .zip(models.par_iter().zip(variants.par_iter()))
+            .map(|(r, (m, v))| match r.status {
+                EngineStatus::Converged => {
+                    let mut sol = crate::solve::statics::solution_at(m, r.state);
+                    sol.iterations = r.iterations;
+                    static_result(case, &v.name, m, &sol)
+                }
+                EngineStatus::Failed(why) => {
+                    let mut again = static_variant(case, &v.name, m);
+                    again.reason = format!("GPU: {why}; re-run on the CPU: {}", again.reason);
+                    if again.status == Status::Converged {
+                        again.status = Status::StepCut;
+                    }
+                    again
+                }
+            })
+            .collect(),
+    ))
 }
 
 /// The `[dynamics]` run of one variant's model from its static equilibrium.
@@ -463,21 +522,31 @@ pub fn run(
             source_name: "--precision".into(),
             line: 0,
             key: "precision".into(),
-            message: "the CPU ensemble computes in f64 (the oracle); f32 needs the GPU engine, which is not built yet".into(),
+            message: "ensembles compute in f64 for now: the f32 engine needs states kept as displacements from the reference (positions of kilometres lose the millimetres in f32); use --precision f64".into(),
         }
         .into());
     }
-    let backend_name = match backend {
-        BackendChoice::Cpu => "cpu",
-        BackendChoice::Auto => {
-            eprintln!("holewall: the GPU ensemble engine is not built yet; running the variants on the CPU (f64)");
-            "cpu"
+    // The GPU engine runs static ensembles; dynamic ones run on the CPU for now.
+    let gpu = match (backend, analysis) {
+        (BackendChoice::Cpu, _) => None,
+        (BackendChoice::Gpu, Analysis::Dynamic) => {
+            return Err(GpuError::Unsupported(
+                "dynamic ensembles on the GPU (the generalised-α update in WGSL) are not built yet; use --backend cpu".into(),
+            )
+            .into())
         }
-        BackendChoice::Gpu => return Err(GpuError::Unsupported(
-            "the GPU ensemble engine (the Newton step in WGSL) is not built yet; use --backend cpu"
-                .into(),
-        )
-        .into()),
+        (BackendChoice::Gpu, Analysis::Static) => Some(crate::gpu::GpuContext::shared()?),
+        (BackendChoice::Auto, Analysis::Dynamic) => {
+            eprintln!("holewall: dynamic ensembles run on the CPU (f64) for now");
+            None
+        }
+        (BackendChoice::Auto, Analysis::Static) => match crate::gpu::GpuContext::shared() {
+            Ok(ctx) if ctx.has_f64 => Some(ctx),
+            _ => {
+                eprintln!("holewall: no GPU adapter with f64; running the variants on the CPU (f64)");
+                None
+            }
+        },
     };
     // Check every variant against the case before any work.
     for v in &variants {
@@ -505,7 +574,21 @@ pub fn run(
         .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
     );
     let start = std::time::Instant::now();
-    let results = run_variants_cpu(&case, analysis, &variants, &bar);
+    let mut backend_name = "cpu";
+    let results = match gpu {
+        Some(ctx) => match run_static_gpu(&case, &variants, ctx)? {
+            Some(r) => {
+                backend_name = "gpu";
+                bar.set_position(variants.len() as u64);
+                r
+            }
+            None => {
+                eprintln!("holewall: the variants move stabilizers (different site layouts); running them on the CPU");
+                run_variants_cpu(&case, analysis, &variants, &bar)
+            }
+        },
+        None => run_variants_cpu(&case, analysis, &variants, &bar),
+    };
     let seconds = start.elapsed().as_secs_f64();
     bar.finish_and_clear();
 
