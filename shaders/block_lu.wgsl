@@ -1,13 +1,17 @@
 // Twin: src/kernels/block_lu.rs (block-tridiagonal LU of every variant's Newton system).
 //
-// One invocation per variant; it walks the chain of n nodes: eliminates the augmented
-// block [G_i | U_i | y_i] (6 × 13, partial pivoting inside the block), keeps X_i = G_i⁻¹U_i
-// and z_i = G_i⁻¹y_i in the workspace, then substitutes back. Layout (field-major, variant
-// fastest; V = variants in this dispatch): block entry rc of node i at [(36 i + rc) V + v],
-// vector entry r of node i at [(6 i + r) V + v].
+// One invocation per variant; it walks the chain: eliminates the augmented block
+// [G_i | U_i | y_i] (6 × 13, partial pivoting inside the block), keeps X_i = G_i⁻¹U_i and
+// z_i = G_i⁻¹y_i in the workspace, then substitutes back. The walk is split into dispatches
+// of at most 32 nodes (dims.begin … dims.end, forward then backward): llvmpipe (lavapipe)
+// silently ends any loop after 65,535 iterations, which a whole chain of more than about
+// 110 nodes exceeds. status starts at 2 (set by the host): 1 singular, 0 solved (set by
+// the last backward dispatch), 2 left means a dispatch did not complete.
+// Layout (field-major, variant fastest; V = variants in this dispatch): block entry rc of
+// node i at [(36 i + rc) V + v], vector entry r of node i at [(6 i + r) V + v].
 #include "shared/layout.wgsl"
 
-@group(0) @binding(0) var<uniform> dims: ChainDims;
+@group(0) @binding(0) var<uniform> dims: LuDims;
 @group(0) @binding(1) var<storage, read> diag: array<real>;
 @group(0) @binding(2) var<storage, read> upper: array<real>;
 @group(0) @binding(3) var<storage, read> lower: array<real>;
@@ -17,7 +21,7 @@
 @group(0) @binding(6) var<storage, read_write> work_z: array<real>;
 // Solution, 6 per node.
 @group(0) @binding(7) var<storage, read_write> x: array<real>;
-// 0 solved, 1 singular (a zero or non-finite pivot).
+// 2 running (host), 1 singular (a zero or non-finite pivot), 0 solved.
 @group(0) @binding(8) var<storage, read_write> status: array<u32>;
 
 fn blk(i: u32, rc: u32, v: u32) -> u32 {
@@ -43,14 +47,41 @@ fn bad_pivot(p: real) -> bool {
 @compute @workgroup_size(64)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let v = gid.x;
-    if (v >= dims.num_variants) {
+    if (v >= dims.num_variants || status[v] == 1u) {
         return;
     }
     let n = dims.num_nodes;
+    if (dims.phase == 1u) {
+        // Back substitution over [begin, end), downwards: x_i = z_i − X_i x_{i+1}.
+        for (var step = dims.begin; step < dims.end; step = step + 1u) {
+            let i = dims.end - 1u - (step - dims.begin);
+            for (var r = 0u; r < 6u; r = r + 1u) {
+                var s = work_z[vec_at(i, r, v)];
+                if (i + 1u < n) {
+                    for (var c = 0u; c < 6u; c = c + 1u) {
+                        s = s - work_x[blk(i, 6u * r + c, v)] * x[vec_at(i + 1u, c, v)];
+                    }
+                }
+                x[vec_at(i, r, v)] = s;
+            }
+        }
+        if (dims.begin == 0u) {
+            status[v] = 0u;
+        }
+        return;
+    }
     var aug: array<real, 78>; // 6 rows × 13 columns, row-major
     var prev_x: array<real, 36>;
     var prev_z: array<real, 6>;
-    for (var i = 0u; i < n; i = i + 1u) {
+    if (dims.begin > 0u) {
+        for (var k = 0u; k < 36u; k = k + 1u) {
+            prev_x[k] = work_x[blk(dims.begin - 1u, k, v)];
+        }
+        for (var k = 0u; k < 6u; k = k + 1u) {
+            prev_z[k] = work_z[vec_at(dims.begin - 1u, k, v)];
+        }
+    }
+    for (var i = dims.begin; i < dims.end; i = i + 1u) {
         for (var r = 0u; r < 6u; r = r + 1u) {
             for (var c = 0u; c < 6u; c = c + 1u) {
                 aug[13u * r + c] = diag[blk(i, 6u * r + c, v)];
@@ -110,26 +141,10 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         for (var r = 0u; r < 6u; r = r + 1u) {
             for (var c = 0u; c < 6u; c = c + 1u) {
                 prev_x[6u * r + c] = aug[13u * r + 6u + c];
-                if (i + 1u < n) {
-                    work_x[blk(i, 6u * r + c, v)] = aug[13u * r + 6u + c];
-                }
+                work_x[blk(i, 6u * r + c, v)] = aug[13u * r + 6u + c];
             }
             prev_z[r] = aug[13u * r + 12u];
             work_z[vec_at(i, r, v)] = aug[13u * r + 12u];
         }
     }
-    // Back substitution: x_{n−1} = z_{n−1}, x_i = z_i − X_i x_{i+1}.
-    for (var step = 0u; step < n; step = step + 1u) {
-        let i = n - 1u - step;
-        for (var r = 0u; r < 6u; r = r + 1u) {
-            var s = work_z[vec_at(i, r, v)];
-            if (i + 1u < n) {
-                for (var c = 0u; c < 6u; c = c + 1u) {
-                    s = s - work_x[blk(i, 6u * r + c, v)] * x[vec_at(i + 1u, c, v)];
-                }
-            }
-            x[vec_at(i, r, v)] = s;
-        }
-    }
-    status[v] = 0u;
 }

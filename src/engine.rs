@@ -5,7 +5,9 @@
 //!
 //! The schedule mirrors `statics::solve_static` without its adaptivity: gravity in full
 //! from the low-side start with friction and bit loads off (λ = 0), then λ = ¼, ½, ¾, 1
-//! (bit loads and friction scaled by λ); plain Newton at each λ. A variant whose Newton
+//! (bit loads and friction scaled by λ); Newton with the solver's line search at each λ
+//! (per variant: energy slope or residual decrease, α halved at most five times). A
+//! variant whose Newton
 //! fails (singular pivot, a non-finite residual, no convergence within the iterations) is
 //! flagged with the reason and frozen; the caller re-runs it on the CPU with step control.
 //! Converged and frozen variants get α = 0, so they stop moving while the others iterate.
@@ -163,6 +165,49 @@ pub struct EngineResult {
     pub iterations: Vec<usize>,
 }
 
+/// Residual and constrained tangent of every variant at `config` (beam, contact and
+/// assembly kernels).
+#[allow(clippy::too_many_arguments)]
+fn evaluate<T: Real, P: KernelPath<T>>(
+    path: &mut P,
+    models: &[Model],
+    config: &ConfigBatch<T>,
+    contact_batch: &mut ContactBatch<T>,
+    terms: &ContactTerms,
+    node_site: &[u32],
+    f_ext: &[T],
+    fixed: &[u32],
+) -> Result<ChainBatch<T>, String> {
+    let t = |x: f64| T::from_f64_lossy(x);
+    let base = &models[0];
+    let (v, n) = (models.len(), base.nodes.len());
+    let (elem_force, elem_tangent) = path.beam(base, v, &config.x, &config.rot)?;
+    for (k, site) in base.sites.iter().enumerate() {
+        let x0 = base.nodes[site.node].position;
+        let axis = base.nodes[site.node].hole_axis;
+        for (j, m) in models.iter().enumerate() {
+            let d: [T; 3] =
+                std::array::from_fn(|a| config.x[(3 * site.node + a) * v + j] - t(x0[a]));
+            let vel: [T; 3] = std::array::from_fn(|a| t(axis[a] * m.axial_speed));
+            contact_batch.set_state(k * v + j, d, vel, t(m.rotation_speed));
+        }
+    }
+    let out = path.contact(terms, contact_batch)?;
+    path.assemble(&AssemblyInputs {
+        num_variants: v,
+        num_nodes: n,
+        num_sites: base.sites.len(),
+        elem_force,
+        elem_tangent,
+        contact: out.values,
+        contact_flag: out.contact,
+        node_site: node_site.to_vec(),
+        f_ext: f_ext.to_vec(),
+        basis: config.basis.clone(),
+        fixed: fixed.to_vec(),
+    })
+}
+
 /// Static equilibrium of every variant through `path`. All models share the mesh and the
 /// site→node map (stabilizer moves go to the CPU path).
 pub fn solve_static_ensemble<T: Real + Send + Sync, P: KernelPath<T>>(
@@ -217,6 +262,10 @@ pub fn solve_static_ensemble<T: Real + Send + Sync, P: KernelPath<T>>(
         }
     }
     let loads: Vec<(Vec<f64>, Vec<f64>)> = models.iter().map(split_loads).collect();
+    let length_scale: Vec<f64> = starts
+        .iter()
+        .map(|s| 1.0 + s.x.iter().flatten().fold(0.0f64, |m, x| m.max(x.abs())))
+        .collect();
     let f_ref: Vec<f64> = models.iter().map(reference_force).collect();
     let terms = ContactTerms {
         spring: SpringLaw::PowerBlend,
@@ -253,31 +302,16 @@ pub fn solve_static_ensemble<T: Real + Send + Sync, P: KernelPath<T>>(
         let mut done = vec![false; v];
         let mut last_step = vec![f64::INFINITY; v];
         for it in 1..=options.max_iterations {
-            let (elem_force, elem_tangent) = path.beam(base, v, &config.x, &config.rot)?;
-            for (k, site) in base.sites.iter().enumerate() {
-                let x0 = base.nodes[site.node].position;
-                let axis = base.nodes[site.node].hole_axis;
-                for (j, m) in models.iter().enumerate() {
-                    let d: [T; 3] =
-                        std::array::from_fn(|a| config.x[(3 * site.node + a) * v + j] - t(x0[a]));
-                    let vel: [T; 3] = std::array::from_fn(|a| t(axis[a] * m.axial_speed));
-                    contact_batch.set_state(k * v + j, d, vel, t(m.rotation_speed));
-                }
-            }
-            let out = path.contact(&terms, &contact_batch)?;
-            let sys = path.assemble(&AssemblyInputs {
-                num_variants: v,
-                num_nodes: n,
-                num_sites: s_count,
-                elem_force,
-                elem_tangent,
-                contact: out.values,
-                contact_flag: out.contact,
-                node_site: node_site.clone(),
-                f_ext: f_ext.clone(),
-                basis: config.basis.clone(),
-                fixed: fixed.clone(),
-            })?;
+            let sys = evaluate(
+                path,
+                models,
+                &config,
+                &mut contact_batch,
+                &terms,
+                &node_site,
+                &f_ext,
+                &fixed,
+            )?;
             let (sol, st) = path.solve(&sys)?;
             let minus = vec![T::zero() - T::one(); v];
             let (rmax, dmax) = path.norms(&sys.rhs, &sol, &minus, n, v)?;
@@ -290,18 +324,74 @@ pub fn solve_static_ensemble<T: Real + Send + Sync, P: KernelPath<T>>(
                 if !measure.is_finite() {
                     status[j] =
                         EngineStatus::Failed(format!("λ = {lambda}: residual is not finite"));
-                } else if measure <= options.tolerance && last_step[j] <= 1e-6 {
+                } else if (measure <= options.tolerance && last_step[j] <= 1e-6)
+                    || (last_step[j] <= 1e-12 * length_scale[j] && measure <= 1e-6)
+                {
+                    // As statics::newton: converged, or the step is down at rounding level
+                    // (positions carry ≈1e-16·|x| of noise) with the residual small anyway.
                     done[j] = true;
                     iterations[j].push(it - 1);
                 } else if st[j] != SOLVED {
                     status[j] = EngineStatus::Failed(format!("λ = {lambda}: singular tangent"));
                 } else {
                     alpha[j] = T::zero() - T::one();
-                    last_step[j] = dmax[j].to_f64_lossy();
                 }
             }
             if (0..v).all(|j| done[j] || status[j] != EngineStatus::Converged) {
                 break;
+            }
+            // Line search per variant, as statics::newton: the full step unless it
+            // overshoots (|s(α)| > |s(0)|, s = Δ·r) and does not lower ‖r‖₂; halved at most
+            // five times (the last, α = 1/32, is taken anyway).
+            let dot = |a: &[T], b: &[T], j: usize| -> f64 {
+                (0..6 * n)
+                    .map(|k| a[k * v + j].to_f64_lossy() * b[k * v + j].to_f64_lossy())
+                    .sum()
+            };
+            let s0: Vec<f64> = (0..v).map(|j| -dot(&sol, &sys.rhs, j)).collect();
+            let norm0: Vec<f64> = (0..v).map(|j| dot(&sys.rhs, &sys.rhs, j).sqrt()).collect();
+            let mut pending: Vec<bool> = alpha.iter().map(|a| a.to_f64_lossy() != 0.0).collect();
+            for _ in 0..5 {
+                if !pending.iter().any(|&p| p) {
+                    break;
+                }
+                let mut trial = config.clone();
+                path.update(&mut trial, &sol, &alpha)?;
+                let r = evaluate(
+                    path,
+                    models,
+                    &trial,
+                    &mut contact_batch,
+                    &terms,
+                    &node_site,
+                    &f_ext,
+                    &fixed,
+                )?;
+                for j in 0..v {
+                    if !pending[j] {
+                        continue;
+                    }
+                    let a = -alpha[j].to_f64_lossy();
+                    let s_a = -dot(&sol, &r.rhs, j);
+                    let norm = dot(&r.rhs, &r.rhs, j).sqrt();
+                    let finite = s_a.is_finite() && norm.is_finite();
+                    if finite && (s_a.abs() <= s0[j].abs() || norm <= (1.0 - 1e-4 * a) * norm0[j]) {
+                        pending[j] = false;
+                    } else {
+                        alpha[j] = alpha[j] * T::from_f64_lossy(0.5);
+                    }
+                }
+            }
+            for j in 0..v {
+                last_step[j] = dmax[j].to_f64_lossy() * alpha[j].to_f64_lossy().abs();
+            }
+            if std::env::var("HOLEWALL_DEBUG_NEWTON").is_ok() {
+                eprintln!(
+                    "  engine λ {lambda:.4} it {it}: variant 0 residual {:.3e} α {:.4} step {:.3e}",
+                    rmax[0].to_f64_lossy() / f_ref[0],
+                    alpha[0].to_f64_lossy().abs(),
+                    last_step[0]
+                );
             }
             path.update(&mut config, &sol, &alpha)?;
         }

@@ -138,6 +138,28 @@ fn twin_matches_faer_on_paper_tangents_and_random_systems() {
 }
 
 #[test]
+fn gpu_matches_the_twin_on_the_paper_tangents() {
+    // 247 and 255 nodes: more than one dispatch pass (llvmpipe ends loops after 65,535
+    // iterations; a single-pass kernel returned zeros beyond ≈ 110 nodes).
+    let Some(ctx) = common::gpu() else { return };
+    if !ctx.has_f64 {
+        return;
+    }
+    for (name, a) in paper_tangents() {
+        let b: Vec<f64> = (0..6 * a.nodes())
+            .map(|k| (k as f64 * 0.37).sin() * 1e4)
+            .collect();
+        let batch = ChainBatch::<f64>::from_systems(&[(&a, b.as_slice()), (&a, b.as_slice())]);
+        let (cpu, st) = block_lu(&batch);
+        let (gpu, gst) = block_lu_gpu(ctx, &batch).unwrap();
+        assert_eq!((st.clone(), gst), (vec![SOLVED; 2], st));
+        let err = relative_error(&batch.unpack(&gpu, 1), &batch.unpack(&cpu, 1));
+        eprintln!("{name}: GPU f64 vs twin {err:.2e}");
+        assert!(err <= 1e-12, "{name}: {err:e}");
+    }
+}
+
+#[test]
 fn gpu_matches_the_twin_and_a_singular_variant_fails_alone() {
     let Some(ctx) = common::gpu() else { return };
     let mut rng = rand::rngs::StdRng::seed_from_u64(11);

@@ -34,3 +34,17 @@ struct BeamDims {
     _pad0: u32,
     _pad1: u32,
 }
+
+// Keep in sync with src/gpu/layout.rs (LuDims).
+struct LuDims {
+    num_variants: u32,
+    num_nodes: u32,
+    // Nodes [begin, end) of this dispatch.
+    begin: u32,
+    end: u32,
+    // 0 forward elimination, 1 back substitution.
+    phase: u32,
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
+}

@@ -7,10 +7,17 @@ use std::collections::BTreeSet;
 use crate::error::GpuError;
 use crate::gpu::compose::compose;
 use crate::gpu::contact::GpuReal;
-use crate::gpu::dispatch::{run_once, Out, WORKGROUP};
-use crate::gpu::layout::ChainDims;
+use crate::gpu::dispatch::{run_passes, Out, WORKGROUP};
+use crate::gpu::layout::LuDims;
 use crate::gpu::GpuContext;
 use crate::kernels::block_lu::ChainBatch;
+
+/// Nodes per dispatch of the block solve: keeps every loop of an invocation far below
+/// llvmpipe's 65,535-iteration cut-off (≈ 700 inner iterations per node).
+pub const NODES_PER_PASS: usize = 32;
+
+/// Status a variant's solve starts with; still there afterwards means it did not finish.
+const RUNNING: u32 = 2;
 
 /// The WGSL text of the block solve at a precision.
 pub fn block_lu_wgsl(f64: bool) -> Result<String, GpuError> {
@@ -75,12 +82,35 @@ pub fn block_lu_gpu_chunked<T: GpuReal>(
             }
             out
         };
-        let uniform = ChainDims {
-            num_variants: len as u32,
-            num_nodes: n as u32,
-            _pad0: 0,
-            _pad1: 0,
-        };
+        // Passes of at most NODES_PER_PASS nodes: forward from the top, then backward from
+        // the bit (see the shader: llvmpipe's loop limit).
+        let mut passes = Vec::new();
+        let mut begin = 0;
+        while begin < n {
+            let end = (begin + NODES_PER_PASS).min(n);
+            passes.push((begin, end, 0u32));
+            begin = end;
+        }
+        let mut end = n;
+        while end > 0 {
+            let begin = end.saturating_sub(NODES_PER_PASS);
+            passes.push((begin, end, 1u32));
+            end = begin;
+        }
+        let uniforms: Vec<LuDims> = passes
+            .iter()
+            .map(|&(begin, end, phase)| LuDims {
+                num_variants: len as u32,
+                num_nodes: n as u32,
+                begin: begin as u32,
+                end: end as u32,
+                phase,
+                _pad0: 0,
+                _pad1: 0,
+                _pad2: 0,
+            })
+            .collect();
+        let uniform_bytes: Vec<&[u8]> = uniforms.iter().map(bytemuck::bytes_of).collect();
         let (diag, upper, lower, rhs) = (
             gather(&batch.diag, 36 * n),
             gather(&batch.upper, 36 * m),
@@ -88,11 +118,12 @@ pub fn block_lu_gpu_chunked<T: GpuReal>(
             gather(&batch.rhs, 6 * n),
         );
         let x_bytes = 6 * n * len * size;
-        let out = run_once(
+        let running = vec![RUNNING; len];
+        let out = run_passes(
             ctx,
             &pipeline,
             "block_lu",
-            bytemuck::bytes_of(&uniform),
+            &uniform_bytes,
             &[
                 bytemuck::cast_slice(&diag),
                 bytemuck::cast_slice(&upper),
@@ -103,7 +134,7 @@ pub fn block_lu_gpu_chunked<T: GpuReal>(
                 Out::Empty(36 * m.max(1) * len * size),
                 Out::Empty(6 * n * len * size),
                 Out::Empty(x_bytes),
-                Out::Empty(4 * len),
+                Out::From(bytemuck::cast_slice(&running)),
             ],
             len,
         )?;
@@ -111,6 +142,11 @@ pub fn block_lu_gpu_chunked<T: GpuReal>(
         let st: &[u32] = bytemuck::cast_slice(&out[3]);
         for k in 0..6 * n {
             x[k * v + offset..k * v + offset + len].copy_from_slice(&xs[k * len..(k + 1) * len]);
+        }
+        if st[..len].contains(&RUNNING) {
+            return Err(GpuError::Device(
+                "block solve: a dispatch did not complete (status left at running)".into(),
+            ));
         }
         status[offset..offset + len].copy_from_slice(&st[..len]);
         offset += len;

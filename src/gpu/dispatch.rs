@@ -38,13 +38,40 @@ pub fn run_once(
     outputs: &[Out],
     invocations: usize,
 ) -> Result<Vec<Vec<u8>>, GpuError> {
+    run_passes(
+        ctx,
+        pipeline,
+        label,
+        &[uniform],
+        inputs,
+        outputs,
+        invocations,
+    )
+}
+
+/// Runs `pipeline` once per uniform, in order, on the same storage buffers (each dispatch
+/// sees the previous one's writes); returns the bytes of each output after the last.
+pub fn run_passes(
+    ctx: &GpuContext,
+    pipeline: &wgpu::ComputePipeline,
+    label: &str,
+    uniforms: &[&[u8]],
+    inputs: &[&[u8]],
+    outputs: &[Out],
+    invocations: usize,
+) -> Result<Vec<Vec<u8>>, GpuError> {
     let output_bytes: Vec<usize> = outputs.iter().map(Out::bytes).collect();
     let device = &ctx.device;
-    let dims = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-        label: Some(label),
-        contents: uniform,
-        usage: wgpu::BufferUsages::UNIFORM,
-    });
+    let dims: Vec<wgpu::Buffer> = uniforms
+        .iter()
+        .map(|u| {
+            device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some(label),
+                contents: u,
+                usage: wgpu::BufferUsages::UNIFORM,
+            })
+        })
+        .collect();
     let inputs: Vec<wgpu::Buffer> = inputs
         .iter()
         .map(|bytes| {
@@ -83,20 +110,26 @@ pub fn run_once(
         usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
         mapped_at_creation: false,
     });
-    let entries: Vec<wgpu::BindGroupEntry> = std::iter::once(&dims)
-        .chain(inputs.iter())
-        .chain(outputs.iter())
-        .enumerate()
-        .map(|(k, b)| wgpu::BindGroupEntry {
-            binding: k as u32,
-            resource: b.as_entire_binding(),
+    let layout = pipeline.get_bind_group_layout(0);
+    let bind_groups: Vec<wgpu::BindGroup> = dims
+        .iter()
+        .map(|d| {
+            let entries: Vec<wgpu::BindGroupEntry> = std::iter::once(d)
+                .chain(inputs.iter())
+                .chain(outputs.iter())
+                .enumerate()
+                .map(|(k, b)| wgpu::BindGroupEntry {
+                    binding: k as u32,
+                    resource: b.as_entire_binding(),
+                })
+                .collect();
+            device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some(label),
+                layout: &layout,
+                entries: &entries,
+            })
         })
         .collect();
-    let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-        label: Some(label),
-        layout: &pipeline.get_bind_group_layout(0),
-        entries: &entries,
-    });
     let mut encoder =
         device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(label) });
     {
@@ -105,8 +138,10 @@ pub fn run_once(
             timestamp_writes: None,
         });
         pass.set_pipeline(pipeline);
-        pass.set_bind_group(0, &bind_group, &[]);
-        pass.dispatch_workgroups(invocations.div_ceil(WORKGROUP) as u32, 1, 1);
+        for bg in &bind_groups {
+            pass.set_bind_group(0, bg, &[]);
+            pass.dispatch_workgroups(invocations.div_ceil(WORKGROUP) as u32, 1, 1);
+        }
     }
     let mut offset = 0u64;
     for (b, &bytes) in outputs.iter().zip(&output_bytes) {

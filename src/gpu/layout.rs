@@ -58,3 +58,26 @@ pub struct BeamDims {
     /// Padding.
     pub _pad1: u32,
 }
+
+/// Dispatch dimensions of one pass of the block solve (uniform binding 0 of
+/// `shaders/block_lu.wgsl`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Pod, Zeroable)]
+pub struct LuDims {
+    /// Variants in this dispatch.
+    pub num_variants: u32,
+    /// Nodes of the chain.
+    pub num_nodes: u32,
+    /// First node of this pass.
+    pub begin: u32,
+    /// One past the last node of this pass.
+    pub end: u32,
+    /// 0 forward elimination, 1 back substitution.
+    pub phase: u32,
+    /// Padding to 32 bytes.
+    pub _pad0: u32,
+    /// Padding.
+    pub _pad1: u32,
+    /// Padding.
+    pub _pad2: u32,
+}
