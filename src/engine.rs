@@ -300,6 +300,7 @@ pub fn solve_static_ensemble<T: Real + Send + Sync, P: KernelPath<T>>(
             }
         }
         let mut done = vec![false; v];
+        let mut polished = vec![false; v];
         let mut last_step = vec![f64::INFINITY; v];
         for it in 1..=options.max_iterations {
             let sys = evaluate(
@@ -329,6 +330,12 @@ pub fn solve_static_ensemble<T: Real + Send + Sync, P: KernelPath<T>>(
                 {
                     // As statics::newton: converged, or the step is down at rounding level
                     // (positions carry ≈1e-16·|x| of noise) with the residual small anyway.
+                    // At full load one more full step polishes it (as solve_static).
+                    if lambda == 1.0 && !polished[j] {
+                        polished[j] = true;
+                        alpha[j] = T::zero() - T::one();
+                        continue;
+                    }
                     done[j] = true;
                     iterations[j].push(it - 1);
                 } else if st[j] != SOLVED {

@@ -653,6 +653,28 @@ pub fn solve_static_from(
             }
         }
     }
+    // Polish: one more Newton step at full load takes the converged state from the
+    // tolerance to rounding level (quadratic convergence), so the answer no longer depends
+    // on the load path that reached it (the ensemble engine does the same).
+    let f_full: Vec<f64> = f_gravity.iter().zip(&f_other).map(|(g, o)| g + o).collect();
+    let once = StaticOptions {
+        max_iterations: 1,
+        ..*options
+    };
+    if let Ok((s, _)) = newton(
+        model,
+        &c,
+        &state,
+        1.0,
+        &f_full,
+        f_ref,
+        &once,
+        &mut solver,
+        &mut residual,
+        &mut tangent,
+    ) {
+        state = s;
+    }
     Ok(finish(model, state, iterations, log))
 }
 
