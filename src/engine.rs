@@ -208,6 +208,21 @@ fn evaluate<T: Real, P: KernelPath<T>>(
     })
 }
 
+/// Copies variant `j`'s entries of `from` into `to` (field-major, variant fastest).
+fn copy_variant<T: Copy>(to: &mut ChainBatch<T>, from: &ChainBatch<T>, j: usize) {
+    let v = to.num_variants;
+    for (a, b) in [
+        (&mut to.diag, &from.diag),
+        (&mut to.upper, &from.upper),
+        (&mut to.lower, &from.lower),
+        (&mut to.rhs, &from.rhs),
+    ] {
+        for f in 0..a.len() / v {
+            a[f * v + j] = b[f * v + j];
+        }
+    }
+}
+
 /// Static equilibrium of every variant through `path`. All models share the mesh and the
 /// site→node map (stabilizer moves go to the CPU path).
 pub fn solve_static_ensemble<T: Real + Send + Sync, P: KernelPath<T>>(
@@ -302,17 +317,23 @@ pub fn solve_static_ensemble<T: Real + Send + Sync, P: KernelPath<T>>(
         let mut done = vec![false; v];
         let mut polished = vec![false; v];
         let mut last_step = vec![f64::INFINITY; v];
+        // The system at the configuration the line search accepted, when it has been
+        // evaluated there already (it has, unless a variant took the untested α = 1/32).
+        let mut carried: Option<ChainBatch<T>> = None;
         for it in 1..=options.max_iterations {
-            let sys = evaluate(
-                path,
-                models,
-                &config,
-                &mut contact_batch,
-                &terms,
-                &node_site,
-                &f_ext,
-                &fixed,
-            )?;
+            let sys = match carried.take() {
+                Some(s) => s,
+                None => evaluate(
+                    path,
+                    models,
+                    &config,
+                    &mut contact_batch,
+                    &terms,
+                    &node_site,
+                    &f_ext,
+                    &fixed,
+                )?,
+            };
             let (sol, st) = path.solve(&sys)?;
             let minus = vec![T::zero() - T::one(); v];
             let (rmax, dmax) = path.norms(&sys.rhs, &sol, &minus, n, v)?;
@@ -358,6 +379,7 @@ pub fn solve_static_ensemble<T: Real + Send + Sync, P: KernelPath<T>>(
             let s0: Vec<f64> = (0..v).map(|j| -dot(&sol, &sys.rhs, j)).collect();
             let norm0: Vec<f64> = (0..v).map(|j| dot(&sys.rhs, &sys.rhs, j).sqrt()).collect();
             let mut pending: Vec<bool> = alpha.iter().map(|a| a.to_f64_lossy() != 0.0).collect();
+            let mut next: Option<ChainBatch<T>> = None;
             for _ in 0..5 {
                 if !pending.iter().any(|&p| p) {
                     break;
@@ -384,10 +406,20 @@ pub fn solve_static_ensemble<T: Real + Send + Sync, P: KernelPath<T>>(
                     let finite = s_a.is_finite() && norm.is_finite();
                     if finite && (s_a.abs() <= s0[j].abs() || norm <= (1.0 - 1e-4 * a) * norm0[j]) {
                         pending[j] = false;
+                        if let Some(nx) = next.as_mut() {
+                            copy_variant(nx, &r, j);
+                        }
                     } else {
                         alpha[j] = alpha[j] * T::from_f64_lossy(0.5);
                     }
                 }
+                // The first trial also holds every variant that does not move (α = 0).
+                if next.is_none() {
+                    next = Some(r);
+                }
+            }
+            if !pending.iter().any(|&p| p) {
+                carried = next;
             }
             for j in 0..v {
                 last_step[j] = dmax[j].to_f64_lossy() * alpha[j].to_f64_lossy().abs();
