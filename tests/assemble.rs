@@ -26,17 +26,7 @@ fn inputs(
     Vec<StaticState>,
     AssemblyInputs<f64>,
 ) {
-    let text = std::fs::read_to_string(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/tests/data/extreme_base.toml"
-    ))
-    .unwrap()
-    .replace("MU", "0.3")
-    .replace("BLADE", "8.25 in")
-    .replace("KE", "6e7")
-    .replace("EXP", "1.5")
-    .replace("EPS", "1e-3");
-    let case = holewall::case::parse_case(std::path::Path::new("bed.toml"), &text).unwrap();
+    let case = common::bed_case("1.5");
     let model = case.model;
     let base = StaticState::on_low_side(&model);
     let mut rng = rand::rngs::StdRng::seed_from_u64(3);

@@ -12,17 +12,7 @@ use rand::{Rng, SeedableRng};
 
 #[test]
 fn gpu_beam_matches_the_twin() {
-    let text = std::fs::read_to_string(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/tests/data/extreme_base.toml"
-    ))
-    .unwrap()
-    .replace("MU", "0.3")
-    .replace("BLADE", "8.25 in")
-    .replace("KE", "6e7")
-    .replace("EXP", "1")
-    .replace("EPS", "1e-3");
-    let case = holewall::case::parse_case(std::path::Path::new("bed.toml"), &text).unwrap();
+    let case = common::bed_case("1");
     let model = case.model;
     let n = model.nodes.len();
     let v = 8;

@@ -26,17 +26,7 @@ fn qoi(
 
 #[test]
 fn kernel_chain_static_ensemble_matches_single_cpu_runs() {
-    let text = std::fs::read_to_string(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/tests/data/extreme_base.toml"
-    ))
-    .unwrap()
-    .replace("MU", "0.3")
-    .replace("BLADE", "8.25 in")
-    .replace("KE", "6e7")
-    .replace("EXP", "1")
-    .replace("EPS", "1e-3");
-    let case = holewall::case::parse_case(std::path::Path::new("bed.toml"), &text).unwrap();
+    let case = common::bed_case("1");
     let variants = variants_from_csv_text(
         "v.csv",
         "mu,wob,k_e\n0.1,5 kN,6e7\n0.2,8 kN,1e8\n0.3,10 kN,6e7\n0.4,12 kN,3e7\n0.15,6 kN,6e7\n0.25,9 kN,2e8\n",
@@ -81,17 +71,7 @@ fn kernel_chain_static_ensemble_matches_single_cpu_runs() {
 
 #[test]
 fn a_failing_variant_fails_alone_in_the_engine() {
-    let text = std::fs::read_to_string(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/tests/data/extreme_base.toml"
-    ))
-    .unwrap()
-    .replace("MU", "0.3")
-    .replace("BLADE", "8.25 in")
-    .replace("KE", "6e7")
-    .replace("EXP", "1")
-    .replace("EPS", "1e-3");
-    let case = holewall::case::parse_case(std::path::Path::new("bed.toml"), &text).unwrap();
+    let case = common::bed_case("1");
     let good =
         variants_from_csv_text("v.csv", "mu,wob,k_e,m\n0.2,8 kN,6e7,1\n0.3,10 kN,6e7,1\n").unwrap();
     let mixed = variants_from_csv_text(

@@ -11,17 +11,7 @@ use holewall::ensemble::{apply, variants_from_csv_text};
 
 /// The 60 m test bed of `tests/extreme.rs` with Table 1 values, written out.
 fn bed(mu: &str, wob: &str) -> String {
-    std::fs::read_to_string(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/tests/data/extreme_base.toml"
-    ))
-    .unwrap()
-    .replace("MU", mu)
-    .replace("BLADE", "8.25 in")
-    .replace("KE", "6e7")
-    .replace("EXP", "1")
-    .replace("EPS", "1e-3")
-    .replace(
+    common::bed_text(mu, "8.25 in", "6e7", "1", "1e-3").replace(
         "weight_on_bit = \"20 kN\"",
         &format!("weight_on_bit = \"{wob}\""),
     )

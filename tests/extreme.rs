@@ -5,42 +5,43 @@
 //! side of a 60° hole, contact at every node, 20 kN on bit, the table ramped towards
 //! 120 rpm; 0.1 s of the spin-up with each extreme in turn.
 
-use holewall::cli::run_cmd::run;
+mod common;
 
-fn case(mu: &str, blade: &str, k_e: &str, m: &str, eps: &str) -> String {
-    std::fs::read_to_string(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/tests/data/extreme_base.toml"
-    ))
-    .unwrap()
-    .replace("MU", mu)
-    .replace("BLADE", blade)
-    .replace("KE", k_e)
-    .replace("EXP", m)
-    .replace("EPS", eps)
-}
+use holewall::cli::run_cmd::run;
 
 #[test]
 fn extreme_contact_cases_finish_without_nan() {
     let dir = std::env::temp_dir().join(format!("holewall-extreme-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let cases = [
-        ("Table 1", case("0.3", "8.25 in", "6e7", "1", "1e-3")),
+        (
+            "Table 1",
+            common::bed_text("0.3", "8.25 in", "6e7", "1", "1e-3"),
+        ),
         (
             "k_e = 1e11 N/m",
-            case("0.3", "8.25 in", "1e11", "1", "1e-3"),
+            common::bed_text("0.3", "8.25 in", "1e11", "1", "1e-3"),
         ),
         (
             "soft, m = 2/3",
-            case("0.3", "8.25 in", "6e7", "0.6666666666666666", "1e-3"),
+            common::bed_text("0.3", "8.25 in", "6e7", "0.6666666666666666", "1e-3"),
         ),
         (
             "hard, m = 3/2",
-            case("0.3", "8.25 in", "6e7", "1.5", "1e-3"),
+            common::bed_text("0.3", "8.25 in", "6e7", "1.5", "1e-3"),
         ),
-        ("eps = 1e-6 m/s", case("0.3", "8.25 in", "6e7", "1", "1e-6")),
-        ("mu = 1", case("1.0", "8.25 in", "6e7", "1", "1e-3")),
-        ("zero clearance", case("0.3", "8.5 in", "6e7", "1", "1e-3")),
+        (
+            "eps = 1e-6 m/s",
+            common::bed_text("0.3", "8.25 in", "6e7", "1", "1e-6"),
+        ),
+        (
+            "mu = 1",
+            common::bed_text("1.0", "8.25 in", "6e7", "1", "1e-3"),
+        ),
+        (
+            "zero clearance",
+            common::bed_text("0.3", "8.5 in", "6e7", "1", "1e-3"),
+        ),
     ];
     let mut cut_somewhere = false;
     for (name, text) in &cases {

@@ -25,12 +25,7 @@ pub fn assemble_gpu<T: GpuReal>(
     ctx: &'static GpuContext,
     a: &AssemblyInputs<T>,
 ) -> Result<ChainBatch<T>, GpuError> {
-    if T::IS_F64 && !ctx.has_f64 {
-        return Err(GpuError::Unsupported(format!(
-            "adapter {} has no SHADER_F64; use --precision f32",
-            ctx.info.name
-        )));
-    }
+    crate::gpu::contact::require_precision::<T>(ctx)?;
     let (n, nv) = (a.num_nodes, a.num_variants);
     let m = n.saturating_sub(1);
     let size = std::mem::size_of::<T>();

@@ -28,12 +28,7 @@ pub fn beam_gpu<T: GpuReal>(
     x: &[T],
     rot: &[T],
 ) -> Result<(Vec<T>, Vec<T>), GpuError> {
-    if T::IS_F64 && !ctx.has_f64 {
-        return Err(GpuError::Unsupported(format!(
-            "adapter {} has no SHADER_F64; use --precision f32",
-            ctx.info.name
-        )));
-    }
+    crate::gpu::contact::require_precision::<T>(ctx)?;
     let ne = model.elements.len();
     let size = std::mem::size_of::<T>();
     if (144 * ne * num_variants * size) as u64 > ctx.max_binding_bytes() {

@@ -50,12 +50,7 @@ pub fn block_lu_gpu_chunked<T: GpuReal>(
     batch: &ChainBatch<T>,
     max_chunk: usize,
 ) -> Result<(Vec<T>, Vec<u32>), GpuError> {
-    if T::IS_F64 && !ctx.has_f64 {
-        return Err(GpuError::Unsupported(format!(
-            "adapter {} has no SHADER_F64; use --precision f32",
-            ctx.info.name
-        )));
-    }
+    crate::gpu::contact::require_precision::<T>(ctx)?;
     let wgsl = block_lu_wgsl(T::IS_F64)?;
     let pipeline = ctx.pipeline("block_lu", &wgsl)?;
     let size = std::mem::size_of::<T>();

@@ -21,6 +21,17 @@ pub trait GpuReal: Real + bytemuck::Pod {
     const IS_F64: bool;
 }
 
+/// An error unless the adapter can run kernels in `T` (f64 needs `SHADER_F64`).
+pub fn require_precision<T: GpuReal>(ctx: &GpuContext) -> Result<(), GpuError> {
+    if T::IS_F64 && !ctx.has_f64 {
+        return Err(GpuError::Unsupported(format!(
+            "adapter {} has no SHADER_F64; use --precision f32",
+            ctx.info.name
+        )));
+    }
+    Ok(())
+}
+
 impl GpuReal for f32 {
     const IS_F64: bool = false;
 }
@@ -115,12 +126,7 @@ impl<T: GpuReal> GpuContactRun<T> {
         batch: &ContactBatch<T>,
         max_chunk_pairs: usize,
     ) -> Result<Self, GpuError> {
-        if T::IS_F64 && !ctx.has_f64 {
-            return Err(GpuError::Unsupported(format!(
-                "adapter {} has no SHADER_F64; use --precision f32",
-                ctx.info.name
-            )));
-        }
+        require_precision::<T>(ctx)?;
         let wgsl = contact_wgsl(terms, T::IS_F64)?;
         let pipeline = ctx.pipeline("contact", &wgsl)?;
         let device = &ctx.device;

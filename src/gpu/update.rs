@@ -22,16 +22,6 @@ pub fn update_wgsl(norms: bool, f64: bool) -> Result<String, GpuError> {
     compose("update.wgsl", &flags, f64)
 }
 
-fn check<T: GpuReal>(ctx: &GpuContext) -> Result<(), GpuError> {
-    if T::IS_F64 && !ctx.has_f64 {
-        return Err(GpuError::Unsupported(format!(
-            "adapter {} has no SHADER_F64; use --precision f32",
-            ctx.info.name
-        )));
-    }
-    Ok(())
-}
-
 fn dims(b_nodes: usize, nv: usize) -> ChainDims {
     ChainDims {
         num_variants: nv as u32,
@@ -48,7 +38,7 @@ pub fn update_gpu<T: GpuReal>(
     delta: &[T],
     alpha: &[T],
 ) -> Result<(), GpuError> {
-    check::<T>(ctx)?;
+    crate::gpu::contact::require_precision::<T>(ctx)?;
     let pipeline = ctx.pipeline("update", &update_wgsl(false, T::IS_F64)?)?;
     let d = dims(b.num_nodes, b.num_variants);
     let out = run_once(
@@ -81,7 +71,7 @@ pub fn norms_gpu<T: GpuReal>(
     num_nodes: usize,
     num_variants: usize,
 ) -> Result<(Vec<T>, Vec<T>), GpuError> {
-    check::<T>(ctx)?;
+    crate::gpu::contact::require_precision::<T>(ctx)?;
     let pipeline = ctx.pipeline("norms", &update_wgsl(true, T::IS_F64)?)?;
     let d = dims(num_nodes, num_variants);
     let size = std::mem::size_of::<T>();

@@ -17,3 +17,28 @@ pub fn gpu() -> Option<&'static GpuContext> {
         }
     }
 }
+
+/// The 60 m test bed (`tests/data/extreme_base.toml`: BHA and pipe on the low side of a 60°
+/// hole, contact at every node) with friction, blade diameter, wall stiffness, exponent
+/// and regularisation speed filled in.
+pub fn bed_text(mu: &str, blade: &str, k_e: &str, m: &str, eps: &str) -> String {
+    std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/tests/data/extreme_base.toml"
+    ))
+    .unwrap()
+    .replace("MU", mu)
+    .replace("BLADE", blade)
+    .replace("KE", k_e)
+    .replace("EXP", m)
+    .replace("EPS", eps)
+}
+
+/// [`bed_text`] parsed, with Table 1 values except the spring exponent `m`.
+pub fn bed_case(m: &str) -> holewall::case::Case {
+    holewall::case::parse_case(
+        std::path::Path::new("bed.toml"),
+        &bed_text("0.3", "8.25 in", "6e7", m, "1e-3"),
+    )
+    .unwrap()
+}
