@@ -230,6 +230,17 @@ pub fn solve_static_ensemble<T: Real + Send + Sync, P: KernelPath<T>>(
     path: &mut P,
     options: &StaticOptions,
 ) -> Result<Vec<EngineResult>, String> {
+    solve_static_ensemble_with_progress(models, path, options, &mut |_| {})
+}
+
+/// As [`solve_static_ensemble`], reporting the fraction of the load schedule done (0 … 1)
+/// after every iteration (for a progress bar).
+pub fn solve_static_ensemble_with_progress<T: Real + Send + Sync, P: KernelPath<T>>(
+    models: &[Model],
+    path: &mut P,
+    options: &StaticOptions,
+    progress: &mut dyn FnMut(f64),
+) -> Result<Vec<EngineResult>, String> {
     let v = models.len();
     let base = models.first().ok_or("no variants")?;
     let n = base.nodes.len();
@@ -299,7 +310,8 @@ pub fn solve_static_ensemble<T: Real + Send + Sync, P: KernelPath<T>>(
     }
     let mut status = vec![EngineStatus::Converged; v];
     let mut iterations = vec![Vec::new(); v];
-    for &lambda in &[0.0, 0.25, 0.5, 0.75, 1.0] {
+    let schedule = [0.0, 0.25, 0.5, 0.75, 1.0];
+    for (step, &lambda) in schedule.iter().enumerate() {
         // Loads and friction of this step.
         let mut f_ext = vec![T::zero(); 6 * n * v];
         for (j, m) in models.iter().enumerate() {
@@ -433,7 +445,11 @@ pub fn solve_static_ensemble<T: Real + Send + Sync, P: KernelPath<T>>(
                 );
             }
             path.update(&mut config, &sol, &alpha)?;
+            progress(
+                (step as f64 + it as f64 / options.max_iterations as f64) / schedule.len() as f64,
+            );
         }
+        progress((step + 1) as f64 / schedule.len() as f64);
         for j in 0..v {
             if !done[j] && status[j] == EngineStatus::Converged {
                 status[j] = EngineStatus::Failed(format!(

@@ -211,8 +211,9 @@ pub fn run_static_gpu(
     case: &Case,
     variants: &[Variant],
     ctx: &'static crate::gpu::GpuContext,
+    bar: &indicatif::ProgressBar,
 ) -> Result<Option<Vec<VariantResult>>, Error> {
-    use crate::engine::{solve_static_ensemble, EngineStatus, GpuPath};
+    use crate::engine::{solve_static_ensemble_with_progress, EngineStatus, GpuPath};
     let models: Vec<Model> = variants
         .iter()
         .map(|v| apply(case, v))
@@ -228,9 +229,13 @@ pub fn run_static_gpu(
     if !shared {
         return Ok(None);
     }
-    let results =
-        solve_static_ensemble::<f64, _>(&models, &mut GpuPath(ctx), &StaticOptions::default())
-            .map_err(|e| Error::Io(std::io::Error::other(format!("GPU engine: {e}"))))?;
+    let results = solve_static_ensemble_with_progress::<f64, _>(
+        &models,
+        &mut GpuPath(ctx),
+        &StaticOptions::default(),
+        &mut |f| bar.set_position((f * variants.len() as f64) as u64),
+    )
+    .map_err(|e| Error::Io(std::io::Error::other(format!("GPU engine: {e}"))))?;
     Ok(Some(
         results
             .into_par_iter()
@@ -576,7 +581,7 @@ pub fn run(
     let start = std::time::Instant::now();
     let mut backend_name = "cpu";
     let results = match gpu {
-        Some(ctx) => match run_static_gpu(&case, &variants, ctx)? {
+        Some(ctx) => match run_static_gpu(&case, &variants, ctx, &bar)? {
             Some(r) => {
                 backend_name = "gpu";
                 bar.set_position(variants.len() as u64);
