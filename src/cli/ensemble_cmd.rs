@@ -546,6 +546,13 @@ pub fn run(
             None
         }
         (BackendChoice::Auto, Analysis::Static) => match crate::gpu::GpuContext::shared() {
+            Ok(ctx) if ctx.info.device_type == wgpu::DeviceType::Cpu => {
+                eprintln!(
+                    "holewall: the only adapter ({}) is a software renderer; running the variants on the CPU (f64), which is faster there",
+                    ctx.info.name
+                );
+                None
+            }
             Ok(ctx) if ctx.has_f64 => Some(ctx),
             _ => {
                 eprintln!("holewall: no GPU adapter with f64; running the variants on the CPU (f64)");
