@@ -341,50 +341,51 @@ fn write_plots(
         })
         .into_iter()
         .collect();
-    line_plot(
-        &out.join("axial_force.png"),
-        &format!("{}: axial force ({name})", case.title),
-        "MD (m)",
-        "effective axial force, tension + (N)",
-        &[Series {
-            name,
-            points: col(&|r| r.axial_force_n),
-        }],
-        &np_marker,
-    )?;
-    line_plot(
-        &out.join("axial_stress.png"),
-        &format!("{}: axial stress ({name})", case.title),
-        "MD (m)",
-        "axial stress (Pa)",
-        &[Series {
-            name,
-            points: col(&|r| r.axial_stress_pa),
-        }],
-        &np_marker,
-    )?;
-    line_plot(
-        &out.join("side_force.png"),
-        &format!("{}: side force ({name})", case.title),
-        "MD (m)",
-        "side force (N)",
-        &[Series {
-            name,
-            points: col(&|r| r.side_force_n),
-        }],
-        &[],
-    )?;
-    line_plot(
-        &out.join("torque.png"),
-        &format!("{}: torque ({name})", case.title),
-        "MD (m)",
-        "torque (N·m)",
-        &[Series {
-            name,
-            points: col(&|r| r.torque_nm),
-        }],
-        &[],
-    )?;
+    // The profiles along the string: (file, title, y label, column, neutral point marked).
+    type Column = fn(&ProfileRow) -> f64;
+    let profiles: [(&str, &str, &str, Column, bool); 4] = [
+        (
+            "axial_force.png",
+            "axial force",
+            "effective axial force, tension + (N)",
+            |r| r.axial_force_n,
+            true,
+        ),
+        (
+            "axial_stress.png",
+            "axial stress",
+            "axial stress (Pa)",
+            |r| r.axial_stress_pa,
+            true,
+        ),
+        (
+            "side_force.png",
+            "side force",
+            "side force (N)",
+            |r| r.side_force_n,
+            false,
+        ),
+        (
+            "torque.png",
+            "torque",
+            "torque (N·m)",
+            |r| r.torque_nm,
+            false,
+        ),
+    ];
+    for (file, what, y_label, f, marked) in profiles {
+        line_plot(
+            &out.join(file),
+            &format!("{}: {what} ({name})", case.title),
+            "MD (m)",
+            y_label,
+            &[Series {
+                name,
+                points: col(&f),
+            }],
+            if marked { &np_marker } else { &[] },
+        )?;
+    }
     let bha_top = case.bit_md - 200.0;
     let bha: Vec<(f64, f64)> = rows
         .iter()
