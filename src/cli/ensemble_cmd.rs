@@ -22,7 +22,6 @@ use crate::ensemble::{apply, stabilizer_sites, variants_from_csv, variants_from_
 use crate::error::{Error, GpuError, InputError};
 use crate::model::Model;
 use crate::output::write_atomic;
-use crate::physics::beam::{local_deformation, section_forces, Mat3};
 use crate::physics::vec3::{dot, scale, sub};
 use crate::plots::{line_plot, Series};
 use crate::solve::dynamics::{DynamicState, Dynamics};
@@ -98,19 +97,8 @@ pub struct EnsembleSummary {
     pub outputs: Vec<String>,
 }
 
-fn mat_mul(a: &Mat3<f64>, b: &Mat3<f64>) -> Mat3<f64> {
-    std::array::from_fn(|r| std::array::from_fn(|c| (0..3).map(|k| a[r][k] * b[k][c]).sum()))
-}
-
 fn element_axial(model: &Model, q: &crate::solve::statics::StaticState, i: usize) -> (f64, f64) {
-    let e = &model.elements[i];
-    let t1 = mat_mul(&q.rot[i], &model.nodes[i].frame0);
-    let t2 = mat_mul(&q.rot[i + 1], &model.nodes[i + 1].frame0);
-    let f = section_forces(
-        &local_deformation(&q.x[i], &q.x[i + 1], &t1, &t2, e.length0),
-        &e.section,
-        e.length0,
-    );
+    let f = crate::solve::statics::element_section_forces(model, q, i);
     (f.axial, f.torque)
 }
 

@@ -9,7 +9,6 @@ use serde::Serialize;
 use crate::case::{load_case, Case};
 use crate::error::{Error, InputError};
 use crate::output::write_atomic;
-use crate::physics::beam::{local_deformation, section_forces, Mat3};
 use crate::physics::vec3::{dot, scale, sub};
 use crate::plots::{line_plot, Series};
 use crate::solve::dynamics::{strain_energy, AlphaParams, DynamicOptions, DynamicState, Dynamics};
@@ -32,10 +31,6 @@ pub struct RunSummary {
     pub outputs: Vec<String>,
 }
 
-fn mat_mul(a: &Mat3<f64>, b: &Mat3<f64>) -> Mat3<f64> {
-    std::array::from_fn(|r| std::array::from_fn(|c| (0..3).map(|k| a[r][k] * b[k][c]).sum()))
-}
-
 struct Recorder {
     series: Vec<[f64; 6]>, // t, bit axial displacement, surface torque, KE, SE, KE+SE
     sites: Vec<(f64, usize, [f64; 5])>, // t, site, [lateral x, lateral y, radius, normal force, spin]
@@ -54,16 +49,7 @@ fn record(
     let bit = n - 1;
     let tb = model.nodes[bit].hole_axis;
     let bit_axial = dot(&sub(&s.q.x[bit], &model.nodes[bit].position), &tb);
-    let forces = |i: usize| {
-        let e = &model.elements[i];
-        let t1 = mat_mul(&s.q.rot[i], &model.nodes[i].frame0);
-        let t2 = mat_mul(&s.q.rot[i + 1], &model.nodes[i + 1].frame0);
-        section_forces(
-            &local_deformation(&s.q.x[i], &s.q.x[i + 1], &t1, &t2, e.length0),
-            &e.section,
-            e.length0,
-        )
-    };
+    let forces = |i: usize| crate::solve::statics::element_section_forces(model, &s.q, i);
     let torque = forces(0).torque.abs();
     let ke = if want("energy") {
         dynamics.kinetic_energy(s)

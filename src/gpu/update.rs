@@ -72,6 +72,13 @@ pub fn norms_gpu<T: GpuReal>(
     num_variants: usize,
 ) -> Result<(Vec<T>, Vec<T>), GpuError> {
     crate::gpu::contact::require_precision::<T>(ctx)?;
+    // One invocation loops over the 6n entries of its variant: keep it under llvmpipe's
+    // silent 65,535-iteration cut-off (see shaders/block_lu.wgsl).
+    if 6 * num_nodes > 60_000 {
+        return Err(GpuError::Unsupported(format!(
+            "norms of {num_nodes} nodes exceed one invocation's loop budget"
+        )));
+    }
     let pipeline = ctx.pipeline("norms", &update_wgsl(true, T::IS_F64)?)?;
     let d = dims(num_nodes, num_variants);
     let size = std::mem::size_of::<T>();

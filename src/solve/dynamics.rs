@@ -748,15 +748,13 @@ fn add_scaled(a: &mut BlockTridiagonal, b: &BlockTridiagonal, s: f64) {
 
 /// Strain energy of the beams at a configuration (for energy balances).
 pub fn strain_energy(model: &Model, q: &StaticState) -> f64 {
-    use crate::physics::beam::{local_deformation, strain_energy as element_energy};
+    use crate::physics::beam::strain_energy as element_energy;
     model
         .elements
         .iter()
         .enumerate()
         .map(|(i, e)| {
-            let t1 = mat_mul(&q.rot[i], &model.nodes[i].frame0);
-            let t2 = mat_mul(&q.rot[i + 1], &model.nodes[i + 1].frame0);
-            let def = local_deformation(&q.x[i], &q.x[i + 1], &t1, &t2, e.length0);
+            let def = crate::solve::statics::element_deformation(model, q, i);
             element_energy(&def, &e.section, e.length0)
         })
         .sum()

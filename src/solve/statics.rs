@@ -848,6 +848,33 @@ fn newton(
     ))
 }
 
+/// Local deformation of element `i` at a configuration (its nodal triads `R_i · frame0_i`).
+pub fn element_deformation(
+    model: &Model,
+    state: &StaticState,
+    i: usize,
+) -> crate::physics::beam::LocalDeformation<f64> {
+    let t1 = mat_mul(&state.rot[i], &model.nodes[i].frame0);
+    let t2 = mat_mul(&state.rot[i + 1], &model.nodes[i + 1].frame0);
+    local_deformation(
+        &state.x[i],
+        &state.x[i + 1],
+        &t1,
+        &t2,
+        model.elements[i].length0,
+    )
+}
+
+/// Section forces of element `i` at a configuration.
+pub fn element_section_forces(
+    model: &Model,
+    state: &StaticState,
+    i: usize,
+) -> crate::physics::beam::SectionForces {
+    let e = &model.elements[i];
+    section_forces(&element_deformation(model, state, i), &e.section, e.length0)
+}
+
 /// The solution (section forces, contact, reactions) at a converged configuration.
 pub fn solution_at(model: &Model, state: StaticState) -> StaticSolution {
     finish(model, state, vec![], vec![])
@@ -864,10 +891,11 @@ fn finish(
         .iter()
         .enumerate()
         .map(|(i, e)| {
-            let t1 = mat_mul(&state.rot[i], &model.nodes[i].frame0);
-            let t2 = mat_mul(&state.rot[i + 1], &model.nodes[i + 1].frame0);
-            let def = local_deformation(&state.x[i], &state.x[i + 1], &t1, &t2, e.length0);
-            section_forces(&def, &e.section, e.length0)
+            section_forces(
+                &element_deformation(model, &state, i),
+                &e.section,
+                e.length0,
+            )
         })
         .collect();
     let contact = model
