@@ -2,7 +2,7 @@
 //
 // `update`: one invocation per (node, variant), index = node · V + variant:
 // x += α B Δu, R ← exp([α Δθ]×) R with the series exponential of the twin.
-// `norms`: one invocation per variant: largest |r| and largest |α Δ|.
+// `norms`: one invocation per variant: largest |r| and largest |α Δ|, Δ · r and r · r.
 #include "shared/layout.wgsl"
 
 // Composed twice: without NORMS the entry point `main` is the update, with NORMS the norms.
@@ -11,7 +11,7 @@
 @group(0) @binding(2) var<storage, read> alpha: array<real>;
 #if NORMS
 @group(0) @binding(3) var<storage, read> residual: array<real>;
-// Per variant: largest |r|, largest |α Δ|.
+// Per variant: largest |r|, largest |α Δ|, Δ · r, r · r.
 @group(0) @binding(4) var<storage, read_write> norm_out: array<real>;
 #else
 @group(0) @binding(3) var<storage, read> basis: array<real>;
@@ -143,17 +143,25 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
     var r = real(0.0);
     var d = real(0.0);
+    var dot_dr = real(0.0);
+    var square = real(0.0);
     for (var k = 0u; k < 6u * dims.num_nodes; k = k + 1u) {
-        let rk = abs(residual[k * nv + v]);
-        let dk = abs(alpha[v] * delta[k * nv + v]);
-        if (rk > r || is_nan_or_inf(rk)) {
-            r = rk;
+        let rk = residual[k * nv + v];
+        let dk = delta[k * nv + v];
+        let ra = abs(rk);
+        let da = abs(alpha[v] * dk);
+        if (ra > r || is_nan_or_inf(ra)) {
+            r = ra;
         }
-        if (dk > d || is_nan_or_inf(dk)) {
-            d = dk;
+        if (da > d || is_nan_or_inf(da)) {
+            d = da;
         }
+        dot_dr = dot_dr + dk * rk;
+        square = square + rk * rk;
     }
-    norm_out[2u * v] = r;
-    norm_out[2u * v + 1u] = d;
+    norm_out[4u * v] = r;
+    norm_out[4u * v + 1u] = d;
+    norm_out[4u * v + 2u] = dot_dr;
+    norm_out[4u * v + 3u] = square;
 }
 #endif

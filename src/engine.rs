@@ -1,147 +1,247 @@
 //! The ensemble Newton iteration through the kernels (issue 5): one static solve for V
-//! variants of one mesh, every iteration made of the six kernels — beam, contact, assembly
-//! (with constraints), block LU, norms, update — on either kernel path: the CPU twins
-//! ([`TwinPath`], f64) or the WGSL kernels ([`GpuPath`], f32 or f64).
+//! variants of one mesh, every iteration made of the kernels — beam, sites, contact,
+//! assembly (with constraints), block LU, norms, update — on either kernel path: the CPU
+//! twins ([`TwinPath`], f64) or the WGSL kernels ([`GpuPath`], f32 or f64).
 //!
 //! The schedule mirrors `statics::solve_static` without its adaptivity: gravity in full
 //! from the low-side start with friction and bit loads off (λ = 0), then λ = ¼, ½, ¾, 1
 //! (bit loads and friction scaled by λ); Newton with the solver's line search at each λ
 //! (per variant: energy slope or residual decrease, α halved at most five times). A
-//! variant whose Newton
-//! fails (singular pivot, a non-finite residual, no convergence within the iterations) is
-//! flagged with the reason and frozen; the caller re-runs it on the CPU with step control.
-//! Converged and frozen variants get α = 0, so they stop moving while the others iterate.
+//! variant whose Newton fails (singular pivot, a non-finite residual, no convergence within
+//! the iterations) is flagged with the reason and frozen; the caller re-runs it on the CPU
+//! with step control. Converged and frozen variants get α = 0, so they stop moving while
+//! the others iterate.
 //!
-//! Today [`GpuPath`] dispatches each kernel with its own buffers and reads every result
-//! back (one-shot runners): the data flow and the numbers are the engine's, the residency
-//! (buffers made once, only the norms read per iteration) is the next step.
+//! Data stay where the path keeps them ([`Ensemble`]): on the GPU the configuration, the
+//! assembled systems and every intermediate live in buffers made once per chunk of
+//! variants; the host reads four numbers and a status per variant per solve or trial
+//! (largest residual, largest step, `Δ·r`, `r·r`) and writes one α per variant. Variants are
+//! split into chunks that fit the adapter's binding limits ([`KernelPath::max_chunk`]).
+//!
+//! Stabilizer moves are allowed: every (site, variant) pair carries its own node and hole
+//! axis, so the variants need only share the mesh and the number of sites.
 
 use crate::kernels::assemble::{assemble, AssemblyInputs, NO_SITE};
 use crate::kernels::block_lu::{block_lu, ChainBatch, SOLVED};
-use crate::kernels::contact::{contact, ContactBatch, ContactOutputs};
-use crate::kernels::update::{norms, update, ConfigBatch};
+use crate::kernels::contact::{contact, ContactBatch, STATE_LEN};
+use crate::kernels::sites::gather_sites;
+use crate::kernels::update::{norms, update, ConfigBatch, Norms};
 use crate::model::Model;
-use crate::physics::contact::{ContactMode, ContactTerms, SpringLaw};
+use crate::physics::contact::{ContactMode, ContactTerms, PARAMS_LEN};
 use crate::physics::Real;
 use crate::solve::statics::{
     constraint_tables, reference_force, split_loads, StaticOptions, StaticState,
 };
 
-/// One kernel path: the six kernels of a Newton iteration over V variants.
+/// What one chunk of variants shares and starts from, built once on the host.
+#[derive(Clone, Debug)]
+pub struct EnsembleTables<T> {
+    /// Variants V in the chunk.
+    pub num_variants: usize,
+    /// Nodes n.
+    pub num_nodes: usize,
+    /// Sites S per variant.
+    pub num_sites: usize,
+    /// Translation basis per node, `9 n`.
+    pub basis: Vec<T>,
+    /// Fixed-DOF mask per node, `n`.
+    pub fixed: Vec<u32>,
+    /// Site at each (node, variant), `n V` ([`NO_SITE`] where none).
+    pub node_site: Vec<u32>,
+    /// Node of each pair `i = site · V + variant`, `P = S V`.
+    pub pair_node: Vec<u32>,
+    /// Reference position per node, `3 n`.
+    pub node_ref: Vec<T>,
+    /// Hole axis per pair, `3 P` (the contact kernel run with one "variant" per site).
+    pub pair_normals: Vec<T>,
+    /// Pair state (`d`, wall-relative velocity, spin), `7 P`, field-major.
+    pub pair_state: Vec<T>,
+    /// The start configuration.
+    pub start: ConfigBatch<T>,
+    /// Contact terms the scene uses (the contact kernel is compiled for these only).
+    pub terms: ContactTerms,
+}
+
+/// A chunk of variants held by a kernel path: a current configuration with its assembled
+/// system, a step `Δ`, and one trial configuration.
+pub trait Ensemble<T> {
+    /// Sets the external loads (`6 n V`) and the pairs' law parameters (`PARAMS_LEN · P`,
+    /// field-major) of a load step.
+    fn set_loads(&mut self, f_ext: &[T], pair_params: &[T]) -> Result<(), String>;
+    /// Residual and constrained tangent at the current configuration.
+    fn evaluate(&mut self) -> Result<(), String>;
+    /// Solves the current system for `Δ`; the norms of its residual and `Δ` (α = 1) and
+    /// the solve's status per variant.
+    fn solve(&mut self) -> Result<(Norms<T>, Vec<u32>), String>;
+    /// Trial = current + `α Δ`, evaluated; the norms of the trial's residual with `Δ`, `α`.
+    fn trial(&mut self, alpha: &[T]) -> Result<Norms<T>, String>;
+    /// Makes the last trial (configuration and system) the current one.
+    fn accept_trial(&mut self);
+    /// Current += `α Δ` (its system must be evaluated again).
+    fn commit(&mut self, alpha: &[T]) -> Result<(), String>;
+    /// The current configuration, read back.
+    fn config(&mut self) -> Result<ConfigBatch<T>, String>;
+}
+
+/// A kernel path: makes the [`Ensemble`] of a chunk of variants.
 pub trait KernelPath<T> {
-    /// Element forces and tangents (`shaders/beam.wgsl`).
-    fn beam(
-        &mut self,
-        model: &Model,
-        v: usize,
-        x: &[T],
-        rot: &[T],
-    ) -> Result<(Vec<T>, Vec<T>), String>;
-    /// Contact responses (`shaders/contact.wgsl`).
-    fn contact(
-        &mut self,
-        terms: &ContactTerms,
-        batch: &ContactBatch<T>,
-    ) -> Result<ContactOutputs<T>, String>;
-    /// Residual and constrained tangent (`shaders/assemble.wgsl`).
-    fn assemble(&mut self, a: &AssemblyInputs<T>) -> Result<ChainBatch<T>, String>;
-    /// Block-tridiagonal solve (`shaders/block_lu.wgsl`).
-    fn solve(&mut self, b: &ChainBatch<T>) -> Result<(Vec<T>, Vec<u32>), String>;
-    /// Largest residual and step per variant (`shaders/update.wgsl`, NORMS).
-    fn norms(
-        &mut self,
-        r: &[T],
-        d: &[T],
-        alpha: &[T],
-        n: usize,
-        v: usize,
-    ) -> Result<(Vec<T>, Vec<T>), String>;
-    /// Configuration update (`shaders/update.wgsl`).
-    fn update(&mut self, c: &mut ConfigBatch<T>, d: &[T], alpha: &[T]) -> Result<(), String>;
+    /// The most variants of `model` one chunk may hold.
+    fn max_chunk(&self, model: &Model) -> usize;
+    /// Uploads a chunk.
+    fn open<'a>(
+        &'a self,
+        model: &'a Model,
+        tables: &EnsembleTables<T>,
+    ) -> Result<Box<dyn Ensemble<T> + 'a>, String>;
 }
 
 /// The CPU twins, f64.
 pub struct TwinPath;
 
-impl KernelPath<f64> for TwinPath {
-    fn beam(
-        &mut self,
-        model: &Model,
-        v: usize,
-        x: &[f64],
-        rot: &[f64],
-    ) -> Result<(Vec<f64>, Vec<f64>), String> {
-        Ok(crate::kernels::beam::beam(model, v, x, rot))
+struct TwinEnsemble<'a> {
+    model: &'a Model,
+    tables: EnsembleTables<f64>,
+    contact: ContactBatch<f64>,
+    f_ext: Vec<f64>,
+    config: [ConfigBatch<f64>; 2],
+    system: [Option<ChainBatch<f64>>; 2],
+    current: usize,
+    delta: Vec<f64>,
+}
+
+impl TwinEnsemble<'_> {
+    fn evaluate_slot(&mut self, slot: usize) {
+        let t = &self.tables;
+        let (v, n) = (t.num_variants, t.num_nodes);
+        let c = &self.config[slot];
+        let (elem_force, elem_tangent) = crate::kernels::beam::beam(self.model, v, &c.x, &c.rot);
+        gather_sites(
+            &t.pair_node,
+            &t.node_ref,
+            &c.x,
+            v,
+            &mut self.contact.pair_state,
+        );
+        let mut out = crate::kernels::contact::ContactOutputs::new(self.contact.num_pairs());
+        contact(&t.terms, &self.contact, &mut out);
+        self.system[slot] = Some(assemble(&AssemblyInputs {
+            num_variants: v,
+            num_nodes: n,
+            num_sites: t.num_sites,
+            elem_force,
+            elem_tangent,
+            contact: out.values,
+            contact_flag: out.contact,
+            node_site: t.node_site.clone(),
+            f_ext: self.f_ext.clone(),
+            basis: t.basis.clone(),
+            fixed: t.fixed.clone(),
+        }));
     }
-    fn contact(
-        &mut self,
-        terms: &ContactTerms,
-        batch: &ContactBatch<f64>,
-    ) -> Result<ContactOutputs<f64>, String> {
-        let mut out = ContactOutputs::new(batch.num_pairs());
-        contact(terms, batch, &mut out);
-        Ok(out)
-    }
-    fn assemble(&mut self, a: &AssemblyInputs<f64>) -> Result<ChainBatch<f64>, String> {
-        Ok(assemble(a))
-    }
-    fn solve(&mut self, b: &ChainBatch<f64>) -> Result<(Vec<f64>, Vec<u32>), String> {
-        Ok(block_lu(b))
-    }
-    fn norms(
-        &mut self,
-        r: &[f64],
-        d: &[f64],
-        alpha: &[f64],
-        n: usize,
-        v: usize,
-    ) -> Result<(Vec<f64>, Vec<f64>), String> {
-        Ok(norms(r, d, alpha, n, v))
-    }
-    fn update(&mut self, c: &mut ConfigBatch<f64>, d: &[f64], alpha: &[f64]) -> Result<(), String> {
-        update(c, d, alpha);
-        Ok(())
+
+    fn rhs(&self, slot: usize) -> Result<&[f64], String> {
+        self.system[slot]
+            .as_ref()
+            .map(|s| s.rhs.as_slice())
+            .ok_or_else(|| "system not evaluated".to_string())
     }
 }
 
-/// The WGSL kernels on the shared GPU context.
+impl Ensemble<f64> for TwinEnsemble<'_> {
+    fn set_loads(&mut self, f_ext: &[f64], pair_params: &[f64]) -> Result<(), String> {
+        self.f_ext = f_ext.to_vec();
+        self.contact.pair_params = pair_params.to_vec();
+        self.system = [None, None];
+        Ok(())
+    }
+    fn evaluate(&mut self) -> Result<(), String> {
+        self.evaluate_slot(self.current);
+        Ok(())
+    }
+    fn solve(&mut self) -> Result<(Norms<f64>, Vec<u32>), String> {
+        let sys = self.system[self.current]
+            .as_ref()
+            .ok_or("system not evaluated")?;
+        let (delta, status) = block_lu(sys);
+        self.delta = delta;
+        let ones = vec![1.0; self.tables.num_variants];
+        let n = norms(
+            &sys.rhs,
+            &self.delta,
+            &ones,
+            self.tables.num_nodes,
+            self.tables.num_variants,
+        );
+        Ok((n, status))
+    }
+    fn trial(&mut self, alpha: &[f64]) -> Result<Norms<f64>, String> {
+        let other = 1 - self.current;
+        self.config[other] = self.config[self.current].clone();
+        update(&mut self.config[other], &self.delta, alpha);
+        self.evaluate_slot(other);
+        Ok(norms(
+            self.rhs(other)?,
+            &self.delta,
+            alpha,
+            self.tables.num_nodes,
+            self.tables.num_variants,
+        ))
+    }
+    fn accept_trial(&mut self) {
+        self.current = 1 - self.current;
+    }
+    fn commit(&mut self, alpha: &[f64]) -> Result<(), String> {
+        update(&mut self.config[self.current], &self.delta, alpha);
+        self.system[self.current] = None;
+        Ok(())
+    }
+    fn config(&mut self) -> Result<ConfigBatch<f64>, String> {
+        Ok(self.config[self.current].clone())
+    }
+}
+
+impl KernelPath<f64> for TwinPath {
+    fn max_chunk(&self, _model: &Model) -> usize {
+        usize::MAX
+    }
+    fn open<'a>(
+        &'a self,
+        model: &'a Model,
+        tables: &EnsembleTables<f64>,
+    ) -> Result<Box<dyn Ensemble<f64> + 'a>, String> {
+        let p = tables.pair_node.len();
+        let mut contact = ContactBatch::new(1, p);
+        contact.site_normals = tables.pair_normals.clone();
+        contact.pair_state = tables.pair_state.clone();
+        Ok(Box::new(TwinEnsemble {
+            model,
+            tables: tables.clone(),
+            contact,
+            f_ext: Vec::new(),
+            config: [tables.start.clone(), tables.start.clone()],
+            system: [None, None],
+            current: 0,
+            delta: vec![0.0; 6 * tables.num_nodes * tables.num_variants],
+        }))
+    }
+}
+
+/// The WGSL kernels on the shared GPU context, resident per chunk
+/// ([`crate::gpu::ensemble::GpuEnsemble`]).
 pub struct GpuPath(pub &'static crate::gpu::GpuContext);
 
 impl<T: crate::gpu::contact::GpuReal> KernelPath<T> for GpuPath {
-    fn beam(
-        &mut self,
-        model: &Model,
-        v: usize,
-        x: &[T],
-        rot: &[T],
-    ) -> Result<(Vec<T>, Vec<T>), String> {
-        crate::gpu::beam::beam_gpu(self.0, model, v, x, rot).map_err(|e| e.to_string())
+    fn max_chunk(&self, model: &Model) -> usize {
+        crate::gpu::ensemble::max_variants(self.0, model, std::mem::size_of::<T>())
     }
-    fn contact(
-        &mut self,
-        terms: &ContactTerms,
-        batch: &ContactBatch<T>,
-    ) -> Result<ContactOutputs<T>, String> {
-        crate::gpu::contact::contact_gpu(self.0, terms, batch).map_err(|e| e.to_string())
-    }
-    fn assemble(&mut self, a: &AssemblyInputs<T>) -> Result<ChainBatch<T>, String> {
-        crate::gpu::assemble::assemble_gpu(self.0, a).map_err(|e| e.to_string())
-    }
-    fn solve(&mut self, b: &ChainBatch<T>) -> Result<(Vec<T>, Vec<u32>), String> {
-        crate::gpu::block_lu::block_lu_gpu(self.0, b).map_err(|e| e.to_string())
-    }
-    fn norms(
-        &mut self,
-        r: &[T],
-        d: &[T],
-        alpha: &[T],
-        n: usize,
-        v: usize,
-    ) -> Result<(Vec<T>, Vec<T>), String> {
-        crate::gpu::update::norms_gpu(self.0, r, d, alpha, n, v).map_err(|e| e.to_string())
-    }
-    fn update(&mut self, c: &mut ConfigBatch<T>, d: &[T], alpha: &[T]) -> Result<(), String> {
-        crate::gpu::update::update_gpu(self.0, c, d, alpha).map_err(|e| e.to_string())
+    fn open<'a>(
+        &'a self,
+        model: &'a Model,
+        tables: &EnsembleTables<T>,
+    ) -> Result<Box<dyn Ensemble<T> + 'a>, String> {
+        crate::gpu::ensemble::GpuEnsemble::new(self.0, model, tables)
+            .map(|e| Box::new(e) as Box<dyn Ensemble<T> + 'a>)
+            .map_err(|e| e.to_string())
     }
 }
 
@@ -165,196 +265,190 @@ pub struct EngineResult {
     pub iterations: Vec<usize>,
 }
 
-/// Residual and constrained tangent of every variant at `config` (beam, contact and
-/// assembly kernels).
-#[allow(clippy::too_many_arguments)]
-fn evaluate<T: Real, P: KernelPath<T>>(
-    path: &mut P,
-    models: &[Model],
-    config: &ConfigBatch<T>,
-    contact_batch: &mut ContactBatch<T>,
-    terms: &ContactTerms,
-    node_site: &[u32],
-    f_ext: &[T],
-    fixed: &[u32],
-) -> Result<ChainBatch<T>, String> {
+/// An error unless every model shares the first one's mesh and number of sites.
+fn check_same_mesh(models: &[Model]) -> Result<(), String> {
+    let base = models.first().ok_or("no variants")?;
+    for m in models {
+        if m.nodes.len() != base.nodes.len()
+            || m.elements.len() != base.elements.len()
+            || m.sites.len() != base.sites.len()
+        {
+            return Err("variants differ in mesh or number of sites; run them on the CPU".into());
+        }
+    }
+    Ok(())
+}
+
+/// The tables of a chunk of variants (all on the first one's mesh).
+pub fn ensemble_tables<T: Real>(models: &[Model]) -> Result<EnsembleTables<T>, String> {
+    check_same_mesh(models)?;
     let t = |x: f64| T::from_f64_lossy(x);
     let base = &models[0];
-    let (v, n) = (models.len(), base.nodes.len());
-    let (elem_force, elem_tangent) = path.beam(base, v, &config.x, &config.rot)?;
-    for (k, site) in base.sites.iter().enumerate() {
-        let x0 = base.nodes[site.node].position;
-        let axis = base.nodes[site.node].hole_axis;
-        for (j, m) in models.iter().enumerate() {
-            let d: [T; 3] =
-                std::array::from_fn(|a| config.x[(3 * site.node + a) * v + j] - t(x0[a]));
-            let vel: [T; 3] = std::array::from_fn(|a| t(axis[a] * m.axial_speed));
-            contact_batch.set_state(k * v + j, d, vel, t(m.rotation_speed));
-        }
-    }
-    let out = path.contact(terms, contact_batch)?;
-    path.assemble(&AssemblyInputs {
-        num_variants: v,
-        num_nodes: n,
-        num_sites: base.sites.len(),
-        elem_force,
-        elem_tangent,
-        contact: out.values,
-        contact_flag: out.contact,
-        node_site: node_site.to_vec(),
-        f_ext: f_ext.to_vec(),
-        basis: config.basis.clone(),
-        fixed: fixed.to_vec(),
-    })
-}
-
-/// Copies variant `j`'s entries of `from` into `to` (field-major, variant fastest).
-fn copy_variant<T: Copy>(to: &mut ChainBatch<T>, from: &ChainBatch<T>, j: usize) {
-    let v = to.num_variants;
-    for (a, b) in [
-        (&mut to.diag, &from.diag),
-        (&mut to.upper, &from.upper),
-        (&mut to.lower, &from.lower),
-        (&mut to.rhs, &from.rhs),
-    ] {
-        for f in 0..a.len() / v {
-            a[f * v + j] = b[f * v + j];
-        }
-    }
-}
-
-/// Static equilibrium of every variant through `path`. All models share the mesh and the
-/// site→node map (stabilizer moves go to the CPU path).
-pub fn solve_static_ensemble<T: Real + Send + Sync, P: KernelPath<T>>(
-    models: &[Model],
-    path: &mut P,
-    options: &StaticOptions,
-) -> Result<Vec<EngineResult>, String> {
-    solve_static_ensemble_with_progress(models, path, options, &mut |_| {})
-}
-
-/// As [`solve_static_ensemble`], reporting the fraction of the load schedule done (0 … 1)
-/// after every iteration (for a progress bar).
-pub fn solve_static_ensemble_with_progress<T: Real + Send + Sync, P: KernelPath<T>>(
-    models: &[Model],
-    path: &mut P,
-    options: &StaticOptions,
-    progress: &mut dyn FnMut(f64),
-) -> Result<Vec<EngineResult>, String> {
-    let v = models.len();
-    let base = models.first().ok_or("no variants")?;
-    let n = base.nodes.len();
-    let s_count = base.sites.len();
-    for m in models {
-        if m.nodes.len() != n
-            || m.sites.len() != s_count
-            || m.sites
-                .iter()
-                .zip(&base.sites)
-                .any(|(a, b)| a.node != b.node)
-        {
-            return Err("variants differ in mesh or site layout; run them on the CPU".into());
-        }
-    }
-    let t = |x: f64| T::from_f64_lossy(x);
+    let (v, n, s_count) = (models.len(), base.nodes.len(), base.sites.len());
     let (basis, fixed) = constraint_tables(base);
-    let starts: Vec<StaticState> = models
-        .iter()
-        .map(|m| {
-            if m.sites.is_empty() {
-                StaticState::initial(m)
-            } else {
-                StaticState::on_low_side(m)
-            }
-        })
-        .collect();
-    let mut config = ConfigBatch {
+    let mut start = ConfigBatch {
         num_variants: v,
         num_nodes: n,
         x: vec![T::zero(); 3 * n * v],
         rot: vec![T::zero(); 9 * n * v],
         basis: basis.iter().map(|&b| t(b)).collect(),
     };
-    for (j, s) in starts.iter().enumerate() {
+    for (j, m) in models.iter().enumerate() {
+        let s = if m.sites.is_empty() {
+            StaticState::initial(m)
+        } else {
+            StaticState::on_low_side(m)
+        };
         for i in 0..n {
             for k in 0..3 {
-                config.x[(3 * i + k) * v + j] = t(s.x[i][k]);
+                start.x[(3 * i + k) * v + j] = t(s.x[i][k]);
             }
             for r in 0..3 {
                 for c in 0..3 {
-                    config.rot[(9 * i + 3 * r + c) * v + j] = t(s.rot[i][r][c]);
+                    start.rot[(9 * i + 3 * r + c) * v + j] = t(s.rot[i][r][c]);
                 }
             }
         }
     }
-    let loads: Vec<(Vec<f64>, Vec<f64>)> = models.iter().map(split_loads).collect();
-    let length_scale: Vec<f64> = starts
-        .iter()
-        .map(|s| 1.0 + s.x.iter().flatten().fold(0.0f64, |m, x| m.max(x.abs())))
-        .collect();
-    let f_ref: Vec<f64> = models.iter().map(reference_force).collect();
-    let terms = ContactTerms {
-        spring: SpringLaw::PowerBlend,
-        damping: false,
-        friction: Some(base.friction),
-        mode: ContactMode::Static,
-    };
+    let p = s_count * v;
     let mut node_site = vec![NO_SITE; n * v];
-    let mut contact_batch = ContactBatch::<T>::new(v, s_count);
-    for (k, site) in base.sites.iter().enumerate() {
-        let axis = base.nodes[site.node].hole_axis;
-        contact_batch.set_site_normal(k, [t(axis[0]), t(axis[1]), t(axis[2])]);
-        for j in 0..v {
+    let mut pair_node = vec![0u32; p];
+    let mut pair_normals = vec![T::zero(); 3 * p];
+    let mut pair_state = vec![T::zero(); STATE_LEN * p];
+    let mut params = vec![T::zero(); PARAMS_LEN * p];
+    for (j, m) in models.iter().enumerate() {
+        for (k, site) in m.sites.iter().enumerate() {
+            let i = k * v + j;
             node_site[site.node * v + j] = k as u32;
+            pair_node[i] = site.node as u32;
+            let axis = m.nodes[site.node].hole_axis;
+            let len = (axis[0] * axis[0] + axis[1] * axis[1] + axis[2] * axis[2]).sqrt();
+            for a in 0..3 {
+                pair_normals[3 * i + a] = t(axis[a] / len);
+                pair_state[(3 + a) * p + i] = t(axis[a] * m.axial_speed);
+            }
+            pair_state[6 * p + i] = t(m.rotation_speed);
+            for (f, x) in site.params.to_array().into_iter().enumerate() {
+                params[f * p + i] = t(x);
+            }
         }
     }
+    let mut batch = ContactBatch::<T>::new(1, p);
+    batch.pair_params = params;
+    let terms = batch.required_terms(base.friction, ContactMode::Static);
+    let node_ref: Vec<T> = base
+        .nodes
+        .iter()
+        .flat_map(|nd| nd.position)
+        .map(t)
+        .collect();
+    Ok(EnsembleTables {
+        num_variants: v,
+        num_nodes: n,
+        num_sites: s_count,
+        basis: start.basis.clone(),
+        fixed,
+        node_site,
+        pair_node,
+        node_ref,
+        pair_normals,
+        pair_state,
+        start,
+        terms,
+    })
+}
+
+/// Static equilibrium of every variant through `path`. All models share the mesh and the
+/// number of sites; stabilizers may sit at other nodes per variant.
+pub fn solve_static_ensemble<T: Real + Send + Sync, P: KernelPath<T>>(
+    models: &[Model],
+    path: &P,
+    options: &StaticOptions,
+) -> Result<Vec<EngineResult>, String> {
+    solve_static_ensemble_with_progress(models, path, options, &mut |_| {})
+}
+
+/// As [`solve_static_ensemble`], reporting the fraction done (0 … 1) after every iteration
+/// (for a progress bar). Chunks of [`KernelPath::max_chunk`] variants run one after another.
+pub fn solve_static_ensemble_with_progress<T: Real + Send + Sync, P: KernelPath<T>>(
+    models: &[Model],
+    path: &P,
+    options: &StaticOptions,
+    progress: &mut dyn FnMut(f64),
+) -> Result<Vec<EngineResult>, String> {
+    check_same_mesh(models)?;
+    let chunk = path.max_chunk(&models[0]).max(1);
+    let total = models.len();
+    let mut results = Vec::with_capacity(total);
+    for (c, group) in models.chunks(chunk).enumerate() {
+        let done_before = (c * chunk) as f64 / total as f64;
+        let share = group.len() as f64 / total as f64;
+        let mut report = |f: f64| progress(done_before + share * f);
+        results.extend(solve_chunk(group, path, options, &mut report)?);
+    }
+    Ok(results)
+}
+
+fn solve_chunk<T: Real + Send + Sync, P: KernelPath<T>>(
+    models: &[Model],
+    path: &P,
+    options: &StaticOptions,
+    progress: &mut dyn FnMut(f64),
+) -> Result<Vec<EngineResult>, String> {
+    let tables = ensemble_tables::<T>(models)?;
+    let (v, n) = (tables.num_variants, tables.num_nodes);
+    let base = &models[0];
+    let t = |x: f64| T::from_f64_lossy(x);
+    let loads: Vec<(Vec<f64>, Vec<f64>)> = models.iter().map(split_loads).collect();
+    let length_scale: Vec<f64> = (0..v)
+        .map(|j| {
+            1.0 + (0..3 * n).fold(0.0f64, |m, k| {
+                m.max(tables.start.x[k * v + j].to_f64_lossy().abs())
+            })
+        })
+        .collect();
+    let f_ref: Vec<f64> = models.iter().map(reference_force).collect();
+    let p = tables.pair_node.len();
+    let mut ensemble = path.open(base, &tables)?;
     let mut status = vec![EngineStatus::Converged; v];
     let mut iterations = vec![Vec::new(); v];
     let schedule = [0.0, 0.25, 0.5, 0.75, 1.0];
+    let minus_one = T::zero() - T::one();
     for (step, &lambda) in schedule.iter().enumerate() {
         // Loads and friction of this step.
         let mut f_ext = vec![T::zero(); 6 * n * v];
+        let mut params = vec![T::zero(); PARAMS_LEN * p];
         for (j, m) in models.iter().enumerate() {
             let gamma = if m.sites.is_empty() { lambda } else { 1.0 };
             for d in 0..6 * n {
                 f_ext[d * v + j] = t(gamma * loads[j].0[d] + lambda * loads[j].1[d]);
             }
             for (k, site) in m.sites.iter().enumerate() {
-                let mut p = site.params;
-                p.mu_t *= lambda;
-                p.mu_l *= lambda;
-                contact_batch.set_params(k * v + j, &p.cast());
+                let mut q = site.params;
+                q.mu_t *= lambda;
+                q.mu_l *= lambda;
+                for (f, x) in q.to_array().into_iter().enumerate() {
+                    params[f * p + k * v + j] = t(x);
+                }
             }
         }
+        ensemble.set_loads(&f_ext, &params)?;
         let mut done = vec![false; v];
         let mut polished = vec![false; v];
         let mut last_step = vec![f64::INFINITY; v];
-        // The system at the configuration the line search accepted, when it has been
-        // evaluated there already (it has, unless a variant took the untested α = 1/32).
-        let mut carried: Option<ChainBatch<T>> = None;
+        // Whether the current configuration's system is evaluated (the accepted trial's).
+        let mut evaluated = false;
         for it in 1..=options.max_iterations {
-            let sys = match carried.take() {
-                Some(s) => s,
-                None => evaluate(
-                    path,
-                    models,
-                    &config,
-                    &mut contact_batch,
-                    &terms,
-                    &node_site,
-                    &f_ext,
-                    &fixed,
-                )?,
-            };
-            let (sol, st) = path.solve(&sys)?;
-            let minus = vec![T::zero() - T::one(); v];
-            let (rmax, dmax) = path.norms(&sys.rhs, &sol, &minus, n, v)?;
+            if !evaluated {
+                ensemble.evaluate()?;
+            }
+            let (now, st) = ensemble.solve()?;
             let mut alpha = vec![T::zero(); v];
             for j in 0..v {
                 if done[j] || status[j] != EngineStatus::Converged {
                     continue;
                 }
-                let measure = rmax[j].to_f64_lossy() / f_ref[j];
+                let measure = now.residual_max[j].to_f64_lossy() / f_ref[j];
                 if !measure.is_finite() {
                     status[j] =
                         EngineStatus::Failed(format!("λ = {lambda}: residual is not finite"));
@@ -366,7 +460,7 @@ pub fn solve_static_ensemble_with_progress<T: Real + Send + Sync, P: KernelPath<
                     // At full load one more full step polishes it (as solve_static).
                     if lambda == 1.0 && !polished[j] {
                         polished[j] = true;
-                        alpha[j] = T::zero() - T::one();
+                        alpha[j] = minus_one;
                         continue;
                     }
                     done[j] = true;
@@ -374,77 +468,68 @@ pub fn solve_static_ensemble_with_progress<T: Real + Send + Sync, P: KernelPath<
                 } else if st[j] != SOLVED {
                     status[j] = EngineStatus::Failed(format!("λ = {lambda}: singular tangent"));
                 } else {
-                    alpha[j] = T::zero() - T::one();
+                    alpha[j] = minus_one;
                 }
             }
             if (0..v).all(|j| done[j] || status[j] != EngineStatus::Converged) {
                 break;
             }
             // Line search per variant, as statics::newton: the full step unless it
-            // overshoots (|s(α)| > |s(0)|, s = Δ·r) and does not lower ‖r‖₂; halved at most
+            // overshoots (|s(α)| > |s(0)|, s = −Δ·r) and does not lower ‖r‖₂; halved at most
             // five times (the last, α = 1/32, is taken anyway).
-            let dot = |a: &[T], b: &[T], j: usize| -> f64 {
-                (0..6 * n)
-                    .map(|k| a[k * v + j].to_f64_lossy() * b[k * v + j].to_f64_lossy())
-                    .sum()
-            };
-            let s0: Vec<f64> = (0..v).map(|j| -dot(&sol, &sys.rhs, j)).collect();
-            let norm0: Vec<f64> = (0..v).map(|j| dot(&sys.rhs, &sys.rhs, j).sqrt()).collect();
+            let s0: Vec<f64> = now
+                .step_dot_residual
+                .iter()
+                .map(|x| -x.to_f64_lossy())
+                .collect();
+            let norm0: Vec<f64> = now
+                .residual_square
+                .iter()
+                .map(|x| x.to_f64_lossy().sqrt())
+                .collect();
             let mut pending: Vec<bool> = alpha.iter().map(|a| a.to_f64_lossy() != 0.0).collect();
-            let mut next: Option<ChainBatch<T>> = None;
+            // The last trial evaluated holds every variant at its final α.
+            let mut trial_is_final = false;
             for _ in 0..5 {
-                if !pending.iter().any(|&p| p) {
+                if !pending.iter().any(|&q| q) {
                     break;
                 }
-                let mut trial = config.clone();
-                path.update(&mut trial, &sol, &alpha)?;
-                let r = evaluate(
-                    path,
-                    models,
-                    &trial,
-                    &mut contact_batch,
-                    &terms,
-                    &node_site,
-                    &f_ext,
-                    &fixed,
-                )?;
+                let r = ensemble.trial(&alpha)?;
+                trial_is_final = true;
                 for j in 0..v {
                     if !pending[j] {
                         continue;
                     }
                     let a = -alpha[j].to_f64_lossy();
-                    let s_a = -dot(&sol, &r.rhs, j);
-                    let norm = dot(&r.rhs, &r.rhs, j).sqrt();
+                    let s_a = -r.step_dot_residual[j].to_f64_lossy();
+                    let norm = r.residual_square[j].to_f64_lossy().sqrt();
                     let finite = s_a.is_finite() && norm.is_finite();
                     if finite && (s_a.abs() <= s0[j].abs() || norm <= (1.0 - 1e-4 * a) * norm0[j]) {
                         pending[j] = false;
-                        if let Some(nx) = next.as_mut() {
-                            copy_variant(nx, &r, j);
-                        }
                     } else {
-                        alpha[j] = alpha[j] * T::from_f64_lossy(0.5);
+                        alpha[j] = alpha[j] * t(0.5);
+                        trial_is_final = false;
                     }
                 }
-                // The first trial also holds every variant that does not move (α = 0).
-                if next.is_none() {
-                    next = Some(r);
-                }
-            }
-            if !pending.iter().any(|&p| p) {
-                carried = next;
             }
             for j in 0..v {
-                last_step[j] = dmax[j].to_f64_lossy() * alpha[j].to_f64_lossy().abs();
+                last_step[j] = now.step_max[j].to_f64_lossy() * alpha[j].to_f64_lossy().abs();
             }
             if std::env::var("HOLEWALL_DEBUG_NEWTON").is_ok() {
                 eprintln!(
                     "  engine λ {lambda:.4} it {it}: variant 0 residual {:.3e} α {:.4} step {:.3e}",
-                    rmax[0].to_f64_lossy() / f_ref[0],
+                    now.residual_max[0].to_f64_lossy() / f_ref[0],
                     alpha[0].to_f64_lossy().abs(),
                     last_step[0]
                 );
             }
-            path.update(&mut config, &sol, &alpha)?;
+            if trial_is_final {
+                ensemble.accept_trial();
+                evaluated = true;
+            } else {
+                ensemble.commit(&alpha)?;
+                evaluated = false;
+            }
             progress(
                 (step as f64 + it as f64 / options.max_iterations as f64) / schedule.len() as f64,
             );
@@ -459,6 +544,7 @@ pub fn solve_static_ensemble_with_progress<T: Real + Send + Sync, P: KernelPath<
             }
         }
     }
+    let config = ensemble.config()?;
     Ok((0..v)
         .map(|j| {
             let mut s = StaticState::initial(base);
@@ -479,4 +565,26 @@ pub fn solve_static_ensemble_with_progress<T: Real + Send + Sync, P: KernelPath<
             }
         })
         .collect())
+}
+
+/// A kernel path with chunks of at most `max` variants (to test chunk boundaries, or to
+/// bound the memory a run takes).
+pub struct Chunked<P> {
+    /// The path.
+    pub inner: P,
+    /// Most variants per chunk.
+    pub max: usize,
+}
+
+impl<T, P: KernelPath<T>> KernelPath<T> for Chunked<P> {
+    fn max_chunk(&self, model: &Model) -> usize {
+        self.inner.max_chunk(model).min(self.max)
+    }
+    fn open<'a>(
+        &'a self,
+        model: &'a Model,
+        tables: &EnsembleTables<T>,
+    ) -> Result<Box<dyn Ensemble<T> + 'a>, String> {
+        self.inner.open(model, tables)
+    }
 }

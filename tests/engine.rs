@@ -34,7 +34,7 @@ fn kernel_chain_static_ensemble_matches_single_cpu_runs() {
     .unwrap();
     let models: Vec<_> = variants.iter().map(|v| apply(&case, v).unwrap()).collect();
     let options = StaticOptions::default();
-    let twin = solve_static_ensemble(&models, &mut TwinPath, &options).unwrap();
+    let twin = solve_static_ensemble(&models, &TwinPath, &options).unwrap();
     let mut worst: f64 = 0.0;
     for (j, (m, r)) in models.iter().zip(&twin).enumerate() {
         assert_eq!(r.status, EngineStatus::Converged, "variant {j}");
@@ -54,7 +54,7 @@ fn kernel_chain_static_ensemble_matches_single_cpu_runs() {
     assert!(worst <= 1e-9, "{worst:e}");
     let Some(ctx) = common::gpu() else { return };
     if ctx.has_f64 {
-        let gpu = solve_static_ensemble::<f64, _>(&models, &mut GpuPath(ctx), &options).unwrap();
+        let gpu = solve_static_ensemble::<f64, _>(&models, &GpuPath(ctx), &options).unwrap();
         let mut diff: f64 = 0.0;
         for (g, t) in gpu.iter().zip(&twin) {
             assert_eq!(g.status, t.status);
@@ -85,8 +85,8 @@ fn a_failing_variant_fails_alone_in_the_engine() {
             .collect::<Vec<_>>()
     };
     let options = StaticOptions::default();
-    let alone = solve_static_ensemble(&models(&good), &mut TwinPath, &options).unwrap();
-    let with_bad = solve_static_ensemble(&models(&mixed), &mut TwinPath, &options).unwrap();
+    let alone = solve_static_ensemble(&models(&good), &TwinPath, &options).unwrap();
+    let with_bad = solve_static_ensemble(&models(&mixed), &TwinPath, &options).unwrap();
     eprintln!("bad variant: {:?}", with_bad[1].status);
     assert!(matches!(with_bad[1].status, EngineStatus::Failed(_)));
     let bits = |r: &holewall::engine::EngineResult| -> Vec<u64> {
@@ -97,11 +97,122 @@ fn a_failing_variant_fails_alone_in_the_engine() {
     let Some(ctx) = common::gpu() else { return };
     if ctx.has_f64 {
         let alone =
-            solve_static_ensemble::<f64, _>(&models(&good), &mut GpuPath(ctx), &options).unwrap();
+            solve_static_ensemble::<f64, _>(&models(&good), &GpuPath(ctx), &options).unwrap();
         let with_bad =
-            solve_static_ensemble::<f64, _>(&models(&mixed), &mut GpuPath(ctx), &options).unwrap();
+            solve_static_ensemble::<f64, _>(&models(&mixed), &GpuPath(ctx), &options).unwrap();
         assert!(matches!(with_bad[1].status, EngineStatus::Failed(_)));
         assert_eq!(bits(&alone[0]), bits(&with_bad[0]));
         assert_eq!(bits(&alone[1]), bits(&with_bad[2]));
+    }
+}
+
+#[test]
+fn stabilizer_moves_and_chunks_in_the_engine() {
+    use holewall::engine::Chunked;
+    let case = common::bed_case("1");
+    // The stabilizer 1.5 m, 3 m and 4.5 m further from the bit than in the case, with
+    // different friction: each variant's pairs sit at other nodes.
+    let variants = variants_from_csv_text(
+        "v.csv",
+        "stab1.from_bit,mu,wob\n6 m,0.2,8 kN\n7.5 m,0.3,8 kN\n9 m,0.25,10 kN\n4.5 m,0.3,6 kN\n6 m,0.35,9 kN\n",
+    )
+    .unwrap();
+    let models: Vec<_> = variants.iter().map(|v| apply(&case, v).unwrap()).collect();
+    let nodes: Vec<usize> = models
+        .iter()
+        .map(|m| m.sites.iter().find(|s| s.stabilizer).unwrap().node)
+        .collect();
+    eprintln!("stabilizer nodes per variant: {nodes:?}");
+    assert!(nodes.windows(2).any(|w| w[0] != w[1]));
+    let options = StaticOptions::default();
+    let twin = solve_static_ensemble(&models, &TwinPath, &options).unwrap();
+    let mut worst: f64 = 0.0;
+    for (m, r) in models.iter().zip(&twin) {
+        assert_eq!(r.status, EngineStatus::Converged);
+        let cpu = solve_static(m, &options).unwrap();
+        let a = qoi(m, &solution_at(m, r.state.clone()), case.bit_md);
+        let b = qoi(m, &cpu, case.bit_md);
+        for k in 0..3 {
+            worst = worst.max((a[k] - b[k]).abs() / b[k].abs().max(1e-300));
+        }
+    }
+    eprintln!("stabilizer moves, twin path vs solve_static: worst relative QoI {worst:.2e}");
+    assert!(worst <= 1e-9, "{worst:e}");
+    // Chunks of two: bit-identical to one chunk (the variants never meet).
+    let bits = |r: &[holewall::engine::EngineResult]| -> Vec<u64> {
+        r.iter()
+            .flat_map(|r| r.state.x.iter().flatten().map(|x| x.to_bits()))
+            .collect()
+    };
+    let chunked = solve_static_ensemble(
+        &models,
+        &Chunked {
+            inner: TwinPath,
+            max: 2,
+        },
+        &options,
+    )
+    .unwrap();
+    assert_eq!(bits(&chunked), bits(&twin));
+    let Some(ctx) = common::gpu() else { return };
+    if ctx.has_f64 {
+        let gpu = solve_static_ensemble::<f64, _>(&models, &GpuPath(ctx), &options).unwrap();
+        let gpu_chunked = solve_static_ensemble::<f64, _>(
+            &models,
+            &Chunked {
+                inner: GpuPath(ctx),
+                max: 2,
+            },
+            &options,
+        )
+        .unwrap();
+        assert_eq!(bits(&gpu_chunked), bits(&gpu));
+        let diff = gpu
+            .iter()
+            .zip(&twin)
+            .flat_map(|(g, t)| g.state.x.iter().flatten().zip(t.state.x.iter().flatten()))
+            .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+        eprintln!("stabilizer moves, GPU f64 vs twin: largest position difference {diff:.2e} m");
+        assert!(diff <= 1e-9);
+    }
+}
+
+#[test]
+fn sites_kernel_equals_its_twin() {
+    use holewall::kernels::sites::gather_sites;
+    use rand::{Rng, SeedableRng};
+    let mut rng = rand::rngs::StdRng::seed_from_u64(3);
+    let (n, v, s) = (40, 7, 5);
+    let p = s * v;
+    let pair_node: Vec<u32> = (0..p).map(|_| rng.random_range(0..n as u32)).collect();
+    let node_ref: Vec<f64> = (0..3 * n).map(|_| rng.random_range(-1e3..1e3)).collect();
+    let x: Vec<f64> = (0..3 * n * v)
+        .map(|_| rng.random_range(-1e3..1e3))
+        .collect();
+    let mut twin: Vec<f64> = (0..7 * p).map(|k| k as f64).collect();
+    let before = twin.clone();
+    gather_sites(&pair_node, &node_ref, &x, v, &mut twin);
+    for i in 0..p {
+        let (node, j) = (pair_node[i] as usize, i % v);
+        for k in 0..3 {
+            assert_eq!(
+                twin[k * p + i],
+                x[(3 * node + k) * v + j] - node_ref[3 * node + k]
+            );
+        }
+        for k in 3..7 {
+            assert_eq!(
+                twin[k * p + i],
+                before[k * p + i],
+                "velocity fields untouched"
+            );
+        }
+    }
+    let Some(ctx) = common::gpu() else { return };
+    if ctx.has_f64 {
+        let gpu =
+            holewall::gpu::ensemble::gather_sites_gpu(ctx, &pair_node, &node_ref, &x, v, &before)
+                .unwrap();
+        assert_eq!(gpu, twin);
     }
 }

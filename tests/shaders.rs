@@ -131,6 +131,7 @@ fn engine_kernels_validate_in_both_precisions() {
             holewall::gpu::update::update_wgsl(false, f64).unwrap(),
             holewall::gpu::update::update_wgsl(true, f64).unwrap(),
             holewall::gpu::beam::beam_wgsl(f64).unwrap(),
+            holewall::gpu::ensemble::sites_wgsl(f64).unwrap(),
         ] {
             validate(&wgsl).unwrap_or_else(|e| panic!("f64={f64}: {e}"));
             assert_eq!(wgsl.contains("f64"), f64, "precision leak, f64={f64}");

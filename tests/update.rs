@@ -85,7 +85,20 @@ fn update_matches_rodrigues_and_gpu_matches_twin() {
     let residual: Vec<f64> = (0..6 * n * v)
         .map(|_| rng.random_range(-1e3..1e3))
         .collect();
-    let (r_twin, d_twin) = norms(&residual, &delta, &alpha, n, v);
+    let twin_norms = norms(&residual, &delta, &alpha, n, v);
+    // Against plain sums.
+    for j in 0..v {
+        let dot: f64 = (0..6 * n)
+            .map(|k| delta[k * v + j] * residual[k * v + j])
+            .sum();
+        let sq: f64 = (0..6 * n).map(|k| residual[k * v + j].powi(2)).sum();
+        let rmax = (0..6 * n).fold(0.0f64, |m, k| m.max(residual[k * v + j].abs()));
+        let dmax = (0..6 * n).fold(0.0f64, |m, k| m.max((alpha[j] * delta[k * v + j]).abs()));
+        assert_eq!(twin_norms.step_dot_residual[j], dot);
+        assert_eq!(twin_norms.residual_square[j], sq);
+        assert_eq!(twin_norms.residual_max[j], rmax);
+        assert_eq!(twin_norms.step_max[j], dmax);
+    }
     let Some(ctx) = common::gpu() else { return };
     if ctx.has_f64 {
         let mut gpu = b0.clone();
@@ -98,8 +111,23 @@ fn update_matches_rodrigues_and_gpu_matches_twin() {
             .fold(0.0f64, |m, (a, b)| m.max((a - b).abs() / b.abs().max(1.0)));
         eprintln!("GPU f64 vs twin: {diff:.2e}");
         assert!(diff <= 1e-15);
-        let (r_gpu, d_gpu) = norms_gpu(ctx, &residual, &delta, &alpha, n, v).unwrap();
-        assert_eq!((r_gpu, d_gpu), (r_twin.clone(), d_twin.clone()));
+        let gpu_norms = norms_gpu(ctx, &residual, &delta, &alpha, n, v).unwrap();
+        assert_eq!(gpu_norms.residual_max, twin_norms.residual_max);
+        assert_eq!(gpu_norms.step_max, twin_norms.step_max);
+        // Sums in the same order; the compiler may fuse multiply-adds.
+        for (a, b) in [
+            (&gpu_norms.step_dot_residual, &twin_norms.step_dot_residual),
+            (&gpu_norms.residual_square, &twin_norms.residual_square),
+        ] {
+            for j in 0..v {
+                assert!(
+                    (a[j] - b[j]).abs() <= 1e-13 * b[j].abs().max(1.0),
+                    "{} vs {}",
+                    a[j],
+                    b[j]
+                );
+            }
+        }
     }
     // f32: against the f64 twin.
     let cast = |x: &[f64]| x.iter().map(|&y| y as f32).collect::<Vec<f32>>();
@@ -121,12 +149,16 @@ fn update_matches_rodrigues_and_gpu_matches_twin() {
     // NaN in one variant's residual shows in its norm only.
     let mut bad = residual.clone();
     bad[7 * v + 3] = f64::NAN;
-    let (r_bad, _) = norms(&bad, &delta, &alpha, n, v);
-    assert!(r_bad[3].is_nan());
+    let bad_norms = norms(&bad, &delta, &alpha, n, v);
+    assert!(bad_norms.residual_max[3].is_nan());
+    assert!(bad_norms.residual_square[3].is_nan());
     for j in (0..v).filter(|&j| j != 3) {
-        assert_eq!(r_bad[j], r_twin[j]);
+        assert_eq!(bad_norms.residual_max[j], twin_norms.residual_max[j]);
+        assert_eq!(bad_norms.residual_square[j], twin_norms.residual_square[j]);
     }
-    let (r_bad32, _) = norms_gpu(ctx, &cast(&bad), &cast(&delta), &cast(&alpha), n, v).unwrap();
+    let r_bad32 = norms_gpu(ctx, &cast(&bad), &cast(&delta), &cast(&alpha), n, v)
+        .unwrap()
+        .residual_max;
     assert!(
         !r_bad32[3].is_finite(),
         "GPU f32 norm of the NaN variant: {}",

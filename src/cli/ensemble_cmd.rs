@@ -193,8 +193,9 @@ pub fn static_result(
 }
 
 /// Static equilibria of every variant through the GPU kernels (f64), the variants that
-/// fail there re-run on the CPU with step control (their reason says so). `None` when
-/// the variants do not share one site layout (stabilizer moves): the caller runs the CPU.
+/// fail there re-run on the CPU with step control (their reason says so). Stabilizer
+/// moves run there too (each pair carries its node). `None` when the variants do not share
+/// the number of sites: the caller runs the CPU.
 pub fn run_static_gpu(
     case: &Case,
     variants: &[Variant],
@@ -207,19 +208,15 @@ pub fn run_static_gpu(
         .map(|v| apply(case, v))
         .collect::<Result<_, _>>()
         .map_err(|e| Error::Io(std::io::Error::other(e)))?;
-    let shared = models.iter().all(|m| {
-        m.sites.len() == case.model.sites.len()
-            && m.sites
-                .iter()
-                .zip(&case.model.sites)
-                .all(|(a, b)| a.node == b.node)
-    });
+    let shared = models
+        .iter()
+        .all(|m| m.sites.len() == case.model.sites.len());
     if !shared {
         return Ok(None);
     }
     let results = solve_static_ensemble_with_progress::<f64, _>(
         &models,
-        &mut GpuPath(ctx),
+        &GpuPath(ctx),
         &StaticOptions::default(),
         &mut |f| bar.set_position((f * variants.len() as f64) as u64),
     )
@@ -583,7 +580,7 @@ pub fn run(
                 r
             }
             None => {
-                eprintln!("holewall: the variants move stabilizers (different site layouts); running them on the CPU");
+                eprintln!("holewall: the variants differ in their number of contact sites; running them on the CPU");
                 run_variants_cpu(&case, analysis, &variants, &bar)
             }
         },

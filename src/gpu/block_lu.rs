@@ -35,6 +35,26 @@ pub fn bytes_per_variant(n: usize, size: usize) -> usize {
     size * (36 * n + 2 * 36 * m + 6 * n + 36 * m + 6 * n + 6 * n) + 4
 }
 
+/// The passes of the block solve of an `n`-node chain, `(begin, end, phase)`: forward
+/// elimination from the top in passes of at most [`NODES_PER_PASS`] nodes, then back
+/// substitution from the bit (see the shader: llvmpipe's loop limit).
+pub fn passes(n: usize) -> Vec<(usize, usize, u32)> {
+    let mut passes = Vec::new();
+    let mut begin = 0;
+    while begin < n {
+        let end = (begin + NODES_PER_PASS).min(n);
+        passes.push((begin, end, 0u32));
+        begin = end;
+    }
+    let mut end = n;
+    while end > 0 {
+        let begin = end.saturating_sub(NODES_PER_PASS);
+        passes.push((begin, end, 1u32));
+        end = begin;
+    }
+    passes
+}
+
 /// Solves every variant of `batch` on the GPU. Returns the field-major solution and a
 /// status per variant, as [`crate::kernels::block_lu::block_lu`].
 pub fn block_lu_gpu<T: GpuReal>(
@@ -77,21 +97,7 @@ pub fn block_lu_gpu_chunked<T: GpuReal>(
             }
             out
         };
-        // Passes of at most NODES_PER_PASS nodes: forward from the top, then backward from
-        // the bit (see the shader: llvmpipe's loop limit).
-        let mut passes = Vec::new();
-        let mut begin = 0;
-        while begin < n {
-            let end = (begin + NODES_PER_PASS).min(n);
-            passes.push((begin, end, 0u32));
-            begin = end;
-        }
-        let mut end = n;
-        while end > 0 {
-            let begin = end.saturating_sub(NODES_PER_PASS);
-            passes.push((begin, end, 1u32));
-            end = begin;
-        }
+        let passes = passes(n);
         let uniforms: Vec<LuDims> = passes
             .iter()
             .map(|&(begin, end, phase)| LuDims {

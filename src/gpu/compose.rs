@@ -20,6 +20,7 @@ pub const SHADERS: &[(&str, &str)] = &[
     ("assemble.wgsl", include_str!("../../shaders/assemble.wgsl")),
     ("update.wgsl", include_str!("../../shaders/update.wgsl")),
     ("beam.wgsl", include_str!("../../shaders/beam.wgsl")),
+    ("sites.wgsl", include_str!("../../shaders/sites.wgsl")),
     (
         "shared/math_f64.wgsl",
         include_str!("../../shaders/shared/math_f64.wgsl"),

@@ -8,7 +8,7 @@ use crate::gpu::contact::GpuReal;
 use crate::gpu::dispatch::{run_once, Out};
 use crate::gpu::layout::ChainDims;
 use crate::gpu::GpuContext;
-use crate::kernels::update::ConfigBatch;
+use crate::kernels::update::{ConfigBatch, Norms};
 
 /// The WGSL text of the update (`norms = false`) or of the norms, at a precision.
 pub fn update_wgsl(norms: bool, f64: bool) -> Result<String, GpuError> {
@@ -62,7 +62,8 @@ pub fn update_gpu<T: GpuReal>(
     Ok(())
 }
 
-/// Per variant the largest `|r|` and `|α Δ|` on the GPU, as [`crate::kernels::update::norms`].
+/// Per variant the largest `|r|` and `|α Δ|`, `Δ · r` and `r · r` on the GPU, as
+/// [`crate::kernels::update::norms`].
 pub fn norms_gpu<T: GpuReal>(
     ctx: &'static GpuContext,
     residual: &[T],
@@ -70,7 +71,7 @@ pub fn norms_gpu<T: GpuReal>(
     alpha: &[T],
     num_nodes: usize,
     num_variants: usize,
-) -> Result<(Vec<T>, Vec<T>), GpuError> {
+) -> Result<Norms<T>, GpuError> {
     crate::gpu::contact::require_precision::<T>(ctx)?;
     // One invocation loops over the 6n entries of its variant: keep it under llvmpipe's
     // silent 65,535-iteration cut-off (see shaders/block_lu.wgsl).
@@ -92,12 +93,13 @@ pub fn norms_gpu<T: GpuReal>(
             bytemuck::cast_slice(alpha),
             bytemuck::cast_slice(residual),
         ],
-        &[Out::Empty(2 * num_variants * size)],
+        &[Out::Empty(4 * num_variants * size)],
         num_variants,
     )?;
-    let pairs: &[T] = bytemuck::cast_slice(&out[0]);
-    Ok((
-        pairs.iter().step_by(2).copied().collect(),
-        pairs.iter().skip(1).step_by(2).copied().collect(),
-    ))
+    let rows: &[T] = bytemuck::cast_slice(&out[0]);
+    let rows: Vec<[T; 4]> = rows
+        .chunks_exact(4)
+        .map(|c| [c[0], c[1], c[2], c[3]])
+        .collect();
+    Ok(Norms::from_rows(&rows))
 }

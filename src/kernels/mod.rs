@@ -9,11 +9,13 @@
 //! | `shaders/assemble.wgsl` | [`assemble`] |
 //! | `shaders/update.wgsl` | [`update`] |
 //! | `shaders/beam.wgsl` | [`beam`] |
+//! | `shaders/sites.wgsl` | [`sites`] |
 
 pub mod assemble;
 pub mod beam;
 pub mod block_lu;
 pub mod contact;
+pub mod sites;
 pub mod update;
 
 /// Every (shader, twin) pair; a test fails if a shader under `shaders/` is missing here.
@@ -23,4 +25,5 @@ pub const TWINS: &[(&str, &str)] = &[
     ("assemble.wgsl", "src/kernels/assemble.rs"),
     ("update.wgsl", "src/kernels/update.rs"),
     ("beam.wgsl", "src/kernels/beam.rs"),
+    ("sites.wgsl", "src/kernels/sites.rs"),
 ];

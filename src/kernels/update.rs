@@ -9,7 +9,8 @@
 //! `sin φ / φ = sinc h · cos h` and `(1 − cos φ)/φ² = ½ sinc² h`, no cancellation anywhere.
 //!
 //! `norms`: one invocation per variant: the largest residual entry and the largest entry of
-//! the applied step `α Δ`, which the host compares with its tolerances.
+//! the applied step `α Δ`, which the host compares with its tolerances, and the line
+//! search's `Δ · r` and `r · r` (so the host reads four numbers per variant, not vectors).
 //!
 //! Layout: node vector entry `k` of node `i`, variant `v` at `[(3 i + k) V + v]` (positions),
 //! `[(9 i + 3 r + c) V + v]` (rotations, row-major), `[(6 i + k) V + v]` (steps and
@@ -152,32 +153,74 @@ pub fn update<T: Real + Send + Sync>(b: &mut ConfigBatch<T>, delta: &[T], alpha:
     }
 }
 
-/// Per variant: the largest `|r|` and the largest `|α Δ|` over its `6 n` entries.
+/// Per-variant measures of a residual `r` and a step `Δ` (the norms kernel's output).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Norms<T> {
+    /// Largest `|r|` (NaN or ∞ where any entry is).
+    pub residual_max: Vec<T>,
+    /// Largest `|α Δ|`.
+    pub step_max: Vec<T>,
+    /// `Δ · r` (the line search's slope; no α).
+    pub step_dot_residual: Vec<T>,
+    /// `r · r`.
+    pub residual_square: Vec<T>,
+}
+
+/// The four measures of variant `v`, summed in index order (as the kernel).
+pub fn norms_of_variant<T: Real>(
+    residual: &[T],
+    delta: &[T],
+    alpha: &[T],
+    num_nodes: usize,
+    num_variants: usize,
+    v: usize,
+) -> [T; 4] {
+    let mut r = T::zero();
+    let mut d = T::zero();
+    let mut dot = T::zero();
+    let mut square = T::zero();
+    for k in 0..6 * num_nodes {
+        let rk = residual[k * num_variants + v];
+        let dk = delta[k * num_variants + v];
+        let ra = rk.abs();
+        let da = (alpha[v] * dk).abs();
+        if ra.to_f64_lossy() > r.to_f64_lossy() || !ra.to_f64_lossy().is_finite() {
+            r = ra;
+        }
+        if da.to_f64_lossy() > d.to_f64_lossy() || !da.to_f64_lossy().is_finite() {
+            d = da;
+        }
+        dot = dot + dk * rk;
+        square = square + rk * rk;
+    }
+    [r, d, dot, square]
+}
+
+/// Per variant: the largest `|r|` and `|α Δ|` over its `6 n` entries, `Δ · r` and `r · r`.
 pub fn norms<T: Real + Send + Sync>(
     residual: &[T],
     delta: &[T],
     alpha: &[T],
     num_nodes: usize,
     num_variants: usize,
-) -> (Vec<T>, Vec<T>) {
-    (0..num_variants)
+) -> Norms<T> {
+    let per: Vec<[T; 4]> = (0..num_variants)
         .into_par_iter()
-        .map(|v| {
-            let mut r = T::zero();
-            let mut d = T::zero();
-            for k in 0..6 * num_nodes {
-                let rk = residual[k * num_variants + v].abs();
-                let dk = (alpha[v] * delta[k * num_variants + v]).abs();
-                if rk.to_f64_lossy() > r.to_f64_lossy() || rk.to_f64_lossy().is_nan() {
-                    r = rk;
-                }
-                if dk.to_f64_lossy() > d.to_f64_lossy() || dk.to_f64_lossy().is_nan() {
-                    d = dk;
-                }
-            }
-            (r, d)
-        })
-        .unzip()
+        .map(|v| norms_of_variant(residual, delta, alpha, num_nodes, num_variants, v))
+        .collect();
+    Norms::from_rows(&per)
+}
+
+impl<T: Copy> Norms<T> {
+    /// From one `[max r, max αΔ, Δ·r, r·r]` row per variant.
+    pub fn from_rows(rows: &[[T; 4]]) -> Self {
+        Norms {
+            residual_max: rows.iter().map(|r| r[0]).collect(),
+            step_max: rows.iter().map(|r| r[1]).collect(),
+            step_dot_residual: rows.iter().map(|r| r[2]).collect(),
+            residual_square: rows.iter().map(|r| r[3]).collect(),
+        }
+    }
 }
 
 #[cfg(test)]

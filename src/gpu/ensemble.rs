@@ -1,0 +1,714 @@
+//! A chunk of variants resident on the GPU for the ensemble Newton iteration
+//! ([`crate::engine`]): every buffer and bind group is made once, when the chunk is opened;
+//! an iteration records the kernels (beam → sites → contact → assembly → block LU → norms,
+//! then update → … for a trial) into command buffers, and the host reads back only the
+//! four norms and the solve status per variant ([`Norms`]), and writes one α per variant.
+//!
+//! Two configuration slots (current and trial) each with their assembled system: a trial
+//! the line search accepts becomes the current one by swapping slots, without evaluating
+//! again.
+
+use std::marker::PhantomData;
+use std::sync::Arc;
+
+use wgpu::util::DeviceExt;
+
+use crate::engine::{Ensemble, EnsembleTables};
+use crate::error::GpuError;
+use crate::gpu::contact::{contact_wgsl, require_precision, GpuReal};
+use crate::gpu::dispatch::WORKGROUP;
+use crate::gpu::layout::{AssembleDims, BeamDims, ChainDims, ContactDims, LuDims};
+use crate::gpu::GpuContext;
+use crate::kernels::contact::{OUTPUT_LEN, STATE_LEN};
+use crate::kernels::update::{ConfigBatch, Norms};
+use crate::model::Model;
+use crate::physics::contact::PARAMS_LEN;
+
+/// Status the block solve starts with; still there afterwards means it did not finish.
+const RUNNING: u32 = 2;
+
+/// Bytes per variant of every buffer of a chunk, for a chain of `n` nodes with `s` sites
+/// at `size`-byte floats: two configurations and two assembled systems, element forces and
+/// tangents, contact inputs and outputs, loads, the factorisation workspace, the step, and
+/// the per-variant scalars. (The shared tables — bases, sections, frames — are per chunk.)
+pub fn bytes_per_variant(n: usize, s: usize, size: usize) -> usize {
+    let m = n.saturating_sub(1);
+    let reals = 2 * 12 * n            // x, rot: two slots
+        + 12 * m + 144 * m            // element force, tangent
+        + (OUTPUT_LEN + STATE_LEN + PARAMS_LEN + 3) * s // contact out, state, params, normals
+        + 6 * n                       // loads
+        + 2 * (36 * n + 72 * m + 6 * n) // two systems
+        + 36 * m + 6 * n + 6 * n      // LU workspace, y, Δ
+        + 4 + 1; // norms, α
+    size * reals + 4 * (n + 2 * s + 1) // node_site, pair_node, contact flags, status
+}
+
+/// The largest per-variant array of one binding, in bytes: the element tangents.
+fn largest_binding_per_variant(n: usize, s: usize, size: usize) -> usize {
+    let m = n.saturating_sub(1);
+    size * (144 * m).max(36 * n).max(OUTPUT_LEN * s)
+}
+
+/// The most variants of `model` one chunk may hold on `ctx`: every binding within the
+/// adapter's limit, every dispatch within its workgroup count.
+pub fn max_variants(ctx: &GpuContext, model: &Model, size: usize) -> usize {
+    let n = model.nodes.len();
+    let s = model.sites.len();
+    let by_binding = ctx.max_binding_bytes() as usize / largest_binding_per_variant(n, s, size);
+    let widest = n.max(s).max(1);
+    let by_groups = ctx.limits.max_compute_workgroups_per_dimension as usize * WORKGROUP / widest;
+    by_binding.min(by_groups).max(1)
+}
+
+struct Slot {
+    x: wgpu::Buffer,
+    rot: wgpu::Buffer,
+    beam: wgpu::BindGroup,
+    sites: wgpu::BindGroup,
+    assemble: wgpu::BindGroup,
+    lu: Vec<wgpu::BindGroup>,
+    norms_solve: wgpu::BindGroup,
+    norms_trial: wgpu::BindGroup,
+    update: wgpu::BindGroup,
+    _keep: Vec<wgpu::Buffer>,
+}
+
+struct Pipelines {
+    beam: Arc<wgpu::ComputePipeline>,
+    sites: Arc<wgpu::ComputePipeline>,
+    contact: Arc<wgpu::ComputePipeline>,
+    assemble: Arc<wgpu::ComputePipeline>,
+    block_lu: Arc<wgpu::ComputePipeline>,
+    norms: Arc<wgpu::ComputePipeline>,
+    update: Arc<wgpu::ComputePipeline>,
+}
+
+/// A chunk of variants on the GPU (see the module docs).
+pub struct GpuEnsemble<T: GpuReal> {
+    ctx: &'static GpuContext,
+    p: Pipelines,
+    slots: [Slot; 2],
+    current: usize,
+    contact: wgpu::BindGroup,
+    f_ext: wgpu::Buffer,
+    params: wgpu::Buffer,
+    alpha: wgpu::Buffer,
+    status: wgpu::Buffer,
+    norms: wgpu::Buffer,
+    staging: wgpu::Buffer,
+    num_variants: usize,
+    num_nodes: usize,
+    num_elements: usize,
+    num_pairs: usize,
+    _keep: Vec<wgpu::Buffer>,
+    _real: PhantomData<T>,
+}
+
+fn storage<T: bytemuck::Pod>(ctx: &GpuContext, label: &str, data: &[T]) -> wgpu::Buffer {
+    let bytes: &[u8] = bytemuck::cast_slice(data);
+    // Bindings may not be empty: pad to one 16-byte word.
+    let padded: Vec<u8>;
+    let contents = if bytes.len() < 16 {
+        padded = bytes
+            .iter()
+            .copied()
+            .chain(std::iter::repeat(0))
+            .take(16)
+            .collect();
+        &padded[..]
+    } else {
+        bytes
+    };
+    ctx.device
+        .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some(label),
+            contents,
+            usage: wgpu::BufferUsages::STORAGE
+                | wgpu::BufferUsages::COPY_DST
+                | wgpu::BufferUsages::COPY_SRC,
+        })
+}
+
+fn empty(ctx: &GpuContext, label: &str, bytes: usize) -> wgpu::Buffer {
+    ctx.device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some(label),
+        size: bytes.max(16) as u64,
+        usage: wgpu::BufferUsages::STORAGE
+            | wgpu::BufferUsages::COPY_DST
+            | wgpu::BufferUsages::COPY_SRC,
+        mapped_at_creation: false,
+    })
+}
+
+fn uniform<U: bytemuck::Pod>(ctx: &GpuContext, label: &str, u: &U) -> wgpu::Buffer {
+    ctx.device
+        .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some(label),
+            contents: bytemuck::bytes_of(u),
+            usage: wgpu::BufferUsages::UNIFORM,
+        })
+}
+
+/// A bind group with `buffers` at bindings 0, 1, … in order.
+fn bind(
+    ctx: &GpuContext,
+    pipeline: &wgpu::ComputePipeline,
+    label: &str,
+    buffers: &[&wgpu::Buffer],
+) -> wgpu::BindGroup {
+    let entries: Vec<wgpu::BindGroupEntry> = buffers
+        .iter()
+        .enumerate()
+        .map(|(k, b)| wgpu::BindGroupEntry {
+            binding: k as u32,
+            resource: b.as_entire_binding(),
+        })
+        .collect();
+    ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some(label),
+        layout: &pipeline.get_bind_group_layout(0),
+        entries: &entries,
+    })
+}
+
+fn dispatch(
+    pass: &mut wgpu::ComputePass,
+    pipeline: &wgpu::ComputePipeline,
+    group: &wgpu::BindGroup,
+    invocations: usize,
+) {
+    if invocations == 0 {
+        return;
+    }
+    pass.set_pipeline(pipeline);
+    pass.set_bind_group(0, group, &[]);
+    pass.dispatch_workgroups(invocations.div_ceil(WORKGROUP) as u32, 1, 1);
+}
+
+impl<T: GpuReal> GpuEnsemble<T> {
+    /// Compiles (or fetches) the kernels for the chunk's terms and precision and uploads
+    /// its tables and start configuration.
+    pub fn new(
+        ctx: &'static GpuContext,
+        model: &Model,
+        tables: &EnsembleTables<T>,
+    ) -> Result<Self, GpuError> {
+        require_precision::<T>(ctx)?;
+        let f64 = T::IS_F64;
+        let (v, n, s) = (tables.num_variants, tables.num_nodes, tables.num_sites);
+        let (m, p) = (n.saturating_sub(1), tables.pair_node.len());
+        let size = std::mem::size_of::<T>();
+        if largest_binding_per_variant(n, s, size) * v > ctx.max_binding_bytes() as usize {
+            return Err(GpuError::Unsupported(format!(
+                "{v} variants of {n} nodes exceed one binding of {} bytes; split the variants",
+                ctx.max_binding_bytes()
+            )));
+        }
+        // The norms loop over 6n entries per invocation: llvmpipe's loop budget.
+        if 6 * n > 60_000 {
+            return Err(GpuError::Unsupported(format!(
+                "norms of {n} nodes exceed one invocation's loop budget"
+            )));
+        }
+        let pipelines = Pipelines {
+            beam: ctx.pipeline("beam", &crate::gpu::beam::beam_wgsl(f64)?)?,
+            sites: ctx.pipeline("sites", &sites_wgsl(f64)?)?,
+            contact: ctx.pipeline("contact", &contact_wgsl(&tables.terms, f64)?)?,
+            assemble: ctx.pipeline("assemble", &crate::gpu::assemble::assemble_wgsl(f64)?)?,
+            block_lu: ctx.pipeline("block_lu", &crate::gpu::block_lu::block_lu_wgsl(f64)?)?,
+            norms: ctx.pipeline("norms", &crate::gpu::update::update_wgsl(true, f64)?)?,
+            update: ctx.pipeline("update", &crate::gpu::update::update_wgsl(false, f64)?)?,
+        };
+        let cast = |x: Vec<f64>| -> Vec<T> { x.into_iter().map(T::from_f64_lossy).collect() };
+        // Shared tables and per-chunk inputs.
+        let sections = storage(
+            ctx,
+            "sections",
+            &cast(crate::kernels::beam::section_table(model)),
+        );
+        let frames = storage(
+            ctx,
+            "frames",
+            &cast(crate::kernels::beam::frame_table(model)),
+        );
+        let basis = storage(ctx, "basis", &tables.basis);
+        let fixed = storage(ctx, "fixed", &tables.fixed);
+        let node_site = storage(ctx, "node_site", &tables.node_site);
+        let pair_node = storage(ctx, "pair_node", &tables.pair_node);
+        let node_ref = storage(ctx, "node_ref", &tables.node_ref);
+        let normals = storage(ctx, "pair_normals", &tables.pair_normals);
+        let pair_state = storage(ctx, "pair_state", &tables.pair_state);
+        let params = empty(ctx, "pair_params", PARAMS_LEN * p * size);
+        let f_ext = empty(ctx, "f_ext", 6 * n * v * size);
+        // Work shared by the slots.
+        let elem_force = empty(ctx, "elem_force", 12 * m * v * size);
+        let elem_tangent = empty(ctx, "elem_tangent", 144 * m * v * size);
+        let values = empty(ctx, "contact_values", OUTPUT_LEN * p * size);
+        let flags = empty(ctx, "contact_flags", 4 * p);
+        let work_x = empty(ctx, "lu_work", 36 * m.max(1) * v * size);
+        let work_z = empty(ctx, "lu_work_z", 6 * n * v * size);
+        let delta = empty(ctx, "delta", 6 * n * v * size);
+        let status = empty(ctx, "status", 4 * v);
+        let ones = storage(ctx, "ones", &vec![T::one(); v]);
+        let alpha = empty(ctx, "alpha", v * size);
+        let norms = empty(ctx, "norms", 4 * v * size);
+        let staging = ctx.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("norms_staging"),
+            size: (4 * v * size + 4 * v) as u64,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let chain_dims = uniform(
+            ctx,
+            "chain_dims",
+            &ChainDims {
+                num_variants: v as u32,
+                num_nodes: n as u32,
+                _pad0: 0,
+                _pad1: 0,
+            },
+        );
+        let beam_dims = uniform(
+            ctx,
+            "beam_dims",
+            &BeamDims {
+                num_variants: v as u32,
+                num_elements: m as u32,
+                _pad0: 0,
+                _pad1: 0,
+            },
+        );
+        let sites_dims = uniform(
+            ctx,
+            "sites_dims",
+            &ContactDims {
+                num_pairs: p as u32,
+                num_variants: v as u32,
+                pair_offset: 0,
+                _pad: 0,
+            },
+        );
+        // The contact kernel sees one "variant" per site: every pair has its own axis.
+        let contact_dims = uniform(
+            ctx,
+            "contact_dims",
+            &ContactDims {
+                num_pairs: p as u32,
+                num_variants: 1,
+                pair_offset: 0,
+                _pad: 0,
+            },
+        );
+        let assemble_dims = uniform(
+            ctx,
+            "assemble_dims",
+            &AssembleDims {
+                num_variants: v as u32,
+                num_nodes: n as u32,
+                num_sites: s as u32,
+                _pad: 0,
+            },
+        );
+        let lu_dims: Vec<wgpu::Buffer> = crate::gpu::block_lu::passes(n)
+            .into_iter()
+            .map(|(begin, end, phase)| {
+                uniform(
+                    ctx,
+                    "lu_dims",
+                    &LuDims {
+                        num_variants: v as u32,
+                        num_nodes: n as u32,
+                        begin: begin as u32,
+                        end: end as u32,
+                        phase,
+                        _pad0: 0,
+                        _pad1: 0,
+                        _pad2: 0,
+                    },
+                )
+            })
+            .collect();
+        let contact = bind(
+            ctx,
+            &pipelines.contact,
+            "contact",
+            &[
+                &contact_dims,
+                &normals,
+                &params,
+                &pair_state,
+                &values,
+                &flags,
+            ],
+        );
+        let make_slot = |label: &str| -> Slot {
+            let x = storage(ctx, label, &tables.start.x);
+            let rot = storage(ctx, label, &tables.start.rot);
+            let diag = empty(ctx, "diag", 36 * n * v * size);
+            let upper = empty(ctx, "upper", 36 * m.max(1) * v * size);
+            let lower = empty(ctx, "lower", 36 * m.max(1) * v * size);
+            let rhs = empty(ctx, "rhs", 6 * n * v * size);
+            let beam = bind(
+                ctx,
+                &pipelines.beam,
+                "beam",
+                &[
+                    &beam_dims,
+                    &x,
+                    &rot,
+                    &frames,
+                    &sections,
+                    &elem_force,
+                    &elem_tangent,
+                ],
+            );
+            let sites = bind(
+                ctx,
+                &pipelines.sites,
+                "sites",
+                &[&sites_dims, &pair_node, &node_ref, &x, &pair_state],
+            );
+            let assemble = bind(
+                ctx,
+                &pipelines.assemble,
+                "assemble",
+                &[
+                    &assemble_dims,
+                    &elem_force,
+                    &elem_tangent,
+                    &values,
+                    &flags,
+                    &node_site,
+                    &f_ext,
+                    &basis,
+                    &fixed,
+                    &diag,
+                    &upper,
+                    &lower,
+                    &rhs,
+                ],
+            );
+            let lu = lu_dims
+                .iter()
+                .map(|d| {
+                    bind(
+                        ctx,
+                        &pipelines.block_lu,
+                        "block_lu",
+                        &[
+                            d, &diag, &upper, &lower, &rhs, &work_x, &work_z, &delta, &status,
+                        ],
+                    )
+                })
+                .collect();
+            let norms_solve = bind(
+                ctx,
+                &pipelines.norms,
+                "norms",
+                &[&chain_dims, &delta, &ones, &rhs, &norms],
+            );
+            let norms_trial = bind(
+                ctx,
+                &pipelines.norms,
+                "norms",
+                &[&chain_dims, &delta, &alpha, &rhs, &norms],
+            );
+            let update = bind(
+                ctx,
+                &pipelines.update,
+                "update",
+                &[&chain_dims, &delta, &alpha, &basis, &x, &rot],
+            );
+            Slot {
+                x,
+                rot,
+                beam,
+                sites,
+                assemble,
+                lu,
+                norms_solve,
+                norms_trial,
+                update,
+                _keep: vec![diag, upper, lower, rhs],
+            }
+        };
+        let slots = [make_slot("config_a"), make_slot("config_b")];
+        Ok(GpuEnsemble {
+            ctx,
+            p: pipelines,
+            slots,
+            current: 0,
+            contact,
+            f_ext,
+            params,
+            alpha,
+            status,
+            norms,
+            staging,
+            num_variants: v,
+            num_nodes: n,
+            num_elements: m,
+            num_pairs: p,
+            _keep: vec![
+                sections,
+                frames,
+                basis,
+                fixed,
+                node_site,
+                pair_node,
+                node_ref,
+                normals,
+                pair_state,
+                elem_force,
+                elem_tangent,
+                values,
+                flags,
+                work_x,
+                work_z,
+                delta,
+                ones,
+                chain_dims,
+                beam_dims,
+                sites_dims,
+                contact_dims,
+                assemble_dims,
+            ]
+            .into_iter()
+            .chain(lu_dims)
+            .collect(),
+            _real: PhantomData,
+        })
+    }
+
+    /// Records the evaluation of `slot`: beam, sites, contact, assembly.
+    fn record_evaluate(&self, pass: &mut wgpu::ComputePass, slot: usize) {
+        let s = &self.slots[slot];
+        let v = self.num_variants;
+        dispatch(pass, &self.p.beam, &s.beam, self.num_elements * v);
+        dispatch(pass, &self.p.sites, &s.sites, self.num_pairs);
+        dispatch(pass, &self.p.contact, &self.contact, self.num_pairs);
+        dispatch(pass, &self.p.assemble, &s.assemble, self.num_nodes * v);
+    }
+
+    fn encoder(&self, label: &str) -> wgpu::CommandEncoder {
+        self.ctx
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(label) })
+    }
+
+    fn wait(&self) -> Result<(), GpuError> {
+        self.ctx
+            .device
+            .poll(wgpu::PollType::wait_indefinitely())
+            .map(|_| ())
+            .map_err(|e| GpuError::Device(e.to_string()))
+    }
+
+    /// Submits `encoder` after copying the norms and statuses out; reads them back.
+    fn finish_with_norms(
+        &self,
+        mut encoder: wgpu::CommandEncoder,
+    ) -> Result<(Norms<T>, Vec<u32>), GpuError> {
+        let v = self.num_variants;
+        let norm_bytes = (4 * v * std::mem::size_of::<T>()) as u64;
+        encoder.copy_buffer_to_buffer(&self.norms, 0, &self.staging, 0, norm_bytes);
+        encoder.copy_buffer_to_buffer(&self.status, 0, &self.staging, norm_bytes, 4 * v as u64);
+        self.ctx.queue.submit([encoder.finish()]);
+        self.staging
+            .slice(..)
+            .map_async(wgpu::MapMode::Read, |_| {});
+        self.wait()?;
+        let (rows, status) = {
+            let view = self
+                .staging
+                .slice(..)
+                .get_mapped_range()
+                .map_err(|e| GpuError::Device(format!("map: {e}")))?;
+            let values: &[T] = bytemuck::cast_slice(&view[..norm_bytes as usize]);
+            let rows: Vec<[T; 4]> = values
+                .chunks_exact(4)
+                .map(|c| [c[0], c[1], c[2], c[3]])
+                .collect();
+            let status: Vec<u32> = bytemuck::cast_slice(&view[norm_bytes as usize..]).to_vec();
+            (rows, status)
+        };
+        self.staging.unmap();
+        Ok((Norms::from_rows(&rows), status))
+    }
+
+    fn read_buffer<U: bytemuck::Pod>(
+        &self,
+        buffer: &wgpu::Buffer,
+        len: usize,
+    ) -> Result<Vec<U>, GpuError> {
+        let bytes = (len * std::mem::size_of::<U>()).max(4) as u64;
+        let staging = self.ctx.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("read"),
+            size: bytes,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let mut encoder = self.encoder("read");
+        encoder.copy_buffer_to_buffer(buffer, 0, &staging, 0, bytes);
+        self.ctx.queue.submit([encoder.finish()]);
+        staging.slice(..).map_async(wgpu::MapMode::Read, |_| {});
+        self.wait()?;
+        let out = {
+            let view = staging
+                .slice(..)
+                .get_mapped_range()
+                .map_err(|e| GpuError::Device(format!("map: {e}")))?;
+            bytemuck::cast_slice::<u8, U>(&view[..len * std::mem::size_of::<U>()]).to_vec()
+        };
+        staging.unmap();
+        Ok(out)
+    }
+}
+
+/// The WGSL text of the sites gather at a precision.
+pub fn sites_wgsl(f64: bool) -> Result<String, GpuError> {
+    let mut flags = std::collections::BTreeSet::new();
+    if f64 {
+        flags.insert("F64");
+    }
+    crate::gpu::compose::compose("sites.wgsl", &flags, f64)
+}
+
+impl<T: GpuReal> Ensemble<T> for GpuEnsemble<T> {
+    fn set_loads(&mut self, f_ext: &[T], pair_params: &[T]) -> Result<(), String> {
+        let q = &self.ctx.queue;
+        q.write_buffer(&self.f_ext, 0, bytemuck::cast_slice(f_ext));
+        if !pair_params.is_empty() {
+            q.write_buffer(&self.params, 0, bytemuck::cast_slice(pair_params));
+        }
+        Ok(())
+    }
+
+    fn evaluate(&mut self) -> Result<(), String> {
+        let mut encoder = self.encoder("evaluate");
+        {
+            let mut pass = encoder.begin_compute_pass(&Default::default());
+            self.record_evaluate(&mut pass, self.current);
+        }
+        self.ctx.queue.submit([encoder.finish()]);
+        Ok(())
+    }
+
+    fn solve(&mut self) -> Result<(Norms<T>, Vec<u32>), String> {
+        let v = self.num_variants;
+        self.ctx
+            .queue
+            .write_buffer(&self.status, 0, bytemuck::cast_slice(&vec![RUNNING; v]));
+        let s = &self.slots[self.current];
+        let mut encoder = self.encoder("solve");
+        {
+            let mut pass = encoder.begin_compute_pass(&Default::default());
+            for group in &s.lu {
+                dispatch(&mut pass, &self.p.block_lu, group, v);
+            }
+            dispatch(&mut pass, &self.p.norms, &s.norms_solve, v);
+        }
+        let (norms, status) = self.finish_with_norms(encoder).map_err(|e| e.to_string())?;
+        if status.contains(&RUNNING) {
+            return Err("block solve: a dispatch did not complete (status left at running)".into());
+        }
+        Ok((norms, status))
+    }
+
+    fn trial(&mut self, alpha: &[T]) -> Result<Norms<T>, String> {
+        let v = self.num_variants;
+        let (cur, other) = (self.current, 1 - self.current);
+        self.ctx
+            .queue
+            .write_buffer(&self.alpha, 0, bytemuck::cast_slice(alpha));
+        let mut encoder = self.encoder("trial");
+        let (a, b) = (&self.slots[cur], &self.slots[other]);
+        encoder.copy_buffer_to_buffer(&a.x, 0, &b.x, 0, a.x.size());
+        encoder.copy_buffer_to_buffer(&a.rot, 0, &b.rot, 0, a.rot.size());
+        {
+            let mut pass = encoder.begin_compute_pass(&Default::default());
+            dispatch(&mut pass, &self.p.update, &b.update, self.num_nodes * v);
+            self.record_evaluate(&mut pass, other);
+            dispatch(&mut pass, &self.p.norms, &b.norms_trial, v);
+        }
+        self.finish_with_norms(encoder)
+            .map(|(n, _)| n)
+            .map_err(|e| e.to_string())
+    }
+
+    fn accept_trial(&mut self) {
+        self.current = 1 - self.current;
+    }
+
+    fn commit(&mut self, alpha: &[T]) -> Result<(), String> {
+        self.ctx
+            .queue
+            .write_buffer(&self.alpha, 0, bytemuck::cast_slice(alpha));
+        let mut encoder = self.encoder("commit");
+        {
+            let mut pass = encoder.begin_compute_pass(&Default::default());
+            dispatch(
+                &mut pass,
+                &self.p.update,
+                &self.slots[self.current].update,
+                self.num_nodes * self.num_variants,
+            );
+        }
+        self.ctx.queue.submit([encoder.finish()]);
+        Ok(())
+    }
+
+    fn config(&mut self) -> Result<ConfigBatch<T>, String> {
+        let (v, n) = (self.num_variants, self.num_nodes);
+        let s = &self.slots[self.current];
+        let x = self
+            .read_buffer::<T>(&s.x, 3 * n * v)
+            .map_err(|e| e.to_string())?;
+        let rot = self
+            .read_buffer::<T>(&s.rot, 9 * n * v)
+            .map_err(|e| e.to_string())?;
+        Ok(ConfigBatch {
+            num_variants: v,
+            num_nodes: n,
+            x,
+            rot,
+            basis: Vec::new(),
+        })
+    }
+}
+
+/// Runs `shaders/sites.wgsl` once (tests against its twin,
+/// [`crate::kernels::sites::gather_sites`]): `pair_state` with `d` of every pair written.
+pub fn gather_sites_gpu<T: GpuReal>(
+    ctx: &'static GpuContext,
+    pair_node: &[u32],
+    node_ref: &[T],
+    x: &[T],
+    num_variants: usize,
+    pair_state: &[T],
+) -> Result<Vec<T>, GpuError> {
+    require_precision::<T>(ctx)?;
+    let pipeline = ctx.pipeline("sites", &sites_wgsl(T::IS_F64)?)?;
+    let dims = ContactDims {
+        num_pairs: pair_node.len() as u32,
+        num_variants: num_variants as u32,
+        pair_offset: 0,
+        _pad: 0,
+    };
+    let out = crate::gpu::dispatch::run_once(
+        ctx,
+        &pipeline,
+        "sites",
+        bytemuck::bytes_of(&dims),
+        &[
+            bytemuck::cast_slice(pair_node),
+            bytemuck::cast_slice(node_ref),
+            bytemuck::cast_slice(x),
+        ],
+        &[crate::gpu::dispatch::Out::From(bytemuck::cast_slice(
+            pair_state,
+        ))],
+        pair_node.len(),
+    )?;
+    Ok(bytemuck::cast_slice(&out[0]).to_vec())
+}
