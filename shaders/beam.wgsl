@@ -6,18 +6,27 @@
 // ε₁; f_j = ∂E/∂δ_j (the ε₁ part), K_jk = ∂²E (the ε₁ε₂ part). Rotations are perturbed as
 // left spins (I + [ε e]×)·triad, as in the twin. Outputs in the assembly's layout:
 // [(12 e + j) V + v] and [(144 e + 12 j + k) V + v].
+//
+// States are displacements u from the reference positions X (kilometres of string lose
+// their millimetres in f32 otherwise): the chord is c + (u₂ − u₁), c = X₂ − X₁ per element.
+// In double precision the element's node positions are taken as u₁ and c + u₂ (as the
+// twin) and the elongation as l − l0; in single precision the elongation is
+// (2 c·Δu + Δu·Δu)/(l + l0), without the cancellation of l − l0 (a strain of 1e-5 would
+// keep two digits).
 #include "shared/layout.wgsl"
 
 @group(0) @binding(0) var<uniform> dims: BeamDims;
-// Node positions, [(3 i + k) V + v]; rotations, [(9 i + 3 r + c) V + v].
+// Node displacements, [(3 i + k) V + v]; rotations, [(9 i + 3 r + c) V + v].
 @group(0) @binding(1) var<storage, read> x: array<real>;
 @group(0) @binding(2) var<storage, read> rot: array<real>;
 // Reference triad per node (row-major, 9 each), shared by the variants.
 @group(0) @binding(3) var<storage, read> frame0: array<real>;
 // Per element: EA/l0, GJ/l0, EI/l0, l0.
 @group(0) @binding(4) var<storage, read> section: array<real>;
-@group(0) @binding(5) var<storage, read_write> elem_force: array<real>;
-@group(0) @binding(6) var<storage, read_write> elem_tangent: array<real>;
+// Reference chord per element, c = X₂ − X₁: [3 e + k].
+@group(0) @binding(5) var<storage, read> chord0: array<real>;
+@group(0) @binding(6) var<storage, read_write> elem_force: array<real>;
+@group(0) @binding(7) var<storage, read_write> elem_tangent: array<real>;
 
 alias hd = vec4<real>;
 
@@ -150,8 +159,19 @@ fn energy(p1: array<hd, 3>, p2: array<hd, 3>, t1: Tri, t2: Tri, e: u32) -> hd {
     let gj = section[4u * e + 1u];
     let ei = section[4u * e + 2u];
     let l0 = section[4u * e + 3u];
+#if F64
     let d = array<hd, 3>(p2[0] - p1[0], p2[1] - p1[1], p2[2] - p1[2]);
     let l = hd_norm(d);
+    let u = l - hd_c(l0);
+#else
+    let c = array<hd, 3>(hd_c(chord0[3u * e]), hd_c(chord0[3u * e + 1u]), hd_c(chord0[3u * e + 2u]));
+    let du = array<hd, 3>(p2[0] - p1[0], p2[1] - p1[1], p2[2] - p1[2]);
+    let d = array<hd, 3>(c[0] + du[0], c[1] + du[1], c[2] + du[2]);
+    let l = hd_norm(d);
+    let two_c_du = hd_mul(hd_c(real(2.0)), hd_mul(c[0], du[0]) + hd_mul(c[1], du[1]) + hd_mul(c[2], du[2]));
+    let du_du = hd_mul(du[0], du[0]) + hd_mul(du[1], du[1]) + hd_mul(du[2], du[2]);
+    let u = hd_div(two_c_du + du_du, l + hd_c(l0));
+#endif
     let e1 = array<hd, 3>(hd_div(d[0], l), hd_div(d[1], l), hd_div(d[2], l));
     let half = hd_c(real(0.5));
     let p = array<hd, 3>(hd_mul(half, t1.m[1] + t2.m[1]), hd_mul(half, t1.m[4] + t2.m[4]), hd_mul(half, t1.m[7] + t2.m[7]));
@@ -162,7 +182,6 @@ fn energy(p1: array<hd, 3>, p2: array<hd, 3>, t1: Tri, t2: Tri, e: u32) -> hd {
     let frame = array<array<hd, 3>, 3>(e1, e2, e3);
     let th1 = rel_log(frame, t1);
     let th2 = rel_log(frame, t2);
-    let u = l - hd_c(l0);
     let twist = th2[0] - th1[0];
     let two = hd_c(real(2.0));
     let by = hd_mul(two, hd_mul(th1[1], th1[1]) + hd_mul(th1[1], th2[1]) + hd_mul(th2[1], th2[1]));
@@ -203,7 +222,12 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     for (var node = 0u; node < 2u; node = node + 1u) {
         let i = e + node;
         for (var k = 0u; k < 3u; k = k + 1u) {
+#if F64
+            // Node 2 at c + u₂ (the twin's positions).
+            p0[node][k] = hd_c(real(node) * chord0[3u * e + k] + x[(3u * i + k) * nv + v]);
+#else
             p0[node][k] = hd_c(x[(3u * i + k) * nv + v]);
+#endif
         }
         // triad = R_i · frame0_i
         for (var r = 0u; r < 3u; r = r + 1u) {

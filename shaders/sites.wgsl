@@ -1,4 +1,4 @@
-// Twin: src/kernels/sites.rs (each contact pair's displacement d = x − x_ref of its node).
+// Twin: src/kernels/sites.rs (each contact pair's displacement d = u of its node).
 //
 // One invocation per (site, variant) pair i = site · V + variant; writes fields 0–2 of the
 // pair state, leaving the velocity and spin fields (3–6) as the host wrote them.
@@ -7,11 +7,9 @@
 @group(0) @binding(0) var<uniform> dims: ContactDims;
 // Node of each pair.
 @group(0) @binding(1) var<storage, read> pair_node: array<u32>;
-// Reference position per node: [3 · node + k].
-@group(0) @binding(2) var<storage, read> node_ref: array<real>;
-// Positions: [(3 · node + k) · V + variant].
-@group(0) @binding(3) var<storage, read> x: array<real>;
-@group(0) @binding(4) var<storage, read_write> pair_state: array<real>;
+// Displacements: [(3 · node + k) · V + variant].
+@group(0) @binding(2) var<storage, read> u: array<real>;
+@group(0) @binding(3) var<storage, read_write> pair_state: array<real>;
 
 @compute @workgroup_size(64)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
@@ -24,6 +22,6 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let v = i % nv;
     let node = pair_node[i];
     for (var k = 0u; k < 3u; k = k + 1u) {
-        pair_state[k * p + i] = x[(3u * node + k) * nv + v] - node_ref[3u * node + k];
+        pair_state[k * p + i] = u[(3u * node + k) * nv + v];
     }
 }

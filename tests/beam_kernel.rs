@@ -36,6 +36,14 @@ fn gpu_beam_matches_the_twin() {
             }
         }
     }
+    // States are displacements from the reference positions.
+    for j in 0..v {
+        for i in 0..n {
+            for a in 0..3 {
+                x[(3 * i + a) * v + j] -= model.nodes[i].position[a];
+            }
+        }
+    }
     let (f_exact, k_exact) = beam(&model, v, &x, &rot);
     let Some(ctx) = common::gpu() else { return };
     let ne = model.elements.len();
@@ -71,9 +79,10 @@ fn gpu_beam_matches_the_twin() {
     let r32: Vec<f32> = rot.iter().map(|&a| a as f32).collect();
     let up = |a: &[f32]| a.iter().map(|&b| b as f64).collect::<Vec<f64>>();
     let (f, k) = beam_gpu(ctx, &model, v, &x32, &r32).unwrap();
-    // Two parts: rounding the inputs to f32 (positions ≈ 60 m carry 4e-6 m, against
-    // deformations of a few mm: the internal force, a difference, loses ≈ 3 digits), and the
-    // kernel's f32 arithmetic (against the twin fed the same rounded inputs).
+    // Two parts: rounding the inputs to f32 (the rigid spins move nodes by up to 60 m, whose
+    // displacements carry 4e-6 m against deformations of a few mm: the internal force, a
+    // difference, loses ≈ 3 digits), and the kernel's f32 arithmetic (against the twin fed
+    // the same rounded inputs).
     let (f_rounded, k_rounded) = beam(&model, v, &up(&x32), &up(&r32));
     let (input_f, input_k) = worst(&f_rounded, &k_rounded, &f_exact, &k_exact);
     let (kernel_f, kernel_k) = worst(&up(&f), &up(&k), &f_rounded, &k_rounded);

@@ -128,7 +128,8 @@ fn grid_dynamic_ensemble_writes_variants_and_series() {
     assert_eq!(csv.lines().count(), 3);
     assert!(out.join("series/1/timeseries.csv").exists());
     assert!(out.join("whirl.png").exists());
-    // f32 and the GPU engine are refused plainly (not built yet), before any output.
+    // Dynamic ensembles in f32 or on the GPU engine are refused plainly (not built yet),
+    // before any output.
     let out2 = dir.join("out2");
     let e = run(
         &path,
@@ -302,4 +303,35 @@ fn sixty_four_variant_static_ensemble_on_the_gpu_matches_the_cpu_runs() {
     );
     assert!(worst <= 1e-9, "{worst:e}");
     assert!(worst_np <= floor, "{worst_np:e} m");
+    // f32 on the GPU engine: the error against the f64 CPU runs, reported and bounded by the
+    // residual the f32 engine accepts (1e4 ε₃₂ ≈ 1.2e-3 of the string's weight).
+    let t0 = std::time::Instant::now();
+    let g32 = run(
+        &case,
+        Some(&f),
+        BackendChoice::Gpu,
+        Precision::F32,
+        &dir.join("gpu32"),
+        false,
+    )
+    .unwrap();
+    let t_32 = t0.elapsed().as_secs_f64();
+    assert_eq!(
+        (g32.backend.as_str(), g32.precision.as_str()),
+        ("gpu", "f32")
+    );
+    let g = read(&dir.join("gpu32"));
+    let mut worst32 = [0.0f64; 4];
+    for (rg, rc) in g.iter().zip(&c).skip(1) {
+        for (n, &k) in cols.iter().enumerate() {
+            if let (Ok(a), Ok(b)) = (rg[k].parse::<f64>(), rc[k].parse::<f64>()) {
+                worst32[n] = worst32[n].max((a - b).abs() / b.abs().max(1e-12));
+            }
+        }
+    }
+    eprintln!(
+        "64 variants, GPU f32 {t_32:.1} s ({} re-run on the CPU): relative error against the CPU f64 runs — neutral point {:.2e}, surface torque {:.2e}, stab1 side force {:.2e}, stab1 lateral {:.2e}",
+        g32.step_cut, worst32[0], worst32[1], worst32[2], worst32[3]
+    );
+    assert!(worst32.iter().all(|&w| w <= 1.2e-3), "{worst32:?}");
 }

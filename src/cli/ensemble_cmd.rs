@@ -81,6 +81,9 @@ pub struct EnsembleSummary {
     pub analysis: String,
     /// Where it ran.
     pub backend: String,
+    /// Float type of the engine (`f64`, or `f32` on the GPU); failed f32 variants re-run
+    /// on the CPU in f64.
+    pub precision: String,
     /// Variants run.
     pub variants: usize,
     /// Converged without cuts.
@@ -192,11 +195,11 @@ pub fn static_result(
     )
 }
 
-/// Static equilibria of every variant through the GPU kernels (f64), the variants that
+/// Static equilibria of every variant through the GPU kernels (in `T`), the variants that
 /// fail there re-run on the CPU with step control (their reason says so). Stabilizer
 /// moves run there too (each pair carries its node). `None` when the variants do not share
 /// the number of sites: the caller runs the CPU.
-pub fn run_static_gpu(
+pub fn run_static_gpu<T: crate::gpu::contact::GpuReal>(
     case: &Case,
     variants: &[Variant],
     ctx: &'static crate::gpu::GpuContext,
@@ -214,7 +217,7 @@ pub fn run_static_gpu(
     if !shared {
         return Ok(None);
     }
-    let results = solve_static_ensemble_with_progress::<f64, _>(
+    let results = solve_static_ensemble_with_progress::<T, _>(
         &models,
         &GpuPath(ctx),
         &StaticOptions::default(),
@@ -508,13 +511,20 @@ pub fn run(
         }
     }
     if precision == Precision::F32 {
-        return Err(InputError {
-            source_name: "--precision".into(),
-            line: 0,
-            key: "precision".into(),
-            message: "ensembles compute in f64 for now: the f32 engine needs states kept as displacements from the reference (positions of kilometres lose the millimetres in f32); use --precision f64".into(),
+        let why = match (backend, analysis) {
+            (_, Analysis::Dynamic) => Some("f32 runs static ensembles on the GPU engine; dynamic ensembles compute in f64 on the CPU for now; use --precision f64"),
+            (BackendChoice::Cpu, _) => Some("the CPU backend computes in f64 (it is the oracle the GPU is tested against); f32 runs on --backend gpu or auto"),
+            _ => None,
+        };
+        if let Some(message) = why {
+            return Err(InputError {
+                source_name: "--precision".into(),
+                line: 0,
+                key: "precision".into(),
+                message: message.into(),
+            }
+            .into());
         }
-        .into());
     }
     // The GPU engine runs static ensembles; dynamic ones run on the CPU for now.
     let gpu = match (backend, analysis) {
@@ -529,6 +539,10 @@ pub fn run(
         (BackendChoice::Auto, Analysis::Dynamic) => {
             eprintln!("holewall: dynamic ensembles run on the CPU (f64) for now");
             None
+        }
+        // f32 was asked for: only the GPU engine computes in f32, whatever the adapter.
+        (BackendChoice::Auto, Analysis::Static) if precision == Precision::F32 => {
+            Some(crate::gpu::GpuContext::shared()?)
         }
         (BackendChoice::Auto, Analysis::Static) => match crate::gpu::GpuContext::shared() {
             Ok(ctx) if ctx.info.device_type == wgpu::DeviceType::Cpu => {
@@ -573,7 +587,11 @@ pub fn run(
     let start = std::time::Instant::now();
     let mut backend_name = "cpu";
     let results = match gpu {
-        Some(ctx) => match run_static_gpu(&case, &variants, ctx, &bar)? {
+        Some(ctx) => match if precision == Precision::F32 {
+            run_static_gpu::<f32>(&case, &variants, ctx, &bar)?
+        } else {
+            run_static_gpu::<f64>(&case, &variants, ctx, &bar)?
+        } {
             Some(r) => {
                 backend_name = "gpu";
                 bar.set_position(variants.len() as u64);
@@ -671,6 +689,12 @@ pub fn run(
         title: case.title.clone(),
         analysis: if dynamic { "dynamic" } else { "static" }.into(),
         backend: backend_name.into(),
+        precision: if backend_name == "gpu" && precision == Precision::F32 {
+            "f32"
+        } else {
+            "f64"
+        }
+        .into(),
         variants: variants.len(),
         converged: count(Status::Converged),
         step_cut: count(Status::StepCut),

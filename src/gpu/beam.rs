@@ -8,7 +8,7 @@ use crate::gpu::contact::GpuReal;
 use crate::gpu::dispatch::{run_once, Out};
 use crate::gpu::layout::BeamDims;
 use crate::gpu::GpuContext;
-use crate::kernels::beam::{frame_table, section_table};
+use crate::kernels::beam::{chord_table, frame_table, section_table};
 use crate::model::Model;
 
 /// The WGSL text of the beam kernel at a precision.
@@ -20,12 +20,13 @@ pub fn beam_wgsl(f64: bool) -> Result<String, GpuError> {
     compose("beam.wgsl", &flags, f64)
 }
 
-/// Element forces and tangents of V variants on the GPU, laid out as the twin's.
+/// Element forces and tangents of V variants on the GPU at displacements `u`, laid out as
+/// the twin's.
 pub fn beam_gpu<T: GpuReal>(
     ctx: &'static GpuContext,
     model: &Model,
     num_variants: usize,
-    x: &[T],
+    u: &[T],
     rot: &[T],
 ) -> Result<(Vec<T>, Vec<T>), GpuError> {
     crate::gpu::contact::require_precision::<T>(ctx)?;
@@ -40,6 +41,7 @@ pub fn beam_gpu<T: GpuReal>(
     let cast = |v: Vec<f64>| -> Vec<T> { v.into_iter().map(T::from_f64_lossy).collect() };
     let sections = cast(section_table(model));
     let frames = cast(frame_table(model));
+    let chords = cast(chord_table(model));
     let dims = BeamDims {
         num_variants: num_variants as u32,
         num_elements: ne as u32,
@@ -52,10 +54,11 @@ pub fn beam_gpu<T: GpuReal>(
         "beam",
         bytemuck::bytes_of(&dims),
         &[
-            bytemuck::cast_slice(x),
+            bytemuck::cast_slice(u),
             bytemuck::cast_slice(rot),
             bytemuck::cast_slice(&frames),
             bytemuck::cast_slice(&sections),
+            bytemuck::cast_slice(&chords),
         ],
         &[
             Out::Empty(12 * ne * num_variants * size),

@@ -235,7 +235,11 @@ impl<T: GpuReal> GpuEnsemble<T> {
         let fixed = storage(ctx, "fixed", &tables.fixed);
         let node_site = storage(ctx, "node_site", &tables.node_site);
         let pair_node = storage(ctx, "pair_node", &tables.pair_node);
-        let node_ref = storage(ctx, "node_ref", &tables.node_ref);
+        let chords = storage(
+            ctx,
+            "chords",
+            &cast(crate::kernels::beam::chord_table(model)),
+        );
         let normals = storage(ctx, "pair_normals", &tables.pair_normals);
         let pair_state = storage(ctx, "pair_state", &tables.pair_state);
         let params = empty(ctx, "pair_params", PARAMS_LEN * p * size);
@@ -358,6 +362,7 @@ impl<T: GpuReal> GpuEnsemble<T> {
                     &rot,
                     &frames,
                     &sections,
+                    &chords,
                     &elem_force,
                     &elem_tangent,
                 ],
@@ -366,7 +371,7 @@ impl<T: GpuReal> GpuEnsemble<T> {
                 ctx,
                 &pipelines.sites,
                 "sites",
-                &[&sites_dims, &pair_node, &node_ref, &x, &pair_state],
+                &[&sites_dims, &pair_node, &x, &pair_state],
             );
             let assemble = bind(
                 ctx,
@@ -456,7 +461,7 @@ impl<T: GpuReal> GpuEnsemble<T> {
                 fixed,
                 node_site,
                 pair_node,
-                node_ref,
+                chords,
                 normals,
                 pair_state,
                 elem_force,
@@ -678,12 +683,12 @@ impl<T: GpuReal> Ensemble<T> for GpuEnsemble<T> {
 }
 
 /// Runs `shaders/sites.wgsl` once (tests against its twin,
-/// [`crate::kernels::sites::gather_sites`]): `pair_state` with `d` of every pair written.
+/// [`crate::kernels::sites::gather_sites`]): `pair_state` with `d` of every pair written
+/// from the displacements `u`.
 pub fn gather_sites_gpu<T: GpuReal>(
     ctx: &'static GpuContext,
     pair_node: &[u32],
-    node_ref: &[T],
-    x: &[T],
+    u: &[T],
     num_variants: usize,
     pair_state: &[T],
 ) -> Result<Vec<T>, GpuError> {
@@ -700,11 +705,7 @@ pub fn gather_sites_gpu<T: GpuReal>(
         &pipeline,
         "sites",
         bytemuck::bytes_of(&dims),
-        &[
-            bytemuck::cast_slice(pair_node),
-            bytemuck::cast_slice(node_ref),
-            bytemuck::cast_slice(x),
-        ],
+        &[bytemuck::cast_slice(pair_node), bytemuck::cast_slice(u)],
         &[crate::gpu::dispatch::Out::From(bytemuck::cast_slice(
             pair_state,
         ))],

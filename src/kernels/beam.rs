@@ -1,9 +1,11 @@
 //! Twin of `shaders/beam.wgsl`: internal force (12) and consistent tangent (12×12) of every
 //! (element, variant), by [`crate::physics::beam::force_and_tangent`] (hyper-dual
 //! evaluations of the co-rotated element energy), laid out for the assembly:
-//! `[(12 e + j) V + v]` and `[(144 e + 12 j + k) V + v]`. Inputs: positions
-//! `[(3 i + k) V + v]`, rotations `[(9 i + 3 r + c) V + v]` (the twin takes them in f64),
-//! reference triads per node and sections per element, shared by the variants.
+//! `[(12 e + j) V + v]` and `[(144 e + 12 j + k) V + v]`. Inputs: displacements from the
+//! reference positions `[(3 i + k) V + v]`, rotations `[(9 i + 3 r + c) V + v]` (the twin
+//! takes them in f64), reference triads per node, sections and reference chords per
+//! element, shared by the variants. An element's nodes are placed at `u₁` and `c + u₂`
+//! (`c = X₂ − X₁`): only the chord matters, and it keeps its digits in f32.
 
 use rayon::prelude::*;
 
@@ -36,15 +38,27 @@ pub fn frame_table(model: &Model) -> Vec<f64> {
         .collect()
 }
 
-/// Element forces and tangents of V variants (rayon over elements × variants).
-pub fn beam(model: &Model, num_variants: usize, x: &[f64], rot: &[f64]) -> (Vec<f64>, Vec<f64>) {
+/// Reference chord `X₂ − X₁` per element (the kernel's `chord0` binding).
+pub fn chord_table(model: &Model) -> Vec<f64> {
+    (0..model.elements.len())
+        .flat_map(|e| {
+            let (a, b) = (model.nodes[e].position, model.nodes[e + 1].position);
+            [b[0] - a[0], b[1] - a[1], b[2] - a[2]]
+        })
+        .collect()
+}
+
+/// Element forces and tangents of V variants (rayon over elements × variants) at
+/// displacements `u` and rotations `rot`.
+pub fn beam(model: &Model, num_variants: usize, u: &[f64], rot: &[f64]) -> (Vec<f64>, Vec<f64>) {
+    let chord = chord_table(model);
     let nv = num_variants;
     let ne = model.elements.len();
     let per: Vec<([f64; 12], [[f64; 12]; 12])> = (0..ne * nv)
         .into_par_iter()
         .map(|idx| {
             let (e, v) = (idx / nv, idx % nv);
-            let pos = |i: usize| -> [f64; 3] { std::array::from_fn(|k| x[(3 * i + k) * nv + v]) };
+            let disp = |i: usize| -> [f64; 3] { std::array::from_fn(|k| u[(3 * i + k) * nv + v]) };
             let triad = |i: usize| -> Mat3<f64> {
                 let f = &model.nodes[i].frame0;
                 std::array::from_fn(|r| {
@@ -56,7 +70,10 @@ pub fn beam(model: &Model, num_variants: usize, x: &[f64], rot: &[f64]) -> (Vec<
                 })
             };
             let es = ElementState {
-                x: [pos(e), pos(e + 1)],
+                x: [
+                    disp(e),
+                    std::array::from_fn(|k| chord[3 * e + k] + u[(3 * (e + 1) + k) * nv + v]),
+                ],
                 triad: [triad(e), triad(e + 1)],
             };
             let el = &model.elements[e];
