@@ -550,3 +550,39 @@ fn stabilizer_rolling_on_the_wall_whirls_backward_and_slips_with_low_friction() 
     );
     assert!(slip > 0.2, "slipping: {slip}");
 }
+
+/// The bit is held laterally in the hole frame (its translation basis): in an inclined
+/// hole its accelerations must stay along the hole axis, so the bit never leaves the axis.
+#[path = "common/mod.rs"]
+mod common;
+
+#[test]
+fn bit_held_laterally_in_an_inclined_hole() {
+    let case = common::bed_case("1");
+    let model = &case.model;
+    let start = solve_static(model, &StaticOptions::default()).unwrap();
+    let density = case.element_density.clone();
+    let options = holewall::cli::run_cmd::options_for(case.dynamics.as_ref().unwrap());
+    let mut dynamics = Dynamics::new(model, options, &|e| density[e]);
+    let mut s = dynamics.initial_state(start.state).unwrap();
+    let bit = model.nodes.len() - 1;
+    let nd = &model.nodes[bit];
+    let mut worst: f64 = 0.0;
+    let mut axial: f64 = 0.0;
+    dynamics
+        .run(&mut s, 0.05, &mut |_, st| {
+            let d: [f64; 3] = std::array::from_fn(|k| st.q.x[bit][k] - nd.position[k]);
+            let along: f64 = (0..3).map(|k| d[k] * nd.hole_axis[k]).sum();
+            let lateral = (0..3)
+                .map(|k| (d[k] - along * nd.hole_axis[k]).powi(2))
+                .sum::<f64>()
+                .sqrt();
+            worst = worst.max(lateral);
+            axial = axial.max(along.abs());
+        })
+        .unwrap();
+    eprintln!(
+        "bit in a 60° hole over 0.05 s: lateral offset {worst:.2e} m, axial travel {axial:.2e} m"
+    );
+    assert!(worst <= 1e-12, "the bit left the hole axis by {worst:e} m");
+}

@@ -35,6 +35,11 @@ fn extreme_contact_cases_finish_without_nan() {
             common::bed_text("0.3", "8.25 in", "6e7", "1", "1e-6"),
         ),
         (
+            "eps = 1e-6 m/s, 10 ms step",
+            common::bed_text("0.3", "8.25 in", "6e7", "1", "1e-6")
+                .replace("time_step = \"2 ms\"", "time_step = \"10 ms\""),
+        ),
+        (
             "mu = 1",
             common::bed_text("1.0", "8.25 in", "6e7", "1", "1e-3"),
         ),
@@ -73,8 +78,8 @@ fn extreme_contact_cases_finish_without_nan() {
         );
         assert!((summary.duration_s - 0.1).abs() < 1e-9);
     }
-    // eps = 1e-6 m/s makes the friction switch within 2 µm/s of slip: the 2 ms step cannot
-    // hold it and is cut, with the cut logged.
+    // eps = 1e-6 m/s makes the friction switch within 2 µm/s of slip: a 10 ms step cannot
+    // hold it and is cut, with the cut logged (2 ms steps can).
     assert!(
         cut_somewhere,
         "some extreme case must need (and log) a step cut"

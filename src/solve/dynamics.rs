@@ -29,7 +29,7 @@ use crate::physics::vec3::{cross, dot, sub, Vec3};
 use crate::solve::chain::{BlockTridiagonal, ChainSolver};
 use crate::solve::statics::{
     constrain, constrain_residual, constraints, element_responses, external_loads, reference_force,
-    StaticState,
+    to_global, StaticState,
 };
 
 /// Generalised-α parameters.
@@ -317,7 +317,9 @@ impl<'a> Dynamics<'a> {
         let c = constraints(self.model);
         let mut rhs: Vec<f64> = r.iter().map(|x| -x).collect();
         constrain(&c, &mut rhs, &mut mass);
-        let dv = self.solver.solve(&mass, &rhs).map_err(|e| e.to_string())?;
+        let mut dv = self.solver.solve(&mass, &rhs).map_err(|e| e.to_string())?;
+        // Held nodes (the bit) solve in their hole frame: back to global axes.
+        to_global(&c, &mut dv);
         for (x, d) in s.vdot.iter_mut().zip(&dv) {
             *x += d;
         }
@@ -618,7 +620,9 @@ impl<'a> Dynamics<'a> {
                 return Err("residual is not finite".into());
             }
             let rhs: Vec<f64> = r.iter().map(|x| -x).collect();
-            let dv = self.solver.solve(&mat, &rhs).map_err(|e| e.to_string())?;
+            let mut dv = self.solver.solve(&mat, &rhs).map_err(|e| e.to_string())?;
+            // Held nodes (the bit) solve in their hole frame: back to global axes.
+            to_global(&c, &mut dv);
             let step_norm = dv.iter().fold(0.0f64, |m, x| m.max(x.abs())) * hhb;
             let length_scale = 1.0 + s.q.x.iter().flatten().fold(0.0f64, |m, x| m.max(x.abs()));
             let converged = measure <= self.options.tolerance

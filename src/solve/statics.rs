@@ -426,6 +426,19 @@ pub(crate) fn constrain(c: &Constraints, residual: &mut [f64], tangent: &mut Blo
     }
 }
 
+/// Takes a correction from constrained coordinates (translations in each node's basis) to
+/// global ones, in place: `Δu ← B Δu` where a node has a basis.
+pub(crate) fn to_global(c: &Constraints, delta: &mut [f64]) {
+    for (i, b) in c.basis.iter().enumerate() {
+        if let Some(b) = b {
+            let d: Vec3<f64> = std::array::from_fn(|k| delta[6 * i + k]);
+            for r in 0..3 {
+                delta[6 * i + r] = (0..3).map(|k| b[r][k] * d[k]).sum();
+            }
+        }
+    }
+}
+
 /// Applies `α·Δ` (constrained coordinates) to a state.
 fn update(c: &Constraints, state: &StaticState, delta: &[f64], alpha: f64) -> StaticState {
     let mut s = state.clone();
