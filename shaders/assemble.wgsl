@@ -1,5 +1,8 @@
 // Twin: src/kernels/assemble.rs (static residual and block-tridiagonal tangent per variant).
 //
+// With DYNAMIC: the generalised-α iteration matrix M + hγ' C_t + h²β' K_t and the inertial
+// residual (lumped mass, gyroscopic moments, mass-proportional Rayleigh damping).
+//
 // One invocation per (node, variant), index = node · V + variant; each gathers the halves of
 // its two elements and its contact site, so no two invocations write the same entry, then
 // applies the constraints to the blocks it owns. Layouts as in the twin's documentation.
@@ -15,10 +18,29 @@
 // Translation basis per node (row-major, identity where none) and fixed-DOF masks.
 @group(0) @binding(7) var<storage, read> basis: array<real>;
 @group(0) @binding(8) var<storage, read> fixed: array<u32>;
+#if DYNAMIC
+// [hγ', h²β', a0].
+@group(0) @binding(9) var<storage, read> dyn_coef: array<real>;
+@group(0) @binding(10) var<storage, read> node_mass: array<real>;
+// Rotary inertia per node at the reference orientation (row-major).
+@group(0) @binding(11) var<storage, read> inertia0: array<real>;
+@group(0) @binding(12) var<storage, read> rot: array<real>;
+@group(0) @binding(13) var<storage, read> vel: array<real>;
+@group(0) @binding(14) var<storage, read> vdot: array<real>;
+// Hole axis per contact pair.
+@group(0) @binding(15) var<storage, read> pair_normals: array<real>;
+@group(0) @binding(16) var<storage, read_write> out_diag: array<real>;
+@group(0) @binding(17) var<storage, read_write> out_upper: array<real>;
+@group(0) @binding(18) var<storage, read_write> out_lower: array<real>;
+@group(0) @binding(19) var<storage, read_write> out_rhs: array<real>;
+const OUT_C: u32 = 24u;
+const OUT_C_OMEGA: u32 = 42u;
+#else
 @group(0) @binding(9) var<storage, read_write> out_diag: array<real>;
 @group(0) @binding(10) var<storage, read_write> out_upper: array<real>;
 @group(0) @binding(11) var<storage, read_write> out_lower: array<real>;
 @group(0) @binding(12) var<storage, read_write> out_rhs: array<real>;
+#endif
 
 // Field offsets of the contact kernel's outputs (src/kernels/contact.rs OUT_G, OUT_K).
 const OUT_G: u32 = 0u;
@@ -117,6 +139,88 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
             }
         }
     }
+#if DYNAMIC
+    let hg = dyn_coef[0];
+    let hhb = dyn_coef[1];
+    let a0 = dyn_coef[2];
+    for (var k = 0u; k < 36u; k = k + 1u) {
+        d[k] = hhb * d[k];
+        u[k] = hhb * u[k];
+        l[k] = hhb * l[k];
+    }
+    if (s != NO_SITE) {
+        let p = s * nv + v;
+        if (contact_flag[p] != 0u) {
+            for (var k = 0u; k < 6u; k = k + 1u) {
+                for (var c = 0u; c < 3u; c = c + 1u) {
+                    d[6u * k + c] = d[6u * k + c] + hg * contact[(OUT_C + 3u * k + c) * pairs + p];
+                    d[6u * k + 3u + c] = d[6u * k + 3u + c]
+                        + hg * contact[(OUT_C_OMEGA + k) * pairs + p] * pair_normals[3u * p + c];
+                }
+            }
+        }
+    }
+    // J = R J0 Rᵀ.
+    var rj: array<array<real, 3>, 3>;
+    for (var a = 0u; a < 3u; a = a + 1u) {
+        for (var c = 0u; c < 3u; c = c + 1u) {
+            var acc_rj = real(0.0);
+            for (var k = 0u; k < 3u; k = k + 1u) {
+                acc_rj = acc_rj + rot[(9u * i + 3u * a + k) * nv + v] * inertia0[9u * i + 3u * k + c];
+            }
+            rj[a][c] = acc_rj;
+        }
+    }
+    var jm: array<array<real, 3>, 3>;
+    for (var a = 0u; a < 3u; a = a + 1u) {
+        for (var c = 0u; c < 3u; c = c + 1u) {
+            var acc_j = real(0.0);
+            for (var k = 0u; k < 3u; k = k + 1u) {
+                acc_j = acc_j + rj[a][k] * rot[(9u * i + 3u * c + k) * nv + v];
+            }
+            jm[a][c] = acc_j;
+        }
+    }
+    let m = node_mass[i];
+    let w = vec3<real>(vel[(6u * i + 3u) * nv + v], vel[(6u * i + 4u) * nv + v], vel[(6u * i + 5u) * nv + v]);
+    var jw = vec3<real>(real(0.0), real(0.0), real(0.0));
+    var jwd = vec3<real>(real(0.0), real(0.0), real(0.0));
+    for (var a = 0u; a < 3u; a = a + 1u) {
+        var s1 = real(0.0);
+        var s2 = real(0.0);
+        for (var k = 0u; k < 3u; k = k + 1u) {
+            s1 = s1 + jm[a][k] * w[k];
+            s2 = s2 + jm[a][k] * vdot[(6u * i + 3u + k) * nv + v];
+        }
+        jw[a] = s1;
+        jwd[a] = s2;
+    }
+    let gyro = vec3<real>(w.y * jw.z - w.z * jw.y, w.z * jw.x - w.x * jw.z, w.x * jw.y - w.y * jw.x);
+    // Rows of [ω]× and [Jω]×.
+    let sw = array<vec3<real>, 3>(
+        vec3<real>(real(0.0), -w.z, w.y),
+        vec3<real>(w.z, real(0.0), -w.x),
+        vec3<real>(-w.y, w.x, real(0.0)),
+    );
+    let sjw = array<vec3<real>, 3>(
+        vec3<real>(real(0.0), -jw.z, jw.y),
+        vec3<real>(jw.z, real(0.0), -jw.x),
+        vec3<real>(-jw.y, jw.x, real(0.0)),
+    );
+    for (var k = 0u; k < 3u; k = k + 1u) {
+        r[k] = r[k] + m * vdot[(6u * i + k) * nv + v] + a0 * m * vel[(6u * i + k) * nv + v];
+        r[3u + k] = r[3u + k] + jwd[k] + gyro[k];
+        d[6u * k + k] = d[6u * k + k] + m + hg * a0 * m;
+        for (var c = 0u; c < 3u; c = c + 1u) {
+            // ∂(ω × Jω)/∂ω = [ω]× J − [Jω]×.
+            var swj = real(0.0);
+            for (var q = 0u; q < 3u; q = q + 1u) {
+                swj = swj + sw[k][q] * jm[q][c];
+            }
+            d[6u * (3u + k) + 3u + c] = d[6u * (3u + k) + 3u + c] + jm[k][c] + hg * (swj - sjw[k][c]);
+        }
+    }
+#endif
     // Constraints (as statics::constrain): bases, then fixed DOFs.
     transform(&d, i, i);
     let rv = vec3<real>(r[0], r[1], r[2]);

@@ -1,7 +1,8 @@
 // Twin: src/kernels/sites.rs (each contact pair's displacement d = u of its node).
 //
 // One invocation per (site, variant) pair i = site · V + variant; writes fields 0–2 of the
-// pair state, leaving the velocity and spin fields (3–6) as the host wrote them.
+// pair state, leaving the velocity and spin fields (3–6) as the host wrote them; with
+// DYNAMIC also those, from the node's velocity and its spin about the hole axis.
 #include "shared/layout.wgsl"
 
 @group(0) @binding(0) var<uniform> dims: ContactDims;
@@ -10,6 +11,11 @@
 // Displacements: [(3 · node + k) · V + variant].
 @group(0) @binding(2) var<storage, read> u: array<real>;
 @group(0) @binding(3) var<storage, read_write> pair_state: array<real>;
+#if DYNAMIC
+// Node velocities [(6 · node + k) · V + variant] (ẋ, ω) and the pairs' hole axes.
+@group(0) @binding(4) var<storage, read> vel: array<real>;
+@group(0) @binding(5) var<storage, read> pair_normals: array<real>;
+#endif
 
 @compute @workgroup_size(64)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
@@ -24,4 +30,13 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     for (var k = 0u; k < 3u; k = k + 1u) {
         pair_state[k * p + i] = u[(3u * node + k) * nv + v];
     }
+#if DYNAMIC
+    // Velocity and spin about the hole axis, n · ω.
+    var spin = real(0.0);
+    for (var k = 0u; k < 3u; k = k + 1u) {
+        pair_state[(3u + k) * p + i] = vel[(6u * node + k) * nv + v];
+        spin = spin + pair_normals[3u * i + k] * vel[(6u * node + 3u + k) * nv + v];
+    }
+    pair_state[6u * p + i] = spin;
+#endif
 }

@@ -58,6 +58,7 @@ fn inputs(
             .flat_map(|_| [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0])
             .collect(),
         fixed: vec![0; n],
+        dynamic: None,
     };
     if constrained {
         let (basis, fixed) = constraint_tables(&model);
@@ -188,6 +189,7 @@ fn twin_gathers_what_the_solver_scatters_and_the_gpu_agrees() {
         f_ext: a.f_ext.iter().map(|&x| x as f32).collect(),
         basis: a.basis.iter().map(|&x| x as f32).collect(),
         fixed: a.fixed.clone(),
+        dynamic: None,
     };
     let gpu32 = assemble_gpu(ctx, &a32).unwrap();
     let twin32 = assemble(&a32);

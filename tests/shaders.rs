@@ -124,6 +124,7 @@ fn composer_handles_nesting_else_and_errors() {
 
 #[test]
 fn engine_kernels_validate_in_both_precisions() {
+    use holewall::gpu::dynamics::DynamicsKernel;
     for f64 in [false, true] {
         for wgsl in [
             holewall::gpu::block_lu::block_lu_wgsl(f64).unwrap(),
@@ -132,6 +133,11 @@ fn engine_kernels_validate_in_both_precisions() {
             holewall::gpu::update::update_wgsl(true, f64).unwrap(),
             holewall::gpu::beam::beam_wgsl(f64).unwrap(),
             holewall::gpu::ensemble::sites_wgsl(f64).unwrap(),
+            holewall::gpu::ensemble::sites_wgsl_for(true, f64).unwrap(),
+            holewall::gpu::assemble::assemble_wgsl_for(true, f64).unwrap(),
+            holewall::gpu::dynamics::dynamics_wgsl(DynamicsKernel::Predict, f64).unwrap(),
+            holewall::gpu::dynamics::dynamics_wgsl(DynamicsKernel::Accelerate, f64).unwrap(),
+            holewall::gpu::dynamics::dynamics_wgsl(DynamicsKernel::Scale, f64).unwrap(),
         ] {
             validate(&wgsl).unwrap_or_else(|e| panic!("f64={f64}: {e}"));
             assert_eq!(wgsl.contains("f64"), f64, "precision leak, f64={f64}");

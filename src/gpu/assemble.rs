@@ -11,11 +11,19 @@ use crate::gpu::GpuContext;
 use crate::kernels::assemble::AssemblyInputs;
 use crate::kernels::block_lu::ChainBatch;
 
-/// The WGSL text of the assembly at a precision.
+/// The WGSL text of the static assembly at a precision.
 pub fn assemble_wgsl(f64: bool) -> Result<String, GpuError> {
+    assemble_wgsl_for(false, f64)
+}
+
+/// The WGSL text of the static or dynamic assembly at a precision.
+pub fn assemble_wgsl_for(dynamic: bool, f64: bool) -> Result<String, GpuError> {
     let mut flags = BTreeSet::new();
     if f64 {
         flags.insert("F64");
+    }
+    if dynamic {
+        flags.insert("DYNAMIC");
     }
     compose("assemble.wgsl", &flags, f64)
 }
@@ -39,28 +47,43 @@ pub fn assemble_gpu<T: GpuReal>(
             ctx.max_binding_bytes()
         )));
     }
-    let pipeline = ctx.pipeline("assemble", &assemble_wgsl(T::IS_F64)?)?;
+    let pipeline = ctx.pipeline(
+        "assemble",
+        &assemble_wgsl_for(a.dynamic.is_some(), T::IS_F64)?,
+    )?;
     let dims = AssembleDims {
         num_variants: nv as u32,
         num_nodes: n as u32,
         num_sites: a.num_sites as u32,
         _pad: 0,
     };
+    let mut inputs: Vec<&[u8]> = vec![
+        bytemuck::cast_slice(&a.elem_force),
+        bytemuck::cast_slice(&a.elem_tangent),
+        bytemuck::cast_slice(&a.contact),
+        bytemuck::cast_slice(&a.contact_flag),
+        bytemuck::cast_slice(&a.node_site),
+        bytemuck::cast_slice(&a.f_ext),
+        bytemuck::cast_slice(&a.basis),
+        bytemuck::cast_slice(&a.fixed),
+    ];
+    if let Some(dy) = &a.dynamic {
+        inputs.extend([
+            bytemuck::cast_slice(&dy.coefficients[..]),
+            bytemuck::cast_slice(&dy.mass),
+            bytemuck::cast_slice(&dy.inertia0),
+            bytemuck::cast_slice(&dy.rot),
+            bytemuck::cast_slice(&dy.vel),
+            bytemuck::cast_slice(&dy.vdot),
+            bytemuck::cast_slice(&dy.pair_normals),
+        ]);
+    }
     let out = run_once(
         ctx,
         &pipeline,
         "assemble",
         bytemuck::bytes_of(&dims),
-        &[
-            bytemuck::cast_slice(&a.elem_force),
-            bytemuck::cast_slice(&a.elem_tangent),
-            bytemuck::cast_slice(&a.contact),
-            bytemuck::cast_slice(&a.contact_flag),
-            bytemuck::cast_slice(&a.node_site),
-            bytemuck::cast_slice(&a.f_ext),
-            bytemuck::cast_slice(&a.basis),
-            bytemuck::cast_slice(&a.fixed),
-        ],
+        &inputs,
         &[
             Out::Empty(36 * n * nv * size),
             Out::Empty(36 * m * nv * size),

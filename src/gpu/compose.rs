@@ -21,9 +21,14 @@ pub const SHADERS: &[(&str, &str)] = &[
     ("update.wgsl", include_str!("../../shaders/update.wgsl")),
     ("beam.wgsl", include_str!("../../shaders/beam.wgsl")),
     ("sites.wgsl", include_str!("../../shaders/sites.wgsl")),
+    ("dynamics.wgsl", include_str!("../../shaders/dynamics.wgsl")),
     (
         "shared/math_f64.wgsl",
         include_str!("../../shaders/shared/math_f64.wgsl"),
+    ),
+    (
+        "shared/rotation_exp.wgsl",
+        include_str!("../../shaders/shared/rotation_exp.wgsl"),
     ),
     (
         "shared/layout.wgsl",

@@ -95,7 +95,6 @@ pub struct GpuEnsemble<T: GpuReal> {
     alpha: wgpu::Buffer,
     status: wgpu::Buffer,
     norms: wgpu::Buffer,
-    staging: wgpu::Buffer,
     num_variants: usize,
     num_nodes: usize,
     num_elements: usize,
@@ -256,12 +255,6 @@ impl<T: GpuReal> GpuEnsemble<T> {
         let ones = storage(ctx, "ones", &vec![T::one(); v]);
         let alpha = empty(ctx, "alpha", v * size);
         let norms = empty(ctx, "norms", 4 * v * size);
-        let staging = ctx.device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("norms_staging"),
-            size: (4 * v * size + 4 * v) as u64,
-            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
         let chain_dims = uniform(
             ctx,
             "chain_dims",
@@ -449,7 +442,6 @@ impl<T: GpuReal> GpuEnsemble<T> {
             alpha,
             status,
             norms,
-            staging,
             num_variants: v,
             num_nodes: n,
             num_elements: m,
@@ -496,85 +488,98 @@ impl<T: GpuReal> GpuEnsemble<T> {
     }
 
     fn encoder(&self, label: &str) -> wgpu::CommandEncoder {
-        self.ctx
-            .device
-            .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(label) })
-    }
-
-    fn wait(&self) -> Result<(), GpuError> {
-        self.ctx
-            .device
-            .poll(wgpu::PollType::wait_indefinitely())
-            .map(|_| ())
-            .map_err(|e| GpuError::Device(e.to_string()))
+        encoder(self.ctx, label)
     }
 
     /// Submits `encoder` after copying the norms and statuses out; reads them back.
     fn finish_with_norms(
         &self,
-        mut encoder: wgpu::CommandEncoder,
+        encoder: wgpu::CommandEncoder,
     ) -> Result<(Norms<T>, Vec<u32>), GpuError> {
         let v = self.num_variants;
         let norm_bytes = (4 * v * std::mem::size_of::<T>()) as u64;
-        encoder.copy_buffer_to_buffer(&self.norms, 0, &self.staging, 0, norm_bytes);
-        encoder.copy_buffer_to_buffer(&self.status, 0, &self.staging, norm_bytes, 4 * v as u64);
-        self.ctx.queue.submit([encoder.finish()]);
-        self.staging
-            .slice(..)
-            .map_async(wgpu::MapMode::Read, |_| {});
-        self.wait()?;
-        let (rows, status) = {
-            let view = self
-                .staging
-                .slice(..)
-                .get_mapped_range()
-                .map_err(|e| GpuError::Device(format!("map: {e}")))?;
-            let values: &[T] = bytemuck::cast_slice(&view[..norm_bytes as usize]);
-            let rows: Vec<[T; 4]> = values
-                .chunks_exact(4)
-                .map(|c| [c[0], c[1], c[2], c[3]])
-                .collect();
-            let status: Vec<u32> = bytemuck::cast_slice(&view[norm_bytes as usize..]).to_vec();
-            (rows, status)
-        };
-        self.staging.unmap();
-        Ok((Norms::from_rows(&rows), status))
-    }
-
-    fn read_buffer<U: bytemuck::Pod>(
-        &self,
-        buffer: &wgpu::Buffer,
-        len: usize,
-    ) -> Result<Vec<U>, GpuError> {
-        let bytes = (len * std::mem::size_of::<U>()).max(4) as u64;
-        let staging = self.ctx.device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("read"),
-            size: bytes,
-            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        let mut encoder = self.encoder("read");
-        encoder.copy_buffer_to_buffer(buffer, 0, &staging, 0, bytes);
-        self.ctx.queue.submit([encoder.finish()]);
-        staging.slice(..).map_async(wgpu::MapMode::Read, |_| {});
-        self.wait()?;
-        let out = {
-            let view = staging
-                .slice(..)
-                .get_mapped_range()
-                .map_err(|e| GpuError::Device(format!("map: {e}")))?;
-            bytemuck::cast_slice::<u8, U>(&view[..len * std::mem::size_of::<U>()]).to_vec()
-        };
-        staging.unmap();
-        Ok(out)
+        let out = submit_and_read(
+            self.ctx,
+            encoder,
+            &[(&self.norms, norm_bytes), (&self.status, 4 * v as u64)],
+        )?;
+        Ok((
+            norms_from_bytes(&out[0]),
+            bytemuck::cast_slice(&out[1]).to_vec(),
+        ))
     }
 }
 
-/// The WGSL text of the sites gather at a precision.
+fn encoder(ctx: &GpuContext, label: &str) -> wgpu::CommandEncoder {
+    ctx.device
+        .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(label) })
+}
+
+/// `[max r, max αΔ, Δ·r, r·r]` rows per variant, from the norms kernel's output bytes.
+fn norms_from_bytes<T: GpuReal>(bytes: &[u8]) -> Norms<T> {
+    let values: &[T] = bytemuck::cast_slice(bytes);
+    let rows: Vec<[T; 4]> = values
+        .chunks_exact(4)
+        .map(|c| [c[0], c[1], c[2], c[3]])
+        .collect();
+    Norms::from_rows(&rows)
+}
+
+/// Submits `encoder` with copies of the first `bytes` of each buffer into one staging
+/// buffer appended, waits, and returns the bytes of each.
+fn submit_and_read(
+    ctx: &GpuContext,
+    mut encoder: wgpu::CommandEncoder,
+    reads: &[(&wgpu::Buffer, u64)],
+) -> Result<Vec<Vec<u8>>, GpuError> {
+    let total: u64 = reads.iter().map(|(_, b)| b.max(&4)).sum();
+    let staging = ctx.device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("read"),
+        size: total.max(4),
+        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    });
+    let mut offset = 0;
+    for (buffer, bytes) in reads {
+        if *bytes > 0 {
+            encoder.copy_buffer_to_buffer(buffer, 0, &staging, offset, *bytes);
+        }
+        offset += bytes.max(&4);
+    }
+    ctx.queue.submit([encoder.finish()]);
+    staging.slice(..).map_async(wgpu::MapMode::Read, |_| {});
+    ctx.device
+        .poll(wgpu::PollType::wait_indefinitely())
+        .map_err(|e| GpuError::Device(e.to_string()))?;
+    let mut out = Vec::with_capacity(reads.len());
+    {
+        let view = staging
+            .slice(..)
+            .get_mapped_range()
+            .map_err(|e| GpuError::Device(format!("map: {e}")))?;
+        let mut offset = 0usize;
+        for (_, bytes) in reads {
+            out.push(view[offset..offset + *bytes as usize].to_vec());
+            offset += (*bytes).max(4) as usize;
+        }
+    }
+    staging.unmap();
+    Ok(out)
+}
+
+/// The WGSL text of the static sites gather at a precision.
 pub fn sites_wgsl(f64: bool) -> Result<String, GpuError> {
+    sites_wgsl_for(false, f64)
+}
+
+/// The WGSL text of the static or dynamic sites gather at a precision.
+pub fn sites_wgsl_for(dynamic: bool, f64: bool) -> Result<String, GpuError> {
     let mut flags = std::collections::BTreeSet::new();
     if f64 {
         flags.insert("F64");
+    }
+    if dynamic {
+        flags.insert("DYNAMIC");
     }
     crate::gpu::compose::compose("sites.wgsl", &flags, f64)
 }
@@ -666,17 +671,21 @@ impl<T: GpuReal> Ensemble<T> for GpuEnsemble<T> {
     fn config(&mut self) -> Result<ConfigBatch<T>, String> {
         let (v, n) = (self.num_variants, self.num_nodes);
         let s = &self.slots[self.current];
-        let x = self
-            .read_buffer::<T>(&s.x, 3 * n * v)
-            .map_err(|e| e.to_string())?;
-        let rot = self
-            .read_buffer::<T>(&s.rot, 9 * n * v)
-            .map_err(|e| e.to_string())?;
+        let size = std::mem::size_of::<T>() as u64;
+        let out = submit_and_read(
+            self.ctx,
+            self.encoder("config"),
+            &[
+                (&s.x, 3 * (n * v) as u64 * size),
+                (&s.rot, 9 * (n * v) as u64 * size),
+            ],
+        )
+        .map_err(|e| e.to_string())?;
         Ok(ConfigBatch {
             num_variants: v,
             num_nodes: n,
-            x,
-            rot,
+            x: bytemuck::cast_slice(&out[0]).to_vec(),
+            rot: bytemuck::cast_slice(&out[1]).to_vec(),
             basis: Vec::new(),
         })
     }
@@ -712,4 +721,609 @@ pub fn gather_sites_gpu<T: GpuReal>(
         pair_node.len(),
     )?;
     Ok(bytemuck::cast_slice(&out[0]).to_vec())
+}
+
+/// A chunk of variants resident on the GPU for a dynamic run
+/// ([`crate::engine::dynamic`]): the state at `t_n`, the Newton unknown `v̇_{n+1}` and a
+/// candidate for the line search, one trial state and its system. Per iteration the host
+/// reads four norms, a status and the inertial scale per variant.
+pub struct GpuDynamic<T: GpuReal> {
+    ctx: &'static GpuContext,
+    p: DynamicPipelines,
+    g: DynamicGroups,
+    b: DynamicBuffers,
+    num_variants: usize,
+    num_nodes: usize,
+    num_elements: usize,
+    num_pairs: usize,
+    a0: T,
+    _keep: Vec<wgpu::Buffer>,
+    _real: PhantomData<T>,
+}
+
+struct DynamicPipelines {
+    predict: Arc<wgpu::ComputePipeline>,
+    accelerate: Arc<wgpu::ComputePipeline>,
+    scale: Arc<wgpu::ComputePipeline>,
+    beam: Arc<wgpu::ComputePipeline>,
+    sites: Arc<wgpu::ComputePipeline>,
+    contact: Arc<wgpu::ComputePipeline>,
+    assemble: Arc<wgpu::ComputePipeline>,
+    block_lu: Arc<wgpu::ComputePipeline>,
+    norms: Arc<wgpu::ComputePipeline>,
+}
+
+struct DynamicGroups {
+    predict_unknown: wgpu::BindGroup,
+    predict_candidate: wgpu::BindGroup,
+    accelerate: wgpu::BindGroup,
+    scale: wgpu::BindGroup,
+    beam: wgpu::BindGroup,
+    sites: wgpu::BindGroup,
+    contact: wgpu::BindGroup,
+    assemble_unknown: wgpu::BindGroup,
+    assemble_candidate: wgpu::BindGroup,
+    lu: Vec<wgpu::BindGroup>,
+    norms_iterate: wgpu::BindGroup,
+    norms_trial: wgpu::BindGroup,
+}
+
+struct DynamicBuffers {
+    coef: wgpu::Buffer,
+    flags: wgpu::Buffer,
+    top: wgpu::Buffer,
+    dyn_coef: wgpu::Buffer,
+    alpha: wgpu::Buffer,
+    status: wgpu::Buffer,
+    norms: wgpu::Buffer,
+    scale: wgpu::Buffer,
+    // State at t_n, the unknown and the candidate, the trial state.
+    u_n: wgpu::Buffer,
+    rot_n: wgpu::Buffer,
+    vel_n: wgpu::Buffer,
+    acc_n: wgpu::Buffer,
+    vdot_n: wgpu::Buffer,
+    vdot_k: wgpu::Buffer,
+    vdot_c: wgpu::Buffer,
+    u_1: wgpu::Buffer,
+    rot_1: wgpu::Buffer,
+    vel_1: wgpu::Buffer,
+    acc_1: wgpu::Buffer,
+}
+
+impl<T: GpuReal> GpuDynamic<T> {
+    /// Compiles (or fetches) the kernels for the chunk's terms and precision and uploads
+    /// its tables and start state.
+    pub fn new(
+        ctx: &'static GpuContext,
+        model: &Model,
+        tables: &EnsembleTables<T>,
+        dynamic: &crate::engine::dynamic::DynamicTables<T>,
+    ) -> Result<Self, GpuError> {
+        use crate::gpu::dynamics::{dynamics_wgsl, DynamicsKernel};
+        require_precision::<T>(ctx)?;
+        let f64 = T::IS_F64;
+        let (v, n, s) = (tables.num_variants, tables.num_nodes, tables.num_sites);
+        let (m, p) = (n.saturating_sub(1), tables.pair_node.len());
+        let size = std::mem::size_of::<T>();
+        if largest_binding_per_variant(n, s, size) * v > ctx.max_binding_bytes() as usize {
+            return Err(GpuError::Unsupported(format!(
+                "{v} variants of {n} nodes exceed one binding of {} bytes; split the variants",
+                ctx.max_binding_bytes()
+            )));
+        }
+        if 6 * n > 60_000 {
+            return Err(GpuError::Unsupported(format!(
+                "norms of {n} nodes exceed one invocation's loop budget"
+            )));
+        }
+        let pl = DynamicPipelines {
+            predict: ctx.pipeline("predict", &dynamics_wgsl(DynamicsKernel::Predict, f64)?)?,
+            accelerate: ctx.pipeline(
+                "accelerate",
+                &dynamics_wgsl(DynamicsKernel::Accelerate, f64)?,
+            )?,
+            scale: ctx.pipeline("scale", &dynamics_wgsl(DynamicsKernel::Scale, f64)?)?,
+            beam: ctx.pipeline("beam", &crate::gpu::beam::beam_wgsl(f64)?)?,
+            sites: ctx.pipeline("sites", &sites_wgsl_for(true, f64)?)?,
+            contact: ctx.pipeline("contact", &contact_wgsl(&tables.terms, f64)?)?,
+            assemble: ctx.pipeline(
+                "assemble",
+                &crate::gpu::assemble::assemble_wgsl_for(true, f64)?,
+            )?,
+            block_lu: ctx.pipeline("block_lu", &crate::gpu::block_lu::block_lu_wgsl(f64)?)?,
+            norms: ctx.pipeline("norms", &crate::gpu::update::update_wgsl(true, f64)?)?,
+        };
+        let cast = |x: Vec<f64>| -> Vec<T> { x.into_iter().map(T::from_f64_lossy).collect() };
+        let sections = storage(
+            ctx,
+            "sections",
+            &cast(crate::kernels::beam::section_table(model)),
+        );
+        let frames = storage(
+            ctx,
+            "frames",
+            &cast(crate::kernels::beam::frame_table(model)),
+        );
+        let chords = storage(
+            ctx,
+            "chords",
+            &cast(crate::kernels::beam::chord_table(model)),
+        );
+        let basis = storage(ctx, "basis", &tables.basis);
+        let fixed = storage(ctx, "fixed", &tables.fixed);
+        let node_site = storage(ctx, "node_site", &tables.node_site);
+        let pair_node = storage(ctx, "pair_node", &tables.pair_node);
+        let normals = storage(ctx, "pair_normals", &tables.pair_normals);
+        let pair_state = storage(ctx, "pair_state", &tables.pair_state);
+        let params = storage(ctx, "pair_params", &dynamic.pair_params);
+        let f_ext = storage(ctx, "f_ext", &dynamic.f_ext);
+        let mass = storage(ctx, "mass", &dynamic.mass);
+        let inertia0 = storage(ctx, "inertia0", &dynamic.inertia0);
+        let elem_force = empty(ctx, "elem_force", 12 * m * v * size);
+        let elem_tangent = empty(ctx, "elem_tangent", 144 * m * v * size);
+        let values = empty(ctx, "contact_values", OUTPUT_LEN * p * size);
+        let flags_out = empty(ctx, "contact_flags", 4 * p);
+        let diag = empty(ctx, "diag", 36 * n * v * size);
+        let upper = empty(ctx, "upper", 36 * m.max(1) * v * size);
+        let lower = empty(ctx, "lower", 36 * m.max(1) * v * size);
+        let rhs = empty(ctx, "rhs", 6 * n * v * size);
+        let work_x = empty(ctx, "lu_work", 36 * m.max(1) * v * size);
+        let work_z = empty(ctx, "lu_work_z", 6 * n * v * size);
+        let delta = empty(ctx, "delta", 6 * n * v * size);
+        let ones = storage(ctx, "ones", &vec![T::one(); v]);
+        let st = &dynamic.start;
+        let b = DynamicBuffers {
+            coef: empty(ctx, "coef", 5 * size),
+            flags: empty(ctx, "step_flags", 4),
+            top: empty(ctx, "top", crate::kernels::dynamics::TOP_LEN * v * size),
+            dyn_coef: empty(ctx, "dyn_coef", 3 * size),
+            alpha: empty(ctx, "alpha", v * size),
+            status: empty(ctx, "status", 4 * v),
+            norms: empty(ctx, "norms", 4 * v * size),
+            scale: empty(ctx, "scale", v * size),
+            u_n: storage(ctx, "u_n", &st.u),
+            rot_n: storage(ctx, "rot_n", &st.rot),
+            vel_n: storage(ctx, "vel_n", &st.vel),
+            acc_n: storage(ctx, "acc_n", &st.acc),
+            vdot_n: storage(ctx, "vdot_n", &st.vdot),
+            vdot_k: storage(ctx, "vdot_k", &st.vdot),
+            vdot_c: storage(ctx, "vdot_c", &st.vdot),
+            u_1: storage(ctx, "u_1", &st.u),
+            rot_1: storage(ctx, "rot_1", &st.rot),
+            vel_1: storage(ctx, "vel_1", &st.vel),
+            acc_1: storage(ctx, "acc_1", &st.acc),
+        };
+        let chain_dims = uniform(
+            ctx,
+            "chain_dims",
+            &ChainDims {
+                num_variants: v as u32,
+                num_nodes: n as u32,
+                _pad0: 0,
+                _pad1: 0,
+            },
+        );
+        let beam_dims = uniform(
+            ctx,
+            "beam_dims",
+            &BeamDims {
+                num_variants: v as u32,
+                num_elements: m as u32,
+                _pad0: 0,
+                _pad1: 0,
+            },
+        );
+        let sites_dims = uniform(
+            ctx,
+            "sites_dims",
+            &ContactDims {
+                num_pairs: p as u32,
+                num_variants: v as u32,
+                pair_offset: 0,
+                _pad: 0,
+            },
+        );
+        let contact_dims = uniform(
+            ctx,
+            "contact_dims",
+            &ContactDims {
+                num_pairs: p as u32,
+                num_variants: 1,
+                pair_offset: 0,
+                _pad: 0,
+            },
+        );
+        let assemble_dims = uniform(
+            ctx,
+            "assemble_dims",
+            &AssembleDims {
+                num_variants: v as u32,
+                num_nodes: n as u32,
+                num_sites: s as u32,
+                _pad: 0,
+            },
+        );
+        let lu_dims: Vec<wgpu::Buffer> = crate::gpu::block_lu::passes(n)
+            .into_iter()
+            .map(|(begin, end, phase)| {
+                uniform(
+                    ctx,
+                    "lu_dims",
+                    &LuDims {
+                        num_variants: v as u32,
+                        num_nodes: n as u32,
+                        begin: begin as u32,
+                        end: end as u32,
+                        phase,
+                        _pad0: 0,
+                        _pad1: 0,
+                        _pad2: 0,
+                    },
+                )
+            })
+            .collect();
+        let predict = |vdot: &wgpu::Buffer| {
+            bind(
+                ctx,
+                &pl.predict,
+                "predict",
+                &[
+                    &chain_dims,
+                    &b.coef,
+                    &b.flags,
+                    &b.top,
+                    &b.u_n,
+                    &b.rot_n,
+                    &b.vel_n,
+                    &b.acc_n,
+                    &b.vdot_n,
+                    vdot,
+                    &b.u_1,
+                    &b.rot_1,
+                    &b.vel_1,
+                    &b.acc_1,
+                ],
+            )
+        };
+        let assemble = |vdot: &wgpu::Buffer| {
+            bind(
+                ctx,
+                &pl.assemble,
+                "assemble",
+                &[
+                    &assemble_dims,
+                    &elem_force,
+                    &elem_tangent,
+                    &values,
+                    &flags_out,
+                    &node_site,
+                    &f_ext,
+                    &basis,
+                    &fixed,
+                    &b.dyn_coef,
+                    &mass,
+                    &inertia0,
+                    &b.rot_1,
+                    &b.vel_1,
+                    vdot,
+                    &normals,
+                    &diag,
+                    &upper,
+                    &lower,
+                    &rhs,
+                ],
+            )
+        };
+        let g = DynamicGroups {
+            predict_unknown: predict(&b.vdot_k),
+            predict_candidate: predict(&b.vdot_c),
+            accelerate: bind(
+                ctx,
+                &pl.accelerate,
+                "accelerate",
+                &[&chain_dims, &basis, &b.vdot_k, &delta, &b.alpha, &b.vdot_c],
+            ),
+            scale: bind(
+                ctx,
+                &pl.scale,
+                "scale",
+                &[&chain_dims, &mass, &b.vdot_k, &b.scale],
+            ),
+            beam: bind(
+                ctx,
+                &pl.beam,
+                "beam",
+                &[
+                    &beam_dims,
+                    &b.u_1,
+                    &b.rot_1,
+                    &frames,
+                    &sections,
+                    &chords,
+                    &elem_force,
+                    &elem_tangent,
+                ],
+            ),
+            sites: bind(
+                ctx,
+                &pl.sites,
+                "sites",
+                &[
+                    &sites_dims,
+                    &pair_node,
+                    &b.u_1,
+                    &pair_state,
+                    &b.vel_1,
+                    &normals,
+                ],
+            ),
+            contact: bind(
+                ctx,
+                &pl.contact,
+                "contact",
+                &[
+                    &contact_dims,
+                    &normals,
+                    &params,
+                    &pair_state,
+                    &values,
+                    &flags_out,
+                ],
+            ),
+            assemble_unknown: assemble(&b.vdot_k),
+            assemble_candidate: assemble(&b.vdot_c),
+            lu: lu_dims
+                .iter()
+                .map(|d| {
+                    bind(
+                        ctx,
+                        &pl.block_lu,
+                        "block_lu",
+                        &[
+                            d, &diag, &upper, &lower, &rhs, &work_x, &work_z, &delta, &b.status,
+                        ],
+                    )
+                })
+                .collect(),
+            norms_iterate: bind(
+                ctx,
+                &pl.norms,
+                "norms",
+                &[&chain_dims, &delta, &ones, &rhs, &b.norms],
+            ),
+            norms_trial: bind(
+                ctx,
+                &pl.norms,
+                "norms",
+                &[&chain_dims, &delta, &b.alpha, &rhs, &b.norms],
+            ),
+        };
+        let keep = vec![
+            sections,
+            frames,
+            chords,
+            basis,
+            fixed,
+            node_site,
+            pair_node,
+            normals,
+            pair_state,
+            params,
+            f_ext,
+            mass,
+            inertia0,
+            elem_force,
+            elem_tangent,
+            values,
+            flags_out,
+            diag,
+            upper,
+            lower,
+            rhs,
+            work_x,
+            work_z,
+            delta,
+            ones,
+            chain_dims,
+            beam_dims,
+            sites_dims,
+            contact_dims,
+            assemble_dims,
+        ]
+        .into_iter()
+        .chain(lu_dims)
+        .collect();
+        Ok(GpuDynamic {
+            ctx,
+            p: pl,
+            g,
+            b,
+            num_variants: v,
+            num_nodes: n,
+            num_elements: m,
+            num_pairs: p,
+            a0: T::from_f64_lossy(dynamic.a0),
+            _keep: keep,
+            _real: PhantomData,
+        })
+    }
+
+    /// Records predict (at the unknown or the candidate), beam, sites, contact, assembly.
+    fn record_evaluate(&self, pass: &mut wgpu::ComputePass, candidate: bool) {
+        let (v, g, p) = (self.num_variants, &self.g, &self.p);
+        let (predict, assemble) = if candidate {
+            (&g.predict_candidate, &g.assemble_candidate)
+        } else {
+            (&g.predict_unknown, &g.assemble_unknown)
+        };
+        dispatch(pass, &p.predict, predict, self.num_nodes * v);
+        dispatch(pass, &p.beam, &g.beam, self.num_elements * v);
+        dispatch(pass, &p.sites, &g.sites, self.num_pairs);
+        dispatch(pass, &p.contact, &g.contact, self.num_pairs);
+        dispatch(pass, &p.assemble, assemble, self.num_nodes * v);
+    }
+
+    fn copy_all(encoder: &mut wgpu::CommandEncoder, pairs: &[(&wgpu::Buffer, &wgpu::Buffer)]) {
+        for (from, to) in pairs {
+            encoder.copy_buffer_to_buffer(from, 0, to, 0, from.size());
+        }
+    }
+}
+
+impl<T: GpuReal> crate::engine::dynamic::DynamicEnsemble<T> for GpuDynamic<T> {
+    fn begin_step(
+        &mut self,
+        c: &crate::kernels::dynamics::StepCoefficients<T>,
+        top: &[T],
+    ) -> Result<(), String> {
+        let q = &self.ctx.queue;
+        let (hg, hhb) = crate::engine::dynamic::options_coefficients(c);
+        q.write_buffer(&self.b.coef, 0, bytemuck::cast_slice(&c.reals()[..]));
+        q.write_buffer(&self.b.flags, 0, bytemuck::cast_slice(&[c.flags()]));
+        q.write_buffer(&self.b.top, 0, bytemuck::cast_slice(top));
+        q.write_buffer(
+            &self.b.dyn_coef,
+            0,
+            bytemuck::cast_slice(&[hg, hhb, self.a0]),
+        );
+        let mut e = encoder(self.ctx, "begin_step");
+        Self::copy_all(&mut e, &[(&self.b.vdot_n, &self.b.vdot_k)]);
+        q.submit([e.finish()]);
+        Ok(())
+    }
+
+    fn iterate(&mut self) -> Result<crate::engine::dynamic::Iteration<T>, String> {
+        let v = self.num_variants;
+        self.ctx
+            .queue
+            .write_buffer(&self.b.status, 0, bytemuck::cast_slice(&vec![RUNNING; v]));
+        let mut e = encoder(self.ctx, "iterate");
+        {
+            let mut pass = e.begin_compute_pass(&Default::default());
+            self.record_evaluate(&mut pass, false);
+            for group in &self.g.lu {
+                dispatch(&mut pass, &self.p.block_lu, group, v);
+            }
+            dispatch(&mut pass, &self.p.norms, &self.g.norms_iterate, v);
+            dispatch(&mut pass, &self.p.scale, &self.g.scale, v);
+        }
+        let size = std::mem::size_of::<T>() as u64;
+        let out = submit_and_read(
+            self.ctx,
+            e,
+            &[
+                (&self.b.norms, 4 * v as u64 * size),
+                (&self.b.status, 4 * v as u64),
+                (&self.b.scale, v as u64 * size),
+            ],
+        )
+        .map_err(|e| e.to_string())?;
+        let status: Vec<u32> = bytemuck::cast_slice(&out[1]).to_vec();
+        if status.contains(&RUNNING) {
+            return Err("block solve: a dispatch did not complete (status left at running)".into());
+        }
+        Ok(crate::engine::dynamic::Iteration {
+            norms: norms_from_bytes(&out[0]),
+            status,
+            inertial: bytemuck::cast_slice(&out[2]).to_vec(),
+        })
+    }
+
+    fn trial(&mut self, alpha: &[T]) -> Result<Norms<T>, String> {
+        let v = self.num_variants;
+        self.ctx
+            .queue
+            .write_buffer(&self.b.alpha, 0, bytemuck::cast_slice(alpha));
+        let mut e = encoder(self.ctx, "trial");
+        {
+            let mut pass = e.begin_compute_pass(&Default::default());
+            dispatch(
+                &mut pass,
+                &self.p.accelerate,
+                &self.g.accelerate,
+                self.num_nodes * v,
+            );
+            self.record_evaluate(&mut pass, true);
+            dispatch(&mut pass, &self.p.norms, &self.g.norms_trial, v);
+        }
+        let size = std::mem::size_of::<T>() as u64;
+        let out = submit_and_read(self.ctx, e, &[(&self.b.norms, 4 * v as u64 * size)])
+            .map_err(|e| e.to_string())?;
+        Ok(norms_from_bytes(&out[0]))
+    }
+
+    fn correct(&mut self, alpha: &[T]) -> Result<(), String> {
+        self.ctx
+            .queue
+            .write_buffer(&self.b.alpha, 0, bytemuck::cast_slice(alpha));
+        let mut e = encoder(self.ctx, "correct");
+        {
+            let mut pass = e.begin_compute_pass(&Default::default());
+            dispatch(
+                &mut pass,
+                &self.p.accelerate,
+                &self.g.accelerate,
+                self.num_nodes * self.num_variants,
+            );
+        }
+        Self::copy_all(&mut e, &[(&self.b.vdot_c, &self.b.vdot_k)]);
+        self.ctx.queue.submit([e.finish()]);
+        Ok(())
+    }
+
+    fn end_step(&mut self) -> Result<(), String> {
+        let mut e = encoder(self.ctx, "end_step");
+        {
+            let mut pass = e.begin_compute_pass(&Default::default());
+            dispatch(
+                &mut pass,
+                &self.p.predict,
+                &self.g.predict_unknown,
+                self.num_nodes * self.num_variants,
+            );
+        }
+        let b = &self.b;
+        Self::copy_all(
+            &mut e,
+            &[
+                (&b.u_1, &b.u_n),
+                (&b.rot_1, &b.rot_n),
+                (&b.vel_1, &b.vel_n),
+                (&b.acc_1, &b.acc_n),
+                (&b.vdot_k, &b.vdot_n),
+            ],
+        );
+        self.ctx.queue.submit([e.finish()]);
+        Ok(())
+    }
+
+    fn state(&mut self) -> Result<crate::kernels::dynamics::DynamicBatch<T>, String> {
+        let (v, n) = (self.num_variants, self.num_nodes);
+        let size = std::mem::size_of::<T>() as u64;
+        let nv = (n * v) as u64 * size;
+        let b = &self.b;
+        let out = submit_and_read(
+            self.ctx,
+            encoder(self.ctx, "state"),
+            &[
+                (&b.u_n, 3 * nv),
+                (&b.rot_n, 9 * nv),
+                (&b.vel_n, 6 * nv),
+                (&b.acc_n, 6 * nv),
+                (&b.vdot_n, 6 * nv),
+            ],
+        )
+        .map_err(|e| e.to_string())?;
+        let cast = |bytes: &Vec<u8>| -> Vec<T> { bytemuck::cast_slice(bytes).to_vec() };
+        Ok(crate::kernels::dynamics::DynamicBatch {
+            num_variants: v,
+            num_nodes: n,
+            u: cast(&out[0]),
+            rot: cast(&out[1]),
+            vel: cast(&out[2]),
+            acc: cast(&out[3]),
+            vdot: cast(&out[4]),
+        })
+    }
 }

@@ -7,6 +7,7 @@ pub mod compose;
 pub mod contact;
 pub mod context;
 pub mod dispatch;
+pub mod dynamics;
 pub mod ensemble;
 pub mod layout;
 pub mod update;

@@ -24,7 +24,7 @@
 use rayon::prelude::*;
 
 use crate::kernels::block_lu::ChainBatch;
-use crate::kernels::contact::{OUT_G, OUT_K};
+use crate::kernels::contact::{OUT_C, OUT_C_OMEGA, OUT_G, OUT_K};
 use crate::physics::Real;
 
 /// No contact site at a node.
@@ -55,6 +55,31 @@ pub struct AssemblyInputs<T> {
     pub basis: Vec<T>,
     /// Fixed-DOF bit mask per node (bit `d`: DOF `d` in the basis), `n`, shared.
     pub fixed: Vec<u32>,
+    /// The dynamic terms (`None`: the static residual and tangent).
+    pub dynamic: Option<DynamicInputs<T>>,
+}
+
+/// What the dynamic assembly adds (generalised-α iteration matrix
+/// `S = M + hγ' C_t + h²β' K_t` and the inertial residual; lumped mass, as
+/// `solve::dynamics` with `mass = "lumped"` and mass-proportional Rayleigh damping on the
+/// translations).
+#[derive(Clone, Debug, PartialEq)]
+pub struct DynamicInputs<T> {
+    /// `[hγ', h²β', a0]` (`γ' = γ(1−α_f)/(1−α_m)`, `β'` likewise; `a0` Rayleigh's mass
+    /// factor).
+    pub coefficients: [T; 3],
+    /// Nodal mass, `n`.
+    pub mass: Vec<T>,
+    /// Nodal rotary inertia at the reference orientation (row-major), `9 n`.
+    pub inertia0: Vec<T>,
+    /// Rotations, `9 n V`.
+    pub rot: Vec<T>,
+    /// Velocities (ẋ, spatial ω), `6 n V`.
+    pub vel: Vec<T>,
+    /// Accelerations v̇, `6 n V`.
+    pub vdot: Vec<T>,
+    /// Hole axis per contact pair, `3 S V` (for the spin's damping column `c_ω nᵀ`).
+    pub pair_normals: Vec<T>,
 }
 
 /// `block ← diag(B_a, I)ᵀ · block · diag(B_b, I)`: rows of node `a`, then columns of node `b`.
@@ -142,6 +167,85 @@ fn node_blocks<T: Real>(
                 for c in 0..3 {
                     d[6 * k + c] = d[6 * k + c] + a.contact[(OUT_K + 3 * k + c) * pairs + p];
                 }
+            }
+        }
+    }
+    if let Some(dy) = &a.dynamic {
+        let [hg, hhb, a0] = dy.coefficients;
+        for k in 0..36 {
+            d[k] = hhb * d[k];
+            u[k] = hhb * u[k];
+            l[k] = hhb * l[k];
+        }
+        if s != NO_SITE {
+            let p = s as usize * nv + v;
+            if a.contact_flag[p] != 0 {
+                for k in 0..6 {
+                    for c in 0..3 {
+                        d[6 * k + c] =
+                            d[6 * k + c] + hg * a.contact[(OUT_C + 3 * k + c) * pairs + p];
+                        d[6 * k + 3 + c] = d[6 * k + 3 + c]
+                            + hg * a.contact[(OUT_C_OMEGA + k) * pairs + p]
+                                * dy.pair_normals[3 * p + c];
+                    }
+                }
+            }
+        }
+        // J = R J0 Rᵀ.
+        let rot = |r: usize, c: usize| dy.rot[(9 * i + 3 * r + c) * nv + v];
+        let mut rj = [[T::zero(); 3]; 3];
+        for r in 0..3 {
+            for c in 0..3 {
+                for k in 0..3 {
+                    rj[r][c] = rj[r][c] + rot(r, k) * dy.inertia0[9 * i + 3 * k + c];
+                }
+            }
+        }
+        let mut j = [[T::zero(); 3]; 3];
+        for r in 0..3 {
+            for c in 0..3 {
+                for k in 0..3 {
+                    j[r][c] = j[r][c] + rj[r][k] * rot(c, k);
+                }
+            }
+        }
+        let m = dy.mass[i];
+        let vel = |k: usize| dy.vel[(6 * i + k) * nv + v];
+        let acc = |k: usize| dy.vdot[(6 * i + k) * nv + v];
+        let w = [vel(3), vel(4), vel(5)];
+        let mut jw = [T::zero(); 3];
+        let mut jwd = [T::zero(); 3];
+        for r in 0..3 {
+            for k in 0..3 {
+                jw[r] = jw[r] + j[r][k] * w[k];
+                jwd[r] = jwd[r] + j[r][k] * acc(3 + k);
+            }
+        }
+        let gyro = [
+            w[1] * jw[2] - w[2] * jw[1],
+            w[2] * jw[0] - w[0] * jw[2],
+            w[0] * jw[1] - w[1] * jw[0],
+        ];
+        let skew = |x: [T; 3]| -> [[T; 3]; 3] {
+            let z = T::zero();
+            [
+                [z, z - x[2], x[1]],
+                [x[2], z, z - x[0]],
+                [z - x[1], x[0], z],
+            ]
+        };
+        let (sw, sjw) = (skew(w), skew(jw));
+        for k in 0..3 {
+            r[k] = r[k] + m * acc(k) + a0 * m * vel(k);
+            r[3 + k] = r[3 + k] + jwd[k] + gyro[k];
+            d[6 * k + k] = d[6 * k + k] + m + hg * a0 * m;
+            for c in 0..3 {
+                // ∂(ω × Jω)/∂ω = [ω]× J − [Jω]×.
+                let mut swj = T::zero();
+                for q in 0..3 {
+                    swj = swj + sw[k][q] * j[q][c];
+                }
+                d[6 * (3 + k) + 3 + c] = d[6 * (3 + k) + 3 + c] + j[k][c] + hg * (swj - sjw[k][c]);
             }
         }
     }

@@ -10,11 +10,13 @@
 //! | `shaders/update.wgsl` | [`update`] |
 //! | `shaders/beam.wgsl` | [`beam`] |
 //! | `shaders/sites.wgsl` | [`sites`] |
+//! | `shaders/dynamics.wgsl` | [`dynamics`] |
 
 pub mod assemble;
 pub mod beam;
 pub mod block_lu;
 pub mod contact;
+pub mod dynamics;
 pub mod sites;
 pub mod update;
 
@@ -26,4 +28,5 @@ pub const TWINS: &[(&str, &str)] = &[
     ("update.wgsl", "src/kernels/update.rs"),
     ("beam.wgsl", "src/kernels/beam.rs"),
     ("sites.wgsl", "src/kernels/sites.rs"),
+    ("dynamics.wgsl", "src/kernels/dynamics.rs"),
 ];

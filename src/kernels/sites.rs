@@ -6,6 +6,9 @@
 //! 3–6, the wall-relative velocity and spin, are the host's: they do not depend on the
 //! configuration in a static solve). `pair_node[i]` is the pair's node, so a variant may
 //! carry its stabilizers at other nodes than its neighbours.
+//!
+//! [`gather_sites_dynamic`] (the kernel's DYNAMIC form) also writes the node's velocity
+//! and its spin about the hole axis, `n · ω` (as `solve::dynamics`).
 
 use crate::physics::Real;
 
@@ -23,5 +26,29 @@ pub fn gather_sites<T: Real>(
         for k in 0..3 {
             pair_state[k * p + i] = u[(3 * node + k) * num_variants + v];
         }
+    }
+}
+
+/// As [`gather_sites`], and fields 3–6 from the node velocities `vel` (`6 n V`: ẋ, ω) and
+/// the pairs' hole axes `pair_normals` (`3 P`): `v = ẋ`, `omega = n · ω`.
+pub fn gather_sites_dynamic<T: Real>(
+    pair_node: &[u32],
+    pair_normals: &[T],
+    u: &[T],
+    vel: &[T],
+    num_variants: usize,
+    pair_state: &mut [T],
+) {
+    gather_sites(pair_node, u, num_variants, pair_state);
+    let p = pair_node.len();
+    for i in 0..p {
+        let v = i % num_variants;
+        let node = pair_node[i] as usize;
+        let mut spin = T::zero();
+        for k in 0..3 {
+            pair_state[(3 + k) * p + i] = vel[(6 * node + k) * num_variants + v];
+            spin = spin + pair_normals[3 * i + k] * vel[(6 * node + 3 + k) * num_variants + v];
+        }
+        pair_state[6 * p + i] = spin;
     }
 }

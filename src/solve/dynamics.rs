@@ -219,6 +219,25 @@ impl<'a> Dynamics<'a> {
         }
     }
 
+    /// The force scale of the convergence test (the loads, or the internal forces of the
+    /// initial state if larger; set by [`Self::initial_state`]).
+    pub fn reference_force(&self) -> f64 {
+        self.f_ref
+    }
+
+    /// Lumped nodal masses and rotary inertias (reference orientation, global axes).
+    pub fn lumped(&self) -> (&[f64], &[Mat3<f64>]) {
+        (&self.mass, &self.inertia0)
+    }
+
+    /// Whether the table turns the top node, and whether the hook lowers it.
+    pub fn top_motion(&self) -> (bool, bool) {
+        (
+            self.table_driven(),
+            self.options.rop != 0.0 && matches!(self.model.top, crate::model::TopBoundary::Clamped),
+        )
+    }
+
     /// Rotary-table angle, speed and acceleration at `t` (ramp from rest).
     pub fn table(&self, t: f64) -> (f64, f64, f64) {
         ramp(self.model.rotation_speed, self.options.ramp_time, t)

@@ -96,6 +96,13 @@ pub trait KernelPath<T> {
         model: &'a Model,
         tables: &EnsembleTables<T>,
     ) -> Result<Box<dyn Ensemble<T> + 'a>, String>;
+    /// Uploads a chunk for a dynamic run.
+    fn open_dynamic<'a>(
+        &'a self,
+        model: &'a Model,
+        tables: &EnsembleTables<T>,
+        dynamic: &dynamic::DynamicTables<T>,
+    ) -> Result<Box<dyn dynamic::DynamicEnsemble<T> + 'a>, String>;
 }
 
 /// The CPU twins, f64.
@@ -133,6 +140,7 @@ impl TwinEnsemble<'_> {
             f_ext: self.f_ext.clone(),
             basis: t.basis.clone(),
             fixed: t.fixed.clone(),
+            dynamic: None,
         }));
     }
 
@@ -221,6 +229,14 @@ impl KernelPath<f64> for TwinPath {
             delta: vec![0.0; 6 * tables.num_nodes * tables.num_variants],
         }))
     }
+    fn open_dynamic<'a>(
+        &'a self,
+        model: &'a Model,
+        tables: &EnsembleTables<f64>,
+        dynamic: &dynamic::DynamicTables<f64>,
+    ) -> Result<Box<dyn dynamic::DynamicEnsemble<f64> + 'a>, String> {
+        Ok(Box::new(self.dynamic(model, tables, dynamic)))
+    }
 }
 
 /// The WGSL kernels on the shared GPU context, resident per chunk
@@ -238,6 +254,16 @@ impl<T: crate::gpu::contact::GpuReal> KernelPath<T> for GpuPath {
     ) -> Result<Box<dyn Ensemble<T> + 'a>, String> {
         crate::gpu::ensemble::GpuEnsemble::new(self.0, model, tables)
             .map(|e| Box::new(e) as Box<dyn Ensemble<T> + 'a>)
+            .map_err(|e| e.to_string())
+    }
+    fn open_dynamic<'a>(
+        &'a self,
+        model: &'a Model,
+        tables: &EnsembleTables<T>,
+        dynamic: &dynamic::DynamicTables<T>,
+    ) -> Result<Box<dyn dynamic::DynamicEnsemble<T> + 'a>, String> {
+        crate::gpu::ensemble::GpuDynamic::new(self.0, model, tables, dynamic)
+            .map(|e| Box::new(e) as Box<dyn dynamic::DynamicEnsemble<T> + 'a>)
             .map_err(|e| e.to_string())
     }
 }
@@ -263,7 +289,7 @@ pub struct EngineResult {
 }
 
 /// An error unless every model shares the first one's mesh and number of sites.
-fn check_same_mesh(models: &[Model]) -> Result<(), String> {
+pub(crate) fn check_same_mesh(models: &[Model]) -> Result<(), String> {
     let base = models.first().ok_or("no variants")?;
     for m in models {
         if m.nodes.len() != base.nodes.len()
@@ -606,4 +632,14 @@ impl<T, P: KernelPath<T>> KernelPath<T> for Chunked<P> {
     ) -> Result<Box<dyn Ensemble<T> + 'a>, String> {
         self.inner.open(model, tables)
     }
+    fn open_dynamic<'a>(
+        &'a self,
+        model: &'a Model,
+        tables: &EnsembleTables<T>,
+        dynamic: &dynamic::DynamicTables<T>,
+    ) -> Result<Box<dyn dynamic::DynamicEnsemble<T> + 'a>, String> {
+        self.inner.open_dynamic(model, tables, dynamic)
+    }
 }
+
+pub mod dynamic;
