@@ -128,8 +128,7 @@ fn grid_dynamic_ensemble_writes_variants_and_series() {
     assert_eq!(csv.lines().count(), 3);
     assert!(out.join("series/1/timeseries.csv").exists());
     assert!(out.join("whirl.png").exists());
-    // Dynamic ensembles in f32 or on the GPU engine are refused plainly (not built yet),
-    // before any output.
+    // f32 on the CPU backend is refused plainly (it is the f64 oracle), before any output.
     let out2 = dir.join("out2");
     let e = run(
         &path,
@@ -141,15 +140,51 @@ fn grid_dynamic_ensemble_writes_variants_and_series() {
     )
     .unwrap_err();
     assert_eq!(e.exit_code(), 2);
-    assert!(run(
-        &path,
-        None,
-        BackendChoice::Gpu,
-        Precision::F64,
-        &out2,
-        false
-    )
-    .is_err());
+    // The GPU engine: the same quantities of interest as the CPU integrator's runs.
+    if common::gpu().is_some() {
+        let out3 = dir.join("out3");
+        let g = run(
+            &path,
+            None,
+            BackendChoice::Gpu,
+            Precision::F64,
+            &out3,
+            false,
+        )
+        .unwrap();
+        assert_eq!(
+            (g.backend.as_str(), g.variants, g.failed, g.step_cut),
+            ("gpu", 2, 0, 0)
+        );
+        let read = |p: &std::path::Path| -> Vec<Vec<String>> {
+            std::fs::read_to_string(p.join("variants.csv"))
+                .unwrap()
+                .lines()
+                .map(|l| l.split(',').map(String::from).collect())
+                .collect()
+        };
+        let (a, b) = (read(&out3), read(&out));
+        assert_eq!(a[0], b[0]);
+        let mut worst: f64 = 0.0;
+        let mut compared = 0;
+        for (ra, rb) in a.iter().zip(&b).skip(1) {
+            for (k, (x, y)) in ra.iter().zip(rb).enumerate() {
+                let name = &a[0][k];
+                if name == "newton_iterations" || name == "reason" {
+                    continue;
+                }
+                match (x.parse::<f64>(), y.parse::<f64>()) {
+                    (Ok(x), Ok(y)) => {
+                        worst = worst.max((x - y).abs() / y.abs().max(1e-9));
+                        compared += 1;
+                    }
+                    _ => assert_eq!(x, y, "{name}"),
+                }
+            }
+        }
+        eprintln!("dynamic grid, GPU engine vs CPU integrator: {compared} quantities, worst relative difference {worst:.2e}");
+        assert!(worst <= 1e-6, "{worst:e}");
+    }
     assert!(!out2.exists());
 }
 

@@ -19,7 +19,7 @@ use crate::backend::{BackendChoice, Precision};
 use crate::case::{load_case, Analysis, Case};
 use crate::cli::static_cmd::{fe_rows, neutral_point, neutral_point_of, nodal_axial_forces};
 use crate::ensemble::{apply, stabilizer_sites, variants_from_csv, variants_from_grid, Variant};
-use crate::error::{Error, GpuError, InputError};
+use crate::error::{Error, InputError};
 use crate::model::Model;
 use crate::output::write_atomic;
 use crate::physics::vec3::{dot, scale, sub};
@@ -247,6 +247,154 @@ pub fn run_static_gpu<T: crate::gpu::contact::GpuReal>(
     ))
 }
 
+/// The `[dynamics]` runs of every variant through the GPU engine (in `T`): static starts
+/// through the static engine, then lockstep generalised-α steps, every step observed for
+/// the quantities of interest. A variant that fails on the GPU (static start or a step)
+/// re-runs on the CPU with step control (its reason says so). `Err` with the reason when
+/// the case needs what only the CPU integrator has (consistent mass, stiffness-
+/// proportional damping): the caller runs the CPU then.
+pub fn run_dynamic_gpu<T: crate::gpu::contact::GpuReal>(
+    case: &Case,
+    variants: &[Variant],
+    ctx: &'static crate::gpu::GpuContext,
+    bar: &indicatif::ProgressBar,
+) -> Result<Result<Vec<VariantResult>, String>, Error> {
+    use crate::engine::dynamic::{run_dynamic_ensemble, unsupported, DynamicStatus};
+    use crate::engine::{solve_static_ensemble, EngineStatus, GpuPath};
+    let Some(settings) = case.dynamics.clone() else {
+        return Ok(Err("no [dynamics] table".into()));
+    };
+    let options = super::run_cmd::options_for(&settings);
+    if let Some(why) = unsupported(&options) {
+        return Ok(Err(why));
+    }
+    let models: Vec<Model> = variants
+        .iter()
+        .map(|v| apply(case, v))
+        .collect::<Result<_, _>>()
+        .map_err(|e| Error::Io(std::io::Error::other(e)))?;
+    if models
+        .iter()
+        .any(|m| m.sites.len() != case.model.sites.len())
+    {
+        return Ok(Err(
+            "the variants differ in their number of contact sites".into()
+        ));
+    }
+    let path = GpuPath(ctx);
+    let statics = solve_static_ensemble::<T, _>(&models, &path, &StaticOptions::default())
+        .map_err(|e| Error::Io(std::io::Error::other(format!("GPU engine: {e}"))))?;
+    // Variants whose static start failed on the GPU run wholly on the CPU.
+    let on_gpu: Vec<usize> = (0..models.len())
+        .filter(|&j| statics[j].status == EngineStatus::Converged)
+        .collect();
+    let gpu_models: Vec<Model> = on_gpu.iter().map(|&j| models[j].clone()).collect();
+    let starts: Vec<_> = on_gpu.iter().map(|&j| statics[j].state.clone()).collect();
+    let density = &case.element_density;
+    let mut cpu: Vec<Dynamics> = gpu_models
+        .iter()
+        .map(|m| Dynamics::new(m, options, &|e| density[e]))
+        .collect();
+    let mut observers: Vec<DynamicObserver> = gpu_models
+        .iter()
+        .map(|m| DynamicObserver::new(m, settings.duration))
+        .collect();
+    let mut last: Vec<Option<DynamicState>> = vec![None; gpu_models.len()];
+    for (j, (d, q)) in cpu.iter_mut().zip(&starts).enumerate() {
+        if let Ok(s) = d.initial_state(q.clone()) {
+            observers[j].observe(&gpu_models[j], d, &s);
+            last[j] = Some(s);
+        }
+    }
+    let results = run_dynamic_ensemble::<T, _>(
+        &gpu_models,
+        &starts,
+        density,
+        &path,
+        &options,
+        settings.duration,
+        1,
+        &mut |first, t, batch| {
+            let (v, n) = (batch.num_variants, batch.num_nodes);
+            for j in 0..v {
+                let g = first + j;
+                let Some(state) = last[g].as_mut() else {
+                    continue;
+                };
+                let m = &gpu_models[g];
+                state.t = t;
+                for i in 0..n {
+                    for k in 0..3 {
+                        state.q.x[i][k] =
+                            m.nodes[i].position[k] + batch.u[(3 * i + k) * v + j].to_f64_lossy();
+                    }
+                    for r in 0..3 {
+                        for c in 0..3 {
+                            state.q.rot[i][r][c] =
+                                batch.rot[(9 * i + 3 * r + c) * v + j].to_f64_lossy();
+                        }
+                    }
+                    for k in 0..6 {
+                        let idx = (6 * i + k) * v + j;
+                        state.v[6 * i + k] = batch.vel[idx].to_f64_lossy();
+                        state.a[6 * i + k] = batch.acc[idx].to_f64_lossy();
+                        state.vdot[6 * i + k] = batch.vdot[idx].to_f64_lossy();
+                    }
+                }
+                observers[g].observe(m, &cpu[g], state);
+            }
+            bar.set_position(((t / settings.duration) * variants.len() as f64) as u64);
+        },
+    )
+    .map_err(|e| Error::Io(std::io::Error::other(format!("GPU engine: {e}"))))?;
+    let mut out: Vec<Option<VariantResult>> = vec![None; models.len()];
+    for ((&j, ((r, obs), state)), d) in on_gpu
+        .iter()
+        .zip(results.into_iter().zip(observers).zip(last))
+        .zip(&cpu)
+    {
+        let name = &variants[j].name;
+        out[j] = Some(match (r.status, state) {
+            (DynamicStatus::Finished, Some(state)) => {
+                obs.finish(case, name, &models[j], &state, &d.log, &r.iterations)
+            }
+            (status, _) => {
+                let why = match status {
+                    DynamicStatus::Failed(t, why) => format!("failed at t = {t:.6} s: {why}"),
+                    DynamicStatus::Finished => "no initial state".into(),
+                };
+                let mut again = dynamic_variant(case, name, &models[j]);
+                again.reason = format!("GPU: {why}; re-run on the CPU: {}", again.reason);
+                if again.status == Status::Converged {
+                    again.status = Status::StepCut;
+                }
+                again
+            }
+        });
+    }
+    Ok(Ok(out
+        .into_iter()
+        .enumerate()
+        .map(|(j, r)| {
+            r.unwrap_or_else(|| {
+                let why = match &statics[j].status {
+                    EngineStatus::Failed(w) => w.clone(),
+                    EngineStatus::Converged => String::new(),
+                };
+                let mut again = dynamic_variant(case, &variants[j].name, &models[j]);
+                again.reason = format!(
+                    "GPU static start: {why}; re-run on the CPU: {}",
+                    again.reason
+                );
+                if again.status == Status::Converged {
+                    again.status = Status::StepCut;
+                }
+                again
+            })
+        })
+        .collect()))
+}
+
 /// The `[dynamics]` run of one variant's model from its static equilibrium.
 pub fn dynamic_variant(case: &Case, name: &str, model: &Model) -> VariantResult {
     let stabs = stabilizer_sites(model);
@@ -264,40 +412,8 @@ pub fn dynamic_variant(case: &Case, name: &str, model: &Model) -> VariantResult 
         Ok(s) => s,
         Err(e) => return failed(name, format!("initial state: {e}"), stabs.len()),
     };
-    let mut qoi = vec![StabilizerQoi::default(); stabs.len()];
-    let mut angles: Vec<Vec<(f64, f64)>> = vec![Vec::new(); stabs.len()];
-    let mut last_angle: Vec<Option<f64>> = vec![None; stabs.len()];
-    let mut unwrapped = vec![0.0; stabs.len()];
-    let mut max_torque: f64 = 0.0;
-    let half = 0.5 * settings.duration;
-    let mut observe = |d: &Dynamics, st: &DynamicState| {
-        max_torque = max_torque.max(element_axial(model, &st.q, 0).1.abs());
-        let contact = d.contact_forces(st);
-        for (j, &k) in stabs.iter().enumerate() {
-            let node = model.sites[k].node;
-            let (x, y) = lateral(model, &st.q, node);
-            let r = x.hypot(y);
-            qoi[j].max_lateral_m = qoi[j].max_lateral_m.max(r);
-            if r > 0.0 {
-                let g = &contact[k].g;
-                let nd = &model.nodes[node];
-                let d = sub(&st.q.x[node], &nd.position);
-                let d_t = sub(&d, &scale(&nd.hole_axis, dot(&d, &nd.hole_axis)));
-                let normal = dot(&[g[0], g[1], g[2]], &d_t) / r;
-                qoi[j].max_side_force_n = qoi[j].max_side_force_n.max(normal);
-            }
-            let a = y.atan2(x);
-            if let Some(l) = last_angle[j] {
-                let mut da = a - l;
-                da -= std::f64::consts::TAU * (da / std::f64::consts::TAU).round();
-                unwrapped[j] += da;
-            }
-            last_angle[j] = Some(a);
-            if st.t >= half && r > 1e-6 {
-                angles[j].push((st.t, unwrapped[j]));
-            }
-        }
-    };
+    let mut observer = DynamicObserver::new(model, settings.duration);
+    let mut observe = |d: &Dynamics, st: &DynamicState| observer.observe(model, d, st);
     observe(&dynamics, &s);
     let result = dynamics.run(&mut s, settings.duration, &mut observe);
     let cuts = dynamics.log.iter().filter(|l| l.contains("cut to")).count();
@@ -306,42 +422,115 @@ pub fn dynamic_variant(case: &Case, name: &str, model: &Model) -> VariantResult 
         f.step_cuts = cuts;
         return f;
     }
-    if s.v.iter().any(|x| !x.is_finite()) {
-        return failed(name, "state is not finite".into(), stabs.len());
+    observer.finish(case, name, model, &s, &dynamics.log, &dynamics.iterations)
+}
+
+/// The quantities of interest of a dynamic run, accumulated step by step (the CPU
+/// integrator's and the GPU engine's runs feed the same observer).
+pub struct DynamicObserver {
+    stabs: Vec<usize>,
+    qoi: Vec<StabilizerQoi>,
+    angles: Vec<Vec<(f64, f64)>>,
+    last_angle: Vec<Option<f64>>,
+    unwrapped: Vec<f64>,
+    max_torque: f64,
+    half: f64,
+}
+
+impl DynamicObserver {
+    /// For a run of `duration` seconds (whirl is fitted over its second half).
+    pub fn new(model: &Model, duration: f64) -> Self {
+        let stabs = stabilizer_sites(model);
+        let k = stabs.len();
+        DynamicObserver {
+            stabs,
+            qoi: vec![StabilizerQoi::default(); k],
+            angles: vec![Vec::new(); k],
+            last_angle: vec![None; k],
+            unwrapped: vec![0.0; k],
+            max_torque: 0.0,
+            half: 0.5 * duration,
+        }
     }
-    let sign = if model.rotation_speed < 0.0 {
-        -1.0
-    } else {
-        1.0
-    };
-    for (j, pts) in angles.iter().enumerate() {
-        if pts.len() >= 3 {
-            let nm = pts.len() as f64;
-            let (mt, ma) = pts
-                .iter()
-                .fold((0.0, 0.0), |(a, b), (t, x)| (a + t / nm, b + x / nm));
-            let den: f64 = pts.iter().map(|(t, _)| (t - mt).powi(2)).sum();
-            if den > 0.0 {
-                let rate = pts.iter().map(|(t, x)| (t - mt) * (x - ma)).sum::<f64>() / den;
-                // Lateral angles are measured about the node's frame0 (e2, e3) = about
-                // the hole axis, the direction of a positive rotation speed.
-                qoi[j].whirl_hz = Some(sign * rate / std::f64::consts::TAU);
+
+    /// Takes one state in.
+    pub fn observe(&mut self, model: &Model, d: &Dynamics, st: &DynamicState) {
+        self.max_torque = self.max_torque.max(element_axial(model, &st.q, 0).1.abs());
+        let contact = d.contact_forces(st);
+        for (j, &k) in self.stabs.iter().enumerate() {
+            let node = model.sites[k].node;
+            let (x, y) = lateral(model, &st.q, node);
+            let r = x.hypot(y);
+            let qoi = &mut self.qoi[j];
+            qoi.max_lateral_m = qoi.max_lateral_m.max(r);
+            if r > 0.0 {
+                let g = &contact[k].g;
+                let nd = &model.nodes[node];
+                let d = sub(&st.q.x[node], &nd.position);
+                let d_t = sub(&d, &scale(&nd.hole_axis, dot(&d, &nd.hole_axis)));
+                let normal = dot(&[g[0], g[1], g[2]], &d_t) / r;
+                qoi.max_side_force_n = qoi.max_side_force_n.max(normal);
+            }
+            let a = y.atan2(x);
+            if let Some(l) = self.last_angle[j] {
+                let mut da = a - l;
+                da -= std::f64::consts::TAU * (da / std::f64::consts::TAU).round();
+                self.unwrapped[j] += da;
+            }
+            self.last_angle[j] = Some(a);
+            if st.t >= self.half && r > 1e-6 {
+                self.angles[j].push((st.t, self.unwrapped[j]));
             }
         }
     }
-    let axial: Vec<f64> = (0..model.elements.len())
-        .map(|i| element_axial(model, &s.q, i).0)
-        .collect();
-    let md: Vec<f64> = model.nodes.iter().map(|n| n.md).collect();
-    let np = neutral_point_of(&md, &nodal_axial_forces(&axial));
-    finished(
-        name,
-        &dynamics.log,
-        &dynamics.iterations,
-        np.map(|x| case.bit_md - x),
-        max_torque,
-        qoi,
-    )
+
+    /// The variant's result from its final state.
+    pub fn finish(
+        mut self,
+        case: &Case,
+        name: &str,
+        model: &Model,
+        last: &DynamicState,
+        log: &[String],
+        iterations: &[usize],
+    ) -> VariantResult {
+        if last.v.iter().any(|x| !x.is_finite()) {
+            return failed(name, "state is not finite".into(), self.stabs.len());
+        }
+        let sign = if model.rotation_speed < 0.0 {
+            -1.0
+        } else {
+            1.0
+        };
+        for (j, pts) in self.angles.iter().enumerate() {
+            if pts.len() >= 3 {
+                let nm = pts.len() as f64;
+                let (mt, ma) = pts
+                    .iter()
+                    .fold((0.0, 0.0), |(a, b), (t, x)| (a + t / nm, b + x / nm));
+                let den: f64 = pts.iter().map(|(t, _)| (t - mt).powi(2)).sum();
+                if den > 0.0 {
+                    let rate = pts.iter().map(|(t, x)| (t - mt) * (x - ma)).sum::<f64>() / den;
+                    // Lateral angles are measured about the node's frame0 (e2, e3) = about
+                    // the hole axis, the direction of a positive rotation speed.
+                    self.qoi[j].whirl_hz = Some(sign * rate / std::f64::consts::TAU);
+                }
+            }
+        }
+        let axial: Vec<f64> = (0..model.elements.len())
+            .map(|i| element_axial(model, &last.q, i).0)
+            .collect();
+        let md: Vec<f64> = model.nodes.iter().map(|n| n.md).collect();
+        let np = neutral_point_of(&md, &nodal_axial_forces(&axial));
+        finished(
+            name,
+            log,
+            iterations,
+            np.map(|x| case.bit_md - x),
+            self.max_torque,
+            self.qoi,
+        )
+    }
 }
 
 /// Runs every variant on the CPU (rayon over variants); results in variant order.
@@ -512,7 +701,6 @@ pub fn run(
     }
     if precision == Precision::F32 {
         let why = match (backend, analysis) {
-            (_, Analysis::Dynamic) => Some("f32 runs static ensembles on the GPU engine; dynamic ensembles compute in f64 on the CPU for now; use --precision f64"),
             (BackendChoice::Cpu, _) => Some("the CPU backend computes in f64 (it is the oracle the GPU is tested against); f32 runs on --backend gpu or auto"),
             _ => None,
         };
@@ -526,25 +714,15 @@ pub fn run(
             .into());
         }
     }
-    // The GPU engine runs static ensembles; dynamic ones run on the CPU for now.
-    let gpu = match (backend, analysis) {
-        (BackendChoice::Cpu, _) => None,
-        (BackendChoice::Gpu, Analysis::Dynamic) => {
-            return Err(GpuError::Unsupported(
-                "dynamic ensembles on the GPU (the generalised-α update in WGSL) are not built yet; use --backend cpu".into(),
-            )
-            .into())
-        }
-        (BackendChoice::Gpu, Analysis::Static) => Some(crate::gpu::GpuContext::shared()?),
-        (BackendChoice::Auto, Analysis::Dynamic) => {
-            eprintln!("holewall: dynamic ensembles run on the CPU (f64) for now");
-            None
-        }
+    // The GPU engine, where asked for (or, with auto, where a hardware adapter has f64).
+    let gpu = match backend {
+        BackendChoice::Cpu => None,
+        BackendChoice::Gpu => Some(crate::gpu::GpuContext::shared()?),
         // f32 was asked for: only the GPU engine computes in f32, whatever the adapter.
-        (BackendChoice::Auto, Analysis::Static) if precision == Precision::F32 => {
+        BackendChoice::Auto if precision == Precision::F32 => {
             Some(crate::gpu::GpuContext::shared()?)
         }
-        (BackendChoice::Auto, Analysis::Static) => match crate::gpu::GpuContext::shared() {
+        BackendChoice::Auto => match crate::gpu::GpuContext::shared() {
             Ok(ctx) if ctx.info.device_type == wgpu::DeviceType::Cpu => {
                 eprintln!(
                     "holewall: the only adapter ({}) is a software renderer; running the variants on the CPU (f64), which is faster there",
@@ -554,7 +732,9 @@ pub fn run(
             }
             Ok(ctx) if ctx.has_f64 => Some(ctx),
             _ => {
-                eprintln!("holewall: no GPU adapter with f64; running the variants on the CPU (f64)");
+                eprintln!(
+                    "holewall: no GPU adapter with f64; running the variants on the CPU (f64)"
+                );
                 None
             }
         },
@@ -586,8 +766,8 @@ pub fn run(
     );
     let start = std::time::Instant::now();
     let mut backend_name = "cpu";
-    let results = match gpu {
-        Some(ctx) => match if precision == Precision::F32 {
+    let results = match (gpu, analysis) {
+        (Some(ctx), Analysis::Static) => match if precision == Precision::F32 {
             run_static_gpu::<f32>(&case, &variants, ctx, &bar)?
         } else {
             run_static_gpu::<f64>(&case, &variants, ctx, &bar)?
@@ -602,7 +782,31 @@ pub fn run(
                 run_variants_cpu(&case, analysis, &variants, &bar)
             }
         },
-        None => run_variants_cpu(&case, analysis, &variants, &bar),
+        (Some(ctx), Analysis::Dynamic) => match if precision == Precision::F32 {
+            run_dynamic_gpu::<f32>(&case, &variants, ctx, &bar)?
+        } else {
+            run_dynamic_gpu::<f64>(&case, &variants, ctx, &bar)?
+        } {
+            Ok(r) => {
+                backend_name = "gpu";
+                bar.set_position(variants.len() as u64);
+                r
+            }
+            Err(why) => {
+                if precision == Precision::F32 {
+                    return Err(InputError {
+                        source_name: "--precision".into(),
+                        line: 0,
+                        key: "precision".into(),
+                        message: format!("f32 runs on the GPU engine, which cannot run this case: {why}; use --precision f64"),
+                    }
+                    .into());
+                }
+                eprintln!("holewall: {why}; running the variants on the CPU");
+                run_variants_cpu(&case, analysis, &variants, &bar)
+            }
+        },
+        (None, _) => run_variants_cpu(&case, analysis, &variants, &bar),
     };
     let seconds = start.elapsed().as_secs_f64();
     bar.finish_and_clear();
