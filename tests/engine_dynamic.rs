@@ -98,7 +98,11 @@ fn bed_variants(csv: &str) -> (holewall::case::Case, Vec<Model>, Vec<StaticState
     let models: Vec<Model> = variants.iter().map(|v| apply(&case, v).unwrap()).collect();
     let starts = models
         .iter()
-        .map(|m| solve_static(m, &StaticOptions::default()).unwrap().state)
+        .map(|m| {
+            solve_static(m, &StaticOptions::default())
+                .map(|s| s.state)
+                .unwrap_or_else(|_| StaticState::initial(m))
+        })
         .collect();
     (case, models, starts)
 }
@@ -157,4 +161,274 @@ fn dynamic_ensemble_matches_the_cpu_integrator_step_for_step() {
         eprintln!("GPU f64 path vs CPU integrator: displacements {gu:.2e}, velocities {gv:.2e}");
         assert!(gu <= 1e-6 && gv <= 1e-6, "{gu:e}, {gv:e}");
     }
+}
+
+#[test]
+fn dynamic_kernels_equal_their_twins() {
+    use holewall::gpu::assemble::assemble_gpu;
+    use holewall::gpu::dynamics::{accelerate_gpu, inertial_scale_gpu, predict_gpu};
+    use holewall::kernels::assemble::{assemble, AssemblyInputs, DynamicInputs, NO_SITE};
+    use holewall::kernels::dynamics::{
+        accelerate, inertial_scale, predict, StepCoefficients, TOP_LEN,
+    };
+    use holewall::kernels::sites::gather_sites_dynamic;
+    use rand::{Rng, SeedableRng};
+    let mut rng = rand::rngs::StdRng::seed_from_u64(17);
+    let (n, v) = (30, 5);
+    let mut r = |lo: f64, hi: f64, len: usize| -> Vec<f64> {
+        (0..len).map(|_| rng.random_range(lo..hi)).collect()
+    };
+    // Rotations: exact ones from random rotation vectors.
+    let mut rot = vec![0.0; 9 * n * v];
+    let angles = r(-2.0, 2.0, 3 * n * v);
+    for idx in 0..n * v {
+        let (i, j) = (idx / v, idx % v);
+        let e = holewall::physics::beam::rotation_exp(&[
+            angles[3 * idx],
+            angles[3 * idx + 1],
+            angles[3 * idx + 2],
+        ]);
+        for a in 0..3 {
+            for c in 0..3 {
+                rot[(9 * i + 3 * a + c) * v + j] = e[a][c];
+            }
+        }
+    }
+    let state = DynamicBatch {
+        num_variants: v,
+        num_nodes: n,
+        u: r(-0.1, 0.1, 3 * n * v),
+        rot,
+        vel: r(-3.0, 3.0, 6 * n * v),
+        acc: r(-50.0, 50.0, 6 * n * v),
+        vdot: r(-50.0, 50.0, 6 * n * v),
+    };
+    let mut top = r(-1.0, 1.0, TOP_LEN * v);
+    for j in 0..v {
+        let e = holewall::physics::beam::rotation_exp(&[0.0, 0.0, 0.3 * j as f64]);
+        for (k, x) in e.iter().flatten().enumerate() {
+            top[k * v + j] = *x;
+        }
+    }
+    let c = StepCoefficients {
+        h: 2e-3,
+        alpha_m: 0.33,
+        alpha_f: 0.44,
+        beta: 0.3,
+        gamma: 0.61,
+        top_fixed: 0b111011,
+        driven: true,
+        lowered: true,
+    };
+    let vdot = r(-50.0, 50.0, 6 * n * v);
+    let mut twin_vdot = vdot.clone();
+    let mut twin = state.clone();
+    predict(&c, &top, &state, &mut twin_vdot, &mut twin);
+    assert_eq!(twin_vdot[5 * v], top[10 * v], "the table's φ̈ written");
+    assert_eq!(twin_vdot[v], 0.0, "a fixed DOF of the top is held");
+    // The rotation part against the CPU integrator's Rodrigues exponential.
+    let basis: Vec<f64> = (0..n)
+        .flat_map(|i| {
+            let e = holewall::physics::beam::rotation_exp(&[0.1 * i as f64, 0.2, -0.3]);
+            e.into_iter().flatten().collect::<Vec<f64>>()
+        })
+        .collect();
+    let delta = r(-1.0, 1.0, 6 * n * v);
+    let alpha = r(-1.0, 1.0, v);
+    let acc_twin = accelerate(&basis, &vdot, &delta, &alpha, n, v);
+    let mass = r(10.0, 500.0, n);
+    let scale_twin = inertial_scale(&mass, &vdot, n, v);
+    for j in 0..v {
+        let want = (0..n)
+            .flat_map(|i| (0..3).map(move |k| (i, k)))
+            .fold(0.0f64, |m, (i, k)| {
+                m.max((mass[i] * vdot[(6 * i + k) * v + j]).abs())
+            });
+        assert_eq!(scale_twin[j], want);
+    }
+    // Dynamic assembly inputs (random element and contact fields: the kernel only adds).
+    let s = 4;
+    let p = s * v;
+    let mut node_site = vec![NO_SITE; n * v];
+    let pair_node: Vec<u32> = (0..p).map(|i| (3 + 5 * (i / v)) as u32).collect();
+    for i in 0..p {
+        node_site[pair_node[i] as usize * v + i % v] = (i / v) as u32;
+    }
+    let pair_normals: Vec<f64> = (0..p).flat_map(|_| [0.0, 0.6, 0.8]).collect();
+    let mut pair_state = r(-1.0, 1.0, 7 * p);
+    gather_sites_dynamic(
+        &pair_node,
+        &pair_normals,
+        &state.u,
+        &state.vel,
+        v,
+        &mut pair_state,
+    );
+    let a = AssemblyInputs {
+        num_variants: v,
+        num_nodes: n,
+        num_sites: s,
+        elem_force: r(-1e4, 1e4, 12 * (n - 1) * v),
+        elem_tangent: r(-1e6, 1e6, 144 * (n - 1) * v),
+        contact: r(-1e3, 1e3, 48 * p),
+        contact_flag: (0..p).map(|i| (i % 3 != 0) as u32).collect(),
+        node_site,
+        f_ext: r(-1e3, 1e3, 6 * n * v),
+        basis: basis.clone(),
+        fixed: (0..n).map(|i| if i == 0 { 63 } else { 0 }).collect(),
+        dynamic: Some(DynamicInputs {
+            coefficients: [1.2e-3, 1.1e-6, 0.5],
+            mass: mass.clone(),
+            inertia0: r(0.1, 5.0, 9 * n),
+            rot: state.rot.clone(),
+            vel: state.vel.clone(),
+            vdot: vdot.clone(),
+            pair_normals: pair_normals.clone(),
+        }),
+    };
+    let asm_twin = assemble(&a);
+    let Some(ctx) = common::gpu() else { return };
+    if !ctx.has_f64 {
+        return;
+    }
+    let rel = |x: &[f64], y: &[f64]| {
+        x.iter()
+            .zip(y)
+            .fold(0.0f64, |m, (a, b)| m.max((a - b).abs() / b.abs().max(1.0)))
+    };
+    let gpu = predict_gpu(ctx, &c, &top, &state, &vdot).unwrap();
+    let d_pred = [
+        rel(&gpu.u, &twin.u),
+        rel(&gpu.rot, &twin.rot),
+        rel(&gpu.vel, &twin.vel),
+        rel(&gpu.acc, &twin.acc),
+        rel(&gpu.vdot, &twin_vdot),
+    ];
+    let d_acc = rel(
+        &accelerate_gpu(ctx, &basis, &vdot, &delta, &alpha, n, v).unwrap(),
+        &acc_twin,
+    );
+    let scale_gpu = inertial_scale_gpu(ctx, &mass, &vdot, n, v).unwrap();
+    let sites_gpu = holewall::gpu::ensemble::gather_sites_dynamic_gpu(
+        ctx,
+        &pair_node,
+        &pair_normals,
+        &state.u,
+        &state.vel,
+        v,
+        &r(-1.0, 1.0, 7 * p),
+    )
+    .unwrap();
+    let asm_gpu = assemble_gpu(ctx, &a).unwrap();
+    let d_asm = [
+        rel(&asm_gpu.diag, &asm_twin.diag),
+        rel(&asm_gpu.upper, &asm_twin.upper),
+        rel(&asm_gpu.lower, &asm_twin.lower),
+        rel(&asm_gpu.rhs, &asm_twin.rhs),
+    ];
+    eprintln!(
+        "GPU f64 vs twin: predict {d_pred:?}, accelerate {d_acc:.1e}, dynamic assembly {d_asm:?}"
+    );
+    assert!(d_pred.iter().chain(&d_asm).all(|&d| d <= 1e-12) && d_acc <= 1e-15);
+    assert_eq!(scale_gpu, scale_twin);
+    assert_eq!(sites_gpu, pair_state);
+}
+
+#[test]
+fn a_failing_variant_fails_alone_in_the_dynamic_engine() {
+    // The middle variant: a wall 1.7e4 times stiffer, started from the first variant's
+    // equilibrium pushed 2 cm further into the wall (terawatts of spring energy): its
+    // Newton cannot converge in a 2 ms step.
+    let (case, models, mut starts) =
+        bed_variants("mu,wob,k_e\n0.3,20 kN,6e7\n0.3,20 kN,1e12\n0.2,15 kN,6e7\n");
+    let mut pushed = starts[0].clone();
+    let m = &models[0];
+    let node = m.sites[m.sites.len() / 2].node;
+    let t = m.nodes[node].hole_axis;
+    let d: Vec<f64> = (0..3)
+        .map(|k| pushed.x[node][k] - m.nodes[node].position[k])
+        .collect();
+    let along: f64 = (0..3).map(|k| d[k] * t[k]).sum();
+    let lateral: Vec<f64> = (0..3).map(|k| d[k] - along * t[k]).collect();
+    let len = lateral.iter().map(|x| x * x).sum::<f64>().sqrt();
+    for x in pushed.x.iter_mut() {
+        for k in 0..3 {
+            x[k] += 0.02 * lateral[k] / len;
+        }
+    }
+    starts[1] = pushed;
+    let settings = case.dynamics.clone().unwrap();
+    let mut options = holewall::cli::run_cmd::options_for(&settings);
+    // The good variants converge in 3–10 iterations; fewer for the bad one to spend (each
+    // with up to 24 line-search trials) keeps the test short.
+    options.max_iterations = 12;
+    let t_end = 0.006;
+    let keep = |m: &[Model], s: &[StaticState]| -> (Vec<Model>, Vec<StaticState>) {
+        (
+            vec![m[0].clone(), m[2].clone()],
+            vec![s[0].clone(), s[2].clone()],
+        )
+    };
+    let (good_models, good_starts) = keep(&models, &starts);
+    let bits = |b: &DynamicBatch<f64>, j: usize| -> Vec<u64> {
+        let v = b.num_variants;
+        (0..b.u.len() / v)
+            .map(|k| b.u[k * v + j].to_bits())
+            .chain((0..b.vel.len() / v).map(|k| b.vel[k * v + j].to_bits()))
+            .collect()
+    };
+    let check = |path_name: &str,
+                 run: &dyn Fn(
+        &[Model],
+        &[StaticState],
+    ) -> (Vec<DynamicStatus>, DynamicBatch<f64>)| {
+        let (status, mixed) = run(&models, &starts);
+        let (good_status, alone) = run(&good_models, &good_starts);
+        eprintln!("{path_name}: failing variant: {:?}", status[1]);
+        assert!(matches!(status[1], DynamicStatus::Failed(..)));
+        assert_eq!(
+            good_status,
+            [DynamicStatus::Finished, DynamicStatus::Finished]
+        );
+        assert_eq!((&status[0], &status[2]), (&good_status[0], &good_status[1]));
+        assert_eq!(bits(&mixed, 0), bits(&alone, 0));
+        assert_eq!(bits(&mixed, 2), bits(&alone, 1));
+    };
+    let density = case.element_density.clone();
+    check("twin", &|m, s| {
+        collect(m, s, &density, &TwinPath, &options, t_end)
+    });
+    let Some(ctx) = common::gpu() else { return };
+    if ctx.has_f64 {
+        check("GPU f64", &|m, s| {
+            collect(m, s, &density, &GpuPath(ctx), &options, t_end)
+        });
+    }
+}
+
+/// Statuses and the last state of a dynamic engine run.
+fn collect<P: holewall::engine::KernelPath<f64>>(
+    models: &[Model],
+    starts: &[StaticState],
+    density: &[f64],
+    path: &P,
+    options: &holewall::solve::dynamics::DynamicOptions,
+    t_end: f64,
+) -> (Vec<DynamicStatus>, DynamicBatch<f64>) {
+    let mut last = None;
+    let status = run_dynamic_ensemble(
+        models,
+        starts,
+        density,
+        path,
+        options,
+        t_end,
+        1,
+        &mut |_, _, b: &DynamicBatch<f64>| last = Some(b.clone()),
+    )
+    .unwrap()
+    .into_iter()
+    .map(|r| r.status)
+    .collect();
+    (status, last.unwrap())
 }

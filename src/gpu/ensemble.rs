@@ -1327,3 +1327,62 @@ impl<T: GpuReal> crate::engine::dynamic::DynamicEnsemble<T> for GpuDynamic<T> {
         })
     }
 }
+
+/// Runs the DYNAMIC form of `shaders/sites.wgsl` once (tests against
+/// [`crate::kernels::sites::gather_sites_dynamic`]).
+pub fn gather_sites_dynamic_gpu<T: GpuReal>(
+    ctx: &'static GpuContext,
+    pair_node: &[u32],
+    pair_normals: &[T],
+    u: &[T],
+    vel: &[T],
+    num_variants: usize,
+    pair_state: &[T],
+) -> Result<Vec<T>, GpuError> {
+    require_precision::<T>(ctx)?;
+    let pipeline = ctx.pipeline("sites", &sites_wgsl_for(true, T::IS_F64)?)?;
+    let dims = ContactDims {
+        num_pairs: pair_node.len() as u32,
+        num_variants: num_variants as u32,
+        pair_offset: 0,
+        _pad: 0,
+    };
+    // Bindings: dims, pair_node, u, pair_state (read-write), vel, pair_normals — the
+    // read-write one sits between inputs, so bind by hand.
+    let device = &ctx.device;
+    let buf = |label: &str, bytes: &[u8], usage: wgpu::BufferUsages| {
+        device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some(label),
+            contents: bytes,
+            usage,
+        })
+    };
+    let st = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC;
+    let dims_b = buf(
+        "dims",
+        bytemuck::bytes_of(&dims),
+        wgpu::BufferUsages::UNIFORM,
+    );
+    let nodes_b = buf("pair_node", bytemuck::cast_slice(pair_node), st);
+    let u_b = buf("u", bytemuck::cast_slice(u), st);
+    let state_b = buf("pair_state", bytemuck::cast_slice(pair_state), st);
+    let vel_b = buf("vel", bytemuck::cast_slice(vel), st);
+    let normals_b = buf("pair_normals", bytemuck::cast_slice(pair_normals), st);
+    let group = bind(
+        ctx,
+        &pipeline,
+        "sites",
+        &[&dims_b, &nodes_b, &u_b, &state_b, &vel_b, &normals_b],
+    );
+    let mut e = encoder(ctx, "sites");
+    {
+        let mut pass = e.begin_compute_pass(&Default::default());
+        dispatch(&mut pass, &pipeline, &group, pair_node.len());
+    }
+    let out = submit_and_read(
+        ctx,
+        e,
+        &[(&state_b, std::mem::size_of_val(pair_state) as u64)],
+    )?;
+    Ok(bytemuck::cast_slice(&out[0]).to_vec())
+}
