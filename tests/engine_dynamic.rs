@@ -377,11 +377,7 @@ fn a_failing_variant_fails_alone_in_the_dynamic_engine() {
             .chain((0..b.vel.len() / v).map(|k| b.vel[k * v + j].to_bits()))
             .collect()
     };
-    let check = |path_name: &str,
-                 run: &dyn Fn(
-        &[Model],
-        &[StaticState],
-    ) -> (Vec<DynamicStatus>, DynamicBatch<f64>)| {
+    let check = |path_name: &str, run: &dyn Fn(&[Model], &[StaticState]) -> Outcome| {
         let (status, mixed) = run(&models, &starts);
         let (good_status, alone) = run(&good_models, &good_starts);
         eprintln!("{path_name}: failing variant: {:?}", status[1]);
@@ -407,6 +403,9 @@ fn a_failing_variant_fails_alone_in_the_dynamic_engine() {
 }
 
 /// Statuses and the last state of a dynamic engine run.
+type Outcome = (Vec<DynamicStatus>, DynamicBatch<f64>);
+
+/// Statuses and the last state of a dynamic engine run.
 fn collect<P: holewall::engine::KernelPath<f64>>(
     models: &[Model],
     starts: &[StaticState],
@@ -414,7 +413,7 @@ fn collect<P: holewall::engine::KernelPath<f64>>(
     path: &P,
     options: &holewall::solve::dynamics::DynamicOptions,
     t_end: f64,
-) -> (Vec<DynamicStatus>, DynamicBatch<f64>) {
+) -> Outcome {
     let mut last = None;
     let status = run_dynamic_ensemble(
         models,
