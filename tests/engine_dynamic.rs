@@ -402,7 +402,7 @@ fn a_failing_variant_fails_alone_in_the_dynamic_engine() {
     }
 }
 
-/// Statuses and the last state of a dynamic engine run.
+/// A run's statuses and its last state.
 type Outcome = (Vec<DynamicStatus>, DynamicBatch<f64>);
 
 /// Statuses and the last state of a dynamic engine run.
