@@ -106,6 +106,35 @@ enum BenchCommand {
         #[arg(long)]
         json: Option<PathBuf>,
     },
+    /// Variant-steps per second of dynamic ensembles (V variants × n nodes): CPU f64
+    /// integrator, GPU engine f64 and f32; bytes and FLOPs per Newton iteration; a
+    /// work-precision table.
+    Ensemble {
+        /// Nodes of the benchmark string (comma-separated).
+        #[arg(long, value_delimiter = ',', default_value = "100,400,1000")]
+        nodes: Vec<usize>,
+        /// Variants per ensemble (comma-separated).
+        #[arg(long, value_delimiter = ',', default_value = "1,16,256,4096")]
+        variants: Vec<usize>,
+        /// Time steps per run (2 ms each, from the static equilibrium).
+        #[arg(long, default_value_t = 5)]
+        steps: usize,
+        /// Timed repeats per cell (the median is reported).
+        #[arg(long, default_value_t = 3)]
+        repeats: usize,
+        /// Skip a cell whose time, estimated from smaller cells, exceeds this (s).
+        #[arg(long, default_value_t = 120.0)]
+        budget: f64,
+        /// CPU only (no GPU rows).
+        #[arg(long)]
+        cpu_only: bool,
+        /// Nodes of the work-precision runs (0: none).
+        #[arg(long, default_value_t = 100)]
+        precision_nodes: usize,
+        /// Also write the results as JSON here.
+        #[arg(long)]
+        json: Option<PathBuf>,
+    },
     /// Time steps per second and Newton iterations per step of `holewall run` (CPU f64).
     Dynamics {
         /// Case file with a `[dynamics]` table.
@@ -219,6 +248,28 @@ fn main() -> ExitCode {
                 backend,
                 json,
             } => match cli::bench::contact(pairs, repeats, backend, json.as_deref()) {
+                Ok(()) => ExitCode::SUCCESS,
+                Err(e) => fail(&[e]),
+            },
+            BenchCommand::Ensemble {
+                nodes,
+                variants,
+                steps,
+                repeats,
+                budget,
+                cpu_only,
+                precision_nodes,
+                json,
+            } => match cli::bench_ensemble::run(
+                &nodes,
+                &variants,
+                steps,
+                repeats,
+                budget,
+                !cpu_only,
+                precision_nodes,
+                json.as_deref(),
+            ) {
                 Ok(()) => ExitCode::SUCCESS,
                 Err(e) => fail(&[e]),
             },

@@ -161,6 +161,43 @@ fn dynamic_ensemble_matches_the_cpu_integrator_step_for_step() {
         eprintln!("GPU f64 path vs CPU integrator: displacements {gu:.2e}, velocities {gv:.2e}");
         assert!(gu <= 1e-6 && gv <= 1e-6, "{gu:e}, {gv:e}");
     }
+    // f32: the error against the f64 CPU runs, reported.
+    let mut seen32 = Vec::new();
+    let r32 = run_dynamic_ensemble::<f32, _>(
+        &models,
+        &starts,
+        &case.element_density,
+        &GpuPath(ctx),
+        &options,
+        t_end,
+        1,
+        &mut |_, t, s: &DynamicBatch<f32>| seen32.push((t, widen(s))),
+    )
+    .unwrap();
+    let (fu, fv) = trajectory_error(&engine_steps(&seen32, v, n), &cpu);
+    eprintln!(
+        "GPU f32 path vs CPU integrator: displacements {fu:.2e}, velocities {fv:.2e}; statuses {:?}",
+        r32.iter().map(|r| &r.status).collect::<Vec<_>>()
+    );
+    for r in &r32 {
+        assert_eq!(r.status, DynamicStatus::Finished);
+    }
+    // The f32 engine accepts residuals up to 1e4 ε₃₂ ≈ 1.2e-3 of the force scale.
+    assert!(fu <= 1.2e-3 && fv <= 1.2e-3, "{fu:e}, {fv:e}");
+}
+
+/// An f32 batch in f64.
+fn widen(b: &DynamicBatch<f32>) -> DynamicBatch<f64> {
+    let up = |x: &[f32]| x.iter().map(|&y| f64::from(y)).collect::<Vec<f64>>();
+    DynamicBatch {
+        num_variants: b.num_variants,
+        num_nodes: b.num_nodes,
+        u: up(&b.u),
+        rot: up(&b.rot),
+        vel: up(&b.vel),
+        acc: up(&b.acc),
+        vdot: up(&b.vdot),
+    }
 }
 
 #[test]
@@ -430,4 +467,123 @@ fn collect<P: holewall::engine::KernelPath<f64>>(
     .map(|r| r.status)
     .collect();
     (status, last.unwrap())
+}
+
+/// 16 variants (RPM × WOB) of the paper's one-stabilizer case (§3.1 dynamics: table ramped
+/// over 50 s, hook lowered at the ROP) for `HOLEWALL_PAPER_SECONDS` (default 1 s) on
+/// `HOLEWALL_PAPER_PATH` = `twin` (default) or `gpu` (f64; f32 reported beside it),
+/// against 16 CPU integrator runs, step for step. Minutes on two cores; run with
+/// `cargo test --release --test engine_dynamic -- --ignored --nocapture`.
+#[test]
+#[ignore]
+fn paper_case_sixteen_variants_match_the_cpu_integrator() {
+    let seconds: f64 = std::env::var("HOLEWALL_PAPER_SECONDS")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(1.0);
+    let gpu = std::env::var("HOLEWALL_PAPER_PATH").as_deref() == Ok("gpu");
+    let case = holewall::case::load_case(std::path::Path::new(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/cases/paper_one_stabilizer.toml"
+    )))
+    .unwrap();
+    let mut csv = String::from("rpm,wob\n");
+    for rpm in [60, 90, 120, 150] {
+        for wob in [60, 75, 89, 100] {
+            csv += &format!("{rpm} rpm,{wob} kN\n");
+        }
+    }
+    let variants = variants_from_csv_text("v.csv", &csv).unwrap();
+    let models: Vec<Model> = variants.iter().map(|v| apply(&case, v).unwrap()).collect();
+    let starts: Vec<StaticState> = models
+        .iter()
+        .map(|m| solve_static(m, &StaticOptions::default()).unwrap().state)
+        .collect();
+    let options = holewall::cli::run_cmd::options_for(case.dynamics.as_ref().unwrap());
+    let t0 = std::time::Instant::now();
+    let cpu = cpu_runs(&models, &starts, &case.element_density, &options, seconds);
+    let t_cpu = t0.elapsed().as_secs_f64();
+    let (v, n) = (models.len(), models[0].nodes.len());
+    let run = |f32_too: bool| -> (f64, f64, f64) {
+        let mut seen = Vec::new();
+        let t0 = std::time::Instant::now();
+        let r = if gpu {
+            let ctx = common::gpu().unwrap();
+            if f32_too {
+                let mut seen32 = Vec::new();
+                let r = run_dynamic_ensemble::<f32, _>(
+                    &models,
+                    &starts,
+                    &case.element_density,
+                    &GpuPath(ctx),
+                    &options,
+                    seconds,
+                    1,
+                    &mut |_, t, s: &DynamicBatch<f32>| seen32.push((t, s.clone())),
+                )
+                .unwrap();
+                let up = |x: &[f32]| x.iter().map(|&y| f64::from(y)).collect::<Vec<f64>>();
+                seen = seen32
+                    .into_iter()
+                    .map(|(t, b)| {
+                        (
+                            t,
+                            DynamicBatch {
+                                num_variants: b.num_variants,
+                                num_nodes: b.num_nodes,
+                                u: up(&b.u),
+                                rot: up(&b.rot),
+                                vel: up(&b.vel),
+                                acc: up(&b.acc),
+                                vdot: up(&b.vdot),
+                            },
+                        )
+                    })
+                    .collect();
+                r
+            } else {
+                run_dynamic_ensemble::<f64, _>(
+                    &models,
+                    &starts,
+                    &case.element_density,
+                    &GpuPath(ctx),
+                    &options,
+                    seconds,
+                    1,
+                    &mut |_, t, s: &DynamicBatch<f64>| seen.push((t, s.clone())),
+                )
+                .unwrap()
+            }
+        } else {
+            run_dynamic_ensemble(
+                &models,
+                &starts,
+                &case.element_density,
+                &TwinPath,
+                &options,
+                seconds,
+                1,
+                &mut |_, t, s: &DynamicBatch<f64>| seen.push((t, s.clone())),
+            )
+            .unwrap()
+        };
+        let elapsed = t0.elapsed().as_secs_f64();
+        for x in &r {
+            assert_eq!(x.status, DynamicStatus::Finished);
+        }
+        let (eu, ev) = trajectory_error(&engine_steps(&seen, v, n), &cpu);
+        (eu, ev, elapsed)
+    };
+    let (eu, ev, t_engine) = run(false);
+    eprintln!(
+        "paper case, {v} variants × {seconds} s ({} path, f64): displacements {eu:.2e}, velocities {ev:.2e} relative; engine {t_engine:.1} s, 16 CPU integrator runs {t_cpu:.1} s",
+        if gpu { "GPU" } else { "twin" }
+    );
+    assert!(eu <= 1e-6 && ev <= 1e-6, "{eu:e}, {ev:e}");
+    if gpu {
+        let (eu, ev, t32) = run(true);
+        eprintln!(
+            "paper case, GPU f32: displacements {eu:.2e}, velocities {ev:.2e} relative to the f64 CPU runs; {t32:.1} s"
+        );
+    }
 }

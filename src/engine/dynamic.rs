@@ -262,6 +262,29 @@ fn run_chunk<T: Real + Send + Sync, P: KernelPath<T>>(
             })
         })
         .collect();
+    // Convergence in the path's precision (as the static engine): in f32 the residual
+    // stalls near 1e-4 of the force scale, so a variant is converged when its correction
+    // is down at 100 ε₃₂ of its displacements and its residual below 1e4 ε₃₂.
+    let f32_path = std::mem::size_of::<T>() == 4;
+    let unit_roundoff = if f32_path {
+        f64::from(f32::EPSILON)
+    } else {
+        f64::EPSILON
+    };
+    let tolerance = options.tolerance.max(400.0 * unit_roundoff);
+    let small_residual = 1e-6f64.max(1e4 * unit_roundoff);
+    let step_floor: Vec<f64> = (0..v)
+        .map(|j| {
+            if f32_path {
+                let u_max = (0..3 * n).fold(0.0f64, |m, k| {
+                    m.max(dynamic.start.u[k * v + j].to_f64_lossy().abs())
+                });
+                100.0 * unit_roundoff * (1.0 + u_max)
+            } else {
+                1e-12 * length_scale[j]
+            }
+        })
+        .collect();
     let mut ensemble = path.open_dynamic(&models[0], &tables, &dynamic)?;
     let p = options.alpha;
     let ratio = (1.0 - p.alpha_f) / (1.0 - p.alpha_m);
@@ -341,8 +364,8 @@ fn run_chunk<T: Real + Send + Sync, P: KernelPath<T>>(
                     continue;
                 }
                 let step_norm = now.step_max[j].to_f64_lossy() * hhb;
-                converged[j] = measure <= options.tolerance
-                    || (step_norm <= 1e-12 * length_scale[j] && measure <= 1e-6);
+                converged[j] = measure <= tolerance
+                    || (step_norm <= step_floor[j] && measure <= small_residual);
                 alpha[j] = minus_one;
                 its[j] = it;
             }
