@@ -147,6 +147,12 @@ struct Report {
     work_precision: Vec<Precision>,
 }
 
+/// Positions per node of one variant.
+type Positions = Vec<[f64; 3]>;
+
+/// Newton iterations of a run, and every variant's final positions.
+type RunOutcome = (usize, Vec<Positions>);
+
 fn io(e: impl std::fmt::Display) -> Error {
     Error::Io(std::io::Error::other(e.to_string()))
 }
@@ -173,9 +179,9 @@ fn run_cpu(
     density: &[f64],
     options: &DynamicOptions,
     t_end: f64,
-) -> Result<(usize, Vec<Vec<[f64; 3]>>), Error> {
+) -> Result<RunOutcome, Error> {
     use rayon::prelude::*;
-    let out: Vec<Result<(usize, Vec<[f64; 3]>), String>> = models
+    let out: Vec<Result<(usize, Positions), String>> = models
         .par_iter()
         .map(|m| {
             let mut d = Dynamics::new(m, *options, &|e| density[e]);
@@ -202,7 +208,7 @@ fn run_gpu<T: GpuReal>(
     density: &[f64],
     options: &DynamicOptions,
     t_end: f64,
-) -> Result<(usize, Vec<Vec<[f64; 3]>>), Error> {
+) -> Result<RunOutcome, Error> {
     use crate::engine::dynamic::run_dynamic_ensemble;
     let starts = vec![start.clone(); models.len()];
     let steps = (t_end / options.dt).round() as usize;
@@ -244,7 +250,7 @@ fn run_gpu<T: GpuReal>(
 
 /// Largest displacement error of `xs` against `reference`, relative to the reference's
 /// largest displacement from `x0`.
-fn relative_error(xs: &[Vec<[f64; 3]>], reference: &[Vec<[f64; 3]>], x0: &[[f64; 3]]) -> f64 {
+fn relative_error(xs: &[Positions], reference: &[Positions], x0: &[[f64; 3]]) -> f64 {
     let mut scale: f64 = 0.0;
     let mut err: f64 = 0.0;
     for (a, b) in xs.iter().zip(reference) {
