@@ -64,10 +64,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
 
 #endif
 #if NORMS
-// NaN-propagating maximum: bit tests, as comparisons with NaN may be folded away.
-fn is_nan_or_inf(p: real) -> bool {
-    return (bitcast<u32>(f32(p)) & 0x7f800000u) == 0x7f800000u;
-}
+#include "shared/finite.wgsl"
 
 @compute @workgroup_size(64)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>) {

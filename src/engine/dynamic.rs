@@ -28,7 +28,7 @@ use crate::physics::Real;
 use crate::solve::dynamics::{DynamicOptions, Dynamics};
 use crate::solve::statics::StaticState;
 
-use super::{ensemble_tables, EnsembleTables, KernelPath, TwinPath};
+use super::{ensemble_tables, Convergence, EnsembleTables, KernelPath, TwinPath};
 
 /// What a dynamic chunk adds to [`EnsembleTables`].
 #[derive(Clone, Debug)]
@@ -254,37 +254,12 @@ fn run_chunk<T: Real + Send + Sync, P: KernelPath<T>>(
     } = dynamic_tables::<T>(models, starts, density, options)?;
     batch.pair_params = dynamic.pair_params.clone();
     tables.terms = batch.required_terms(models[0].friction, ContactMode::Dynamic);
-    let (v, n) = (tables.num_variants, tables.num_nodes);
-    let length_scale: Vec<f64> = (0..v)
-        .map(|j| {
-            1.0 + (0..3 * n).fold(0.0f64, |m, k| {
-                m.max((tables.node_ref[k] + dynamic.start.u[k * v + j].to_f64_lossy()).abs())
-            })
-        })
-        .collect();
-    // Convergence in the path's precision (as the static engine): in f32 the residual
-    // stalls near 1e-4 of the force scale, so a variant is converged when its correction
-    // is down at 100 ε₃₂ of its displacements and its residual below 1e4 ε₃₂.
-    let f32_path = std::mem::size_of::<T>() == 4;
-    let unit_roundoff = if f32_path {
-        f64::from(f32::EPSILON)
-    } else {
-        f64::EPSILON
-    };
-    let tolerance = options.tolerance.max(400.0 * unit_roundoff);
-    let small_residual = 1e-6f64.max(1e4 * unit_roundoff);
-    let step_floor: Vec<f64> = (0..v)
-        .map(|j| {
-            if f32_path {
-                let u_max = (0..3 * n).fold(0.0f64, |m, k| {
-                    m.max(dynamic.start.u[k * v + j].to_f64_lossy().abs())
-                });
-                100.0 * unit_roundoff * (1.0 + u_max)
-            } else {
-                1e-12 * length_scale[j]
-            }
-        })
-        .collect();
+    let v = tables.num_variants;
+    let Convergence {
+        tolerance,
+        small_residual,
+        step_floor,
+    } = Convergence::for_path::<T>(options.tolerance, &tables.node_ref, &dynamic.start.u, v);
     let mut ensemble = path.open_dynamic(&models[0], &tables, &dynamic)?;
     let p = options.alpha;
     let ratio = (1.0 - p.alpha_f) / (1.0 - p.alpha_m);

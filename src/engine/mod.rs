@@ -36,6 +36,56 @@ use crate::solve::statics::{
     constraint_tables, reference_force, split_loads, StaticOptions, StaticState,
 };
 
+/// The convergence tests of a kernel path in its precision, per variant.
+///
+/// In f64 as the CPU solvers: the residual below `tolerance`, or the step at rounding level
+/// (1e-12 of the largest coordinate) with the residual below 1e-6. In f32 the residual
+/// stalls near 1e-4 of the force scale (nodal sums of element forces of 1e5 N, and
+/// stiffnesses of 1e8 N/m times displacements rounded at 1e-8 m) and the steps at a few
+/// 1e-7 m: a variant is converged when its step is down at 100 ε₃₂ of its displacements and
+/// its residual below 1e4 ε₃₂ ≈ 1.2e-3 (the error this leaves is measured against f64 in
+/// tests/engine.rs and tests/engine_dynamic.rs).
+pub(crate) struct Convergence {
+    /// Residual (relative to the force scale) that converges on its own.
+    pub tolerance: f64,
+    /// Residual below which a step at `step_floor` converges.
+    pub small_residual: f64,
+    /// Per variant: a step (m) at rounding level.
+    pub step_floor: Vec<f64>,
+}
+
+impl Convergence {
+    /// For a path in `T`, `v` variants with displacements `u` from `node_ref`.
+    pub(crate) fn for_path<T: Real>(tolerance: f64, node_ref: &[f64], u: &[T], v: usize) -> Self {
+        let f32_path = std::mem::size_of::<T>() == 4;
+        let unit_roundoff = if f32_path {
+            f64::from(f32::EPSILON)
+        } else {
+            f64::EPSILON
+        };
+        let step_floor = (0..v)
+            .map(|j| {
+                let largest = |shift: bool| {
+                    (0..node_ref.len()).fold(0.0f64, |m, k| {
+                        let x = u[k * v + j].to_f64_lossy() + if shift { node_ref[k] } else { 0.0 };
+                        m.max(x.abs())
+                    })
+                };
+                if f32_path {
+                    100.0 * unit_roundoff * (1.0 + largest(false))
+                } else {
+                    1e-12 * (1.0 + largest(true))
+                }
+            })
+            .collect();
+        Convergence {
+            tolerance: tolerance.max(400.0 * unit_roundoff),
+            small_residual: 1e-6f64.max(1e4 * unit_roundoff),
+            step_floor,
+        }
+    }
+}
+
 /// What one chunk of variants shares and starts from, built once on the host.
 #[derive(Clone, Debug)]
 pub struct EnsembleTables<T> {
@@ -418,41 +468,13 @@ fn solve_chunk<T: Real + Send + Sync, P: KernelPath<T>>(
     let base = &models[0];
     let t = |x: f64| T::from_f64_lossy(x);
     let loads: Vec<(Vec<f64>, Vec<f64>)> = models.iter().map(split_loads).collect();
-    let length_scale: Vec<f64> = (0..v)
-        .map(|j| {
-            1.0 + (0..3 * n).fold(0.0f64, |m, k| {
-                m.max((tables.node_ref[k] + tables.start.x[k * v + j].to_f64_lossy()).abs())
-            })
-        })
-        .collect();
     let f_ref: Vec<f64> = models.iter().map(reference_force).collect();
     let p = tables.pair_node.len();
-    // Convergence in the path's precision. In f64 as the CPU solver. In f32 the residual
-    // stalls near 1e-4 of the reference force (nodal sums of element forces of 1e5 N, and
-    // stiffnesses of 1e8 N/m times displacements rounded at 1e-8 m) and the Newton steps at
-    // a few 1e-7 m: a variant is converged when its step is down at 100 ε₃₂ of its
-    // displacements and its residual below 1e4 ε₃₂ ≈ 1e-3 (the error this leaves in the
-    // quantities of interest is measured against f64 in tests/engine.rs).
-    let f32_path = std::mem::size_of::<T>() == 4;
-    let unit_roundoff = if f32_path {
-        f64::from(f32::EPSILON)
-    } else {
-        f64::EPSILON
-    };
-    let tolerance = options.tolerance.max(400.0 * unit_roundoff);
-    let small_residual = 1e-6f64.max(1e4 * unit_roundoff);
-    let step_floor: Vec<f64> = (0..v)
-        .map(|j| {
-            if f32_path {
-                let u_max = (0..3 * n).fold(0.0f64, |m, k| {
-                    m.max(tables.start.x[k * v + j].to_f64_lossy().abs())
-                });
-                100.0 * unit_roundoff * (1.0 + u_max)
-            } else {
-                1e-12 * length_scale[j]
-            }
-        })
-        .collect();
+    let Convergence {
+        tolerance,
+        small_residual,
+        step_floor,
+    } = Convergence::for_path::<T>(options.tolerance, &tables.node_ref, &tables.start.x, v);
     let mut ensemble = path.open(base, &tables)?;
     let mut status = vec![EngineStatus::Converged; v];
     let mut iterations = vec![Vec::new(); v];

@@ -55,6 +55,23 @@ pub fn passes(n: usize) -> Vec<(usize, usize, u32)> {
     passes
 }
 
+/// The uniform of every pass of [`passes`] for `v` variants.
+pub fn pass_dims(n: usize, v: usize) -> Vec<LuDims> {
+    passes(n)
+        .into_iter()
+        .map(|(begin, end, phase)| LuDims {
+            num_variants: v as u32,
+            num_nodes: n as u32,
+            begin: begin as u32,
+            end: end as u32,
+            phase,
+            _pad0: 0,
+            _pad1: 0,
+            _pad2: 0,
+        })
+        .collect()
+}
+
 /// Solves every variant of `batch` on the GPU. Returns the field-major solution and a
 /// status per variant, as [`crate::kernels::block_lu::block_lu`].
 pub fn block_lu_gpu<T: GpuReal>(
@@ -97,20 +114,7 @@ pub fn block_lu_gpu_chunked<T: GpuReal>(
             }
             out
         };
-        let passes = passes(n);
-        let uniforms: Vec<LuDims> = passes
-            .iter()
-            .map(|&(begin, end, phase)| LuDims {
-                num_variants: len as u32,
-                num_nodes: n as u32,
-                begin: begin as u32,
-                end: end as u32,
-                phase,
-                _pad0: 0,
-                _pad1: 0,
-                _pad2: 0,
-            })
-            .collect();
+        let uniforms = pass_dims(n, len);
         let uniform_bytes: Vec<&[u8]> = uniforms.iter().map(bytemuck::bytes_of).collect();
         let (diag, upper, lower, rhs) = (
             gather(&batch.diag, 36 * n),

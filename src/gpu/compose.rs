@@ -27,6 +27,10 @@ pub const SHADERS: &[(&str, &str)] = &[
         include_str!("../../shaders/shared/math_f64.wgsl"),
     ),
     (
+        "shared/finite.wgsl",
+        include_str!("../../shaders/shared/finite.wgsl"),
+    ),
+    (
         "shared/rotation_exp.wgsl",
         include_str!("../../shaders/shared/rotation_exp.wgsl"),
     ),

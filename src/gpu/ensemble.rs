@@ -17,7 +17,7 @@ use crate::engine::{Ensemble, EnsembleTables};
 use crate::error::GpuError;
 use crate::gpu::contact::{contact_wgsl, require_precision, GpuReal};
 use crate::gpu::dispatch::WORKGROUP;
-use crate::gpu::layout::{AssembleDims, BeamDims, ChainDims, ContactDims, LuDims};
+use crate::gpu::layout::{AssembleDims, BeamDims, ChainDims, ContactDims};
 use crate::gpu::GpuContext;
 use crate::kernels::contact::{OUTPUT_LEN, STATE_LEN};
 use crate::kernels::update::{ConfigBatch, Norms};
@@ -184,16 +184,50 @@ fn dispatch(
     pass.dispatch_workgroups(invocations.div_ceil(WORKGROUP) as u32, 1, 1);
 }
 
-impl<T: GpuReal> GpuEnsemble<T> {
-    /// Compiles (or fetches) the kernels for the chunk's terms and precision and uploads
-    /// its tables and start configuration.
-    pub fn new(
+/// The buffers every chunk has, static or dynamic: shared tables, contact and element
+/// work, the block solve's workspace and step, the per-variant scalars, and the uniforms.
+struct Common {
+    sections: wgpu::Buffer,
+    frames: wgpu::Buffer,
+    chords: wgpu::Buffer,
+    basis: wgpu::Buffer,
+    fixed: wgpu::Buffer,
+    node_site: wgpu::Buffer,
+    pair_node: wgpu::Buffer,
+    normals: wgpu::Buffer,
+    pair_state: wgpu::Buffer,
+    params: wgpu::Buffer,
+    f_ext: wgpu::Buffer,
+    elem_force: wgpu::Buffer,
+    elem_tangent: wgpu::Buffer,
+    values: wgpu::Buffer,
+    flags: wgpu::Buffer,
+    work_x: wgpu::Buffer,
+    work_z: wgpu::Buffer,
+    delta: wgpu::Buffer,
+    status: wgpu::Buffer,
+    ones: wgpu::Buffer,
+    alpha: wgpu::Buffer,
+    norms: wgpu::Buffer,
+    chain_dims: wgpu::Buffer,
+    beam_dims: wgpu::Buffer,
+    sites_dims: wgpu::Buffer,
+    contact_dims: wgpu::Buffer,
+    assemble_dims: wgpu::Buffer,
+    lu_dims: Vec<wgpu::Buffer>,
+}
+
+impl Common {
+    /// Checks the chunk against the adapter's limits and makes its common buffers; the
+    /// pair parameters and loads start as given (or empty, written per load step).
+    fn new<T: GpuReal>(
         ctx: &'static GpuContext,
         model: &Model,
         tables: &EnsembleTables<T>,
+        params: Option<&[T]>,
+        f_ext: Option<&[T]>,
     ) -> Result<Self, GpuError> {
         require_precision::<T>(ctx)?;
-        let f64 = T::IS_F64;
         let (v, n, s) = (tables.num_variants, tables.num_nodes, tables.num_sites);
         let (m, p) = (n.saturating_sub(1), tables.pair_node.len());
         let size = std::mem::size_of::<T>();
@@ -209,6 +243,136 @@ impl<T: GpuReal> GpuEnsemble<T> {
                 "norms of {n} nodes exceed one invocation's loop budget"
             )));
         }
+        let cast = |x: Vec<f64>| -> Vec<T> { x.into_iter().map(T::from_f64_lossy).collect() };
+        let table = |label: &str, x: Vec<f64>| storage(ctx, label, &cast(x));
+        let given = |label: &str, x: Option<&[T]>, len: usize| match x {
+            Some(x) => storage(ctx, label, x),
+            None => empty(ctx, label, len * size),
+        };
+        Ok(Common {
+            sections: table("sections", crate::kernels::beam::section_table(model)),
+            frames: table("frames", crate::kernels::beam::frame_table(model)),
+            chords: table("chords", crate::kernels::beam::chord_table(model)),
+            basis: storage(ctx, "basis", &tables.basis),
+            fixed: storage(ctx, "fixed", &tables.fixed),
+            node_site: storage(ctx, "node_site", &tables.node_site),
+            pair_node: storage(ctx, "pair_node", &tables.pair_node),
+            normals: storage(ctx, "pair_normals", &tables.pair_normals),
+            pair_state: storage(ctx, "pair_state", &tables.pair_state),
+            params: given("pair_params", params, PARAMS_LEN * p),
+            f_ext: given("f_ext", f_ext, 6 * n * v),
+            elem_force: empty(ctx, "elem_force", 12 * m * v * size),
+            elem_tangent: empty(ctx, "elem_tangent", 144 * m * v * size),
+            values: empty(ctx, "contact_values", OUTPUT_LEN * p * size),
+            flags: empty(ctx, "contact_flags", 4 * p),
+            work_x: empty(ctx, "lu_work", 36 * m.max(1) * v * size),
+            work_z: empty(ctx, "lu_work_z", 6 * n * v * size),
+            delta: empty(ctx, "delta", 6 * n * v * size),
+            status: empty(ctx, "status", 4 * v),
+            ones: storage(ctx, "ones", &vec![T::one(); v]),
+            alpha: empty(ctx, "alpha", v * size),
+            norms: empty(ctx, "norms", 4 * v * size),
+            chain_dims: uniform(
+                ctx,
+                "chain_dims",
+                &ChainDims {
+                    num_variants: v as u32,
+                    num_nodes: n as u32,
+                    _pad0: 0,
+                    _pad1: 0,
+                },
+            ),
+            beam_dims: uniform(
+                ctx,
+                "beam_dims",
+                &BeamDims {
+                    num_variants: v as u32,
+                    num_elements: m as u32,
+                    _pad0: 0,
+                    _pad1: 0,
+                },
+            ),
+            sites_dims: uniform(
+                ctx,
+                "sites_dims",
+                &ContactDims {
+                    num_pairs: p as u32,
+                    num_variants: v as u32,
+                    pair_offset: 0,
+                    _pad: 0,
+                },
+            ),
+            // The contact kernel sees one "variant" per site: every pair has its own axis.
+            contact_dims: uniform(
+                ctx,
+                "contact_dims",
+                &ContactDims {
+                    num_pairs: p as u32,
+                    num_variants: 1,
+                    pair_offset: 0,
+                    _pad: 0,
+                },
+            ),
+            assemble_dims: uniform(
+                ctx,
+                "assemble_dims",
+                &AssembleDims {
+                    num_variants: v as u32,
+                    num_nodes: n as u32,
+                    num_sites: s as u32,
+                    _pad: 0,
+                },
+            ),
+            lu_dims: crate::gpu::block_lu::pass_dims(n, v)
+                .iter()
+                .map(|d| uniform(ctx, "lu_dims", d))
+                .collect(),
+        })
+    }
+}
+
+impl<T: GpuReal> GpuEnsemble<T> {
+    /// Compiles (or fetches) the kernels for the chunk's terms and precision and uploads
+    /// its tables and start configuration.
+    pub fn new(
+        ctx: &'static GpuContext,
+        model: &Model,
+        tables: &EnsembleTables<T>,
+    ) -> Result<Self, GpuError> {
+        let f64 = T::IS_F64;
+        let (v, n) = (tables.num_variants, tables.num_nodes);
+        let (m, p) = (n.saturating_sub(1), tables.pair_node.len());
+        let size = std::mem::size_of::<T>();
+        let Common {
+            sections,
+            frames,
+            chords,
+            basis,
+            fixed,
+            node_site,
+            pair_node,
+            normals,
+            pair_state,
+            params,
+            f_ext,
+            elem_force,
+            elem_tangent,
+            values,
+            flags,
+            work_x,
+            work_z,
+            delta,
+            status,
+            ones,
+            alpha,
+            norms,
+            chain_dims,
+            beam_dims,
+            sites_dims,
+            contact_dims,
+            assemble_dims,
+            lu_dims,
+        } = Common::new(ctx, model, tables, None, None)?;
         let pipelines = Pipelines {
             beam: ctx.pipeline("beam", &crate::gpu::beam::beam_wgsl(f64)?)?,
             sites: ctx.pipeline("sites", &sites_wgsl(f64)?)?,
@@ -218,113 +382,6 @@ impl<T: GpuReal> GpuEnsemble<T> {
             norms: ctx.pipeline("norms", &crate::gpu::update::update_wgsl(true, f64)?)?,
             update: ctx.pipeline("update", &crate::gpu::update::update_wgsl(false, f64)?)?,
         };
-        let cast = |x: Vec<f64>| -> Vec<T> { x.into_iter().map(T::from_f64_lossy).collect() };
-        // Shared tables and per-chunk inputs.
-        let sections = storage(
-            ctx,
-            "sections",
-            &cast(crate::kernels::beam::section_table(model)),
-        );
-        let frames = storage(
-            ctx,
-            "frames",
-            &cast(crate::kernels::beam::frame_table(model)),
-        );
-        let basis = storage(ctx, "basis", &tables.basis);
-        let fixed = storage(ctx, "fixed", &tables.fixed);
-        let node_site = storage(ctx, "node_site", &tables.node_site);
-        let pair_node = storage(ctx, "pair_node", &tables.pair_node);
-        let chords = storage(
-            ctx,
-            "chords",
-            &cast(crate::kernels::beam::chord_table(model)),
-        );
-        let normals = storage(ctx, "pair_normals", &tables.pair_normals);
-        let pair_state = storage(ctx, "pair_state", &tables.pair_state);
-        let params = empty(ctx, "pair_params", PARAMS_LEN * p * size);
-        let f_ext = empty(ctx, "f_ext", 6 * n * v * size);
-        // Work shared by the slots.
-        let elem_force = empty(ctx, "elem_force", 12 * m * v * size);
-        let elem_tangent = empty(ctx, "elem_tangent", 144 * m * v * size);
-        let values = empty(ctx, "contact_values", OUTPUT_LEN * p * size);
-        let flags = empty(ctx, "contact_flags", 4 * p);
-        let work_x = empty(ctx, "lu_work", 36 * m.max(1) * v * size);
-        let work_z = empty(ctx, "lu_work_z", 6 * n * v * size);
-        let delta = empty(ctx, "delta", 6 * n * v * size);
-        let status = empty(ctx, "status", 4 * v);
-        let ones = storage(ctx, "ones", &vec![T::one(); v]);
-        let alpha = empty(ctx, "alpha", v * size);
-        let norms = empty(ctx, "norms", 4 * v * size);
-        let chain_dims = uniform(
-            ctx,
-            "chain_dims",
-            &ChainDims {
-                num_variants: v as u32,
-                num_nodes: n as u32,
-                _pad0: 0,
-                _pad1: 0,
-            },
-        );
-        let beam_dims = uniform(
-            ctx,
-            "beam_dims",
-            &BeamDims {
-                num_variants: v as u32,
-                num_elements: m as u32,
-                _pad0: 0,
-                _pad1: 0,
-            },
-        );
-        let sites_dims = uniform(
-            ctx,
-            "sites_dims",
-            &ContactDims {
-                num_pairs: p as u32,
-                num_variants: v as u32,
-                pair_offset: 0,
-                _pad: 0,
-            },
-        );
-        // The contact kernel sees one "variant" per site: every pair has its own axis.
-        let contact_dims = uniform(
-            ctx,
-            "contact_dims",
-            &ContactDims {
-                num_pairs: p as u32,
-                num_variants: 1,
-                pair_offset: 0,
-                _pad: 0,
-            },
-        );
-        let assemble_dims = uniform(
-            ctx,
-            "assemble_dims",
-            &AssembleDims {
-                num_variants: v as u32,
-                num_nodes: n as u32,
-                num_sites: s as u32,
-                _pad: 0,
-            },
-        );
-        let lu_dims: Vec<wgpu::Buffer> = crate::gpu::block_lu::passes(n)
-            .into_iter()
-            .map(|(begin, end, phase)| {
-                uniform(
-                    ctx,
-                    "lu_dims",
-                    &LuDims {
-                        num_variants: v as u32,
-                        num_nodes: n as u32,
-                        begin: begin as u32,
-                        end: end as u32,
-                        phase,
-                        _pad0: 0,
-                        _pad1: 0,
-                        _pad2: 0,
-                    },
-                )
-            })
-            .collect();
         let contact = bind(
             ctx,
             &pipelines.contact,
@@ -801,22 +858,46 @@ impl<T: GpuReal> GpuDynamic<T> {
         dynamic: &crate::engine::dynamic::DynamicTables<T>,
     ) -> Result<Self, GpuError> {
         use crate::gpu::dynamics::{dynamics_wgsl, DynamicsKernel};
-        require_precision::<T>(ctx)?;
         let f64 = T::IS_F64;
-        let (v, n, s) = (tables.num_variants, tables.num_nodes, tables.num_sites);
+        let (v, n) = (tables.num_variants, tables.num_nodes);
         let (m, p) = (n.saturating_sub(1), tables.pair_node.len());
         let size = std::mem::size_of::<T>();
-        if largest_binding_per_variant(n, s, size) * v > ctx.max_binding_bytes() as usize {
-            return Err(GpuError::Unsupported(format!(
-                "{v} variants of {n} nodes exceed one binding of {} bytes; split the variants",
-                ctx.max_binding_bytes()
-            )));
-        }
-        if 6 * n > 60_000 {
-            return Err(GpuError::Unsupported(format!(
-                "norms of {n} nodes exceed one invocation's loop budget"
-            )));
-        }
+        let Common {
+            sections,
+            frames,
+            chords,
+            basis,
+            fixed,
+            node_site,
+            pair_node,
+            normals,
+            pair_state,
+            params,
+            f_ext,
+            elem_force,
+            elem_tangent,
+            values,
+            flags: flags_out,
+            work_x,
+            work_z,
+            delta,
+            status,
+            ones,
+            alpha,
+            norms,
+            chain_dims,
+            beam_dims,
+            sites_dims,
+            contact_dims,
+            assemble_dims,
+            lu_dims,
+        } = Common::new(
+            ctx,
+            model,
+            tables,
+            Some(&dynamic.pair_params),
+            Some(&dynamic.f_ext),
+        )?;
         let pl = DynamicPipelines {
             predict: ctx.pipeline("predict", &dynamics_wgsl(DynamicsKernel::Predict, f64)?)?,
             accelerate: ctx.pipeline(
@@ -834,53 +915,21 @@ impl<T: GpuReal> GpuDynamic<T> {
             block_lu: ctx.pipeline("block_lu", &crate::gpu::block_lu::block_lu_wgsl(f64)?)?,
             norms: ctx.pipeline("norms", &crate::gpu::update::update_wgsl(true, f64)?)?,
         };
-        let cast = |x: Vec<f64>| -> Vec<T> { x.into_iter().map(T::from_f64_lossy).collect() };
-        let sections = storage(
-            ctx,
-            "sections",
-            &cast(crate::kernels::beam::section_table(model)),
-        );
-        let frames = storage(
-            ctx,
-            "frames",
-            &cast(crate::kernels::beam::frame_table(model)),
-        );
-        let chords = storage(
-            ctx,
-            "chords",
-            &cast(crate::kernels::beam::chord_table(model)),
-        );
-        let basis = storage(ctx, "basis", &tables.basis);
-        let fixed = storage(ctx, "fixed", &tables.fixed);
-        let node_site = storage(ctx, "node_site", &tables.node_site);
-        let pair_node = storage(ctx, "pair_node", &tables.pair_node);
-        let normals = storage(ctx, "pair_normals", &tables.pair_normals);
-        let pair_state = storage(ctx, "pair_state", &tables.pair_state);
-        let params = storage(ctx, "pair_params", &dynamic.pair_params);
-        let f_ext = storage(ctx, "f_ext", &dynamic.f_ext);
         let mass = storage(ctx, "mass", &dynamic.mass);
         let inertia0 = storage(ctx, "inertia0", &dynamic.inertia0);
-        let elem_force = empty(ctx, "elem_force", 12 * m * v * size);
-        let elem_tangent = empty(ctx, "elem_tangent", 144 * m * v * size);
-        let values = empty(ctx, "contact_values", OUTPUT_LEN * p * size);
-        let flags_out = empty(ctx, "contact_flags", 4 * p);
         let diag = empty(ctx, "diag", 36 * n * v * size);
         let upper = empty(ctx, "upper", 36 * m.max(1) * v * size);
         let lower = empty(ctx, "lower", 36 * m.max(1) * v * size);
         let rhs = empty(ctx, "rhs", 6 * n * v * size);
-        let work_x = empty(ctx, "lu_work", 36 * m.max(1) * v * size);
-        let work_z = empty(ctx, "lu_work_z", 6 * n * v * size);
-        let delta = empty(ctx, "delta", 6 * n * v * size);
-        let ones = storage(ctx, "ones", &vec![T::one(); v]);
         let st = &dynamic.start;
         let b = DynamicBuffers {
             coef: empty(ctx, "coef", 5 * size),
             flags: empty(ctx, "step_flags", 4),
             top: empty(ctx, "top", crate::kernels::dynamics::TOP_LEN * v * size),
             dyn_coef: empty(ctx, "dyn_coef", 3 * size),
-            alpha: empty(ctx, "alpha", v * size),
-            status: empty(ctx, "status", 4 * v),
-            norms: empty(ctx, "norms", 4 * v * size),
+            alpha,
+            status,
+            norms,
             scale: empty(ctx, "scale", v * size),
             u_n: storage(ctx, "u_n", &st.u),
             rot_n: storage(ctx, "rot_n", &st.rot),
@@ -894,75 +943,6 @@ impl<T: GpuReal> GpuDynamic<T> {
             vel_1: storage(ctx, "vel_1", &st.vel),
             acc_1: storage(ctx, "acc_1", &st.acc),
         };
-        let chain_dims = uniform(
-            ctx,
-            "chain_dims",
-            &ChainDims {
-                num_variants: v as u32,
-                num_nodes: n as u32,
-                _pad0: 0,
-                _pad1: 0,
-            },
-        );
-        let beam_dims = uniform(
-            ctx,
-            "beam_dims",
-            &BeamDims {
-                num_variants: v as u32,
-                num_elements: m as u32,
-                _pad0: 0,
-                _pad1: 0,
-            },
-        );
-        let sites_dims = uniform(
-            ctx,
-            "sites_dims",
-            &ContactDims {
-                num_pairs: p as u32,
-                num_variants: v as u32,
-                pair_offset: 0,
-                _pad: 0,
-            },
-        );
-        let contact_dims = uniform(
-            ctx,
-            "contact_dims",
-            &ContactDims {
-                num_pairs: p as u32,
-                num_variants: 1,
-                pair_offset: 0,
-                _pad: 0,
-            },
-        );
-        let assemble_dims = uniform(
-            ctx,
-            "assemble_dims",
-            &AssembleDims {
-                num_variants: v as u32,
-                num_nodes: n as u32,
-                num_sites: s as u32,
-                _pad: 0,
-            },
-        );
-        let lu_dims: Vec<wgpu::Buffer> = crate::gpu::block_lu::passes(n)
-            .into_iter()
-            .map(|(begin, end, phase)| {
-                uniform(
-                    ctx,
-                    "lu_dims",
-                    &LuDims {
-                        num_variants: v as u32,
-                        num_nodes: n as u32,
-                        begin: begin as u32,
-                        end: end as u32,
-                        phase,
-                        _pad0: 0,
-                        _pad1: 0,
-                        _pad2: 0,
-                    },
-                )
-            })
-            .collect();
         let predict = |vdot: &wgpu::Buffer| {
             bind(
                 ctx,
