@@ -90,16 +90,11 @@ pub struct GpuEnsemble<T: GpuReal> {
     slots: [Slot; 2],
     current: usize,
     contact: wgpu::BindGroup,
-    f_ext: wgpu::Buffer,
-    params: wgpu::Buffer,
-    alpha: wgpu::Buffer,
-    status: wgpu::Buffer,
-    norms: wgpu::Buffer,
+    c: Common,
     num_variants: usize,
     num_nodes: usize,
     num_elements: usize,
     num_pairs: usize,
-    _keep: Vec<wgpu::Buffer>,
     _real: PhantomData<T>,
 }
 
@@ -218,6 +213,110 @@ struct Common {
 }
 
 impl Common {
+    /// The beam kernel's bind group on configuration (`x`, `rot`).
+    fn beam_group(
+        &self,
+        ctx: &GpuContext,
+        pipeline: &wgpu::ComputePipeline,
+        x: &wgpu::Buffer,
+        rot: &wgpu::Buffer,
+    ) -> wgpu::BindGroup {
+        bind(
+            ctx,
+            pipeline,
+            "beam",
+            &[
+                &self.beam_dims,
+                x,
+                rot,
+                &self.frames,
+                &self.sections,
+                &self.chords,
+                &self.elem_force,
+                &self.elem_tangent,
+            ],
+        )
+    }
+
+    /// The contact kernel's bind group.
+    fn contact_group(&self, ctx: &GpuContext, pipeline: &wgpu::ComputePipeline) -> wgpu::BindGroup {
+        bind(
+            ctx,
+            pipeline,
+            "contact",
+            &[
+                &self.contact_dims,
+                &self.normals,
+                &self.params,
+                &self.pair_state,
+                &self.values,
+                &self.flags,
+            ],
+        )
+    }
+
+    /// The assembly's inputs before the constraints (bindings 1–8).
+    fn assembly_inputs(&self) -> [&wgpu::Buffer; 9] {
+        [
+            &self.assemble_dims,
+            &self.elem_force,
+            &self.elem_tangent,
+            &self.values,
+            &self.flags,
+            &self.node_site,
+            &self.f_ext,
+            &self.basis,
+            &self.fixed,
+        ]
+    }
+
+    /// One bind group per pass of the block solve of `system` (diag, upper, lower, rhs).
+    fn lu_groups(
+        &self,
+        ctx: &GpuContext,
+        pipeline: &wgpu::ComputePipeline,
+        system: [&wgpu::Buffer; 4],
+    ) -> Vec<wgpu::BindGroup> {
+        self.lu_dims
+            .iter()
+            .map(|d| {
+                let [diag, upper, lower, rhs] = system;
+                bind(
+                    ctx,
+                    pipeline,
+                    "block_lu",
+                    &[
+                        d,
+                        diag,
+                        upper,
+                        lower,
+                        rhs,
+                        &self.work_x,
+                        &self.work_z,
+                        &self.delta,
+                        &self.status,
+                    ],
+                )
+            })
+            .collect()
+    }
+
+    /// The norms of `rhs` and the step with `alpha` (or ones).
+    fn norms_group(
+        &self,
+        ctx: &GpuContext,
+        pipeline: &wgpu::ComputePipeline,
+        alpha: &wgpu::Buffer,
+        rhs: &wgpu::Buffer,
+    ) -> wgpu::BindGroup {
+        bind(
+            ctx,
+            pipeline,
+            "norms",
+            &[&self.chain_dims, &self.delta, alpha, rhs, &self.norms],
+        )
+    }
+
     /// Checks the chunk against the adapter's limits and makes its common buffers; the
     /// pair parameters and loads start as given (or empty, written per load step).
     fn new<T: GpuReal>(
@@ -343,36 +442,7 @@ impl<T: GpuReal> GpuEnsemble<T> {
         let (v, n) = (tables.num_variants, tables.num_nodes);
         let (m, p) = (n.saturating_sub(1), tables.pair_node.len());
         let size = std::mem::size_of::<T>();
-        let Common {
-            sections,
-            frames,
-            chords,
-            basis,
-            fixed,
-            node_site,
-            pair_node,
-            normals,
-            pair_state,
-            params,
-            f_ext,
-            elem_force,
-            elem_tangent,
-            values,
-            flags,
-            work_x,
-            work_z,
-            delta,
-            status,
-            ones,
-            alpha,
-            norms,
-            chain_dims,
-            beam_dims,
-            sites_dims,
-            contact_dims,
-            assemble_dims,
-            lu_dims,
-        } = Common::new(ctx, model, tables, None, None)?;
+        let c = Common::new(ctx, model, tables, None, None)?;
         let pipelines = Pipelines {
             beam: ctx.pipeline("beam", &crate::gpu::beam::beam_wgsl(f64)?)?,
             sites: ctx.pipeline("sites", &sites_wgsl(f64)?)?,
@@ -382,19 +452,7 @@ impl<T: GpuReal> GpuEnsemble<T> {
             norms: ctx.pipeline("norms", &crate::gpu::update::update_wgsl(true, f64)?)?,
             update: ctx.pipeline("update", &crate::gpu::update::update_wgsl(false, f64)?)?,
         };
-        let contact = bind(
-            ctx,
-            &pipelines.contact,
-            "contact",
-            &[
-                &contact_dims,
-                &normals,
-                &params,
-                &pair_state,
-                &values,
-                &flags,
-            ],
-        );
+        let contact = c.contact_group(ctx, &pipelines.contact);
         let make_slot = |label: &str| -> Slot {
             let x = storage(ctx, label, &tables.start.x);
             let rot = storage(ctx, label, &tables.start.rot);
@@ -402,77 +460,28 @@ impl<T: GpuReal> GpuEnsemble<T> {
             let upper = empty(ctx, "upper", 36 * m.max(1) * v * size);
             let lower = empty(ctx, "lower", 36 * m.max(1) * v * size);
             let rhs = empty(ctx, "rhs", 6 * n * v * size);
-            let beam = bind(
-                ctx,
-                &pipelines.beam,
-                "beam",
-                &[
-                    &beam_dims,
-                    &x,
-                    &rot,
-                    &frames,
-                    &sections,
-                    &chords,
-                    &elem_force,
-                    &elem_tangent,
-                ],
-            );
+            let beam = c.beam_group(ctx, &pipelines.beam, &x, &rot);
             let sites = bind(
                 ctx,
                 &pipelines.sites,
                 "sites",
-                &[&sites_dims, &pair_node, &x, &pair_state],
+                &[&c.sites_dims, &c.pair_node, &x, &c.pair_state],
             );
+            let inputs = c.assembly_inputs();
             let assemble = bind(
                 ctx,
                 &pipelines.assemble,
                 "assemble",
-                &[
-                    &assemble_dims,
-                    &elem_force,
-                    &elem_tangent,
-                    &values,
-                    &flags,
-                    &node_site,
-                    &f_ext,
-                    &basis,
-                    &fixed,
-                    &diag,
-                    &upper,
-                    &lower,
-                    &rhs,
-                ],
+                &[&inputs[..], &[&diag, &upper, &lower, &rhs]].concat(),
             );
-            let lu = lu_dims
-                .iter()
-                .map(|d| {
-                    bind(
-                        ctx,
-                        &pipelines.block_lu,
-                        "block_lu",
-                        &[
-                            d, &diag, &upper, &lower, &rhs, &work_x, &work_z, &delta, &status,
-                        ],
-                    )
-                })
-                .collect();
-            let norms_solve = bind(
-                ctx,
-                &pipelines.norms,
-                "norms",
-                &[&chain_dims, &delta, &ones, &rhs, &norms],
-            );
-            let norms_trial = bind(
-                ctx,
-                &pipelines.norms,
-                "norms",
-                &[&chain_dims, &delta, &alpha, &rhs, &norms],
-            );
+            let lu = c.lu_groups(ctx, &pipelines.block_lu, [&diag, &upper, &lower, &rhs]);
+            let norms_solve = c.norms_group(ctx, &pipelines.norms, &c.ones, &rhs);
+            let norms_trial = c.norms_group(ctx, &pipelines.norms, &c.alpha, &rhs);
             let update = bind(
                 ctx,
                 &pipelines.update,
                 "update",
-                &[&chain_dims, &delta, &alpha, &basis, &x, &rot],
+                &[&c.chain_dims, &c.delta, &c.alpha, &c.basis, &x, &rot],
             );
             Slot {
                 x,
@@ -494,42 +503,11 @@ impl<T: GpuReal> GpuEnsemble<T> {
             slots,
             current: 0,
             contact,
-            f_ext,
-            params,
-            alpha,
-            status,
-            norms,
+            c,
             num_variants: v,
             num_nodes: n,
             num_elements: m,
             num_pairs: p,
-            _keep: vec![
-                sections,
-                frames,
-                basis,
-                fixed,
-                node_site,
-                pair_node,
-                chords,
-                normals,
-                pair_state,
-                elem_force,
-                elem_tangent,
-                values,
-                flags,
-                work_x,
-                work_z,
-                delta,
-                ones,
-                chain_dims,
-                beam_dims,
-                sites_dims,
-                contact_dims,
-                assemble_dims,
-            ]
-            .into_iter()
-            .chain(lu_dims)
-            .collect(),
             _real: PhantomData,
         })
     }
@@ -558,7 +536,7 @@ impl<T: GpuReal> GpuEnsemble<T> {
         let out = submit_and_read(
             self.ctx,
             encoder,
-            &[(&self.norms, norm_bytes), (&self.status, 4 * v as u64)],
+            &[(&self.c.norms, norm_bytes), (&self.c.status, 4 * v as u64)],
         )?;
         Ok((
             norms_from_bytes(&out[0]),
@@ -644,9 +622,9 @@ pub fn sites_wgsl_for(dynamic: bool, f64: bool) -> Result<String, GpuError> {
 impl<T: GpuReal> Ensemble<T> for GpuEnsemble<T> {
     fn set_loads(&mut self, f_ext: &[T], pair_params: &[T]) -> Result<(), String> {
         let q = &self.ctx.queue;
-        q.write_buffer(&self.f_ext, 0, bytemuck::cast_slice(f_ext));
+        q.write_buffer(&self.c.f_ext, 0, bytemuck::cast_slice(f_ext));
         if !pair_params.is_empty() {
-            q.write_buffer(&self.params, 0, bytemuck::cast_slice(pair_params));
+            q.write_buffer(&self.c.params, 0, bytemuck::cast_slice(pair_params));
         }
         Ok(())
     }
@@ -665,7 +643,7 @@ impl<T: GpuReal> Ensemble<T> for GpuEnsemble<T> {
         let v = self.num_variants;
         self.ctx
             .queue
-            .write_buffer(&self.status, 0, bytemuck::cast_slice(&vec![RUNNING; v]));
+            .write_buffer(&self.c.status, 0, bytemuck::cast_slice(&vec![RUNNING; v]));
         let s = &self.slots[self.current];
         let mut encoder = self.encoder("solve");
         {
@@ -687,7 +665,7 @@ impl<T: GpuReal> Ensemble<T> for GpuEnsemble<T> {
         let (cur, other) = (self.current, 1 - self.current);
         self.ctx
             .queue
-            .write_buffer(&self.alpha, 0, bytemuck::cast_slice(alpha));
+            .write_buffer(&self.c.alpha, 0, bytemuck::cast_slice(alpha));
         let mut encoder = self.encoder("trial");
         let (a, b) = (&self.slots[cur], &self.slots[other]);
         encoder.copy_buffer_to_buffer(&a.x, 0, &b.x, 0, a.x.size());
@@ -710,7 +688,7 @@ impl<T: GpuReal> Ensemble<T> for GpuEnsemble<T> {
     fn commit(&mut self, alpha: &[T]) -> Result<(), String> {
         self.ctx
             .queue
-            .write_buffer(&self.alpha, 0, bytemuck::cast_slice(alpha));
+            .write_buffer(&self.c.alpha, 0, bytemuck::cast_slice(alpha));
         let mut encoder = self.encoder("commit");
         {
             let mut pass = encoder.begin_compute_pass(&Default::default());
@@ -794,6 +772,7 @@ pub struct GpuDynamic<T: GpuReal> {
     num_elements: usize,
     num_pairs: usize,
     a0: T,
+    c: Common,
     _keep: Vec<wgpu::Buffer>,
     _real: PhantomData<T>,
 }
@@ -830,9 +809,6 @@ struct DynamicBuffers {
     flags: wgpu::Buffer,
     top: wgpu::Buffer,
     dyn_coef: wgpu::Buffer,
-    alpha: wgpu::Buffer,
-    status: wgpu::Buffer,
-    norms: wgpu::Buffer,
     scale: wgpu::Buffer,
     // State at t_n, the unknown and the candidate, the trial state.
     u_n: wgpu::Buffer,
@@ -862,36 +838,7 @@ impl<T: GpuReal> GpuDynamic<T> {
         let (v, n) = (tables.num_variants, tables.num_nodes);
         let (m, p) = (n.saturating_sub(1), tables.pair_node.len());
         let size = std::mem::size_of::<T>();
-        let Common {
-            sections,
-            frames,
-            chords,
-            basis,
-            fixed,
-            node_site,
-            pair_node,
-            normals,
-            pair_state,
-            params,
-            f_ext,
-            elem_force,
-            elem_tangent,
-            values,
-            flags: flags_out,
-            work_x,
-            work_z,
-            delta,
-            status,
-            ones,
-            alpha,
-            norms,
-            chain_dims,
-            beam_dims,
-            sites_dims,
-            contact_dims,
-            assemble_dims,
-            lu_dims,
-        } = Common::new(
+        let c = Common::new(
             ctx,
             model,
             tables,
@@ -927,9 +874,6 @@ impl<T: GpuReal> GpuDynamic<T> {
             flags: empty(ctx, "step_flags", 4),
             top: empty(ctx, "top", crate::kernels::dynamics::TOP_LEN * v * size),
             dyn_coef: empty(ctx, "dyn_coef", 3 * size),
-            alpha,
-            status,
-            norms,
             scale: empty(ctx, "scale", v * size),
             u_n: storage(ctx, "u_n", &st.u),
             rot_n: storage(ctx, "rot_n", &st.rot),
@@ -949,7 +893,7 @@ impl<T: GpuReal> GpuDynamic<T> {
                 &pl.predict,
                 "predict",
                 &[
-                    &chain_dims,
+                    &c.chain_dims,
                     &b.coef,
                     &b.flags,
                     &b.top,
@@ -966,33 +910,26 @@ impl<T: GpuReal> GpuDynamic<T> {
                 ],
             )
         };
+        let inputs = c.assembly_inputs();
         let assemble = |vdot: &wgpu::Buffer| {
+            let dynamic_inputs = [
+                &b.dyn_coef,
+                &mass,
+                &inertia0,
+                &b.rot_1,
+                &b.vel_1,
+                vdot,
+                &c.normals,
+                &diag,
+                &upper,
+                &lower,
+                &rhs,
+            ];
             bind(
                 ctx,
                 &pl.assemble,
                 "assemble",
-                &[
-                    &assemble_dims,
-                    &elem_force,
-                    &elem_tangent,
-                    &values,
-                    &flags_out,
-                    &node_site,
-                    &f_ext,
-                    &basis,
-                    &fixed,
-                    &b.dyn_coef,
-                    &mass,
-                    &inertia0,
-                    &b.rot_1,
-                    &b.vel_1,
-                    vdot,
-                    &normals,
-                    &diag,
-                    &upper,
-                    &lower,
-                    &rhs,
-                ],
+                &[&inputs[..], &dynamic_inputs[..]].concat(),
             )
         };
         let g = DynamicGroups {
@@ -1002,118 +939,42 @@ impl<T: GpuReal> GpuDynamic<T> {
                 ctx,
                 &pl.accelerate,
                 "accelerate",
-                &[&chain_dims, &basis, &b.vdot_k, &delta, &b.alpha, &b.vdot_c],
+                &[
+                    &c.chain_dims,
+                    &c.basis,
+                    &b.vdot_k,
+                    &c.delta,
+                    &c.alpha,
+                    &b.vdot_c,
+                ],
             ),
             scale: bind(
                 ctx,
                 &pl.scale,
                 "scale",
-                &[&chain_dims, &mass, &b.vdot_k, &b.scale],
+                &[&c.chain_dims, &mass, &b.vdot_k, &b.scale],
             ),
-            beam: bind(
-                ctx,
-                &pl.beam,
-                "beam",
-                &[
-                    &beam_dims,
-                    &b.u_1,
-                    &b.rot_1,
-                    &frames,
-                    &sections,
-                    &chords,
-                    &elem_force,
-                    &elem_tangent,
-                ],
-            ),
+            beam: c.beam_group(ctx, &pl.beam, &b.u_1, &b.rot_1),
             sites: bind(
                 ctx,
                 &pl.sites,
                 "sites",
                 &[
-                    &sites_dims,
-                    &pair_node,
+                    &c.sites_dims,
+                    &c.pair_node,
                     &b.u_1,
-                    &pair_state,
+                    &c.pair_state,
                     &b.vel_1,
-                    &normals,
+                    &c.normals,
                 ],
             ),
-            contact: bind(
-                ctx,
-                &pl.contact,
-                "contact",
-                &[
-                    &contact_dims,
-                    &normals,
-                    &params,
-                    &pair_state,
-                    &values,
-                    &flags_out,
-                ],
-            ),
+            contact: c.contact_group(ctx, &pl.contact),
             assemble_unknown: assemble(&b.vdot_k),
             assemble_candidate: assemble(&b.vdot_c),
-            lu: lu_dims
-                .iter()
-                .map(|d| {
-                    bind(
-                        ctx,
-                        &pl.block_lu,
-                        "block_lu",
-                        &[
-                            d, &diag, &upper, &lower, &rhs, &work_x, &work_z, &delta, &b.status,
-                        ],
-                    )
-                })
-                .collect(),
-            norms_iterate: bind(
-                ctx,
-                &pl.norms,
-                "norms",
-                &[&chain_dims, &delta, &ones, &rhs, &b.norms],
-            ),
-            norms_trial: bind(
-                ctx,
-                &pl.norms,
-                "norms",
-                &[&chain_dims, &delta, &b.alpha, &rhs, &b.norms],
-            ),
+            lu: c.lu_groups(ctx, &pl.block_lu, [&diag, &upper, &lower, &rhs]),
+            norms_iterate: c.norms_group(ctx, &pl.norms, &c.ones, &rhs),
+            norms_trial: c.norms_group(ctx, &pl.norms, &c.alpha, &rhs),
         };
-        let keep = vec![
-            sections,
-            frames,
-            chords,
-            basis,
-            fixed,
-            node_site,
-            pair_node,
-            normals,
-            pair_state,
-            params,
-            f_ext,
-            mass,
-            inertia0,
-            elem_force,
-            elem_tangent,
-            values,
-            flags_out,
-            diag,
-            upper,
-            lower,
-            rhs,
-            work_x,
-            work_z,
-            delta,
-            ones,
-            chain_dims,
-            beam_dims,
-            sites_dims,
-            contact_dims,
-            assemble_dims,
-        ]
-        .into_iter()
-        .chain(lu_dims)
-        .collect();
         Ok(GpuDynamic {
             ctx,
             p: pl,
@@ -1124,7 +985,8 @@ impl<T: GpuReal> GpuDynamic<T> {
             num_elements: m,
             num_pairs: p,
             a0: T::from_f64_lossy(dynamic.a0),
-            _keep: keep,
+            c,
+            _keep: vec![mass, inertia0, diag, upper, lower, rhs],
             _real: PhantomData,
         })
     }
@@ -1177,7 +1039,7 @@ impl<T: GpuReal> crate::engine::dynamic::DynamicEnsemble<T> for GpuDynamic<T> {
         let v = self.num_variants;
         self.ctx
             .queue
-            .write_buffer(&self.b.status, 0, bytemuck::cast_slice(&vec![RUNNING; v]));
+            .write_buffer(&self.c.status, 0, bytemuck::cast_slice(&vec![RUNNING; v]));
         let mut e = encoder(self.ctx, "iterate");
         {
             let mut pass = e.begin_compute_pass(&Default::default());
@@ -1193,8 +1055,8 @@ impl<T: GpuReal> crate::engine::dynamic::DynamicEnsemble<T> for GpuDynamic<T> {
             self.ctx,
             e,
             &[
-                (&self.b.norms, 4 * v as u64 * size),
-                (&self.b.status, 4 * v as u64),
+                (&self.c.norms, 4 * v as u64 * size),
+                (&self.c.status, 4 * v as u64),
                 (&self.b.scale, v as u64 * size),
             ],
         )
@@ -1214,7 +1076,7 @@ impl<T: GpuReal> crate::engine::dynamic::DynamicEnsemble<T> for GpuDynamic<T> {
         let v = self.num_variants;
         self.ctx
             .queue
-            .write_buffer(&self.b.alpha, 0, bytemuck::cast_slice(alpha));
+            .write_buffer(&self.c.alpha, 0, bytemuck::cast_slice(alpha));
         let mut e = encoder(self.ctx, "trial");
         {
             let mut pass = e.begin_compute_pass(&Default::default());
@@ -1228,7 +1090,7 @@ impl<T: GpuReal> crate::engine::dynamic::DynamicEnsemble<T> for GpuDynamic<T> {
             dispatch(&mut pass, &self.p.norms, &self.g.norms_trial, v);
         }
         let size = std::mem::size_of::<T>() as u64;
-        let out = submit_and_read(self.ctx, e, &[(&self.b.norms, 4 * v as u64 * size)])
+        let out = submit_and_read(self.ctx, e, &[(&self.c.norms, 4 * v as u64 * size)])
             .map_err(|e| e.to_string())?;
         Ok(norms_from_bytes(&out[0]))
     }
@@ -1236,7 +1098,7 @@ impl<T: GpuReal> crate::engine::dynamic::DynamicEnsemble<T> for GpuDynamic<T> {
     fn correct(&mut self, alpha: &[T]) -> Result<(), String> {
         self.ctx
             .queue
-            .write_buffer(&self.b.alpha, 0, bytemuck::cast_slice(alpha));
+            .write_buffer(&self.c.alpha, 0, bytemuck::cast_slice(alpha));
         let mut e = encoder(self.ctx, "correct");
         {
             let mut pass = e.begin_compute_pass(&Default::default());
