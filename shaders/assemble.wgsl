@@ -8,7 +8,7 @@
 // applies the constraints to the blocks it owns. Layouts as in the twin's documentation.
 #include "shared/layout.wgsl"
 
-@group(0) @binding(0) var<uniform> dims: AssembleDims;
+@group(0) @binding(0) var<storage, read> dims: AssembleDims;
 @group(0) @binding(1) var<storage, read> elem_force: array<real>;
 @group(0) @binding(2) var<storage, read> elem_tangent: array<real>;
 @group(0) @binding(3) var<storage, read> contact: array<real>;

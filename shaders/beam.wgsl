@@ -15,7 +15,7 @@
 // keep two digits).
 #include "shared/layout.wgsl"
 
-@group(0) @binding(0) var<uniform> dims: BeamDims;
+@group(0) @binding(0) var<storage, read> dims: BeamDims;
 // Node displacements, [(3 i + k) V + v]; rotations, [(9 i + 3 r + c) V + v].
 @group(0) @binding(1) var<storage, read> x: array<real>;
 @group(0) @binding(2) var<storage, read> rot: array<real>;

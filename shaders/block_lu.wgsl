@@ -11,7 +11,7 @@
 // node i at [(36 i + rc) V + v], vector entry r of node i at [(6 i + r) V + v].
 #include "shared/layout.wgsl"
 
-@group(0) @binding(0) var<uniform> dims: LuDims;
+@group(0) @binding(0) var<storage, read> dims: LuDims;
 @group(0) @binding(1) var<storage, read> diag: array<real>;
 @group(0) @binding(2) var<storage, read> upper: array<real>;
 @group(0) @binding(3) var<storage, read> lower: array<real>;

@@ -19,7 +19,7 @@ fn pow_pos(x: f32, m: f32) -> f32 {
 #endif
 #endif
 
-@group(0) @binding(0) var<uniform> dims: ContactDims;
+@group(0) @binding(0) var<storage, read> dims: ContactDims;
 // Hole axis n per site: [3 · site + k].
 @group(0) @binding(1) var<storage, read> site_normals: array<real>;
 // clearance, disk_radius, k_e, m, c, mu_t, mu_l, eps, soft_blend.

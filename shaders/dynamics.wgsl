@@ -7,7 +7,7 @@
 // SCALE, one invocation per variant: max_i m_i |v̇_u,i|. Layouts as in the twin.
 #include "shared/layout.wgsl"
 
-@group(0) @binding(0) var<uniform> dims: ChainDims;
+@group(0) @binding(0) var<storage, read> dims: ChainDims;
 #if PREDICT
 // [h, α_m, α_f, β, γ].
 @group(0) @binding(1) var<storage, read> coef: array<real>;

@@ -5,7 +5,7 @@
 // DYNAMIC also those, from the node's velocity and its spin about the hole axis.
 #include "shared/layout.wgsl"
 
-@group(0) @binding(0) var<uniform> dims: ContactDims;
+@group(0) @binding(0) var<storage, read> dims: ContactDims;
 // Node of each pair.
 @group(0) @binding(1) var<storage, read> pair_node: array<u32>;
 // Displacements: [(3 · node + k) · V + variant].

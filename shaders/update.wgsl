@@ -6,7 +6,7 @@
 #include "shared/layout.wgsl"
 
 // Composed twice: without NORMS the entry point `main` is the update, with NORMS the norms.
-@group(0) @binding(0) var<uniform> dims: ChainDims;
+@group(0) @binding(0) var<storage, read> dims: ChainDims;
 @group(0) @binding(1) var<storage, read> delta: array<real>;
 @group(0) @binding(2) var<storage, read> alpha: array<real>;
 #if NORMS

@@ -55,7 +55,7 @@ pub fn passes(n: usize) -> Vec<(usize, usize, u32)> {
     passes
 }
 
-/// The uniform of every pass of [`passes`] for `v` variants.
+/// The parameter block of every pass of [`passes`] for `v` variants.
 pub fn pass_dims(n: usize, v: usize) -> Vec<LuDims> {
     passes(n)
         .into_iter()
@@ -114,8 +114,8 @@ pub fn block_lu_gpu_chunked<T: GpuReal>(
             }
             out
         };
-        let uniforms = pass_dims(n, len);
-        let uniform_bytes: Vec<&[u8]> = uniforms.iter().map(bytemuck::bytes_of).collect();
+        let params = pass_dims(n, len);
+        let param_bytes: Vec<&[u8]> = params.iter().map(bytemuck::bytes_of).collect();
         let (diag, upper, lower, rhs) = (
             gather(&batch.diag, 36 * n),
             gather(&batch.upper, 36 * m),
@@ -128,7 +128,7 @@ pub fn block_lu_gpu_chunked<T: GpuReal>(
             ctx,
             &pipeline,
             "block_lu",
-            &uniform_bytes,
+            &param_bytes,
             &[
                 bytemuck::cast_slice(&diag),
                 bytemuck::cast_slice(&upper),

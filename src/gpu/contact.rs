@@ -204,7 +204,7 @@ impl<T: GpuReal> GpuContactRun<T> {
             let dims = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some("contact_dims"),
                 contents: bytemuck::bytes_of(&dims),
-                usage: wgpu::BufferUsages::UNIFORM,
+                usage: wgpu::BufferUsages::STORAGE,
             });
             let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
                 label: Some("contact"),

@@ -1,4 +1,5 @@
-//! One-shot dispatch of a kernel whose bindings are: a uniform (binding 0), read-only
+//! One-shot dispatch of a kernel whose bindings are: its parameters (binding 0, a read-only
+//! storage buffer, not a uniform: see `tests/shaders.rs`), read-only
 //! storage inputs, then read-write storage outputs, in that order. Buffers are made, the
 //! kernel runs once over `invocations` (workgroups of 64), and every output is read back.
 
@@ -33,7 +34,7 @@ pub fn run_once(
     ctx: &GpuContext,
     pipeline: &wgpu::ComputePipeline,
     label: &str,
-    uniform: &[u8],
+    params: &[u8],
     inputs: &[&[u8]],
     outputs: &[Out],
     invocations: usize,
@@ -42,33 +43,33 @@ pub fn run_once(
         ctx,
         pipeline,
         label,
-        &[uniform],
+        &[params],
         inputs,
         outputs,
         invocations,
     )
 }
 
-/// Runs `pipeline` once per uniform, in order, on the same storage buffers (each dispatch
+/// Runs `pipeline` once per parameter block, in order, on the same storage buffers (each dispatch
 /// sees the previous one's writes); returns the bytes of each output after the last.
 pub fn run_passes(
     ctx: &GpuContext,
     pipeline: &wgpu::ComputePipeline,
     label: &str,
-    uniforms: &[&[u8]],
+    params: &[&[u8]],
     inputs: &[&[u8]],
     outputs: &[Out],
     invocations: usize,
 ) -> Result<Vec<Vec<u8>>, GpuError> {
     let output_bytes: Vec<usize> = outputs.iter().map(Out::bytes).collect();
     let device = &ctx.device;
-    let dims: Vec<wgpu::Buffer> = uniforms
+    let dims: Vec<wgpu::Buffer> = params
         .iter()
         .map(|u| {
             device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some(label),
                 contents: u,
-                usage: wgpu::BufferUsages::UNIFORM,
+                usage: wgpu::BufferUsages::STORAGE,
             })
         })
         .collect();

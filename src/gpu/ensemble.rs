@@ -134,12 +134,14 @@ fn empty(ctx: &GpuContext, label: &str, bytes: usize) -> wgpu::Buffer {
     })
 }
 
-fn uniform<U: bytemuck::Pod>(ctx: &GpuContext, label: &str, u: &U) -> wgpu::Buffer {
+/// A kernel's parameter block (binding 0): read-only storage, not a uniform, which lavapipe
+/// would inline and recompile the kernel for at every dispatch (see `tests/shaders.rs`).
+fn param_block<U: bytemuck::Pod>(ctx: &GpuContext, label: &str, u: &U) -> wgpu::Buffer {
     ctx.device
         .create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some(label),
             contents: bytemuck::bytes_of(u),
-            usage: wgpu::BufferUsages::UNIFORM,
+            usage: wgpu::BufferUsages::STORAGE,
         })
 }
 
@@ -180,7 +182,7 @@ fn dispatch(
 }
 
 /// The buffers every chunk has, static or dynamic: shared tables, contact and element
-/// work, the block solve's workspace and step, the per-variant scalars, and the uniforms.
+/// work, the block solve's workspace and step, the per-variant scalars, and the parameter blocks.
 struct Common {
     sections: wgpu::Buffer,
     frames: wgpu::Buffer,
@@ -371,7 +373,7 @@ impl Common {
             ones: storage(ctx, "ones", &vec![T::one(); v]),
             alpha: empty(ctx, "alpha", v * size),
             norms: empty(ctx, "norms", 4 * v * size),
-            chain_dims: uniform(
+            chain_dims: param_block(
                 ctx,
                 "chain_dims",
                 &ChainDims {
@@ -381,7 +383,7 @@ impl Common {
                     _pad1: 0,
                 },
             ),
-            beam_dims: uniform(
+            beam_dims: param_block(
                 ctx,
                 "beam_dims",
                 &BeamDims {
@@ -391,7 +393,7 @@ impl Common {
                     _pad1: 0,
                 },
             ),
-            sites_dims: uniform(
+            sites_dims: param_block(
                 ctx,
                 "sites_dims",
                 &ContactDims {
@@ -402,7 +404,7 @@ impl Common {
                 },
             ),
             // The contact kernel sees one "variant" per site: every pair has its own axis.
-            contact_dims: uniform(
+            contact_dims: param_block(
                 ctx,
                 "contact_dims",
                 &ContactDims {
@@ -412,7 +414,7 @@ impl Common {
                     _pad: 0,
                 },
             ),
-            assemble_dims: uniform(
+            assemble_dims: param_block(
                 ctx,
                 "assemble_dims",
                 &AssembleDims {
@@ -424,7 +426,7 @@ impl Common {
             ),
             lu_dims: crate::gpu::block_lu::pass_dims(n, v)
                 .iter()
-                .map(|d| uniform(ctx, "lu_dims", d))
+                .map(|d| param_block(ctx, "lu_dims", d))
                 .collect(),
         })
     }
@@ -1203,7 +1205,7 @@ pub fn gather_sites_dynamic_gpu<T: GpuReal>(
     let dims_b = buf(
         "dims",
         bytemuck::bytes_of(&dims),
-        wgpu::BufferUsages::UNIFORM,
+        wgpu::BufferUsages::STORAGE,
     );
     let nodes_b = buf("pair_node", bytemuck::cast_slice(pair_node), st);
     let u_b = buf("u", bytemuck::cast_slice(u), st);

@@ -2,7 +2,7 @@
 
 use bytemuck::{Pod, Zeroable};
 
-/// Dispatch dimensions of the contact kernel (uniform binding 0 of `shaders/contact.wgsl`).
+/// Dispatch dimensions of the contact kernel (parameter binding 0 of `shaders/contact.wgsl`).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Pod, Zeroable)]
 pub struct ContactDims {
@@ -16,7 +16,7 @@ pub struct ContactDims {
     pub _pad: u32,
 }
 
-/// Dispatch dimensions of the block-tridiagonal solve (uniform binding 0 of
+/// Dispatch dimensions of the block-tridiagonal solve (parameter binding 0 of
 /// `shaders/block_lu.wgsl`).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Pod, Zeroable)]
@@ -31,7 +31,7 @@ pub struct ChainDims {
     pub _pad1: u32,
 }
 
-/// Dispatch dimensions of the assembly (uniform binding 0 of `shaders/assemble.wgsl`).
+/// Dispatch dimensions of the assembly (parameter binding 0 of `shaders/assemble.wgsl`).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Pod, Zeroable)]
 pub struct AssembleDims {
@@ -45,7 +45,7 @@ pub struct AssembleDims {
     pub _pad: u32,
 }
 
-/// Dispatch dimensions of the beam kernel (uniform binding 0 of `shaders/beam.wgsl`).
+/// Dispatch dimensions of the beam kernel (parameter binding 0 of `shaders/beam.wgsl`).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Pod, Zeroable)]
 pub struct BeamDims {
@@ -59,7 +59,7 @@ pub struct BeamDims {
     pub _pad1: u32,
 }
 
-/// Dispatch dimensions of one pass of the block solve (uniform binding 0 of
+/// Dispatch dimensions of one pass of the block solve (parameter binding 0 of
 /// `shaders/block_lu.wgsl`).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Pod, Zeroable)]
