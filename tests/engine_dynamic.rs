@@ -574,11 +574,20 @@ fn paper_case_sixteen_variants_match_the_cpu_integrator() {
         for x in &r {
             assert_eq!(x.status, DynamicStatus::Finished);
         }
+        let its: Vec<usize> = r
+            .iter()
+            .flat_map(|x| x.iterations.iter().copied())
+            .collect();
+        eprintln!(
+            "  {}: Newton iterations per variant-step: mean {:.2}, max {}",
+            if f32_too { "f32" } else { "f64" },
+            its.iter().sum::<usize>() as f64 / its.len().max(1) as f64,
+            its.iter().max().unwrap_or(&0)
+        );
         let (eu, ev) = trajectory_error(&engine_steps(&seen, v, n), &cpu);
         (eu, ev, elapsed)
     };
-    // `HOLEWALL_PAPER_PRECISION=f32` runs the GPU in f32 only (lavapipe leaks host memory
-    // per block-LU dispatch: two 1 s runs in one process do not fit in 24 GB).
+    // `HOLEWALL_PAPER_PRECISION=f32` runs the GPU in f32 only.
     if gpu && std::env::var("HOLEWALL_PAPER_PRECISION").as_deref() == Ok("f32") {
         let (eu, ev, t32) = run(true);
         eprintln!(

@@ -260,6 +260,7 @@ fn run_chunk<T: Real + Send + Sync, P: KernelPath<T>>(
         small_residual,
         step_floor,
     } = Convergence::for_path::<T>(options.tolerance, &tables.node_ref, &dynamic.start.u, v);
+    let f32_path = std::mem::size_of::<T>() == 4;
     let mut ensemble = path.open_dynamic(&models[0], &tables, &dynamic)?;
     let p = options.alpha;
     let ratio = (1.0 - p.alpha_f) / (1.0 - p.alpha_m);
@@ -322,6 +323,7 @@ fn run_chunk<T: Real + Send + Sync, P: KernelPath<T>>(
             } = ensemble.iterate()?;
             let mut alpha = vec![T::zero(); v];
             let mut converged = vec![false; v];
+            let mut at_floor = vec![false; v];
             for j in 0..v {
                 if done[j] {
                     continue;
@@ -341,25 +343,32 @@ fn run_chunk<T: Real + Send + Sync, P: KernelPath<T>>(
                 let step_norm = now.step_max[j].to_f64_lossy() * hhb;
                 converged[j] = measure <= tolerance
                     || (step_norm <= step_floor[j] && measure <= small_residual);
+                at_floor[j] = f32_path && measure <= small_residual;
                 alpha[j] = minus_one;
                 its[j] = it;
             }
             // Backtracking on the residual's 2-norm for the variants not converged (as the
             // CPU integrator): α halved up to 24 times; the full step kept when nothing
-            // shorter lowers the residual.
+            // shorter lowers the residual. In f32 a variant whose residual is already at the
+            // precision's floor takes the full step: there its residual norm is rounding
+            // noise, which halving cannot lower, and each halving costs an evaluation.
             let norm0: Vec<f64> = now
                 .residual_square
                 .iter()
                 .map(|x| x.to_f64_lossy().sqrt())
                 .collect();
             let mut pending: Vec<bool> = (0..v)
-                .map(|j| !done[j] && !converged[j] && alpha[j].to_f64_lossy() != 0.0)
+                .map(|j| {
+                    !done[j] && !converged[j] && !at_floor[j] && alpha[j].to_f64_lossy() != 0.0
+                })
                 .collect();
             let mut accepted = vec![false; v];
+            let mut trials = 0;
             for _ in 0..24 {
                 if !pending.iter().any(|&q| q) {
                     break;
                 }
+                trials += 1;
                 let r = ensemble.trial(&alpha)?;
                 for j in 0..v {
                     if !pending[j] {
@@ -383,9 +392,10 @@ fn run_chunk<T: Real + Send + Sync, P: KernelPath<T>>(
             ensemble.correct(&alpha)?;
             if std::env::var("HOLEWALL_DEBUG_NEWTON").is_ok() {
                 eprintln!(
-                    "  engine dyn t {t1:.6} it {it}: variant 0 residual {:.3e} α {:.4}",
+                    "  engine dyn t {t1:.6} it {it}: variant 0 residual {:.3e} α {:.4}; {} variants open, {trials} line-search trials",
                     now.residual_max[0].to_f64_lossy() / f_ref[0],
-                    alpha[0].to_f64_lossy().abs()
+                    alpha[0].to_f64_lossy().abs(),
+                    done.iter().filter(|&&d| !d).count()
                 );
             }
             for j in 0..v {
