@@ -475,7 +475,7 @@ fn collect<P: holewall::engine::KernelPath<f64>>(
 /// against 16 CPU integrator runs, step for step. Over much shorter runs the velocities
 /// are still at the scale the Newton tolerance leaves (the table has barely started: at
 /// 0.02 s the GPU path shows 1.2e-6 of the largest velocity), so the 1 s of the issue is
-/// the meaningful length. Minutes on two cores (17 min on lavapipe); run with
+/// the meaningful length. Minutes on two cores (8 min on lavapipe in f64); run with
 /// `cargo test --release --test engine_dynamic -- --ignored --nocapture`.
 #[test]
 #[ignore]
@@ -571,8 +571,17 @@ fn paper_case_sixteen_variants_match_the_cpu_integrator() {
             .unwrap()
         };
         let elapsed = t0.elapsed().as_secs_f64();
-        for x in &r {
-            assert_eq!(x.status, DynamicStatus::Finished);
+        // f64 must finish every variant; in f32 a variant whose Newton stalls on the
+        // precision's residual floor fails (the CLI re-runs it on the CPU): reported, and
+        // the error taken over the variants that finished.
+        let finished: Vec<usize> = (0..v)
+            .filter(|&j| r[j].status == DynamicStatus::Finished)
+            .collect();
+        for (j, x) in r.iter().enumerate() {
+            if x.status != DynamicStatus::Finished {
+                assert!(f32_too, "variant {j}: {:?}", x.status);
+                eprintln!("  f32: variant {j} {:?}", x.status);
+            }
         }
         let its: Vec<usize> = r
             .iter()
@@ -584,7 +593,11 @@ fn paper_case_sixteen_variants_match_the_cpu_integrator() {
             its.iter().sum::<usize>() as f64 / its.len().max(1) as f64,
             its.iter().max().unwrap_or(&0)
         );
-        let (eu, ev) = trajectory_error(&engine_steps(&seen, v, n), &cpu);
+        let engine = engine_steps(&seen, v, n);
+        let pick = |runs: &[Vec<(Vec<f64>, Vec<f64>)>]| -> Vec<Vec<(Vec<f64>, Vec<f64>)>> {
+            finished.iter().map(|&j| runs[j].clone()).collect()
+        };
+        let (eu, ev) = trajectory_error(&pick(&engine), &pick(&cpu));
         (eu, ev, elapsed)
     };
     // `HOLEWALL_PAPER_PRECISION=f32` runs the GPU in f32 only.
