@@ -513,8 +513,7 @@ fn paper_case_sixteen_variants_match_the_cpu_integrator() {
         let r = if gpu {
             let ctx = common::gpu().unwrap();
             if f32_too {
-                let mut seen32 = Vec::new();
-                let r = run_dynamic_ensemble::<f32, _>(
+                run_dynamic_ensemble::<f32, _>(
                     &models,
                     &starts,
                     &case.element_density,
@@ -522,28 +521,9 @@ fn paper_case_sixteen_variants_match_the_cpu_integrator() {
                     &options,
                     seconds,
                     1,
-                    &mut |_, t, s: &DynamicBatch<f32>| seen32.push((t, s.clone())),
+                    &mut |_, t, s: &DynamicBatch<f32>| seen.push((t, widen(s))),
                 )
-                .unwrap();
-                let up = |x: &[f32]| x.iter().map(|&y| f64::from(y)).collect::<Vec<f64>>();
-                seen = seen32
-                    .into_iter()
-                    .map(|(t, b)| {
-                        (
-                            t,
-                            DynamicBatch {
-                                num_variants: b.num_variants,
-                                num_nodes: b.num_nodes,
-                                u: up(&b.u),
-                                rot: up(&b.rot),
-                                vel: up(&b.vel),
-                                acc: up(&b.acc),
-                                vdot: up(&b.vdot),
-                            },
-                        )
-                    })
-                    .collect();
-                r
+                .unwrap()
             } else {
                 run_dynamic_ensemble::<f64, _>(
                     &models,
