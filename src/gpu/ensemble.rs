@@ -203,6 +203,8 @@ struct Common {
     work_z: wgpu::Buffer,
     delta: wgpu::Buffer,
     status: wgpu::Buffer,
+    /// [`RUNNING`] per variant: copied into `status` before every block solve.
+    running: wgpu::Buffer,
     ones: wgpu::Buffer,
     alpha: wgpu::Buffer,
     norms: wgpu::Buffer,
@@ -303,6 +305,11 @@ impl Common {
             .collect()
     }
 
+    /// Sets every variant's block-solve status to [`RUNNING`] (recorded on `encoder`).
+    fn reset_status(&self, encoder: &mut wgpu::CommandEncoder, v: usize) {
+        encoder.copy_buffer_to_buffer(&self.running, 0, &self.status, 0, 4 * v as u64);
+    }
+
     /// The norms of `rhs` and the step with `alpha` (or ones).
     fn norms_group(
         &self,
@@ -370,6 +377,7 @@ impl Common {
             work_z: empty(ctx, "lu_work_z", 6 * n * v * size),
             delta: empty(ctx, "delta", 6 * n * v * size),
             status: empty(ctx, "status", 4 * v),
+            running: storage(ctx, "status_running", &vec![RUNNING; v]),
             ones: storage(ctx, "ones", &vec![T::one(); v]),
             alpha: empty(ctx, "alpha", v * size),
             norms: empty(ctx, "norms", 4 * v * size),
@@ -643,11 +651,9 @@ impl<T: GpuReal> Ensemble<T> for GpuEnsemble<T> {
 
     fn solve(&mut self) -> Result<(Norms<T>, Vec<u32>), String> {
         let v = self.num_variants;
-        self.ctx
-            .queue
-            .write_buffer(&self.c.status, 0, bytemuck::cast_slice(&vec![RUNNING; v]));
         let s = &self.slots[self.current];
         let mut encoder = self.encoder("solve");
+        self.c.reset_status(&mut encoder, v);
         {
             let mut pass = encoder.begin_compute_pass(&Default::default());
             for group in &s.lu {
@@ -1039,10 +1045,8 @@ impl<T: GpuReal> crate::engine::dynamic::DynamicEnsemble<T> for GpuDynamic<T> {
 
     fn iterate(&mut self) -> Result<crate::engine::dynamic::Iteration<T>, String> {
         let v = self.num_variants;
-        self.ctx
-            .queue
-            .write_buffer(&self.c.status, 0, bytemuck::cast_slice(&vec![RUNNING; v]));
         let mut e = encoder(self.ctx, "iterate");
+        self.c.reset_status(&mut e, v);
         {
             let mut pass = e.begin_compute_pass(&Default::default());
             self.record_evaluate(&mut pass, false);
