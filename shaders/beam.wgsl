@@ -7,12 +7,15 @@
 // left spins (I + [ε e]×)·triad, as in the twin. Outputs in the assembly's layout:
 // [(12 e + j) V + v] and [(144 e + 12 j + k) V + v].
 //
-// States are displacements u from the reference positions X (kilometres of string lose
-// their millimetres in f32 otherwise): the chord is c + (u₂ − u₁), c = X₂ − X₁ per element.
-// In double precision the element's node positions are taken as u₁ and c + u₂ (as the
-// twin) and the elongation as l − l0; in single precision the elongation is
-// (2 c·Δu + Δu·Δu)/(l + l0), without the cancellation of l − l0 (a strain of 1e-5 would
-// keep two digits).
+// States are displacements w from each variant's base configuration X + b (kilometres of
+// string lose their millimetres in f32 otherwise; the dynamic engine's base is the static
+// equilibrium, the f32 static engine's the last load step's, so w is the motion): the
+// chord is c + (w₂ − w₁), with the base chord c = (X₂ + b₂) − (X₁ + b₁) and its stretch
+// s = |c| − l0 given per element and variant (formed in double precision on the host). In
+// double precision the element's node positions are taken as w₁ and c + w₂ (as the twin)
+// and the elongation as l − l0; in single precision the elongation is
+// s + (2 c·Δw + Δw·Δw)/(l + |c|), without the cancellation of l − l0 (a strain of 1e-5
+// would keep two digits) and without the metres the base has moved.
 #include "shared/layout.wgsl"
 
 @group(0) @binding(0) var<storage, read> dims: BeamDims;
@@ -23,8 +26,9 @@
 @group(0) @binding(3) var<storage, read> frame0: array<real>;
 // Per element: EA/l0, GJ/l0, EI/l0, l0.
 @group(0) @binding(4) var<storage, read> section: array<real>;
-// Reference chord per element, c = X₂ − X₁: [3 e + k].
-@group(0) @binding(5) var<storage, read> chord0: array<real>;
+// Base chord and stretch per element and variant: [(4 e + k) V + v], k = 0–2 the chord,
+// 3 the stretch |c| − l0.
+@group(0) @binding(5) var<storage, read> chord: array<real>;
 @group(0) @binding(6) var<storage, read_write> elem_force: array<real>;
 @group(0) @binding(7) var<storage, read_write> elem_tangent: array<real>;
 
@@ -154,7 +158,7 @@ fn rel_log(e: array<array<hd, 3>, 3>, t: Tri) -> array<hd, 3> {
     return array<hd, 3>(hd_mul(factor, w0), hd_mul(factor, w1), hd_mul(factor, w2));
 }
 
-fn energy(p1: array<hd, 3>, p2: array<hd, 3>, t1: Tri, t2: Tri, e: u32) -> hd {
+fn energy(p1: array<hd, 3>, p2: array<hd, 3>, t1: Tri, t2: Tri, e: u32, v: u32) -> hd {
     let ea = section[4u * e];
     let gj = section[4u * e + 1u];
     let ei = section[4u * e + 2u];
@@ -164,13 +168,17 @@ fn energy(p1: array<hd, 3>, p2: array<hd, 3>, t1: Tri, t2: Tri, e: u32) -> hd {
     let l = hd_norm(d);
     let u = l - hd_c(l0);
 #else
-    let c = array<hd, 3>(hd_c(chord0[3u * e]), hd_c(chord0[3u * e + 1u]), hd_c(chord0[3u * e + 2u]));
+    let nv = dims.num_variants;
+    let cr = array<real, 3>(chord[(4u * e) * nv + v], chord[(4u * e + 1u) * nv + v], chord[(4u * e + 2u) * nv + v]);
+    let stretch = chord[(4u * e + 3u) * nv + v];
+    let lc = sqrt(cr[0] * cr[0] + cr[1] * cr[1] + cr[2] * cr[2]);
+    let c = array<hd, 3>(hd_c(cr[0]), hd_c(cr[1]), hd_c(cr[2]));
     let du = array<hd, 3>(p2[0] - p1[0], p2[1] - p1[1], p2[2] - p1[2]);
     let d = array<hd, 3>(c[0] + du[0], c[1] + du[1], c[2] + du[2]);
     let l = hd_norm(d);
     let two_c_du = hd_mul(hd_c(real(2.0)), hd_mul(c[0], du[0]) + hd_mul(c[1], du[1]) + hd_mul(c[2], du[2]));
     let du_du = hd_mul(du[0], du[0]) + hd_mul(du[1], du[1]) + hd_mul(du[2], du[2]);
-    let u = hd_div(two_c_du + du_du, l + hd_c(l0));
+    let u = hd_c(stretch) + hd_div(two_c_du + du_du, l + hd_c(lc));
 #endif
     let e1 = array<hd, 3>(hd_div(d[0], l), hd_div(d[1], l), hd_div(d[2], l));
     let half = hd_c(real(0.5));
@@ -223,8 +231,8 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         let i = e + node;
         for (var k = 0u; k < 3u; k = k + 1u) {
 #if F64
-            // Node 2 at c + u₂ (the twin's positions).
-            p0[node][k] = hd_c(real(node) * chord0[3u * e + k] + x[(3u * i + k) * nv + v]);
+            // Node 2 at c + w₂ (the twin's positions).
+            p0[node][k] = hd_c(real(node) * chord[(4u * e + k) * nv + v] + x[(3u * i + k) * nv + v]);
 #else
             p0[node][k] = hd_c(x[(3u * i + k) * nv + v]);
 #endif
@@ -250,7 +258,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
             var pj = pk;
             var tj = tk;
             perturb(&pj, &tj, j, eps1);
-            let en = energy(pj[0], pj[1], tj[0], tj[1], e);
+            let en = energy(pj[0], pj[1], tj[0], tj[1], e, v);
             elem_tangent[(144u * e + 12u * j + k) * nv + v] = en.w;
             if (k == 0u) {
                 elem_force[(12u * e + j) * nv + v] = en.y;

@@ -1,20 +1,23 @@
-// Twin: src/kernels/sites.rs (each contact pair's displacement d = u of its node).
+// Twin: src/kernels/sites.rs (each contact pair's displacement d = b + w of its node).
 //
 // One invocation per (site, variant) pair i = site · V + variant; writes fields 0–2 of the
-// pair state, leaving the velocity and spin fields (3–6) as the host wrote them; with
+// pair state, d = b + w (the base's displacement from the reference plus the state's from
+// the base), leaving the velocity and spin fields (3–6) as the host wrote them; with
 // DYNAMIC also those, from the node's velocity and its spin about the hole axis.
 #include "shared/layout.wgsl"
 
 @group(0) @binding(0) var<storage, read> dims: ContactDims;
 // Node of each pair.
 @group(0) @binding(1) var<storage, read> pair_node: array<u32>;
-// Displacements: [(3 · node + k) · V + variant].
+// Displacements from the base, w, and the base's from the reference, b:
+// [(3 · node + k) · V + variant].
 @group(0) @binding(2) var<storage, read> u: array<real>;
-@group(0) @binding(3) var<storage, read_write> pair_state: array<real>;
+@group(0) @binding(3) var<storage, read> base: array<real>;
+@group(0) @binding(4) var<storage, read_write> pair_state: array<real>;
 #if DYNAMIC
 // Node velocities [(6 · node + k) · V + variant] (ẋ, ω) and the pairs' hole axes.
-@group(0) @binding(4) var<storage, read> vel: array<real>;
-@group(0) @binding(5) var<storage, read> pair_normals: array<real>;
+@group(0) @binding(5) var<storage, read> vel: array<real>;
+@group(0) @binding(6) var<storage, read> pair_normals: array<real>;
 #endif
 
 @compute @workgroup_size(64)
@@ -28,7 +31,8 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let v = i % nv;
     let node = pair_node[i];
     for (var k = 0u; k < 3u; k = k + 1u) {
-        pair_state[k * p + i] = u[(3u * node + k) * nv + v];
+        let at = (3u * node + k) * nv + v;
+        pair_state[k * p + i] = base[at] + u[at];
     }
 #if DYNAMIC
     // Velocity and spin about the hole axis, n · ω.

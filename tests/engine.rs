@@ -188,13 +188,17 @@ fn sites_kernel_equals_its_twin() {
     let x: Vec<f64> = (0..3 * n * v)
         .map(|_| rng.random_range(-1e3..1e3))
         .collect();
+    let base: Vec<f64> = (0..3 * n * v)
+        .map(|_| rng.random_range(-3.0..3.0))
+        .collect();
     let mut twin: Vec<f64> = (0..7 * p).map(|k| k as f64).collect();
     let before = twin.clone();
-    gather_sites(&pair_node, &x, v, &mut twin);
+    gather_sites(&pair_node, &x, &base, v, &mut twin);
     for i in 0..p {
         let (node, j) = (pair_node[i] as usize, i % v);
         for k in 0..3 {
-            assert_eq!(twin[k * p + i], x[(3 * node + k) * v + j]);
+            let at = (3 * node + k) * v + j;
+            assert_eq!(twin[k * p + i], base[at] + x[at]);
         }
         for k in 3..7 {
             assert_eq!(
@@ -206,8 +210,8 @@ fn sites_kernel_equals_its_twin() {
     }
     let Some(ctx) = common::gpu() else { return };
     if ctx.has_f64 {
-        let gpu =
-            holewall::gpu::ensemble::gather_sites_gpu(ctx, &pair_node, &x, v, &before).unwrap();
+        let gpu = holewall::gpu::ensemble::gather_sites_gpu(ctx, &pair_node, &x, &base, v, &before)
+            .unwrap();
         assert_eq!(gpu, twin);
     }
 }

@@ -293,14 +293,13 @@ fn dynamic_kernels_equal_their_twins() {
     }
     let pair_normals: Vec<f64> = (0..p).flat_map(|_| [0.0, 0.6, 0.8]).collect();
     let mut pair_state = r(-1.0, 1.0, 7 * p);
-    gather_sites_dynamic(
-        &pair_node,
-        &pair_normals,
-        &state.u,
-        &state.vel,
-        v,
-        &mut pair_state,
-    );
+    // The base the displacements are taken from (a hanging string's metres).
+    let base = r(-3.0, 3.0, 3 * n * v);
+    gather_sites_dynamic(&pair_node, &pair_normals, &state, &base, &mut pair_state);
+    for i in 0..p {
+        let at = (3 * pair_node[i] as usize + 2) * v + i % v;
+        assert_eq!(pair_state[2 * p + i], base[at] + state.u[at], "d = b + w");
+    }
     let a = AssemblyInputs {
         num_variants: v,
         num_nodes: n,
@@ -350,9 +349,8 @@ fn dynamic_kernels_equal_their_twins() {
         ctx,
         &pair_node,
         &pair_normals,
-        &state.u,
-        &state.vel,
-        v,
+        &state,
+        &base,
         &r(-1.0, 1.0, 7 * p),
     )
     .unwrap();

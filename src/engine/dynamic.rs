@@ -43,7 +43,8 @@ pub struct DynamicTables<T> {
     pub f_ext: Vec<T>,
     /// Law parameters per pair, `PARAMS_LEN · P`.
     pub pair_params: Vec<T>,
-    /// The state at t = 0 (displacements from the reference).
+    /// The state at t = 0 (displacements from the base, [`EnsembleTables::base`]: each
+    /// variant's static equilibrium).
     pub start: DynamicBatch<T>,
 }
 
@@ -103,6 +104,8 @@ pub fn unsupported(options: &DynamicOptions) -> Option<String> {
 /// A chunk's start: its tables, each variant's force scale, and what moves the top.
 struct Start<T> {
     tables: DynamicTables<T>,
+    /// The base: each variant's static equilibrium ([`EnsembleTables::base`]).
+    base: Vec<f64>,
     f_ref: Vec<f64>,
     driven: bool,
     lowered: bool,
@@ -128,6 +131,7 @@ fn dynamic_tables<T: Real>(
         acc: vec![T::zero(); 6 * n * v],
         vdot: vec![T::zero(); 6 * n * v],
     };
+    let mut base = vec![0.0; 3 * n * v];
     let mut f_ref = Vec::with_capacity(v);
     let mut f_ext = vec![T::zero(); 6 * n * v];
     let mut pair_params = vec![T::zero(); PARAMS_LEN * p];
@@ -146,7 +150,12 @@ fn dynamic_tables<T: Real>(
         }
         for i in 0..n {
             for k in 0..3 {
-                start.u[(3 * i + k) * v + j] = t(s.q.x[i][k] - m.nodes[i].position[k]);
+                let at = (3 * i + k) * v + j;
+                let from_reference = s.q.x[i][k] - m.nodes[i].position[k];
+                if i > 0 {
+                    base[at] = from_reference;
+                }
+                start.u[at] = t(from_reference - base[at]);
             }
             for r in 0..3 {
                 for c in 0..3 {
@@ -179,6 +188,7 @@ fn dynamic_tables<T: Real>(
             pair_params,
             start,
         },
+        base,
         f_ref,
         driven: top.0,
         lowered: top.1,
@@ -248,6 +258,7 @@ fn run_chunk<T: Real + Send + Sync, P: KernelPath<T>>(
     let mut batch = ContactBatch::<T>::new(1, tables.pair_node.len());
     let Start {
         tables: dynamic,
+        base,
         f_ref,
         driven,
         lowered,
@@ -255,11 +266,22 @@ fn run_chunk<T: Real + Send + Sync, P: KernelPath<T>>(
     batch.pair_params = dynamic.pair_params.clone();
     tables.terms = batch.required_terms(models[0].friction, ContactMode::Dynamic);
     let v = tables.num_variants;
+    tables.chords = crate::kernels::beam::base_chords(&models[0], Some(&base), v)
+        .into_iter()
+        .map(t)
+        .collect();
+    tables.base = base;
     let Convergence {
         tolerance,
         small_residual,
         step_floor,
-    } = Convergence::for_path::<T>(options.tolerance, &tables.node_ref, &dynamic.start.u, v);
+    } = Convergence::for_path::<T>(
+        options.tolerance,
+        &tables.node_ref,
+        Some(&tables.base),
+        &dynamic.start.u,
+        v,
+    );
     let f32_path = std::mem::size_of::<T>() == 4;
     let mut ensemble = path.open_dynamic(&models[0], &tables, &dynamic)?;
     let p = options.alpha;
@@ -420,7 +442,11 @@ fn run_chunk<T: Real + Send + Sync, P: KernelPath<T>>(
         time = t1;
         step += 1;
         if every > 0 && step.is_multiple_of(every) {
-            let s = ensemble.state()?;
+            let mut s = ensemble.state()?;
+            // Displacements from the reference for the observer (summed in f64).
+            for (w, b) in s.u.iter_mut().zip(&tables.base) {
+                *w = t(b + w.to_f64_lossy());
+            }
             observe(time, &s);
         }
     }
@@ -478,13 +504,13 @@ impl<'a> TwinDynamic<'a> {
         let t = &self.tables;
         let (v, n) = (t.num_variants, t.num_nodes);
         let tr = &self.trial;
-        let (elem_force, elem_tangent) = crate::kernels::beam::beam(self.model, v, &tr.u, &tr.rot);
+        let (elem_force, elem_tangent) =
+            crate::kernels::beam::beam(self.model, v, &tr.u, &tr.rot, &t.chords);
         gather_sites_dynamic(
             &t.pair_node,
             &t.pair_normals,
-            &tr.u,
-            &tr.vel,
-            v,
+            tr,
+            &t.base,
             &mut self.contact.pair_state,
         );
         let mut out = ContactOutputs::new(self.contact.num_pairs());

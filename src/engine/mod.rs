@@ -55,8 +55,16 @@ pub(crate) struct Convergence {
 }
 
 impl Convergence {
-    /// For a path in `T`, `v` variants with displacements `u` from `node_ref`.
-    pub(crate) fn for_path<T: Real>(tolerance: f64, node_ref: &[f64], u: &[T], v: usize) -> Self {
+    /// For a path in `T`, `v` variants with displacements `u` from `node_ref` shifted by
+    /// `base` (`3 n V`; none: the reference). The f32 floor scales with the states
+    /// themselves (their rounding), the f64 one with the coordinates.
+    pub(crate) fn for_path<T: Real>(
+        tolerance: f64,
+        node_ref: &[f64],
+        base: Option<&[f64]>,
+        u: &[T],
+        v: usize,
+    ) -> Self {
         let f32_path = std::mem::size_of::<T>() == 4;
         let unit_roundoff = if f32_path {
             f64::from(f32::EPSILON)
@@ -67,7 +75,9 @@ impl Convergence {
             .map(|j| {
                 let largest = |shift: bool| {
                     (0..node_ref.len()).fold(0.0f64, |m, k| {
-                        let x = u[k * v + j].to_f64_lossy() + if shift { node_ref[k] } else { 0.0 };
+                        let b = base.map_or(0.0, |b| b[k * v + j]);
+                        let x =
+                            u[k * v + j].to_f64_lossy() + if shift { node_ref[k] + b } else { 0.0 };
                         m.max(x.abs())
                     })
                 };
@@ -109,8 +119,18 @@ pub struct EnsembleTables<T> {
     pub pair_normals: Vec<T>,
     /// Pair state (`d`, wall-relative velocity, spin), `7 P`, field-major.
     pub pair_state: Vec<T>,
-    /// The start configuration (displacements `u` and rotations).
+    /// The start configuration (displacements `u` from the base and rotations).
     pub start: ConfigBatch<T>,
+    /// The base the states are displacements from: its displacements from the reference,
+    /// `3 n V`, in f64 — zero at the start of a static solve (the f32 engine moves it to
+    /// the converged configuration at each load step); each variant's static equilibrium
+    /// in a dynamic run (the top node's stays at the reference, where the hook's travel is
+    /// prescribed). The states are then the motion from there — millimetres, where a
+    /// kilometre string hangs metres down — so f32 keeps their digits.
+    pub base: Vec<f64>,
+    /// Base chords and stretches per element and variant, `4 (n − 1) V`
+    /// ([`crate::kernels::beam::base_chords`] of `base`).
+    pub chords: Vec<T>,
     /// Contact terms the scene uses (the contact kernel is compiled for these only).
     pub terms: ContactTerms,
 }
@@ -134,6 +154,10 @@ pub trait Ensemble<T> {
     fn commit(&mut self, alpha: &[T]) -> Result<(), String>;
     /// The current configuration, read back.
     fn config(&mut self) -> Result<ConfigBatch<T>, String>;
+    /// Moves the base to the current configuration: the tables' `base` (f64, the host's
+    /// sum of the old base and the current displacements) and `chords`; the displacements
+    /// from it are set to zero, the rotations kept (the system must be evaluated again).
+    fn rebase(&mut self, base: &[f64], chords: &[T]) -> Result<(), String>;
 }
 
 /// A kernel path: makes the [`Ensemble`] of a chunk of variants.
@@ -174,8 +198,9 @@ impl TwinEnsemble<'_> {
         let t = &self.tables;
         let (v, n) = (t.num_variants, t.num_nodes);
         let c = &self.config[slot];
-        let (elem_force, elem_tangent) = crate::kernels::beam::beam(self.model, v, &c.x, &c.rot);
-        gather_sites(&t.pair_node, &c.x, v, &mut self.contact.pair_state);
+        let (elem_force, elem_tangent) =
+            crate::kernels::beam::beam(self.model, v, &c.x, &c.rot, &t.chords);
+        gather_sites(&t.pair_node, &c.x, &t.base, v, &mut self.contact.pair_state);
         let mut out = crate::kernels::contact::ContactOutputs::new(self.contact.num_pairs());
         contact(&t.terms, &self.contact, &mut out);
         self.system[slot] = Some(assemble(&AssemblyInputs {
@@ -252,6 +277,13 @@ impl Ensemble<f64> for TwinEnsemble<'_> {
     }
     fn config(&mut self) -> Result<ConfigBatch<f64>, String> {
         Ok(self.config[self.current].clone())
+    }
+    fn rebase(&mut self, base: &[f64], chords: &[f64]) -> Result<(), String> {
+        self.tables.base = base.to_vec();
+        self.tables.chords = chords.to_vec();
+        self.config[self.current].x.fill(0.0);
+        self.system[self.current] = None;
+        Ok(())
     }
 }
 
@@ -422,6 +454,11 @@ pub fn ensemble_tables<T: Real>(models: &[Model]) -> Result<EnsembleTables<T>, S
         pair_normals,
         pair_state,
         start,
+        base: vec![0.0; 3 * n * v],
+        chords: crate::kernels::beam::base_chords(base, None, v)
+            .into_iter()
+            .map(t)
+            .collect(),
         terms,
     })
 }
@@ -474,13 +511,42 @@ fn solve_chunk<T: Real + Send + Sync, P: KernelPath<T>>(
         tolerance,
         small_residual,
         step_floor,
-    } = Convergence::for_path::<T>(options.tolerance, &tables.node_ref, &tables.start.x, v);
+    } = Convergence::for_path::<T>(
+        options.tolerance,
+        &tables.node_ref,
+        None,
+        &tables.start.x,
+        v,
+    );
     let mut ensemble = path.open(base, &tables)?;
     let mut status = vec![EngineStatus::Converged; v];
     let mut iterations = vec![Vec::new(); v];
-    let schedule = [0.0, 0.25, 0.5, 0.75, 1.0];
+    // In f32 each load step starts by moving the base to the configuration reached (its
+    // displacements summed in f64 on the host), so the states are the step's motion, not
+    // the metres from the reference; and full load is solved twice, the second time from
+    // its own converged configuration as base: the answer's last digits are then f32's
+    // rounding of millimetres, not of the string's whole sag (the neutral point, from
+    // axial forces of EA·Δl/l, gains ≈ 2 digits; `docs/validation.md`).
+    let f32_path = std::mem::size_of::<T>() == 4;
+    let schedule: &[f64] = if f32_path {
+        &[0.0, 0.25, 0.5, 0.75, 1.0, 1.0]
+    } else {
+        &[0.0, 0.25, 0.5, 0.75, 1.0]
+    };
+    let mut moved = tables.base.clone();
     let minus_one = T::zero() - T::one();
     for (step, &lambda) in schedule.iter().enumerate() {
+        if f32_path && step > 0 {
+            let config = ensemble.config()?;
+            for (b, w) in moved.iter_mut().zip(&config.x) {
+                *b += w.to_f64_lossy();
+            }
+            let chords: Vec<T> = crate::kernels::beam::base_chords(base, Some(&moved), v)
+                .into_iter()
+                .map(t)
+                .collect();
+            ensemble.rebase(&moved, &chords)?;
+        }
         // Loads and friction of this step.
         let mut f_ext = vec![T::zero(); 6 * n * v];
         let mut params = vec![T::zero(); PARAMS_LEN * p];
@@ -616,8 +682,9 @@ fn solve_chunk<T: Real + Send + Sync, P: KernelPath<T>>(
             let mut s = StaticState::initial(base);
             for i in 0..n {
                 for k in 0..3 {
+                    let at = (3 * i + k) * v + j;
                     s.x[i][k] =
-                        tables.node_ref[3 * i + k] + config.x[(3 * i + k) * v + j].to_f64_lossy();
+                        tables.node_ref[3 * i + k] + moved[at] + config.x[at].to_f64_lossy();
                 }
                 for r in 0..3 {
                     for c in 0..3 {

@@ -8,7 +8,7 @@ use crate::gpu::contact::GpuReal;
 use crate::gpu::dispatch::{run_once, Out};
 use crate::gpu::layout::BeamDims;
 use crate::gpu::GpuContext;
-use crate::kernels::beam::{chord_table, frame_table, section_table};
+use crate::kernels::beam::{frame_table, section_table};
 use crate::model::Model;
 
 /// The WGSL text of the beam kernel at a precision.
@@ -20,14 +20,15 @@ pub fn beam_wgsl(f64: bool) -> Result<String, GpuError> {
     compose("beam.wgsl", &flags, f64)
 }
 
-/// Element forces and tangents of V variants on the GPU at displacements `u`, laid out as
-/// the twin's.
+/// Element forces and tangents of V variants on the GPU at displacements `u` from the base
+/// whose chords are `chords` ([`crate::kernels::beam::base_chords`]), laid out as the twin's.
 pub fn beam_gpu<T: GpuReal>(
     ctx: &'static GpuContext,
     model: &Model,
     num_variants: usize,
     u: &[T],
     rot: &[T],
+    chords: &[f64],
 ) -> Result<(Vec<T>, Vec<T>), GpuError> {
     crate::gpu::contact::require_precision::<T>(ctx)?;
     let ne = model.elements.len();
@@ -41,7 +42,7 @@ pub fn beam_gpu<T: GpuReal>(
     let cast = |v: Vec<f64>| -> Vec<T> { v.into_iter().map(T::from_f64_lossy).collect() };
     let sections = cast(section_table(model));
     let frames = cast(frame_table(model));
-    let chords = cast(chord_table(model));
+    let chords = cast(chords.to_vec());
     let dims = BeamDims {
         num_variants: num_variants as u32,
         num_elements: ne as u32,

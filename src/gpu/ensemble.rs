@@ -28,12 +28,14 @@ use crate::physics::contact::PARAMS_LEN;
 const RUNNING: u32 = 2;
 
 /// Bytes per variant of every buffer of a chunk, for a chain of `n` nodes with `s` sites
-/// at `size`-byte floats: two configurations and two assembled systems, element forces and
-/// tangents, contact inputs and outputs, loads, the factorisation workspace, the step, and
-/// the per-variant scalars. (The shared tables — bases, sections, frames — are per chunk.)
+/// at `size`-byte floats: two configurations and two assembled systems, the base and its
+/// chords, element forces and tangents, contact inputs and outputs, loads, the
+/// factorisation workspace, the step, and the per-variant scalars. (The shared tables —
+/// translation bases, sections, frames — are per chunk.)
 pub fn bytes_per_variant(n: usize, s: usize, size: usize) -> usize {
     let m = n.saturating_sub(1);
     let reals = 2 * 12 * n            // x, rot: two slots
+        + 3 * n + 4 * m               // base, base chords and stretches
         + 12 * m + 144 * m            // element force, tangent
         + (OUTPUT_LEN + STATE_LEN + PARAMS_LEN + 3) * s // contact out, state, params, normals
         + 6 * n                       // loads
@@ -187,6 +189,8 @@ struct Common {
     sections: wgpu::Buffer,
     frames: wgpu::Buffer,
     chords: wgpu::Buffer,
+    /// The base's displacements from the reference, `3 n V` (the sites kernel's `b`).
+    base: wgpu::Buffer,
     basis: wgpu::Buffer,
     fixed: wgpu::Buffer,
     node_site: wgpu::Buffer,
@@ -360,7 +364,8 @@ impl Common {
         Ok(Common {
             sections: table("sections", crate::kernels::beam::section_table(model)),
             frames: table("frames", crate::kernels::beam::frame_table(model)),
-            chords: table("chords", crate::kernels::beam::chord_table(model)),
+            chords: storage(ctx, "chords", &tables.chords),
+            base: table("base", tables.base.clone()),
             basis: storage(ctx, "basis", &tables.basis),
             fixed: storage(ctx, "fixed", &tables.fixed),
             node_site: storage(ctx, "node_site", &tables.node_site),
@@ -475,7 +480,7 @@ impl<T: GpuReal> GpuEnsemble<T> {
                 ctx,
                 &pipelines.sites,
                 "sites",
-                &[&c.sites_dims, &c.pair_node, &x, &c.pair_state],
+                &[&c.sites_dims, &c.pair_node, &x, &c.base, &c.pair_state],
             );
             let inputs = c.assembly_inputs();
             let assemble = bind(
@@ -732,15 +737,27 @@ impl<T: GpuReal> Ensemble<T> for GpuEnsemble<T> {
             basis: Vec::new(),
         })
     }
+
+    fn rebase(&mut self, base: &[f64], chords: &[T]) -> Result<(), String> {
+        let base: Vec<T> = base.iter().map(|&b| T::from_f64_lossy(b)).collect();
+        let q = &self.ctx.queue;
+        q.write_buffer(&self.c.base, 0, bytemuck::cast_slice(&base));
+        q.write_buffer(&self.c.chords, 0, bytemuck::cast_slice(chords));
+        let mut encoder = self.encoder("rebase");
+        encoder.clear_buffer(&self.slots[self.current].x, 0, None);
+        q.submit([encoder.finish()]);
+        Ok(())
+    }
 }
 
 /// Runs `shaders/sites.wgsl` once (tests against its twin,
 /// [`crate::kernels::sites::gather_sites`]): `pair_state` with `d` of every pair written
-/// from the displacements `u`.
+/// from the displacements `u` off the base `base`.
 pub fn gather_sites_gpu<T: GpuReal>(
     ctx: &'static GpuContext,
     pair_node: &[u32],
     u: &[T],
+    base: &[T],
     num_variants: usize,
     pair_state: &[T],
 ) -> Result<Vec<T>, GpuError> {
@@ -757,7 +774,11 @@ pub fn gather_sites_gpu<T: GpuReal>(
         &pipeline,
         "sites",
         bytemuck::bytes_of(&dims),
-        &[bytemuck::cast_slice(pair_node), bytemuck::cast_slice(u)],
+        &[
+            bytemuck::cast_slice(pair_node),
+            bytemuck::cast_slice(u),
+            bytemuck::cast_slice(base),
+        ],
         &[crate::gpu::dispatch::Out::From(bytemuck::cast_slice(
             pair_state,
         ))],
@@ -971,6 +992,7 @@ impl<T: GpuReal> GpuDynamic<T> {
                     &c.sites_dims,
                     &c.pair_node,
                     &b.u_1,
+                    &c.base,
                     &c.pair_state,
                     &b.vel_1,
                     &c.normals,
@@ -1182,11 +1204,11 @@ pub fn gather_sites_dynamic_gpu<T: GpuReal>(
     ctx: &'static GpuContext,
     pair_node: &[u32],
     pair_normals: &[T],
-    u: &[T],
-    vel: &[T],
-    num_variants: usize,
+    state: &crate::kernels::dynamics::DynamicBatch<T>,
+    base: &[T],
     pair_state: &[T],
 ) -> Result<Vec<T>, GpuError> {
+    let (u, vel, num_variants) = (&state.u, &state.vel, state.num_variants);
     require_precision::<T>(ctx)?;
     let pipeline = ctx.pipeline("sites", &sites_wgsl_for(true, T::IS_F64)?)?;
     let dims = ContactDims {
@@ -1195,7 +1217,7 @@ pub fn gather_sites_dynamic_gpu<T: GpuReal>(
         pair_offset: 0,
         _pad: 0,
     };
-    // Bindings: dims, pair_node, u, pair_state (read-write), vel, pair_normals — the
+    // Bindings: dims, pair_node, u, base, pair_state (read-write), vel, pair_normals — the
     // read-write one sits between inputs, so bind by hand.
     let device = &ctx.device;
     let buf = |label: &str, bytes: &[u8], usage: wgpu::BufferUsages| {
@@ -1216,11 +1238,14 @@ pub fn gather_sites_dynamic_gpu<T: GpuReal>(
     let state_b = buf("pair_state", bytemuck::cast_slice(pair_state), st);
     let vel_b = buf("vel", bytemuck::cast_slice(vel), st);
     let normals_b = buf("pair_normals", bytemuck::cast_slice(pair_normals), st);
+    let base_b = buf("base", bytemuck::cast_slice(base), st);
     let group = bind(
         ctx,
         &pipeline,
         "sites",
-        &[&dims_b, &nodes_b, &u_b, &state_b, &vel_b, &normals_b],
+        &[
+            &dims_b, &nodes_b, &u_b, &base_b, &state_b, &vel_b, &normals_b,
+        ],
     );
     let mut e = encoder(ctx, "sites");
     {

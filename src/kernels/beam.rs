@@ -1,11 +1,17 @@
 //! Twin of `shaders/beam.wgsl`: internal force (12) and consistent tangent (12×12) of every
 //! (element, variant), by [`crate::physics::beam::force_and_tangent`] (hyper-dual
 //! evaluations of the co-rotated element energy), laid out for the assembly:
-//! `[(12 e + j) V + v]` and `[(144 e + 12 j + k) V + v]`. Inputs: displacements from the
-//! reference positions `[(3 i + k) V + v]`, rotations `[(9 i + 3 r + c) V + v]` (the twin
-//! takes them in f64), reference triads per node, sections and reference chords per
-//! element, shared by the variants. An element's nodes are placed at `u₁` and `c + u₂`
-//! (`c = X₂ − X₁`): only the chord matters, and it keeps its digits in f32.
+//! `[(12 e + j) V + v]` and `[(144 e + 12 j + k) V + v]`. Inputs: displacements `w` from
+//! each variant's *base* configuration `X + b` `[(3 i + k) V + v]`, rotations
+//! `[(9 i + 3 r + c) V + v]` (the twin takes them in f64), reference triads per node and
+//! sections per element (shared by the variants), and per element and variant the base
+//! chord `c = (X₂ + b₂) − (X₁ + b₁)` with its stretch `|c| − l0` ([`base_chords`]). An
+//! element's nodes are placed at `w₁` and `c + w₂`: only the chord matters, and it keeps
+//! its digits in f32. The static engine's base starts at the reference (`b = 0`) and in
+//! f32 moves to the configuration reached at each load step; the dynamic engine's is each
+//! variant's static equilibrium, so its states are the millimetres of motion, not the
+//! metres a kilometre string hangs down (whose f32 quantum, 2.4e-7 m at 2 m, times a
+//! collar's axial stiffness is a kilonewton).
 
 use rayon::prelude::*;
 
@@ -38,20 +44,45 @@ pub fn frame_table(model: &Model) -> Vec<f64> {
         .collect()
 }
 
-/// Reference chord `X₂ − X₁` per element (the kernel's `chord0` binding).
-pub fn chord_table(model: &Model) -> Vec<f64> {
-    (0..model.elements.len())
-        .flat_map(|e| {
-            let (a, b) = (model.nodes[e].position, model.nodes[e + 1].position);
-            [b[0] - a[0], b[1] - a[1], b[2] - a[2]]
-        })
-        .collect()
+/// Values per (element, variant) in [`base_chords`]: the chord's three components and its
+/// stretch.
+pub const CHORD_LEN: usize = 4;
+
+/// The kernel's `chord` binding, `[(4 e + k) V + v]`: per element and variant the base
+/// chord `c = (X₂ + b₂) − (X₁ + b₁)` (`k` = 0–2) and its stretch `|c| − l0` (`k` = 3),
+/// both in f64 (the stretch is what f32 cannot form from the chord: a strain of 1e-4 is
+/// 1e-4 m on an element, three digits of its length). `base` holds the displacements `b`
+/// of the base from the reference, `[(3 i + k) V + v]`; `None`: the reference itself.
+pub fn base_chords(model: &Model, base: Option<&[f64]>, num_variants: usize) -> Vec<f64> {
+    let nv = num_variants;
+    let ne = model.elements.len();
+    let mut out = vec![0.0; CHORD_LEN * ne * nv];
+    for (e, el) in model.elements.iter().enumerate() {
+        let (a, b) = (model.nodes[e].position, model.nodes[e + 1].position);
+        for v in 0..nv {
+            let shift = |i: usize, k: usize| base.map_or(0.0, |s| s[(3 * i + k) * nv + v]);
+            let c: [f64; 3] =
+                std::array::from_fn(|k| (b[k] + shift(e + 1, k)) - (a[k] + shift(e, k)));
+            for k in 0..3 {
+                out[(CHORD_LEN * e + k) * nv + v] = c[k];
+            }
+            let l = (c[0] * c[0] + c[1] * c[1] + c[2] * c[2]).sqrt();
+            out[(CHORD_LEN * e + 3) * nv + v] = l - el.length0;
+        }
+    }
+    out
 }
 
 /// Element forces and tangents of V variants (rayon over elements × variants) at
-/// displacements `u` and rotations `rot`.
-pub fn beam(model: &Model, num_variants: usize, u: &[f64], rot: &[f64]) -> (Vec<f64>, Vec<f64>) {
-    let chord = chord_table(model);
+/// displacements `u` from the base whose chords are `chords` ([`base_chords`]) and
+/// rotations `rot`.
+pub fn beam(
+    model: &Model,
+    num_variants: usize,
+    u: &[f64],
+    rot: &[f64],
+    chords: &[f64],
+) -> (Vec<f64>, Vec<f64>) {
     let nv = num_variants;
     let ne = model.elements.len();
     let per: Vec<([f64; 12], [[f64; 12]; 12])> = (0..ne * nv)
@@ -72,7 +103,9 @@ pub fn beam(model: &Model, num_variants: usize, u: &[f64], rot: &[f64]) -> (Vec<
             let es = ElementState {
                 x: [
                     disp(e),
-                    std::array::from_fn(|k| chord[3 * e + k] + u[(3 * (e + 1) + k) * nv + v]),
+                    std::array::from_fn(|k| {
+                        chords[(CHORD_LEN * e + k) * nv + v] + u[(3 * (e + 1) + k) * nv + v]
+                    }),
                 ],
                 triad: [triad(e), triad(e + 1)],
             };

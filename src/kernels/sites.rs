@@ -1,21 +1,26 @@
 //! Twin of `shaders/sites.wgsl`: each contact pair's displacement, gathered from the
-//! configuration (the contact kernel's `d`; states are displacements from the reference).
+//! configuration (the contact kernel's `d = b + w`; states `w` are displacements from a
+//! base configuration, `b` the base's from the reference).
 //!
 //! One invocation per (site, variant) pair `i = site · V + variant`:
-//! `d_k = u[(3 node + k) V + variant]`, written to fields 0–2 of the pair state (fields
-//! 3–6, the wall-relative velocity and spin, are the host's: they do not depend on the
-//! configuration in a static solve). `pair_node[i]` is the pair's node, so a variant may
+//! `d_k = b[(3 node + k) V + variant] + w[(3 node + k) V + variant]`, written to fields 0–2
+//! of the pair state (fields 3–6, the wall-relative velocity and spin, are the host's: they
+//! do not depend on the configuration in a static solve). `pair_node[i]` is the pair's node, so a variant may
 //! carry its stabilizers at other nodes than its neighbours.
 //!
-//! [`gather_sites_dynamic`] (the kernel's DYNAMIC form) also writes the node's velocity
-//! and its spin about the hole axis, `n · ω` (as `solve::dynamics`).
+//! [`gather_sites_dynamic`] (the kernel's DYNAMIC form, whose base is each variant's
+//! static equilibrium) also writes the node's velocity and its spin about the hole axis,
+//! `n · ω` (as `solve::dynamics`).
 
+use crate::kernels::dynamics::DynamicBatch;
 use crate::physics::Real;
 
-/// Writes `d` of every pair into `pair_state` (field-major, `[field · P + i]`).
+/// Writes `d = b + w` of every pair into `pair_state` (field-major, `[field · P + i]`):
+/// `u` the displacements `w` from the base, `base` the base's `b` from the reference.
 pub fn gather_sites<T: Real>(
     pair_node: &[u32],
     u: &[T],
+    base: &[T],
     num_variants: usize,
     pair_state: &mut [T],
 ) {
@@ -24,22 +29,24 @@ pub fn gather_sites<T: Real>(
         let v = i % num_variants;
         let node = pair_node[i] as usize;
         for k in 0..3 {
-            pair_state[k * p + i] = u[(3 * node + k) * num_variants + v];
+            let at = (3 * node + k) * num_variants + v;
+            pair_state[k * p + i] = base[at] + u[at];
         }
     }
 }
 
-/// As [`gather_sites`], and fields 3–6 from the node velocities `vel` (`6 n V`: ẋ, ω) and
+/// As [`gather_sites`] from `state`, whose displacements `u` are from the base `base`
+/// (`3 n V`, `d = b + u`), and fields 3–6 from its velocities `vel` (`6 n V`: ẋ, ω) and
 /// the pairs' hole axes `pair_normals` (`3 P`): `v = ẋ`, `omega = n · ω`.
 pub fn gather_sites_dynamic<T: Real>(
     pair_node: &[u32],
     pair_normals: &[T],
-    u: &[T],
-    vel: &[T],
-    num_variants: usize,
+    state: &DynamicBatch<T>,
+    base: &[T],
     pair_state: &mut [T],
 ) {
-    gather_sites(pair_node, u, num_variants, pair_state);
+    let (vel, num_variants) = (&state.vel, state.num_variants);
+    gather_sites(pair_node, &state.u, base, num_variants, pair_state);
     let p = pair_node.len();
     for i in 0..p {
         let v = i % num_variants;
