@@ -469,12 +469,13 @@ fn collect<P: holewall::engine::KernelPath<f64>>(
 
 /// 16 variants (RPM × WOB) of the paper's one-stabilizer case (§3.1 dynamics: table ramped
 /// over 50 s, hook lowered at the ROP) for `HOLEWALL_PAPER_SECONDS` (default 1 s) on
-/// `HOLEWALL_PAPER_PATH` = `twin` (default) or `gpu` (f64; f32 reported beside it),
+/// `HOLEWALL_PAPER_PATH` = `twin` (default) or `gpu` (f64 within 1e-6, then f32 within
+/// 1.2e-3, the residual the f32 engine accepts; `HOLEWALL_PAPER_PRECISION=f32`: f32 only),
 /// against 16 CPU integrator runs, step for step. Over much shorter runs the velocities
 /// are still at the scale the Newton tolerance leaves (the table has barely started: at
 /// 0.02 s the GPU path shows 1.2e-6 of the largest velocity), so the 1 s of the issue is
-/// the meaningful length. Minutes on two cores (8 min on lavapipe in f64); run with
-/// `cargo test --release --test engine_dynamic -- --ignored --nocapture`.
+/// the meaningful length. Minutes on two cores (8 min on lavapipe in f64, 4.5 in f32); run
+/// with `cargo test --release --test engine_dynamic -- --ignored --nocapture`.
 #[test]
 #[ignore]
 fn paper_case_sixteen_variants_match_the_cpu_integrator() {
@@ -549,17 +550,16 @@ fn paper_case_sixteen_variants_match_the_cpu_integrator() {
             .unwrap()
         };
         let elapsed = t0.elapsed().as_secs_f64();
-        // f64 must finish every variant; in f32 a variant whose Newton stalls on the
-        // precision's residual floor fails (the CLI re-runs it on the CPU): reported, and
-        // the error taken over the variants that finished.
-        let finished: Vec<usize> = (0..v)
-            .filter(|&j| r[j].status == DynamicStatus::Finished)
-            .collect();
+        // Every variant must finish, in f32 too: its states are the motion from the static
+        // equilibrium, whose f32 quantum is far below the residual it accepts (with
+        // displacements from the undeformed mesh, metres at the bit, a variant stalled at
+        // t = 0.816 s on the f32 rounding of the BHA's axial forces).
         for (j, x) in r.iter().enumerate() {
-            if x.status != DynamicStatus::Finished {
-                assert!(f32_too, "variant {j}: {:?}", x.status);
-                eprintln!("  f32: variant {j} {:?}", x.status);
-            }
+            assert_eq!(
+                x.status,
+                DynamicStatus::Finished,
+                "variant {j}, f32 {f32_too}"
+            );
         }
         let its: Vec<usize> = r
             .iter()
@@ -572,10 +572,7 @@ fn paper_case_sixteen_variants_match_the_cpu_integrator() {
             its.iter().max().unwrap_or(&0)
         );
         let engine = engine_steps(&seen, v, n);
-        let pick = |runs: &[Vec<(Vec<f64>, Vec<f64>)>]| -> Vec<Vec<(Vec<f64>, Vec<f64>)>> {
-            finished.iter().map(|&j| runs[j].clone()).collect()
-        };
-        let (eu, ev) = trajectory_error(&pick(&engine), &pick(&cpu));
+        let (eu, ev) = trajectory_error(&engine, &cpu);
         (eu, ev, elapsed)
     };
     // `HOLEWALL_PAPER_PRECISION=f32` runs the GPU in f32 only.
@@ -584,6 +581,8 @@ fn paper_case_sixteen_variants_match_the_cpu_integrator() {
         eprintln!(
             "paper case, {v} variants × {seconds} s, GPU f32: displacements {eu:.2e}, velocities {ev:.2e} relative to the f64 CPU runs; engine {t32:.1} s, CPU runs {t_cpu:.1} s"
         );
+        // The f32 engine accepts residuals up to 1e4 ε₃₂ ≈ 1.2e-3 of the force scale.
+        assert!(eu <= 1.2e-3 && ev <= 1.2e-3, "f32 {eu:e}, {ev:e}");
         return;
     }
     let (eu, ev, t_engine) = run(false);
@@ -597,5 +596,6 @@ fn paper_case_sixteen_variants_match_the_cpu_integrator() {
         eprintln!(
             "paper case, GPU f32: displacements {eu:.2e}, velocities {ev:.2e} relative to the f64 CPU runs; {t32:.1} s"
         );
+        assert!(eu <= 1.2e-3 && ev <= 1.2e-3, "f32 {eu:e}, {ev:e}");
     }
 }
