@@ -179,7 +179,7 @@ fn stabilizer_moves_and_chunks_in_the_engine() {
 
 #[test]
 fn sites_kernel_equals_its_twin() {
-    use holewall::kernels::sites::gather_sites;
+    use holewall::kernels::sites::{gather_sites, pair_base};
     use rand::{Rng, SeedableRng};
     let mut rng = rand::rngs::StdRng::seed_from_u64(3);
     let (n, v, s) = (40, 7, 5);
@@ -188,17 +188,41 @@ fn sites_kernel_equals_its_twin() {
     let x: Vec<f64> = (0..3 * n * v)
         .map(|_| rng.random_range(-1e3..1e3))
         .collect();
+    // A base of metres per node, and a hole axis per pair (deviated).
     let base: Vec<f64> = (0..3 * n * v)
         .map(|_| rng.random_range(-3.0..3.0))
         .collect();
+    let normals: Vec<f64> = (0..p)
+        .flat_map(|_| {
+            let a: [f64; 3] = std::array::from_fn(|_| rng.random_range(-1.0..1.0));
+            let l = (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt();
+            a.map(|c| c / l)
+        })
+        .collect();
+    let at_pairs = pair_base(&pair_node, &normals, &base, v);
     let mut twin: Vec<f64> = (0..7 * p).map(|k| k as f64).collect();
     let before = twin.clone();
-    gather_sites(&pair_node, &x, &base, v, &mut twin);
+    gather_sites(&pair_node, &x, &at_pairs, v, &mut twin);
+    let across = |d: [f64; 3], i: usize| -> [f64; 3] {
+        let n = &normals[3 * i..3 * i + 3];
+        let along: f64 = (0..3).map(|k| d[k] * n[k]).sum();
+        std::array::from_fn(|k| d[k] - n[k] * along)
+    };
     for i in 0..p {
         let (node, j) = (pair_node[i] as usize, i % v);
         for k in 0..3 {
             let at = (3 * node + k) * v + j;
-            assert_eq!(twin[k * p + i], base[at] + x[at]);
+            assert_eq!(twin[k * p + i], at_pairs[3 * i + k] + x[at]);
+        }
+        // Across the hole axis (all the contact uses) d is the whole b + w.
+        let full: [f64; 3] = std::array::from_fn(|k| {
+            let at = (3 * node + k) * v + j;
+            base[at] + x[at]
+        });
+        let d: [f64; 3] = std::array::from_fn(|k| twin[k * p + i]);
+        let (a, b) = (across(d, i), across(full, i));
+        for k in 0..3 {
+            assert!((a[k] - b[k]).abs() <= 1e-12 * 1e3, "{a:?} vs {b:?}");
         }
         for k in 3..7 {
             assert_eq!(
@@ -210,8 +234,9 @@ fn sites_kernel_equals_its_twin() {
     }
     let Some(ctx) = common::gpu() else { return };
     if ctx.has_f64 {
-        let gpu = holewall::gpu::ensemble::gather_sites_gpu(ctx, &pair_node, &x, &base, v, &before)
-            .unwrap();
+        let gpu =
+            holewall::gpu::ensemble::gather_sites_gpu(ctx, &pair_node, &x, &at_pairs, v, &before)
+                .unwrap();
         assert_eq!(gpu, twin);
     }
 }

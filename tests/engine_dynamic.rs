@@ -293,12 +293,17 @@ fn dynamic_kernels_equal_their_twins() {
     }
     let pair_normals: Vec<f64> = (0..p).flat_map(|_| [0.0, 0.6, 0.8]).collect();
     let mut pair_state = r(-1.0, 1.0, 7 * p);
-    // The base the displacements are taken from (a hanging string's metres).
-    let base = r(-3.0, 3.0, 3 * n * v);
+    // The base the displacements are taken from (a hanging string's metres), at the pairs.
+    let node_base = r(-3.0, 3.0, 3 * n * v);
+    let base = holewall::kernels::sites::pair_base(&pair_node, &pair_normals, &node_base, v);
     gather_sites_dynamic(&pair_node, &pair_normals, &state, &base, &mut pair_state);
     for i in 0..p {
         let at = (3 * pair_node[i] as usize + 2) * v + i % v;
-        assert_eq!(pair_state[2 * p + i], base[at] + state.u[at], "d = b + w");
+        assert_eq!(
+            pair_state[2 * p + i],
+            base[3 * i + 2] + state.u[at],
+            "d = b + w"
+        );
     }
     let a = AssemblyInputs {
         num_variants: v,

@@ -266,11 +266,7 @@ fn run_chunk<T: Real + Send + Sync, P: KernelPath<T>>(
     batch.pair_params = dynamic.pair_params.clone();
     tables.terms = batch.required_terms(models[0].friction, ContactMode::Dynamic);
     let v = tables.num_variants;
-    tables.chords = crate::kernels::beam::base_chords(&models[0], Some(&base), v)
-        .into_iter()
-        .map(t)
-        .collect();
-    tables.base = base;
+    tables.set_base(&models[0], base);
     let Convergence {
         tolerance,
         small_residual,
@@ -510,7 +506,7 @@ impl<'a> TwinDynamic<'a> {
             &t.pair_node,
             &t.pair_normals,
             tr,
-            &t.base,
+            &t.pair_base,
             &mut self.contact.pair_state,
         );
         let mut out = ContactOutputs::new(self.contact.num_pairs());

@@ -128,11 +128,33 @@ pub struct EnsembleTables<T> {
     /// prescribed). The states are then the motion from there — millimetres, where a
     /// kilometre string hangs metres down — so f32 keeps their digits.
     pub base: Vec<f64>,
+    /// The base at every pair across its hole axis, `3 P`
+    /// ([`crate::kernels::sites::pair_base`] of `base`).
+    pub pair_base: Vec<T>,
     /// Base chords and stretches per element and variant, `4 (n − 1) V`
     /// ([`crate::kernels::beam::base_chords`] of `base`).
     pub chords: Vec<T>,
     /// Contact terms the scene uses (the contact kernel is compiled for these only).
     pub terms: ContactTerms,
+}
+
+impl<T: Real> EnsembleTables<T> {
+    /// Moves the base to `base` (displacements from `model`'s reference, `3 n V`), with
+    /// the pairs' and the elements' tables formed from it in f64.
+    pub fn set_base(&mut self, model: &Model, base: Vec<f64>) {
+        let t = |x: f64| T::from_f64_lossy(x);
+        let v = self.num_variants;
+        self.chords = crate::kernels::beam::base_chords(model, Some(&base), v)
+            .into_iter()
+            .map(t)
+            .collect();
+        self.pair_base =
+            crate::kernels::sites::pair_base(&self.pair_node, &self.pair_normals, &base, v)
+                .into_iter()
+                .map(t)
+                .collect();
+        self.base = base;
+    }
 }
 
 /// A chunk of variants held by a kernel path: a current configuration with its assembled
@@ -154,10 +176,11 @@ pub trait Ensemble<T> {
     fn commit(&mut self, alpha: &[T]) -> Result<(), String>;
     /// The current configuration, read back.
     fn config(&mut self) -> Result<ConfigBatch<T>, String>;
-    /// Moves the base to the current configuration: the tables' `base` (f64, the host's
-    /// sum of the old base and the current displacements) and `chords`; the displacements
-    /// from it are set to zero, the rotations kept (the system must be evaluated again).
-    fn rebase(&mut self, base: &[f64], chords: &[T]) -> Result<(), String>;
+    /// Moves the base to the current configuration, given as `tables` after
+    /// [`EnsembleTables::set_base`] with the host's sum of the old base and the current
+    /// displacements: the displacements from it are set to zero, the rotations kept (the
+    /// system must be evaluated again).
+    fn rebase(&mut self, tables: &EnsembleTables<T>) -> Result<(), String>;
 }
 
 /// A kernel path: makes the [`Ensemble`] of a chunk of variants.
@@ -200,7 +223,13 @@ impl TwinEnsemble<'_> {
         let c = &self.config[slot];
         let (elem_force, elem_tangent) =
             crate::kernels::beam::beam(self.model, v, &c.x, &c.rot, &t.chords);
-        gather_sites(&t.pair_node, &c.x, &t.base, v, &mut self.contact.pair_state);
+        gather_sites(
+            &t.pair_node,
+            &c.x,
+            &t.pair_base,
+            v,
+            &mut self.contact.pair_state,
+        );
         let mut out = crate::kernels::contact::ContactOutputs::new(self.contact.num_pairs());
         contact(&t.terms, &self.contact, &mut out);
         self.system[slot] = Some(assemble(&AssemblyInputs {
@@ -278,9 +307,8 @@ impl Ensemble<f64> for TwinEnsemble<'_> {
     fn config(&mut self) -> Result<ConfigBatch<f64>, String> {
         Ok(self.config[self.current].clone())
     }
-    fn rebase(&mut self, base: &[f64], chords: &[f64]) -> Result<(), String> {
-        self.tables.base = base.to_vec();
-        self.tables.chords = chords.to_vec();
+    fn rebase(&mut self, tables: &EnsembleTables<f64>) -> Result<(), String> {
+        self.tables = tables.clone();
         self.config[self.current].x.fill(0.0);
         self.system[self.current] = None;
         Ok(())
@@ -455,6 +483,7 @@ pub fn ensemble_tables<T: Real>(models: &[Model]) -> Result<EnsembleTables<T>, S
         pair_state,
         start,
         base: vec![0.0; 3 * n * v],
+        pair_base: vec![T::zero(); 3 * p],
         chords: crate::kernels::beam::base_chords(base, None, v)
             .into_iter()
             .map(t)
@@ -533,19 +562,17 @@ fn solve_chunk<T: Real + Send + Sync, P: KernelPath<T>>(
     } else {
         &[0.0, 0.25, 0.5, 0.75, 1.0]
     };
-    let mut moved = tables.base.clone();
+    let mut tables = tables;
     let minus_one = T::zero() - T::one();
     for (step, &lambda) in schedule.iter().enumerate() {
         if f32_path && step > 0 {
             let config = ensemble.config()?;
+            let mut moved = tables.base.clone();
             for (b, w) in moved.iter_mut().zip(&config.x) {
                 *b += w.to_f64_lossy();
             }
-            let chords: Vec<T> = crate::kernels::beam::base_chords(base, Some(&moved), v)
-                .into_iter()
-                .map(t)
-                .collect();
-            ensemble.rebase(&moved, &chords)?;
+            tables.set_base(base, moved);
+            ensemble.rebase(&tables)?;
         }
         // Loads and friction of this step.
         let mut f_ext = vec![T::zero(); 6 * n * v];
@@ -684,7 +711,7 @@ fn solve_chunk<T: Real + Send + Sync, P: KernelPath<T>>(
                 for k in 0..3 {
                     let at = (3 * i + k) * v + j;
                     s.x[i][k] =
-                        tables.node_ref[3 * i + k] + moved[at] + config.x[at].to_f64_lossy();
+                        tables.node_ref[3 * i + k] + tables.base[at] + config.x[at].to_f64_lossy();
                 }
                 for r in 0..3 {
                     for c in 0..3 {

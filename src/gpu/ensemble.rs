@@ -35,9 +35,9 @@ const RUNNING: u32 = 2;
 pub fn bytes_per_variant(n: usize, s: usize, size: usize) -> usize {
     let m = n.saturating_sub(1);
     let reals = 2 * 12 * n            // x, rot: two slots
-        + 3 * n + 4 * m               // base, base chords and stretches
+        + 4 * m                       // base chords and stretches
         + 12 * m + 144 * m            // element force, tangent
-        + (OUTPUT_LEN + STATE_LEN + PARAMS_LEN + 3) * s // contact out, state, params, normals
+        + (OUTPUT_LEN + STATE_LEN + PARAMS_LEN + 6) * s // contact out, state, params, normals, base
         + 6 * n                       // loads
         + 2 * (36 * n + 72 * m + 6 * n) // two systems
         + 36 * m + 6 * n + 6 * n      // LU workspace, y, Δ
@@ -189,8 +189,8 @@ struct Common {
     sections: wgpu::Buffer,
     frames: wgpu::Buffer,
     chords: wgpu::Buffer,
-    /// The base's displacements from the reference, `3 n V` (the sites kernel's `b`).
-    base: wgpu::Buffer,
+    /// The base at every pair across its hole axis, `3 P` (the sites kernel's `b`).
+    pair_base: wgpu::Buffer,
     basis: wgpu::Buffer,
     fixed: wgpu::Buffer,
     node_site: wgpu::Buffer,
@@ -365,7 +365,7 @@ impl Common {
             sections: table("sections", crate::kernels::beam::section_table(model)),
             frames: table("frames", crate::kernels::beam::frame_table(model)),
             chords: storage(ctx, "chords", &tables.chords),
-            base: table("base", tables.base.clone()),
+            pair_base: storage(ctx, "pair_base", &tables.pair_base),
             basis: storage(ctx, "basis", &tables.basis),
             fixed: storage(ctx, "fixed", &tables.fixed),
             node_site: storage(ctx, "node_site", &tables.node_site),
@@ -480,7 +480,7 @@ impl<T: GpuReal> GpuEnsemble<T> {
                 ctx,
                 &pipelines.sites,
                 "sites",
-                &[&c.sites_dims, &c.pair_node, &x, &c.base, &c.pair_state],
+                &[&c.sites_dims, &c.pair_node, &x, &c.pair_base, &c.pair_state],
             );
             let inputs = c.assembly_inputs();
             let assemble = bind(
@@ -738,11 +738,16 @@ impl<T: GpuReal> Ensemble<T> for GpuEnsemble<T> {
         })
     }
 
-    fn rebase(&mut self, base: &[f64], chords: &[T]) -> Result<(), String> {
-        let base: Vec<T> = base.iter().map(|&b| T::from_f64_lossy(b)).collect();
+    fn rebase(&mut self, tables: &EnsembleTables<T>) -> Result<(), String> {
         let q = &self.ctx.queue;
-        q.write_buffer(&self.c.base, 0, bytemuck::cast_slice(&base));
-        q.write_buffer(&self.c.chords, 0, bytemuck::cast_slice(chords));
+        if !tables.pair_base.is_empty() {
+            q.write_buffer(
+                &self.c.pair_base,
+                0,
+                bytemuck::cast_slice(&tables.pair_base),
+            );
+        }
+        q.write_buffer(&self.c.chords, 0, bytemuck::cast_slice(&tables.chords));
         let mut encoder = self.encoder("rebase");
         encoder.clear_buffer(&self.slots[self.current].x, 0, None);
         q.submit([encoder.finish()]);
@@ -752,12 +757,12 @@ impl<T: GpuReal> Ensemble<T> for GpuEnsemble<T> {
 
 /// Runs `shaders/sites.wgsl` once (tests against its twin,
 /// [`crate::kernels::sites::gather_sites`]): `pair_state` with `d` of every pair written
-/// from the displacements `u` off the base `base`.
+/// from the displacements `u` off the base (at the pairs, `pair_base`).
 pub fn gather_sites_gpu<T: GpuReal>(
     ctx: &'static GpuContext,
     pair_node: &[u32],
     u: &[T],
-    base: &[T],
+    pair_base: &[T],
     num_variants: usize,
     pair_state: &[T],
 ) -> Result<Vec<T>, GpuError> {
@@ -777,7 +782,7 @@ pub fn gather_sites_gpu<T: GpuReal>(
         &[
             bytemuck::cast_slice(pair_node),
             bytemuck::cast_slice(u),
-            bytemuck::cast_slice(base),
+            bytemuck::cast_slice(pair_base),
         ],
         &[crate::gpu::dispatch::Out::From(bytemuck::cast_slice(
             pair_state,
@@ -992,7 +997,7 @@ impl<T: GpuReal> GpuDynamic<T> {
                     &c.sites_dims,
                     &c.pair_node,
                     &b.u_1,
-                    &c.base,
+                    &c.pair_base,
                     &c.pair_state,
                     &b.vel_1,
                     &c.normals,
@@ -1205,7 +1210,7 @@ pub fn gather_sites_dynamic_gpu<T: GpuReal>(
     pair_node: &[u32],
     pair_normals: &[T],
     state: &crate::kernels::dynamics::DynamicBatch<T>,
-    base: &[T],
+    pair_base: &[T],
     pair_state: &[T],
 ) -> Result<Vec<T>, GpuError> {
     let (u, vel, num_variants) = (&state.u, &state.vel, state.num_variants);
@@ -1217,7 +1222,7 @@ pub fn gather_sites_dynamic_gpu<T: GpuReal>(
         pair_offset: 0,
         _pad: 0,
     };
-    // Bindings: dims, pair_node, u, base, pair_state (read-write), vel, pair_normals — the
+    // Bindings: dims, pair_node, u, pair_base, pair_state (read-write), vel, pair_normals — the
     // read-write one sits between inputs, so bind by hand.
     let device = &ctx.device;
     let buf = |label: &str, bytes: &[u8], usage: wgpu::BufferUsages| {
@@ -1238,7 +1243,7 @@ pub fn gather_sites_dynamic_gpu<T: GpuReal>(
     let state_b = buf("pair_state", bytemuck::cast_slice(pair_state), st);
     let vel_b = buf("vel", bytemuck::cast_slice(vel), st);
     let normals_b = buf("pair_normals", bytemuck::cast_slice(pair_normals), st);
-    let base_b = buf("base", bytemuck::cast_slice(base), st);
+    let base_b = buf("pair_base", bytemuck::cast_slice(pair_base), st);
     let group = bind(
         ctx,
         &pipeline,
