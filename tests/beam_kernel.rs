@@ -48,11 +48,11 @@ fn gpu_beam_matches_the_twin() {
             }
         }
     }
-    let reference = base_chords(&model, None, v);
+    let reference = base_chords(&model, &vec![0.0; 3 * n * v], v);
     let (f_exact, k_exact) = beam(&model, v, &x, &rot, &reference);
     // The same configurations as displacements `w` from the spun base (millimetres).
     let w: Vec<f64> = x.iter().zip(&spun).map(|(a, b)| a - b).collect();
-    let based = base_chords(&model, Some(&spun), v);
+    let based = base_chords(&model, &spun, v);
     let ne = model.elements.len();
     // Normwise relative difference per (element, variant), worst over all.
     let worst = |f: &[f64], k: &[f64], f_twin: &[f64], k_twin: &[f64]| {

@@ -144,7 +144,7 @@ impl<T: Real> EnsembleTables<T> {
     pub fn set_base(&mut self, model: &Model, base: Vec<f64>) {
         let t = |x: f64| T::from_f64_lossy(x);
         let v = self.num_variants;
-        self.chords = crate::kernels::beam::base_chords(model, Some(&base), v)
+        self.chords = crate::kernels::beam::base_chords(model, &base, v)
             .into_iter()
             .map(t)
             .collect();
@@ -470,7 +470,7 @@ pub fn ensemble_tables<T: Real>(models: &[Model]) -> Result<EnsembleTables<T>, S
     batch.pair_params = params;
     let terms = batch.required_terms(base.friction, ContactMode::Static);
     let node_ref: Vec<f64> = base.nodes.iter().flat_map(|nd| nd.position).collect();
-    Ok(EnsembleTables {
+    let mut tables = EnsembleTables {
         num_variants: v,
         num_nodes: n,
         num_sites: s_count,
@@ -482,14 +482,14 @@ pub fn ensemble_tables<T: Real>(models: &[Model]) -> Result<EnsembleTables<T>, S
         pair_normals,
         pair_state,
         start,
-        base: vec![0.0; 3 * n * v],
-        pair_base: vec![T::zero(); 3 * p],
-        chords: crate::kernels::beam::base_chords(base, None, v)
-            .into_iter()
-            .map(t)
-            .collect(),
+        base: Vec::new(),
+        pair_base: Vec::new(),
+        chords: Vec::new(),
         terms,
-    })
+    };
+    // The static solve starts from the reference as base.
+    tables.set_base(base, vec![0.0; 3 * n * v]);
+    Ok(tables)
 }
 
 /// Static equilibrium of every variant through `path`. All models share the mesh and the

@@ -52,15 +52,15 @@ pub const CHORD_LEN: usize = 4;
 /// chord `c = (X₂ + b₂) − (X₁ + b₁)` (`k` = 0–2) and its stretch `|c| − l0` (`k` = 3),
 /// both in f64 (the stretch is what f32 cannot form from the chord: a strain of 1e-4 is
 /// 1e-4 m on an element, three digits of its length). `base` holds the displacements `b`
-/// of the base from the reference, `[(3 i + k) V + v]`; `None`: the reference itself.
-pub fn base_chords(model: &Model, base: Option<&[f64]>, num_variants: usize) -> Vec<f64> {
+/// of the base from the reference, `[(3 i + k) V + v]` (zeros: the reference itself).
+pub fn base_chords(model: &Model, base: &[f64], num_variants: usize) -> Vec<f64> {
     let nv = num_variants;
     let ne = model.elements.len();
     let mut out = vec![0.0; CHORD_LEN * ne * nv];
     for (e, el) in model.elements.iter().enumerate() {
         let (a, b) = (model.nodes[e].position, model.nodes[e + 1].position);
         for v in 0..nv {
-            let shift = |i: usize, k: usize| base.map_or(0.0, |s| s[(3 * i + k) * nv + v]);
+            let shift = |i: usize, k: usize| base[(3 * i + k) * nv + v];
             let c: [f64; 3] =
                 std::array::from_fn(|k| (b[k] + shift(e + 1, k)) - (a[k] + shift(e, k)));
             for k in 0..3 {

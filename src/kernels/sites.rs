@@ -3,10 +3,10 @@
 //! base configuration, `b` the base's from the reference, across the pair's hole axis).
 //!
 //! One invocation per (site, variant) pair `i = site · V + variant`:
-//! `d_k = b[3 i + k] + w[(3 node + k) V + variant]`, written to fields 0–2
-//! of the pair state (fields 3–6, the wall-relative velocity and spin, are the host's: they
-//! do not depend on the configuration in a static solve). `pair_node[i]` is the pair's node, so a variant may
-//! carry its stabilizers at other nodes than its neighbours.
+//! `d_k = b[3 i + k] + w[(3 node + k) V + variant]`, written to fields 0–2 of the pair
+//! state (fields 3–6, the wall-relative velocity and spin, are the host's: they do not
+//! depend on the configuration in a static solve). `pair_node[i]` is the pair's node, so a
+//! variant may carry its stabilizers at other nodes than its neighbours.
 //!
 //! [`gather_sites_dynamic`] (the kernel's DYNAMIC form, whose base is each variant's
 //! static equilibrium) also writes the node's velocity and its spin about the hole axis,
