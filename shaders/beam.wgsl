@@ -158,7 +158,9 @@ fn rel_log(e: array<array<hd, 3>, 3>, t: Tri) -> array<hd, 3> {
     return array<hd, 3>(hd_mul(factor, w0), hd_mul(factor, w1), hd_mul(factor, w2));
 }
 
-fn energy(p1: array<hd, 3>, p2: array<hd, 3>, t1: Tri, t2: Tri, e: u32, v: u32) -> hd {
+// `base`: the element's base chord (xyz) and stretch (w), `lc` the chord's length — read
+// and formed once per invocation, not per evaluation (single precision uses them).
+fn energy(p1: array<hd, 3>, p2: array<hd, 3>, t1: Tri, t2: Tri, e: u32, base: vec4<real>, lc: real) -> hd {
     let ea = section[4u * e];
     let gj = section[4u * e + 1u];
     let ei = section[4u * e + 2u];
@@ -168,17 +170,13 @@ fn energy(p1: array<hd, 3>, p2: array<hd, 3>, t1: Tri, t2: Tri, e: u32, v: u32) 
     let l = hd_norm(d);
     let u = l - hd_c(l0);
 #else
-    let nv = dims.num_variants;
-    let cr = array<real, 3>(chord[(4u * e) * nv + v], chord[(4u * e + 1u) * nv + v], chord[(4u * e + 2u) * nv + v]);
-    let stretch = chord[(4u * e + 3u) * nv + v];
-    let lc = sqrt(cr[0] * cr[0] + cr[1] * cr[1] + cr[2] * cr[2]);
-    let c = array<hd, 3>(hd_c(cr[0]), hd_c(cr[1]), hd_c(cr[2]));
+    let c = array<hd, 3>(hd_c(base.x), hd_c(base.y), hd_c(base.z));
     let du = array<hd, 3>(p2[0] - p1[0], p2[1] - p1[1], p2[2] - p1[2]);
     let d = array<hd, 3>(c[0] + du[0], c[1] + du[1], c[2] + du[2]);
     let l = hd_norm(d);
     let two_c_du = hd_mul(hd_c(real(2.0)), hd_mul(c[0], du[0]) + hd_mul(c[1], du[1]) + hd_mul(c[2], du[2]));
     let du_du = hd_mul(du[0], du[0]) + hd_mul(du[1], du[1]) + hd_mul(du[2], du[2]);
-    let u = hd_c(stretch) + hd_div(two_c_du + du_du, l + hd_c(lc));
+    let u = hd_c(base.w) + hd_div(two_c_du + du_du, l + hd_c(lc));
 #endif
     let e1 = array<hd, 3>(hd_div(d[0], l), hd_div(d[1], l), hd_div(d[2], l));
     let half = hd_c(real(0.5));
@@ -225,6 +223,9 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
     let e = gid.x / nv;
     let v = gid.x % nv;
+    let base = vec4<real>(chord[(4u * e) * nv + v], chord[(4u * e + 1u) * nv + v], chord[(4u * e + 2u) * nv + v],
+                          chord[(4u * e + 3u) * nv + v]);
+    let lc = sqrt(base.x * base.x + base.y * base.y + base.z * base.z);
     var p0: array<array<hd, 3>, 2>;
     var t0: array<Tri, 2>;
     for (var node = 0u; node < 2u; node = node + 1u) {
@@ -232,7 +233,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         for (var k = 0u; k < 3u; k = k + 1u) {
 #if F64
             // Node 2 at c + w₂ (the twin's positions).
-            p0[node][k] = hd_c(real(node) * chord[(4u * e + k) * nv + v] + x[(3u * i + k) * nv + v]);
+            p0[node][k] = hd_c(real(node) * base[k] + x[(3u * i + k) * nv + v]);
 #else
             p0[node][k] = hd_c(x[(3u * i + k) * nv + v]);
 #endif
@@ -258,7 +259,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
             var pj = pk;
             var tj = tk;
             perturb(&pj, &tj, j, eps1);
-            let en = energy(pj[0], pj[1], tj[0], tj[1], e, v);
+            let en = energy(pj[0], pj[1], tj[0], tj[1], e, base, lc);
             elem_tangent[(144u * e + 12u * j + k) * nv + v] = en.w;
             if (k == 0u) {
                 elem_force[(12u * e + j) * nv + v] = en.y;
