@@ -1,6 +1,8 @@
 //! Solvers: the chain linear algebra and the static equilibrium.
 
 pub mod chain;
+pub mod continuation;
 pub mod dynamics;
 pub mod modal;
+pub mod newton;
 pub mod statics;

@@ -17,7 +17,7 @@ use crate::physics::beam::{
 };
 use crate::physics::contact::{evaluate, ContactMode, ContactResponse, ContactTerms, SpringLaw};
 use crate::physics::vec3::{cross, dot, scale, sub, Vec3};
-use crate::solve::chain::{BlockTridiagonal, ChainSolver, LinearSolveError};
+use crate::solve::chain::{BlockTridiagonal, ChainSolver};
 
 /// Solver settings.
 #[derive(Clone, Copy, Debug)]
@@ -554,213 +554,205 @@ pub fn internal_forces(model: &Model, state: &StaticState) -> Vec<f64> {
 }
 
 /// As [`solve_static`], from a given starting configuration (e.g. a string laid on the
-/// low side of the hole).
+/// low side of the hole). The load path and Newton are the ensemble engine's
+/// ([`crate::solve::continuation`], [`crate::solve::newton`]), run for one variant.
 pub fn solve_static_from(
     model: &Model,
     start: StaticState,
     options: &StaticOptions,
 ) -> Result<StaticSolution, StaticError> {
-    let c = constraints(model);
-    let (f_gravity, f_other) = split_loads(model);
-    let f_ref = reference_force(model);
-    let n = model.nodes.len();
-    let mut residual = vec![0.0; 6 * n];
-    let mut tangent = BlockTridiagonal::zeros(n);
-    let mut solver = ChainSolver::new();
-    let mut state = start;
-    // With contact, gravity acts in full from the start (the string lies on the wall, as
-    // the starting guess has it) and λ ramps the bit loads, point loads and friction;
-    // without contact every load ramps.
-    let full_gravity = !model.sites.is_empty();
-    let mut lambda = 0.0;
-    let mut pending_zero = full_gravity;
-    let mut step = 1.0 / options.initial_steps.max(1) as f64;
-    let mut iterations = Vec::new();
-    let mut log = Vec::new();
-    while lambda < 1.0 || pending_zero {
-        let target = if pending_zero {
-            0.0
-        } else {
-            (lambda + step).min(1.0)
-        };
-        let gamma = if full_gravity { 1.0 } else { target };
-        let f_step: Vec<f64> = f_gravity
-            .iter()
-            .zip(&f_other)
-            .map(|(g, o)| gamma * g + target * o)
-            .collect();
-        let scaled = scale_friction(model, target);
-        match newton(
-            &scaled,
-            &c,
-            &state,
-            1.0,
-            &f_step,
-            f_ref,
-            options,
-            &mut solver,
-            &mut residual,
-            &mut tangent,
-        ) {
-            Ok((s, its)) => {
-                state = s;
-                iterations.push(its);
-                if pending_zero {
-                    pending_zero = false;
-                    continue;
-                }
-                lambda = target;
-                if its <= 6 {
-                    step = (step * 1.5).min(1.0);
-                }
-            }
-            Err(reason) if pending_zero => {
-                // Gravity alone failed from the low-side start: continue from the linear
-                // spring law to the case's exponent (a soft law's onset stiffness is huge
-                // and contacts cycle in and out); every stage is logged.
-                let continued = exponent_continuation(
-                    model,
-                    &c,
-                    &state,
-                    &f_gravity,
-                    f_ref,
-                    options,
-                    &mut solver,
-                    &mut residual,
-                    &mut tangent,
-                    &mut log,
-                );
-                match continued {
-                    Some((s, its)) => {
-                        log.push(format!(
-                            "gravity step failed directly ({reason}); reached by continuation of the spring exponent"
-                        ));
-                        state = s;
-                        iterations.extend(its);
-                        pending_zero = false;
-                    }
-                    None => {
-                        return Err(StaticError::LoadStep {
-                            from: lambda,
-                            step,
-                            min: options.min_step,
-                            reason,
-                        })
-                    }
-                }
-            }
-            Err(reason) => {
-                if step / 2.0 < options.min_step {
-                    return Err(StaticError::LoadStep {
-                        from: lambda,
-                        step,
-                        min: options.min_step,
-                        reason,
-                    });
-                }
-                log.push(format!(
-                    "load step λ {lambda:.6} → {target:.6} failed ({reason}); step cut to {:.3e}",
-                    step / 2.0
-                ));
-                step /= 2.0;
-            }
-        }
+    use crate::solve::continuation::{solve_loads, LoadPath};
+    use crate::solve::newton::NewtonSettings;
+    let mut sys = CpuStatic::new(model, start);
+    let linear = model.sites.iter().all(|s| s.params.spring_exponent == 1.0);
+    let mut paths = [LoadPath::new(options, !model.sites.is_empty(), linear, false)];
+    let settings = NewtonSettings::statics(options.max_iterations, options.tolerance, 8);
+    if let Err(reason) = solve_loads(&mut sys, &mut paths, settings, &mut |_| {}) {
+        return Err(StaticError::LoadStep {
+            from: 0.0,
+            step: 0.0,
+            min: options.min_step,
+            reason,
+        });
     }
-    // Polish: one more Newton step at full load takes the converged state from the
-    // tolerance to rounding level (quadratic convergence), so the answer no longer depends
-    // on the load path that reached it (the ensemble engine does the same).
-    let f_full: Vec<f64> = f_gravity.iter().zip(&f_other).map(|(g, o)| g + o).collect();
-    let once = StaticOptions {
-        max_iterations: 1,
-        ..*options
-    };
-    if let Ok((s, _)) = newton(
-        model,
-        &c,
-        &state,
-        1.0,
-        &f_full,
-        f_ref,
-        &once,
-        &mut solver,
-        &mut residual,
-        &mut tangent,
-    ) {
-        state = s;
+    let [path] = paths;
+    if let Some(e) = path.error {
+        return Err(e);
     }
-    Ok(finish(model, state, iterations, log))
+    Ok(finish(model, sys.state, path.iterations, path.log))
 }
 
-/// Equilibrium under gravity (no bit loads, no friction) reached by continuation of every
-/// site's spring exponent from 1 (linear) to its own value, with adaptive steps. `None`
-/// when the law is linear everywhere or a stage fails below the minimum step.
-#[allow(clippy::too_many_arguments)]
-fn exponent_continuation(
-    model: &Model,
-    c: &Constraints,
-    start: &StaticState,
-    f_gravity: &[f64],
+/// One model's static Newton system on the CPU (faer), for [`solve_static_from`].
+struct CpuStatic<'a> {
+    model: &'a Model,
+    c: Constraints,
+    f_gravity: Vec<f64>,
+    f_other: Vec<f64>,
     f_ref: f64,
-    options: &StaticOptions,
-    solver: &mut ChainSolver,
-    residual: &mut [f64],
-    tangent: &mut BlockTridiagonal,
-    log: &mut Vec<String>,
-) -> Option<(StaticState, Vec<usize>)> {
-    if model.sites.iter().all(|s| s.params.spring_exponent == 1.0) {
-        return None;
-    }
-    let frictionless = scale_friction(model, 0.0);
-    let at = |s: f64| {
-        let mut m = frictionless.clone();
-        for site in &mut m.sites {
-            let target = site.params.spring_exponent;
-            site.params.spring_exponent = 1.0 + s * (target - 1.0);
-        }
-        m
-    };
-    let mut state = start.clone();
-    let mut its = Vec::new();
-    let (mut s, mut step) = (0.0f64, 1.0f64);
-    let mut first = true;
-    while first || s < 1.0 {
-        let target = if first { 0.0 } else { (s + step).min(1.0) };
-        match newton(
-            &at(target),
-            c,
-            &state,
-            1.0,
+    /// The model with the target's friction and spring exponents.
+    loaded: Model,
+    /// External loads of the target.
+    f_step: Vec<f64>,
+    state: StaticState,
+    saved: StaticState,
+    solver: ChainSolver,
+    residual: Vec<f64>,
+    tangent: BlockTridiagonal,
+    trial: Vec<f64>,
+    delta: Vec<f64>,
+    trial_state: Option<(f64, StaticState)>,
+    evaluated: bool,
+}
+
+impl<'a> CpuStatic<'a> {
+    fn new(model: &'a Model, start: StaticState) -> Self {
+        let (f_gravity, f_other) = split_loads(model);
+        let n = model.nodes.len();
+        CpuStatic {
+            model,
+            c: constraints(model),
+            f_ref: reference_force(model),
+            f_step: vec![0.0; 6 * n],
             f_gravity,
-            f_ref,
-            options,
-            solver,
-            residual,
-            tangent,
-        ) {
-            Ok((next, k)) => {
-                state = next;
-                its.push(k);
-                first = false;
-                s = target;
-                if k <= 6 {
-                    step = (1.5 * step).min(1.0);
-                }
-            }
-            Err(reason) => {
-                if first || step / 2.0 < options.min_step {
-                    log.push(format!(
-                        "exponent continuation failed at s = {s:.4}: {reason}"
-                    ));
-                    return None;
-                }
-                step /= 2.0;
-                log.push(format!(
-                    "exponent continuation {s:.4} → {target:.4} failed ({reason}); step cut to {step:.3e}"
-                ));
-            }
+            f_other,
+            loaded: model.clone(),
+            saved: start.clone(),
+            state: start,
+            solver: ChainSolver::new(),
+            residual: vec![0.0; 6 * n],
+            tangent: BlockTridiagonal::zeros(n),
+            trial: vec![0.0; 6 * n],
+            delta: vec![0.0; 6 * n],
+            trial_state: None,
+            evaluated: false,
         }
     }
-    Some((state, its))
+}
+
+impl crate::solve::newton::NewtonSystem for CpuStatic<'_> {
+    fn variants(&self) -> usize {
+        1
+    }
+    fn solve(&mut self) -> Result<crate::solve::newton::Probe, String> {
+        if !self.evaluated {
+            assemble(
+                &self.loaded,
+                &self.state,
+                1.0,
+                &self.f_step,
+                &mut self.residual,
+                Some(&mut self.tangent),
+            );
+            constrain(&self.c, &mut self.residual, &mut self.tangent);
+            self.evaluated = true;
+        }
+        let rhs: Vec<f64> = self.residual.iter().map(|x| -x).collect();
+        let solved = match self.solver.solve(&self.tangent, &rhs) {
+            Ok(d) => {
+                self.delta = d;
+                true
+            }
+            Err(_) => {
+                self.delta.fill(0.0);
+                false
+            }
+        };
+        Ok(crate::solve::newton::Probe {
+            measure: vec![residual_measure(&self.residual, self.f_ref)],
+            step: vec![self.delta.iter().fold(0.0f64, |m, x| m.max(x.abs()))],
+            slope: vec![dot_n(&self.delta, &self.residual)],
+            norm: vec![dot_n(&self.residual, &self.residual).sqrt()],
+            solved: vec![solved],
+        })
+    }
+    fn trial(&mut self, alpha: &[f64]) -> Result<crate::solve::newton::TrialProbe, String> {
+        let s = update(&self.c, &self.state, &self.delta, alpha[0]);
+        assemble(
+            &self.loaded,
+            &s,
+            1.0,
+            &self.f_step,
+            &mut self.trial,
+            None,
+        );
+        constrain_residual(&self.c, &mut self.trial);
+        self.trial_state = Some((alpha[0], s));
+        Ok(crate::solve::newton::TrialProbe {
+            slope: vec![dot_n(&self.delta, &self.trial)],
+            norm: vec![dot_n(&self.trial, &self.trial).sqrt()],
+        })
+    }
+    fn accept(&mut self, alpha: &[f64], trial_matches: bool) -> Result<(), String> {
+        if alpha[0] == 0.0 {
+            return Ok(());
+        }
+        self.state = match self.trial_state.take() {
+            Some((a, s)) if trial_matches && a == alpha[0] => s,
+            _ => update(&self.c, &self.state, &self.delta, alpha[0]),
+        };
+        self.evaluated = false;
+        Ok(())
+    }
+}
+
+impl crate::solve::continuation::StaticSystem for CpuStatic<'_> {
+    fn set_target(
+        &mut self,
+        _j: usize,
+        target: &crate::solve::continuation::LoadTarget,
+    ) -> Result<(), String> {
+        self.loaded = loaded_model(self.model, target);
+        for (f, (g, o)) in self
+            .f_step
+            .iter_mut()
+            .zip(self.f_gravity.iter().zip(&self.f_other))
+        {
+            *f = target.gravity * g + target.lambda * o;
+        }
+        self.evaluated = false;
+        Ok(())
+    }
+    fn save(&mut self, _j: usize) -> Result<(), String> {
+        self.saved = self.state.clone();
+        Ok(())
+    }
+    fn restore(&mut self, _j: usize) -> Result<(), String> {
+        self.state = self.saved.clone();
+        self.evaluated = false;
+        Ok(())
+    }
+    fn step_floor(&mut self, _j: usize) -> Result<f64, String> {
+        let largest = self.state.x.iter().flatten().fold(0.0f64, |m, x| m.max(x.abs()));
+        Ok(crate::solve::newton::NewtonSettings::step_floor(8, largest))
+    }
+}
+
+fn dot_n(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| x * y).sum()
+}
+
+/// The model with a load target's friction factor and spring-exponent blend applied to
+/// every site (the parameters the contact elements of that step use).
+pub fn loaded_model(model: &Model, target: &crate::solve::continuation::LoadTarget) -> Model {
+    let mut m = model.clone();
+    for site in &mut m.sites {
+        site.params = loaded_params(&site.params, target);
+    }
+    m
+}
+
+/// A site's law parameters at a load target: friction scaled, exponent blended from 1.
+pub fn loaded_params(
+    p: &crate::physics::contact::ContactParams<f64>,
+    target: &crate::solve::continuation::LoadTarget,
+) -> crate::physics::contact::ContactParams<f64> {
+    let mut q = *p;
+    q.mu_t *= target.friction;
+    q.mu_l *= target.friction;
+    if target.exponent != 1.0 {
+        q.spring_exponent = 1.0 + target.exponent * (p.spring_exponent - 1.0);
+    }
+    q
 }
 
 /// Gravity loads and the other external loads (bit, point loads), at full value.
@@ -773,92 +765,6 @@ pub fn split_loads(model: &Model) -> (Vec<f64>, Vec<f64>) {
     let all = external_loads(model);
     let other = all.iter().zip(&gravity).map(|(a, g)| a - g).collect();
     (gravity, other)
-}
-
-/// The model with every friction coefficient scaled by `factor`.
-fn scale_friction(model: &Model, factor: f64) -> Model {
-    let mut m = model.clone();
-    for site in &mut m.sites {
-        site.params.mu_t *= factor;
-        site.params.mu_l *= factor;
-    }
-    m
-}
-
-#[allow(clippy::too_many_arguments)]
-fn newton(
-    model: &Model,
-    c: &Constraints,
-    start: &StaticState,
-    lambda: f64,
-    f_ext: &[f64],
-    f_ref: f64,
-    options: &StaticOptions,
-    solver: &mut ChainSolver,
-    residual: &mut [f64],
-    tangent: &mut BlockTridiagonal,
-) -> Result<(StaticState, usize), String> {
-    let mut state = start.clone();
-    let length_scale = 1.0 + start.x.iter().flatten().fold(0.0f64, |m, x| m.max(x.abs()));
-    assemble(model, &state, lambda, f_ext, residual, Some(tangent));
-    constrain(c, residual, tangent);
-    let mut measure = residual_measure(residual, f_ref);
-    let mut trial = vec![0.0; residual.len()];
-    for it in 1..=options.max_iterations {
-        let rhs: Vec<f64> = residual.iter().map(|x| -x).collect();
-        let delta = solver
-            .solve(tangent, &rhs)
-            .map_err(|e: LinearSolveError| e.to_string())?;
-        // Line search on the energy slope s(α) = Δ·r(α): the full step is taken unless
-        // it overshoots (|s(1)| > |s(0)|), then halved until it does not (at most 6 times).
-        // Also accepted: a step that lowers the residual's 2-norm (friction makes the
-        // tangent unsymmetric, and the energy slope alone then rejects good steps).
-        let s0 = delta
-            .iter()
-            .zip(residual.iter())
-            .map(|(d, r)| d * r)
-            .sum::<f64>();
-        let norm0 = residual.iter().map(|r| r * r).sum::<f64>().sqrt();
-        let mut alpha = 1.0;
-        let mut trial_state;
-        loop {
-            trial_state = update(c, &state, &delta, alpha);
-            assemble(model, &trial_state, lambda, f_ext, &mut trial, None);
-            constrain_residual(c, &mut trial);
-            let s = delta.iter().zip(&trial).map(|(d, r)| d * r).sum::<f64>();
-            let norm = trial.iter().map(|r| r * r).sum::<f64>().sqrt();
-            let finite = trial.iter().all(|x| x.is_finite());
-            if (finite && (s.abs() <= s0.abs() || norm <= (1.0 - 1e-4 * alpha) * norm0))
-                || alpha < 1.0 / 32.0
-            {
-                break;
-            }
-            alpha *= 0.5;
-        }
-        if !trial.iter().all(|x| x.is_finite()) {
-            return Err("residual is not finite".into());
-        }
-        state = trial_state;
-        assemble(model, &state, lambda, f_ext, residual, Some(tangent));
-        constrain(c, residual, tangent);
-        measure = residual_measure(residual, f_ref);
-        let step_size = delta.iter().fold(0.0f64, |m, x| m.max(x.abs())) * alpha;
-        if std::env::var("HOLEWALL_DEBUG_NEWTON").is_ok() {
-            eprintln!("  newton λ {lambda:.4} it {it}: α {alpha} step {step_size:.3e} residual {measure:.3e}");
-        }
-        // Converged: residual below tolerance with a small last step, or the step down at
-        // rounding level (positions carry ≈1e-16·|x| of noise, which a stiff string turns
-        // into residual forces above a tight tolerance) with the residual small anyway.
-        if (measure <= options.tolerance && step_size <= 1e-6)
-            || (step_size <= 1e-12 * length_scale && measure <= 1e-6)
-        {
-            return Ok((state, it));
-        }
-    }
-    Err(format!(
-        "Newton did not converge in {} iterations (residual {measure:.3e} of the reference force)",
-        options.max_iterations
-    ))
 }
 
 /// Local deformation of element `i` at a configuration (its nodal triads `R_i · frame0_i`).

@@ -1,0 +1,353 @@
+//! Load stepping of a static solve, per variant: the one continuation policy that
+//! `solve_static` (one variant, faer) and the ensemble engine (V variants, kernels) both
+//! run, so a variant fails in the engine exactly where `solve_static` fails.
+//!
+//! Each variant carries its own load factor λ and step Δλ ([`LoadPath`]):
+//! 1. With contact sites, gravity acts in full from the start (the string laid on the wall,
+//!    [`crate::solve::statics::StaticState::on_low_side`]) with bit loads and friction off
+//!    (λ = 0). If that fails and some spring law is not linear, the same state is reached by
+//!    continuation of the spring exponent from 1 to its own value (adaptive steps).
+//!    Without sites every load ramps with λ.
+//! 2. λ → 1 in steps (bit loads, point loads and friction scaled by λ): a step that fails
+//!    is cut in half from the last converged state; a step taken in at most 6 iterations
+//!    grows the next by 1.5. Below `min_step` the variant fails.
+//! 3. At λ = 1 one more full Newton step polishes the answer to rounding level (so it does
+//!    not depend on the load path). In f32 the full load is solved a second time from its
+//!    own converged state as base ([`LoadPath::new`]'s `refine`).
+//!
+//! [`solve_loads`] runs the paths of every variant of a [`StaticSystem`] through one
+//! [`Newton`], all variants advancing in the same evaluations: a variant that completes a
+//! step starts its next one in the same iteration, one that fails is returned to its
+//! restart point, and a finished one stops costing line searches.
+
+use super::newton::{Event, Newton, NewtonSettings, NewtonSystem};
+use super::statics::{StaticError, StaticOptions};
+
+/// The loads a variant is solved for: each a factor of the full value.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LoadTarget {
+    /// Gravity factor γ.
+    pub gravity: f64,
+    /// Factor λ of the bit loads and point loads.
+    pub lambda: f64,
+    /// Factor of the friction coefficients.
+    pub friction: f64,
+    /// Spring exponent blend `s`: each site's exponent is `1 + s (m − 1)`.
+    pub exponent: f64,
+}
+
+/// What follows the end of a step's solve.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Next {
+    /// Solve the path's next target ([`LoadPath::target`]).
+    Step,
+    /// The path is done (its last converged state is the answer).
+    Finished,
+    /// The variant failed ([`LoadPath::error`]).
+    Failed,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Stage {
+    Gravity,
+    Exponent { first: bool },
+    Load,
+    Refine,
+    Done,
+    Failed,
+}
+
+/// One variant's load path (module docs).
+#[derive(Clone, Debug)]
+pub struct LoadPath {
+    stage: Stage,
+    has_sites: bool,
+    linear_law: bool,
+    refine: bool,
+    lambda: f64,
+    step: f64,
+    s: f64,
+    s_step: f64,
+    target: LoadTarget,
+    min_step: f64,
+    gravity_reason: String,
+    /// Newton iterations of every completed step.
+    pub iterations: Vec<usize>,
+    /// Step cuts and stage changes, with why.
+    pub log: Vec<String>,
+    /// Why the variant failed, once it has.
+    pub error: Option<StaticError>,
+}
+
+impl LoadPath {
+    /// A variant's path: `has_sites` (contact: gravity in full from the start),
+    /// `linear_law` (every site's spring exponent is 1: no exponent continuation),
+    /// `refine` (f32: full load solved again from its own converged state).
+    pub fn new(options: &StaticOptions, has_sites: bool, linear_law: bool, refine: bool) -> Self {
+        let step = 1.0 / options.initial_steps.max(1) as f64;
+        let mut p = LoadPath {
+            stage: if has_sites {
+                Stage::Gravity
+            } else {
+                Stage::Load
+            },
+            has_sites,
+            linear_law,
+            refine,
+            lambda: 0.0,
+            step,
+            s: 0.0,
+            s_step: 1.0,
+            target: LoadTarget {
+                gravity: 1.0,
+                lambda: 0.0,
+                friction: 0.0,
+                exponent: 1.0,
+            },
+            min_step: options.min_step,
+            gravity_reason: String::new(),
+            iterations: Vec::new(),
+            log: Vec::new(),
+            error: None,
+        };
+        p.set_target();
+        p
+    }
+
+    fn set_target(&mut self) {
+        self.target = match self.stage {
+            Stage::Gravity => LoadTarget {
+                gravity: 1.0,
+                lambda: 0.0,
+                friction: 0.0,
+                exponent: 1.0,
+            },
+            Stage::Exponent { first } => LoadTarget {
+                gravity: 1.0,
+                lambda: 0.0,
+                friction: 0.0,
+                exponent: if first {
+                    0.0
+                } else {
+                    (self.s + self.s_step).min(1.0)
+                },
+            },
+            Stage::Load => {
+                let lambda = (self.lambda + self.step).min(1.0);
+                LoadTarget {
+                    gravity: if self.has_sites { 1.0 } else { lambda },
+                    lambda,
+                    friction: lambda,
+                    exponent: 1.0,
+                }
+            }
+            Stage::Refine | Stage::Done | Stage::Failed => LoadTarget {
+                gravity: 1.0,
+                lambda: 1.0,
+                friction: 1.0,
+                exponent: 1.0,
+            },
+        };
+    }
+
+    /// The loads of the step being solved.
+    pub fn target(&self) -> LoadTarget {
+        self.target
+    }
+
+    /// Whether the step being solved ends the path with a polishing step.
+    pub fn polish(&self) -> bool {
+        match self.stage {
+            Stage::Load => self.target.lambda >= 1.0 && !self.refine,
+            Stage::Refine => true,
+            _ => false,
+        }
+    }
+
+    /// Whether the path is finished (converged or failed).
+    pub fn finished(&self) -> bool {
+        matches!(self.stage, Stage::Done | Stage::Failed)
+    }
+
+    /// Load factor reached (0 … 1, for progress).
+    pub fn progress(&self) -> f64 {
+        match self.stage {
+            Stage::Done | Stage::Failed => 1.0,
+            Stage::Refine => 0.99,
+            _ => self.lambda,
+        }
+    }
+
+    /// The step converged in `iterations`: what follows.
+    pub fn converged(&mut self, iterations: usize) -> Next {
+        self.iterations.push(iterations);
+        match self.stage {
+            Stage::Gravity => self.stage = Stage::Load,
+            Stage::Exponent { .. } => {
+                self.s = self.target.exponent;
+                if self.s >= 1.0 {
+                    self.log.push(format!(
+                        "gravity step failed directly ({}); reached by continuation of the spring exponent",
+                        self.gravity_reason
+                    ));
+                    self.stage = Stage::Load;
+                } else {
+                    if iterations <= 6 && !matches!(self.stage, Stage::Exponent { first: true }) {
+                        self.s_step = (1.5 * self.s_step).min(1.0);
+                    }
+                    self.stage = Stage::Exponent { first: false };
+                }
+            }
+            Stage::Load => {
+                self.lambda = self.target.lambda;
+                if iterations <= 6 {
+                    self.step = (self.step * 1.5).min(1.0);
+                }
+                if self.lambda >= 1.0 {
+                    self.stage = if self.refine {
+                        Stage::Refine
+                    } else {
+                        Stage::Done
+                    };
+                }
+            }
+            Stage::Refine => self.stage = Stage::Done,
+            Stage::Done | Stage::Failed => {}
+        }
+        self.set_target();
+        if self.finished() {
+            Next::Finished
+        } else {
+            Next::Step
+        }
+    }
+
+    /// The step failed (`reason`): what follows, from the last converged state
+    /// ([`Next::Failed`]: the variant has failed, [`LoadPath::error`] says why).
+    pub fn failed(&mut self, reason: String) -> Next {
+        let fail = |p: &mut LoadPath, step: f64, reason: String| {
+            p.error = Some(StaticError::LoadStep {
+                from: p.lambda,
+                step,
+                min: p.min_step,
+                reason,
+            });
+            p.stage = Stage::Failed;
+            Next::Failed
+        };
+        match self.stage {
+            Stage::Gravity => {
+                if self.linear_law {
+                    return fail(self, self.step, reason);
+                }
+                // A soft law's onset stiffness is huge and contacts cycle in and out:
+                // continue from the linear law to the case's exponent.
+                self.gravity_reason = reason;
+                self.stage = Stage::Exponent { first: true };
+            }
+            Stage::Exponent { first } => {
+                if first || self.s_step / 2.0 < self.min_step {
+                    self.log.push(format!(
+                        "exponent continuation failed at s = {:.4}: {reason}",
+                        self.s
+                    ));
+                    let why = std::mem::take(&mut self.gravity_reason);
+                    return fail(self, self.step, why);
+                }
+                self.s_step /= 2.0;
+                self.log.push(format!(
+                    "exponent continuation {:.4} → {:.4} failed ({reason}); step cut to {:.3e}",
+                    self.s, self.target.exponent, self.s_step
+                ));
+            }
+            Stage::Refine => {
+                // f32's second solve at full load did not converge: the first one stands.
+                self.log.push(format!(
+                    "full load solved again from its own state as base failed ({reason}); the first solution kept"
+                ));
+                self.stage = Stage::Done;
+                return Next::Finished;
+            }
+            Stage::Load => {
+                if self.step / 2.0 < self.min_step {
+                    return fail(self, self.step, reason);
+                }
+                self.log.push(format!(
+                    "load step λ {:.6} → {:.6} failed ({reason}); step cut to {:.3e}",
+                    self.lambda,
+                    self.target.lambda,
+                    self.step / 2.0
+                ));
+                self.step /= 2.0;
+            }
+            Stage::Done | Stage::Failed => return Next::Failed,
+        }
+        self.set_target();
+        Next::Step
+    }
+}
+
+/// A static problem of V variants that [`solve_loads`] can step through its loads.
+pub trait StaticSystem: NewtonSystem {
+    /// Sets variant `j`'s loads (effective from the next solve).
+    fn set_target(&mut self, j: usize, target: &LoadTarget) -> Result<(), String>;
+    /// Keeps variant `j`'s current state as its restart point (a step completed).
+    fn save(&mut self, j: usize) -> Result<(), String>;
+    /// Returns variant `j` to its restart point.
+    fn restore(&mut self, j: usize) -> Result<(), String>;
+    /// The rounding floor of a step of variant `j` ([`NewtonSettings::step_floor`]).
+    fn step_floor(&mut self, j: usize) -> Result<f64, String>;
+}
+
+/// Runs every variant's load path to its end through one [`Newton`]; `progress` gets the
+/// mean load factor reached after each iteration. Returns the Newton's solve count.
+pub fn solve_loads(
+    sys: &mut dyn StaticSystem,
+    paths: &mut [LoadPath],
+    settings: NewtonSettings,
+    progress: &mut dyn FnMut(f64),
+) -> Result<usize, String> {
+    let v = sys.variants();
+    let mut newton = Newton::new(settings, v);
+    for (j, path) in paths.iter().enumerate() {
+        sys.set_target(j, &path.target())?;
+        sys.save(j)?;
+        let floor = sys.step_floor(j)?;
+        newton.start(j, floor, path.polish());
+    }
+    while newton.any_running() {
+        let events = newton.test(sys)?;
+        next_steps(sys, paths, &mut newton, events)?;
+        let events = newton.advance(sys)?;
+        next_steps(sys, paths, &mut newton, events)?;
+        progress(paths.iter().map(LoadPath::progress).sum::<f64>() / v.max(1) as f64);
+    }
+    Ok(newton.solves)
+}
+
+/// Variants whose solve ended: the next step of their path from the state it needs.
+fn next_steps(
+    sys: &mut dyn StaticSystem,
+    paths: &mut [LoadPath],
+    newton: &mut Newton,
+    events: Vec<(usize, Event)>,
+) -> Result<(), String> {
+    for (j, event) in events {
+        let path = &mut paths[j];
+        let (next, converged) = match event {
+            Event::Converged(its) => (path.converged(its), true),
+            Event::Failed(reason) => (path.failed(reason), false),
+        };
+        match (next, converged) {
+            (Next::Step, true) => sys.save(j)?,
+            (Next::Step | Next::Finished, false) => sys.restore(j)?,
+            _ => {}
+        }
+        if next == Next::Step {
+            sys.set_target(j, &path.target())?;
+            let floor = sys.step_floor(j)?;
+            newton.start(j, floor, path.polish());
+        }
+    }
+    Ok(())
+}

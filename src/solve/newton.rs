@@ -1,0 +1,526 @@
+//! The one Newton iteration of holewall: convergence test, line search, step acceptance,
+//! trace and tolerances per precision, for many variants at once with a mask.
+//!
+//! Every solver calls it — `solve_static` and the CPU integrator (one variant each), the
+//! static and dynamic ensemble engines (V variants, twin or GPU kernels) — through
+//! [`NewtonSystem`], which knows how to evaluate and solve a problem and nothing about the
+//! policy. The caller loops [`Newton::iterate`] (as diffsol's solvers let the caller loop
+//! `step()`), starting and stopping variants as its own continuation or step control
+//! decides: a variant that is not running gets `α = 0` (its state is not changed) and costs
+//! no line search.
+//!
+//! The policy (the same constants everywhere):
+//! - **Converged** when the residual measure (largest residual over the force scale) is
+//!   below `tolerance` with a step below `step_tolerance`, or when the step is down at the
+//!   variant's rounding floor (`1e-12` of its largest coordinate in f64; `100 ε₃₂` of its
+//!   displacements in f32) with the residual below `small_residual` (1e-6 in f64, `1e4 ε₃₂`
+//!   in f32). Statics test the step just taken ([`StepTest::Taken`]), dynamics the
+//!   correction about to be taken ([`StepTest::Next`], applied on convergence).
+//! - **Line search** per variant ([`LineSearch`]): the full step unless it fails the test,
+//!   then halved. Statics accept a step whose energy slope `|Δ·r(α)|` does not exceed
+//!   `|Δ·r(0)|` or that lowers `‖r‖₂` by `1e-4 α`, halving at most 5 times and taking the
+//!   last (α = 1/32); dynamics accept only a lower `‖r‖₂`, halving up to 24 times and
+//!   taking the full step when nothing shorter helps. In f32 a variant whose residual is at
+//!   the precision's floor takes the full step without a search (its residual norm is
+//!   rounding noise there, which halving cannot lower).
+//! - **Failure** per variant: a non-finite residual, a singular tangent, or no convergence
+//!   within `max_iterations` updates. The failing variant stops; the others go on.
+
+/// Which step the convergence test looks at.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum StepTest {
+    /// The update just taken (`α |Δ|`): statics.
+    Taken,
+    /// The correction about to be taken (`|Δ|`, α = 1), applied on convergence: dynamics.
+    Next,
+}
+
+/// The line search.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LineSearch {
+    /// Also accept a step whose energy slope `|Δ·r(α)|` is at most `|Δ·r(0)|`.
+    pub slope_test: bool,
+    /// Trials after the full step (each halves α).
+    pub max_halvings: usize,
+    /// When no trial passes: take the smallest α tried (`true`) or the full step.
+    pub take_smallest: bool,
+}
+
+/// Newton settings: iterations, tolerances, line search.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct NewtonSettings {
+    /// Updates before a variant fails.
+    pub max_iterations: usize,
+    /// Residual measure that converges (with a step below `step_tolerance`).
+    pub tolerance: f64,
+    /// Step below which `tolerance` converges (m or rad; ∞: no condition).
+    pub step_tolerance: f64,
+    /// Residual measure below which a step at the rounding floor converges.
+    pub small_residual: f64,
+    /// Which step the test looks at.
+    pub step_test: StepTest,
+    /// The line search.
+    pub line_search: LineSearch,
+    /// f32: a variant with its residual below `small_residual` takes the full step
+    /// without a search.
+    pub full_step_at_floor: bool,
+}
+
+/// The unit roundoff of a float type of `size` bytes.
+pub fn unit_roundoff(size: usize) -> f64 {
+    if size == 4 {
+        f64::from(f32::EPSILON)
+    } else {
+        f64::EPSILON
+    }
+}
+
+impl NewtonSettings {
+    /// Statics (load steps) in a precision of `size` bytes: `tolerance` on the residual
+    /// with steps below 1 µm, the energy-slope line search.
+    pub fn statics(max_iterations: usize, tolerance: f64, size: usize) -> Self {
+        let u = unit_roundoff(size);
+        NewtonSettings {
+            max_iterations,
+            tolerance: tolerance.max(400.0 * u),
+            step_tolerance: 1e-6,
+            small_residual: 1e-6f64.max(1e4 * u),
+            step_test: StepTest::Taken,
+            line_search: LineSearch {
+                slope_test: true,
+                max_halvings: 5,
+                take_smallest: true,
+            },
+            full_step_at_floor: size == 4,
+        }
+    }
+
+    /// Dynamics (a time step's correction of the accelerations) in a precision of `size`
+    /// bytes: the residual line search.
+    pub fn dynamics(max_iterations: usize, tolerance: f64, size: usize) -> Self {
+        let u = unit_roundoff(size);
+        NewtonSettings {
+            max_iterations,
+            tolerance: tolerance.max(400.0 * u),
+            step_tolerance: f64::INFINITY,
+            small_residual: 1e-6f64.max(1e4 * u),
+            step_test: StepTest::Next,
+            line_search: LineSearch {
+                slope_test: false,
+                max_halvings: 24,
+                take_smallest: false,
+            },
+            full_step_at_floor: size == 4,
+        }
+    }
+
+    /// The rounding floor of a step for a variant whose largest coordinate (f64: position
+    /// from the origin; f32: displacement from its base) is `largest`.
+    pub fn step_floor(size: usize, largest: f64) -> f64 {
+        if size == 4 {
+            100.0 * unit_roundoff(4) * (1.0 + largest)
+        } else {
+            1e-12 * (1.0 + largest)
+        }
+    }
+}
+
+/// What a solve at the current point gives per variant.
+#[derive(Clone, Debug, Default)]
+pub struct Probe {
+    /// Residual measure: largest residual over the variant's force scale.
+    pub measure: Vec<f64>,
+    /// Largest component of the Newton step `Δ` (α = 1), in the unit of the step test.
+    pub step: Vec<f64>,
+    /// `Δ·r` at the current point.
+    pub slope: Vec<f64>,
+    /// `‖r‖₂` at the current point.
+    pub norm: Vec<f64>,
+    /// Whether the linear solve succeeded.
+    pub solved: Vec<bool>,
+}
+
+/// What a trial point gives per variant.
+#[derive(Clone, Debug, Default)]
+pub struct TrialProbe {
+    /// `Δ·r(α)`.
+    pub slope: Vec<f64>,
+    /// `‖r(α)‖₂`.
+    pub norm: Vec<f64>,
+}
+
+/// A problem of V variants Newton can iterate on.
+pub trait NewtonSystem {
+    /// Variants V.
+    fn variants(&self) -> usize;
+    /// Evaluates (where its system is stale) and solves at the current point of every
+    /// variant.
+    fn solve(&mut self) -> Result<Probe, String>;
+    /// Evaluates the trial point `current + α Δ` of every variant (α = 0: the current).
+    fn trial(&mut self, alpha: &[f64]) -> Result<TrialProbe, String>;
+    /// Current `+= α Δ`. `trial_matches`: the last trial was at exactly these α (its
+    /// evaluation may be kept).
+    fn accept(&mut self, alpha: &[f64], trial_matches: bool) -> Result<(), String>;
+}
+
+/// How a variant's Newton solve ended.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Event {
+    /// Converged after this many updates.
+    Converged(usize),
+    /// Failed: why.
+    Failed(String),
+}
+
+#[derive(Clone, Debug, Default)]
+struct Track {
+    running: bool,
+    polish: bool,
+    finishing: bool,
+    updates: usize,
+    last_step: f64,
+    floor: f64,
+}
+
+/// The Newton iteration of V variants (see the module docs for its policy).
+pub struct Newton {
+    /// Settings.
+    pub settings: NewtonSettings,
+    tracks: Vec<Track>,
+    /// Solves (evaluations of the tangent) so far, over all variants together.
+    pub solves: usize,
+    /// Trials (residual-only evaluations) so far.
+    pub trials: usize,
+    trace: bool,
+    round: Round,
+}
+
+/// What [`Newton::test`] leaves for [`Newton::advance`].
+#[derive(Clone, Debug, Default)]
+struct Round {
+    alpha: Vec<f64>,
+    pending: Vec<bool>,
+    ends: Vec<bool>,
+    probe: Probe,
+}
+
+impl Newton {
+    /// V idle variants.
+    pub fn new(settings: NewtonSettings, variants: usize) -> Self {
+        Newton {
+            settings,
+            tracks: vec![Track::default(); variants],
+            solves: 0,
+            trials: 0,
+            trace: std::env::var("HOLEWALL_DEBUG_NEWTON").is_ok(),
+            round: Round::default(),
+        }
+    }
+
+    /// Starts a solve of variant `j` from its current point; `floor` is its step's rounding
+    /// floor ([`NewtonSettings::step_floor`]); `polish`: after converging, take one more
+    /// step (to rounding level), then stop.
+    pub fn start(&mut self, j: usize, floor: f64, polish: bool) {
+        self.tracks[j] = Track {
+            running: true,
+            polish,
+            finishing: false,
+            updates: 0,
+            last_step: f64::INFINITY,
+            floor,
+        };
+        if let Some(a) = self.round.alpha.get_mut(j) {
+            *a = 0.0;
+            self.round.pending[j] = false;
+            self.round.ends[j] = false;
+        }
+    }
+
+    /// Stops variant `j` without an event.
+    pub fn stop(&mut self, j: usize) {
+        self.tracks[j].running = false;
+        if let Some(a) = self.round.alpha.get_mut(j) {
+            *a = 0.0;
+            self.round.pending[j] = false;
+            self.round.ends[j] = false;
+        }
+    }
+
+    /// Whether variant `j` is running.
+    pub fn is_running(&self, j: usize) -> bool {
+        self.tracks[j].running
+    }
+
+    /// Whether any variant is running.
+    pub fn any_running(&self) -> bool {
+        self.tracks.iter().any(|t| t.running)
+    }
+
+    /// One iteration of every running variant: [`Newton::test`], then
+    /// [`Newton::advance`]. Returns the variants whose solve ended in it, with how.
+    pub fn iterate(&mut self, sys: &mut dyn NewtonSystem) -> Result<Vec<(usize, Event)>, String> {
+        let mut events = self.test(sys)?;
+        events.extend(self.advance(sys)?);
+        Ok(events)
+    }
+
+    /// First half of an iteration: solves at the current point of every variant and tests
+    /// the running ones. Returns the variants whose solve ended (converged with the step
+    /// just taken, or failed); the caller may [`Newton::start`] them again (new load,
+    /// restored state) before [`Newton::advance`], which then leaves them in place.
+    pub fn test(&mut self, sys: &mut dyn NewtonSystem) -> Result<Vec<(usize, Event)>, String> {
+        let v = self.tracks.len();
+        let s = self.settings;
+        let probe = sys.solve()?;
+        self.solves += 1;
+        let mut events = Vec::new();
+        self.round = Round {
+            alpha: vec![0.0; v],
+            pending: vec![false; v],
+            ends: vec![false; v],
+            probe: Probe::default(),
+        };
+        let round = &mut self.round;
+        for (j, track) in self.tracks.iter_mut().enumerate() {
+            if !track.running {
+                continue;
+            }
+            let measure = probe.measure[j];
+            if !measure.is_finite() {
+                track.running = false;
+                events.push((j, Event::Failed("residual is not finite".into())));
+                continue;
+            }
+            if track.finishing {
+                // The polishing step is taken: done.
+                track.running = false;
+                events.push((j, Event::Converged(track.updates)));
+                continue;
+            }
+            let step = match s.step_test {
+                StepTest::Taken => track.last_step,
+                StepTest::Next => probe.step[j],
+            };
+            let converged = (measure <= s.tolerance && step <= s.step_tolerance)
+                || (step <= track.floor && measure <= s.small_residual);
+            if converged && s.step_test == StepTest::Taken && !track.polish {
+                track.running = false;
+                events.push((j, Event::Converged(track.updates)));
+                continue;
+            }
+            if !probe.solved[j] {
+                track.running = false;
+                events.push((j, Event::Failed("singular tangent".into())));
+                continue;
+            }
+            let at_floor = s.full_step_at_floor && measure <= s.small_residual;
+            if converged {
+                round.alpha[j] = 1.0;
+                track.polish = false;
+                if s.step_test == StepTest::Taken {
+                    // Statics: one more step (the polish), with the search, then stop.
+                    track.finishing = true;
+                    round.pending[j] = !at_floor;
+                } else {
+                    // Dynamics: the converged correction is applied, and the solve ends.
+                    round.ends[j] = true;
+                }
+                continue;
+            }
+            if track.updates >= s.max_iterations {
+                track.running = false;
+                events.push((
+                    j,
+                    Event::Failed(format!(
+                        "Newton did not converge in {} iterations (residual {measure:.3e} of the force scale)",
+                        s.max_iterations
+                    )),
+                ));
+                continue;
+            }
+            round.alpha[j] = 1.0;
+            round.pending[j] = !at_floor;
+        }
+        round.probe = probe;
+        Ok(events)
+    }
+
+    /// Second half of an iteration: the line search of every running variant (all in the
+    /// same trials) and the update. Variants (re)started since [`Newton::test`] stay
+    /// where they are. Returns the variants whose solve ended in it.
+    pub fn advance(&mut self, sys: &mut dyn NewtonSystem) -> Result<Vec<(usize, Event)>, String> {
+        let v = self.tracks.len();
+        let s = self.settings;
+        let Round {
+            mut alpha,
+            mut pending,
+            ends,
+            probe,
+        } = std::mem::take(&mut self.round);
+        if alpha.len() != v {
+            return Err("Newton::advance without Newton::test".into());
+        }
+        let mut events = Vec::new();
+        let mut trial_matches = false;
+        let mut last_finite = vec![true; v];
+        for trial in 0..=s.line_search.max_halvings {
+            if !pending.iter().any(|&p| p) {
+                break;
+            }
+            let r = sys.trial(&alpha)?;
+            self.trials += 1;
+            trial_matches = true;
+            let last = trial == s.line_search.max_halvings;
+            for j in 0..v {
+                if !pending[j] {
+                    continue;
+                }
+                let a = alpha[j];
+                let finite = r.slope[j].is_finite() && r.norm[j].is_finite();
+                last_finite[j] = finite;
+                let slope_ok =
+                    s.line_search.slope_test && r.slope[j].abs() <= probe.slope[j].abs();
+                let norm_ok = r.norm[j] <= (1.0 - 1e-4 * a) * probe.norm[j];
+                if finite && (slope_ok || norm_ok) {
+                    pending[j] = false;
+                } else if last {
+                    pending[j] = false;
+                    if !s.line_search.take_smallest {
+                        alpha[j] = 1.0;
+                        trial_matches = false;
+                    }
+                } else {
+                    alpha[j] *= 0.5;
+                    trial_matches = false;
+                }
+            }
+        }
+        for (j, track) in self.tracks.iter_mut().enumerate() {
+            if track.running && alpha[j] != 0.0 && s.line_search.take_smallest && !last_finite[j]
+            {
+                // Every trial down to the smallest α gave a non-finite residual.
+                track.running = false;
+                alpha[j] = 0.0;
+                trial_matches = false;
+                events.push((j, Event::Failed("residual is not finite".into())));
+            }
+        }
+        sys.accept(&alpha, trial_matches)?;
+        for (j, track) in self.tracks.iter_mut().enumerate() {
+            if !track.running || alpha[j] == 0.0 {
+                continue;
+            }
+            if !track.finishing {
+                track.updates += 1;
+            }
+            track.last_step = probe.step[j] * alpha[j];
+            if ends[j] {
+                track.running = false;
+                events.push((j, Event::Converged(track.updates)));
+            }
+        }
+        if self.trace {
+            if let Some(j) = (0..v).find(|&j| alpha[j] != 0.0) {
+                eprintln!(
+                    "  newton variant {j}: residual {:.3e} step {:.3e} α {}; {} running",
+                    probe.measure[j],
+                    probe.step[j],
+                    alpha[j],
+                    self.tracks.iter().filter(|t| t.running).count()
+                );
+            }
+        }
+        Ok(events)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Independent scalar problems `r_j(x) = x³ + x − b_j` (one per variant).
+    struct Cubic {
+        x: Vec<f64>,
+        b: Vec<f64>,
+        delta: Vec<f64>,
+    }
+
+    impl NewtonSystem for Cubic {
+        fn variants(&self) -> usize {
+            self.x.len()
+        }
+        fn solve(&mut self) -> Result<Probe, String> {
+            let mut p = Probe::default();
+            self.delta.clear();
+            for (x, b) in self.x.iter().zip(&self.b) {
+                let r = x * x * x + x - b;
+                let d = -r / (3.0 * x * x + 1.0);
+                self.delta.push(d);
+                p.measure.push(r.abs() / b.abs().max(1.0));
+                p.step.push(d.abs());
+                p.slope.push(d * r);
+                p.norm.push(r.abs());
+                p.solved.push(true);
+            }
+            Ok(p)
+        }
+        fn trial(&mut self, alpha: &[f64]) -> Result<TrialProbe, String> {
+            let mut t = TrialProbe::default();
+            for j in 0..self.x.len() {
+                let x = self.x[j] + alpha[j] * self.delta[j];
+                let r = x * x * x + x - self.b[j];
+                t.slope.push(self.delta[j] * r);
+                t.norm.push(r.abs());
+            }
+            Ok(t)
+        }
+        fn accept(&mut self, alpha: &[f64], _: bool) -> Result<(), String> {
+            for j in 0..self.x.len() {
+                self.x[j] += alpha[j] * self.delta[j];
+            }
+            Ok(())
+        }
+    }
+
+    #[test]
+    fn variants_converge_independently_and_idle_ones_do_not_move() {
+        let mut sys = Cubic {
+            x: vec![0.0, 10.0, 3.0],
+            b: vec![2.0, 1e3, 30.0],
+            delta: vec![],
+        };
+        let mut newton = Newton::new(NewtonSettings::statics(40, 1e-12, 8), 3);
+        newton.start(0, 1e-12, false);
+        newton.start(1, 1e-12, true);
+        // Variant 2 idle.
+        let mut ended = Vec::new();
+        while newton.any_running() {
+            ended.extend(newton.iterate(&mut sys).unwrap());
+        }
+        assert_eq!(sys.x[2], 3.0);
+        assert!((sys.x[0] - 1.0).abs() < 1e-12, "{}", sys.x[0]);
+        let root = sys.x[1];
+        assert!((root * root * root + root - 1e3).abs() < 1e-9);
+        assert_eq!(ended.len(), 2);
+        assert!(ended.iter().all(|(_, e)| matches!(e, Event::Converged(_))));
+    }
+
+    #[test]
+    fn a_failing_variant_stops_alone() {
+        let mut sys = Cubic {
+            x: vec![0.0, f64::NAN],
+            b: vec![2.0, 1.0],
+            delta: vec![],
+        };
+        let mut newton = Newton::new(NewtonSettings::dynamics(40, 1e-12, 8), 2);
+        newton.start(0, 1e-12, false);
+        newton.start(1, 1e-12, false);
+        let mut ended = Vec::new();
+        while newton.any_running() {
+            ended.extend(newton.iterate(&mut sys).unwrap());
+        }
+        ended.sort_by_key(|e| e.0);
+        assert!(matches!(ended[0].1, Event::Converged(_)));
+        assert_eq!(ended[1].1, Event::Failed("residual is not finite".into()));
+    }
+}
