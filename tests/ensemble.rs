@@ -153,8 +153,14 @@ fn grid_dynamic_ensemble_writes_variants_and_series() {
         )
         .unwrap();
         assert_eq!(
-            (g.backend.as_str(), g.variants, g.failed, g.step_cut),
-            ("gpu", 2, 0, 0)
+            (
+                g.backend.as_str(),
+                g.variants,
+                g.failed,
+                g.step_cut,
+                g.solved_by_engine
+            ),
+            ("gpu", 2, 0, 0, 2)
         );
         let read = |p: &std::path::Path| -> Vec<Vec<String>> {
             std::fs::read_to_string(p.join("variants.csv"))
@@ -171,6 +177,11 @@ fn grid_dynamic_ensemble_writes_variants_and_series() {
             for (k, (x, y)) in ra.iter().zip(rb).enumerate() {
                 let name = &a[0][k];
                 if name == "newton_iterations" || name == "reason" {
+                    continue;
+                }
+                if name == "solved_by" {
+                    // The engine solved every variant on the GPU backend, the CPU on its own.
+                    assert_eq!((x.as_str(), y.as_str()), ("engine", "cpu"));
                     continue;
                 }
                 match (x.parse::<f64>(), y.parse::<f64>()) {
@@ -334,8 +345,9 @@ fn sixty_four_variant_static_ensemble_on_the_gpu_matches_the_cpu_runs() {
     }
     eprintln!(
         "64 variants: GPU {t_gpu:.1} s ({} re-run on the CPU), CPU {t_cpu:.1} s; {compared} quantities: torque, side force, lateral worst relative difference {worst:.2e}; neutral point {worst_np:.2e} m (rounding floor {floor:.1e} m)",
-        gpu.step_cut
+        gpu.solved_by_cpu
     );
+    assert_eq!(gpu.solved_by_cpu, 0, "the engine must solve every variant");
     assert!(worst <= 1e-9, "{worst:e}");
     assert!(worst_np <= floor, "{worst_np:e} m");
     // f32 on the GPU engine: the error against the f64 CPU runs, reported and bounded by the
@@ -366,7 +378,11 @@ fn sixty_four_variant_static_ensemble_on_the_gpu_matches_the_cpu_runs() {
     }
     eprintln!(
         "64 variants, GPU f32 {t_32:.1} s ({} re-run on the CPU): relative error against the CPU f64 runs — neutral point {:.2e}, surface torque {:.2e}, stab1 side force {:.2e}, stab1 lateral {:.2e}",
-        g32.step_cut, worst32[0], worst32[1], worst32[2], worst32[3]
+        g32.solved_by_cpu, worst32[0], worst32[1], worst32[2], worst32[3]
+    );
+    assert_eq!(
+        g32.solved_by_cpu, 0,
+        "the f32 engine must solve every variant"
     );
     assert!(worst32.iter().all(|&w| w <= 1.2e-3), "{worst32:?}");
 }

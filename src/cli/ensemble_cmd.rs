@@ -51,6 +51,26 @@ pub enum Status {
     Failed,
 }
 
+/// Which solver produced a variant's result.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SolvedBy {
+    /// The kernel engine (GPU, or the CPU twins of its kernels).
+    Engine,
+    /// The CPU solver (the CPU backend, or a re-run of a variant the engine failed).
+    Cpu,
+}
+
+impl SolvedBy {
+    /// The name in `variants.csv`.
+    pub fn name(self) -> &'static str {
+        match self {
+            SolvedBy::Engine => "engine",
+            SolvedBy::Cpu => "cpu",
+        }
+    }
+}
+
 /// One variant's result.
 #[derive(Clone, Debug, Serialize)]
 pub struct VariantResult {
@@ -58,6 +78,8 @@ pub struct VariantResult {
     pub name: String,
     /// Status.
     pub status: Status,
+    /// Who solved it (a CPU re-run of an engine failure says so in `reason`).
+    pub solved_by: SolvedBy,
     /// Why it failed, or the first step cut.
     pub reason: String,
     /// Neutral point from the bit (m): static solution, or the last state of a dynamic run.
@@ -94,6 +116,11 @@ pub struct EnsembleSummary {
     pub failed: usize,
     /// Names and reasons of the failed variants.
     pub failures: Vec<(String, String)>,
+    /// Variants the kernel engine solved.
+    pub solved_by_engine: usize,
+    /// Variants the CPU solved: all of them on the CPU backend; on the GPU backend, the
+    /// engine's failures re-run there (each one's reason gives the engine's failure).
+    pub solved_by_cpu: usize,
     /// Wall time of the variant runs (s).
     pub seconds: f64,
     /// Files written.
@@ -121,6 +148,7 @@ fn failed(name: &str, reason: String, stabs: usize) -> VariantResult {
     VariantResult {
         name: name.to_string(),
         status: Status::Failed,
+        solved_by: SolvedBy::Cpu,
         reason,
         neutral_point_from_bit_m: None,
         max_surface_torque_nm: f64::NAN,
@@ -147,6 +175,7 @@ fn finished(
         } else {
             Status::Converged
         },
+        solved_by: SolvedBy::Cpu,
         reason: log.first().cloned().unwrap_or_default(),
         neutral_point_from_bit_m,
         max_surface_torque_nm,
@@ -232,7 +261,10 @@ pub fn run_static_gpu<T: crate::gpu::contact::GpuReal>(
                 EngineStatus::Converged => {
                     let mut sol = crate::solve::statics::solution_at(m, r.state);
                     sol.iterations = r.iterations;
-                    static_result(case, &v.name, m, &sol)
+                    sol.log = r.log;
+                    let mut done = static_result(case, &v.name, m, &sol);
+                    done.solved_by = SolvedBy::Engine;
+                    done
                 }
                 EngineStatus::Failed(why) => {
                     let mut again = static_variant(case, &v.name, m);
@@ -356,7 +388,9 @@ pub fn run_dynamic_gpu<T: crate::gpu::contact::GpuReal>(
         let name = &variants[j].name;
         out[j] = Some(match (r.status, state) {
             (DynamicStatus::Finished, Some(state)) => {
-                obs.finish(case, name, &models[j], &state, &d.log, &r.iterations)
+                let mut done = obs.finish(case, name, &models[j], &state, &d.log, &r.iterations);
+                done.solved_by = SolvedBy::Engine;
+                done
             }
             (status, _) => {
                 let why = match status {
@@ -585,6 +619,7 @@ fn variants_csv(
     header.extend(
         [
             "status",
+            "solved_by",
             "reason",
             "neutral_point_from_bit_m",
             "max_surface_torque_nm",
@@ -621,6 +656,7 @@ fn variants_csv(
             }
             .into(),
         );
+        row.push(r.solved_by.name().into());
         row.push(r.reason.clone());
         row.push(r.neutral_point_from_bit_m.map(fmt).unwrap_or_default());
         row.push(fmt(r.max_surface_torque_nm));
@@ -810,6 +846,18 @@ pub fn run(
     };
     let seconds = start.elapsed().as_secs_f64();
     bar.finish_and_clear();
+    if backend_name == "gpu" {
+        let rerun = results
+            .iter()
+            .filter(|r| r.solved_by == SolvedBy::Cpu)
+            .count();
+        if rerun > 0 {
+            eprintln!(
+                "holewall: the engine failed {rerun} of {} variants; they were re-run on the CPU (variants.csv: solved_by, reason)",
+                results.len()
+            );
+        }
+    }
 
     std::fs::create_dir_all(out)?;
     let stabs = stabilizer_sites(&case.model).len();
@@ -908,6 +956,14 @@ pub fn run(
             .filter(|r| r.status == Status::Failed)
             .map(|r| (r.name.clone(), r.reason.clone()))
             .collect(),
+        solved_by_engine: results
+            .iter()
+            .filter(|r| r.status != Status::Failed && r.solved_by == SolvedBy::Engine)
+            .count(),
+        solved_by_cpu: results
+            .iter()
+            .filter(|r| r.status != Status::Failed && r.solved_by == SolvedBy::Cpu)
+            .count(),
         seconds,
         outputs,
     };

@@ -32,8 +32,10 @@ use crate::kernels::update::{norms, update, ConfigBatch, Norms};
 use crate::model::Model;
 use crate::physics::contact::{ContactMode, ContactTerms, PARAMS_LEN};
 use crate::physics::Real;
+use crate::solve::continuation::{solve_loads, LoadPath, LoadTarget, StaticSystem};
+use crate::solve::newton::{NewtonSettings, NewtonSystem, Probe, TrialProbe};
 use crate::solve::statics::{
-    constraint_tables, reference_force, split_loads, StaticOptions, StaticState,
+    constraint_tables, loaded_params, reference_force, split_loads, StaticOptions, StaticState,
 };
 
 /// The convergence tests of a kernel path in its precision, per variant.
@@ -176,6 +178,9 @@ pub trait Ensemble<T> {
     fn commit(&mut self, alpha: &[T]) -> Result<(), String>;
     /// The current configuration, read back.
     fn config(&mut self) -> Result<ConfigBatch<T>, String>;
+    /// Replaces the current configuration (displacements from the base and rotations;
+    /// its system must be evaluated again).
+    fn set_config(&mut self, config: &ConfigBatch<T>) -> Result<(), String>;
     /// Moves the base to the current configuration, given as `tables` after
     /// [`EnsembleTables::set_base`] with the host's sum of the old base and the current
     /// displacements: the displacements from it are set to zero, the rotations kept (the
@@ -307,6 +312,13 @@ impl Ensemble<f64> for TwinEnsemble<'_> {
     fn config(&mut self) -> Result<ConfigBatch<f64>, String> {
         Ok(self.config[self.current].clone())
     }
+    fn set_config(&mut self, config: &ConfigBatch<f64>) -> Result<(), String> {
+        let c = &mut self.config[self.current];
+        c.x.copy_from_slice(&config.x);
+        c.rot.copy_from_slice(&config.rot);
+        self.system[self.current] = None;
+        Ok(())
+    }
     fn rebase(&mut self, tables: &EnsembleTables<f64>) -> Result<(), String> {
         self.tables = tables.clone();
         self.config[self.current].x.fill(0.0);
@@ -396,6 +408,8 @@ pub struct EngineResult {
     pub status: EngineStatus,
     /// Newton iterations per load step.
     pub iterations: Vec<usize>,
+    /// Step cuts and stage changes of its load path, with why.
+    pub log: Vec<String>,
 }
 
 /// An error unless every model shares the first one's mesh and number of sites.
@@ -532,180 +546,27 @@ fn solve_chunk<T: Real + Send + Sync, P: KernelPath<T>>(
     let tables = ensemble_tables::<T>(models)?;
     let (v, n) = (tables.num_variants, tables.num_nodes);
     let base = &models[0];
-    let t = |x: f64| T::from_f64_lossy(x);
-    let loads: Vec<(Vec<f64>, Vec<f64>)> = models.iter().map(split_loads).collect();
-    let f_ref: Vec<f64> = models.iter().map(reference_force).collect();
-    let p = tables.pair_node.len();
-    let Convergence {
-        tolerance,
-        small_residual,
-        step_floor,
-    } = Convergence::for_path::<T>(
-        options.tolerance,
-        &tables.node_ref,
-        None,
-        &tables.start.x,
-        v,
-    );
-    let mut ensemble = path.open(base, &tables)?;
-    let mut status = vec![EngineStatus::Converged; v];
-    let mut iterations = vec![Vec::new(); v];
-    // In f32 each load step starts by moving the base to the configuration reached (its
-    // displacements summed in f64 on the host), so the states are the step's motion, not
-    // the metres from the reference; and full load is solved twice, the second time from
-    // its own converged configuration as base: the answer's last digits are then f32's
-    // rounding of millimetres, not of the string's whole sag (the neutral point, from
-    // axial forces of EA·Δl/l, gains ≈ 2 digits; `docs/validation.md`).
-    let f32_path = std::mem::size_of::<T>() == 4;
-    let schedule: &[f64] = if f32_path {
-        &[0.0, 0.25, 0.5, 0.75, 1.0, 1.0]
-    } else {
-        &[0.0, 0.25, 0.5, 0.75, 1.0]
-    };
-    let mut tables = tables;
-    let minus_one = T::zero() - T::one();
-    for (step, &lambda) in schedule.iter().enumerate() {
-        if f32_path && step > 0 {
-            let config = ensemble.config()?;
-            let mut moved = tables.base.clone();
-            for (b, w) in moved.iter_mut().zip(&config.x) {
-                *b += w.to_f64_lossy();
-            }
-            tables.set_base(base, moved);
-            ensemble.rebase(&tables)?;
-        }
-        // Loads and friction of this step.
-        let mut f_ext = vec![T::zero(); 6 * n * v];
-        let mut params = vec![T::zero(); PARAMS_LEN * p];
-        for (j, m) in models.iter().enumerate() {
-            let gamma = if m.sites.is_empty() { lambda } else { 1.0 };
-            for d in 0..6 * n {
-                f_ext[d * v + j] = t(gamma * loads[j].0[d] + lambda * loads[j].1[d]);
-            }
-            for (k, site) in m.sites.iter().enumerate() {
-                let mut q = site.params;
-                q.mu_t *= lambda;
-                q.mu_l *= lambda;
-                for (f, x) in q.to_array().into_iter().enumerate() {
-                    params[f * p + k * v + j] = t(x);
-                }
-            }
-        }
-        ensemble.set_loads(&f_ext, &params)?;
-        let mut done = vec![false; v];
-        let mut polished = vec![false; v];
-        let mut last_step = vec![f64::INFINITY; v];
-        // Whether the current configuration's system is evaluated (the accepted trial's).
-        let mut evaluated = false;
-        for it in 1..=options.max_iterations {
-            if !evaluated {
-                ensemble.evaluate()?;
-            }
-            let (now, st) = ensemble.solve()?;
-            let mut alpha = vec![T::zero(); v];
-            for j in 0..v {
-                if done[j] || status[j] != EngineStatus::Converged {
-                    continue;
-                }
-                let measure = now.residual_max[j].to_f64_lossy() / f_ref[j];
-                if !measure.is_finite() {
-                    status[j] =
-                        EngineStatus::Failed(format!("λ = {lambda}: residual is not finite"));
-                } else if (measure <= tolerance && last_step[j] <= 1e-6)
-                    || (last_step[j] <= step_floor[j] && measure <= small_residual)
-                {
-                    // As statics::newton: converged, or the step is down at rounding level
-                    // (positions carry ≈1e-16·|x| of noise) with the residual small anyway.
-                    // At full load one more full step polishes it (as solve_static).
-                    if lambda == 1.0 && !polished[j] {
-                        polished[j] = true;
-                        alpha[j] = minus_one;
-                        continue;
-                    }
-                    done[j] = true;
-                    iterations[j].push(it - 1);
-                } else if st[j] != SOLVED {
-                    status[j] = EngineStatus::Failed(format!("λ = {lambda}: singular tangent"));
-                } else {
-                    alpha[j] = minus_one;
-                }
-            }
-            if (0..v).all(|j| done[j] || status[j] != EngineStatus::Converged) {
-                break;
-            }
-            // Line search per variant, as statics::newton: the full step unless it
-            // overshoots (|s(α)| > |s(0)|, s = −Δ·r) and does not lower ‖r‖₂; halved at most
-            // five times (the last, α = 1/32, is taken anyway).
-            let s0: Vec<f64> = now
-                .step_dot_residual
-                .iter()
-                .map(|x| -x.to_f64_lossy())
-                .collect();
-            let norm0: Vec<f64> = now
-                .residual_square
-                .iter()
-                .map(|x| x.to_f64_lossy().sqrt())
-                .collect();
-            let mut pending: Vec<bool> = alpha.iter().map(|a| a.to_f64_lossy() != 0.0).collect();
-            // The last trial evaluated holds every variant at its final α.
-            let mut trial_is_final = false;
-            for _ in 0..5 {
-                if !pending.iter().any(|&q| q) {
-                    break;
-                }
-                let r = ensemble.trial(&alpha)?;
-                trial_is_final = true;
-                for j in 0..v {
-                    if !pending[j] {
-                        continue;
-                    }
-                    let a = -alpha[j].to_f64_lossy();
-                    let s_a = -r.step_dot_residual[j].to_f64_lossy();
-                    let norm = r.residual_square[j].to_f64_lossy().sqrt();
-                    let finite = s_a.is_finite() && norm.is_finite();
-                    if finite && (s_a.abs() <= s0[j].abs() || norm <= (1.0 - 1e-4 * a) * norm0[j]) {
-                        pending[j] = false;
-                    } else {
-                        alpha[j] = alpha[j] * t(0.5);
-                        trial_is_final = false;
-                    }
-                }
-            }
-            for j in 0..v {
-                last_step[j] = now.step_max[j].to_f64_lossy() * alpha[j].to_f64_lossy().abs();
-            }
-            if std::env::var("HOLEWALL_DEBUG_NEWTON").is_ok() {
-                eprintln!(
-                    "  engine λ {lambda:.4} it {it}: variant 0 residual {:.3e} α {:.4} step {:.3e}",
-                    now.residual_max[0].to_f64_lossy() / f_ref[0],
-                    alpha[0].to_f64_lossy().abs(),
-                    last_step[0]
-                );
-            }
-            if trial_is_final {
-                ensemble.accept_trial();
-                evaluated = true;
-            } else {
-                ensemble.commit(&alpha)?;
-                evaluated = false;
-            }
-            progress(
-                (step as f64 + it as f64 / options.max_iterations as f64) / schedule.len() as f64,
-            );
-        }
-        progress((step + 1) as f64 / schedule.len() as f64);
-        for j in 0..v {
-            if !done[j] && status[j] == EngineStatus::Converged {
-                status[j] = EngineStatus::Failed(format!(
-                    "λ = {lambda}: Newton did not converge in {} iterations",
-                    options.max_iterations
-                ));
-            }
-        }
-    }
-    let config = ensemble.config()?;
-    Ok((0..v)
-        .map(|j| {
+    let size = std::mem::size_of::<T>();
+    let ensemble = path.open(base, &tables)?;
+    let mut sys = EngineStatic::new(models, ensemble, tables);
+    // f32 solves full load a second time from its own converged state as base: the
+    // answer's last digits are then f32's rounding of millimetres, not of the string's
+    // whole sag (`docs/validation.md`).
+    let mut paths: Vec<LoadPath> = models
+        .iter()
+        .map(|m| {
+            let linear = m.sites.iter().all(|s| s.params.spring_exponent == 1.0);
+            LoadPath::new(options, !m.sites.is_empty(), linear, size == 4)
+        })
+        .collect();
+    let settings = NewtonSettings::statics(options.max_iterations, options.tolerance, size);
+    solve_loads(&mut sys, &mut paths, settings, progress)?;
+    let config = sys.ensemble.config()?;
+    let tables = &sys.tables;
+    Ok(paths
+        .into_iter()
+        .enumerate()
+        .map(|(j, path)| {
             let mut s = StaticState::initial(base);
             for i in 0..n {
                 for k in 0..3 {
@@ -721,11 +582,229 @@ fn solve_chunk<T: Real + Send + Sync, P: KernelPath<T>>(
             }
             EngineResult {
                 state: s,
-                status: status[j].clone(),
-                iterations: iterations[j].clone(),
+                status: match &path.error {
+                    None => EngineStatus::Converged,
+                    Some(e) => EngineStatus::Failed(e.to_string()),
+                },
+                iterations: path.iterations,
+                log: path.log,
             }
         })
         .collect())
+}
+
+/// A chunk's static Newton system on a kernel path, for [`solve_loads`]: per variant its
+/// loads, its restart point (kept on the host in f64, as displacements from the reference
+/// and rotations) and its step floor. Saves, restores and load changes are gathered and
+/// carried out together before the next kernel work (one read and one write of the
+/// configuration); in f32 every save also moves the base to the current configuration.
+struct EngineStatic<'a, T> {
+    models: &'a [Model],
+    ensemble: Box<dyn Ensemble<T> + 'a>,
+    tables: EnsembleTables<T>,
+    loads: Vec<(Vec<f64>, Vec<f64>)>,
+    f_ref: Vec<f64>,
+    f_ext: Vec<T>,
+    params: Vec<T>,
+    loads_changed: bool,
+    evaluated: bool,
+    /// Per variant: displacements from the reference (`3 n`) and rotations (`9 n`).
+    saved: Vec<(Vec<f64>, Vec<f64>)>,
+    to_save: Vec<usize>,
+    to_restore: Vec<usize>,
+    to_rebase: bool,
+}
+
+impl<'a, T: Real> EngineStatic<'a, T> {
+    fn new(
+        models: &'a [Model],
+        ensemble: Box<dyn Ensemble<T> + 'a>,
+        tables: EnsembleTables<T>,
+    ) -> Self {
+        let (v, n, p) = (
+            tables.num_variants,
+            tables.num_nodes,
+            tables.pair_node.len(),
+        );
+        let saved = (0..v)
+            .map(|j| {
+                let x = (0..3 * n)
+                    .map(|k| tables.base[k * v + j] + tables.start.x[k * v + j].to_f64_lossy())
+                    .collect();
+                let rot = (0..9 * n)
+                    .map(|k| tables.start.rot[k * v + j].to_f64_lossy())
+                    .collect();
+                (x, rot)
+            })
+            .collect();
+        EngineStatic {
+            models,
+            ensemble,
+            loads: models.iter().map(split_loads).collect(),
+            f_ref: models.iter().map(reference_force).collect(),
+            f_ext: vec![T::zero(); 6 * n * v],
+            params: vec![T::zero(); PARAMS_LEN * p],
+            tables,
+            loads_changed: true,
+            evaluated: false,
+            saved,
+            to_save: Vec::new(),
+            to_restore: Vec::new(),
+            to_rebase: false,
+        }
+    }
+
+    /// Carries out the gathered saves, restores (and f32 rebase) and load changes.
+    fn flush(&mut self) -> Result<(), String> {
+        let v = self.tables.num_variants;
+        if !self.to_save.is_empty() || !self.to_restore.is_empty() {
+            let mut config = self.ensemble.config()?;
+            for j in std::mem::take(&mut self.to_save) {
+                let (x, rot) = &mut self.saved[j];
+                for (k, x) in x.iter_mut().enumerate() {
+                    *x = self.tables.base[k * v + j] + config.x[k * v + j].to_f64_lossy();
+                }
+                for (k, r) in rot.iter_mut().enumerate() {
+                    *r = config.rot[k * v + j].to_f64_lossy();
+                }
+                if std::mem::size_of::<T>() == 4 {
+                    self.to_rebase = true;
+                }
+            }
+            let restores = std::mem::take(&mut self.to_restore);
+            for &j in &restores {
+                let (x, rot) = &self.saved[j];
+                for (k, x) in x.iter().enumerate() {
+                    config.x[k * v + j] = T::from_f64_lossy(x - self.tables.base[k * v + j]);
+                }
+                for (k, r) in rot.iter().enumerate() {
+                    config.rot[k * v + j] = T::from_f64_lossy(*r);
+                }
+            }
+            if !restores.is_empty() {
+                self.ensemble.set_config(&config)?;
+                self.evaluated = false;
+            }
+            if std::mem::take(&mut self.to_rebase) {
+                // f32: the states become the motion from here (host sums in f64).
+                let mut moved = self.tables.base.clone();
+                for (b, w) in moved.iter_mut().zip(&config.x) {
+                    *b += w.to_f64_lossy();
+                }
+                self.tables.set_base(&self.models[0], moved);
+                self.ensemble.rebase(&self.tables)?;
+                self.evaluated = false;
+            }
+        }
+        if self.loads_changed {
+            self.ensemble.set_loads(&self.f_ext, &self.params)?;
+            self.loads_changed = false;
+            self.evaluated = false;
+        }
+        Ok(())
+    }
+}
+
+/// `−α` in the path's float type (the kernels' `Δ` is the negative Newton step).
+fn negated<T: Real>(alpha: &[f64]) -> Vec<T> {
+    alpha.iter().map(|&a| T::from_f64_lossy(-a)).collect()
+}
+
+impl<T: Real> NewtonSystem for EngineStatic<'_, T> {
+    fn variants(&self) -> usize {
+        self.tables.num_variants
+    }
+    fn solve(&mut self) -> Result<Probe, String> {
+        self.flush()?;
+        if !self.evaluated {
+            self.ensemble.evaluate()?;
+            self.evaluated = true;
+        }
+        let (now, status) = self.ensemble.solve()?;
+        let f = |x: &T| x.to_f64_lossy();
+        Ok(Probe {
+            measure: now
+                .residual_max
+                .iter()
+                .zip(&self.f_ref)
+                .map(|(r, f_ref)| f(r) / f_ref)
+                .collect(),
+            step: now.step_max.iter().map(f).collect(),
+            slope: now.step_dot_residual.iter().map(f).collect(),
+            norm: now.residual_square.iter().map(|x| f(x).sqrt()).collect(),
+            solved: status.iter().map(|&s| s == SOLVED).collect(),
+        })
+    }
+    fn trial(&mut self, alpha: &[f64]) -> Result<TrialProbe, String> {
+        self.flush()?;
+        let r = self.ensemble.trial(&negated::<T>(alpha))?;
+        Ok(TrialProbe {
+            slope: r
+                .step_dot_residual
+                .iter()
+                .map(|x| x.to_f64_lossy())
+                .collect(),
+            norm: r
+                .residual_square
+                .iter()
+                .map(|x| x.to_f64_lossy().sqrt())
+                .collect(),
+        })
+    }
+    fn accept(&mut self, alpha: &[f64], trial_matches: bool) -> Result<(), String> {
+        self.flush()?;
+        if trial_matches {
+            self.ensemble.accept_trial();
+            self.evaluated = true;
+        } else if alpha.iter().any(|&a| a != 0.0) {
+            self.ensemble.commit(&negated::<T>(alpha))?;
+            self.evaluated = false;
+        }
+        Ok(())
+    }
+}
+
+impl<T: Real> StaticSystem for EngineStatic<'_, T> {
+    fn set_target(&mut self, j: usize, target: &LoadTarget) -> Result<(), String> {
+        let v = self.tables.num_variants;
+        let p = self.tables.pair_node.len();
+        let (gravity, other) = &self.loads[j];
+        for (d, (g, o)) in gravity.iter().zip(other).enumerate() {
+            self.f_ext[d * v + j] = T::from_f64_lossy(target.gravity * g + target.lambda * o);
+        }
+        for (k, site) in self.models[j].sites.iter().enumerate() {
+            let q = loaded_params(&site.params, target);
+            for (f, x) in q.to_array().into_iter().enumerate() {
+                self.params[f * p + k * v + j] = T::from_f64_lossy(x);
+            }
+        }
+        self.loads_changed = true;
+        Ok(())
+    }
+    fn save(&mut self, j: usize) -> Result<(), String> {
+        self.to_save.push(j);
+        Ok(())
+    }
+    fn restore(&mut self, j: usize) -> Result<(), String> {
+        self.to_restore.push(j);
+        Ok(())
+    }
+    fn step_floor(&mut self, j: usize) -> Result<f64, String> {
+        // From the last saved state (a save pending now is at most one step away).
+        let v = self.tables.num_variants;
+        let x = &self.saved[j].0;
+        let size = std::mem::size_of::<T>();
+        let largest = if size == 4 {
+            x.iter().enumerate().fold(0.0f64, |m, (k, x)| {
+                m.max((x - self.tables.base[k * v + j]).abs())
+            })
+        } else {
+            x.iter().enumerate().fold(0.0f64, |m, (k, x)| {
+                m.max((self.tables.node_ref[k] + x).abs())
+            })
+        };
+        Ok(NewtonSettings::step_floor(size, largest))
+    }
 }
 
 /// A kernel path with chunks of at most `max` variants (to test chunk boundaries, or to

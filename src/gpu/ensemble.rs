@@ -738,6 +738,14 @@ impl<T: GpuReal> Ensemble<T> for GpuEnsemble<T> {
         })
     }
 
+    fn set_config(&mut self, config: &ConfigBatch<T>) -> Result<(), String> {
+        let s = &self.slots[self.current];
+        let q = &self.ctx.queue;
+        q.write_buffer(&s.x, 0, bytemuck::cast_slice(&config.x));
+        q.write_buffer(&s.rot, 0, bytemuck::cast_slice(&config.rot));
+        Ok(())
+    }
+
     fn rebase(&mut self, tables: &EnsembleTables<T>) -> Result<(), String> {
         let q = &self.ctx.queue;
         if !tables.pair_base.is_empty() {

@@ -551,149 +551,31 @@ impl<'a> Dynamics<'a> {
             .collect()
     }
 
-    /// Advances `s` by one step of size `h`; on failure `s` is unchanged.
+    /// Advances `s` by one step of size `h`; on failure `s` is unchanged. Newton on the
+    /// accelerations `v̇_{n+1}` ([`crate::solve::newton`], dynamics settings).
     pub fn step(&mut self, s: &mut DynamicState, h: f64) -> Result<usize, String> {
-        let p = self.options.alpha;
-        let n = self.model.nodes.len();
-        let c = constraints(self.model);
-        let ratio = (1.0 - p.alpha_f) / (1.0 - p.alpha_m);
-        let hg = h * p.gamma * ratio;
-        let hhb = h * h * p.beta * ratio;
-        let t1 = s.t + h;
-        let (phi, phidot, phiddot) = self.table(t1);
-        let (zh, zhdot, zhddot) = self.hook(t1);
-        let lowered =
-            self.options.rop != 0.0 && matches!(self.model.top, crate::model::TopBoundary::Clamped);
-        let top_z = self.model.nodes[0].position[2];
-        let mut trial = s.clone();
-        trial.t = t1;
-        // Predictor: v̇_{n+1} = v̇_n.
-        let apply = |tr: &mut DynamicState, vdot: &[f64]| {
-            for d in 0..6 * n {
-                let a1 = ratio * vdot[d]
-                    + (p.alpha_f * s.vdot[d] - p.alpha_m * s.a[d]) / (1.0 - p.alpha_m);
-                tr.vdot[d] = vdot[d];
-                tr.a[d] = a1;
-                tr.v[d] = s.v[d] + h * ((1.0 - p.gamma) * s.a[d] + p.gamma * a1);
-            }
-            for i in 0..n {
-                let dq: Vec<f64> = (0..6)
-                    .map(|k| {
-                        s.v[6 * i + k]
-                            + h * ((0.5 - p.beta) * s.a[6 * i + k] + p.beta * tr.a[6 * i + k])
-                    })
-                    .collect();
-                for k in 0..3 {
-                    tr.q.x[i][k] = s.q.x[i][k] + h * dq[k];
-                }
-                tr.q.rot[i] = mat_mul(
-                    &rotation_exp(&[h * dq[3], h * dq[4], h * dq[5]]),
-                    &s.q.rot[i],
-                );
-            }
-        };
-        let mut vdot = s.vdot.clone();
-        // The table: prescribed spin about z at the top node.
-        let driven = self.table_driven();
-        let fixed_top = c.fixed[0];
-        let top_prescribed = |vd: &mut Vec<f64>| {
-            for k in 0..6 {
-                if fixed_top[k] {
-                    vd[k] = 0.0;
-                }
-            }
-            if driven {
-                vd[5] = phiddot;
-            }
-            if lowered {
-                vd[2] = zhddot;
-            }
-        };
-        let table = |tr: &mut DynamicState| {
-            if driven {
-                tr.q.rot[0] = rotation_exp(&[0.0, 0.0, phi]);
-                tr.v[3] = 0.0;
-                tr.v[4] = 0.0;
-                tr.v[5] = phidot;
-            }
-            if lowered {
-                tr.q.x[0][2] = top_z + zh;
-                tr.v[2] = zhdot;
-            }
-        };
-        top_prescribed(&mut vdot);
-        for it in 1..=self.options.max_iterations {
-            apply(&mut trial, &vdot);
-            // Exact table kinematics at the top node.
-            table(&mut trial);
-            let (mut r, mut mat) = self.residual_and_matrix(&trial, hg, hhb, true);
-            constrain(&c, &mut r, &mut mat);
-            // Scale: the loads, or the inertial forces if larger (a whirling string).
-            let inertial = (0..n).fold(0.0f64, |m, i| {
-                (0..3).fold(m, |m, k| {
-                    m.max((self.mass[i] * trial.vdot[6 * i + k]).abs())
-                })
-            });
-            let measure = r.iter().fold(0.0f64, |m, x| m.max(x.abs())) / self.f_ref.max(inertial);
-            if !measure.is_finite() {
-                return Err("residual is not finite".into());
-            }
-            let rhs: Vec<f64> = r.iter().map(|x| -x).collect();
-            let mut dv = self.solver.solve(&mat, &rhs).map_err(|e| e.to_string())?;
-            // Held nodes (the bit) solve in their hole frame: back to global axes.
-            to_global(&c, &mut dv);
-            let step_norm = dv.iter().fold(0.0f64, |m, x| m.max(x.abs())) * hhb;
-            let length_scale = 1.0 + s.q.x.iter().flatten().fold(0.0f64, |m, x| m.max(x.abs()));
-            let converged = measure <= self.options.tolerance
-                || (step_norm <= 1e-12 * length_scale && measure <= 1e-6);
-            // Backtracking on the residual's 2-norm: a regularised sign with a tiny `eps`
-            // (or a contact switching on and off) makes full Newton steps jump across the
-            // narrow transition and cycle; a shorter step lands in it. Full steps are kept
-            // when nothing shorter lowers the residual.
-            let mut alpha = 1.0;
-            if !converged {
-                let norm0 = r.iter().map(|x| x * x).sum::<f64>().sqrt();
-                let mut probe = trial.clone();
-                let mut accepted = false;
-                for _ in 0..24 {
-                    let mut cand: Vec<f64> =
-                        vdot.iter().zip(&dv).map(|(x, d)| x + alpha * d).collect();
-                    top_prescribed(&mut cand);
-                    apply(&mut probe, &cand);
-                    table(&mut probe);
-                    let (mut rc, _) = self.residual_and_matrix(&probe, hg, hhb, false);
-                    constrain_residual(&c, &mut rc);
-                    let norm = rc.iter().map(|x| x * x).sum::<f64>().sqrt();
-                    if norm.is_finite() && norm <= (1.0 - 1e-4 * alpha) * norm0 {
-                        accepted = true;
-                        break;
+        use crate::solve::newton::{Event, Newton, NewtonSettings};
+        let settings =
+            NewtonSettings::dynamics(self.options.max_iterations, self.options.tolerance, 8);
+        let largest = s.q.x.iter().flatten().fold(0.0f64, |m, x| m.max(x.abs()));
+        let floor = NewtonSettings::step_floor(8, largest);
+        let mut sys = CpuStep::new(self, s, h);
+        let mut newton = Newton::new(settings, 1);
+        newton.start(0, floor, false);
+        loop {
+            for (_, event) in newton.iterate(&mut sys)? {
+                match event {
+                    Event::Converged(its) => {
+                        let vdot = sys.vdot.clone();
+                        let mut next = sys.trial.clone();
+                        sys.predict(&mut next, &vdot);
+                        *s = next;
+                        return Ok(its);
                     }
-                    alpha *= 0.5;
+                    Event::Failed(reason) => return Err(reason),
                 }
-                if !accepted {
-                    alpha = 1.0;
-                }
-            }
-            for (x, d) in vdot.iter_mut().zip(&dv) {
-                *x += alpha * d;
-            }
-            top_prescribed(&mut vdot);
-            if std::env::var("HOLEWALL_DEBUG_NEWTON").is_ok() {
-                eprintln!(
-                    "  dyn t {t1:.6} it {it}: residual {measure:.3e} correction {step_norm:.3e} α {alpha}"
-                );
-            }
-            if converged {
-                apply(&mut trial, &vdot);
-                table(&mut trial);
-                *s = trial;
-                return Ok(it);
             }
         }
-        Err(format!(
-            "Newton did not converge in {} iterations",
-            self.options.max_iterations
-        ))
     }
 
     /// Integrates to `t_end`, calling `observe` after every step; cuts the step on failure
@@ -728,6 +610,183 @@ impl<'a> Dynamics<'a> {
                     ));
                 }
             }
+        }
+        Ok(())
+    }
+}
+
+/// One generalised-α step of the CPU integrator as a Newton system (one variant): the
+/// unknown is `v̇_{n+1}`; the predictor gives the trial state from it, with the top's
+/// prescribed kinematics (table, hook).
+struct CpuStep<'s, 'a> {
+    d: &'s mut Dynamics<'a>,
+    s: &'s DynamicState,
+    c: crate::solve::statics::Constraints,
+    h: f64,
+    hg: f64,
+    hhb: f64,
+    table: (f64, f64, f64),
+    hook: (f64, f64, f64),
+    driven: bool,
+    lowered: bool,
+    /// The unknown.
+    vdot: Vec<f64>,
+    /// The Newton correction (global axes).
+    dv: Vec<f64>,
+    trial: DynamicState,
+}
+
+impl<'s, 'a> CpuStep<'s, 'a> {
+    fn new(d: &'s mut Dynamics<'a>, s: &'s DynamicState, h: f64) -> Self {
+        let p = d.options.alpha;
+        let ratio = (1.0 - p.alpha_f) / (1.0 - p.alpha_m);
+        let t1 = s.t + h;
+        let (driven, lowered) = d.top_motion();
+        let mut trial = s.clone();
+        trial.t = t1;
+        let mut step = CpuStep {
+            c: constraints(d.model),
+            table: d.table(t1),
+            hook: d.hook(t1),
+            driven,
+            lowered,
+            hg: h * p.gamma * ratio,
+            hhb: h * h * p.beta * ratio,
+            h,
+            vdot: s.vdot.clone(),
+            dv: vec![0.0; s.vdot.len()],
+            trial,
+            s,
+            d,
+        };
+        // Predictor: v̇_{n+1} = v̇_n, with the top's prescribed accelerations.
+        let mut vdot = std::mem::take(&mut step.vdot);
+        step.prescribe(&mut vdot);
+        step.vdot = vdot;
+        step
+    }
+
+    /// The top node's prescribed accelerations written into `vd`.
+    fn prescribe(&self, vd: &mut [f64]) {
+        for k in 0..6 {
+            if self.c.fixed[0][k] {
+                vd[k] = 0.0;
+            }
+        }
+        if self.driven {
+            vd[5] = self.table.2;
+        }
+        if self.lowered {
+            vd[2] = self.hook.2;
+        }
+    }
+
+    /// The state at `t_{n+1}` for the unknown `vdot`, the top's kinematics exact.
+    fn predict(&self, tr: &mut DynamicState, vdot: &[f64]) {
+        let p = self.d.options.alpha;
+        let (s, h) = (self.s, self.h);
+        let n = self.d.model.nodes.len();
+        let ratio = (1.0 - p.alpha_f) / (1.0 - p.alpha_m);
+        for dof in 0..6 * n {
+            let a1 = ratio * vdot[dof]
+                + (p.alpha_f * s.vdot[dof] - p.alpha_m * s.a[dof]) / (1.0 - p.alpha_m);
+            tr.vdot[dof] = vdot[dof];
+            tr.a[dof] = a1;
+            tr.v[dof] = s.v[dof] + h * ((1.0 - p.gamma) * s.a[dof] + p.gamma * a1);
+        }
+        for i in 0..n {
+            let dq: Vec<f64> = (0..6)
+                .map(|k| {
+                    s.v[6 * i + k]
+                        + h * ((0.5 - p.beta) * s.a[6 * i + k] + p.beta * tr.a[6 * i + k])
+                })
+                .collect();
+            for k in 0..3 {
+                tr.q.x[i][k] = s.q.x[i][k] + h * dq[k];
+            }
+            tr.q.rot[i] = mat_mul(
+                &rotation_exp(&[h * dq[3], h * dq[4], h * dq[5]]),
+                &s.q.rot[i],
+            );
+        }
+        if self.driven {
+            tr.q.rot[0] = rotation_exp(&[0.0, 0.0, self.table.0]);
+            tr.v[3] = 0.0;
+            tr.v[4] = 0.0;
+            tr.v[5] = self.table.1;
+        }
+        if self.lowered {
+            tr.q.x[0][2] = self.d.model.nodes[0].position[2] + self.hook.0;
+            tr.v[2] = self.hook.1;
+        }
+    }
+
+    /// The unknown moved by `α Δ`, the top's accelerations kept.
+    fn moved(&self, alpha: f64) -> Vec<f64> {
+        let mut v: Vec<f64> = self
+            .vdot
+            .iter()
+            .zip(&self.dv)
+            .map(|(x, d)| x + alpha * d)
+            .collect();
+        self.prescribe(&mut v);
+        v
+    }
+}
+
+impl crate::solve::newton::NewtonSystem for CpuStep<'_, '_> {
+    fn variants(&self) -> usize {
+        1
+    }
+    fn solve(&mut self) -> Result<crate::solve::newton::Probe, String> {
+        let mut trial = std::mem::replace(&mut self.trial, self.s.clone());
+        self.predict(&mut trial, &self.vdot);
+        let (mut r, mut mat) = self.d.residual_and_matrix(&trial, self.hg, self.hhb, true);
+        self.trial = trial;
+        constrain(&self.c, &mut r, &mut mat);
+        // Scale: the loads, or the inertial forces if larger (a whirling string).
+        let n = self.d.model.nodes.len();
+        let inertial = (0..n).fold(0.0f64, |m, i| {
+            (0..3).fold(m, |m, k| {
+                m.max((self.d.mass[i] * self.trial.vdot[6 * i + k]).abs())
+            })
+        });
+        let measure = r.iter().fold(0.0f64, |m, x| m.max(x.abs())) / self.d.f_ref.max(inertial);
+        let rhs: Vec<f64> = r.iter().map(|x| -x).collect();
+        let solved = match self.d.solver.solve(&mat, &rhs) {
+            Ok(mut dv) => {
+                // Held nodes (the bit) solve in their hole frame: back to global axes.
+                to_global(&self.c, &mut dv);
+                self.dv = dv;
+                true
+            }
+            Err(_) => {
+                self.dv.fill(0.0);
+                false
+            }
+        };
+        Ok(crate::solve::newton::Probe {
+            measure: vec![measure],
+            step: vec![self.dv.iter().fold(0.0f64, |m, x| m.max(x.abs())) * self.hhb],
+            slope: vec![dot_n(&self.dv, &r)],
+            norm: vec![dot_n(&r, &r).sqrt()],
+            solved: vec![solved],
+        })
+    }
+    fn trial(&mut self, alpha: &[f64]) -> Result<crate::solve::newton::TrialProbe, String> {
+        let cand = self.moved(alpha[0]);
+        let mut probe = self.trial.clone();
+        self.predict(&mut probe, &cand);
+        let (mut rc, _) = self.d.residual_and_matrix(&probe, self.hg, self.hhb, false);
+        constrain_residual(&self.c, &mut rc);
+        Ok(crate::solve::newton::TrialProbe {
+            slope: vec![dot_n(&self.dv, &rc)],
+            norm: vec![dot_n(&rc, &rc).sqrt()],
+        })
+    }
+    fn accept(&mut self, alpha: &[f64], _trial_matches: bool) -> Result<(), String> {
+        if alpha[0] != 0.0 {
+            self.vdot = self.moved(alpha[0]);
         }
         Ok(())
     }

@@ -378,8 +378,7 @@ impl Newton {
                 let a = alpha[j];
                 let finite = r.slope[j].is_finite() && r.norm[j].is_finite();
                 last_finite[j] = finite;
-                let slope_ok =
-                    s.line_search.slope_test && r.slope[j].abs() <= probe.slope[j].abs();
+                let slope_ok = s.line_search.slope_test && r.slope[j].abs() <= probe.slope[j].abs();
                 let norm_ok = r.norm[j] <= (1.0 - 1e-4 * a) * probe.norm[j];
                 if finite && (slope_ok || norm_ok) {
                     pending[j] = false;
@@ -396,8 +395,7 @@ impl Newton {
             }
         }
         for (j, track) in self.tracks.iter_mut().enumerate() {
-            if track.running && alpha[j] != 0.0 && s.line_search.take_smallest && !last_finite[j]
-            {
+            if track.running && alpha[j] != 0.0 && s.line_search.take_smallest && !last_finite[j] {
                 // Every trial down to the smallest α gave a non-finite residual.
                 track.running = false;
                 alpha[j] = 0.0;

@@ -565,7 +565,12 @@ pub fn solve_static_from(
     use crate::solve::newton::NewtonSettings;
     let mut sys = CpuStatic::new(model, start);
     let linear = model.sites.iter().all(|s| s.params.spring_exponent == 1.0);
-    let mut paths = [LoadPath::new(options, !model.sites.is_empty(), linear, false)];
+    let mut paths = [LoadPath::new(
+        options,
+        !model.sites.is_empty(),
+        linear,
+        false,
+    )];
     let settings = NewtonSettings::statics(options.max_iterations, options.tolerance, 8);
     if let Err(reason) = solve_loads(&mut sys, &mut paths, settings, &mut |_| {}) {
         return Err(StaticError::LoadStep {
@@ -667,14 +672,7 @@ impl crate::solve::newton::NewtonSystem for CpuStatic<'_> {
     }
     fn trial(&mut self, alpha: &[f64]) -> Result<crate::solve::newton::TrialProbe, String> {
         let s = update(&self.c, &self.state, &self.delta, alpha[0]);
-        assemble(
-            &self.loaded,
-            &s,
-            1.0,
-            &self.f_step,
-            &mut self.trial,
-            None,
-        );
+        assemble(&self.loaded, &s, 1.0, &self.f_step, &mut self.trial, None);
         constrain_residual(&self.c, &mut self.trial);
         self.trial_state = Some((alpha[0], s));
         Ok(crate::solve::newton::TrialProbe {
@@ -722,7 +720,12 @@ impl crate::solve::continuation::StaticSystem for CpuStatic<'_> {
         Ok(())
     }
     fn step_floor(&mut self, _j: usize) -> Result<f64, String> {
-        let largest = self.state.x.iter().flatten().fold(0.0f64, |m, x| m.max(x.abs()));
+        let largest = self
+            .state
+            .x
+            .iter()
+            .flatten()
+            .fold(0.0f64, |m, x| m.max(x.abs()));
         Ok(crate::solve::newton::NewtonSettings::step_floor(8, largest))
     }
 }
