@@ -380,15 +380,15 @@ pub fn run_dynamic_gpu<T: crate::gpu::contact::GpuReal>(
     )
     .map_err(|e| Error::Io(std::io::Error::other(format!("GPU engine: {e}"))))?;
     let mut out: Vec<Option<VariantResult>> = vec![None; models.len()];
-    for ((&j, ((r, obs), state)), d) in on_gpu
+    for (&j, ((r, obs), state)) in on_gpu
         .iter()
         .zip(results.into_iter().zip(observers).zip(last))
-        .zip(&cpu)
     {
         let name = &variants[j].name;
         out[j] = Some(match (r.status, state) {
             (DynamicStatus::Finished, Some(state)) => {
-                let mut done = obs.finish(case, name, &models[j], &state, &d.log, &r.iterations);
+                // The engine's step cuts, as the CPU integrator's log would give them.
+                let mut done = obs.finish(case, name, &models[j], &state, &r.log, &r.iterations);
                 done.solved_by = SolvedBy::Engine;
                 done
             }

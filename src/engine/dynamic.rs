@@ -28,7 +28,8 @@ use crate::physics::Real;
 use crate::solve::dynamics::{DynamicOptions, Dynamics};
 use crate::solve::statics::StaticState;
 
-use super::{ensemble_tables, Convergence, EnsembleTables, KernelPath, TwinPath};
+use super::{ensemble_tables, EnsembleTables, KernelPath, TwinPath};
+use crate::solve::newton::{Event, Newton, NewtonSettings, NewtonSystem, Probe, TrialProbe};
 
 /// What a dynamic chunk adds to [`EnsembleTables`].
 #[derive(Clone, Debug)]
@@ -76,6 +77,8 @@ pub trait DynamicEnsemble<T> {
     fn end_step(&mut self) -> Result<(), String>;
     /// The state, read back.
     fn state(&mut self) -> Result<DynamicBatch<T>, String>;
+    /// Replaces the state at `t_n` (between steps).
+    fn set_state(&mut self, state: &DynamicBatch<T>) -> Result<(), String>;
 }
 
 /// How a variant's dynamic run ended.
@@ -200,13 +203,22 @@ fn dynamic_tables<T: Real>(
 pub struct DynamicResult {
     /// Status.
     pub status: DynamicStatus,
-    /// Newton iterations of every step taken.
+    /// Newton iterations of every step taken (sub-steps included).
     pub iterations: Vec<usize>,
+    /// Step cuts, with why.
+    pub log: Vec<String>,
 }
 
 /// Runs every variant from its static equilibrium `starts[j]` to `t_end` in steps of
 /// `options.dt` on `path`, calling `observe(first_variant, t, state)` for each chunk after
 /// every `every`-th step (0: never). `density` gives each element's steel density.
+///
+/// Step control per variant: a variant whose Newton fails on `t → t + h` is taken back to
+/// `t` and re-tried alone with the others that failed there — in a chunk of their own, in
+/// two steps of `h/2` (cut again where those fail, down to `options.min_dt`) — while the
+/// rest wait; at `t + h` its state rejoins the chunk, which goes on with `h`. So the
+/// ensemble stays in lockstep at every step of `h` and no variant needs the CPU integrator
+/// unless a step below `min_dt` would be needed there too.
 #[allow(clippy::too_many_arguments)]
 pub fn run_dynamic_ensemble<T: Real + Send + Sync, P: KernelPath<T>>(
     models: &[Model],
@@ -241,6 +253,62 @@ pub fn run_dynamic_ensemble<T: Real + Send + Sync, P: KernelPath<T>>(
     Ok(results)
 }
 
+/// The columns `pick` of a variant-fastest array of `v` variants.
+fn columns<T: Copy>(data: &[T], v: usize, pick: &[usize]) -> Vec<T> {
+    data.chunks_exact(v)
+        .flat_map(|row| pick.iter().map(move |&j| row[j]))
+        .collect()
+}
+
+/// Writes `src` (the columns `pick`, variant-fastest) into `dst` of `v` variants.
+fn put_columns<T: Copy>(dst: &mut [T], v: usize, pick: &[usize], src: &[T]) {
+    for (row, from) in dst.chunks_exact_mut(v).zip(src.chunks_exact(pick.len())) {
+        for (&j, &x) in pick.iter().zip(from) {
+            row[j] = x;
+        }
+    }
+}
+
+fn batch_columns<T: Copy>(b: &DynamicBatch<T>, pick: &[usize]) -> DynamicBatch<T> {
+    let v = b.num_variants;
+    DynamicBatch {
+        num_variants: pick.len(),
+        num_nodes: b.num_nodes,
+        u: columns(&b.u, v, pick),
+        rot: columns(&b.rot, v, pick),
+        vel: columns(&b.vel, v, pick),
+        acc: columns(&b.acc, v, pick),
+        vdot: columns(&b.vdot, v, pick),
+    }
+}
+
+fn put_batch_columns<T: Copy>(dst: &mut DynamicBatch<T>, pick: &[usize], src: &DynamicBatch<T>) {
+    let v = dst.num_variants;
+    put_columns(&mut dst.u, v, pick, &src.u);
+    put_columns(&mut dst.rot, v, pick, &src.rot);
+    put_columns(&mut dst.vel, v, pick, &src.vel);
+    put_columns(&mut dst.acc, v, pick, &src.acc);
+    put_columns(&mut dst.vdot, v, pick, &src.vdot);
+}
+
+/// What every span of a chunk shares: the chunk's tables, per variant its force scale,
+/// step floor and top drive, and the outcome so far.
+struct Chunk<'a, T, P> {
+    models: &'a [Model],
+    path: &'a P,
+    options: &'a DynamicOptions,
+    tables: EnsembleTables<T>,
+    dynamic: DynamicTables<T>,
+    f_ref: Vec<f64>,
+    floors: Vec<f64>,
+    driven: bool,
+    lowered: bool,
+    drives: Vec<Dynamics<'a>>,
+    status: Vec<DynamicStatus>,
+    iterations: Vec<Vec<usize>>,
+    log: Vec<Vec<String>>,
+}
+
 #[allow(clippy::too_many_arguments)]
 fn run_chunk<T: Real + Send + Sync, P: KernelPath<T>>(
     models: &[Model],
@@ -252,10 +320,7 @@ fn run_chunk<T: Real + Send + Sync, P: KernelPath<T>>(
     every: usize,
     observe: &mut dyn FnMut(f64, &DynamicBatch<T>),
 ) -> Result<Vec<DynamicResult>, String> {
-    let t = |x: f64| T::from_f64_lossy(x);
     let mut tables = ensemble_tables::<T>(models)?;
-    // The contact terms of the dynamic scene (damping where some c > 0).
-    let mut batch = ContactBatch::<T>::new(1, tables.pair_node.len());
     let Start {
         tables: dynamic,
         base,
@@ -263,194 +328,290 @@ fn run_chunk<T: Real + Send + Sync, P: KernelPath<T>>(
         driven,
         lowered,
     } = dynamic_tables::<T>(models, starts, density, options)?;
+    // The contact terms of the dynamic scene (damping where some c > 0).
+    let mut batch = ContactBatch::<T>::new(1, tables.pair_node.len());
     batch.pair_params = dynamic.pair_params.clone();
     tables.terms = batch.required_terms(models[0].friction, ContactMode::Dynamic);
     let v = tables.num_variants;
     tables.set_base(&models[0], base);
-    let Convergence {
-        tolerance,
-        small_residual,
-        step_floor,
-    } = Convergence::for_path::<T>(
-        options.tolerance,
-        &tables.node_ref,
-        Some(&tables.base),
-        &dynamic.start.u,
-        v,
-    );
-    let f32_path = std::mem::size_of::<T>() == 4;
+    let size = std::mem::size_of::<T>();
+    // Step floors: f64 from the positions, f32 from the motion off the base.
+    let floors = (0..v)
+        .map(|j| {
+            let largest = (0..tables.node_ref.len()).fold(0.0f64, |m, k| {
+                let w = dynamic.start.u[k * v + j].to_f64_lossy();
+                let x = if size == 4 {
+                    w
+                } else {
+                    tables.node_ref[k] + tables.base[k * v + j] + w
+                };
+                m.max(x.abs())
+            });
+            NewtonSettings::step_floor(size, largest)
+        })
+        .collect();
     let mut ensemble = path.open_dynamic(&models[0], &tables, &dynamic)?;
+    let mut chunk = Chunk {
+        models,
+        path,
+        options,
+        drives: models
+            .iter()
+            .map(|m| Dynamics::new(m, *options, &|e| density[e]))
+            .collect(),
+        tables,
+        dynamic,
+        f_ref,
+        floors,
+        driven,
+        lowered,
+        status: vec![DynamicStatus::Finished; v],
+        iterations: vec![Vec::new(); v],
+        log: vec![Vec::new(); v],
+    };
+    let members: Vec<usize> = (0..v).collect();
+    run_span(
+        &mut chunk,
+        ensemble.as_mut(),
+        &members,
+        0.0,
+        t_end,
+        options.dt,
+        Some((every, observe)),
+    )?;
+    Ok(chunk
+        .status
+        .into_iter()
+        .zip(chunk.iterations)
+        .zip(chunk.log)
+        .map(|((status, iterations), log)| DynamicResult {
+            status,
+            iterations,
+            log,
+        })
+        .collect())
+}
+
+/// Advances the chunk's variants `members` (the ensemble's variants, in order) from `t0`
+/// to `t_end` in steps of `h`; variants that fail a step are re-tried in a chunk of their
+/// own with half the step (recursively) and rejoin at its end.
+#[allow(clippy::type_complexity)]
+fn run_span<T: Real + Send + Sync, P: KernelPath<T>>(
+    chunk: &mut Chunk<'_, T, P>,
+    ensemble: &mut dyn DynamicEnsemble<T>,
+    members: &[usize],
+    t0: f64,
+    t_end: f64,
+    h: f64,
+    mut observe: Option<(usize, &mut dyn FnMut(f64, &DynamicBatch<T>))>,
+) -> Result<(), String> {
+    let t = |x: f64| T::from_f64_lossy(x);
+    let m = members.len();
+    let size = std::mem::size_of::<T>();
+    let options = chunk.options;
     let p = options.alpha;
     let ratio = (1.0 - p.alpha_f) / (1.0 - p.alpha_m);
-    let mut status = vec![DynamicStatus::Finished; v];
-    let mut iterations = vec![Vec::new(); v];
-    let mut time = 0.0;
+    let settings = NewtonSettings::dynamics(options.max_iterations, options.tolerance, size);
+    let mut time = t0;
     let mut step = 0usize;
-    let minus_one = T::zero() - T::one();
-    // The CPU integrator's table and hook, per variant.
-    let cpu: Vec<Dynamics> = models
-        .iter()
-        .map(|m| Dynamics::new(m, *options, &|e| density[e]))
-        .collect();
-    let top_z: Vec<f64> = models.iter().map(|m| m.nodes[0].position[2]).collect();
-    while time < t_end - 1e-12 {
-        let h = options.dt.min(t_end - time);
-        let t1 = time + h;
-        let hhb = h * h * p.beta * ratio;
+    while time < t_end - 1e-12 * t_end.abs().max(1.0) {
+        let hh = h.min(t_end - time);
+        let t1 = time + hh;
         let coefficients = StepCoefficients {
-            h: t(h),
+            h: t(hh),
             alpha_m: t(p.alpha_m),
             alpha_f: t(p.alpha_f),
             beta: t(p.beta),
             gamma: t(p.gamma),
-            top_fixed: tables.fixed[0],
-            driven,
-            lowered,
+            top_fixed: chunk.tables.fixed[0],
+            driven: chunk.driven,
+            lowered: chunk.lowered,
         };
-        let mut top = vec![T::zero(); TOP_LEN * v];
-        for (j, d) in cpu.iter().enumerate() {
+        let mut top = vec![T::zero(); TOP_LEN * m];
+        for (i, &j) in members.iter().enumerate() {
+            let d = &chunk.drives[j];
             let (phi, phidot, phiddot) = d.table(t1);
             let (zh, zhdot, zhddot) = d.hook(t1);
             let r = crate::physics::beam::rotation_exp(&[0.0, 0.0, phi]);
             for (k, x) in r.iter().flatten().enumerate() {
-                top[k * v + j] = t(*x);
+                top[k * m + i] = t(*x);
             }
             // The hook's travel as a displacement of the top node: (z0 + z_h) − z0.
-            let travel = (top_z[j] + zh) - top_z[j];
+            let z0 = chunk.models[j].nodes[0].position[2];
+            let travel = (z0 + zh) - z0;
             for (k, x) in [phidot, phiddot, travel, zhdot, zhddot]
                 .into_iter()
                 .enumerate()
             {
-                top[(9 + k) * v + j] = t(x);
+                top[(9 + k) * m + i] = t(x);
             }
         }
         ensemble.begin_step(&coefficients, &top)?;
-        let mut done: Vec<bool> = status
-            .iter()
-            .map(|s| *s != DynamicStatus::Finished)
-            .collect();
-        let mut its = vec![0usize; v];
-        for it in 1..=options.max_iterations {
-            if done.iter().all(|&d| d) {
-                break;
+        let mut newton = Newton::new(settings, m);
+        for (i, &j) in members.iter().enumerate() {
+            if chunk.status[j] == DynamicStatus::Finished {
+                newton.start(i, chunk.floors[j], false);
             }
-            let Iteration {
-                norms: now,
-                status: st,
-                inertial,
-            } = ensemble.iterate()?;
-            let mut alpha = vec![T::zero(); v];
-            let mut converged = vec![false; v];
-            let mut at_floor = vec![false; v];
-            for j in 0..v {
-                if done[j] {
-                    continue;
+        }
+        let mut sys = DynamicStep {
+            ensemble: &mut *ensemble,
+            f_ref: members.iter().map(|&j| chunk.f_ref[j]).collect(),
+            hhb: hh * hh * p.beta * ratio,
+        };
+        let mut failed = Vec::new();
+        while newton.any_running() {
+            for (i, event) in newton.iterate(&mut sys)? {
+                match event {
+                    Event::Converged(its) => chunk.iterations[members[i]].push(its),
+                    Event::Failed(reason) => failed.push((i, reason)),
                 }
-                let measure =
-                    now.residual_max[j].to_f64_lossy() / f_ref[j].max(inertial[j].to_f64_lossy());
-                if !measure.is_finite() {
-                    status[j] = DynamicStatus::Failed(t1, "residual is not finite".into());
-                    done[j] = true;
-                    continue;
-                }
-                if st[j] != SOLVED {
-                    status[j] = DynamicStatus::Failed(t1, "singular iteration matrix".into());
-                    done[j] = true;
-                    continue;
-                }
-                let step_norm = now.step_max[j].to_f64_lossy() * hhb;
-                converged[j] = measure <= tolerance
-                    || (step_norm <= step_floor[j] && measure <= small_residual);
-                at_floor[j] = f32_path && measure <= small_residual;
-                alpha[j] = minus_one;
-                its[j] = it;
             }
-            // Backtracking on the residual's 2-norm for the variants not converged (as the
-            // CPU integrator): α halved up to 24 times; the full step kept when nothing
-            // shorter lowers the residual. In f32 a variant whose residual is already at the
-            // precision's floor takes the full step: there its residual norm is rounding
-            // noise, which halving cannot lower, and each halving costs an evaluation.
-            let norm0: Vec<f64> = now
+        }
+        // The failed variants' state at t_n, before the step ends.
+        let before = if failed.is_empty() {
+            None
+        } else {
+            Some(ensemble.state()?)
+        };
+        ensemble.end_step()?;
+        if let Some(before) = before {
+            let cut = hh / 2.0;
+            let mut retry = Vec::new();
+            for (i, reason) in failed {
+                let j = members[i];
+                if cut < options.min_dt {
+                    chunk.status[j] = DynamicStatus::Failed(
+                        t1,
+                        format!(
+                            "step {hh:.3e} s failed and cannot be cut below {:.1e} s: {reason}",
+                            options.min_dt
+                        ),
+                    );
+                } else {
+                    chunk.log[j].push(format!(
+                        "t = {time:.6} s: step {hh:.3e} s failed ({reason}); cut to {cut:.3e} s"
+                    ));
+                    retry.push(i);
+                }
+            }
+            if !retry.is_empty() {
+                let again: Vec<usize> = retry.iter().map(|&i| members[i]).collect();
+                let after = retry_alone(
+                    chunk,
+                    &again,
+                    &batch_columns(&before, &retry),
+                    time,
+                    t1,
+                    cut,
+                )?;
+                let mut now = ensemble.state()?;
+                put_batch_columns(&mut now, &retry, &after);
+                ensemble.set_state(&now)?;
+            }
+        }
+        time = t1;
+        step += 1;
+        if let Some((every, observe)) = observe.as_mut() {
+            if *every > 0 && step.is_multiple_of(*every) {
+                let mut s = ensemble.state()?;
+                // Displacements from the reference for the observer (summed in f64).
+                let v = chunk.tables.num_variants;
+                for (w, b) in s.u.iter_mut().zip(&chunk.tables.base) {
+                    *w = t(b + w.to_f64_lossy());
+                }
+                debug_assert_eq!(v, m);
+                observe(time, &s);
+            }
+        }
+    }
+    Ok(())
+}
+
+/// The chunk's variants `again`, at `start` (their state at `t0`), taken to `t1` in a chunk
+/// of their own with steps of `h`; their state at `t1`.
+fn retry_alone<T: Real + Send + Sync, P: KernelPath<T>>(
+    chunk: &mut Chunk<'_, T, P>,
+    again: &[usize],
+    start: &DynamicBatch<T>,
+    t0: f64,
+    t1: f64,
+    h: f64,
+) -> Result<DynamicBatch<T>, String> {
+    let v = chunk.tables.num_variants;
+    let models: Vec<Model> = again.iter().map(|&j| chunk.models[j].clone()).collect();
+    let mut tables = ensemble_tables::<T>(&models)?;
+    tables.terms = chunk.tables.terms;
+    tables.set_base(&models[0], columns(&chunk.tables.base, v, again));
+    let d = &chunk.dynamic;
+    let dynamic = DynamicTables {
+        mass: d.mass.clone(),
+        inertia0: d.inertia0.clone(),
+        a0: d.a0,
+        f_ext: columns(&d.f_ext, v, again),
+        pair_params: columns(&d.pair_params, v, again),
+        start: start.clone(),
+    };
+    let path = chunk.path;
+    let mut sub = path.open_dynamic(&chunk.models[again[0]], &tables, &dynamic)?;
+    run_span(chunk, sub.as_mut(), again, t0, t1, h, None)?;
+    sub.state()
+}
+
+/// A dynamic chunk's step as a Newton system: the unknown is `v̇_{n+1}` of every variant.
+struct DynamicStep<'e, T> {
+    ensemble: &'e mut dyn DynamicEnsemble<T>,
+    f_ref: Vec<f64>,
+    hhb: f64,
+}
+
+/// `−α` in the path's float type (the kernels' `Δ` is the negative Newton step).
+fn negated<T: Real>(alpha: &[f64]) -> Vec<T> {
+    alpha.iter().map(|&a| T::from_f64_lossy(-a)).collect()
+}
+
+impl<T: Real> NewtonSystem for DynamicStep<'_, T> {
+    fn variants(&self) -> usize {
+        self.f_ref.len()
+    }
+    fn solve(&mut self) -> Result<Probe, String> {
+        let Iteration {
+            norms,
+            status,
+            inertial,
+        } = self.ensemble.iterate()?;
+        let f = |x: &T| x.to_f64_lossy();
+        Ok(Probe {
+            // Scale: the loads, or the inertial forces if larger (a whirling string).
+            measure: (0..self.f_ref.len())
+                .map(|j| f(&norms.residual_max[j]) / self.f_ref[j].max(f(&inertial[j])))
+                .collect(),
+            step: norms.step_max.iter().map(|x| f(x) * self.hhb).collect(),
+            slope: norms.step_dot_residual.iter().map(f).collect(),
+            norm: norms.residual_square.iter().map(|x| f(x).sqrt()).collect(),
+            solved: status.iter().map(|&s| s == SOLVED).collect(),
+        })
+    }
+    fn trial(&mut self, alpha: &[f64]) -> Result<TrialProbe, String> {
+        let r = self.ensemble.trial(&negated::<T>(alpha))?;
+        Ok(TrialProbe {
+            slope: r
+                .step_dot_residual
+                .iter()
+                .map(|x| x.to_f64_lossy())
+                .collect(),
+            norm: r
                 .residual_square
                 .iter()
                 .map(|x| x.to_f64_lossy().sqrt())
-                .collect();
-            let mut pending: Vec<bool> = (0..v)
-                .map(|j| {
-                    !done[j] && !converged[j] && !at_floor[j] && alpha[j].to_f64_lossy() != 0.0
-                })
-                .collect();
-            let mut accepted = vec![false; v];
-            let mut trials = 0;
-            for _ in 0..24 {
-                if !pending.iter().any(|&q| q) {
-                    break;
-                }
-                trials += 1;
-                let r = ensemble.trial(&alpha)?;
-                for j in 0..v {
-                    if !pending[j] {
-                        continue;
-                    }
-                    let a = -alpha[j].to_f64_lossy();
-                    let norm = r.residual_square[j].to_f64_lossy().sqrt();
-                    if norm.is_finite() && norm <= (1.0 - 1e-4 * a) * norm0[j] {
-                        pending[j] = false;
-                        accepted[j] = true;
-                    } else {
-                        alpha[j] = alpha[j] * t(0.5);
-                    }
-                }
-            }
-            for j in 0..v {
-                if !done[j] && !converged[j] && !accepted[j] {
-                    alpha[j] = minus_one;
-                }
-            }
-            ensemble.correct(&alpha)?;
-            if std::env::var("HOLEWALL_DEBUG_NEWTON").is_ok() {
-                eprintln!(
-                    "  engine dyn t {t1:.6} it {it}: variant 0 residual {:.3e} α {:.4}; {} variants open, {trials} line-search trials",
-                    now.residual_max[0].to_f64_lossy() / f_ref[0],
-                    alpha[0].to_f64_lossy().abs(),
-                    done.iter().filter(|&&d| !d).count()
-                );
-            }
-            for j in 0..v {
-                if converged[j] {
-                    done[j] = true;
-                    iterations[j].push(its[j]);
-                }
-            }
-        }
-        for j in 0..v {
-            if !done[j] {
-                status[j] = DynamicStatus::Failed(
-                    t1,
-                    format!(
-                        "Newton did not converge in {} iterations",
-                        options.max_iterations
-                    ),
-                );
-            }
-        }
-        ensemble.end_step()?;
-        time = t1;
-        step += 1;
-        if every > 0 && step.is_multiple_of(every) {
-            let mut s = ensemble.state()?;
-            // Displacements from the reference for the observer (summed in f64).
-            for (w, b) in s.u.iter_mut().zip(&tables.base) {
-                *w = t(b + w.to_f64_lossy());
-            }
-            observe(time, &s);
-        }
+                .collect(),
+        })
     }
-    Ok(status
-        .into_iter()
-        .zip(iterations)
-        .map(|(status, iterations)| DynamicResult { status, iterations })
-        .collect())
+    fn accept(&mut self, alpha: &[f64], _trial_matches: bool) -> Result<(), String> {
+        if alpha.iter().any(|&a| a != 0.0) {
+            self.ensemble.correct(&negated::<T>(alpha))?;
+        }
+        Ok(())
+    }
 }
 
 /// The twins' dynamic chunk (f64).
@@ -587,6 +748,10 @@ impl DynamicEnsemble<f64> for TwinDynamic<'_> {
     }
     fn state(&mut self) -> Result<DynamicBatch<f64>, String> {
         Ok(self.state.clone())
+    }
+    fn set_state(&mut self, state: &DynamicBatch<f64>) -> Result<(), String> {
+        self.state = state.clone();
+        Ok(())
     }
 }
 

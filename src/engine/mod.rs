@@ -38,66 +38,6 @@ use crate::solve::statics::{
     constraint_tables, loaded_params, reference_force, split_loads, StaticOptions, StaticState,
 };
 
-/// The convergence tests of a kernel path in its precision, per variant.
-///
-/// In f64 as the CPU solvers: the residual below `tolerance`, or the step at rounding level
-/// (1e-12 of the largest coordinate) with the residual below 1e-6. In f32 the residual
-/// stalls near 1e-4 of the force scale (nodal sums of element forces of 1e5 N, and
-/// stiffnesses of 1e8 N/m times displacements rounded at 1e-8 m) and the steps at a few
-/// 1e-7 m: a variant is converged when its step is down at 100 ε₃₂ of its displacements and
-/// its residual below 1e4 ε₃₂ ≈ 1.2e-3 (the error this leaves is measured against f64 in
-/// tests/engine.rs and tests/engine_dynamic.rs).
-pub(crate) struct Convergence {
-    /// Residual (relative to the force scale) that converges on its own.
-    pub tolerance: f64,
-    /// Residual below which a step at `step_floor` converges.
-    pub small_residual: f64,
-    /// Per variant: a step (m) at rounding level.
-    pub step_floor: Vec<f64>,
-}
-
-impl Convergence {
-    /// For a path in `T`, `v` variants with displacements `u` from `node_ref` shifted by
-    /// `base` (`3 n V`; none: the reference). The f32 floor scales with the states
-    /// themselves (their rounding), the f64 one with the coordinates.
-    pub(crate) fn for_path<T: Real>(
-        tolerance: f64,
-        node_ref: &[f64],
-        base: Option<&[f64]>,
-        u: &[T],
-        v: usize,
-    ) -> Self {
-        let f32_path = std::mem::size_of::<T>() == 4;
-        let unit_roundoff = if f32_path {
-            f64::from(f32::EPSILON)
-        } else {
-            f64::EPSILON
-        };
-        let step_floor = (0..v)
-            .map(|j| {
-                let largest = |shift: bool| {
-                    (0..node_ref.len()).fold(0.0f64, |m, k| {
-                        let b = base.map_or(0.0, |b| b[k * v + j]);
-                        let x =
-                            u[k * v + j].to_f64_lossy() + if shift { node_ref[k] + b } else { 0.0 };
-                        m.max(x.abs())
-                    })
-                };
-                if f32_path {
-                    100.0 * unit_roundoff * (1.0 + largest(false))
-                } else {
-                    1e-12 * (1.0 + largest(true))
-                }
-            })
-            .collect();
-        Convergence {
-            tolerance: tolerance.max(400.0 * unit_roundoff),
-            small_residual: 1e-6f64.max(1e4 * unit_roundoff),
-            step_floor,
-        }
-    }
-}
-
 /// What one chunk of variants shares and starts from, built once on the host.
 #[derive(Clone, Debug)]
 pub struct EnsembleTables<T> {

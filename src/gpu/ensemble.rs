@@ -1181,6 +1181,21 @@ impl<T: GpuReal> crate::engine::dynamic::DynamicEnsemble<T> for GpuDynamic<T> {
         Ok(())
     }
 
+    fn set_state(&mut self, s: &crate::kernels::dynamics::DynamicBatch<T>) -> Result<(), String> {
+        let b = &self.b;
+        let q = &self.ctx.queue;
+        for (buffer, data) in [
+            (&b.u_n, &s.u),
+            (&b.rot_n, &s.rot),
+            (&b.vel_n, &s.vel),
+            (&b.acc_n, &s.acc),
+            (&b.vdot_n, &s.vdot),
+        ] {
+            q.write_buffer(buffer, 0, bytemuck::cast_slice(data));
+        }
+        Ok(())
+    }
+
     fn state(&mut self) -> Result<crate::kernels::dynamics::DynamicBatch<T>, String> {
         let (v, n) = (self.num_variants, self.num_nodes);
         let size = std::mem::size_of::<T>() as u64;
