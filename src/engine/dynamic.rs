@@ -13,13 +13,11 @@
 //! CPU): consistent mass and stiffness-proportional damping (`a1`, which needs the initial
 //! tangent per variant), and load factors in time.
 
-use crate::kernels::assemble::{assemble, AssemblyInputs, DynamicInputs};
 use crate::kernels::block_lu::{block_lu, ChainBatch, SOLVED};
-use crate::kernels::contact::{contact, ContactBatch, ContactOutputs};
+use crate::kernels::contact::ContactBatch;
 use crate::kernels::dynamics::{
     accelerate, inertial_scale, predict, DynamicBatch, StepCoefficients, TOP_LEN,
 };
-use crate::kernels::sites::gather_sites_dynamic;
 use crate::kernels::update::{norms, Norms};
 use crate::model::Model;
 use crate::physics::contact::{ContactMode, PARAMS_LEN};
@@ -658,43 +656,24 @@ impl<'a> TwinDynamic<'a> {
     fn evaluate_at(&mut self, mut vdot: Vec<f64>) -> Result<ChainBatch<f64>, String> {
         let c = self.coefficients.ok_or("no step begun")?;
         predict(&c, &self.top, &self.state, &mut vdot, &mut self.trial);
-        let t = &self.tables;
-        let (v, n) = (t.num_variants, t.num_nodes);
-        let tr = &self.trial;
-        let (elem_force, elem_tangent) =
-            crate::kernels::beam::beam(self.model, v, &tr.u, &tr.rot, &t.chords);
-        gather_sites_dynamic(
-            &t.pair_node,
-            &t.pair_normals,
-            tr,
-            &t.pair_base,
-            &mut self.contact.pair_state,
-        );
-        let mut out = ContactOutputs::new(self.contact.num_pairs());
-        contact(&t.terms, &self.contact, &mut out);
         let p = options_coefficients(&c);
-        Ok(assemble(&AssemblyInputs {
-            num_variants: v,
-            num_nodes: n,
-            num_sites: t.num_sites,
-            elem_force,
-            elem_tangent,
-            contact: out.values,
-            contact_flag: out.contact,
-            node_site: t.node_site.clone(),
-            f_ext: self.dynamic.f_ext.clone(),
-            basis: t.basis.clone(),
-            fixed: t.fixed.clone(),
-            dynamic: Some(DynamicInputs {
-                coefficients: [p.0, p.1, self.dynamic.a0],
-                mass: self.dynamic.mass.clone(),
-                inertia0: self.dynamic.inertia0.clone(),
-                rot: tr.rot.clone(),
-                vel: tr.vel.clone(),
-                vdot: tr.vdot.clone(),
-                pair_normals: t.pair_normals.clone(),
-            }),
-        }))
+        let tr = &self.trial;
+        Ok(super::twin_evaluate(
+            self.model,
+            &self.tables,
+            &mut self.contact,
+            &tr.u,
+            &tr.rot,
+            &self.dynamic.f_ext,
+            Some((
+                tr,
+                super::AssemblyDynamic {
+                    coefficients: [p.0, p.1, self.dynamic.a0],
+                    mass: &self.dynamic.mass,
+                    inertia0: &self.dynamic.inertia0,
+                },
+            )),
+        ))
     }
 }
 

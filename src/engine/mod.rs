@@ -147,6 +147,131 @@ pub trait KernelPath<T> {
     ) -> Result<Box<dyn dynamic::DynamicEnsemble<T> + 'a>, String>;
 }
 
+/// One kernel of the evaluation chain.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Stage {
+    /// Generalised-α predictor: the trial state from the unknown accelerations (dynamic).
+    Predict,
+    /// Co-rotational beam element force and tangent, per (element, variant).
+    Beam,
+    /// Each contact pair's state (displacement; dynamic: velocity, spin) from its node.
+    Sites,
+    /// The contact element, per pair.
+    Contact,
+    /// Residual and block-tridiagonal tangent per (node, variant), constraints applied.
+    Assemble,
+}
+
+/// The evaluation chain of a Newton iteration, described once: the kernels, in order,
+/// that turn a configuration into its constrained residual and tangent — static, or
+/// dynamic (predictor first, and dynamic sites and assembly). The twin path runs it in
+/// [`twin_evaluate`], the GPU path records it (`gpu::ensemble`), both from this list.
+pub fn evaluation(dynamic: bool) -> &'static [Stage] {
+    if dynamic {
+        &[
+            Stage::Predict,
+            Stage::Beam,
+            Stage::Sites,
+            Stage::Contact,
+            Stage::Assemble,
+        ]
+    } else {
+        &[Stage::Beam, Stage::Sites, Stage::Contact, Stage::Assemble]
+    }
+}
+
+/// Invocations of a stage for `n` nodes, `v` variants and `p` contact pairs.
+pub fn invocations(stage: Stage, n: usize, v: usize, p: usize) -> usize {
+    match stage {
+        Stage::Predict | Stage::Assemble => n * v,
+        Stage::Beam => n.saturating_sub(1) * v,
+        Stage::Sites | Stage::Contact => p,
+    }
+}
+
+/// The twins' run of [`evaluation`] on a configuration (`x` displacements from the base,
+/// `rot`): the constrained system. `dynamic`: the predicted trial state and the dynamic
+/// assembly's inputs (the predictor itself is run by the caller, which owns the step's
+/// state).
+pub(crate) fn twin_evaluate(
+    model: &Model,
+    t: &EnsembleTables<f64>,
+    contact_batch: &mut ContactBatch<f64>,
+    x: &[f64],
+    rot: &[f64],
+    f_ext: &[f64],
+    dynamic: Option<(
+        &crate::kernels::dynamics::DynamicBatch<f64>,
+        AssemblyDynamic,
+    )>,
+) -> ChainBatch<f64> {
+    let (v, n) = (t.num_variants, t.num_nodes);
+    let mut elements = None;
+    let mut out = crate::kernels::contact::ContactOutputs::new(contact_batch.num_pairs());
+    let mut system = None;
+    for stage in evaluation(dynamic.is_some()) {
+        match stage {
+            Stage::Predict => {}
+            Stage::Beam => elements = Some(crate::kernels::beam::beam(model, v, x, rot, &t.chords)),
+            Stage::Sites => match &dynamic {
+                Some((trial, _)) => crate::kernels::sites::gather_sites_dynamic(
+                    &t.pair_node,
+                    &t.pair_normals,
+                    trial,
+                    &t.pair_base,
+                    &mut contact_batch.pair_state,
+                ),
+                None => gather_sites(
+                    &t.pair_node,
+                    x,
+                    &t.pair_base,
+                    v,
+                    &mut contact_batch.pair_state,
+                ),
+            },
+            Stage::Contact => contact(&t.terms, contact_batch, &mut out),
+            Stage::Assemble => {
+                let (elem_force, elem_tangent) = elements.take().unwrap_or_default();
+                system = Some(assemble(&AssemblyInputs {
+                    num_variants: v,
+                    num_nodes: n,
+                    num_sites: t.num_sites,
+                    elem_force,
+                    elem_tangent,
+                    contact: std::mem::take(&mut out.values),
+                    contact_flag: std::mem::take(&mut out.contact),
+                    node_site: t.node_site.clone(),
+                    f_ext: f_ext.to_vec(),
+                    basis: t.basis.clone(),
+                    fixed: t.fixed.clone(),
+                    dynamic: dynamic.as_ref().map(|(trial, d)| {
+                        crate::kernels::assemble::DynamicInputs {
+                            coefficients: d.coefficients,
+                            mass: d.mass.to_vec(),
+                            inertia0: d.inertia0.to_vec(),
+                            rot: trial.rot.clone(),
+                            vel: trial.vel.clone(),
+                            vdot: trial.vdot.clone(),
+                            pair_normals: t.pair_normals.clone(),
+                        }
+                    }),
+                }));
+            }
+        }
+    }
+    system.unwrap_or_else(|| unreachable!("the chain ends with the assembly"))
+}
+
+/// What the dynamic assembly adds to a twin evaluation.
+pub(crate) struct AssemblyDynamic<'a> {
+    /// `[hγ', h²β', a0]`.
+    pub coefficients: [f64; 3],
+    /// Lumped nodal mass, `n`.
+    pub mass: &'a [f64],
+    /// Rotary inertia at the reference orientation, `9 n`.
+    pub inertia0: &'a [f64],
+}
+
 /// The CPU twins, f64.
 pub struct TwinPath;
 
@@ -163,34 +288,16 @@ struct TwinEnsemble<'a> {
 
 impl TwinEnsemble<'_> {
     fn evaluate_slot(&mut self, slot: usize) {
-        let t = &self.tables;
-        let (v, n) = (t.num_variants, t.num_nodes);
         let c = &self.config[slot];
-        let (elem_force, elem_tangent) =
-            crate::kernels::beam::beam(self.model, v, &c.x, &c.rot, &t.chords);
-        gather_sites(
-            &t.pair_node,
+        self.system[slot] = Some(twin_evaluate(
+            self.model,
+            &self.tables,
+            &mut self.contact,
             &c.x,
-            &t.pair_base,
-            v,
-            &mut self.contact.pair_state,
-        );
-        let mut out = crate::kernels::contact::ContactOutputs::new(self.contact.num_pairs());
-        contact(&t.terms, &self.contact, &mut out);
-        self.system[slot] = Some(assemble(&AssemblyInputs {
-            num_variants: v,
-            num_nodes: n,
-            num_sites: t.num_sites,
-            elem_force,
-            elem_tangent,
-            contact: out.values,
-            contact_flag: out.contact,
-            node_site: t.node_site.clone(),
-            f_ext: self.f_ext.clone(),
-            basis: t.basis.clone(),
-            fixed: t.fixed.clone(),
-            dynamic: None,
-        }));
+            &c.rot,
+            &self.f_ext,
+            None,
+        ));
     }
 
     fn rhs(&self, slot: usize) -> Result<&[f64], String> {

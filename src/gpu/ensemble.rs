@@ -13,6 +13,7 @@ use std::sync::Arc;
 
 use wgpu::util::DeviceExt;
 
+use crate::engine::Stage;
 use crate::engine::{Ensemble, EnsembleTables};
 use crate::error::GpuError;
 use crate::gpu::contact::{contact_wgsl, require_precision, GpuReal};
@@ -95,7 +96,6 @@ pub struct GpuEnsemble<T: GpuReal> {
     c: Common,
     num_variants: usize,
     num_nodes: usize,
-    num_elements: usize,
     num_pairs: usize,
     _real: PhantomData<T>,
 }
@@ -521,7 +521,6 @@ impl<T: GpuReal> GpuEnsemble<T> {
             c,
             num_variants: v,
             num_nodes: n,
-            num_elements: m,
             num_pairs: p,
             _real: PhantomData,
         })
@@ -530,11 +529,21 @@ impl<T: GpuReal> GpuEnsemble<T> {
     /// Records the evaluation of `slot`: beam, sites, contact, assembly.
     fn record_evaluate(&self, pass: &mut wgpu::ComputePass, slot: usize) {
         let s = &self.slots[slot];
-        let v = self.num_variants;
-        dispatch(pass, &self.p.beam, &s.beam, self.num_elements * v);
-        dispatch(pass, &self.p.sites, &s.sites, self.num_pairs);
-        dispatch(pass, &self.p.contact, &self.contact, self.num_pairs);
-        dispatch(pass, &self.p.assemble, &s.assemble, self.num_nodes * v);
+        let p = &self.p;
+        record_chain(
+            pass,
+            false,
+            self.num_nodes,
+            self.num_variants,
+            self.num_pairs,
+            |stage| match stage {
+                Stage::Predict => None,
+                Stage::Beam => Some((&*p.beam, &s.beam)),
+                Stage::Sites => Some((&*p.sites, &s.sites)),
+                Stage::Contact => Some((&*p.contact, &self.contact)),
+                Stage::Assemble => Some((&*p.assemble, &s.assemble)),
+            },
+        );
     }
 
     fn encoder(&self, label: &str) -> wgpu::CommandEncoder {
@@ -557,6 +566,28 @@ impl<T: GpuReal> GpuEnsemble<T> {
             norms_from_bytes(&out[0]),
             bytemuck::cast_slice(&out[1]).to_vec(),
         ))
+    }
+}
+
+/// Records the evaluation chain ([`crate::engine::evaluation`]) into `pass`, each stage
+/// with the pipeline and bind group `bind` gives it (`None`: not on this path).
+fn record_chain<'b>(
+    pass: &mut wgpu::ComputePass,
+    dynamic: bool,
+    n: usize,
+    v: usize,
+    p: usize,
+    bind: impl Fn(Stage) -> Option<(&'b wgpu::ComputePipeline, &'b wgpu::BindGroup)>,
+) {
+    for &stage in crate::engine::evaluation(dynamic) {
+        if let Some((pipeline, group)) = bind(stage) {
+            dispatch(
+                pass,
+                pipeline,
+                group,
+                crate::engine::invocations(stage, n, v, p),
+            );
+        }
     }
 }
 
@@ -811,7 +842,6 @@ pub struct GpuDynamic<T: GpuReal> {
     b: DynamicBuffers,
     num_variants: usize,
     num_nodes: usize,
-    num_elements: usize,
     num_pairs: usize,
     a0: T,
     c: Common,
@@ -1025,7 +1055,6 @@ impl<T: GpuReal> GpuDynamic<T> {
             b,
             num_variants: v,
             num_nodes: n,
-            num_elements: m,
             num_pairs: p,
             a0: T::from_f64_lossy(dynamic.a0),
             c,
@@ -1036,17 +1065,26 @@ impl<T: GpuReal> GpuDynamic<T> {
 
     /// Records predict (at the unknown or the candidate), beam, sites, contact, assembly.
     fn record_evaluate(&self, pass: &mut wgpu::ComputePass, candidate: bool) {
-        let (v, g, p) = (self.num_variants, &self.g, &self.p);
+        let (g, p) = (&self.g, &self.p);
         let (predict, assemble) = if candidate {
             (&g.predict_candidate, &g.assemble_candidate)
         } else {
             (&g.predict_unknown, &g.assemble_unknown)
         };
-        dispatch(pass, &p.predict, predict, self.num_nodes * v);
-        dispatch(pass, &p.beam, &g.beam, self.num_elements * v);
-        dispatch(pass, &p.sites, &g.sites, self.num_pairs);
-        dispatch(pass, &p.contact, &g.contact, self.num_pairs);
-        dispatch(pass, &p.assemble, assemble, self.num_nodes * v);
+        record_chain(
+            pass,
+            true,
+            self.num_nodes,
+            self.num_variants,
+            self.num_pairs,
+            |stage| match stage {
+                Stage::Predict => Some((&*p.predict, predict)),
+                Stage::Beam => Some((&*p.beam, &g.beam)),
+                Stage::Sites => Some((&*p.sites, &g.sites)),
+                Stage::Contact => Some((&*p.contact, &g.contact)),
+                Stage::Assemble => Some((&*p.assemble, assemble)),
+            },
+        );
     }
 
     fn copy_all(encoder: &mut wgpu::CommandEncoder, pairs: &[(&wgpu::Buffer, &wgpu::Buffer)]) {

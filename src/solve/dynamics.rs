@@ -563,17 +563,18 @@ impl<'a> Dynamics<'a> {
         let mut newton = Newton::new(settings, 1);
         newton.start(0, floor, false);
         loop {
-            for (_, event) in newton.iterate(&mut sys)? {
-                match event {
+            // One variant: its first event ends the step.
+            if let Some((_, event)) = newton.iterate(&mut sys)?.into_iter().next() {
+                return match event {
                     Event::Converged(its) => {
                         let vdot = sys.vdot.clone();
                         let mut next = sys.trial.clone();
                         sys.predict(&mut next, &vdot);
                         *s = next;
-                        return Ok(its);
+                        Ok(its)
                     }
-                    Event::Failed(reason) => return Err(reason),
-                }
+                    Event::Failed(reason) => Err(reason),
+                };
             }
         }
     }
