@@ -15,12 +15,41 @@
 @group(0) @binding(4) var<storage, read_write> norm_out: array<real>;
 #else
 @group(0) @binding(3) var<storage, read> basis: array<real>;
-@group(0) @binding(4) var<storage, read_write> x: array<real>;
-@group(0) @binding(5) var<storage, read_write> rot: array<real>;
+// Site at each (node, variant), NO_SITE where none; per pair (site · V + variant) the base
+// across the hole axis (3), the hole axis (3) and the law parameters (field-major,
+// clearance first): a contact node near its wall steps along it.
+@group(0) @binding(4) var<storage, read> node_site: array<u32>;
+@group(0) @binding(5) var<storage, read> pair_base: array<real>;
+@group(0) @binding(6) var<storage, read> pair_normals: array<real>;
+@group(0) @binding(7) var<storage, read> pair_params: array<real>;
+@group(0) @binding(8) var<storage, read_write> x: array<real>;
+@group(0) @binding(9) var<storage, read_write> rot: array<real>;
 #endif
 
 #if !NORMS
 #include "shared/rotation_exp.wgsl"
+
+const NO_SITE: u32 = 0xffffffffu;
+
+// Twin: physics::contact::wall_following_step. The step `du` of a node at offset `d` from
+// its hole axis point (axis `t`), its lateral part split into radial and circumferential
+// parts and put back on the circle of the new radius.
+fn wall_following_step(d: vec3<real>, t: vec3<real>, du: vec3<real>, min_radius: real) -> vec3<real> {
+    let along = dot(d, t);
+    let d_perp = d - along * t;
+    let r = sqrt(dot(d_perp, d_perp));
+    if (r < min_radius || r == real(0.0)) {
+        return du;
+    }
+    let e_r = d_perp / r;
+    let e_t = cross(t, e_r);
+    let dr = dot(du, e_r);
+    let ds = dot(du, e_t);
+    let da = dot(du, t);
+    let phi = ds / r;
+    let scale = (r + dr) / (r * sqrt(real(1.0) + phi * phi));
+    return da * t + scale * (d_perp + ds * e_t) - d_perp;
+}
 
 @compute @workgroup_size(64)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
@@ -37,9 +66,22 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         al * delta[(6u * i + 1u) * nv + v],
         al * delta[(6u * i + 2u) * nv + v],
     );
+    var step = vec3<real>(real(0.0), real(0.0), real(0.0));
     for (var r = 0u; r < 3u; r = r + 1u) {
         let brow = vec3<real>(basis[9u * i + 3u * r], basis[9u * i + 3u * r + 1u], basis[9u * i + 3u * r + 2u]);
-        x[(3u * i + r) * nv + v] = x[(3u * i + r) * nv + v] + dot(brow, du);
+        step[r] = dot(brow, du);
+    }
+    let x_old = vec3<real>(x[(3u * i) * nv + v], x[(3u * i + 1u) * nv + v], x[(3u * i + 2u) * nv + v]);
+    let site = node_site[i * nv + v];
+    if (site != NO_SITE) {
+        let pair = site * nv + v;
+        let d = vec3<real>(pair_base[3u * pair], pair_base[3u * pair + 1u], pair_base[3u * pair + 2u]) + x_old;
+        let t = vec3<real>(pair_normals[3u * pair], pair_normals[3u * pair + 1u], pair_normals[3u * pair + 2u]);
+        // physics::contact::wall_following_radius: half the clearance.
+        step = wall_following_step(d, t, step, real(0.5) * pair_params[pair]);
+    }
+    for (var r = 0u; r < 3u; r = r + 1u) {
+        x[(3u * i + r) * nv + v] = x_old[r] + step[r];
     }
     let e = rotation_exp(vec3<real>(
         al * delta[(6u * i + 3u) * nv + v],

@@ -72,11 +72,16 @@ fn kernel_chain_static_ensemble_matches_single_cpu_runs() {
 #[test]
 fn a_failing_variant_fails_alone_in_the_engine() {
     let case = common::bed_case("1");
-    let good =
-        variants_from_csv_text("v.csv", "mu,wob,k_e,m\n0.2,8 kN,6e7,1\n0.3,10 kN,6e7,1\n").unwrap();
+    // The middle variant: 9 MN on the bit and 1 MN·m on it, a 1e12 N/m hard-spring wall —
+    // solve_static fails it too (Newton stalls at λ ≈ 0.68 below the smallest load step).
+    let good = variants_from_csv_text(
+        "v.csv",
+        "mu,wob,k_e,m,tob\n0.2,8 kN,6e7,1,0\n0.3,10 kN,6e7,1,0\n",
+    )
+    .unwrap();
     let mixed = variants_from_csv_text(
         "v.csv",
-        "mu,wob,k_e,m\n0.2,8 kN,6e7,1\n0.3,9000 kN,1e12,3\n0.3,10 kN,6e7,1\n",
+        "mu,wob,k_e,m,tob\n0.2,8 kN,6e7,1,0\n0.3,9000 kN,1e12,3,1000 kN.m\n0.3,10 kN,6e7,1,0\n",
     )
     .unwrap();
     let models = |v: &[holewall::ensemble::Variant]| {

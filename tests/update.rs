@@ -6,7 +6,7 @@
 mod common;
 
 use holewall::gpu::update::{norms_gpu, update_gpu};
-use holewall::kernels::update::{norms, update, ConfigBatch};
+use holewall::kernels::update::{norms, update, ConfigBatch, UpdateWalls};
 use holewall::physics::beam::rotation_exp;
 use rand::{Rng, SeedableRng};
 
@@ -59,7 +59,7 @@ fn update_matches_rodrigues_and_gpu_matches_twin() {
     let (v, n) = (16, 20);
     let (b0, delta, alpha) = batch(v, n, &mut rng);
     let mut twin = b0.clone();
-    update(&mut twin, &delta, &alpha);
+    update(&mut twin, &UpdateWalls::default(), &delta, &alpha);
     // Against the formulas with std trigonometry (the static solver's update).
     let mut worst: f64 = 0.0;
     for j in 0..v {
@@ -102,7 +102,7 @@ fn update_matches_rodrigues_and_gpu_matches_twin() {
     let Some(ctx) = common::gpu() else { return };
     if ctx.has_f64 {
         let mut gpu = b0.clone();
-        update_gpu(ctx, &mut gpu, &delta, &alpha).unwrap();
+        update_gpu(ctx, &mut gpu, &UpdateWalls::default(), &delta, &alpha).unwrap();
         let diff = gpu
             .x
             .iter()
@@ -138,7 +138,14 @@ fn update_matches_rodrigues_and_gpu_matches_twin() {
         rot: cast(&b0.rot),
         basis: cast(&b0.basis),
     };
-    update_gpu(ctx, &mut b32, &cast(&delta), &cast(&alpha)).unwrap();
+    update_gpu(
+        ctx,
+        &mut b32,
+        &UpdateWalls::default(),
+        &cast(&delta),
+        &cast(&alpha),
+    )
+    .unwrap();
     let rot_err = b32
         .rot
         .iter()
@@ -168,4 +175,79 @@ fn update_matches_rodrigues_and_gpu_matches_twin() {
         .iter()
         .enumerate()
         .all(|(j, x)| j == 3 || x.is_finite()));
+}
+
+/// Contact nodes near their wall step along it: a circumferential step keeps the radius
+/// (where a straight one would push the node `s²/2r` into the wall), a step is unchanged to
+/// first order, and the GPU kernel equals the twin.
+#[test]
+fn contact_nodes_step_along_their_wall_on_both_paths() {
+    use holewall::physics::contact::wall_following_step;
+    let t = [0.0, 0.6, 0.8];
+    let (r, e_t) = (0.04, [0.0, 0.8, -0.6]);
+    let d = [r, 0.0, 0.0];
+    for s in [1e-6, 1e-4, 1e-2] {
+        let du = [0.0, 0.8 * s, -0.6 * s];
+        let moved = wall_following_step(&d, &t, &du, 0.02);
+        let x: Vec<f64> = (0..3).map(|k| d[k] + moved[k]).collect();
+        let radius = (x[0] * x[0] + x[1] * x[1] + x[2] * x[2]).sqrt();
+        assert!((radius - r).abs() <= 1e-16 * 4.0, "{radius} vs {r}");
+        // First order: the difference from the straight step is O(s²/r).
+        let diff = (0..3)
+            .map(|k| (moved[k] - du[k]).powi(2))
+            .sum::<f64>()
+            .sqrt();
+        assert!(diff <= s * s / r, "{diff:e} for s = {s:e}");
+        let _ = e_t;
+    }
+    // Inside min_radius: unchanged.
+    assert_eq!(
+        wall_following_step(&[0.01, 0.0, 0.0], &t, &[1e-3, 2e-3, 0.0], 0.02),
+        [1e-3, 2e-3, 0.0]
+    );
+    // A batch with sites at every other node, offsets at the wall, both paths.
+    let mut rng = rand::rngs::StdRng::seed_from_u64(11);
+    let (v, n) = (8, 12);
+    let (mut b0, delta, alpha) = batch(v, n, &mut rng);
+    let sites: Vec<usize> = (0..n).step_by(2).collect();
+    let p = sites.len() * v;
+    let mut walls = UpdateWalls {
+        node_site: vec![holewall::kernels::assemble::NO_SITE; n * v],
+        pair_base: vec![0.0; 3 * p],
+        pair_normals: vec![0.0; 3 * p],
+        pair_params: vec![0.0; holewall::physics::contact::PARAMS_LEN * p],
+    };
+    for (k, &node) in sites.iter().enumerate() {
+        for j in 0..v {
+            let i = k * v + j;
+            walls.node_site[node * v + j] = k as u32;
+            let axis: [f64; 3] = std::array::from_fn(|_| rng.random_range(-1.0..1.0));
+            let len = (axis[0] * axis[0] + axis[1] * axis[1] + axis[2] * axis[2]).sqrt();
+            for a in 0..3 {
+                walls.pair_normals[3 * i + a] = axis[a] / len;
+                walls.pair_base[3 * i + a] = rng.random_range(-0.01..0.01);
+                // Displacements of a few centimetres: near the wall of a 4 cm clearance.
+                b0.x[(3 * node + a) * v + j] = rng.random_range(-0.05..0.05);
+            }
+            walls.pair_params[i] = 0.04;
+        }
+    }
+    let mut twin = b0.clone();
+    update(&mut twin, &walls, &delta, &alpha);
+    let mut plain = b0.clone();
+    update(&mut plain, &UpdateWalls::default(), &delta, &alpha);
+    let moved = twin.x.iter().zip(&plain.x).filter(|(a, b)| a != b).count();
+    assert!(moved > 0, "no node followed its wall");
+    let Some(ctx) = common::gpu() else { return };
+    if ctx.has_f64 {
+        let mut gpu = b0.clone();
+        update_gpu(ctx, &mut gpu, &walls, &delta, &alpha).unwrap();
+        let diff = gpu
+            .x
+            .iter()
+            .zip(&twin.x)
+            .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+        eprintln!("wall-following update, GPU f64 vs twin: {diff:.2e} m ({moved} coordinates moved off the straight step)");
+        assert!(diff <= 1e-15);
+    }
 }

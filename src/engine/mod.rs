@@ -300,6 +300,17 @@ impl TwinEnsemble<'_> {
         ));
     }
 
+    /// What the update needs to make contact nodes follow their wall.
+    fn walls(&self) -> crate::kernels::update::UpdateWalls<f64> {
+        let t = &self.tables;
+        crate::kernels::update::UpdateWalls {
+            node_site: t.node_site.clone(),
+            pair_base: t.pair_base.clone(),
+            pair_normals: t.pair_normals.clone(),
+            pair_params: self.contact.pair_params.clone(),
+        }
+    }
+
     fn rhs(&self, slot: usize) -> Result<&[f64], String> {
         self.system[slot]
             .as_ref()
@@ -338,7 +349,8 @@ impl Ensemble<f64> for TwinEnsemble<'_> {
     fn trial(&mut self, alpha: &[f64]) -> Result<Norms<f64>, String> {
         let other = 1 - self.current;
         self.config[other] = self.config[self.current].clone();
-        update(&mut self.config[other], &self.delta, alpha);
+        let walls = self.walls();
+        update(&mut self.config[other], &walls, &self.delta, alpha);
         self.evaluate_slot(other);
         Ok(norms(
             self.rhs(other)?,
@@ -352,7 +364,8 @@ impl Ensemble<f64> for TwinEnsemble<'_> {
         self.current = 1 - self.current;
     }
     fn commit(&mut self, alpha: &[f64]) -> Result<(), String> {
-        update(&mut self.config[self.current], &self.delta, alpha);
+        let walls = self.walls();
+        update(&mut self.config[self.current], &walls, &self.delta, alpha);
         self.system[self.current] = None;
         Ok(())
     }

@@ -496,7 +496,18 @@ impl<T: GpuReal> GpuEnsemble<T> {
                 ctx,
                 &pipelines.update,
                 "update",
-                &[&c.chain_dims, &c.delta, &c.alpha, &c.basis, &x, &rot],
+                &[
+                    &c.chain_dims,
+                    &c.delta,
+                    &c.alpha,
+                    &c.basis,
+                    &c.node_site,
+                    &c.pair_base,
+                    &c.normals,
+                    &c.params,
+                    &x,
+                    &rot,
+                ],
             );
             Slot {
                 x,

@@ -35,12 +35,26 @@ fn dims(b_nodes: usize, nv: usize) -> ChainDims {
 pub fn update_gpu<T: GpuReal>(
     ctx: &'static GpuContext,
     b: &mut ConfigBatch<T>,
+    walls: &crate::kernels::update::UpdateWalls<T>,
     delta: &[T],
     alpha: &[T],
 ) -> Result<(), GpuError> {
     crate::gpu::contact::require_precision::<T>(ctx)?;
     let pipeline = ctx.pipeline("update", &update_wgsl(false, T::IS_F64)?)?;
     let d = dims(b.num_nodes, b.num_variants);
+    let node_site = if walls.node_site.is_empty() {
+        vec![crate::kernels::assemble::NO_SITE; b.num_nodes * b.num_variants]
+    } else {
+        walls.node_site.clone()
+    };
+    // Bindings must not be empty.
+    let pad = |v: &[T]| -> Vec<T> {
+        if v.is_empty() {
+            vec![T::zero()]
+        } else {
+            v.to_vec()
+        }
+    };
     let out = run_once(
         ctx,
         &pipeline,
@@ -50,6 +64,10 @@ pub fn update_gpu<T: GpuReal>(
             bytemuck::cast_slice(delta),
             bytemuck::cast_slice(alpha),
             bytemuck::cast_slice(&b.basis),
+            bytemuck::cast_slice(&node_site),
+            bytemuck::cast_slice(&pad(&walls.pair_base)),
+            bytemuck::cast_slice(&pad(&walls.pair_normals)),
+            bytemuck::cast_slice(&pad(&walls.pair_params)),
         ],
         &[
             Out::From(bytemuck::cast_slice(&b.x)),

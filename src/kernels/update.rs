@@ -2,7 +2,8 @@
 //! its convergence measures.
 //!
 //! `update`: one invocation per (node, variant): `x_i += α B_i Δu_i` (`B_i` the node's
-//! translation basis, identity but at a bit held in the hole frame) and
+//! translation basis, identity but at a bit held in the hole frame; at a contact site near
+//! its wall the step follows the wall, `physics::contact::wall_following_step`) and
 //! `R_i ← exp([α Δθ_i]×) R_i`. The exponential is written with series, the same in both
 //! (no f64 trigonometry on Vulkan): with `φ = |θ|` reduced to `[0, π]` (a rotation by
 //! `φ > π` is one by `φ − 2π·round(φ/2π)` about the same axis) and `h = φ/2`,
@@ -101,9 +102,25 @@ pub struct ConfigBatch<T> {
     pub basis: Vec<T>,
 }
 
+/// The contact sites the update makes follow the wall
+/// ([`crate::physics::contact::wall_following_step`], as `solve_static`'s update).
+#[derive(Clone, Debug, Default)]
+pub struct UpdateWalls<T> {
+    /// Site at each (node, variant), `n V` ([`crate::kernels::assemble::NO_SITE`] where
+    /// none); empty: no site anywhere.
+    pub node_site: Vec<u32>,
+    /// The base across the hole axis per pair `i = site · V + variant`, `3 P`.
+    pub pair_base: Vec<T>,
+    /// Hole axis per pair, `3 P`.
+    pub pair_normals: Vec<T>,
+    /// Law parameters per pair, `PARAMS_LEN · P`, field-major (clearance first).
+    pub pair_params: Vec<T>,
+}
+
 /// The update of node `i`, variant `v`: new position and rotation.
 fn update_node<T: Real>(
     b: &ConfigBatch<T>,
+    walls: &UpdateWalls<T>,
     delta: &[T],
     alpha: &[T],
     i: usize,
@@ -112,14 +129,34 @@ fn update_node<T: Real>(
     let nv = b.num_variants;
     let al = alpha[v];
     let du: [T; 3] = std::array::from_fn(|k| al * delta[(6 * i + k) * nv + v]);
-    let mut x = [T::zero(); 3];
+    let mut step = [T::zero(); 3];
     for r in 0..3 {
         let mut s = T::zero();
         for k in 0..3 {
             s = s + b.basis[9 * i + 3 * r + k] * du[k];
         }
-        x[r] = b.x[(3 * i + r) * nv + v] + s;
+        step[r] = s;
     }
+    let old: [T; 3] = std::array::from_fn(|k| b.x[(3 * i + k) * nv + v]);
+    let site = walls
+        .node_site
+        .get(i * nv + v)
+        .copied()
+        .unwrap_or(crate::kernels::assemble::NO_SITE);
+    if site != crate::kernels::assemble::NO_SITE {
+        // The node's offset from its hole axis point: the base across the axis plus the
+        // displacement (the step uses only the part across the axis).
+        let pair = site as usize * nv + v;
+        let p = walls.pair_normals.len() / 3;
+        let d: [T; 3] = std::array::from_fn(|k| walls.pair_base[3 * pair + k] + old[k]);
+        let t: [T; 3] = std::array::from_fn(|k| walls.pair_normals[3 * pair + k]);
+        let min_radius = T::from_f64_lossy(crate::physics::contact::wall_following_radius(
+            walls.pair_params[pair].to_f64_lossy(),
+        ));
+        debug_assert!(pair < p);
+        step = crate::physics::contact::wall_following_step(&d, &t, &step, min_radius);
+    }
+    let x: [T; 3] = std::array::from_fn(|k| old[k] + step[k]);
     let dth: [T; 3] = std::array::from_fn(|k| al * delta[(6 * i + 3 + k) * nv + v]);
     let e = rotation_exp_series(dth);
     let mut rot = [T::zero(); 9];
@@ -135,12 +172,18 @@ fn update_node<T: Real>(
     (x, rot)
 }
 
-/// Applies `α_v Δ_v` to every variant (rayon over nodes × variants).
-pub fn update<T: Real + Send + Sync>(b: &mut ConfigBatch<T>, delta: &[T], alpha: &[T]) {
+/// Applies `α_v Δ_v` to every variant (rayon over nodes × variants), contact nodes near
+/// their wall moving along it.
+pub fn update<T: Real + Send + Sync>(
+    b: &mut ConfigBatch<T>,
+    walls: &UpdateWalls<T>,
+    delta: &[T],
+    alpha: &[T],
+) {
     let (n, nv) = (b.num_nodes, b.num_variants);
     let new: Vec<_> = (0..n * nv)
         .into_par_iter()
-        .map(|idx| update_node(b, delta, alpha, idx / nv, idx % nv))
+        .map(|idx| update_node(b, walls, delta, alpha, idx / nv, idx % nv))
         .collect();
     for (idx, (x, rot)) in new.into_iter().enumerate() {
         let (i, v) = (idx / nv, idx % nv);

@@ -439,13 +439,24 @@ pub(crate) fn to_global(c: &Constraints, delta: &mut [f64]) {
     }
 }
 
-/// Applies `α·Δ` (constrained coordinates) to a state.
-fn update(c: &Constraints, state: &StaticState, delta: &[f64], alpha: f64) -> StaticState {
+/// Applies `α·Δ` (constrained coordinates) to a state; contact nodes near the wall move
+/// along it ([`crate::physics::contact::wall_following_step`]).
+fn update(
+    c: &Constraints,
+    walls: &[Option<Wall>],
+    state: &StaticState,
+    delta: &[f64],
+    alpha: f64,
+) -> StaticState {
     let mut s = state.clone();
     for i in 0..s.x.len() {
         let mut du: Vec3<f64> = std::array::from_fn(|k| alpha * delta[6 * i + k]);
         if let Some(b) = &c.basis[i] {
             du = std::array::from_fn(|r| (0..3).map(|k| b[r][k] * du[k]).sum());
+        }
+        if let Some(w) = &walls[i] {
+            let d = sub(&s.x[i], &w.origin);
+            du = crate::physics::contact::wall_following_step(&d, &w.axis, &du, w.min_radius);
         }
         for (x, d) in s.x[i].iter_mut().zip(du) {
             *x += d;
@@ -454,6 +465,29 @@ fn update(c: &Constraints, state: &StaticState, delta: &[f64], alpha: f64) -> St
         s.rot[i] = mat_mul(&rotation_exp(&dth), &s.rot[i]);
     }
     s
+}
+
+/// A contact node's hole: its point on the axis, the axis, and the lateral offset from
+/// which its steps follow the wall.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Wall {
+    origin: Vec3<f64>,
+    axis: Vec3<f64>,
+    min_radius: f64,
+}
+
+/// Per node, the hole its contact site sits in (none where no site).
+pub(crate) fn walls(model: &Model) -> Vec<Option<Wall>> {
+    let mut w = vec![None; model.nodes.len()];
+    for site in &model.sites {
+        let node = &model.nodes[site.node];
+        w[site.node] = Some(Wall {
+            origin: node.position,
+            axis: node.hole_axis,
+            min_radius: crate::physics::contact::wall_following_radius(site.params.clearance),
+        });
+    }
+    w
 }
 
 /// Residual measure: max(|force| / F_ref, |moment| / (F_ref·1 m)).
@@ -591,6 +625,7 @@ pub fn solve_static_from(
 struct CpuStatic<'a> {
     model: &'a Model,
     c: Constraints,
+    walls: Vec<Option<Wall>>,
     f_gravity: Vec<f64>,
     f_other: Vec<f64>,
     f_ref: f64,
@@ -616,6 +651,7 @@ impl<'a> CpuStatic<'a> {
         CpuStatic {
             model,
             c: constraints(model),
+            walls: walls(model),
             f_ref: reference_force(model),
             f_step: vec![0.0; 6 * n],
             f_gravity,
@@ -671,7 +707,7 @@ impl crate::solve::newton::NewtonSystem for CpuStatic<'_> {
         })
     }
     fn trial(&mut self, alpha: &[f64]) -> Result<crate::solve::newton::TrialProbe, String> {
-        let s = update(&self.c, &self.state, &self.delta, alpha[0]);
+        let s = update(&self.c, &self.walls, &self.state, &self.delta, alpha[0]);
         assemble(&self.loaded, &s, 1.0, &self.f_step, &mut self.trial, None);
         constrain_residual(&self.c, &mut self.trial);
         self.trial_state = Some((alpha[0], s));
@@ -686,7 +722,7 @@ impl crate::solve::newton::NewtonSystem for CpuStatic<'_> {
         }
         self.state = match self.trial_state.take() {
             Some((a, s)) if trial_matches && a == alpha[0] => s,
-            _ => update(&self.c, &self.state, &self.delta, alpha[0]),
+            _ => update(&self.c, &self.walls, &self.state, &self.delta, alpha[0]),
         };
         self.evaluated = false;
         Ok(())
