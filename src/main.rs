@@ -135,6 +135,21 @@ enum BenchCommand {
         #[arg(long)]
         json: Option<PathBuf>,
     },
+    /// Wall time of a static ensemble on every path in one run: CPU backend, engine on the
+    /// CPU twins, engine on the GPU (f64, f32); iterations per load step and cuts of each.
+    Statics {
+        /// Case file.
+        case: PathBuf,
+        /// CSV of variants (default: the case's `[ensemble.grid]`, else the case alone).
+        #[arg(long)]
+        variants: Option<PathBuf>,
+        /// Timed repeats per path (the median is reported).
+        #[arg(long, default_value_t = 3)]
+        repeats: usize,
+        /// Also write the results as JSON here.
+        #[arg(long)]
+        json: Option<PathBuf>,
+    },
     /// Time steps per second and Newton iterations per step of `holewall run` (CPU f64).
     Dynamics {
         /// Case file with a `[dynamics]` table.
@@ -270,6 +285,15 @@ fn main() -> ExitCode {
                 precision_nodes,
                 json.as_deref(),
             ) {
+                Ok(()) => ExitCode::SUCCESS,
+                Err(e) => fail(&[e]),
+            },
+            BenchCommand::Statics {
+                case,
+                variants,
+                repeats,
+                json,
+            } => match cli::bench::statics(&case, variants.as_deref(), repeats, json.as_deref()) {
                 Ok(()) => ExitCode::SUCCESS,
                 Err(e) => fail(&[e]),
             },

@@ -62,11 +62,11 @@ fn a_failing_variant_fails_alone_and_the_others_are_bit_identical() {
     let dir = tmp("fail");
     let case = parse_case(&dir.join("base.toml"), &bed("0.3", "20 kN")).unwrap();
     let good = variants_from_csv_text("v.csv", "name,mu,wob\na,0.2,15 kN\nb,0.4,25 kN\n").unwrap();
-    // An absurd spring: k_e at the top of its range with m = 3 and a soft start cannot be
-    // brought to equilibrium.
+    // Absurd loads on an absurd spring: 9 MN and 1 MN·m on the bit, k_e at the top of its
+    // range with m = 3, cannot be brought to equilibrium.
     let with_bad = variants_from_csv_text(
         "v.csv",
-        "name,mu,wob,k_e,m\na,0.2,15 kN,6e7,1\nbad,0.3,9000 kN,1e12,3\nb,0.4,25 kN,6e7,1\n",
+        "name,mu,wob,k_e,m,tob\na,0.2,15 kN,6e7,1,0\nbad,0.3,9000 kN,1e12,3,1000 kN.m\nb,0.4,25 kN,6e7,1,0\n",
     )
     .unwrap();
     let bar = indicatif::ProgressBar::hidden();

@@ -219,3 +219,178 @@ pub fn dynamics(
     }
     Ok(())
 }
+
+#[derive(Serialize)]
+struct StaticsRow {
+    path: String,
+    median_s: f64,
+    ratio_to_cpu_backend: f64,
+    /// Variants this path solved itself (the engine's failures would be re-run on the CPU).
+    solved: usize,
+    load_steps: usize,
+    newton_iterations_per_load_step_mean: f64,
+    newton_iterations_per_load_step_median: usize,
+    step_cuts: usize,
+}
+
+#[derive(Serialize)]
+struct StaticsReport {
+    case: String,
+    variants: usize,
+    nodes: usize,
+    contact_sites: usize,
+    repeats: usize,
+    cpu_threads: usize,
+    adapter: String,
+    rows: Vec<StaticsRow>,
+}
+
+/// Wall time of a static ensemble — the case's variants (`variants` CSV, or its
+/// `[ensemble.grid]`) — on every path in one run: the CPU backend (`solve_static` per
+/// variant, rayon), the engine on the CPU twins (f64) and on the GPU (f64, f32) where an
+/// adapter is; medians over `repeats`, with each path's own solves, iterations per load
+/// step and cuts.
+pub fn statics(
+    case_path: &Path,
+    variants: Option<&Path>,
+    repeats: usize,
+    json: Option<&Path>,
+) -> Result<(), Error> {
+    use crate::engine::{solve_static_ensemble, EngineResult, EngineStatus, GpuPath, TwinPath};
+    use crate::solve::statics::{solve_static, StaticOptions};
+    use rayon::prelude::*;
+    let case = crate::case::load_case(case_path)?;
+    let list = match (variants, case.ensemble.as_ref()) {
+        (Some(f), _) => crate::ensemble::variants_from_csv(f)?,
+        (None, Some(s)) if !s.grid.is_empty() => crate::ensemble::variants_from_grid(&s.grid),
+        _ => vec![crate::ensemble::Variant {
+            name: "case".into(),
+            overrides: Vec::new(),
+        }],
+    };
+    let io = |e: String| Error::Io(std::io::Error::other(e));
+    let models: Vec<crate::model::Model> = list
+        .iter()
+        .map(|v| crate::ensemble::apply(&case, v))
+        .collect::<Result<_, _>>()
+        .map_err(io)?;
+    let options = StaticOptions::default();
+    let summary = |its: Vec<Vec<usize>>, cuts: usize, solved: usize| {
+        let mut all: Vec<usize> = its.into_iter().flatten().collect();
+        all.sort_unstable();
+        (
+            all.len(),
+            all.iter().sum::<usize>() as f64 / all.len().max(1) as f64,
+            all.get(all.len() / 2).copied().unwrap_or(0),
+            cuts,
+            solved,
+        )
+    };
+    type Figures = (usize, f64, usize, usize, usize);
+    let mut rows: Vec<(String, f64, Figures)> = Vec::new();
+    let mut figures = None;
+    let t = median_seconds::<Error>(repeats, || {
+        let out: Vec<_> = models
+            .par_iter()
+            .map(|m| solve_static(m, &options))
+            .collect();
+        let cuts = out
+            .iter()
+            .flatten()
+            .map(|s| s.log.iter().filter(|l| l.contains("cut")).count())
+            .sum();
+        let solved = out.iter().filter(|s| s.is_ok()).count();
+        let its = out.into_iter().flatten().map(|s| s.iterations).collect();
+        figures = Some(summary(its, cuts, solved));
+        Ok(())
+    })?;
+    rows.push((
+        "cpu backend (solve_static per variant, f64)".into(),
+        t,
+        figures.take().unwrap_or_default(),
+    ));
+    let engine_figures = |r: &[EngineResult]| {
+        let cuts = r
+            .iter()
+            .map(|x| x.log.iter().filter(|l| l.contains("cut")).count())
+            .sum();
+        let solved = r
+            .iter()
+            .filter(|x| x.status == EngineStatus::Converged)
+            .count();
+        summary(
+            r.iter().map(|x| x.iterations.clone()).collect(),
+            cuts,
+            solved,
+        )
+    };
+    let t = median_seconds::<Error>(repeats, || {
+        let r = solve_static_ensemble(&models, &TwinPath, &options).map_err(io)?;
+        figures = Some(engine_figures(&r));
+        Ok(())
+    })?;
+    rows.push((
+        "engine, CPU twins (f64)".into(),
+        t,
+        figures.take().unwrap_or_default(),
+    ));
+    let mut adapter = "none".to_string();
+    if let Ok(ctx) = GpuContext::shared() {
+        adapter = ctx.describe();
+        if ctx.has_f64 {
+            let t = median_seconds::<Error>(repeats, || {
+                let r = solve_static_ensemble::<f64, _>(&models, &GpuPath(ctx), &options)
+                    .map_err(io)?;
+                figures = Some(engine_figures(&r));
+                Ok(())
+            })?;
+            rows.push((
+                "engine, GPU f64".into(),
+                t,
+                figures.take().unwrap_or_default(),
+            ));
+        }
+        let t = median_seconds::<Error>(repeats, || {
+            let r =
+                solve_static_ensemble::<f32, _>(&models, &GpuPath(ctx), &options).map_err(io)?;
+            figures = Some(engine_figures(&r));
+            Ok(())
+        })?;
+        rows.push((
+            "engine, GPU f32".into(),
+            t,
+            figures.take().unwrap_or_default(),
+        ));
+    }
+    let cpu = rows[0].1;
+    let report = StaticsReport {
+        case: case_path.display().to_string(),
+        variants: models.len(),
+        nodes: models[0].nodes.len(),
+        contact_sites: models[0].sites.len(),
+        repeats,
+        cpu_threads: rayon::current_num_threads(),
+        adapter,
+        rows: rows
+            .into_iter()
+            .map(
+                |(path, t, (steps, mean, median, cuts, solved))| StaticsRow {
+                    path,
+                    median_s: t,
+                    ratio_to_cpu_backend: cpu / t,
+                    solved,
+                    load_steps: steps,
+                    newton_iterations_per_load_step_mean: mean,
+                    newton_iterations_per_load_step_median: median,
+                    step_cuts: cuts,
+                },
+            )
+            .collect(),
+    };
+    let text = serde_json::to_string_pretty(&report).unwrap_or_default();
+    println!("{text}");
+    if let Some(path) = json {
+        write_atomic(path, text.as_bytes())?;
+    }
+    Ok(())
+}
