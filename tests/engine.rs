@@ -3,25 +3,18 @@
 
 mod common;
 
-use holewall::cli::static_cmd::{fe_rows, neutral_point};
 use holewall::engine::{solve_static_ensemble, EngineStatus, GpuPath, TwinPath};
 use holewall::ensemble::{apply, variants_from_csv_text};
 use holewall::solve::statics::{solution_at, solve_static, StaticOptions};
 
+/// Neutral point, surface torque, largest side force.
 fn qoi(
     model: &holewall::model::Model,
     sol: &holewall::solve::statics::StaticSolution,
     bit_md: f64,
 ) -> [f64; 3] {
-    let (rows, _, torque, _) = fe_rows(model, sol);
-    let side = sol.contact.iter().map(|c| c.1).fold(0.0f64, f64::max);
-    [
-        neutral_point(&rows)
-            .map(|md| bit_md - md)
-            .unwrap_or(f64::NAN),
-        torque,
-        side,
-    ]
+    let q = common::static_qois(model, sol, bit_md);
+    [q[0], q[1], q[2]]
 }
 
 #[test]

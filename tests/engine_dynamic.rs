@@ -604,3 +604,101 @@ fn paper_case_sixteen_variants_match_the_cpu_integrator() {
         assert!(eu <= 1.2e-3 && ev <= 1.2e-3, "f32 {eu:e}, {ev:e}");
     }
 }
+
+/// Per-variant step control in the dynamic engine: with a regularisation speed of 1e-6 m/s
+/// and 10 ms steps the friction's sign is too sharp for a full step; the variant is taken
+/// back and re-tried in half steps on its own (twin and GPU), finishing with its cuts
+/// logged where the CPU integrator cuts too, and its end state close to the CPU
+/// integrator's (which regrows its step on its own schedule, so the two differ by the
+/// integration error of the cut steps, not by rounding).
+#[test]
+fn a_variant_whose_step_fails_is_cut_on_its_own_in_the_engine() {
+    let text = common::bed_text("0.3", "8.25 in", "6e7", "1", "1e-6")
+        .replace("time_step = \"2 ms\"", "time_step = \"10 ms\"");
+    let case = holewall::case::parse_case(std::path::Path::new("bed.toml"), &text).unwrap();
+    let variants = variants_from_csv_text("v.csv", "eps\n1e-3\n1e-6\n").unwrap();
+    let models: Vec<Model> = variants.iter().map(|v| apply(&case, v).unwrap()).collect();
+    let starts: Vec<StaticState> = models
+        .iter()
+        .map(|m| solve_static(m, &StaticOptions::default()).unwrap().state)
+        .collect();
+    let options = holewall::cli::run_cmd::options_for(case.dynamics.as_ref().unwrap());
+    let density = case.element_density.clone();
+    let t_end = 0.05;
+    // The CPU integrator on the variant that needs cuts.
+    let m = &models[1];
+    let mut d = Dynamics::new(m, options, &|e| density[e]);
+    let mut s = d.initial_state(starts[1].clone()).unwrap();
+    d.run(&mut s, t_end, &mut |_, _| {}).unwrap();
+    assert!(!d.log.is_empty(), "the CPU integrator did not cut");
+    let n = m.nodes.len();
+    let cpu_u: Vec<f64> = (0..n)
+        .flat_map(|i| (0..3).map(move |k| (i, k)))
+        .map(|(i, k)| s.q.x[i][k] - m.nodes[i].position[k])
+        .collect();
+    let check = |label: &str,
+                 path: &dyn Fn() -> Vec<holewall::engine::dynamic::DynamicResult>,
+                 last: &dyn Fn() -> DynamicBatch<f64>| {
+        let results = path();
+        for (j, r) in results.iter().enumerate() {
+            assert_eq!(r.status, DynamicStatus::Finished, "{label}: variant {j}");
+        }
+        eprintln!(
+            "{label}: variant 1 cuts: {:?}; CPU integrator: {:?}",
+            results[1].log, d.log
+        );
+        assert!(
+            !results[1].log.is_empty(),
+            "{label}: no cut where the CPU cuts"
+        );
+        let b = last();
+        let v = b.num_variants;
+        let scale = cpu_u.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        let diff = (0..3 * n).fold(0.0f64, |m, k| m.max((b.u[k * v + 1] - cpu_u[k]).abs()));
+        eprintln!(
+            "{label}: end displacement vs the CPU integrator {:.2e} of the largest ({scale:.2e} m)",
+            diff / scale
+        );
+        assert!(diff <= 1e-2 * scale, "{diff:e} of {scale:e}");
+    };
+    let last_state = std::cell::RefCell::new(None);
+    let twin_run = || {
+        let mut last = None;
+        let r = run_dynamic_ensemble(
+            &models,
+            &starts,
+            &density,
+            &TwinPath,
+            &options,
+            t_end,
+            1,
+            &mut |_, _, b: &DynamicBatch<f64>| last = Some(b.clone()),
+        )
+        .unwrap();
+        *last_state.borrow_mut() = last;
+        r
+    };
+    check("twin", &twin_run, &|| last_state.borrow().clone().unwrap());
+    let Some(ctx) = common::gpu() else { return };
+    if ctx.has_f64 {
+        let gpu_run = || {
+            let mut last = None;
+            let r = run_dynamic_ensemble(
+                &models,
+                &starts,
+                &density,
+                &GpuPath(ctx),
+                &options,
+                t_end,
+                1,
+                &mut |_, _, b: &DynamicBatch<f64>| last = Some(b.clone()),
+            )
+            .unwrap();
+            *last_state.borrow_mut() = last;
+            r
+        };
+        check("GPU f64", &gpu_run, &|| {
+            last_state.borrow().clone().unwrap()
+        });
+    }
+}

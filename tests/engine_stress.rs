@@ -15,7 +15,6 @@
 
 mod common;
 
-use holewall::cli::static_cmd::{fe_rows, neutral_point};
 use holewall::engine::{solve_static_ensemble, EngineResult, EngineStatus, GpuPath, TwinPath};
 use holewall::ensemble::{apply, variants_from_csv_text};
 use holewall::model::Model;
@@ -106,16 +105,7 @@ bha_element_length = "1.5 m"
 
 /// Neutral point from the bit, surface torque, largest side force, hook load.
 fn qoi(model: &Model, sol: &StaticSolution, bit_md: f64) -> [f64; 4] {
-    let (rows, hook, torque, _) = fe_rows(model, sol);
-    let side = sol.contact.iter().map(|c| c.1).fold(0.0f64, f64::max);
-    [
-        neutral_point(&rows)
-            .map(|md| bit_md - md)
-            .unwrap_or(f64::NAN),
-        torque,
-        side,
-        hook,
-    ]
+    common::static_qois(model, sol, bit_md)
 }
 
 /// Largest difference per quantity: the neutral point in m, the forces and the torque

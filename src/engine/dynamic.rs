@@ -26,7 +26,7 @@ use crate::physics::Real;
 use crate::solve::dynamics::{DynamicOptions, Dynamics};
 use crate::solve::statics::StaticState;
 
-use super::{ensemble_tables, EnsembleTables, KernelPath, TwinPath};
+use super::{ensemble_tables, negated, trial_probe, EnsembleTables, KernelPath, TwinPath};
 use crate::solve::newton::{Event, Newton, NewtonSettings, NewtonSystem, Probe, TrialProbe};
 
 /// What a dynamic chunk adds to [`EnsembleTables`].
@@ -562,11 +562,6 @@ struct DynamicStep<'e, T> {
     hhb: f64,
 }
 
-/// `−α` in the path's float type (the kernels' `Δ` is the negative Newton step).
-fn negated<T: Real>(alpha: &[f64]) -> Vec<T> {
-    alpha.iter().map(|&a| T::from_f64_lossy(-a)).collect()
-}
-
 impl<T: Real> NewtonSystem for DynamicStep<'_, T> {
     fn variants(&self) -> usize {
         self.f_ref.len()
@@ -591,18 +586,7 @@ impl<T: Real> NewtonSystem for DynamicStep<'_, T> {
     }
     fn trial(&mut self, alpha: &[f64]) -> Result<TrialProbe, String> {
         let r = self.ensemble.trial(&negated::<T>(alpha))?;
-        Ok(TrialProbe {
-            slope: r
-                .step_dot_residual
-                .iter()
-                .map(|x| x.to_f64_lossy())
-                .collect(),
-            norm: r
-                .residual_square
-                .iter()
-                .map(|x| x.to_f64_lossy().sqrt())
-                .collect(),
-        })
+        Ok(trial_probe(&r))
     }
     fn accept(&mut self, alpha: &[f64], _trial_matches: bool) -> Result<(), String> {
         if alpha.iter().any(|&a| a != 0.0) {

@@ -766,8 +766,24 @@ impl<'a, T: Real> EngineStatic<'a, T> {
 }
 
 /// `−α` in the path's float type (the kernels' `Δ` is the negative Newton step).
-fn negated<T: Real>(alpha: &[f64]) -> Vec<T> {
+pub(crate) fn negated<T: Real>(alpha: &[f64]) -> Vec<T> {
     alpha.iter().map(|&a| T::from_f64_lossy(-a)).collect()
+}
+
+/// A trial's slope `Δ·r(α)` and `‖r(α)‖₂` per variant from the norms kernel's output.
+pub(crate) fn trial_probe<T: Real>(r: &Norms<T>) -> TrialProbe {
+    TrialProbe {
+        slope: r
+            .step_dot_residual
+            .iter()
+            .map(|x| x.to_f64_lossy())
+            .collect(),
+        norm: r
+            .residual_square
+            .iter()
+            .map(|x| x.to_f64_lossy().sqrt())
+            .collect(),
+    }
 }
 
 impl<T: Real> NewtonSystem for EngineStatic<'_, T> {
@@ -798,18 +814,7 @@ impl<T: Real> NewtonSystem for EngineStatic<'_, T> {
     fn trial(&mut self, alpha: &[f64]) -> Result<TrialProbe, String> {
         self.flush()?;
         let r = self.ensemble.trial(&negated::<T>(alpha))?;
-        Ok(TrialProbe {
-            slope: r
-                .step_dot_residual
-                .iter()
-                .map(|x| x.to_f64_lossy())
-                .collect(),
-            norm: r
-                .residual_square
-                .iter()
-                .map(|x| x.to_f64_lossy().sqrt())
-                .collect(),
-        })
+        Ok(trial_probe(&r))
     }
     fn accept(&mut self, alpha: &[f64], trial_matches: bool) -> Result<(), String> {
         self.flush()?;

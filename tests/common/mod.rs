@@ -42,3 +42,23 @@ pub fn bed_case(m: &str) -> holewall::case::Case {
     )
     .unwrap()
 }
+
+/// Quantities of interest of a static solution: neutral point from the bit (m, NaN where
+/// none), surface torque (N·m), largest side force (N), hook load (N).
+pub fn static_qois(
+    model: &holewall::model::Model,
+    sol: &holewall::solve::statics::StaticSolution,
+    bit_md: f64,
+) -> [f64; 4] {
+    use holewall::cli::static_cmd::{fe_rows, neutral_point};
+    let (rows, hook, torque, _) = fe_rows(model, sol);
+    let side = sol.contact.iter().map(|c| c.1).fold(0.0f64, f64::max);
+    [
+        neutral_point(&rows)
+            .map(|md| bit_md - md)
+            .unwrap_or(f64::NAN),
+        torque,
+        side,
+        hook,
+    ]
+}
