@@ -26,7 +26,7 @@ use crate::physics::Real;
 use crate::solve::dynamics::{DynamicOptions, Dynamics};
 use crate::solve::statics::StaticState;
 
-use super::{ensemble_tables, negated, trial_probe, EnsembleTables, KernelPath, TwinPath};
+use super::{columns, ensemble_tables, negated, trial_probe, EnsembleTables, KernelPath, TwinPath};
 use crate::solve::newton::{Event, Newton, NewtonSettings, NewtonSystem, Probe, TrialProbe};
 
 /// What a dynamic chunk adds to [`EnsembleTables`].
@@ -249,13 +249,6 @@ pub fn run_dynamic_ensemble<T: Real + Send + Sync, P: KernelPath<T>>(
         )?);
     }
     Ok(results)
-}
-
-/// The columns `pick` of a variant-fastest array of `v` variants.
-fn columns<T: Copy>(data: &[T], v: usize, pick: &[usize]) -> Vec<T> {
-    data.chunks_exact(v)
-        .flat_map(|row| pick.iter().map(move |&j| row[j]))
-        .collect()
 }
 
 /// Writes `src` (the columns `pick`, variant-fastest) into `dst` of `v` variants.

@@ -32,7 +32,7 @@ use crate::kernels::update::{norms, update, ConfigBatch, Norms};
 use crate::model::Model;
 use crate::physics::contact::{ContactMode, ContactTerms, PARAMS_LEN};
 use crate::physics::Real;
-use crate::solve::continuation::{solve_loads, LoadPath, LoadTarget, StaticSystem};
+use crate::solve::continuation::{solve_loads_from, LoadPath, LoadTarget, StaticSystem};
 use crate::solve::newton::{NewtonSettings, NewtonSystem, Probe, TrialProbe};
 use crate::solve::statics::{
     constraint_tables, loaded_params, reference_force, split_loads, StaticOptions, StaticState,
@@ -604,11 +604,12 @@ fn solve_chunk<T: Real + Send + Sync, P: KernelPath<T>>(
     progress: &mut dyn FnMut(f64),
 ) -> Result<Vec<EngineResult>, String> {
     let tables = ensemble_tables::<T>(models)?;
-    let (v, n) = (tables.num_variants, tables.num_nodes);
-    let base = &models[0];
+    let v = tables.num_variants;
+    // The mesh every variant shares (the kernels read sections and frames from it).
+    let mesh = &models[0];
     let size = std::mem::size_of::<T>();
-    let ensemble = path.open(base, &tables)?;
-    let mut sys = EngineStatic::new(models, ensemble, tables);
+    let ensemble = path.open(mesh, &tables)?;
+    let mut sys = EngineStatic::new(models.iter().collect(), ensemble, tables, None);
     // f32 solves full load a second time from its own converged state as base: the
     // answer's last digits are then f32's rounding of millimetres, not of the string's
     // whole sag (`docs/validation.md`).
@@ -620,37 +621,100 @@ fn solve_chunk<T: Real + Send + Sync, P: KernelPath<T>>(
         })
         .collect();
     let settings = NewtonSettings::statics(options.max_iterations, options.tolerance, size);
-    solve_loads(&mut sys, &mut paths, settings, progress)?;
-    let config = sys.ensemble.config()?;
-    let tables = &sys.tables;
+    // Compaction: once no more than half of a chunk's variants are still running, the
+    // others (finished) leave it — the running ones go on in a chunk of their own, each
+    // exactly where it stands (state, restart point, Newton state), so no kernel works on
+    // a finished variant for long and the answers do not depend on the compaction.
+    let stop = |running: usize, total: usize| total >= COMPACT_MIN && 2 * running <= total;
+    let mut members: Vec<usize> = (0..v).collect();
+    let mut finals: Vec<Option<StaticState>> = vec![None; v];
+    let mut resume = None;
+    let mut solves = 0;
+    loop {
+        let m = members.len();
+        let mut sub: Vec<LoadPath> = members.iter().map(|&j| paths[j].clone()).collect();
+        let done_before = (v - m) as f64;
+        let mut report = |f: f64| progress((done_before + f * m as f64) / v as f64);
+        let states = solve_loads_from(
+            &mut sys,
+            &mut sub,
+            settings,
+            resume.as_deref(),
+            &stop,
+            &mut solves,
+            &mut report,
+        )?;
+        sys.flush()?;
+        let config = sys.ensemble.config()?;
+        let keep: Vec<usize> = (0..m).filter(|&i| !sub[i].finished()).collect();
+        for (i, path) in sub.into_iter().enumerate() {
+            let j = members[i];
+            if path.finished() {
+                finals[j] = Some(state_of(mesh, &sys.tables, &config, i));
+            }
+            paths[j] = path;
+        }
+        if keep.is_empty() {
+            break;
+        }
+        let sub_models: Vec<Model> = keep.iter().map(|&i| sys.models[i].clone()).collect();
+        let mut tables = ensemble_tables::<T>(&sub_models)?;
+        tables.start.x = columns(&config.x, m, &keep);
+        tables.start.rot = columns(&config.rot, m, &keep);
+        tables.set_base(mesh, columns(&sys.tables.base, m, &keep));
+        let saved = keep.iter().map(|&i| sys.saved[i].clone()).collect();
+        let kept_models = keep.iter().map(|&i| sys.models[i]).collect();
+        let ensemble = path.open(mesh, &tables)?;
+        sys = EngineStatic::new(kept_models, ensemble, tables, Some(saved));
+        resume = Some(keep.iter().map(|&i| states[i].clone()).collect::<Vec<_>>());
+        members = keep.iter().map(|&i| members[i]).collect();
+    }
     Ok(paths
         .into_iter()
-        .enumerate()
-        .map(|(j, path)| {
-            let mut s = StaticState::initial(base);
-            for i in 0..n {
-                for k in 0..3 {
-                    let at = (3 * i + k) * v + j;
-                    s.x[i][k] =
-                        tables.node_ref[3 * i + k] + tables.base[at] + config.x[at].to_f64_lossy();
-                }
-                for r in 0..3 {
-                    for c in 0..3 {
-                        s.rot[i][r][c] = config.rot[(9 * i + 3 * r + c) * v + j].to_f64_lossy();
-                    }
-                }
-            }
-            EngineResult {
-                state: s,
-                status: match &path.error {
-                    None => EngineStatus::Converged,
-                    Some(e) => EngineStatus::Failed(e.to_string()),
-                },
-                iterations: path.iterations,
-                log: path.log,
-            }
+        .zip(finals)
+        .map(|(path, state)| EngineResult {
+            state: state.unwrap_or_else(|| StaticState::initial(mesh)),
+            status: match &path.error {
+                None => EngineStatus::Converged,
+                Some(e) => EngineStatus::Failed(e.to_string()),
+            },
+            iterations: path.iterations,
+            log: path.log,
         })
         .collect())
+}
+
+/// Chunks of fewer variants are not compacted (a new chunk costs more than it saves).
+const COMPACT_MIN: usize = 4;
+
+/// Variant `j`'s configuration (f64, from the reference) in a chunk of `tables`.
+fn state_of<T: Real>(
+    mesh: &Model,
+    tables: &EnsembleTables<T>,
+    config: &ConfigBatch<T>,
+    j: usize,
+) -> StaticState {
+    let (v, n) = (tables.num_variants, tables.num_nodes);
+    let mut s = StaticState::initial(mesh);
+    for i in 0..n {
+        for k in 0..3 {
+            let at = (3 * i + k) * v + j;
+            s.x[i][k] = tables.node_ref[3 * i + k] + tables.base[at] + config.x[at].to_f64_lossy();
+        }
+        for r in 0..3 {
+            for c in 0..3 {
+                s.rot[i][r][c] = config.rot[(9 * i + 3 * r + c) * v + j].to_f64_lossy();
+            }
+        }
+    }
+    s
+}
+
+/// The columns `pick` of a variant-fastest array of `v` variants.
+pub(crate) fn columns<X: Copy>(data: &[X], v: usize, pick: &[usize]) -> Vec<X> {
+    data.chunks_exact(v)
+        .flat_map(|row| pick.iter().map(move |&j| row[j]))
+        .collect()
 }
 
 /// A chunk's static Newton system on a kernel path, for [`solve_loads`]: per variant its
@@ -659,7 +723,7 @@ fn solve_chunk<T: Real + Send + Sync, P: KernelPath<T>>(
 /// carried out together before the next kernel work (one read and one write of the
 /// configuration); in f32 every save also moves the base to the current configuration.
 struct EngineStatic<'a, T> {
-    models: &'a [Model],
+    models: Vec<&'a Model>,
     ensemble: Box<dyn Ensemble<T> + 'a>,
     tables: EnsembleTables<T>,
     loads: Vec<(Vec<f64>, Vec<f64>)>,
@@ -676,32 +740,36 @@ struct EngineStatic<'a, T> {
 }
 
 impl<'a, T: Real> EngineStatic<'a, T> {
+    /// `saved`: the variants' restart points (none: their start states).
     fn new(
-        models: &'a [Model],
+        models: Vec<&'a Model>,
         ensemble: Box<dyn Ensemble<T> + 'a>,
         tables: EnsembleTables<T>,
+        saved: Option<Vec<(Vec<f64>, Vec<f64>)>>,
     ) -> Self {
         let (v, n, p) = (
             tables.num_variants,
             tables.num_nodes,
             tables.pair_node.len(),
         );
-        let saved = (0..v)
-            .map(|j| {
-                let x = (0..3 * n)
-                    .map(|k| tables.base[k * v + j] + tables.start.x[k * v + j].to_f64_lossy())
-                    .collect();
-                let rot = (0..9 * n)
-                    .map(|k| tables.start.rot[k * v + j].to_f64_lossy())
-                    .collect();
-                (x, rot)
-            })
-            .collect();
+        let saved = saved.unwrap_or_else(|| {
+            (0..v)
+                .map(|j| {
+                    let x = (0..3 * n)
+                        .map(|k| tables.base[k * v + j] + tables.start.x[k * v + j].to_f64_lossy())
+                        .collect();
+                    let rot = (0..9 * n)
+                        .map(|k| tables.start.rot[k * v + j].to_f64_lossy())
+                        .collect();
+                    (x, rot)
+                })
+                .collect()
+        });
         EngineStatic {
+            loads: models.iter().map(|m| split_loads(m)).collect(),
+            f_ref: models.iter().map(|m| reference_force(m)).collect(),
             models,
             ensemble,
-            loads: models.iter().map(split_loads).collect(),
-            f_ref: models.iter().map(reference_force).collect(),
             f_ext: vec![T::zero(); 6 * n * v],
             params: vec![T::zero(); PARAMS_LEN * p],
             tables,
@@ -751,7 +819,7 @@ impl<'a, T: Real> EngineStatic<'a, T> {
                 for (b, w) in moved.iter_mut().zip(&config.x) {
                     *b += w.to_f64_lossy();
                 }
-                self.tables.set_base(&self.models[0], moved);
+                self.tables.set_base(self.models[0], moved);
                 self.ensemble.rebase(&self.tables)?;
                 self.evaluated = false;
             }

@@ -20,7 +20,7 @@
 //! step starts its next one in the same iteration, one that fails is returned to its
 //! restart point, and a finished one stops costing line searches.
 
-use super::newton::{Event, Newton, NewtonSettings, NewtonSystem};
+use super::newton::{Event, Newton, NewtonSettings, NewtonState, NewtonSystem};
 use super::statics::{StaticError, StaticOptions};
 
 /// The loads a variant is solved for: each a factor of the full value.
@@ -307,13 +307,49 @@ pub fn solve_loads(
     settings: NewtonSettings,
     progress: &mut dyn FnMut(f64),
 ) -> Result<usize, String> {
+    let mut solves = 0;
+    solve_loads_from(
+        sys,
+        paths,
+        settings,
+        None,
+        &|_, _| false,
+        &mut solves,
+        progress,
+    )?;
+    Ok(solves)
+}
+
+/// As [`solve_loads`], resuming (`resume`: each variant's Newton state, the system built
+/// on their current states and restart points) or from the start (every variant's state
+/// saved as its first restart point), until every path is finished or, between
+/// iterations, `stop(running, variants)` says so. Returns each variant's Newton state then
+/// (for [`solve_loads_from`] on a compacted system); adds the solves to `solves`.
+#[allow(clippy::too_many_arguments)]
+pub fn solve_loads_from(
+    sys: &mut dyn StaticSystem,
+    paths: &mut [LoadPath],
+    settings: NewtonSettings,
+    resume: Option<&[NewtonState]>,
+    stop: &dyn Fn(usize, usize) -> bool,
+    solves: &mut usize,
+    progress: &mut dyn FnMut(f64),
+) -> Result<Vec<NewtonState>, String> {
     let v = sys.variants();
     let mut newton = Newton::new(settings, v);
     for (j, path) in paths.iter().enumerate() {
+        if path.finished() {
+            continue;
+        }
         sys.set_target(j, &path.target())?;
-        sys.save(j)?;
-        let floor = sys.step_floor(j)?;
-        newton.start(j, floor, path.polish());
+        match resume {
+            Some(states) => newton.resume(j, states[j].clone()),
+            None => {
+                sys.save(j)?;
+                let floor = sys.step_floor(j)?;
+                newton.start(j, floor, path.polish());
+            }
+        }
     }
     while newton.any_running() {
         let events = newton.test(sys)?;
@@ -321,8 +357,12 @@ pub fn solve_loads(
         let events = newton.advance(sys)?;
         next_steps(sys, paths, &mut newton, events)?;
         progress(paths.iter().map(LoadPath::progress).sum::<f64>() / v.max(1) as f64);
+        if stop(newton.running_count(), v) {
+            break;
+        }
     }
-    Ok(newton.solves)
+    *solves += newton.solves;
+    Ok((0..v).map(|j| newton.state(j)).collect())
 }
 
 /// Variants whose solve ended: the next step of their path from the state it needs.

@@ -182,6 +182,10 @@ struct Track {
     floor: f64,
 }
 
+/// One variant's Newton state ([`Newton::state`]).
+#[derive(Clone, Debug, Default)]
+pub struct NewtonState(Track);
+
 /// The Newton iteration of V variants (see the module docs for its policy).
 pub struct Newton {
     /// Settings.
@@ -254,6 +258,23 @@ impl Newton {
     /// Whether any variant is running.
     pub fn any_running(&self) -> bool {
         self.tracks.iter().any(|t| t.running)
+    }
+
+    /// How many variants are running.
+    pub fn running_count(&self) -> usize {
+        self.tracks.iter().filter(|t| t.running).count()
+    }
+
+    /// Variant `j`'s state between iterations, to carry it on in another [`Newton`]
+    /// ([`Newton::resume`]) exactly where it stands (a chunk compacted to its running
+    /// variants goes on bit for bit).
+    pub fn state(&self, j: usize) -> NewtonState {
+        NewtonState(self.tracks[j].clone())
+    }
+
+    /// Variant `j` goes on from `state` ([`Newton::state`]).
+    pub fn resume(&mut self, j: usize, state: NewtonState) {
+        self.tracks[j] = state.0;
     }
 
     /// One iteration of every running variant: [`Newton::test`], then
