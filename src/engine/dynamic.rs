@@ -77,6 +77,10 @@ pub trait DynamicEnsemble<T> {
     fn state(&mut self) -> Result<DynamicBatch<T>, String>;
     /// Replaces the state at `t_n` (between steps).
     fn set_state(&mut self, state: &DynamicBatch<T>) -> Result<(), String>;
+    /// The Newton unknown `v̇_{n+1}`, `6 n V`, read back (mid-step).
+    fn unknown(&mut self) -> Result<Vec<T>, String>;
+    /// Replaces the Newton unknown (after [`DynamicEnsemble::begin_step`]).
+    fn set_unknown(&mut self, vdot: &[T]) -> Result<(), String>;
 }
 
 /// How a variant's dynamic run ended.
@@ -444,27 +448,9 @@ fn run_span<T: Real + Send + Sync, P: KernelPath<T>>(
                 newton.start(i, chunk.floors[j], false);
             }
         }
-        let mut sys = DynamicStep {
-            ensemble: &mut *ensemble,
-            f_ref: members.iter().map(|&j| chunk.f_ref[j]).collect(),
-            hhb: hh * hh * p.beta * ratio,
-        };
-        let mut failed = Vec::new();
-        while newton.any_running() {
-            for (i, event) in newton.iterate(&mut sys)? {
-                match event {
-                    Event::Converged(its) => chunk.iterations[members[i]].push(its),
-                    Event::Failed(reason) => failed.push((i, reason)),
-                }
-            }
-        }
-        // The failed variants' state at t_n, before the step ends.
-        let before = if failed.is_empty() {
-            None
-        } else {
-            Some(ensemble.state()?)
-        };
-        ensemble.end_step()?;
+        let hhb = hh * hh * p.beta * ratio;
+        let (failed, before) =
+            solve_step(chunk, ensemble, members, &coefficients, &top, newton, hhb)?;
         if let Some(before) = before {
             let cut = hh / 2.0;
             let mut retry = Vec::new();
@@ -518,6 +504,111 @@ fn run_span<T: Real + Send + Sync, P: KernelPath<T>>(
     Ok(())
 }
 
+/// The Newton of one time step for the ensemble's running variants (started in `newton`),
+/// then the step's end (the state at `t_n + h`). Once no more than half of them are still
+/// running (ensembles of [`super::COMPACT_MIN`] or more), the stragglers go on in a chunk
+/// of their own exactly where they stand (state at `t_n`, Newton unknown, Newton state),
+/// bit for bit, so converged variants cost no more kernel work; their end state is
+/// written back. Returns the variants whose Newton failed (local index, reason) and, if
+/// any failed, every variant's state at `t_n`.
+#[allow(clippy::type_complexity)]
+fn solve_step<T: Real + Send + Sync, P: KernelPath<T>>(
+    chunk: &mut Chunk<'_, T, P>,
+    ensemble: &mut dyn DynamicEnsemble<T>,
+    members: &[usize],
+    coefficients: &StepCoefficients<T>,
+    top: &[T],
+    mut newton: Newton,
+    hhb: f64,
+) -> Result<(Vec<(usize, String)>, Option<DynamicBatch<T>>), String> {
+    let m = members.len();
+    let mut failed = Vec::new();
+    let mut compact = false;
+    {
+        let mut sys = DynamicStep {
+            ensemble: &mut *ensemble,
+            f_ref: members.iter().map(|&j| chunk.f_ref[j]).collect(),
+            hhb,
+        };
+        while newton.any_running() {
+            for (i, event) in newton.iterate(&mut sys)? {
+                match event {
+                    Event::Converged(its) => chunk.iterations[members[i]].push(its),
+                    Event::Failed(reason) => failed.push((i, reason)),
+                }
+            }
+            let running = newton.running_count();
+            if m >= super::COMPACT_MIN && running > 0 && 2 * running <= m {
+                compact = true;
+                break;
+            }
+        }
+    }
+    // Every variant's state at t_n, where one failed or stragglers move.
+    let before = if failed.is_empty() && !compact {
+        None
+    } else {
+        Some(ensemble.state()?)
+    };
+    let mut moved = None;
+    if let (true, Some(at_n)) = (compact, before.as_ref()) {
+        let s: Vec<usize> = (0..m).filter(|&i| newton.is_running(i)).collect();
+        let sub_members: Vec<usize> = s.iter().map(|&i| members[i]).collect();
+        let unknown = ensemble.unknown()?;
+        let sub_top = columns(top, m, &s);
+        let mut sub = open_subset(chunk, &sub_members, &batch_columns(at_n, &s))?;
+        sub.begin_step(coefficients, &sub_top)?;
+        sub.set_unknown(&columns(&unknown, m, &s))?;
+        let mut sub_newton = Newton::new(newton.settings, s.len());
+        for (k, &i) in s.iter().enumerate() {
+            sub_newton.resume(k, newton.state(i));
+        }
+        let (sub_failed, _) = solve_step(
+            chunk,
+            sub.as_mut(),
+            &sub_members,
+            coefficients,
+            &sub_top,
+            sub_newton,
+            hhb,
+        )?;
+        failed.extend(sub_failed.into_iter().map(|(k, why)| (s[k], why)));
+        moved = Some((s, sub.state()?));
+    }
+    ensemble.end_step()?;
+    if let Some((s, after)) = moved {
+        let mut now = ensemble.state()?;
+        put_batch_columns(&mut now, &s, &after);
+        ensemble.set_state(&now)?;
+    }
+    Ok((failed, before))
+}
+
+/// A chunk of the chunk's variants `members` (each with its tables, loads and base) at the
+/// state `start`.
+fn open_subset<'c, T: Real + Send + Sync, P: KernelPath<T>>(
+    chunk: &Chunk<'c, T, P>,
+    members: &[usize],
+    start: &DynamicBatch<T>,
+) -> Result<Box<dyn DynamicEnsemble<T> + 'c>, String> {
+    let v = chunk.tables.num_variants;
+    let models: Vec<Model> = members.iter().map(|&j| chunk.models[j].clone()).collect();
+    let mut tables = ensemble_tables::<T>(&models)?;
+    tables.terms = chunk.tables.terms;
+    tables.set_base(&models[0], columns(&chunk.tables.base, v, members));
+    let d = &chunk.dynamic;
+    let dynamic = DynamicTables {
+        mass: d.mass.clone(),
+        inertia0: d.inertia0.clone(),
+        a0: d.a0,
+        f_ext: columns(&d.f_ext, v, members),
+        pair_params: columns(&d.pair_params, v, members),
+        start: start.clone(),
+    };
+    let path: &'c P = chunk.path;
+    path.open_dynamic(&chunk.models[members[0]], &tables, &dynamic)
+}
+
 /// The chunk's variants `again`, at `start` (their state at `t0`), taken to `t1` in a chunk
 /// of their own with steps of `h`; their state at `t1`.
 fn retry_alone<T: Real + Send + Sync, P: KernelPath<T>>(
@@ -528,22 +619,7 @@ fn retry_alone<T: Real + Send + Sync, P: KernelPath<T>>(
     t1: f64,
     h: f64,
 ) -> Result<DynamicBatch<T>, String> {
-    let v = chunk.tables.num_variants;
-    let models: Vec<Model> = again.iter().map(|&j| chunk.models[j].clone()).collect();
-    let mut tables = ensemble_tables::<T>(&models)?;
-    tables.terms = chunk.tables.terms;
-    tables.set_base(&models[0], columns(&chunk.tables.base, v, again));
-    let d = &chunk.dynamic;
-    let dynamic = DynamicTables {
-        mass: d.mass.clone(),
-        inertia0: d.inertia0.clone(),
-        a0: d.a0,
-        f_ext: columns(&d.f_ext, v, again),
-        pair_params: columns(&d.pair_params, v, again),
-        start: start.clone(),
-    };
-    let path = chunk.path;
-    let mut sub = path.open_dynamic(&chunk.models[again[0]], &tables, &dynamic)?;
+    let mut sub = open_subset(chunk, again, start)?;
     run_span(chunk, sub.as_mut(), again, t0, t1, h, None)?;
     sub.state()
 }
@@ -707,6 +783,13 @@ impl DynamicEnsemble<f64> for TwinDynamic<'_> {
     }
     fn set_state(&mut self, state: &DynamicBatch<f64>) -> Result<(), String> {
         self.state = state.clone();
+        Ok(())
+    }
+    fn unknown(&mut self) -> Result<Vec<f64>, String> {
+        Ok(self.unknown.clone())
+    }
+    fn set_unknown(&mut self, vdot: &[f64]) -> Result<(), String> {
+        self.unknown = vdot.to_vec();
         Ok(())
     }
 }

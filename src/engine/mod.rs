@@ -685,7 +685,7 @@ fn solve_chunk<T: Real + Send + Sync, P: KernelPath<T>>(
 }
 
 /// Chunks of fewer variants are not compacted (a new chunk costs more than it saves).
-const COMPACT_MIN: usize = 4;
+pub(crate) const COMPACT_MIN: usize = 4;
 
 /// Variant `j`'s configuration (f64, from the reference) in a chunk of `tables`.
 fn state_of<T: Real>(

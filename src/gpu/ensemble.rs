@@ -1245,6 +1245,25 @@ impl<T: GpuReal> crate::engine::dynamic::DynamicEnsemble<T> for GpuDynamic<T> {
         Ok(())
     }
 
+    fn unknown(&mut self) -> Result<Vec<T>, String> {
+        let size = std::mem::size_of::<T>() as u64;
+        let bytes = 6 * (self.num_nodes * self.num_variants) as u64 * size;
+        let out = submit_and_read(
+            self.ctx,
+            encoder(self.ctx, "unknown"),
+            &[(&self.b.vdot_k, bytes)],
+        )
+        .map_err(|e| e.to_string())?;
+        Ok(bytemuck::cast_slice(&out[0]).to_vec())
+    }
+
+    fn set_unknown(&mut self, vdot: &[T]) -> Result<(), String> {
+        self.ctx
+            .queue
+            .write_buffer(&self.b.vdot_k, 0, bytemuck::cast_slice(vdot));
+        Ok(())
+    }
+
     fn state(&mut self) -> Result<crate::kernels::dynamics::DynamicBatch<T>, String> {
         let (v, n) = (self.num_variants, self.num_nodes);
         let size = std::mem::size_of::<T>() as u64;
