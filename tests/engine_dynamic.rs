@@ -703,6 +703,9 @@ fn a_variant_whose_step_fails_is_cut_on_its_own_in_the_engine() {
     }
 }
 
+/// A run of some variants with the number of dynamic chunks it opened.
+type CountedRun = Box<dyn Fn(&[Model], &[StaticState]) -> (Outcome, usize)>;
+
 /// A kernel path that counts the dynamic chunks it opens (compaction opens more).
 struct Counting<P> {
     inner: P,
@@ -750,20 +753,18 @@ fn stragglers_compacted_within_a_step_go_on_bit_for_bit() {
             .chain((0..b.vel.len() / v).map(|k| b.vel[k * v + j].to_bits()))
             .collect()
     };
-    let check =
-        |label: &str,
-         path: &dyn Fn() -> Box<dyn Fn(&[Model], &[StaticState]) -> (Outcome, usize)>| {
-            let run = path();
-            let ((status, together), opens) = run(&models, &starts);
-            eprintln!("{label}: {opens} dynamic chunks opened for 6 variants × 10 steps");
-            assert!(opens > 1, "{label}: no compaction happened");
-            for j in 0..models.len() {
-                assert_eq!(status[j], DynamicStatus::Finished);
-                let ((_, alone), _) = run(&models[j..j + 1], &starts[j..j + 1]);
-                assert_eq!(bits(&together, j), bits(&alone, 0), "{label}: variant {j}");
-            }
-        };
-    let twin = || -> Box<dyn Fn(&[Model], &[StaticState]) -> (Outcome, usize)> {
+    let check = |label: &str, path: &dyn Fn() -> CountedRun| {
+        let run = path();
+        let ((status, together), opens) = run(&models, &starts);
+        eprintln!("{label}: {opens} dynamic chunks opened for 6 variants × 10 steps");
+        assert!(opens > 1, "{label}: no compaction happened");
+        for j in 0..models.len() {
+            assert_eq!(status[j], DynamicStatus::Finished);
+            let ((_, alone), _) = run(&models[j..j + 1], &starts[j..j + 1]);
+            assert_eq!(bits(&together, j), bits(&alone, 0), "{label}: variant {j}");
+        }
+    };
+    let twin = || -> CountedRun {
         let density = density.clone();
         Box::new(move |m: &[Model], s: &[StaticState]| {
             let path = Counting {
@@ -777,7 +778,7 @@ fn stragglers_compacted_within_a_step_go_on_bit_for_bit() {
     check("twin", &twin);
     let Some(ctx) = common::gpu() else { return };
     if ctx.has_f64 {
-        let gpu = || -> Box<dyn Fn(&[Model], &[StaticState]) -> (Outcome, usize)> {
+        let gpu = || -> CountedRun {
             let density = density.clone();
             Box::new(move |m: &[Model], s: &[StaticState]| {
                 let path = Counting {
