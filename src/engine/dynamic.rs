@@ -3,10 +3,14 @@
 //! iteration made of the predictor, beam, sites, contact, dynamic assembly, block LU and
 //! norms kernels, and the per-variant residual line search of the CPU integrator.
 //!
-//! Every variant takes the same steps. A variant whose Newton fails at a step (non-finite
-//! residual, singular matrix, no convergence in the iterations) is frozen with the reason
-//! and the time; the caller re-runs it on the CPU, whose integrator cuts the step. The
-//! others go on, unaffected: no kernel mixes variants.
+//! Every variant takes the same steps of `h` through the one Newton
+//! ([`crate::solve::newton`], dynamics settings). A variant whose Newton fails at a step
+//! (non-finite residual, singular matrix, no convergence in the iterations) is taken back
+//! and re-tried on its own in half steps, recursively down to `min_dt`, while the others
+//! wait ([`run_dynamic_ensemble`]); only below `min_dt` does it fail, as the CPU
+//! integrator would. Within a step, once no more than half of the variants are still
+//! iterating, the stragglers go on in a chunk of their own. No kernel mixes variants: the
+//! others are unaffected, bit for bit.
 //!
 //! Supported: lumped mass, mass-proportional Rayleigh damping (`a0`), the table's spin and
 //! the hook's travel at the top, every contact law. Not here (the caller runs those on the

@@ -3,16 +3,16 @@
 //! assembly (with constraints), block LU, norms, update — on either kernel path: the CPU
 //! twins ([`TwinPath`], f64) or the WGSL kernels ([`GpuPath`], f32 or f64).
 //!
-//! The schedule mirrors `statics::solve_static` without its adaptivity: gravity in full
-//! from the low-side start with friction and bit loads off (λ = 0), then λ = ¼, ½, ¾, 1
-//! (bit loads and friction scaled by λ); Newton with the solver's line search at each λ
-//! (per variant: energy slope or residual decrease, α halved at most five times). A
-//! variant whose Newton fails (singular pivot, a non-finite residual, no convergence within
-//! the iterations) is flagged with the reason and frozen; the caller re-runs it on the CPU
-//! with step control. Converged and frozen variants get α = 0, so they stop moving while
-//! the others iterate.
+//! Each variant follows its own load path, the one `statics::solve_static` follows
+//! ([`crate::solve::continuation::LoadPath`]: gravity in full from the low-side start,
+//! exponent continuation where that fails, λ steps cut on failure and regrown after easy
+//! ones, the polish), through the one Newton ([`crate::solve::newton`]); all variants
+//! advance in the same dispatches, each at its own λ. A variant fails only where
+//! `solve_static` fails (below the smallest load step); the caller then re-runs it on the
+//! CPU and says so. Finished variants get α = 0, and once no more than half of a chunk is
+//! running the rest go on in a chunk of their own (compaction, bit for bit).
 //!
-//! States are displacements `u` from the reference positions (kept in f64 on the host):
+//! States are displacements `u` from a per-variant base (kept in f64 on the host):
 //! positions of kilometres would lose their millimetres in f32.
 //!
 //! Data stay where the path keeps them ([`Ensemble`]): on the GPU the configuration, the
