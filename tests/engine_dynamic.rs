@@ -94,8 +94,15 @@ fn trajectory_error(
 
 fn bed_variants(csv: &str) -> (holewall::case::Case, Vec<Model>, Vec<StaticState>) {
     let case = common::bed_case("1");
+    let (models, starts) = with_starts(&case, csv);
+    (case, models, starts)
+}
+
+/// The variants of `csv` applied to `case`, each with its static equilibrium (the undeformed
+/// string where that fails).
+fn with_starts(case: &holewall::case::Case, csv: &str) -> (Vec<Model>, Vec<StaticState>) {
     let variants = variants_from_csv_text("v.csv", csv).unwrap();
-    let models: Vec<Model> = variants.iter().map(|v| apply(&case, v).unwrap()).collect();
+    let models: Vec<Model> = variants.iter().map(|v| apply(case, v).unwrap()).collect();
     let starts = models
         .iter()
         .map(|m| {
@@ -104,7 +111,7 @@ fn bed_variants(csv: &str) -> (holewall::case::Case, Vec<Model>, Vec<StaticState
                 .unwrap_or_else(|_| StaticState::initial(m))
         })
         .collect();
-    (case, models, starts)
+    (models, starts)
 }
 
 #[test]
@@ -500,12 +507,7 @@ fn paper_case_sixteen_variants_match_the_cpu_integrator() {
             csv += &format!("{rpm} rpm,{wob} kN\n");
         }
     }
-    let variants = variants_from_csv_text("v.csv", &csv).unwrap();
-    let models: Vec<Model> = variants.iter().map(|v| apply(&case, v).unwrap()).collect();
-    let starts: Vec<StaticState> = models
-        .iter()
-        .map(|m| solve_static(m, &StaticOptions::default()).unwrap().state)
-        .collect();
+    let (models, starts) = with_starts(&case, &csv);
     let options = holewall::cli::run_cmd::options_for(case.dynamics.as_ref().unwrap());
     let t0 = std::time::Instant::now();
     let cpu = cpu_runs(&models, &starts, &case.element_density, &options, seconds);
@@ -616,12 +618,7 @@ fn a_variant_whose_step_fails_is_cut_on_its_own_in_the_engine() {
     let text = common::bed_text("0.3", "8.25 in", "6e7", "1", "1e-6")
         .replace("time_step = \"2 ms\"", "time_step = \"10 ms\"");
     let case = holewall::case::parse_case(std::path::Path::new("bed.toml"), &text).unwrap();
-    let variants = variants_from_csv_text("v.csv", "eps\n1e-3\n1e-6\n").unwrap();
-    let models: Vec<Model> = variants.iter().map(|v| apply(&case, v).unwrap()).collect();
-    let starts: Vec<StaticState> = models
-        .iter()
-        .map(|m| solve_static(m, &StaticOptions::default()).unwrap().state)
-        .collect();
+    let (models, starts) = with_starts(&case, "eps\n1e-3\n1e-6\n");
     let options = holewall::cli::run_cmd::options_for(case.dynamics.as_ref().unwrap());
     let density = case.element_density.clone();
     let t_end = 0.05;
