@@ -304,6 +304,8 @@ struct Chunk<'a, T, P> {
     lowered: bool,
     drives: Vec<Dynamics<'a>>,
     status: Vec<DynamicStatus>,
+    /// Per variant its own step: `dt`, or cut and not yet regrown.
+    step: Vec<f64>,
     iterations: Vec<Vec<usize>>,
     log: Vec<Vec<String>>,
 }
@@ -365,6 +367,7 @@ fn run_chunk<T: Real + Send + Sync, P: KernelPath<T>>(
         driven,
         lowered,
         status: vec![DynamicStatus::Finished; v],
+        step: vec![options.dt; v],
         iterations: vec![Vec::new(); v],
         log: vec![Vec::new(); v],
     };
@@ -446,49 +449,73 @@ fn run_span<T: Real + Send + Sync, P: KernelPath<T>>(
             }
         }
         ensemble.begin_step(&coefficients, &top)?;
+        // Variants whose own step is shorter than this one (cut before, not yet regrown,
+        // as the CPU integrator keeps it) take this step in sub-steps of their own.
+        let deferred: Vec<usize> = (0..m)
+            .filter(|&i| {
+                let j = members[i];
+                chunk.status[j] == DynamicStatus::Finished && chunk.step[j] < hh * (1.0 - 1e-9)
+            })
+            .collect();
+        let at_n = if deferred.is_empty() {
+            None
+        } else {
+            Some(ensemble.state()?)
+        };
         let mut newton = Newton::new(settings, m);
         for (i, &j) in members.iter().enumerate() {
-            if chunk.status[j] == DynamicStatus::Finished {
+            if chunk.status[j] == DynamicStatus::Finished && !deferred.contains(&i) {
                 newton.start(i, chunk.floors[j], false);
             }
         }
         let hhb = hh * hh * p.beta * ratio;
         let (failed, before) =
             solve_step(chunk, ensemble, members, &coefficients, &top, newton, hhb)?;
-        if let Some(before) = before {
-            let cut = hh / 2.0;
-            let mut retry = Vec::new();
-            for (i, reason) in failed {
-                let j = members[i];
-                if cut < options.min_dt {
-                    chunk.status[j] = DynamicStatus::Failed(
-                        t1,
-                        format!(
-                            "step {hh:.3e} s failed and cannot be cut below {:.1e} s: {reason}",
-                            options.min_dt
-                        ),
-                    );
-                } else {
-                    chunk.log[j].push(format!(
-                        "t = {time:.6} s: step {hh:.3e} s failed ({reason}); cut to {cut:.3e} s"
-                    ));
-                    retry.push(i);
-                }
+        // (local index, its sub-step) of every variant to take this step in sub-steps.
+        let mut retry: Vec<(usize, f64)> = deferred
+            .iter()
+            .map(|&i| (i, chunk.step[members[i]]))
+            .collect();
+        let cut = hh / 2.0;
+        for (i, reason) in failed {
+            let j = members[i];
+            if cut < options.min_dt {
+                chunk.status[j] = DynamicStatus::Failed(
+                    t1,
+                    format!(
+                        "step {hh:.3e} s failed and cannot be cut below {:.1e} s: {reason}",
+                        options.min_dt
+                    ),
+                );
+            } else {
+                chunk.log[j].push(format!(
+                    "t = {time:.6} s: step {hh:.3e} s failed ({reason}); cut to {cut:.3e} s"
+                ));
+                chunk.step[j] = cut;
+                retry.push((i, cut));
             }
-            if !retry.is_empty() {
-                let again: Vec<usize> = retry.iter().map(|&i| members[i]).collect();
+        }
+        if !retry.is_empty() {
+            let at_n = before.or(at_n).ok_or("no state at the step's start")?;
+            let mut now = ensemble.state()?;
+            let mut steps: Vec<f64> = retry.iter().map(|r| r.1).collect();
+            steps.sort_by(|a, b| b.total_cmp(a));
+            steps.dedup();
+            for h_sub in steps {
+                let group: Vec<usize> =
+                    retry.iter().filter(|r| r.1 == h_sub).map(|r| r.0).collect();
+                let again: Vec<usize> = group.iter().map(|&i| members[i]).collect();
                 let after = retry_alone(
                     chunk,
                     &again,
-                    &batch_columns(&before, &retry),
+                    &batch_columns(&at_n, &group),
                     time,
                     t1,
-                    cut,
+                    h_sub,
                 )?;
-                let mut now = ensemble.state()?;
-                put_batch_columns(&mut now, &retry, &after);
-                ensemble.set_state(&now)?;
+                put_batch_columns(&mut now, &group, &after);
             }
+            ensemble.set_state(&now)?;
         }
         time = t1;
         step += 1;
@@ -537,7 +564,15 @@ fn solve_step<T: Real + Send + Sync, P: KernelPath<T>>(
         while newton.any_running() {
             for (i, event) in newton.iterate(&mut sys)? {
                 match event {
-                    Event::Converged(its) => chunk.iterations[members[i]].push(its),
+                    Event::Converged(its) => {
+                        let j = members[i];
+                        chunk.iterations[j].push(its);
+                        // As the CPU integrator: a cut step doubles after an easy one.
+                        if its <= 4 && chunk.step[j] < chunk.options.dt {
+                            chunk.step[j] = (2.0 * chunk.step[j]).min(chunk.options.dt);
+                            chunk.log[j].push(format!("step regrown to {:.3e} s", chunk.step[j]));
+                        }
+                    }
                     Event::Failed(reason) => failed.push((i, reason)),
                 }
             }
