@@ -83,8 +83,9 @@ rho_inf = 0.8
 }
 
 /// Bytes read and written by one Newton iteration of one variant (every kernel of the
-/// dynamic engine once, plus the line search's one trial evaluation), at `size`-byte
-/// floats, for `n` nodes and `s` contact sites.
+/// dynamic engine once: the line search's trial evaluation, once accepted, is the next
+/// iteration's system, so an iteration evaluates about once), at `size`-byte floats, for
+/// `n` nodes and `s` contact sites.
 pub fn bytes_per_iteration(n: usize, s: usize, size: usize) -> usize {
     let m = n - 1;
     let predict = 36 * n + 24 * n;
@@ -95,11 +96,11 @@ pub fn bytes_per_iteration(n: usize, s: usize, size: usize) -> usize {
     let lu = 2 * (36 * n + 72 * m + 6 * n) + 2 * (36 * m + 12 * n);
     let norms = 12 * n;
     let evaluation = predict + beam + sites + contact + assemble;
-    size * (2 * evaluation + lu + 2 * norms + 12 * n)
+    size * (evaluation + lu + 2 * norms + 12 * n)
 }
 
-/// Floating-point operations of one Newton iteration of one variant: two evaluations
-/// (iteration and trial) and one block solve. The beam kernel dominates: 144 hyper-dual
+/// Floating-point operations of one Newton iteration of one variant: one evaluation (the
+/// accepted trial's is the next iteration's system) and one block solve. The beam kernel dominates: 144 hyper-dual
 /// evaluations of the element energy per element, ≈ 240 hyper-dual operations each
 /// (chord, frame, two relative rotation logs, the energy) at ≈ 10 real operations per
 /// hyper-dual operation — an estimate from the kernel's text, not a count.
@@ -111,7 +112,7 @@ pub fn flops_per_iteration(n: usize, s: usize) -> f64 {
     // Block LU per node: a 6×6 factorisation with 12 right-hand columns, two block
     // products and two solves.
     let lu = (2.0 / 3.0 * 216.0 + 2.0 * 216.0 * 2.0 + 2.0 * 432.0 + 4.0 * 36.0) * n as f64;
-    2.0 * (beam + contact + assemble) + lu
+    beam + contact + assemble + lu
 }
 
 #[derive(Serialize, Clone)]

@@ -75,6 +75,9 @@ pub trait DynamicEnsemble<T> {
     fn trial(&mut self, alpha: &[T]) -> Result<Norms<T>, String>;
     /// The unknown `+= α Δ`.
     fn correct(&mut self, alpha: &[T]) -> Result<(), String>;
+    /// The unknown becomes the last trial's candidate, whose evaluated system the next
+    /// [`DynamicEnsemble::iterate`] solves without evaluating it again.
+    fn accept_trial(&mut self) -> Result<(), String>;
     /// Ends the step: the state at `t_{n+1}` from the unknown.
     fn end_step(&mut self) -> Result<(), String>;
     /// The state, read back.
@@ -696,8 +699,11 @@ impl<T: Real> NewtonSystem for DynamicStep<'_, T> {
         let r = self.ensemble.trial(&negated::<T>(alpha))?;
         Ok(trial_probe(&r))
     }
-    fn accept(&mut self, alpha: &[f64], _trial_matches: bool) -> Result<(), String> {
-        if alpha.iter().any(|&a| a != 0.0) {
+    fn accept(&mut self, alpha: &[f64], trial_matches: bool) -> Result<(), String> {
+        if trial_matches {
+            // The trial at these α was evaluated: its system is the next iteration's.
+            self.ensemble.accept_trial()?;
+        } else if alpha.iter().any(|&a| a != 0.0) {
             self.ensemble.correct(&negated::<T>(alpha))?;
         }
         Ok(())
@@ -716,6 +722,9 @@ pub struct TwinDynamic<'a> {
     unknown: Vec<f64>,
     trial: DynamicBatch<f64>,
     delta: Vec<f64>,
+    /// The last trial's system, and the system the next iteration solves as it is.
+    trial_system: Option<ChainBatch<f64>>,
+    ready: Option<ChainBatch<f64>>,
 }
 
 impl<'a> TwinDynamic<'a> {
@@ -741,6 +750,8 @@ impl<'a> TwinDynamic<'a> {
             unknown: dynamic.start.vdot.clone(),
             trial: dynamic.start.clone(),
             delta: vec![0.0; 6 * tables.num_nodes * tables.num_variants],
+            trial_system: None,
+            ready: None,
         }
     }
 
@@ -781,12 +792,19 @@ impl DynamicEnsemble<f64> for TwinDynamic<'_> {
         self.coefficients = Some(*c);
         self.top = top.to_vec();
         self.unknown = self.state.vdot.clone();
+        self.ready = None;
         Ok(())
     }
     fn iterate(&mut self) -> Result<Iteration<f64>, String> {
-        let sys = self.evaluate_at(self.unknown.clone())?;
-        // The top's prescribed accelerations, as the predictor wrote them.
-        self.unknown = self.trial.vdot.clone();
+        let sys = match self.ready.take() {
+            Some(sys) => sys,
+            None => {
+                let sys = self.evaluate_at(self.unknown.clone())?;
+                // The top's prescribed accelerations, as the predictor wrote them.
+                self.unknown = self.trial.vdot.clone();
+                sys
+            }
+        };
         let (delta, status) = block_lu(&sys);
         self.delta = delta;
         let (v, n) = (self.tables.num_variants, self.tables.num_nodes);
@@ -802,11 +820,20 @@ impl DynamicEnsemble<f64> for TwinDynamic<'_> {
         let (v, n) = (self.tables.num_variants, self.tables.num_nodes);
         let cand = accelerate(&self.tables.basis, &self.unknown, &self.delta, alpha, n, v);
         let sys = self.evaluate_at(cand)?;
-        Ok(norms(&sys.rhs, &self.delta, alpha, n, v))
+        let out = norms(&sys.rhs, &self.delta, alpha, n, v);
+        self.trial_system = Some(sys);
+        Ok(out)
     }
     fn correct(&mut self, alpha: &[f64]) -> Result<(), String> {
         let (v, n) = (self.tables.num_variants, self.tables.num_nodes);
         self.unknown = accelerate(&self.tables.basis, &self.unknown, &self.delta, alpha, n, v);
+        self.ready = None;
+        Ok(())
+    }
+    fn accept_trial(&mut self) -> Result<(), String> {
+        // The candidate with the top's prescribed accelerations, as the predictor wrote it.
+        self.unknown = self.trial.vdot.clone();
+        self.ready = Some(self.trial_system.take().ok_or("no trial to accept")?);
         Ok(())
     }
     fn end_step(&mut self) -> Result<(), String> {
@@ -822,6 +849,7 @@ impl DynamicEnsemble<f64> for TwinDynamic<'_> {
     }
     fn set_state(&mut self, state: &DynamicBatch<f64>) -> Result<(), String> {
         self.state = state.clone();
+        self.ready = None;
         Ok(())
     }
     fn unknown(&mut self) -> Result<Vec<f64>, String> {
@@ -829,6 +857,7 @@ impl DynamicEnsemble<f64> for TwinDynamic<'_> {
     }
     fn set_unknown(&mut self, vdot: &[f64]) -> Result<(), String> {
         self.unknown = vdot.to_vec();
+        self.ready = None;
         Ok(())
     }
 }

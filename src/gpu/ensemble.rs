@@ -856,6 +856,9 @@ pub struct GpuDynamic<T: GpuReal> {
     num_pairs: usize,
     a0: T,
     c: Common,
+    /// The system in the buffers is the unknown's (an accepted trial's): the next iteration
+    /// solves it without evaluating it again.
+    ready: bool,
     _keep: Vec<wgpu::Buffer>,
     _real: PhantomData<T>,
 }
@@ -1069,6 +1072,7 @@ impl<T: GpuReal> GpuDynamic<T> {
             num_pairs: p,
             a0: T::from_f64_lossy(dynamic.a0),
             c,
+            ready: false,
             _keep: vec![mass, inertia0, diag, upper, lower, rhs],
             _real: PhantomData,
         })
@@ -1124,6 +1128,7 @@ impl<T: GpuReal> crate::engine::dynamic::DynamicEnsemble<T> for GpuDynamic<T> {
         let mut e = encoder(self.ctx, "begin_step");
         Self::copy_all(&mut e, &[(&self.b.vdot_n, &self.b.vdot_k)]);
         q.submit([e.finish()]);
+        self.ready = false;
         Ok(())
     }
 
@@ -1133,7 +1138,9 @@ impl<T: GpuReal> crate::engine::dynamic::DynamicEnsemble<T> for GpuDynamic<T> {
         self.c.reset_status(&mut e, v);
         {
             let mut pass = e.begin_compute_pass(&Default::default());
-            self.record_evaluate(&mut pass, false);
+            if !std::mem::take(&mut self.ready) {
+                self.record_evaluate(&mut pass, false);
+            }
             for group in &self.g.lu {
                 dispatch(&mut pass, &self.p.block_lu, group, v);
             }
@@ -1201,6 +1208,17 @@ impl<T: GpuReal> crate::engine::dynamic::DynamicEnsemble<T> for GpuDynamic<T> {
         }
         Self::copy_all(&mut e, &[(&self.b.vdot_c, &self.b.vdot_k)]);
         self.ctx.queue.submit([e.finish()]);
+        self.ready = false;
+        Ok(())
+    }
+
+    fn accept_trial(&mut self) -> Result<(), String> {
+        // The candidate (with the top's prescribed accelerations the predictor wrote into
+        // it) becomes the unknown; the system the trial assembled stays for the next solve.
+        let mut e = encoder(self.ctx, "accept_trial");
+        Self::copy_all(&mut e, &[(&self.b.vdot_c, &self.b.vdot_k)]);
+        self.ctx.queue.submit([e.finish()]);
+        self.ready = true;
         Ok(())
     }
 
@@ -1242,6 +1260,7 @@ impl<T: GpuReal> crate::engine::dynamic::DynamicEnsemble<T> for GpuDynamic<T> {
         ] {
             q.write_buffer(buffer, 0, bytemuck::cast_slice(data));
         }
+        self.ready = false;
         Ok(())
     }
 
@@ -1261,6 +1280,7 @@ impl<T: GpuReal> crate::engine::dynamic::DynamicEnsemble<T> for GpuDynamic<T> {
         self.ctx
             .queue
             .write_buffer(&self.b.vdot_k, 0, bytemuck::cast_slice(vdot));
+        self.ready = false;
         Ok(())
     }
 
