@@ -100,13 +100,13 @@ pub fn bytes_per_iteration(n: usize, s: usize, size: usize) -> usize {
 }
 
 /// Floating-point operations of one Newton iteration of one variant: one evaluation (the
-/// accepted trial's is the next iteration's system) and one block solve. The beam kernel dominates: 144 hyper-dual
+/// accepted trial's is the next iteration's system) and one block solve. The beam kernel dominates: 78 hyper-dual
 /// evaluations of the element energy per element, ≈ 240 hyper-dual operations each
 /// (chord, frame, two relative rotation logs, the energy) at ≈ 10 real operations per
 /// hyper-dual operation — an estimate from the kernel's text, not a count.
 pub fn flops_per_iteration(n: usize, s: usize) -> f64 {
     let m = (n - 1) as f64;
-    let beam = 144.0 * 240.0 * 10.0 * m;
+    let beam = 78.0 * 240.0 * 10.0 * m;
     let contact = 400.0 * s as f64;
     let assemble = 1200.0 * n as f64;
     // Block LU per node: a 6×6 factorisation with 12 right-hand columns, two block

@@ -540,7 +540,9 @@ mod tests {
         // rotations up to 2.5 rad.
         let mut seed = 12345u64;
         let mut rnd = |a: f64| {
-            seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
             a * ((seed >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0)
         };
         let l = 9.0;
