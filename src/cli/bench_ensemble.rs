@@ -100,13 +100,14 @@ pub fn bytes_per_iteration(n: usize, s: usize, size: usize) -> usize {
 }
 
 /// Floating-point operations of one Newton iteration of one variant: one evaluation (the
-/// accepted trial's is the next iteration's system) and one block solve. The beam kernel dominates: 78 hyper-dual
-/// evaluations of the element energy per element, ≈ 240 hyper-dual operations each
+/// accepted trial's is the next iteration's system) and one block solve. The beam dominates: `tangent_evaluations` hyper-dual
+/// evaluations of the element energy per element (144 in the GPU kernel, 78 on the CPU,
+/// `physics::beam::force_and_tangent`), ≈ 240 hyper-dual operations each
 /// (chord, frame, two relative rotation logs, the energy) at ≈ 10 real operations per
 /// hyper-dual operation — an estimate from the kernel's text, not a count.
-pub fn flops_per_iteration(n: usize, s: usize) -> f64 {
+pub fn flops_per_iteration(n: usize, s: usize, tangent_evaluations: usize) -> f64 {
     let m = (n - 1) as f64;
-    let beam = 78.0 * 240.0 * 10.0 * m;
+    let beam = tangent_evaluations as f64 * 240.0 * 10.0 * m;
     let contact = 400.0 * s as f64;
     let assemble = 1200.0 * n as f64;
     // Block LU per node: a 6×6 factorisation with 12 right-hand columns, two block
@@ -350,7 +351,9 @@ pub fn run(
                 cell.median_s = Some(t);
                 cell.variant_steps_per_s = Some((v * steps) as f64 / t);
                 cell.newton_iterations_per_step = Some(per_it);
-                cell.effective_gflops = Some(flops_per_iteration(nodes, s) * its as f64 / t / 1e9);
+                let evaluations = if path.starts_with("GPU") { 144 } else { 78 };
+                cell.effective_gflops =
+                    Some(flops_per_iteration(nodes, s, evaluations) * its as f64 / t / 1e9);
                 cell.effective_gbytes_per_s =
                     Some(bytes_per_iteration(nodes, s, size) as f64 * its as f64 / t / 1e9);
                 if path == "CPU f64" {

@@ -1,6 +1,6 @@
 //! Twin of `shaders/beam.wgsl`: internal force (12) and consistent tangent (12×12) of every
-//! (element, variant), by [`crate::physics::beam::force_and_tangent`] (hyper-dual
-//! evaluations of the co-rotated element energy), laid out for the assembly:
+//! (element, variant), by [`crate::physics::beam::force_and_tangent_full`] (all 144
+//! hyper-dual evaluations of the co-rotated element energy, as the kernel), laid out for the assembly:
 //! `[(12 e + j) V + v]` and `[(144 e + 12 j + k) V + v]`. Inputs: displacements `w` from
 //! each variant's *base* configuration `X + b` `[(3 i + k) V + v]`, rotations
 //! `[(9 i + 3 r + c) V + v]` (the twin takes them in f64), reference triads per node and
@@ -16,7 +16,7 @@
 use rayon::prelude::*;
 
 use crate::model::Model;
-use crate::physics::beam::{force_and_tangent, ElementState, Mat3};
+use crate::physics::beam::{force_and_tangent_full, ElementState, Mat3};
 
 /// Per element: `EA/l0, GJ/l0, EI/l0, l0` (the kernel's `section` binding).
 pub fn section_table(model: &Model) -> Vec<f64> {
@@ -110,7 +110,7 @@ pub fn beam(
                 triad: [triad(e), triad(e + 1)],
             };
             let el = &model.elements[e];
-            force_and_tangent(&es, &el.section, el.length0)
+            force_and_tangent_full(&es, &el.section, el.length0)
         })
         .collect();
     let mut force = vec![0.0; 12 * ne * nv];

@@ -374,7 +374,11 @@ pub fn spin_commutator<T: Real>(force: &[T; 12], j: usize, k: usize) -> T {
     }
 }
 
-/// As [`force_and_tangent`], from all 144 hyper-dual evaluations (the test oracle).
+/// As [`force_and_tangent`], from all 144 hyper-dual evaluations: the test oracle, and
+/// the beam kernel's formula (`shaders/beam.wgsl` keeps 144: with the 78-evaluation form
+/// the f32 static engine lost one stress variant — μ = 1 on a 1e10 N/m wall at a
+/// full-gauge stabilizer, which needs 4 load-step cuts in f32 already — to the different
+/// rounding of its tangent).
 #[allow(clippy::needless_range_loop)]
 pub fn force_and_tangent_full(
     state: &ElementState,
