@@ -658,13 +658,13 @@ fn a_variant_whose_step_fails_is_cut_on_its_own_in_the_engine() {
         assert!(diff <= 1e-10 * scale, "{diff:e} of {scale:e}");
     };
     let last_state = std::cell::RefCell::new(None);
-    let twin_run = || {
+    let run_on = |path: &dyn holewall::engine::KernelPath<f64>| {
         let mut last = None;
         let r = run_dynamic_ensemble(
             &models,
             &starts,
             &density,
-            &TwinPath,
+            &Dyn(path),
             &options,
             t_end,
             1,
@@ -674,28 +674,38 @@ fn a_variant_whose_step_fails_is_cut_on_its_own_in_the_engine() {
         *last_state.borrow_mut() = last;
         r
     };
-    check("twin", &twin_run, &|| last_state.borrow().clone().unwrap());
+    check("twin", &|| run_on(&TwinPath), &|| {
+        last_state.borrow().clone().unwrap()
+    });
     let Some(ctx) = common::gpu() else { return };
     if ctx.has_f64 {
-        let gpu_run = || {
-            let mut last = None;
-            let r = run_dynamic_ensemble(
-                &models,
-                &starts,
-                &density,
-                &GpuPath(ctx),
-                &options,
-                t_end,
-                1,
-                &mut |_, _, b: &DynamicBatch<f64>| last = Some(b.clone()),
-            )
-            .unwrap();
-            *last_state.borrow_mut() = last;
-            r
-        };
-        check("GPU f64", &gpu_run, &|| {
+        check("GPU f64", &|| run_on(&GpuPath(ctx)), &|| {
             last_state.borrow().clone().unwrap()
         });
+    }
+}
+
+/// A kernel path behind a reference (one closure for the twin and the GPU).
+struct Dyn<'p>(&'p dyn holewall::engine::KernelPath<f64>);
+
+impl holewall::engine::KernelPath<f64> for Dyn<'_> {
+    fn max_chunk(&self, model: &Model) -> usize {
+        self.0.max_chunk(model)
+    }
+    fn open<'a>(
+        &'a self,
+        model: &'a Model,
+        tables: &holewall::engine::EnsembleTables<f64>,
+    ) -> Result<Box<dyn holewall::engine::Ensemble<f64> + 'a>, String> {
+        self.0.open(model, tables)
+    }
+    fn open_dynamic<'a>(
+        &'a self,
+        model: &'a Model,
+        tables: &holewall::engine::EnsembleTables<f64>,
+        dynamic: &holewall::engine::dynamic::DynamicTables<f64>,
+    ) -> Result<Box<dyn holewall::engine::dynamic::DynamicEnsemble<f64> + 'a>, String> {
+        self.0.open_dynamic(model, tables, dynamic)
     }
 }
 

@@ -336,16 +336,12 @@ pub fn force_and_tangent(
     let mut force = [0.0; 12];
     let mut tangent = [[0.0; 12]; 12];
     for k in 0..12 {
-        // Δ_k (ε₂) applied first, then δ_j (ε₁) on top.
-        let mut base = lift(state);
-        perturb(&mut base.0, &mut base.1, k, EPS2);
-        for j in 0..=k {
-            let e = energy_varied(&base, j, section, length0);
+        for_each_second_derivative(state, section, length0, k, 0..k + 1, |j, e| {
             tangent[j][k] = e.e12;
             if k == 11 {
                 force[j] = e.e1;
             }
-        }
+        });
     }
     for k in 0..12 {
         for j in 0..k {
@@ -388,17 +384,31 @@ pub fn force_and_tangent_full(
     let mut force = [0.0; 12];
     let mut tangent = [[0.0; 12]; 12];
     for k in 0..12 {
-        let mut base = lift(state);
-        perturb(&mut base.0, &mut base.1, k, EPS2);
-        for j in 0..12 {
-            let e = energy_varied(&base, j, section, length0);
+        for_each_second_derivative(state, section, length0, k, 0..12, |j, e| {
             tangent[j][k] = e.e12;
             if k == 0 {
                 force[j] = e.e1;
             }
-        }
+        });
     }
     (force, tangent)
+}
+
+/// The energy with `Δ_k` (ε₂) applied first and each `δ_j`, `j` in `js`, (ε₁) on top:
+/// `visit(j, E)` gets `∂E/∂δ_j` (ε₁ part) and `∂²E/∂δ_j∂Δ_k` (ε₁ε₂ part).
+fn for_each_second_derivative(
+    state: &ElementState,
+    section: &BeamSection,
+    length0: f64,
+    k: usize,
+    js: std::ops::Range<usize>,
+    mut visit: impl FnMut(usize, HyperDual),
+) {
+    let mut base = lift(state);
+    perturb(&mut base.0, &mut base.1, k, EPS2);
+    for j in js {
+        visit(j, energy_varied(&base, j, section, length0));
+    }
 }
 
 #[cfg(test)]
