@@ -664,7 +664,7 @@ fn a_variant_whose_step_fails_is_cut_on_its_own_in_the_engine() {
             &models,
             &starts,
             &density,
-            &Dyn(path),
+            &Counting::new(path),
             &options,
             t_end,
             1,
@@ -685,40 +685,26 @@ fn a_variant_whose_step_fails_is_cut_on_its_own_in_the_engine() {
     }
 }
 
-/// A kernel path behind a reference (one closure for the twin and the GPU).
-struct Dyn<'p>(&'p dyn holewall::engine::KernelPath<f64>);
-
-impl holewall::engine::KernelPath<f64> for Dyn<'_> {
-    fn max_chunk(&self, model: &Model) -> usize {
-        self.0.max_chunk(model)
-    }
-    fn open<'a>(
-        &'a self,
-        model: &'a Model,
-        tables: &holewall::engine::EnsembleTables<f64>,
-    ) -> Result<Box<dyn holewall::engine::Ensemble<f64> + 'a>, String> {
-        self.0.open(model, tables)
-    }
-    fn open_dynamic<'a>(
-        &'a self,
-        model: &'a Model,
-        tables: &holewall::engine::EnsembleTables<f64>,
-        dynamic: &holewall::engine::dynamic::DynamicTables<f64>,
-    ) -> Result<Box<dyn holewall::engine::dynamic::DynamicEnsemble<f64> + 'a>, String> {
-        self.0.open_dynamic(model, tables, dynamic)
-    }
-}
-
 /// A run of some variants with the number of dynamic chunks it opened.
 type CountedRun = Box<dyn Fn(&[Model], &[StaticState]) -> (Outcome, usize)>;
 
-/// A kernel path that counts the dynamic chunks it opens (compaction opens more).
-struct Counting<P> {
-    inner: P,
+/// A kernel path (behind a reference, so one closure serves the twin and the GPU) that
+/// counts the dynamic chunks it opens (compaction opens more).
+struct Counting<'p> {
+    inner: &'p dyn holewall::engine::KernelPath<f64>,
     opens: std::cell::Cell<usize>,
 }
 
-impl<P: holewall::engine::KernelPath<f64>> holewall::engine::KernelPath<f64> for Counting<P> {
+impl<'p> Counting<'p> {
+    fn new(inner: &'p dyn holewall::engine::KernelPath<f64>) -> Self {
+        Counting {
+            inner,
+            opens: std::cell::Cell::new(0),
+        }
+    }
+}
+
+impl holewall::engine::KernelPath<f64> for Counting<'_> {
     fn max_chunk(&self, model: &Model) -> usize {
         self.inner.max_chunk(model)
     }
@@ -773,10 +759,7 @@ fn stragglers_compacted_within_a_step_go_on_bit_for_bit() {
     let twin = || -> CountedRun {
         let density = density.clone();
         Box::new(move |m: &[Model], s: &[StaticState]| {
-            let path = Counting {
-                inner: TwinPath,
-                opens: std::cell::Cell::new(0),
-            };
+            let path = Counting::new(&TwinPath);
             let out = collect(m, s, &density, &path, &options, t_end);
             (out, path.opens.get())
         })
@@ -787,10 +770,8 @@ fn stragglers_compacted_within_a_step_go_on_bit_for_bit() {
         let gpu = || -> CountedRun {
             let density = density.clone();
             Box::new(move |m: &[Model], s: &[StaticState]| {
-                let path = Counting {
-                    inner: GpuPath(ctx),
-                    opens: std::cell::Cell::new(0),
-                };
+                let gpu = GpuPath(ctx);
+                let path = Counting::new(&gpu);
                 let out = collect(m, s, &density, &path, &options, t_end);
                 (out, path.opens.get())
             })
