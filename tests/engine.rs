@@ -274,34 +274,6 @@ fn f32_engine_error_against_f64() {
     assert!(worst.iter().all(|&w| w <= 1.2e-3), "{worst:?}");
 }
 
-/// A kernel path that counts the static chunks it opens (compaction opens more).
-struct Counting<P> {
-    inner: P,
-    opens: std::cell::Cell<usize>,
-}
-
-impl<P: holewall::engine::KernelPath<f64>> holewall::engine::KernelPath<f64> for Counting<P> {
-    fn max_chunk(&self, model: &holewall::model::Model) -> usize {
-        self.inner.max_chunk(model)
-    }
-    fn open<'a>(
-        &'a self,
-        model: &'a holewall::model::Model,
-        tables: &holewall::engine::EnsembleTables<f64>,
-    ) -> Result<Box<dyn holewall::engine::Ensemble<f64> + 'a>, String> {
-        self.opens.set(self.opens.get() + 1);
-        self.inner.open(model, tables)
-    }
-    fn open_dynamic<'a>(
-        &'a self,
-        model: &'a holewall::model::Model,
-        tables: &holewall::engine::EnsembleTables<f64>,
-        dynamic: &holewall::engine::dynamic::DynamicTables<f64>,
-    ) -> Result<Box<dyn holewall::engine::dynamic::DynamicEnsemble<f64> + 'a>, String> {
-        self.inner.open_dynamic(model, tables, dynamic)
-    }
-}
-
 /// Compaction of the static engine: once no more than half of the variants are running,
 /// the rest go on in a chunk of their own exactly where they stand — every variant of a
 /// 6-variant run ends bit-identical to its run alone, and the run did compact.
@@ -324,10 +296,7 @@ fn compacted_static_variants_go_on_bit_for_bit() {
             .map(|x| x.to_bits())
             .collect()
     };
-    let counting = Counting {
-        inner: TwinPath,
-        opens: std::cell::Cell::new(0),
-    };
+    let counting = common::Counting::new(&TwinPath);
     let together = solve_static_ensemble(&models, &counting, &options).unwrap();
     eprintln!(
         "{} chunks opened for 6 variants; iterations per load step {:?}",

@@ -664,7 +664,7 @@ fn a_variant_whose_step_fails_is_cut_on_its_own_in_the_engine() {
             &models,
             &starts,
             &density,
-            &Counting::new(path),
+            &common::Counting::new(path),
             &options,
             t_end,
             1,
@@ -687,44 +687,6 @@ fn a_variant_whose_step_fails_is_cut_on_its_own_in_the_engine() {
 
 /// A run of some variants with the number of dynamic chunks it opened.
 type CountedRun = Box<dyn Fn(&[Model], &[StaticState]) -> (Outcome, usize)>;
-
-/// A kernel path (behind a reference, so one closure serves the twin and the GPU) that
-/// counts the dynamic chunks it opens (compaction opens more).
-struct Counting<'p> {
-    inner: &'p dyn holewall::engine::KernelPath<f64>,
-    opens: std::cell::Cell<usize>,
-}
-
-impl<'p> Counting<'p> {
-    fn new(inner: &'p dyn holewall::engine::KernelPath<f64>) -> Self {
-        Counting {
-            inner,
-            opens: std::cell::Cell::new(0),
-        }
-    }
-}
-
-impl holewall::engine::KernelPath<f64> for Counting<'_> {
-    fn max_chunk(&self, model: &Model) -> usize {
-        self.inner.max_chunk(model)
-    }
-    fn open<'a>(
-        &'a self,
-        model: &'a Model,
-        tables: &holewall::engine::EnsembleTables<f64>,
-    ) -> Result<Box<dyn holewall::engine::Ensemble<f64> + 'a>, String> {
-        self.inner.open(model, tables)
-    }
-    fn open_dynamic<'a>(
-        &'a self,
-        model: &'a Model,
-        tables: &holewall::engine::EnsembleTables<f64>,
-        dynamic: &holewall::engine::dynamic::DynamicTables<f64>,
-    ) -> Result<Box<dyn holewall::engine::dynamic::DynamicEnsemble<f64> + 'a>, String> {
-        self.opens.set(self.opens.get() + 1);
-        self.inner.open_dynamic(model, tables, dynamic)
-    }
-}
 
 /// Stragglers of a time step move to a chunk of their own (compaction) exactly where they
 /// stand: every variant of a 6-variant run ends bit-identical to its run alone (twin and
@@ -759,9 +721,9 @@ fn stragglers_compacted_within_a_step_go_on_bit_for_bit() {
     let twin = || -> CountedRun {
         let density = density.clone();
         Box::new(move |m: &[Model], s: &[StaticState]| {
-            let path = Counting::new(&TwinPath);
+            let path = common::Counting::new(&TwinPath);
             let out = collect(m, s, &density, &path, &options, t_end);
-            (out, path.opens.get())
+            (out, path.dynamic_opens.get())
         })
     };
     check("twin", &twin);
@@ -771,9 +733,9 @@ fn stragglers_compacted_within_a_step_go_on_bit_for_bit() {
             let density = density.clone();
             Box::new(move |m: &[Model], s: &[StaticState]| {
                 let gpu = GpuPath(ctx);
-                let path = Counting::new(&gpu);
+                let path = common::Counting::new(&gpu);
                 let out = collect(m, s, &density, &path, &options, t_end);
-                (out, path.opens.get())
+                (out, path.dynamic_opens.get())
             })
         };
         check("GPU f64", &gpu);

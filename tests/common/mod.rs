@@ -62,3 +62,46 @@ pub fn static_qois(
         hook,
     ]
 }
+
+/// A kernel path (behind a reference, so one closure serves the twin and the GPU) that
+/// counts the static and the dynamic chunks it opens (compaction opens more).
+pub struct Counting<'p> {
+    inner: &'p dyn holewall::engine::KernelPath<f64>,
+    /// Static chunks opened.
+    pub opens: std::cell::Cell<usize>,
+    /// Dynamic chunks opened.
+    pub dynamic_opens: std::cell::Cell<usize>,
+}
+
+impl<'p> Counting<'p> {
+    pub fn new(inner: &'p dyn holewall::engine::KernelPath<f64>) -> Self {
+        Counting {
+            inner,
+            opens: std::cell::Cell::new(0),
+            dynamic_opens: std::cell::Cell::new(0),
+        }
+    }
+}
+
+impl holewall::engine::KernelPath<f64> for Counting<'_> {
+    fn max_chunk(&self, model: &holewall::model::Model) -> usize {
+        self.inner.max_chunk(model)
+    }
+    fn open<'a>(
+        &'a self,
+        model: &'a holewall::model::Model,
+        tables: &holewall::engine::EnsembleTables<f64>,
+    ) -> Result<Box<dyn holewall::engine::Ensemble<f64> + 'a>, String> {
+        self.opens.set(self.opens.get() + 1);
+        self.inner.open(model, tables)
+    }
+    fn open_dynamic<'a>(
+        &'a self,
+        model: &'a holewall::model::Model,
+        tables: &holewall::engine::EnsembleTables<f64>,
+        dynamic: &holewall::engine::dynamic::DynamicTables<f64>,
+    ) -> Result<Box<dyn holewall::engine::dynamic::DynamicEnsemble<f64> + 'a>, String> {
+        self.dynamic_opens.set(self.dynamic_opens.get() + 1);
+        self.inner.open_dynamic(model, tables, dynamic)
+    }
+}
