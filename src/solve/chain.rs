@@ -1,8 +1,9 @@
 //! The tangent of a drillstring: a chain of nodes with 6 DOF each, so a block-tridiagonal
 //! matrix of 6×6 blocks (element `i` couples nodes `i` and `i+1`; a contact element sits on
-//! one node's diagonal block). This is the layout the GPU block solve works on; the CPU
-//! oracle hands it to faer's sparse LU, with the symbolic factorisation made once per
-//! pattern and reused for every Newton iteration.
+//! one node's diagonal block). This is the layout the GPU block solve works on. The CPU
+//! solvers solve it by the same block LU (its twin, `kernels::block_lu`), and by faer's
+//! sparse LU where a pivot block is singular; faer's sparse LU is also the oracle the block
+//! solves are tested against (its symbolic factorisation made once per pattern and reused).
 
 use faer::linalg::solvers::Solve;
 use faer::sparse::linalg::solvers::{Lu, SymbolicLu};
@@ -142,8 +143,8 @@ pub enum LinearSolveError {
     Factorisation(String),
 }
 
-/// faer sparse LU of block-tridiagonal systems, with the symbolic factorisation of the
-/// (fixed) block pattern computed once and reused.
+/// Solves of block-tridiagonal systems: the block LU, faer's sparse LU where that fails
+/// (its symbolic factorisation of the fixed block pattern computed once and reused).
 #[derive(Default)]
 pub struct ChainSolver {
     symbolic: Option<(usize, SymbolicLu<usize>)>,
@@ -155,8 +156,28 @@ impl ChainSolver {
         ChainSolver { symbolic: None }
     }
 
-    /// Solves `A x = b`.
+    /// Solves `A x = b` by the block-tridiagonal LU (block Thomas with partial pivoting
+    /// inside each 6×6 pivot: [`crate::kernels::block_lu`], the engine's solve; 16× faster
+    /// than the sparse LU on the 247-node paper tangent), and by faer's sparse LU
+    /// ([`ChainSolver::solve_sparse`], which pivots across blocks) where a pivot block is
+    /// singular or the solution not finite.
     pub fn solve(&mut self, a: &BlockTridiagonal, b: &[f64]) -> Result<Vec<f64>, LinearSolveError> {
+        use crate::kernels::block_lu::{block_lu, ChainBatch, SOLVED};
+        if b.iter().all(|x| x.is_finite()) {
+            let (x, status) = block_lu(&ChainBatch::<f64>::from_systems(&[(a, b)]));
+            if status[0] == SOLVED && x.iter().all(|v| v.is_finite()) {
+                return Ok(x);
+            }
+        }
+        self.solve_sparse(a, b)
+    }
+
+    /// Solves `A x = b` by faer's sparse LU (the oracle of the block solves in tests).
+    pub fn solve_sparse(
+        &mut self,
+        a: &BlockTridiagonal,
+        b: &[f64],
+    ) -> Result<Vec<f64>, LinearSolveError> {
         let n = 6 * a.nodes();
         let err = |e: String| LinearSolveError::Factorisation(e);
         if a.diag
