@@ -30,7 +30,9 @@ use crate::physics::Real;
 use crate::solve::dynamics::{DynamicOptions, Dynamics};
 use crate::solve::statics::StaticState;
 
-use super::{columns, ensemble_tables, negated, trial_probe, EnsembleTables, KernelPath, TwinPath};
+use super::{
+    columns, ensemble_tables_from, negated, trial_probe, EnsembleTables, KernelPath, TwinPath,
+};
 use crate::solve::newton::{Event, Newton, NewtonSettings, NewtonSystem, Probe, TrialProbe};
 
 /// What a dynamic chunk adds to [`EnsembleTables`].
@@ -324,7 +326,7 @@ fn run_chunk<T: Real + Send + Sync, P: KernelPath<T>>(
     every: usize,
     observe: &mut dyn FnMut(f64, &DynamicBatch<T>),
 ) -> Result<Vec<DynamicResult>, String> {
-    let mut tables = ensemble_tables::<T>(models)?;
+    super::check_same_mesh(models)?;
     let Start {
         tables: dynamic,
         base,
@@ -332,6 +334,9 @@ fn run_chunk<T: Real + Send + Sync, P: KernelPath<T>>(
         driven,
         lowered,
     } = dynamic_tables::<T>(models, starts, density, options)?;
+    // The chunk's state is the dynamic start; the static tables need no start of their own.
+    let static_start = (dynamic.start.u.clone(), dynamic.start.rot.clone());
+    let mut tables = ensemble_tables_from::<T>(models, Some(static_start))?;
     // The contact terms of the dynamic scene (damping where some c > 0).
     let mut batch = ContactBatch::<T>::new(1, tables.pair_node.len());
     batch.pair_params = dynamic.pair_params.clone();
@@ -635,7 +640,9 @@ fn open_subset<'c, T: Real + Send + Sync, P: KernelPath<T>>(
 ) -> Result<Box<dyn DynamicEnsemble<T> + 'c>, String> {
     let v = chunk.tables.num_variants;
     let models: Vec<Model> = members.iter().map(|&j| chunk.models[j].clone()).collect();
-    let mut tables = ensemble_tables::<T>(&models)?;
+    // The static start is not used by a dynamic chunk: the state is `start`.
+    let mut tables =
+        ensemble_tables_from::<T>(&models, Some((start.u.clone(), start.rot.clone())))?;
     tables.terms = chunk.tables.terms;
     tables.set_base(&models[0], columns(&chunk.tables.base, v, members));
     let d = &chunk.dynamic;

@@ -284,6 +284,9 @@ struct TwinEnsemble<'a> {
     system: [Option<ChainBatch<f64>>; 2],
     current: usize,
     delta: Vec<f64>,
+    /// What the update needs to make contact nodes follow their wall (kept in step with
+    /// the loads and the base).
+    walls: crate::kernels::update::UpdateWalls<f64>,
 }
 
 impl TwinEnsemble<'_> {
@@ -300,15 +303,15 @@ impl TwinEnsemble<'_> {
         ));
     }
 
-    /// What the update needs to make contact nodes follow their wall.
-    fn walls(&self) -> crate::kernels::update::UpdateWalls<f64> {
+    /// The update's walls from the current tables and law parameters.
+    fn refresh_walls(&mut self) {
         let t = &self.tables;
-        crate::kernels::update::UpdateWalls {
+        self.walls = crate::kernels::update::UpdateWalls {
             node_site: t.node_site.clone(),
             pair_base: t.pair_base.clone(),
             pair_normals: t.pair_normals.clone(),
             pair_params: self.contact.pair_params.clone(),
-        }
+        };
     }
 
     fn rhs(&self, slot: usize) -> Result<&[f64], String> {
@@ -324,6 +327,7 @@ impl Ensemble<f64> for TwinEnsemble<'_> {
         self.f_ext = f_ext.to_vec();
         self.contact.pair_params = pair_params.to_vec();
         self.system = [None, None];
+        self.refresh_walls();
         Ok(())
     }
     fn evaluate(&mut self) -> Result<(), String> {
@@ -349,8 +353,7 @@ impl Ensemble<f64> for TwinEnsemble<'_> {
     fn trial(&mut self, alpha: &[f64]) -> Result<Norms<f64>, String> {
         let other = 1 - self.current;
         self.config[other] = self.config[self.current].clone();
-        let walls = self.walls();
-        update(&mut self.config[other], &walls, &self.delta, alpha);
+        update(&mut self.config[other], &self.walls, &self.delta, alpha);
         self.evaluate_slot(other);
         Ok(norms(
             self.rhs(other)?,
@@ -364,8 +367,12 @@ impl Ensemble<f64> for TwinEnsemble<'_> {
         self.current = 1 - self.current;
     }
     fn commit(&mut self, alpha: &[f64]) -> Result<(), String> {
-        let walls = self.walls();
-        update(&mut self.config[self.current], &walls, &self.delta, alpha);
+        update(
+            &mut self.config[self.current],
+            &self.walls,
+            &self.delta,
+            alpha,
+        );
         self.system[self.current] = None;
         Ok(())
     }
@@ -381,6 +388,7 @@ impl Ensemble<f64> for TwinEnsemble<'_> {
     }
     fn rebase(&mut self, tables: &EnsembleTables<f64>) -> Result<(), String> {
         self.tables = tables.clone();
+        self.refresh_walls();
         self.config[self.current].x.fill(0.0);
         self.system[self.current] = None;
         Ok(())
@@ -400,7 +408,7 @@ impl KernelPath<f64> for TwinPath {
         let mut contact = ContactBatch::new(1, p);
         contact.site_normals = tables.pair_normals.clone();
         contact.pair_state = tables.pair_state.clone();
-        Ok(Box::new(TwinEnsemble {
+        let mut twin = TwinEnsemble {
             model,
             tables: tables.clone(),
             contact,
@@ -409,7 +417,10 @@ impl KernelPath<f64> for TwinPath {
             system: [None, None],
             current: 0,
             delta: vec![0.0; 6 * tables.num_nodes * tables.num_variants],
-        }))
+            walls: Default::default(),
+        };
+        twin.refresh_walls();
+        Ok(Box::new(twin))
     }
     fn open_dynamic<'a>(
         &'a self,
@@ -488,19 +499,33 @@ pub(crate) fn check_same_mesh(models: &[Model]) -> Result<(), String> {
 
 /// The tables of a chunk of variants (all on the first one's mesh).
 pub fn ensemble_tables<T: Real>(models: &[Model]) -> Result<EnsembleTables<T>, String> {
+    ensemble_tables_from(models, None)
+}
+
+/// As [`ensemble_tables`], the chunk starting from `start` (displacements from the
+/// reference `3 n V`, rotations `9 n V`; none: each variant laid on the low side) — a
+/// compacted or re-tried chunk starts where its variants stand, and does not lay them out
+/// again.
+pub fn ensemble_tables_from<T: Real>(
+    models: &[Model],
+    start: Option<(Vec<T>, Vec<T>)>,
+) -> Result<EnsembleTables<T>, String> {
     check_same_mesh(models)?;
     let t = |x: f64| T::from_f64_lossy(x);
     let base = &models[0];
     let (v, n, s_count) = (models.len(), base.nodes.len(), base.sites.len());
     let (basis, fixed) = constraint_tables(base);
+    let given = start.is_some();
+    let (x, rot) =
+        start.unwrap_or_else(|| (vec![T::zero(); 3 * n * v], vec![T::zero(); 9 * n * v]));
     let mut start = ConfigBatch {
         num_variants: v,
         num_nodes: n,
-        x: vec![T::zero(); 3 * n * v],
-        rot: vec![T::zero(); 9 * n * v],
+        x,
+        rot,
         basis: basis.iter().map(|&b| t(b)).collect(),
     };
-    for (j, m) in models.iter().enumerate() {
+    for (j, m) in models.iter().enumerate().filter(|_| !given) {
         let s = if m.sites.is_empty() {
             StaticState::initial(m)
         } else {
@@ -615,10 +640,7 @@ fn solve_chunk<T: Real + Send + Sync, P: KernelPath<T>>(
     // whole sag (`docs/validation.md`).
     let mut paths: Vec<LoadPath> = models
         .iter()
-        .map(|m| {
-            let linear = m.sites.iter().all(|s| s.params.spring_exponent == 1.0);
-            LoadPath::new(options, !m.sites.is_empty(), linear, size == 4)
-        })
+        .map(|m| LoadPath::for_model(options, m, size == 4))
         .collect();
     let settings = NewtonSettings::statics(options.max_iterations, options.tolerance, size);
     // Compaction: once no more than half of a chunk's variants are still running, the
@@ -658,9 +680,8 @@ fn solve_chunk<T: Real + Send + Sync, P: KernelPath<T>>(
             break;
         }
         let sub_models: Vec<Model> = keep.iter().map(|&i| sys.models[i].clone()).collect();
-        let mut tables = ensemble_tables::<T>(&sub_models)?;
-        tables.start.x = columns(&config.x, m, &keep);
-        tables.start.rot = columns(&config.rot, m, &keep);
+        let start = (columns(&config.x, m, &keep), columns(&config.rot, m, &keep));
+        let mut tables = ensemble_tables_from::<T>(&sub_models, Some(start))?;
         tables.set_base(mesh, columns(&sys.tables.base, m, &keep));
         let saved = keep.iter().map(|&i| sys.saved[i].clone()).collect();
         let kept_models = keep.iter().map(|&i| sys.models[i]).collect();

@@ -114,6 +114,12 @@ impl LoadPath {
         p
     }
 
+    /// A model's path ([`LoadPath::new`] with its sites and spring laws).
+    pub fn for_model(options: &StaticOptions, model: &crate::model::Model, refine: bool) -> Self {
+        let linear = model.sites.iter().all(|s| s.params.spring_exponent == 1.0);
+        LoadPath::new(options, !model.sites.is_empty(), linear, refine)
+    }
+
     fn set_target(&mut self) {
         self.target = match self.stage {
             Stage::Gravity => LoadTarget {

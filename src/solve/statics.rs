@@ -598,13 +598,7 @@ pub fn solve_static_from(
     use crate::solve::continuation::{solve_loads, LoadPath};
     use crate::solve::newton::NewtonSettings;
     let mut sys = CpuStatic::new(model, start);
-    let linear = model.sites.iter().all(|s| s.params.spring_exponent == 1.0);
-    let mut paths = [LoadPath::new(
-        options,
-        !model.sites.is_empty(),
-        linear,
-        false,
-    )];
+    let mut paths = [LoadPath::for_model(options, model, false)];
     let settings = NewtonSettings::statics(options.max_iterations, options.tolerance, 8);
     if let Err(reason) = solve_loads(&mut sys, &mut paths, settings, &mut |_| {}) {
         return Err(StaticError::LoadStep {
