@@ -162,6 +162,16 @@ impl Key {
     }
 }
 
+/// A case's variants: the CSV `file` if given, else its `[ensemble.grid]`; `None` when it
+/// has neither.
+pub fn case_variants(case: &Case, file: Option<&Path>) -> Result<Option<Vec<Variant>>, InputError> {
+    Ok(match (file, case.ensemble.as_ref()) {
+        (Some(f), _) => Some(variants_from_csv(f)?),
+        (None, Some(s)) if !s.grid.is_empty() => Some(variants_from_grid(&s.grid)),
+        _ => None,
+    })
+}
+
 /// One variant: a name and its overrides (SI).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Variant {

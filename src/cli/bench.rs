@@ -260,14 +260,12 @@ pub fn statics(
     use crate::solve::statics::{solve_static, StaticOptions};
     use rayon::prelude::*;
     let case = crate::case::load_case(case_path)?;
-    let list = match (variants, case.ensemble.as_ref()) {
-        (Some(f), _) => crate::ensemble::variants_from_csv(f)?,
-        (None, Some(s)) if !s.grid.is_empty() => crate::ensemble::variants_from_grid(&s.grid),
-        _ => vec![crate::ensemble::Variant {
+    let list = crate::ensemble::case_variants(&case, variants)?.unwrap_or_else(|| {
+        vec![crate::ensemble::Variant {
             name: "case".into(),
             overrides: Vec::new(),
-        }],
-    };
+        }]
+    });
     let io = |e: String| Error::Io(std::io::Error::other(e));
     let models: Vec<crate::model::Model> = list
         .iter()

@@ -18,7 +18,7 @@ use serde::Serialize;
 use crate::backend::{BackendChoice, Precision};
 use crate::case::{load_case, Analysis, Case};
 use crate::cli::static_cmd::{fe_rows, neutral_point, neutral_point_of, nodal_axial_forces};
-use crate::ensemble::{apply, stabilizer_sites, variants_from_csv, variants_from_grid, Variant};
+use crate::ensemble::{apply, stabilizer_sites, Variant};
 use crate::error::{Error, InputError};
 use crate::model::Model;
 use crate::output::write_atomic;
@@ -694,18 +694,14 @@ pub fn run(
 ) -> Result<EnsembleSummary, Error> {
     let case = load_case(case_path)?;
     let settings = case.ensemble.clone();
-    let variants = match (variants_file, &settings) {
-        (Some(f), _) => variants_from_csv(f)?,
-        (None, Some(s)) if !s.grid.is_empty() => variants_from_grid(&s.grid),
-        _ => {
-            return Err(InputError {
-                source_name: case_path.display().to_string(),
-                line: 1,
-                key: "ensemble.grid".into(),
-                message: "no variants: give --variants FILE or an [ensemble.grid] table".into(),
-            }
-            .into())
+    let Some(variants) = crate::ensemble::case_variants(&case, variants_file)? else {
+        return Err(InputError {
+            source_name: case_path.display().to_string(),
+            line: 1,
+            key: "ensemble.grid".into(),
+            message: "no variants: give --variants FILE or an [ensemble.grid] table".into(),
         }
+        .into());
     };
     let analysis = settings
         .as_ref()
