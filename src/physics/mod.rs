@@ -5,6 +5,7 @@
 
 pub mod beam;
 pub mod contact;
+pub mod dual;
 pub mod hyperdual;
 pub mod mass;
 pub mod soft_string;
