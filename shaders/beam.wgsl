@@ -1,21 +1,28 @@
-// Twin: src/kernels/beam.rs (formulas: src/physics/beam.rs, the co-rotational element).
+// Twin: src/kernels/beam.rs (formulas: src/physics/beam.rs, `element_force` and
+// `force_and_tangent_closed`, the co-rotational element in closed form).
 //
-// One invocation per (element, variant), index = element · V + variant. The element energy
-// E (Euler–Bernoulli in the co-rotated frame) is evaluated in hyper-dual numbers
-// (re, ε₁, ε₂, ε₁ε₂) — here vec4<real> — 144 times: DOF k perturbed along ε₂, DOF j along
-// ε₁; f_j = ∂E/∂δ_j (the ε₁ part), K_jk = ∂²E (the ε₁ε₂ part). Rotations are perturbed as
-// left spins (I + [ε e]×)·triad, as in the twin. Outputs in the assembly's layout:
-// [(12 e + j) V + v] and [(144 e + 12 j + k) V + v].
+// One invocation per (element, variant), index = element · V + variant. The internal force
+// is the closed form of physics::beam::element_force (frame: chord and the mean of the
+// nodal triads' second axes; local moments through J⁻ᵀ of the rotation logs, the frame's
+// spin through η and n):
+//   f_x₂ = −f_x₁ = N e1 + ((η V₁ + V₂) e3 − V₃ e2)/l,  f_θᵢ = R_r v̄_i − V₁/(2n)·(b_i × e3).
+// The consistent tangent is that force in dual numbers (value, derivative) — here
+// vec2<real>, vectors as (value, derivative) pairs of vec3<real> — once per column k: DOF k
+// seeded as a translation or a left spin (I + [ε e]×)·triad. K_jk = ∂f_j/∂Δ_k. Built with
+// FORCE_ONLY it evaluates the force alone (line-search trials: 1/12 of the work and no
+// tangent written). Outputs in the assembly's layout: [(12 e + j) V + v] and
+// [(144 e + 12 j + k) V + v].
 //
 // States are displacements w from each variant's base configuration X + b (kilometres of
 // string lose their millimetres in f32 otherwise; the dynamic engine's base is the static
 // equilibrium, the f32 static engine's the last load step's, so w is the motion): the
 // chord is c + (w₂ − w₁), with the base chord c = (X₂ + b₂) − (X₁ + b₁) and its stretch
 // s = |c| − l0 given per element and variant (formed in double precision on the host). In
-// double precision the element's node positions are taken as w₁ and c + w₂ (as the twin)
-// and the elongation as l − l0; in single precision the elongation is
-// s + (2 c·Δw + Δw·Δw)/(l + |c|), without the cancellation of l − l0 (a strain of 1e-5
-// would keep two digits) and without the metres the base has moved.
+// double precision the element's node positions are taken as w₁ and c + w₂ (as the twin,
+// physics::beam::Chord::Positions) and the elongation as l − l0; in single precision
+// (Chord::Base) the elongation is s + (2 c·Δw + Δw·Δw)/(l + |c|), without the cancellation
+// of l − l0 (a strain of 1e-5 would keep two digits) and without the metres the base has
+// moved.
 #include "shared/layout.wgsl"
 
 @group(0) @binding(0) var<storage, read> dims: BeamDims;
@@ -30,32 +37,70 @@
 // 3 the stretch |c| − l0.
 @group(0) @binding(5) var<storage, read> chord: array<real>;
 @group(0) @binding(6) var<storage, read_write> elem_force: array<real>;
+#if !FORCE_ONLY
 @group(0) @binding(7) var<storage, read_write> elem_tangent: array<real>;
+#endif
 
-alias hd = vec4<real>;
-
-fn hd_c(a: real) -> hd {
-    return hd(a, real(0.0), real(0.0), real(0.0));
+// A dual number (value, derivative) and a dual 3-vector.
+alias dl = vec2<real>;
+struct DV {
+    v: vec3<real>,
+    d: vec3<real>,
 }
 
-fn hd_mul(a: hd, b: hd) -> hd {
-    return hd(a.x * b.x, a.x * b.y + a.y * b.x, a.x * b.z + a.z * b.x,
-              a.x * b.w + a.y * b.z + a.z * b.y + a.w * b.x);
+fn dmul(a: dl, b: dl) -> dl {
+    return dl(a.x * b.x, a.x * b.y + a.y * b.x);
 }
 
-// g(a) with g', g'' at a.x.
-fn hd_chain(a: hd, g: real, g1: real, g2: real) -> hd {
-    return hd(g, g1 * a.y, g1 * a.z, g1 * a.w + g2 * a.y * a.z);
+fn ddiv(a: dl, b: dl) -> dl {
+    let q = a.x / b.x;
+    return dl(q, (a.y - q * b.y) / b.x);
 }
 
-fn hd_div(a: hd, b: hd) -> hd {
-    let inv = real(1.0) / b.x;
-    return hd_mul(a, hd_chain(b, inv, -inv * inv, real(2.0) * inv * inv * inv));
-}
-
-fn hd_sqrt(a: hd) -> hd {
+fn dsqrt(a: dl) -> dl {
     let s = sqrt(a.x);
-    return hd_chain(a, s, real(0.5) / s, real(-0.25) / (a.x * s));
+    return dl(s, real(0.5) * a.y / s);
+}
+
+fn dc(a: real) -> dl {
+    return dl(a, real(0.0));
+}
+
+fn cr(a: vec3<real>, b: vec3<real>) -> vec3<real> {
+    return a.yzx * b.zxy - a.zxy * b.yzx;
+}
+
+fn dt(a: vec3<real>, b: vec3<real>) -> real {
+    return a.x * b.x + a.y * b.y + a.z * b.z;
+}
+
+fn vdot(a: DV, b: DV) -> dl {
+    return dl(dt(a.v, b.v), dt(a.d, b.v) + dt(a.v, b.d));
+}
+
+fn vcross(a: DV, b: DV) -> DV {
+    return DV(cr(a.v, b.v), cr(a.d, b.v) + cr(a.v, b.d));
+}
+
+fn vscale(a: DV, s: dl) -> DV {
+    return DV(a.v * s.x, a.d * s.x + a.v * s.y);
+}
+
+fn vdivs(a: DV, s: dl) -> DV {
+    let q = a.v / s.x;
+    return DV(q, (a.d - q * s.y) / s.x);
+}
+
+fn vadd(a: DV, b: DV) -> DV {
+    return DV(a.v + b.v, a.d + b.d);
+}
+
+fn vsub(a: DV, b: DV) -> DV {
+    return DV(a.v - b.v, a.d - b.d);
+}
+
+fn vnorm(a: DV) -> dl {
+    return dsqrt(vdot(a, a));
 }
 
 #if F64
@@ -100,119 +145,124 @@ fn atan2_real(y: real, x: real) -> real {
 }
 #endif
 
-// atan2 of hyper-duals (second order in both arguments), as HyperDual::atan2.
-fn hd_atan2(y: hd, x: hd) -> hd {
-    let r2 = x.x * x.x + y.x * y.x;
-    let r4 = r2 * r2;
-    let tx = -y.x / r2;
-    let ty = x.x / r2;
-    let txx = real(2.0) * x.x * y.x / r4;
-    let tyy = -txx;
-    let txy = (y.x * y.x - x.x * x.x) / r4;
-    return hd(
-        atan2_real(y.x, x.x),
-        tx * x.y + ty * y.y,
-        tx * x.z + ty * y.z,
-        tx * x.w + ty * y.w + txx * x.y * x.z + txy * (x.y * y.z + y.y * x.z) + tyy * y.y * y.z,
+fn datan2(y: dl, x: dl) -> dl {
+    return dl(atan2_real(y.x, x.x), (x.x * y.y - y.x * x.y) / (x.x * x.x + y.x * y.x));
+}
+
+// A nodal triad by its columns (the element's initial axes carried by the node).
+struct Triad {
+    c0: DV,
+    c1: DV,
+    c2: DV,
+}
+
+// The rotation vector of Rrᵀ·t (Rr = [e1 e2 e3]) and the coefficient c(θ) of J⁻¹(θ),
+// as physics::beam::rotation_log_and_jacobian.
+struct LogJ {
+    th: DV,
+    c: dl,
+}
+
+fn rel_log(e1: DV, e2: DV, e3: DV, t: Triad) -> LogJ {
+    let half = real(0.5);
+    // r[a][b] = e_a · t_b.
+    let w = DV(
+        half * vec3<real>(vdot(e3, t.c1).x - vdot(e2, t.c2).x, vdot(e1, t.c2).x - vdot(e3, t.c0).x,
+                          vdot(e2, t.c0).x - vdot(e1, t.c1).x),
+        half * vec3<real>(vdot(e3, t.c1).y - vdot(e2, t.c2).y, vdot(e1, t.c2).y - vdot(e3, t.c0).y,
+                          vdot(e2, t.c0).y - vdot(e1, t.c1).y),
     );
-}
-
-struct Tri {
-    m: array<hd, 9>,
-}
-
-fn hd_cross(a: array<hd, 3>, b: array<hd, 3>) -> array<hd, 3> {
-    return array<hd, 3>(
-        hd_mul(a[1], b[2]) - hd_mul(a[2], b[1]),
-        hd_mul(a[2], b[0]) - hd_mul(a[0], b[2]),
-        hd_mul(a[0], b[1]) - hd_mul(a[1], b[0]),
-    );
-}
-
-fn hd_norm(a: array<hd, 3>) -> hd {
-    return hd_sqrt(hd_mul(a[0], a[0]) + hd_mul(a[1], a[1]) + hd_mul(a[2], a[2]));
-}
-
-// log of the rotation Rrᵀ·t (Rr columns e1, e2, e3), as physics::beam::rotation_log.
-fn rel_log(e: array<array<hd, 3>, 3>, t: Tri) -> array<hd, 3> {
-    // r[a][b] = Σ_k e[a][k] t[k][b]  (e[a] is column a of Rr, i.e. row a of Rrᵀ).
-    var r: array<hd, 9>;
-    for (var a = 0u; a < 3u; a = a + 1u) {
-        for (var b = 0u; b < 3u; b = b + 1u) {
-            r[3u * a + b] = hd_mul(e[a][0], t.m[b]) + hd_mul(e[a][1], t.m[3u + b]) + hd_mul(e[a][2], t.m[6u + b]);
-        }
-    }
-    let half = hd_c(real(0.5));
-    let w0 = hd_mul(half, r[7] - r[5]);
-    let w1 = hd_mul(half, r[2] - r[6]);
-    let w2 = hd_mul(half, r[3] - r[1]);
-    let s2 = hd_mul(w0, w0) + hd_mul(w1, w1) + hd_mul(w2, w2);
-    let c = hd_mul(half, r[0] + r[4] + r[8] - hd_c(real(1.0)));
-    var factor: hd;
-    if (s2.x < real(1e-6) && c.x > real(0.0)) {
-        factor = hd_c(real(1.0)) + hd_mul(s2, hd_c(real(1.0) / real(6.0)) + hd_mul(s2, hd_c(real(3.0) / real(40.0))));
+    let s2 = vdot(w, w);
+    let c = half * (vdot(e1, t.c0) + vdot(e2, t.c1) + vdot(e3, t.c2) - dc(real(1.0)));
+    var factor: dl;
+    var s = dc(real(0.0));
+    let series = s2.x < real(1e-6) && c.x > real(0.0);
+    if (series) {
+        factor = dc(real(1.0)) + dmul(s2, dc(real(1.0) / real(6.0)) + dmul(s2, dc(real(3.0) / real(40.0))));
     } else {
-        let s = hd_sqrt(s2);
-        factor = hd_div(hd_atan2(s, c), s);
+        s = dsqrt(s2);
+        factor = ddiv(datan2(s, c), s);
     }
-    return array<hd, 3>(hd_mul(factor, w0), hd_mul(factor, w1), hd_mul(factor, w2));
-}
-
-// `base`: the element's base chord (xyz) and stretch (w), `lc` the chord's length — read
-// and formed once per invocation, not per evaluation (single precision uses them).
-fn energy(p1: array<hd, 3>, p2: array<hd, 3>, t1: Tri, t2: Tri, e: u32, base: vec4<real>, lc: real) -> hd {
-    let ea = section[4u * e];
-    let gj = section[4u * e + 1u];
-    let ei = section[4u * e + 2u];
-    let l0 = section[4u * e + 3u];
-#if F64
-    let d = array<hd, 3>(p2[0] - p1[0], p2[1] - p1[1], p2[2] - p1[2]);
-    let l = hd_norm(d);
-    let u = l - hd_c(l0);
-#else
-    let c = array<hd, 3>(hd_c(base.x), hd_c(base.y), hd_c(base.z));
-    let du = array<hd, 3>(p2[0] - p1[0], p2[1] - p1[1], p2[2] - p1[2]);
-    let d = array<hd, 3>(c[0] + du[0], c[1] + du[1], c[2] + du[2]);
-    let l = hd_norm(d);
-    let two_c_du = hd_mul(hd_c(real(2.0)), hd_mul(c[0], du[0]) + hd_mul(c[1], du[1]) + hd_mul(c[2], du[2]));
-    let du_du = hd_mul(du[0], du[0]) + hd_mul(du[1], du[1]) + hd_mul(du[2], du[2]);
-    let u = hd_c(base.w) + hd_div(two_c_du + du_du, l + hd_c(lc));
-#endif
-    let e1 = array<hd, 3>(hd_div(d[0], l), hd_div(d[1], l), hd_div(d[2], l));
-    let half = hd_c(real(0.5));
-    let p = array<hd, 3>(hd_mul(half, t1.m[1] + t2.m[1]), hd_mul(half, t1.m[4] + t2.m[4]), hd_mul(half, t1.m[7] + t2.m[7]));
-    let e3u = hd_cross(e1, p);
-    let n3 = hd_norm(e3u);
-    let e3 = array<hd, 3>(hd_div(e3u[0], n3), hd_div(e3u[1], n3), hd_div(e3u[2], n3));
-    let e2 = hd_cross(e3, e1);
-    let frame = array<array<hd, 3>, 3>(e1, e2, e3);
-    let th1 = rel_log(frame, t1);
-    let th2 = rel_log(frame, t2);
-    let twist = th2[0] - th1[0];
-    let two = hd_c(real(2.0));
-    let by = hd_mul(two, hd_mul(th1[1], th1[1]) + hd_mul(th1[1], th2[1]) + hd_mul(th2[1], th2[1]));
-    let bz = hd_mul(two, hd_mul(th1[2], th1[2]) + hd_mul(th1[2], th2[2]) + hd_mul(th2[2], th2[2]));
-    return hd_mul(half, hd_mul(hd_c(ea), hd_mul(u, u))) + hd_mul(half, hd_mul(hd_c(gj), hd_mul(twist, twist)))
-        + hd_mul(hd_c(ei), by + bz);
-}
-
-// Perturbs DOF `dof` (node·6 + [u, θ]) by `unit`: translation, or left spin of the triad.
-fn perturb(p: ptr<function, array<array<hd, 3>, 2>>, t: ptr<function, array<Tri, 2>>, dof: u32, unit: hd) {
-    let node = dof / 6u;
-    let k = dof % 6u;
-    if (k < 3u) {
-        (*p)[node][k] = (*p)[node][k] + unit;
+    let theta2 = dmul(dmul(factor, factor), s2);
+    var coefficient: dl;
+    if (!series && theta2.x >= real(0.1)) {
+        let theta = dmul(factor, s);
+        coefficient = ddiv(dc(real(1.0)) - ddiv(dmul(theta, dc(real(1.0)) + c), s + s), theta2);
     } else {
-        let axis = k - 3u;
-        let a = (axis + 1u) % 3u;
-        let b = (axis + 2u) % 3u;
-        // spin = I + unit·(E_ba − E_ab): rows a and b of the triad mix.
-        let old = (*t)[node];
-        for (var c = 0u; c < 3u; c = c + 1u) {
-            (*t)[node].m[3u * b + c] = old.m[3u * b + c] + hd_mul(unit, old.m[3u * a + c]);
-            (*t)[node].m[3u * a + c] = old.m[3u * a + c] - hd_mul(unit, old.m[3u * b + c]);
-        }
+        coefficient = dc(real(1.0) / real(12.0)) + dmul(theta2, dc(real(1.0) / real(720.0))
+            + dmul(theta2, dc(real(1.0) / real(30240.0)) + dmul(theta2, dc(real(1.0) / real(1209600.0))
+            + dmul(theta2, dc(real(1.0) / real(47900160.0))))));
     }
+    return LogJ(vscale(w, factor), coefficient);
+}
+
+// v̄ = J⁻ᵀ(θ) m̄ = m̄ + ½ θ × m̄ + c θ × (θ × m̄).
+fn jt(l: LogJ, m: DV) -> DV {
+    let tm = vcross(l.th, m);
+    let ttm = vcross(l.th, tm);
+    return vadd(vadd(m, vscale(tm, dc(real(0.5)))), vscale(ttm, l.c));
+}
+
+// The force (12, as dual numbers) of the element with chord d, elongation u and triads t1,
+// t2; stiffness k = (EA/l0, GJ/l0, EI/l0).
+struct Force {
+    x1: DV,
+    t1: DV,
+    x2: DV,
+    t2: DV,
+}
+
+fn element_force(d: DV, u: dl, t1: Triad, t2: Triad, k: vec3<real>) -> Force {
+    let half = dc(real(0.5));
+    let l = vnorm(d);
+    let e1 = vdivs(d, l);
+    let p = vscale(vadd(t1.c1, t2.c1), half);
+    let a = vcross(e1, p);
+    let n = vnorm(a);
+    let e3 = vdivs(a, n);
+    let e2 = vcross(e3, e1);
+    let eta = ddiv(vdot(p, e1), n);
+    let l1 = rel_log(e1, e2, e3, t1);
+    let l2 = rel_log(e1, e2, e3, t2);
+    let twist = dmul(dc(k.y), dl(l2.th.v.x - l1.th.v.x, l2.th.d.x - l1.th.d.x));
+    let four = dc(real(4.0) * k.z);
+    let two = dc(real(2.0) * k.z);
+    let t1y = dl(l1.th.v.y, l1.th.d.y);
+    let t1z = dl(l1.th.v.z, l1.th.d.z);
+    let t2y = dl(l2.th.v.y, l2.th.d.y);
+    let t2z = dl(l2.th.v.z, l2.th.d.z);
+    let m1y = dmul(four, t1y) + dmul(two, t2y);
+    let m1z = dmul(four, t1z) + dmul(two, t2z);
+    let m2y = dmul(four, t2y) + dmul(two, t1y);
+    let m2z = dmul(four, t2z) + dmul(two, t1z);
+    let m1 = DV(vec3<real>(-twist.x, m1y.x, m1z.x), vec3<real>(-twist.y, m1y.y, m1z.y));
+    let m2 = DV(vec3<real>(twist.x, m2y.x, m2z.x), vec3<real>(twist.y, m2y.y, m2z.y));
+    let v1 = jt(l1, m1);
+    let v2 = jt(l2, m2);
+    let vs = vadd(v1, v2);
+    let vs0 = dl(vs.v.x, vs.d.x);
+    let vs1 = dl(vs.v.y, vs.d.y);
+    let vs2 = dl(vs.v.z, vs.d.z);
+    let axial = dmul(dc(k.x), u);
+    let g3 = ddiv(dmul(eta, vs0) + vs1, l);
+    let g2 = ddiv(vs2, l);
+    let g = vsub(vadd(vscale(e1, axial), vscale(e3, g3)), vscale(e2, g2));
+    let q = ddiv(vs0, n + n);
+    // R_r v̄ − q (b × e3).
+    let f1 = vsub(vadd(vadd(vscale(e1, dl(v1.v.x, v1.d.x)), vscale(e2, dl(v1.v.y, v1.d.y))),
+                       vscale(e3, dl(v1.v.z, v1.d.z))), vscale(vcross(t1.c1, e3), q));
+    let f2 = vsub(vadd(vadd(vscale(e1, dl(v2.v.x, v2.d.x)), vscale(e2, dl(v2.v.y, v2.d.y))),
+                       vscale(e3, dl(v2.v.z, v2.d.z))), vscale(vcross(t2.c1, e3), q));
+    return Force(DV(-g.v, -g.d), f1, g, f2);
+}
+
+fn constant(v: vec3<real>) -> DV {
+    return DV(v, vec3<real>(real(0.0)));
+}
+
+// The triad's columns with the derivative of a spin about `axis` (zero: none).
+fn spun(t: Triad, axis: vec3<real>) -> Triad {
+    return Triad(DV(t.c0.v, cr(axis, t.c0.v)), DV(t.c1.v, cr(axis, t.c1.v)), DV(t.c2.v, cr(axis, t.c2.v)));
 }
 
 @compute @workgroup_size(64)
@@ -223,47 +273,76 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
     let e = gid.x / nv;
     let v = gid.x % nv;
-    let base = vec4<real>(chord[(4u * e) * nv + v], chord[(4u * e + 1u) * nv + v], chord[(4u * e + 2u) * nv + v],
-                          chord[(4u * e + 3u) * nv + v]);
-    let lc = sqrt(base.x * base.x + base.y * base.y + base.z * base.z);
-    var p0: array<array<hd, 3>, 2>;
-    var t0: array<Tri, 2>;
+    let base = vec3<real>(chord[(4u * e) * nv + v], chord[(4u * e + 1u) * nv + v], chord[(4u * e + 2u) * nv + v]);
+    let stretch = chord[(4u * e + 3u) * nv + v];
+    let k = vec3<real>(section[4u * e], section[4u * e + 1u], section[4u * e + 2u]);
+    let l0 = section[4u * e + 3u];
+    var w: array<vec3<real>, 2>;
+    var tri: array<Triad, 2>;
     for (var node = 0u; node < 2u; node = node + 1u) {
         let i = e + node;
-        for (var k = 0u; k < 3u; k = k + 1u) {
-#if F64
-            // Node 2 at c + w₂ (the twin's positions).
-            p0[node][k] = hd_c(real(node) * base[k] + x[(3u * i + k) * nv + v]);
-#else
-            p0[node][k] = hd_c(x[(3u * i + k) * nv + v]);
-#endif
-        }
-        // triad = R_i · frame0_i
-        for (var r = 0u; r < 3u; r = r + 1u) {
-            for (var c = 0u; c < 3u; c = c + 1u) {
+        w[node] = vec3<real>(x[(3u * i) * nv + v], x[(3u * i + 1u) * nv + v], x[(3u * i + 2u) * nv + v]);
+        // triad = R_i · frame0_i, by columns.
+        var cols: array<vec3<real>, 3>;
+        for (var c = 0u; c < 3u; c = c + 1u) {
+            for (var r = 0u; r < 3u; r = r + 1u) {
                 var s = real(0.0);
                 for (var m = 0u; m < 3u; m = m + 1u) {
                     s = s + rot[(9u * i + 3u * r + m) * nv + v] * frame0[9u * i + 3u * m + c];
                 }
-                t0[node].m[3u * r + c] = hd_c(s);
+                cols[c][r] = s;
             }
         }
+        tri[node] = Triad(constant(cols[0]), constant(cols[1]), constant(cols[2]));
     }
-    let eps1 = hd(real(0.0), real(1.0), real(0.0), real(0.0));
-    let eps2 = hd(real(0.0), real(0.0), real(1.0), real(0.0));
-    for (var k = 0u; k < 12u; k = k + 1u) {
-        var pk = p0;
-        var tk = t0;
-        perturb(&pk, &tk, k, eps2);
+#if F64
+    // Node 2 at c + w₂ (the twin's positions): d = (c + w₂) − w₁, ū = |d| − l0.
+    let d0 = (base + w[1]) - w[0];
+#else
+    let dw = w[1] - w[0];
+    let d0 = base + dw;
+    let lc = sqrt(dt(base, base));
+#endif
+    let zero = vec3<real>(real(0.0));
+#if FORCE_ONLY
+    let columns = 1u;
+#else
+    let columns = 12u;
+#endif
+    for (var col = 0u; col < columns; col = col + 1u) {
+        // Seed: DOF col (the force alone: none).
+        var dd = zero;
+        var spin = array<vec3<real>, 2>(zero, zero);
+#if !FORCE_ONLY
+        let node = col / 6u;
+        let axis = col % 6u;
+        var unit = zero;
+        unit[axis % 3u] = real(1.0);
+        if (axis < 3u) {
+            dd = select(-unit, unit, node == 1u);
+        } else {
+            spin[node] = unit;
+        }
+#endif
+        let d = DV(d0, dd);
+#if F64
+        let u = vnorm(d) - dc(l0);
+#else
+        let dwd = DV(dw, dd);
+        let bd = constant(base);
+        let num = dmul(dc(real(2.0)), vdot(bd, dwd)) + vdot(dwd, dwd);
+        let u = dc(stretch) + ddiv(num, vnorm(d) + dc(lc));
+#endif
+        let f = element_force(d, u, spun(tri[0], spin[0]), spun(tri[1], spin[1]), k);
+        let out = array<DV, 4>(f.x1, f.t1, f.x2, f.t2);
         for (var j = 0u; j < 12u; j = j + 1u) {
-            var pj = pk;
-            var tj = tk;
-            perturb(&pj, &tj, j, eps1);
-            let en = energy(pj[0], pj[1], tj[0], tj[1], e, base, lc);
-            elem_tangent[(144u * e + 12u * j + k) * nv + v] = en.w;
-            if (k == 0u) {
-                elem_force[(12u * e + j) * nv + v] = en.y;
+            let part = out[j / 3u];
+            if (col == 0u) {
+                elem_force[(12u * e + j) * nv + v] = part.v[j % 3u];
             }
+#if !FORCE_ONLY
+            elem_tangent[(144u * e + 12u * j + col) * nv + v] = part.d[j % 3u];
+#endif
         }
     }
 }

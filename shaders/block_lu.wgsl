@@ -1,12 +1,23 @@
 // Twin: src/kernels/block_lu.rs (block-tridiagonal LU of every variant's Newton system).
 //
-// One invocation per variant; it walks the chain: eliminates the augmented block
-// [G_i | U_i | y_i] (6 × 13, partial pivoting inside the block), keeps X_i = G_i⁻¹U_i and
-// z_i = G_i⁻¹y_i in the workspace, then substitutes back. The walk is split into dispatches
-// of at most 32 nodes (dims.begin … dims.end, forward then backward): llvmpipe (lavapipe)
-// silently ends any loop after 65,535 iterations, which a whole chain of more than about
-// 110 nodes exceeds. status starts at 2 (set by the host): 1 singular, 0 solved (set by
-// the last backward dispatch), 2 left means a dispatch did not complete.
+// Eight lanes per variant (eight variants per workgroup of 64), lane r < 6 holding row r of
+// the augmented block [G_i | U_i | y_i] (6 × 13) as the chain is walked: the Schur
+// complement G_i = D_i − L_{i−1} X_{i−1} row by row, then Gauss–Jordan with partial pivoting
+// with the pivot column and the pivot row passed through workgroup memory (the rows stay in
+// their lanes; a permutation, the same in every lane, records the twin's row swaps, so the
+// pivots and operations are the twin's). X_i = G_i⁻¹U_i and z_i = G_i⁻¹y_i are kept in the
+// workspace (and X_i, z_i in workgroup memory for the next node); back substitution
+// x_i = z_i − X_i x_{i+1}, a row per lane. The walk over the chain stays sequential (its
+// length is the latency), the work per node is spread over six lanes, and a chunk of V
+// variants occupies 8 V invocations — 4096 variants fill 512 workgroups, not 64.
+//
+// The walk is split into dispatches of at most 32 nodes (dims.begin … dims.end, forward
+// then backward): llvmpipe (lavapipe) silently ends any loop after 65,535 iterations,
+// which a whole chain of more than about 110 nodes exceeds. status starts at 2 (set by the
+// host): 1 singular, 0 solved (set by the last backward dispatch), 2 left means a
+// dispatch did not complete. Barriers sit in loops whose bounds are the same for the whole
+// workgroup; lanes without work (rows 6, 7, variants past the end, singular variants)
+// only skip the arithmetic.
 // Layout (field-major, variant fastest; V = variants in this dispatch): block entry rc of
 // node i at [(36 i + rc) V + v], vector entry r of node i at [(6 i + r) V + v].
 #include "shared/layout.wgsl"
@@ -23,6 +34,18 @@
 @group(0) @binding(7) var<storage, read_write> x: array<real>;
 // 2 running (host), 1 singular (a zero or non-finite pivot), 0 solved.
 @group(0) @binding(8) var<storage, read_write> status: array<u32>;
+
+// Lanes per variant (src/gpu/block_lu.rs LANES) and variants per workgroup.
+const LANES: u32 = 8u;
+const SLOTS: u32 = 8u;
+
+// Per variant of the workgroup: X and z of the previous node, the pivot row, the pivot
+// column, and x_{i+1} during the back substitution.
+var<workgroup> px: array<real, 288>;
+var<workgroup> pz: array<real, 48>;
+var<workgroup> prow: array<real, 104>;
+var<workgroup> pcol: array<real, 48>;
+var<workgroup> xs: array<real, 48>;
 
 fn blk(i: u32, rc: u32, v: u32) -> u32 {
     return (36u * i + rc) * dims.num_variants + v;
@@ -45,106 +68,143 @@ fn bad_pivot(p: real) -> bool {
 }
 
 @compute @workgroup_size(64)
-fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
-    let v = gid.x;
-    if (v >= dims.num_variants || status[v] == 1u) {
-        return;
-    }
+fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_invocation_id) lid: vec3<u32>) {
+    let v = gid.x / LANES;
+    let r = lid.x % LANES;
+    let slot = lid.x / LANES;
     let n = dims.num_nodes;
+    // This lane has a row of a variant still being solved.
+    var live = v < dims.num_variants && r < 6u;
+    if (live) {
+        live = status[v] != 1u;
+    }
     if (dims.phase == 1u) {
         // Back substitution over [begin, end), downwards: x_i = z_i − X_i x_{i+1}.
+        if (live && dims.end < n) {
+            xs[6u * slot + r] = x[vec_at(dims.end, r, v)];
+        }
+        workgroupBarrier();
         for (var step = dims.begin; step < dims.end; step = step + 1u) {
             let i = dims.end - 1u - (step - dims.begin);
-            for (var r = 0u; r < 6u; r = r + 1u) {
-                var s = work_z[vec_at(i, r, v)];
+            var s = real(0.0);
+            if (live) {
+                s = work_z[vec_at(i, r, v)];
                 if (i + 1u < n) {
                     for (var c = 0u; c < 6u; c = c + 1u) {
-                        s = s - work_x[blk(i, 6u * r + c, v)] * x[vec_at(i + 1u, c, v)];
+                        s = s - work_x[blk(i, 6u * r + c, v)] * xs[6u * slot + c];
                     }
                 }
+            }
+            workgroupBarrier();
+            if (live) {
+                xs[6u * slot + r] = s;
                 x[vec_at(i, r, v)] = s;
             }
+            workgroupBarrier();
         }
-        if (dims.begin == 0u) {
+        if (live && r == 0u && dims.begin == 0u) {
             status[v] = 0u;
         }
         return;
     }
-    var aug: array<real, 78>; // 6 rows × 13 columns, row-major
-    var prev_x: array<real, 36>;
-    var prev_z: array<real, 6>;
-    if (dims.begin > 0u) {
-        for (var k = 0u; k < 36u; k = k + 1u) {
-            prev_x[k] = work_x[blk(dims.begin - 1u, k, v)];
-        }
+    if (live && dims.begin > 0u) {
         for (var k = 0u; k < 6u; k = k + 1u) {
-            prev_z[k] = work_z[vec_at(dims.begin - 1u, k, v)];
+            px[36u * slot + 6u * r + k] = work_x[blk(dims.begin - 1u, 6u * r + k, v)];
         }
+        pz[6u * slot + r] = work_z[vec_at(dims.begin - 1u, r, v)];
     }
+    workgroupBarrier();
     for (var i = dims.begin; i < dims.end; i = i + 1u) {
-        for (var r = 0u; r < 6u; r = r + 1u) {
+        var row: array<real, 13>;
+        if (live) {
             for (var c = 0u; c < 6u; c = c + 1u) {
-                aug[13u * r + c] = diag[blk(i, 6u * r + c, v)];
+                row[c] = diag[blk(i, 6u * r + c, v)];
                 if (i + 1u < n) {
-                    aug[13u * r + 6u + c] = upper[blk(i, 6u * r + c, v)];
+                    row[6u + c] = upper[blk(i, 6u * r + c, v)];
                 } else {
-                    aug[13u * r + 6u + c] = real(0.0);
+                    row[6u + c] = real(0.0);
                 }
             }
-            aug[13u * r + 12u] = rhs[vec_at(i, r, v)];
+            row[12] = rhs[vec_at(i, r, v)];
             if (i > 0u) {
                 for (var k = 0u; k < 6u; k = k + 1u) {
                     let l = lower[blk(i - 1u, 6u * r + k, v)];
                     for (var c = 0u; c < 6u; c = c + 1u) {
-                        aug[13u * r + c] = aug[13u * r + c] - l * prev_x[6u * k + c];
+                        row[c] = row[c] - l * px[36u * slot + 6u * k + c];
                     }
-                    aug[13u * r + 12u] = aug[13u * r + 12u] - l * prev_z[k];
+                    row[12] = row[12] - l * pz[6u * slot + k];
                 }
             }
         }
-        // Gauss–Jordan with partial pivoting on the 6 × 13 block.
+        // Gauss–Jordan with partial pivoting: perm[q] is the lane holding row q of the
+        // twin's (swapped) block.
+        var perm = array<u32, 6>(0u, 1u, 2u, 3u, 4u, 5u);
+        var bad = false;
         for (var col = 0u; col < 6u; col = col + 1u) {
+            workgroupBarrier();
+            if (live) {
+                pcol[6u * slot + r] = row[col];
+            }
+            workgroupBarrier();
             var p = col;
-            for (var r = col + 1u; r < 6u; r = r + 1u) {
-                if (abs(aug[13u * r + col]) > abs(aug[13u * p + col])) {
-                    p = r;
+            var pivot = real(0.0);
+            if (live) {
+                for (var q = col + 1u; q < 6u; q = q + 1u) {
+                    if (abs(pcol[6u * slot + perm[q]]) > abs(pcol[6u * slot + perm[p]])) {
+                        p = q;
+                    }
                 }
-            }
-            if (p != col) {
-                for (var c = 0u; c < 13u; c = c + 1u) {
-                    let t = aug[13u * col + c];
-                    aug[13u * col + c] = aug[13u * p + c];
-                    aug[13u * p + c] = t;
+                let t = perm[col];
+                perm[col] = perm[p];
+                perm[p] = t;
+                pivot = pcol[6u * slot + perm[col]];
+                if (bad_pivot(pivot)) {
+                    bad = true;
                 }
-            }
-            let pivot = aug[13u * col + col];
-            if (bad_pivot(pivot)) {
-                status[v] = 1u;
-                for (var k = 0u; k < 6u * n; k = k + 1u) {
-                    x[k * dims.num_variants + v] = real(0.0);
-                }
-                return;
-            }
-            let inv = real(1.0) / pivot;
-            for (var c = col; c < 13u; c = c + 1u) {
-                aug[13u * col + c] = aug[13u * col + c] * inv;
-            }
-            for (var r = 0u; r < 6u; r = r + 1u) {
-                if (r != col) {
-                    let f = aug[13u * r + col];
+                if (r == perm[col]) {
+                    let inv = real(1.0) / pivot;
                     for (var c = col; c < 13u; c = c + 1u) {
-                        aug[13u * r + c] = aug[13u * r + c] - f * aug[13u * col + c];
+                        row[c] = row[c] * inv;
+                        prow[13u * slot + c] = row[c];
                     }
                 }
             }
-        }
-        for (var r = 0u; r < 6u; r = r + 1u) {
-            for (var c = 0u; c < 6u; c = c + 1u) {
-                prev_x[6u * r + c] = aug[13u * r + 6u + c];
-                work_x[blk(i, 6u * r + c, v)] = aug[13u * r + 6u + c];
+            workgroupBarrier();
+            if (live && r != perm[col]) {
+                let f = row[col];
+                for (var c = col; c < 13u; c = c + 1u) {
+                    row[c] = row[c] - f * prow[13u * slot + c];
+                }
             }
-            prev_z[r] = aug[13u * r + 12u];
-            work_z[vec_at(i, r, v)] = aug[13u * r + 12u];
         }
+        if (live && bad) {
+            // Singular: the twin's zero solution, and the variant stops here.
+            if (r == 0u) {
+                status[v] = 1u;
+            }
+            for (var k = r; k < 6u * n; k = k + 6u) {
+                x[k * dims.num_variants + v] = real(0.0);
+            }
+            live = false;
+        }
+        workgroupBarrier();
+        if (live) {
+            // This lane's row is row q of X_i and z_i.
+            var q = 0u;
+            for (var k = 0u; k < 6u; k = k + 1u) {
+                if (perm[k] == r) {
+                    q = k;
+                }
+            }
+            for (var c = 0u; c < 6u; c = c + 1u) {
+                px[36u * slot + 6u * q + c] = row[6u + c];
+                if (i + 1u < n) {
+                    work_x[blk(i, 6u * q + c, v)] = row[6u + c];
+                }
+            }
+            pz[6u * slot + q] = row[12];
+            work_z[vec_at(i, q, v)] = row[12];
+        }
+        workgroupBarrier();
     }
 }

@@ -150,6 +150,19 @@ enum BenchCommand {
         #[arg(long)]
         json: Option<PathBuf>,
     },
+    /// Operations and time per beam element: the hyper-dual forms against the closed form
+    /// (force only; force and tangent in f64 and f32), one core; their agreement.
+    Element {
+        /// Random element states timed per repeat.
+        #[arg(long, default_value_t = 2000)]
+        states: usize,
+        /// Timed repeats (the median is reported).
+        #[arg(long, default_value_t = 7)]
+        repeats: usize,
+        /// Also write the results as JSON here.
+        #[arg(long)]
+        json: Option<PathBuf>,
+    },
     /// Time steps per second and Newton iterations per step of `holewall run` (CPU f64).
     Dynamics {
         /// Case file with a `[dynamics]` table.
@@ -294,6 +307,14 @@ fn main() -> ExitCode {
                 repeats,
                 json,
             } => match cli::bench::statics(&case, variants.as_deref(), repeats, json.as_deref()) {
+                Ok(()) => ExitCode::SUCCESS,
+                Err(e) => fail(&[e]),
+            },
+            BenchCommand::Element {
+                states,
+                repeats,
+                json,
+            } => match cli::bench::element(states, repeats, json.as_deref()) {
                 Ok(()) => ExitCode::SUCCESS,
                 Err(e) => fail(&[e]),
             },

@@ -49,7 +49,7 @@ fn gpu_beam_matches_the_twin() {
         }
     }
     let reference = base_chords(&model, &vec![0.0; 3 * n * v], v);
-    let (f_exact, k_exact) = beam(&model, v, &x, &rot, &reference);
+    let (f_exact, k_exact) = beam(&model, v, &x, &rot, &reference, true);
     // The same configurations as displacements `w` from the spun base (millimetres).
     let w: Vec<f64> = x.iter().zip(&spun).map(|(a, b)| a - b).collect();
     let based = base_chords(&model, &spun, v);
@@ -77,17 +77,50 @@ fn gpu_beam_matches_the_twin() {
         w
     };
     // The twin from the base: the same element forces (the chord formed in another order).
-    let (f_based, k_based) = beam(&model, v, &w, &rot, &based);
+    let (f_based, k_based) = beam(&model, v, &w, &rot, &based, true);
     let (bf, bk) = worst(&f_based, &k_based, &f_exact, &k_exact);
     eprintln!("twin from the spun base vs from the reference: force {bf:.2e}, tangent {bk:.2e}");
     assert!(bf <= 1e-8 && bk <= 1e-12, "force {bf:e}, tangent {bk:e}");
+    // The force alone (line-search trials): the same numbers as the force of the full run.
+    let (f_only, k_none) = beam(&model, v, &x, &rot, &reference, false);
+    assert_eq!(
+        f_only, f_exact,
+        "twin force-only = the tangent run's force, bit for bit"
+    );
+    assert!(k_none.iter().all(|&k| k == 0.0));
     let Some(ctx) = common::gpu() else { return };
+    let close = |a: &[f64], b: &[f64]| {
+        let scale = b.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        a.iter()
+            .zip(b)
+            .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()))
+            / scale
+    };
+    if ctx.has_f64 {
+        let (f_full, _) = beam_gpu(ctx, &model, v, &w, &rot, &based, true).unwrap();
+        let (f_force, k_empty) = beam_gpu(ctx, &model, v, &w, &rot, &based, false).unwrap();
+        let d = close(&f_force, &f_full);
+        eprintln!("GPU f64 force-only vs full kernel's force: {d:.1e}");
+        assert!(k_empty.is_empty() && d <= 1e-14, "{d:e}");
+    }
+    {
+        let (w32, r32) = (
+            w.iter().map(|&a| a as f32).collect::<Vec<f32>>(),
+            rot.iter().map(|&a| a as f32).collect::<Vec<f32>>(),
+        );
+        let up = |a: &[f32]| a.iter().map(|&b| b as f64).collect::<Vec<f64>>();
+        let (f_full, _) = beam_gpu(ctx, &model, v, &w32, &r32, &based, true).unwrap();
+        let (f_force, _) = beam_gpu(ctx, &model, v, &w32, &r32, &based, false).unwrap();
+        let d = close(&up(&f_force), &up(&f_full));
+        eprintln!("GPU f32 force-only vs full kernel's force: {d:.1e}");
+        assert!(d <= 1e-6, "{d:e}");
+    }
     if ctx.has_f64 {
         for (label, u, chords, f_twin, k_twin) in [
             ("reference", &x, &reference, &f_exact, &k_exact),
             ("base", &w, &based, &f_based, &k_based),
         ] {
-            let (f, k) = beam_gpu(ctx, &model, v, u, &rot, chords).unwrap();
+            let (f, k) = beam_gpu(ctx, &model, v, u, &rot, chords, true).unwrap();
             let (wf, wk) = worst(&f, &k, f_twin, k_twin);
             eprintln!("GPU f64 vs twin ({label}): force {wf:.2e}, tangent {wk:.2e}");
             assert!(wf <= 1e-9 && wk <= 1e-12, "force {wf:e}, tangent {wk:e}");
@@ -107,8 +140,8 @@ fn gpu_beam_matches_the_twin() {
         let u32 = to32(u);
         // The chords go in f64 to both (the kernel takes them in f32 with the stretch
         // formed in f64: part of its arithmetic here).
-        let (f, k) = beam_gpu(ctx, &model, v, &u32, &r32, chords).unwrap();
-        let (f_rounded, k_rounded) = beam(&model, v, &up(&u32), &up(&r32), chords);
+        let (f, k) = beam_gpu(ctx, &model, v, &u32, &r32, chords, true).unwrap();
+        let (f_rounded, k_rounded) = beam(&model, v, &up(&u32), &up(&r32), chords, true);
         let (input_f, input_k) = worst(&f_rounded, &k_rounded, &f_exact, &k_exact);
         let (kernel_f, kernel_k) = worst(&up(&f), &up(&k), &f_rounded, &k_rounded);
         let (total_f, total_k) = worst(&up(&f), &up(&k), &f_exact, &k_exact);

@@ -392,3 +392,202 @@ pub fn statics(
     }
     Ok(())
 }
+
+#[derive(Serialize)]
+struct ElementRow {
+    method: String,
+    /// Floating-point operations per element, counted (a transcendental as 20).
+    flops: u64,
+    counts: crate::physics::count::OpCounts,
+    median_us_per_element: f64,
+    ops_ratio_to_closed: f64,
+    time_ratio_to_closed: f64,
+}
+
+#[derive(Serialize)]
+struct ElementReport {
+    states: usize,
+    repeats: usize,
+    /// Worst difference of the closed form from the 144-evaluation hyper-dual oracle over
+    /// the states, relative to the largest entry (force, tangent).
+    closed_vs_hyperdual_f64: (f64, f64),
+    /// Worst difference of the closed form in f32 (base chord form) from the f64 oracle.
+    closed_f32_vs_hyperdual_f64: (f64, f64),
+    rows: Vec<ElementRow>,
+}
+
+/// Cost per transcendental (sin, cos, atan2, powf) in the FLOP figures: a polynomial of
+/// about this many operations (the f64 `atan2` written out for the GPU takes ≈ 40).
+const TRANSCENDENTAL_FLOPS: u64 = 20;
+
+/// Random element states of a 9 m collar: stretched, bent, twisted, spun rigidly by up to
+/// 300 rad, relative rotations up to 0.5 rad (reproducible).
+fn element_states(count: usize) -> Vec<crate::physics::beam::ElementState> {
+    use crate::physics::beam::{rotation_exp, ElementState};
+    use rand::{Rng, SeedableRng};
+    let mut rng = rand::rngs::StdRng::seed_from_u64(13);
+    let l = 9.0;
+    (0..count)
+        .map(|_| {
+            let spin = rotation_exp(&std::array::from_fn(|_| rng.random_range(-300.0..300.0)));
+            let rot = |rng: &mut rand::rngs::StdRng| {
+                let r = rotation_exp(&std::array::from_fn(|_| rng.random_range(-0.3..0.3)));
+                std::array::from_fn(|a| {
+                    std::array::from_fn(|b| (0..3).map(|m| r[a][m] * spin[m][b]).sum())
+                })
+            };
+            let (r1, r2) = (rot(&mut rng), rot(&mut rng));
+            let x1: [f64; 3] = std::array::from_fn(|_| rng.random_range(-1e3..1e3));
+            let stretch = l + rng.random_range(-0.01..0.01);
+            let x2 =
+                std::array::from_fn(|k| x1[k] + spin[k][0] * stretch + rng.random_range(-0.1..0.1));
+            ElementState {
+                x: [x1, x2],
+                triad: [r1, r2],
+            }
+        })
+        .collect()
+}
+
+/// Operations and time per element of the beam element's force and tangent: the
+/// hyper-dual forms (144 evaluations of the energy: the GPU kernel and twin before the
+/// closed form; 78: the CPU path before), the closed form (force only, force and tangent
+/// in f64 and f32), one core, `states` random states, median of `repeats`. Operation counts
+/// from running the same generic code on a counting float.
+pub fn element(states: usize, repeats: usize, json: Option<&Path>) -> Result<(), Error> {
+    use crate::physics::beam::{
+        element_force, force_and_tangent_closed, force_and_tangent_hyperdual, BeamSection, Chord,
+        ElementStiffness,
+    };
+    use crate::physics::count::{count, Counted};
+    let section = BeamSection::tube(0.165, 0.071, 2.1e11, 0.3);
+    let l0 = 9.0;
+    let list = element_states(states.max(1));
+    let k64 = ElementStiffness::of(&section, l0);
+    let form = Chord::Positions { length0: l0 };
+    // The f32 inputs: displacements from a base chord rounded to f32 (the engine's form).
+    let f32_inputs: Vec<_> = list
+        .iter()
+        .map(|s| {
+            let d: [f64; 3] = std::array::from_fn(|k| s.x[1][k] - s.x[0][k]);
+            let c = d.map(|v| v as f32 as f64);
+            let lc = (c[0] * c[0] + c[1] * c[1] + c[2] * c[2]).sqrt();
+            let w2: [f32; 3] = std::array::from_fn(|k| (d[k] - c[k]) as f32);
+            let base = Chord::Base {
+                chord: c,
+                stretch: lc - l0,
+                length: lc,
+            }
+            .map(|v| v as f32);
+            let t = s.triad.map(|m| m.map(|r| r.map(|v| v as f32)));
+            ([[0.0f32; 3], w2], t, base)
+        })
+        .collect();
+    let k32 = k64.map(|v| v as f32);
+    // Agreement with the oracle.
+    let worst = |f: &[f64; 12], k: &[[f64; 12]; 12], f0: &[f64; 12], k0: &[[f64; 12]; 12]| {
+        let fs = f0.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        let ks = k0.iter().flatten().fold(0.0f64, |m, x| m.max(x.abs()));
+        let df = (0..12).fold(0.0f64, |m, a| m.max((f[a] - f0[a]).abs() / fs));
+        let dk = (0..144).fold(0.0f64, |m, i| {
+            m.max((k[i / 12][i % 12] - k0[i / 12][i % 12]).abs() / ks)
+        });
+        (df, dk)
+    };
+    let (mut agree64, mut agree32) = ((0.0f64, 0.0f64), (0.0f64, 0.0f64));
+    for (s, (x32, t32, b32)) in list.iter().zip(&f32_inputs) {
+        let (f0, k0) = force_and_tangent_hyperdual(&s.x, &s.triad, &section, l0, false);
+        let (f, k) = force_and_tangent_closed(&s.x, &s.triad, &form, &k64);
+        let w = worst(&f, &k, &f0, &k0);
+        agree64 = (agree64.0.max(w.0), agree64.1.max(w.1));
+        let (f, k) = force_and_tangent_closed(x32, t32, b32, &k32);
+        let up = |v: f32| v as f64;
+        let w = worst(&f.map(up), &k.map(|r| r.map(up)), &f0, &k0);
+        agree32 = (agree32.0.max(w.0), agree32.1.max(w.1));
+    }
+    // Counts on the first state (the branches taken are those of a deformed element).
+    let s0 = list[0];
+    let cx = s0.x.map(|p| p.map(Counted));
+    let ct = s0.triad.map(|m| m.map(|r| r.map(Counted)));
+    let cform = form.map(Counted);
+    let ck = k64.map(Counted);
+    let counts = [
+        count(|| force_and_tangent_hyperdual(&cx, &ct, &section, l0, false)).1,
+        count(|| force_and_tangent_hyperdual(&cx, &ct, &section, l0, true)).1,
+        count(|| element_force(&cx, &ct, &cform, &ck)).1,
+        count(|| force_and_tangent_closed(&cx, &ct, &cform, &ck)).1,
+        count(|| force_and_tangent_closed(&cx, &ct, &cform, &ck)).1,
+    ];
+    let sink = std::cell::Cell::new(0.0f64);
+    let per = |f: &mut dyn FnMut()| -> Result<f64, Error> {
+        let t = median_seconds::<Error>(repeats, || {
+            f();
+            Ok(())
+        })?;
+        Ok(1e6 * t / list.len() as f64)
+    };
+    let times = [
+        per(&mut || {
+            for s in &list {
+                let r = force_and_tangent_hyperdual(&s.x, &s.triad, &section, l0, false);
+                sink.set(sink.get() + r.1[3][4]);
+            }
+        })?,
+        per(&mut || {
+            for s in &list {
+                let r = force_and_tangent_hyperdual(&s.x, &s.triad, &section, l0, true);
+                sink.set(sink.get() + r.1[3][4]);
+            }
+        })?,
+        per(&mut || {
+            for s in &list {
+                let r = element_force(&s.x, &s.triad, &form, &k64);
+                sink.set(sink.get() + r[4]);
+            }
+        })?,
+        per(&mut || {
+            for s in &list {
+                let r = force_and_tangent_closed(&s.x, &s.triad, &form, &k64);
+                sink.set(sink.get() + r.1[3][4]);
+            }
+        })?,
+        per(&mut || {
+            for (x, t, b) in &f32_inputs {
+                let r = force_and_tangent_closed(x, t, b, &k32);
+                sink.set(sink.get() + r.1[3][4] as f64);
+            }
+        })?,
+    ];
+    std::hint::black_box(sink.get());
+    let names = [
+        "hyper-dual, 144 evaluations (GPU kernel and twin before)",
+        "hyper-dual, 78 evaluations (CPU path before)",
+        "closed form, force only (line-search trials)",
+        "closed form, force and tangent, f64",
+        "closed form, force and tangent, f32",
+    ];
+    let closed = (counts[3].flops(TRANSCENDENTAL_FLOPS), times[3]);
+    let rows = (0..names.len())
+        .map(|i| ElementRow {
+            method: names[i].to_string(),
+            flops: counts[i].flops(TRANSCENDENTAL_FLOPS),
+            counts: counts[i],
+            median_us_per_element: times[i],
+            ops_ratio_to_closed: counts[i].flops(TRANSCENDENTAL_FLOPS) as f64 / closed.0 as f64,
+            time_ratio_to_closed: times[i] / closed.1,
+        })
+        .collect();
+    let report = ElementReport {
+        states: list.len(),
+        repeats,
+        closed_vs_hyperdual_f64: agree64,
+        closed_f32_vs_hyperdual_f64: agree32,
+        rows,
+    };
+    let text = serde_json::to_string_pretty(&report).unwrap_or_default();
+    println!("{text}");
+    if let Some(path) = json {
+        write_atomic(path, text.as_bytes())?;
+    }
+    Ok(())
+}

@@ -73,12 +73,13 @@ pub trait DynamicEnsemble<T> {
     /// Predicts at the unknown, evaluates and solves: the norms of the residual and the
     /// correction `Δ` (α = 1), the solve's status and the inertial force scale per variant.
     fn iterate(&mut self) -> Result<Iteration<T>, String>;
-    /// The residual at `v̇ + α Δ` (line search): its norms with `Δ`, `α`.
+    /// The residual at `v̇ + α Δ` (line search; the force-only beam kernel): its norms
+    /// with `Δ`, `α`.
     fn trial(&mut self, alpha: &[T]) -> Result<Norms<T>, String>;
     /// The unknown `+= α Δ`.
     fn correct(&mut self, alpha: &[T]) -> Result<(), String>;
-    /// The unknown becomes the last trial's candidate, whose evaluated system the next
-    /// [`DynamicEnsemble::iterate`] solves without evaluating it again.
+    /// The unknown becomes the last trial's candidate (a trial forms its residual only:
+    /// the next [`DynamicEnsemble::iterate`] evaluates the candidate's system).
     fn accept_trial(&mut self) -> Result<(), String>;
     /// Ends the step: the state at `t_{n+1}` from the unknown.
     fn end_step(&mut self) -> Result<(), String>;
@@ -708,7 +709,7 @@ impl<T: Real> NewtonSystem for DynamicStep<'_, T> {
     }
     fn accept(&mut self, alpha: &[f64], trial_matches: bool) -> Result<(), String> {
         if trial_matches {
-            // The trial at these α was evaluated: its system is the next iteration's.
+            // The trial at these α is the new unknown.
             self.ensemble.accept_trial()?;
         } else if alpha.iter().any(|&a| a != 0.0) {
             self.ensemble.correct(&negated::<T>(alpha))?;
@@ -729,9 +730,6 @@ pub struct TwinDynamic<'a> {
     unknown: Vec<f64>,
     trial: DynamicBatch<f64>,
     delta: Vec<f64>,
-    /// The last trial's system, and the system the next iteration solves as it is.
-    trial_system: Option<ChainBatch<f64>>,
-    ready: Option<ChainBatch<f64>>,
 }
 
 impl<'a> TwinDynamic<'a> {
@@ -757,13 +755,15 @@ impl<'a> TwinDynamic<'a> {
             unknown: dynamic.start.vdot.clone(),
             trial: dynamic.start.clone(),
             delta: vec![0.0; 6 * tables.num_nodes * tables.num_variants],
-            trial_system: None,
-            ready: None,
         }
     }
 
-    /// Predicts the trial at `vdot` and assembles its system.
-    fn evaluate_at(&mut self, mut vdot: Vec<f64>) -> Result<ChainBatch<f64>, String> {
+    /// Predicts the trial at `vdot` and assembles its system (`tangent`) or its residual.
+    fn evaluate_at(
+        &mut self,
+        mut vdot: Vec<f64>,
+        tangent: bool,
+    ) -> Result<ChainBatch<f64>, String> {
         let c = self.coefficients.ok_or("no step begun")?;
         predict(&c, &self.top, &self.state, &mut vdot, &mut self.trial);
         let p = options_coefficients(&c);
@@ -775,6 +775,7 @@ impl<'a> TwinDynamic<'a> {
             &tr.u,
             &tr.rot,
             &self.dynamic.f_ext,
+            tangent,
             Some((
                 tr,
                 super::AssemblyDynamic {
@@ -799,19 +800,12 @@ impl DynamicEnsemble<f64> for TwinDynamic<'_> {
         self.coefficients = Some(*c);
         self.top = top.to_vec();
         self.unknown = self.state.vdot.clone();
-        self.ready = None;
         Ok(())
     }
     fn iterate(&mut self) -> Result<Iteration<f64>, String> {
-        let sys = match self.ready.take() {
-            Some(sys) => sys,
-            None => {
-                let sys = self.evaluate_at(self.unknown.clone())?;
-                // The top's prescribed accelerations, as the predictor wrote them.
-                self.unknown = self.trial.vdot.clone();
-                sys
-            }
-        };
+        let sys = self.evaluate_at(self.unknown.clone(), true)?;
+        // The top's prescribed accelerations, as the predictor wrote them.
+        self.unknown = self.trial.vdot.clone();
         let (delta, status) = block_lu(&sys);
         self.delta = delta;
         let (v, n) = (self.tables.num_variants, self.tables.num_nodes);
@@ -826,21 +820,18 @@ impl DynamicEnsemble<f64> for TwinDynamic<'_> {
     fn trial(&mut self, alpha: &[f64]) -> Result<Norms<f64>, String> {
         let (v, n) = (self.tables.num_variants, self.tables.num_nodes);
         let cand = accelerate(&self.tables.basis, &self.unknown, &self.delta, alpha, n, v);
-        let sys = self.evaluate_at(cand)?;
-        let out = norms(&sys.rhs, &self.delta, alpha, n, v);
-        self.trial_system = Some(sys);
-        Ok(out)
+        let sys = self.evaluate_at(cand, false)?;
+        Ok(norms(&sys.rhs, &self.delta, alpha, n, v))
     }
     fn correct(&mut self, alpha: &[f64]) -> Result<(), String> {
         let (v, n) = (self.tables.num_variants, self.tables.num_nodes);
         self.unknown = accelerate(&self.tables.basis, &self.unknown, &self.delta, alpha, n, v);
-        self.ready = None;
         Ok(())
     }
     fn accept_trial(&mut self) -> Result<(), String> {
-        // The candidate with the top's prescribed accelerations, as the predictor wrote it.
+        // The candidate with the top's prescribed accelerations, as the predictor wrote it
+        // (the trial formed its residual only: the next iteration evaluates its system).
         self.unknown = self.trial.vdot.clone();
-        self.ready = Some(self.trial_system.take().ok_or("no trial to accept")?);
         Ok(())
     }
     fn end_step(&mut self) -> Result<(), String> {
@@ -856,7 +847,6 @@ impl DynamicEnsemble<f64> for TwinDynamic<'_> {
     }
     fn set_state(&mut self, state: &DynamicBatch<f64>) -> Result<(), String> {
         self.state = state.clone();
-        self.ready = None;
         Ok(())
     }
     fn unknown(&mut self) -> Result<Vec<f64>, String> {
@@ -864,7 +854,6 @@ impl DynamicEnsemble<f64> for TwinDynamic<'_> {
     }
     fn set_unknown(&mut self, vdot: &[f64]) -> Result<(), String> {
         self.unknown = vdot.to_vec();
-        self.ready = None;
         Ok(())
     }
 }

@@ -110,9 +110,12 @@ pub trait Ensemble<T> {
     /// Solves the current system for `Δ`; the norms of its residual and `Δ` (α = 1) and
     /// the solve's status per variant.
     fn solve(&mut self) -> Result<(Norms<T>, Vec<u32>), String>;
-    /// Trial = current + `α Δ`, evaluated; the norms of the trial's residual with `Δ`, `α`.
+    /// Trial = current + `α Δ`, its residual evaluated (not its tangent: a rejected
+    /// trial's tangent would be wasted, and the tangent is most of an evaluation); the norms of the
+    /// trial's residual with `Δ`, `α`.
     fn trial(&mut self, alpha: &[T]) -> Result<Norms<T>, String>;
-    /// Makes the last trial (configuration and system) the current one.
+    /// Makes the last trial (configuration and residual) the current one; its tangent is
+    /// formed by the next [`Ensemble::evaluate`].
     fn accept_trial(&mut self);
     /// Current += `α Δ` (its system must be evaluated again).
     fn commit(&mut self, alpha: &[T]) -> Result<(), String>;
@@ -190,9 +193,11 @@ pub fn invocations(stage: Stage, n: usize, v: usize, p: usize) -> usize {
 }
 
 /// The twins' run of [`evaluation`] on a configuration (`x` displacements from the base,
-/// `rot`): the constrained system. `dynamic`: the predicted trial state and the dynamic
+/// `rot`): the constrained system — its residual alone where `tangent` is false (the
+/// beam stage forms forces only; the tangent blocks are then meaningless). `dynamic`: the predicted trial state and the dynamic
 /// assembly's inputs (the predictor itself is run by the caller, which owns the step's
 /// state).
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn twin_evaluate(
     model: &Model,
     t: &EnsembleTables<f64>,
@@ -200,6 +205,7 @@ pub(crate) fn twin_evaluate(
     x: &[f64],
     rot: &[f64],
     f_ext: &[f64],
+    tangent: bool,
     dynamic: Option<(
         &crate::kernels::dynamics::DynamicBatch<f64>,
         AssemblyDynamic,
@@ -212,7 +218,11 @@ pub(crate) fn twin_evaluate(
     for stage in evaluation(dynamic.is_some()) {
         match stage {
             Stage::Predict => {}
-            Stage::Beam => elements = Some(crate::kernels::beam::beam(model, v, x, rot, &t.chords)),
+            Stage::Beam => {
+                elements = Some(crate::kernels::beam::beam(
+                    model, v, x, rot, &t.chords, tangent,
+                ))
+            }
             Stage::Sites => match &dynamic {
                 Some((trial, _)) => crate::kernels::sites::gather_sites_dynamic(
                     &t.pair_node,
@@ -281,7 +291,8 @@ struct TwinEnsemble<'a> {
     contact: ContactBatch<f64>,
     f_ext: Vec<f64>,
     config: [ConfigBatch<f64>; 2],
-    system: [Option<ChainBatch<f64>>; 2],
+    /// Each slot's system and whether its tangent is formed (trials form the residual only).
+    system: [Option<(ChainBatch<f64>, bool)>; 2],
     current: usize,
     delta: Vec<f64>,
     /// What the update needs to make contact nodes follow their wall (kept in step with
@@ -290,17 +301,19 @@ struct TwinEnsemble<'a> {
 }
 
 impl TwinEnsemble<'_> {
-    fn evaluate_slot(&mut self, slot: usize) {
+    fn evaluate_slot(&mut self, slot: usize, tangent: bool) {
         let c = &self.config[slot];
-        self.system[slot] = Some(twin_evaluate(
+        let system = twin_evaluate(
             self.model,
             &self.tables,
             &mut self.contact,
             &c.x,
             &c.rot,
             &self.f_ext,
+            tangent,
             None,
-        ));
+        );
+        self.system[slot] = Some((system, tangent));
     }
 
     /// The update's walls from the current tables and law parameters.
@@ -317,7 +330,7 @@ impl TwinEnsemble<'_> {
     fn rhs(&self, slot: usize) -> Result<&[f64], String> {
         self.system[slot]
             .as_ref()
-            .map(|s| s.rhs.as_slice())
+            .map(|s| s.0.rhs.as_slice())
             .ok_or_else(|| "system not evaluated".to_string())
     }
 }
@@ -331,13 +344,15 @@ impl Ensemble<f64> for TwinEnsemble<'_> {
         Ok(())
     }
     fn evaluate(&mut self) -> Result<(), String> {
-        self.evaluate_slot(self.current);
+        self.evaluate_slot(self.current, true);
         Ok(())
     }
     fn solve(&mut self) -> Result<(Norms<f64>, Vec<u32>), String> {
-        let sys = self.system[self.current]
-            .as_ref()
-            .ok_or("system not evaluated")?;
+        let sys = match &self.system[self.current] {
+            Some((sys, true)) => sys,
+            Some((_, false)) => return Err("tangent not formed (a trial's residual only)".into()),
+            None => return Err("system not evaluated".into()),
+        };
         let (delta, status) = block_lu(sys);
         self.delta = delta;
         let ones = vec![1.0; self.tables.num_variants];
@@ -354,7 +369,7 @@ impl Ensemble<f64> for TwinEnsemble<'_> {
         let other = 1 - self.current;
         self.config[other] = self.config[self.current].clone();
         update(&mut self.config[other], &self.walls, &self.delta, alpha);
-        self.evaluate_slot(other);
+        self.evaluate_slot(other, false);
         Ok(norms(
             self.rhs(other)?,
             &self.delta,
@@ -908,8 +923,9 @@ impl<T: Real> NewtonSystem for EngineStatic<'_, T> {
     fn accept(&mut self, alpha: &[f64], trial_matches: bool) -> Result<(), String> {
         self.flush()?;
         if trial_matches {
+            // The trial's residual only: its tangent is formed when the next solve needs it.
             self.ensemble.accept_trial();
-            self.evaluated = true;
+            self.evaluated = false;
         } else if alpha.iter().any(|&a| a != 0.0) {
             self.ensemble.commit(&negated::<T>(alpha))?;
             self.evaluated = false;

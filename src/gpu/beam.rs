@@ -11,17 +11,22 @@ use crate::gpu::GpuContext;
 use crate::kernels::beam::{frame_table, section_table};
 use crate::model::Model;
 
-/// The WGSL text of the beam kernel at a precision.
-pub fn beam_wgsl(f64: bool) -> Result<String, GpuError> {
+/// The WGSL text of the beam kernel at a precision: force and tangent, or (`force_only`)
+/// the force alone, without the tangent binding (7).
+pub fn beam_wgsl(f64: bool, force_only: bool) -> Result<String, GpuError> {
     let mut flags = BTreeSet::new();
     if f64 {
         flags.insert("F64");
+    }
+    if force_only {
+        flags.insert("FORCE_ONLY");
     }
     compose("beam.wgsl", &flags, f64)
 }
 
 /// Element forces and tangents of V variants on the GPU at displacements `u` from the base
-/// whose chords are `chords` ([`crate::kernels::beam::base_chords`]), laid out as the twin's.
+/// whose chords are `chords` ([`crate::kernels::beam::base_chords`]), laid out as the twin's;
+/// with `tangent` false the forces alone (an empty tangent).
 pub fn beam_gpu<T: GpuReal>(
     ctx: &'static GpuContext,
     model: &Model,
@@ -29,6 +34,7 @@ pub fn beam_gpu<T: GpuReal>(
     u: &[T],
     rot: &[T],
     chords: &[f64],
+    tangent: bool,
 ) -> Result<(Vec<T>, Vec<T>), GpuError> {
     crate::gpu::contact::require_precision::<T>(ctx)?;
     let ne = model.elements.len();
@@ -38,7 +44,7 @@ pub fn beam_gpu<T: GpuReal>(
             "element tangents exceed one binding; split the variants".into(),
         ));
     }
-    let pipeline = ctx.pipeline("beam", &beam_wgsl(T::IS_F64)?)?;
+    let pipeline = ctx.pipeline("beam", &beam_wgsl(T::IS_F64, !tangent)?)?;
     let cast = |v: Vec<f64>| -> Vec<T> { v.into_iter().map(T::from_f64_lossy).collect() };
     let sections = cast(section_table(model));
     let frames = cast(frame_table(model));
@@ -49,6 +55,10 @@ pub fn beam_gpu<T: GpuReal>(
         _pad0: 0,
         _pad1: 0,
     };
+    let outputs = [
+        Out::Empty(12 * ne * num_variants * size),
+        Out::Empty(144 * ne * num_variants * size),
+    ];
     let out = run_once(
         ctx,
         &pipeline,
@@ -61,14 +71,13 @@ pub fn beam_gpu<T: GpuReal>(
             bytemuck::cast_slice(&sections),
             bytemuck::cast_slice(&chords),
         ],
-        &[
-            Out::Empty(12 * ne * num_variants * size),
-            Out::Empty(144 * ne * num_variants * size),
-        ],
+        &outputs[..1 + usize::from(tangent)],
         ne * num_variants,
     )?;
     Ok((
         bytemuck::cast_slice(&out[0]).to_vec(),
-        bytemuck::cast_slice(&out[1]).to_vec(),
+        out.get(1)
+            .map(|t| bytemuck::cast_slice(t).to_vec())
+            .unwrap_or_default(),
     ))
 }

@@ -1,6 +1,6 @@
 //! Runs `shaders/block_lu.wgsl` (twin: `src/kernels/block_lu.rs`): every variant's
-//! block-tridiagonal system solved by one invocation, variants split into chunks that fit
-//! the adapter's binding limits.
+//! block-tridiagonal system solved by [`LANES`] invocations (a row of the 6 × 13 block per
+//! lane), variants split into chunks that fit the adapter's binding limits.
 
 use std::collections::BTreeSet;
 
@@ -15,6 +15,10 @@ use crate::kernels::block_lu::ChainBatch;
 /// Nodes per dispatch of the block solve: keeps every loop of an invocation far below
 /// llvmpipe's 65,535-iteration cut-off (≈ 700 inner iterations per node).
 pub const NODES_PER_PASS: usize = 32;
+
+/// Invocations per variant (`shaders/block_lu.wgsl`: six rows and two idle lanes, eight
+/// variants per workgroup of 64).
+pub const LANES: usize = 8;
 
 /// Status a variant's solve starts with; still there afterwards means it did not finish.
 const RUNNING: u32 = 2;
@@ -96,7 +100,7 @@ pub fn block_lu_gpu_chunked<T: GpuReal>(
     let max_binding = ctx.max_binding_bytes() as usize;
     // The largest array per variant is a 36-float block field over n nodes.
     let cap = (max_binding / (36 * n.max(1) * size))
-        .min(ctx.limits.max_compute_workgroups_per_dimension as usize * WORKGROUP)
+        .min(ctx.limits.max_compute_workgroups_per_dimension as usize * WORKGROUP / LANES)
         .min(max_chunk)
         .max(1);
     let mut x = vec![T::zero(); 6 * n * v];
@@ -141,7 +145,7 @@ pub fn block_lu_gpu_chunked<T: GpuReal>(
                 Out::Empty(x_bytes),
                 Out::From(bytemuck::cast_slice(&running)),
             ],
-            len,
+            LANES * len,
         )?;
         let xs: &[T] = bytemuck::cast_slice(&out[2]);
         let st: &[u32] = bytemuck::cast_slice(&out[3]);

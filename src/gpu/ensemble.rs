@@ -16,6 +16,7 @@ use wgpu::util::DeviceExt;
 use crate::engine::Stage;
 use crate::engine::{Ensemble, EnsembleTables};
 use crate::error::GpuError;
+use crate::gpu::block_lu::LANES as LU_LANES;
 use crate::gpu::contact::{contact_wgsl, require_precision, GpuReal};
 use crate::gpu::dispatch::WORKGROUP;
 use crate::gpu::layout::{AssembleDims, BeamDims, ChainDims, ContactDims};
@@ -58,7 +59,7 @@ pub fn max_variants(ctx: &GpuContext, model: &Model, size: usize) -> usize {
     let n = model.nodes.len();
     let s = model.sites.len();
     let by_binding = ctx.max_binding_bytes() as usize / largest_binding_per_variant(n, s, size);
-    let widest = n.max(s).max(1);
+    let widest = n.max(s).max(LU_LANES);
     let by_groups = ctx.limits.max_compute_workgroups_per_dimension as usize * WORKGROUP / widest;
     by_binding.min(by_groups).max(1)
 }
@@ -67,6 +68,8 @@ struct Slot {
     x: wgpu::Buffer,
     rot: wgpu::Buffer,
     beam: wgpu::BindGroup,
+    /// The force-only beam kernel's group (trials).
+    beam_force: wgpu::BindGroup,
     sites: wgpu::BindGroup,
     assemble: wgpu::BindGroup,
     lu: Vec<wgpu::BindGroup>,
@@ -78,6 +81,8 @@ struct Slot {
 
 struct Pipelines {
     beam: Arc<wgpu::ComputePipeline>,
+    /// The beam kernel built `FORCE_ONLY` (line-search trials).
+    beam_force: Arc<wgpu::ComputePipeline>,
     sites: Arc<wgpu::ComputePipeline>,
     contact: Arc<wgpu::ComputePipeline>,
     assemble: Arc<wgpu::ComputePipeline>,
@@ -91,6 +96,8 @@ pub struct GpuEnsemble<T: GpuReal> {
     ctx: &'static GpuContext,
     p: Pipelines,
     slots: [Slot; 2],
+    /// Whether each slot's assembled system has its tangent (a trial's has its residual only).
+    formed: [bool; 2],
     current: usize,
     contact: wgpu::BindGroup,
     c: Common,
@@ -221,28 +228,31 @@ struct Common {
 }
 
 impl Common {
-    /// The beam kernel's bind group on configuration (`x`, `rot`).
+    /// The beam kernel's bind group on configuration (`x`, `rot`); `force_only`: for the
+    /// kernel built `FORCE_ONLY`, which has no tangent binding.
     fn beam_group(
         &self,
         ctx: &GpuContext,
         pipeline: &wgpu::ComputePipeline,
         x: &wgpu::Buffer,
         rot: &wgpu::Buffer,
+        force_only: bool,
     ) -> wgpu::BindGroup {
+        let all = [
+            &self.beam_dims,
+            x,
+            rot,
+            &self.frames,
+            &self.sections,
+            &self.chords,
+            &self.elem_force,
+            &self.elem_tangent,
+        ];
         bind(
             ctx,
             pipeline,
             "beam",
-            &[
-                &self.beam_dims,
-                x,
-                rot,
-                &self.frames,
-                &self.sections,
-                &self.chords,
-                &self.elem_force,
-                &self.elem_tangent,
-            ],
+            &all[..all.len() - usize::from(force_only)],
         )
     }
 
@@ -459,7 +469,8 @@ impl<T: GpuReal> GpuEnsemble<T> {
         let size = std::mem::size_of::<T>();
         let c = Common::new(ctx, model, tables, None, None)?;
         let pipelines = Pipelines {
-            beam: ctx.pipeline("beam", &crate::gpu::beam::beam_wgsl(f64)?)?,
+            beam: ctx.pipeline("beam", &crate::gpu::beam::beam_wgsl(f64, false)?)?,
+            beam_force: ctx.pipeline("beam_force", &crate::gpu::beam::beam_wgsl(f64, true)?)?,
             sites: ctx.pipeline("sites", &sites_wgsl(f64)?)?,
             contact: ctx.pipeline("contact", &contact_wgsl(&tables.terms, f64)?)?,
             assemble: ctx.pipeline("assemble", &crate::gpu::assemble::assemble_wgsl(f64)?)?,
@@ -475,7 +486,8 @@ impl<T: GpuReal> GpuEnsemble<T> {
             let upper = empty(ctx, "upper", 36 * m.max(1) * v * size);
             let lower = empty(ctx, "lower", 36 * m.max(1) * v * size);
             let rhs = empty(ctx, "rhs", 6 * n * v * size);
-            let beam = c.beam_group(ctx, &pipelines.beam, &x, &rot);
+            let beam = c.beam_group(ctx, &pipelines.beam, &x, &rot, false);
+            let beam_force = c.beam_group(ctx, &pipelines.beam_force, &x, &rot, true);
             let sites = bind(
                 ctx,
                 &pipelines.sites,
@@ -513,6 +525,7 @@ impl<T: GpuReal> GpuEnsemble<T> {
                 x,
                 rot,
                 beam,
+                beam_force,
                 sites,
                 assemble,
                 lu,
@@ -527,6 +540,7 @@ impl<T: GpuReal> GpuEnsemble<T> {
             ctx,
             p: pipelines,
             slots,
+            formed: [false; 2],
             current: 0,
             contact,
             c,
@@ -537,8 +551,9 @@ impl<T: GpuReal> GpuEnsemble<T> {
         })
     }
 
-    /// Records the evaluation of `slot`: beam, sites, contact, assembly.
-    fn record_evaluate(&self, pass: &mut wgpu::ComputePass, slot: usize) {
+    /// Records the evaluation of `slot`: beam, sites, contact, assembly — the residual
+    /// alone (the force-only beam kernel) where `tangent` is false.
+    fn record_evaluate(&self, pass: &mut wgpu::ComputePass, slot: usize, tangent: bool) {
         let s = &self.slots[slot];
         let p = &self.p;
         record_chain(
@@ -549,7 +564,8 @@ impl<T: GpuReal> GpuEnsemble<T> {
             self.num_pairs,
             |stage| match stage {
                 Stage::Predict => None,
-                Stage::Beam => Some((&*p.beam, &s.beam)),
+                Stage::Beam if tangent => Some((&*p.beam, &s.beam)),
+                Stage::Beam => Some((&*p.beam_force, &s.beam_force)),
                 Stage::Sites => Some((&*p.sites, &s.sites)),
                 Stage::Contact => Some((&*p.contact, &self.contact)),
                 Stage::Assemble => Some((&*p.assemble, &s.assemble)),
@@ -690,13 +706,17 @@ impl<T: GpuReal> Ensemble<T> for GpuEnsemble<T> {
         let mut encoder = self.encoder("evaluate");
         {
             let mut pass = encoder.begin_compute_pass(&Default::default());
-            self.record_evaluate(&mut pass, self.current);
+            self.record_evaluate(&mut pass, self.current, true);
         }
         self.ctx.queue.submit([encoder.finish()]);
+        self.formed[self.current] = true;
         Ok(())
     }
 
     fn solve(&mut self) -> Result<(Norms<T>, Vec<u32>), String> {
+        if !self.formed[self.current] {
+            return Err("tangent not formed (a trial's residual only)".into());
+        }
         let v = self.num_variants;
         let s = &self.slots[self.current];
         let mut encoder = self.encoder("solve");
@@ -704,7 +724,7 @@ impl<T: GpuReal> Ensemble<T> for GpuEnsemble<T> {
         {
             let mut pass = encoder.begin_compute_pass(&Default::default());
             for group in &s.lu {
-                dispatch(&mut pass, &self.p.block_lu, group, v);
+                dispatch(&mut pass, &self.p.block_lu, group, LU_LANES * v);
             }
             dispatch(&mut pass, &self.p.norms, &s.norms_solve, v);
         }
@@ -728,9 +748,10 @@ impl<T: GpuReal> Ensemble<T> for GpuEnsemble<T> {
         {
             let mut pass = encoder.begin_compute_pass(&Default::default());
             dispatch(&mut pass, &self.p.update, &b.update, self.num_nodes * v);
-            self.record_evaluate(&mut pass, other);
+            self.record_evaluate(&mut pass, other, false);
             dispatch(&mut pass, &self.p.norms, &b.norms_trial, v);
         }
+        self.formed[other] = false;
         self.finish_with_norms(encoder)
             .map(|(n, _)| n)
             .map_err(|e| e.to_string())
@@ -785,6 +806,7 @@ impl<T: GpuReal> Ensemble<T> for GpuEnsemble<T> {
         let q = &self.ctx.queue;
         q.write_buffer(&s.x, 0, bytemuck::cast_slice(&config.x));
         q.write_buffer(&s.rot, 0, bytemuck::cast_slice(&config.rot));
+        self.formed[self.current] = false;
         Ok(())
     }
 
@@ -801,6 +823,7 @@ impl<T: GpuReal> Ensemble<T> for GpuEnsemble<T> {
         let mut encoder = self.encoder("rebase");
         encoder.clear_buffer(&self.slots[self.current].x, 0, None);
         q.submit([encoder.finish()]);
+        self.formed[self.current] = false;
         Ok(())
     }
 }
@@ -856,9 +879,6 @@ pub struct GpuDynamic<T: GpuReal> {
     num_pairs: usize,
     a0: T,
     c: Common,
-    /// The system in the buffers is the unknown's (an accepted trial's): the next iteration
-    /// solves it without evaluating it again.
-    ready: bool,
     _keep: Vec<wgpu::Buffer>,
     _real: PhantomData<T>,
 }
@@ -873,6 +893,8 @@ struct DynamicPipelines {
     assemble: Arc<wgpu::ComputePipeline>,
     block_lu: Arc<wgpu::ComputePipeline>,
     norms: Arc<wgpu::ComputePipeline>,
+    /// The beam kernel built `FORCE_ONLY` (line-search trials).
+    beam_force: Arc<wgpu::ComputePipeline>,
 }
 
 struct DynamicGroups {
@@ -881,6 +903,7 @@ struct DynamicGroups {
     accelerate: wgpu::BindGroup,
     scale: wgpu::BindGroup,
     beam: wgpu::BindGroup,
+    beam_force: wgpu::BindGroup,
     sites: wgpu::BindGroup,
     contact: wgpu::BindGroup,
     assemble_unknown: wgpu::BindGroup,
@@ -938,7 +961,8 @@ impl<T: GpuReal> GpuDynamic<T> {
                 &dynamics_wgsl(DynamicsKernel::Accelerate, f64)?,
             )?,
             scale: ctx.pipeline("scale", &dynamics_wgsl(DynamicsKernel::Scale, f64)?)?,
-            beam: ctx.pipeline("beam", &crate::gpu::beam::beam_wgsl(f64)?)?,
+            beam: ctx.pipeline("beam", &crate::gpu::beam::beam_wgsl(f64, false)?)?,
+            beam_force: ctx.pipeline("beam_force", &crate::gpu::beam::beam_wgsl(f64, true)?)?,
             sites: ctx.pipeline("sites", &sites_wgsl_for(true, f64)?)?,
             contact: ctx.pipeline("contact", &contact_wgsl(&tables.terms, f64)?)?,
             assemble: ctx.pipeline(
@@ -1040,7 +1064,8 @@ impl<T: GpuReal> GpuDynamic<T> {
                 "scale",
                 &[&c.chain_dims, &mass, &b.vdot_k, &b.scale],
             ),
-            beam: c.beam_group(ctx, &pl.beam, &b.u_1, &b.rot_1),
+            beam: c.beam_group(ctx, &pl.beam, &b.u_1, &b.rot_1, false),
+            beam_force: c.beam_group(ctx, &pl.beam_force, &b.u_1, &b.rot_1, true),
             sites: bind(
                 ctx,
                 &pl.sites,
@@ -1072,13 +1097,13 @@ impl<T: GpuReal> GpuDynamic<T> {
             num_pairs: p,
             a0: T::from_f64_lossy(dynamic.a0),
             c,
-            ready: false,
             _keep: vec![mass, inertia0, diag, upper, lower, rhs],
             _real: PhantomData,
         })
     }
 
-    /// Records predict (at the unknown or the candidate), beam, sites, contact, assembly.
+    /// Records predict (at the unknown or the candidate), beam, sites, contact, assembly:
+    /// at the unknown the system, at a (line-search) candidate its residual alone.
     fn record_evaluate(&self, pass: &mut wgpu::ComputePass, candidate: bool) {
         let (g, p) = (&self.g, &self.p);
         let (predict, assemble) = if candidate {
@@ -1094,6 +1119,7 @@ impl<T: GpuReal> GpuDynamic<T> {
             self.num_pairs,
             |stage| match stage {
                 Stage::Predict => Some((&*p.predict, predict)),
+                Stage::Beam if candidate => Some((&*p.beam_force, &g.beam_force)),
                 Stage::Beam => Some((&*p.beam, &g.beam)),
                 Stage::Sites => Some((&*p.sites, &g.sites)),
                 Stage::Contact => Some((&*p.contact, &g.contact)),
@@ -1128,7 +1154,6 @@ impl<T: GpuReal> crate::engine::dynamic::DynamicEnsemble<T> for GpuDynamic<T> {
         let mut e = encoder(self.ctx, "begin_step");
         Self::copy_all(&mut e, &[(&self.b.vdot_n, &self.b.vdot_k)]);
         q.submit([e.finish()]);
-        self.ready = false;
         Ok(())
     }
 
@@ -1138,11 +1163,9 @@ impl<T: GpuReal> crate::engine::dynamic::DynamicEnsemble<T> for GpuDynamic<T> {
         self.c.reset_status(&mut e, v);
         {
             let mut pass = e.begin_compute_pass(&Default::default());
-            if !std::mem::take(&mut self.ready) {
-                self.record_evaluate(&mut pass, false);
-            }
+            self.record_evaluate(&mut pass, false);
             for group in &self.g.lu {
-                dispatch(&mut pass, &self.p.block_lu, group, v);
+                dispatch(&mut pass, &self.p.block_lu, group, LU_LANES * v);
             }
             dispatch(&mut pass, &self.p.norms, &self.g.norms_iterate, v);
             dispatch(&mut pass, &self.p.scale, &self.g.scale, v);
@@ -1208,17 +1231,16 @@ impl<T: GpuReal> crate::engine::dynamic::DynamicEnsemble<T> for GpuDynamic<T> {
         }
         Self::copy_all(&mut e, &[(&self.b.vdot_c, &self.b.vdot_k)]);
         self.ctx.queue.submit([e.finish()]);
-        self.ready = false;
         Ok(())
     }
 
     fn accept_trial(&mut self) -> Result<(), String> {
         // The candidate (with the top's prescribed accelerations the predictor wrote into
-        // it) becomes the unknown; the system the trial assembled stays for the next solve.
+        // it) becomes the unknown; the trial formed its residual only, so the next
+        // iteration evaluates its system.
         let mut e = encoder(self.ctx, "accept_trial");
         Self::copy_all(&mut e, &[(&self.b.vdot_c, &self.b.vdot_k)]);
         self.ctx.queue.submit([e.finish()]);
-        self.ready = true;
         Ok(())
     }
 
@@ -1260,7 +1282,6 @@ impl<T: GpuReal> crate::engine::dynamic::DynamicEnsemble<T> for GpuDynamic<T> {
         ] {
             q.write_buffer(buffer, 0, bytemuck::cast_slice(data));
         }
-        self.ready = false;
         Ok(())
     }
 
@@ -1280,7 +1301,6 @@ impl<T: GpuReal> crate::engine::dynamic::DynamicEnsemble<T> for GpuDynamic<T> {
         self.ctx
             .queue
             .write_buffer(&self.b.vdot_k, 0, bytemuck::cast_slice(vdot));
-        self.ready = false;
         Ok(())
     }
 

@@ -1,6 +1,7 @@
 //! Twin of `shaders/beam.wgsl`: internal force (12) and consistent tangent (12×12) of every
-//! (element, variant), by [`crate::physics::beam::force_and_tangent_full`] (all 144
-//! hyper-dual evaluations of the co-rotated element energy, as the kernel), laid out for the assembly:
+//! (element, variant), by [`crate::physics::beam::force_and_tangent_closed`] (the closed-form
+//! force, and its derivative in dual numbers per column, as the kernel) — or the force alone
+//! ([`crate::physics::beam::element_force`], the kernel built with `FORCE_ONLY`) — laid out for the assembly:
 //! `[(12 e + j) V + v]` and `[(144 e + 12 j + k) V + v]`. Inputs: displacements `w` from
 //! each variant's *base* configuration `X + b` `[(3 i + k) V + v]`, rotations
 //! `[(9 i + 3 r + c) V + v]` (the twin takes them in f64), reference triads per node and
@@ -16,7 +17,9 @@
 use rayon::prelude::*;
 
 use crate::model::Model;
-use crate::physics::beam::{force_and_tangent_full, ElementState, Mat3};
+use crate::physics::beam::{
+    element_force, force_and_tangent_closed, Chord, ElementStiffness, Mat3,
+};
 
 /// Per element: `EA/l0, GJ/l0, EI/l0, l0` (the kernel's `section` binding).
 pub fn section_table(model: &Model) -> Vec<f64> {
@@ -75,13 +78,15 @@ pub fn base_chords(model: &Model, base: &[f64], num_variants: usize) -> Vec<f64>
 
 /// Element forces and tangents of V variants (rayon over elements × variants) at
 /// displacements `u` from the base whose chords are `chords` ([`base_chords`]) and
-/// rotations `rot`.
+/// rotations `rot`; with `tangent` false the forces alone (the tangents returned are
+/// zeros, as the force-only kernel leaves its tangent binding out).
 pub fn beam(
     model: &Model,
     num_variants: usize,
     u: &[f64],
     rot: &[f64],
     chords: &[f64],
+    tangent: bool,
 ) -> (Vec<f64>, Vec<f64>) {
     let nv = num_variants;
     let ne = model.elements.len();
@@ -100,29 +105,38 @@ pub fn beam(
                     })
                 })
             };
-            let es = ElementState {
-                x: [
-                    disp(e),
-                    std::array::from_fn(|k| {
-                        chords[(CHORD_LEN * e + k) * nv + v] + u[(3 * (e + 1) + k) * nv + v]
-                    }),
-                ],
-                triad: [triad(e), triad(e + 1)],
-            };
+            // Node 2 at c + w₂: the chord's positions form (the f64 kernel's).
+            let x = [
+                disp(e),
+                std::array::from_fn(|k| {
+                    chords[(CHORD_LEN * e + k) * nv + v] + u[(3 * (e + 1) + k) * nv + v]
+                }),
+            ];
+            let t = [triad(e), triad(e + 1)];
             let el = &model.elements[e];
-            force_and_tangent_full(&es, &el.section, el.length0)
+            let form = Chord::Positions {
+                length0: el.length0,
+            };
+            let k = ElementStiffness::of(&el.section, el.length0);
+            if tangent {
+                force_and_tangent_closed(&x, &t, &form, &k)
+            } else {
+                (element_force(&x, &t, &form, &k), [[0.0; 12]; 12])
+            }
         })
         .collect();
     let mut force = vec![0.0; 12 * ne * nv];
-    let mut tangent = vec![0.0; 144 * ne * nv];
+    let mut tangent_out = vec![0.0; 144 * ne * nv];
     for (idx, (f, k)) in per.into_iter().enumerate() {
         let (e, v) = (idx / nv, idx % nv);
         for j in 0..12 {
             force[(12 * e + j) * nv + v] = f[j];
-            for c in 0..12 {
-                tangent[(144 * e + 12 * j + c) * nv + v] = k[j][c];
+            if tangent {
+                for c in 0..12 {
+                    tangent_out[(144 * e + 12 * j + c) * nv + v] = k[j][c];
+                }
             }
         }
     }
-    (force, tangent)
+    (force, tangent_out)
 }

@@ -5,8 +5,8 @@
 
 pub mod beam;
 pub mod contact;
+pub mod count;
 pub mod dual;
-pub mod hyperdual;
 pub mod mass;
 pub mod soft_string;
 pub mod vec3;

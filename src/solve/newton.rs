@@ -21,8 +21,10 @@
 //!   `|Δ·r(0)|` or that lowers `‖r‖₂` by `1e-4 α`, halving at most 5 times and taking the
 //!   last (α = 1/32); dynamics accept only a lower `‖r‖₂`, halving up to 24 times and
 //!   taking the full step when nothing shorter helps. In f32 a variant whose residual is at
-//!   the precision's floor takes the full step without a search (its residual norm is
-//!   rounding noise there, which halving cannot lower).
+//!   the precision's floor accepts a trial that keeps `‖r‖₂` within twice its value (its
+//!   residual norm is rounding noise there, which halving cannot lower) — but not one that
+//!   leaves the noise band: a full step along a soft direction (a pinned stabilizer with
+//!   μ = 1 on a 1e10 N/m wall) can jump from 4e-4 of the force scale to 150.
 //! - **Failure** per variant: a non-finite residual, a singular tangent, or no convergence
 //!   within `max_iterations` updates. The failing variant stops; the others go on.
 
@@ -61,9 +63,9 @@ pub struct NewtonSettings {
     pub step_test: StepTest,
     /// The line search.
     pub line_search: LineSearch,
-    /// f32: a variant with its residual below `small_residual` takes the full step
-    /// without a search.
-    pub full_step_at_floor: bool,
+    /// f32: a variant with its residual below `small_residual` accepts a trial that keeps
+    /// `‖r‖₂` within twice its value (the rounding-noise band) without a decrease.
+    pub noise_band_at_floor: bool,
 }
 
 /// The unit roundoff of a float type of `size` bytes.
@@ -91,7 +93,7 @@ impl NewtonSettings {
                 max_halvings: 5,
                 take_smallest: true,
             },
-            full_step_at_floor: size == 4,
+            noise_band_at_floor: size == 4,
         }
     }
 
@@ -110,7 +112,7 @@ impl NewtonSettings {
                 max_halvings: 24,
                 take_smallest: false,
             },
-            full_step_at_floor: size == 4,
+            noise_band_at_floor: size == 4,
         }
     }
 
@@ -204,6 +206,8 @@ pub struct Newton {
 struct Round {
     alpha: Vec<f64>,
     pending: Vec<bool>,
+    /// At the precision's floor: the noise band accepts a trial.
+    at_floor: Vec<bool>,
     ends: Vec<bool>,
     probe: Probe,
 }
@@ -298,6 +302,7 @@ impl Newton {
         self.round = Round {
             alpha: vec![0.0; v],
             pending: vec![false; v],
+            at_floor: vec![false; v],
             ends: vec![false; v],
             probe: Probe::default(),
         };
@@ -334,14 +339,14 @@ impl Newton {
                 events.push((j, Event::Failed("singular tangent".into())));
                 continue;
             }
-            let at_floor = s.full_step_at_floor && measure <= s.small_residual;
+            round.at_floor[j] = s.noise_band_at_floor && measure <= s.small_residual;
             if converged {
                 round.alpha[j] = 1.0;
                 track.polish = false;
                 if s.step_test == StepTest::Taken {
                     // Statics: one more step (the polish), with the search, then stop.
                     track.finishing = true;
-                    round.pending[j] = !at_floor;
+                    round.pending[j] = true;
                 } else {
                     // Dynamics: the converged correction is applied, and the solve ends.
                     round.ends[j] = true;
@@ -360,7 +365,7 @@ impl Newton {
                 continue;
             }
             round.alpha[j] = 1.0;
-            round.pending[j] = !at_floor;
+            round.pending[j] = true;
         }
         round.probe = probe;
         Ok(events)
@@ -375,6 +380,7 @@ impl Newton {
         let Round {
             mut alpha,
             mut pending,
+            at_floor,
             ends,
             probe,
         } = std::mem::take(&mut self.round);
@@ -401,7 +407,8 @@ impl Newton {
                 last_finite[j] = finite;
                 let slope_ok = s.line_search.slope_test && r.slope[j].abs() <= probe.slope[j].abs();
                 let norm_ok = r.norm[j] <= (1.0 - 1e-4 * a) * probe.norm[j];
-                if finite && (slope_ok || norm_ok) {
+                let band_ok = at_floor[j] && r.norm[j] <= 2.0 * probe.norm[j];
+                if finite && (slope_ok || norm_ok || band_ok) {
                     pending[j] = false;
                 } else if last {
                     pending[j] = false;
