@@ -19,7 +19,7 @@
 //! compression softens the string and buckling appears. The oracle is the energy itself,
 //! differentiated twice by hyper-dual numbers ([`force_and_tangent_hyperdual`]).
 
-use super::dual::Dual;
+use super::dual::{Dual, DualN};
 use super::Real;
 
 /// 3×3 matrix, row-major.
@@ -455,12 +455,14 @@ pub fn element_force<T: Trig>(
 }
 
 /// Internal force (12) and consistent tangent (12×12) from the closed form: the force
-/// [`element_force`] evaluated in dual numbers once per column, seeded with DOF `k` as a
-/// translation or a left spin `(I + [ε e]×)·t` — `K_jk = ∂f_j/∂Δ_k`, the derivative under
-/// the multiplicative update, with the geometric stiffness (`N/l` on the lateral
-/// translations) and the non-symmetric part of spatial spins. 12 force evaluations in
-/// dual numbers, ≈ 1.5e4 operations (the hyper-dual form, [`force_and_tangent_full`], is
-/// the oracle). The force is the evaluations' value part, bit for bit [`element_force`]'s.
+/// [`element_force`] evaluated once in 12-direction dual numbers ([`DualN`]), direction `k`
+/// seeded with DOF `k` as a translation or a left spin `(I + [ε e]×)·t` — `K_jk = ∂f_j/∂Δ_k`,
+/// the derivative under the multiplicative update, with the geometric stiffness (`N/l` on
+/// the lateral translations) and the non-symmetric part of spatial spins. ≈ 1.5e4
+/// operations counted as 12 single-direction passes (the GPU kernel's form: each direction
+/// gives the same numbers); one pass shares the value part and the transcendentals. The
+/// hyper-dual form ([`force_and_tangent_hyperdual`]) is the oracle. The force is the value
+/// part, bit for bit [`element_force`]'s.
 #[allow(clippy::needless_range_loop)]
 pub fn force_and_tangent_closed<T: Trig>(
     x: &[[T; 3]; 2],
@@ -468,35 +470,60 @@ pub fn force_and_tangent_closed<T: Trig>(
     chord: &Chord<T>,
     k: &ElementStiffness<T>,
 ) -> ([T; 12], [[T; 12]; 12]) {
-    let xd = x.map(|p| p.map(Dual::constant));
-    let td = triad.map(|m| m.map(|r| r.map(Dual::constant)));
+    type D<T> = DualN<T, 12>;
+    let mut xs: [[D<T>; 3]; 2] = x.map(|p| p.map(D::constant));
+    let mut ts: [Mat3<D<T>>; 2] = triad.map(|m| m.map(|r| r.map(D::constant)));
+    for node in 0..2 {
+        for axis in 0..3 {
+            // Translation: d x = e.
+            xs[node][axis].d[6 * node + axis] = T::one();
+            // Spin about e_axis: d t = [e]× t, rows a and b of the triad mix.
+            let col = 6 * node + 3 + axis;
+            let (a, b) = ((axis + 1) % 3, (axis + 2) % 3);
+            for c in 0..3 {
+                ts[node][b][c].d[col] = triad[node][a][c];
+                ts[node][a][c].d[col] = T::zero() - triad[node][b][c];
+            }
+        }
+    }
+    let f = element_force(&xs, &ts, &chord.map(D::constant), &k.map(D::constant));
+    let force = f.map(|v| v.re);
+    let tangent = f.map(|v| v.d);
+    (force, tangent)
+}
+
+/// [`force_and_tangent_closed`] one direction at a time, as `shaders/beam.wgsl` runs it
+/// (12 passes of [`element_force`] on [`Dual`]: fewer registers, the value part computed
+/// 12 times); the same numbers. For the benchmark and the test of that identity.
+#[allow(clippy::needless_range_loop)]
+pub fn force_and_tangent_by_direction<T: Trig>(
+    x: &[[T; 3]; 2],
+    triad: &[Mat3<T>; 2],
+    chord: &Chord<T>,
+    k: &ElementStiffness<T>,
+) -> ([T; 12], [[T; 12]; 12]) {
     let cd = chord.map(Dual::constant);
     let kd = k.map(Dual::constant);
     let mut force = [T::zero(); 12];
     let mut tangent = [[T::zero(); 12]; 12];
     for col in 0..12 {
-        let (mut xs, mut ts) = (xd, td);
-        let unit = Dual::new(T::zero(), T::one());
-        let node = col / 6;
-        let axis = col % 6;
+        let mut xs = x.map(|p| p.map(Dual::constant));
+        let mut ts = triad.map(|m| m.map(|r| r.map(Dual::constant)));
+        let (node, axis) = (col / 6, col % 6);
         if axis < 3 {
-            xs[node][axis] = xs[node][axis] + unit;
+            xs[node][axis].d = T::one();
         } else {
-            // (I + ε[e]×)·t: rows a and b of the triad mix.
             let (a, b) = ((axis - 3 + 1) % 3, (axis - 3 + 2) % 3);
-            let old = ts[node];
             for c in 0..3 {
-                ts[node][b][c] = old[b][c] + unit * old[a][c];
-                ts[node][a][c] = old[a][c] - unit * old[b][c];
+                ts[node][b][c].d = triad[node][a][c];
+                ts[node][a][c].d = T::zero() - triad[node][b][c];
             }
         }
         let f = element_force(&xs, &ts, &cd, &kd);
         for j in 0..12 {
             tangent[j][col] = f[j].d;
         }
-        if col == 0 {
-            force = f.map(|v| v.re);
-        }
+        force = f.map(|v| v.re);
     }
     (force, tangent)
 }

@@ -145,6 +145,149 @@ impl<T: Trig> Trig for Dual<T> {
     }
 }
 
+/// A dual number with `N` derivative directions at once, `a + Σ b_k ε_k` (ε_j ε_k = 0): one
+/// evaluation gives the value and the derivative along `N` directions, the value part and
+/// every transcendental computed once (the CPU form of the element tangent: 12 directions
+/// in one pass; the GPU kernel runs the directions one by one on [`Dual`] to keep its
+/// registers).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DualN<T, const N: usize> {
+    /// Value.
+    pub re: T,
+    /// Derivatives along the `N` seeded directions.
+    pub d: [T; N],
+}
+
+impl<T: Real, const N: usize> Default for DualN<T, N> {
+    fn default() -> Self {
+        Self::constant(T::zero())
+    }
+}
+
+impl<T: Real, const N: usize> DualN<T, N> {
+    /// A constant.
+    pub fn constant(re: T) -> Self {
+        DualN {
+            re,
+            d: [T::zero(); N],
+        }
+    }
+
+    /// g(self) with value `g` and derivative `g1` at `self.re`.
+    fn chain(self, g: T, g1: T) -> Self {
+        DualN {
+            re: g,
+            d: self.d.map(|x| g1 * x),
+        }
+    }
+}
+
+impl<T: Real, const N: usize> Add for DualN<T, N> {
+    type Output = Self;
+    fn add(self, o: Self) -> Self {
+        DualN {
+            re: self.re + o.re,
+            d: std::array::from_fn(|k| self.d[k] + o.d[k]),
+        }
+    }
+}
+
+impl<T: Real, const N: usize> Sub for DualN<T, N> {
+    type Output = Self;
+    fn sub(self, o: Self) -> Self {
+        DualN {
+            re: self.re - o.re,
+            d: std::array::from_fn(|k| self.d[k] - o.d[k]),
+        }
+    }
+}
+
+impl<T: Real, const N: usize> Neg for DualN<T, N> {
+    type Output = Self;
+    fn neg(self) -> Self {
+        DualN {
+            re: -self.re,
+            d: self.d.map(|x| -x),
+        }
+    }
+}
+
+impl<T: Real, const N: usize> Mul for DualN<T, N> {
+    type Output = Self;
+    fn mul(self, o: Self) -> Self {
+        DualN {
+            re: self.re * o.re,
+            d: std::array::from_fn(|k| self.re * o.d[k] + self.d[k] * o.re),
+        }
+    }
+}
+
+impl<T: Real, const N: usize> Div for DualN<T, N> {
+    type Output = Self;
+    fn div(self, o: Self) -> Self {
+        let q = self.re / o.re;
+        DualN {
+            re: q,
+            d: std::array::from_fn(|k| (self.d[k] - q * o.d[k]) / o.re),
+        }
+    }
+}
+
+impl<T: Real, const N: usize> PartialOrd for DualN<T, N> {
+    fn partial_cmp(&self, o: &Self) -> Option<std::cmp::Ordering> {
+        self.re.partial_cmp(&o.re)
+    }
+}
+
+impl<T: Real, const N: usize> Real for DualN<T, N> {
+    fn zero() -> Self {
+        Self::constant(T::zero())
+    }
+    fn one() -> Self {
+        Self::constant(T::one())
+    }
+    fn abs(self) -> Self {
+        if self.re < T::zero() {
+            -self
+        } else {
+            self
+        }
+    }
+    fn sqrt(self) -> Self {
+        let s = self.re.sqrt();
+        self.chain(s, T::from_f64_lossy(0.5) / s)
+    }
+    fn powf(self, e: Self) -> Self {
+        let p = self.re.powf(e.re);
+        self.chain(p, e.re * p / self.re)
+    }
+    fn from_f64_lossy(x: f64) -> Self {
+        Self::constant(T::from_f64_lossy(x))
+    }
+    fn to_f64_lossy(self) -> f64 {
+        self.re.to_f64_lossy()
+    }
+    const UNIT_ROUNDOFF: f64 = T::UNIT_ROUNDOFF;
+    const NAME: &'static str = "dual-n";
+}
+
+impl<T: Trig, const N: usize> Trig for DualN<T, N> {
+    fn sin(self) -> Self {
+        self.chain(self.re.sin(), self.re.cos())
+    }
+    fn cos(self) -> Self {
+        self.chain(self.re.cos(), -self.re.sin())
+    }
+    fn atan2(self, x: Self) -> Self {
+        let y = self;
+        let r2 = x.re * x.re + y.re * y.re;
+        DualN {
+            re: y.re.atan2(x.re),
+            d: std::array::from_fn(|k| (x.re * y.d[k] - y.re * x.d[k]) / r2),
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
