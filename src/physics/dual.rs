@@ -4,6 +4,9 @@
 //! one direction per column (`src/physics/beam.rs`); `shaders/beam.wgsl` does the same on
 //! `vec2<real>`.
 
+// The product and quotient rules put `+` and `−` inside `Mul` and `Div`: that is the point.
+#![allow(clippy::suspicious_arithmetic_impl)]
+
 use std::ops::{Add, Div, Mul, Neg, Sub};
 
 use super::beam::Trig;
