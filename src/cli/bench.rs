@@ -451,6 +451,39 @@ fn element_states(count: usize) -> Vec<crate::physics::beam::ElementState> {
         .collect()
 }
 
+/// Floating-point operations per element, counted ([`TRANSCENDENTAL_FLOPS`] per
+/// transcendental) on a deformed element: the force and tangent one direction at a time
+/// (the GPU kernel), in one 12-direction pass (the CPU), and the force alone.
+#[derive(Clone, Copy, Debug, Serialize)]
+pub struct ElementFlops {
+    /// Force and tangent, one direction at a time.
+    pub by_direction: u64,
+    /// Force and tangent in one pass.
+    pub one_pass: u64,
+    /// Force alone.
+    pub force: u64,
+}
+
+/// [`ElementFlops`], counted.
+pub fn element_flops() -> ElementFlops {
+    use crate::physics::beam::{
+        element_force, force_and_tangent_by_direction, force_and_tangent_closed, BeamSection,
+        Chord, ElementStiffness,
+    };
+    use crate::physics::count::{count, Counted};
+    let s = element_states(1)[0];
+    let x = s.x.map(|p| p.map(Counted));
+    let t = s.triad.map(|m| m.map(|r| r.map(Counted)));
+    let form = Chord::Positions { length0: 9.0 }.map(Counted);
+    let k = ElementStiffness::of(&BeamSection::tube(0.165, 0.071, 2.1e11, 0.3), 9.0).map(Counted);
+    let flops = |c: crate::physics::count::OpCounts| c.flops(TRANSCENDENTAL_FLOPS);
+    ElementFlops {
+        by_direction: flops(count(|| force_and_tangent_by_direction(&x, &t, &form, &k)).1),
+        one_pass: flops(count(|| force_and_tangent_closed(&x, &t, &form, &k)).1),
+        force: flops(count(|| element_force(&x, &t, &form, &k)).1),
+    }
+}
+
 /// Operations and time per element of the beam element's force and tangent: the
 /// hyper-dual forms (144 evaluations of the energy: the GPU kernel and twin before the
 /// closed form; 78: the CPU path before), the closed form (force only, force and tangent

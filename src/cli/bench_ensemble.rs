@@ -82,34 +82,34 @@ rho_inf = 0.8
     )
 }
 
-/// Bytes read and written by one Newton iteration of one variant (every kernel of the
-/// dynamic engine once: the line search's trial evaluation, once accepted, is the next
-/// iteration's system, so an iteration evaluates about once), at `size`-byte floats, for
-/// `n` nodes and `s` contact sites.
+/// Bytes read and written by one Newton iteration of one variant: one evaluation of the
+/// system (every kernel of the dynamic engine once, the beam kernel with its tangent), one
+/// line-search trial (the same chain with the force-only beam kernel: no 144-value tangent
+/// written) and the block solve, at `size`-byte floats, for `n` nodes and `s` contact sites.
 pub fn bytes_per_iteration(n: usize, s: usize, size: usize) -> usize {
     let m = n - 1;
     let predict = 36 * n + 24 * n;
     let beam = 24 * m + 156 * m;
+    let beam_force = 24 * m + 12 * m;
     let sites = 3 * s + 6 * s + 3 * s + 7 * s;
     let contact = 19 * s + 48 * s;
     let assemble = 156 * m + 48 * s + 6 * n + 21 * n + 36 * n + 72 * m + 6 * n;
     let lu = 2 * (36 * n + 72 * m + 6 * n) + 2 * (36 * m + 12 * n);
     let norms = 12 * n;
-    let evaluation = predict + beam + sites + contact + assemble;
-    size * (evaluation + lu + 2 * norms + 12 * n)
+    let chain = predict + sites + contact + assemble;
+    size * (2 * chain + beam + beam_force + lu + 2 * norms + 12 * n)
 }
 
-/// Floating-point operations of one Newton iteration of one variant: one evaluation (the
-/// accepted trial's is the next iteration's system) and one block solve. The beam dominates: `tangent_evaluations` hyper-dual
-/// evaluations of the element energy per element (144 in the GPU kernel, 78 on the CPU,
-/// `physics::beam::force_and_tangent`), ≈ 240 hyper-dual operations each
-/// (chord, frame, two relative rotation logs, the energy) at ≈ 10 real operations per
-/// hyper-dual operation — an estimate from the kernel's text, not a count.
-pub fn flops_per_iteration(n: usize, s: usize, tangent_evaluations: usize) -> f64 {
+/// Floating-point operations of one Newton iteration of one variant: one evaluation with
+/// the element tangent (`tangent_flops` per element: counted, `cli::bench::element_flops`),
+/// one line-search trial (`force_flops` per element), the contact element and assembly
+/// (estimates from the kernels' text: ≈ 400 per site, ≈ 1200 per node, twice) and the
+/// block solve.
+pub fn flops_per_iteration(n: usize, s: usize, tangent_flops: u64, force_flops: u64) -> f64 {
     let m = (n - 1) as f64;
-    let beam = tangent_evaluations as f64 * 240.0 * 10.0 * m;
-    let contact = 400.0 * s as f64;
-    let assemble = 1200.0 * n as f64;
+    let beam = (tangent_flops + force_flops) as f64 * m;
+    let contact = 2.0 * 400.0 * s as f64;
+    let assemble = 2.0 * 1200.0 * n as f64;
     // Block LU per node: a 6×6 factorisation with 12 right-hand columns, two block
     // products and two solves.
     let lu = (2.0 / 3.0 * 216.0 + 2.0 * 216.0 * 2.0 + 2.0 * 432.0 + 4.0 * 36.0) * n as f64;
@@ -351,9 +351,14 @@ pub fn run(
                 cell.median_s = Some(t);
                 cell.variant_steps_per_s = Some((v * steps) as f64 / t);
                 cell.newton_iterations_per_step = Some(per_it);
-                let evaluations = if path.starts_with("GPU") { 144 } else { 78 };
+                let e = super::bench::element_flops();
+                let tangent = if path.starts_with("GPU") {
+                    e.by_direction
+                } else {
+                    e.one_pass
+                };
                 cell.effective_gflops =
-                    Some(flops_per_iteration(nodes, s, evaluations) * its as f64 / t / 1e9);
+                    Some(flops_per_iteration(nodes, s, tangent, e.force) * its as f64 / t / 1e9);
                 cell.effective_gbytes_per_s =
                     Some(bytes_per_iteration(nodes, s, size) as f64 * its as f64 / t / 1e9);
                 if path == "CPU f64" {
