@@ -1,6 +1,14 @@
 // Twin: src/kernels/block_lu.rs (block-tridiagonal LU of every variant's Newton system).
 //
-// Eight lanes per variant (eight variants per workgroup of 64), lane r < 6 holding row r of
+// Two forms (src/gpu/block_lu.rs picks by adapter: `lanes`).
+//
+// SERIAL (CPU-type adapters: lavapipe): one invocation per variant walks the chain,
+// eliminating the augmented block [G_i | U_i | y_i] (6 × 13) with partial pivoting in
+// private memory. lavapipe runs a workgroup's invocations as SIMD lanes of one core, so
+// variants are its parallelism, and a workgroup barrier costs it more than the work it
+// splits (measured: the lane form below takes 2× the time there).
+//
+// Otherwise (GPUs): eight lanes per variant (eight variants per workgroup of 64), lane r < 6 holding row r of
 // the augmented block [G_i | U_i | y_i] (6 × 13) as the chain is walked: the Schur
 // complement G_i = D_i − L_{i−1} X_{i−1} row by row, then Gauss–Jordan with partial pivoting
 // with the pivot column and the pivot row passed through workgroup memory (the rows stay in
@@ -35,18 +43,6 @@
 // 2 running (host), 1 singular (a zero or non-finite pivot), 0 solved.
 @group(0) @binding(8) var<storage, read_write> status: array<u32>;
 
-// Lanes per variant (src/gpu/block_lu.rs LANES) and variants per workgroup.
-const LANES: u32 = 8u;
-const SLOTS: u32 = 8u;
-
-// Per variant of the workgroup: X and z of the previous node, the pivot row, the pivot
-// column, and x_{i+1} during the back substitution.
-var<workgroup> px: array<real, 288>;
-var<workgroup> pz: array<real, 48>;
-var<workgroup> prow: array<real, 104>;
-var<workgroup> pcol: array<real, 48>;
-var<workgroup> xs: array<real, 48>;
-
 fn blk(i: u32, rc: u32, v: u32) -> u32 {
     return (36u * i + rc) * dims.num_variants + v;
 }
@@ -66,6 +62,126 @@ fn bad_pivot(p: real) -> bool {
     return (bitcast<u32>(p) & 0x7f800000u) == 0x7f800000u || p == real(0.0);
 #endif
 }
+
+#if SERIAL
+@compute @workgroup_size(64)
+fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let v = gid.x;
+    if (v >= dims.num_variants || status[v] == 1u) {
+        return;
+    }
+    let n = dims.num_nodes;
+    if (dims.phase == 1u) {
+        // Back substitution over [begin, end), downwards: x_i = z_i − X_i x_{i+1}.
+        for (var step = dims.begin; step < dims.end; step = step + 1u) {
+            let i = dims.end - 1u - (step - dims.begin);
+            for (var r = 0u; r < 6u; r = r + 1u) {
+                var s = work_z[vec_at(i, r, v)];
+                if (i + 1u < n) {
+                    for (var c = 0u; c < 6u; c = c + 1u) {
+                        s = s - work_x[blk(i, 6u * r + c, v)] * x[vec_at(i + 1u, c, v)];
+                    }
+                }
+                x[vec_at(i, r, v)] = s;
+            }
+        }
+        if (dims.begin == 0u) {
+            status[v] = 0u;
+        }
+        return;
+    }
+    var aug: array<real, 78>; // 6 rows × 13 columns, row-major
+    var prev_x: array<real, 36>;
+    var prev_z: array<real, 6>;
+    if (dims.begin > 0u) {
+        for (var k = 0u; k < 36u; k = k + 1u) {
+            prev_x[k] = work_x[blk(dims.begin - 1u, k, v)];
+        }
+        for (var k = 0u; k < 6u; k = k + 1u) {
+            prev_z[k] = work_z[vec_at(dims.begin - 1u, k, v)];
+        }
+    }
+    for (var i = dims.begin; i < dims.end; i = i + 1u) {
+        for (var r = 0u; r < 6u; r = r + 1u) {
+            for (var c = 0u; c < 6u; c = c + 1u) {
+                aug[13u * r + c] = diag[blk(i, 6u * r + c, v)];
+                if (i + 1u < n) {
+                    aug[13u * r + 6u + c] = upper[blk(i, 6u * r + c, v)];
+                } else {
+                    aug[13u * r + 6u + c] = real(0.0);
+                }
+            }
+            aug[13u * r + 12u] = rhs[vec_at(i, r, v)];
+            if (i > 0u) {
+                for (var k = 0u; k < 6u; k = k + 1u) {
+                    let l = lower[blk(i - 1u, 6u * r + k, v)];
+                    for (var c = 0u; c < 6u; c = c + 1u) {
+                        aug[13u * r + c] = aug[13u * r + c] - l * prev_x[6u * k + c];
+                    }
+                    aug[13u * r + 12u] = aug[13u * r + 12u] - l * prev_z[k];
+                }
+            }
+        }
+        // Gauss–Jordan with partial pivoting on the 6 × 13 block.
+        for (var col = 0u; col < 6u; col = col + 1u) {
+            var p = col;
+            for (var r = col + 1u; r < 6u; r = r + 1u) {
+                if (abs(aug[13u * r + col]) > abs(aug[13u * p + col])) {
+                    p = r;
+                }
+            }
+            if (p != col) {
+                for (var c = 0u; c < 13u; c = c + 1u) {
+                    let t = aug[13u * col + c];
+                    aug[13u * col + c] = aug[13u * p + c];
+                    aug[13u * p + c] = t;
+                }
+            }
+            let pivot = aug[13u * col + col];
+            if (bad_pivot(pivot)) {
+                status[v] = 1u;
+                for (var k = 0u; k < 6u * n; k = k + 1u) {
+                    x[k * dims.num_variants + v] = real(0.0);
+                }
+                return;
+            }
+            let inv = real(1.0) / pivot;
+            for (var c = col; c < 13u; c = c + 1u) {
+                aug[13u * col + c] = aug[13u * col + c] * inv;
+            }
+            for (var r = 0u; r < 6u; r = r + 1u) {
+                if (r != col) {
+                    let f = aug[13u * r + col];
+                    for (var c = col; c < 13u; c = c + 1u) {
+                        aug[13u * r + c] = aug[13u * r + c] - f * aug[13u * col + c];
+                    }
+                }
+            }
+        }
+        for (var r = 0u; r < 6u; r = r + 1u) {
+            for (var c = 0u; c < 6u; c = c + 1u) {
+                prev_x[6u * r + c] = aug[13u * r + 6u + c];
+                if (i + 1u < n) {
+                    work_x[blk(i, 6u * r + c, v)] = aug[13u * r + 6u + c];
+                }
+            }
+            prev_z[r] = aug[13u * r + 12u];
+            work_z[vec_at(i, r, v)] = aug[13u * r + 12u];
+        }
+    }
+}
+#else
+// Lanes per variant (src/gpu/block_lu.rs LANES) and variants per workgroup.
+const LANES: u32 = 8u;
+const SLOTS: u32 = 8u;
+
+// Per variant of the workgroup: X and z of the previous node, the pivot row, the pivot
+// column, and x_{i+1} during the back substitution.
+var<workgroup> px: array<real, 288>;
+var<workgroup> pz: array<real, 48>;
+var<workgroup> prow: array<real, 104>;
+var<workgroup> pcol: array<real, 48>;
+var<workgroup> xs: array<real, 48>;
 
 @compute @workgroup_size(64)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_invocation_id) lid: vec3<u32>) {
@@ -208,3 +324,4 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_invocation
         workgroupBarrier();
     }
 }
+#endif

@@ -4,7 +4,7 @@
 
 mod common;
 
-use holewall::gpu::block_lu::{block_lu_gpu, block_lu_gpu_chunked};
+use holewall::gpu::block_lu::{block_lu_gpu, block_lu_gpu_chunked, block_lu_gpu_form, LuForm};
 use holewall::kernels::block_lu::{block_lu, ChainBatch, SINGULAR, SOLVED};
 use holewall::solve::chain::{BlockTridiagonal, ChainSolver};
 use rand::{Rng, SeedableRng};
@@ -180,6 +180,14 @@ fn gpu_matches_the_twin_and_a_singular_variant_fails_alone() {
         }
         eprintln!("GPU f64 vs twin: worst relative difference {worst:.2e}");
         assert!(worst <= 1e-12);
+        // Both forms (serial, six lanes per variant) are the twin's operations: the same
+        // bits, also chunked.
+        for form in [LuForm::Serial, LuForm::Lanes] {
+            let (x, s) = block_lu_gpu_form(ctx, &b64, usize::MAX, form).unwrap();
+            assert_eq!((&x, &s), (&gpu, &gst), "{form:?}");
+            let (x, _) = block_lu_gpu_form(ctx, &b64, 5, form).unwrap();
+            assert_eq!(x, gpu, "{form:?} in chunks of 5");
+        }
         // Chunked dispatches (7 variants each) give the same numbers.
         let (chunked, _) = block_lu_gpu_chunked(ctx, &b64, 7).unwrap();
         assert_eq!(chunked, gpu);
@@ -230,9 +238,12 @@ fn gpu_matches_the_twin_and_a_singular_variant_fails_alone() {
             "twin variant {j}"
         );
     }
-    if ctx.has_f64 {
-        let (gpu_bad64, gst64) = block_lu_gpu(ctx, &bb).unwrap();
-        assert_eq!(gst64, st_bad, "GPU f64 flags the same variants");
+    for form in [LuForm::Serial, LuForm::Lanes] {
+        if !ctx.has_f64 {
+            break;
+        }
+        let (gpu_bad64, gst64) = block_lu_gpu_form(ctx, &bb, usize::MAX, form).unwrap();
+        assert_eq!(gst64, st_bad, "GPU f64 ({form:?}) flags the same variants");
         for j in (0..64).filter(|j| *j != 5 && *j != 9) {
             assert_eq!(
                 bb.unpack(&gpu_bad64, j),
@@ -242,6 +253,18 @@ fn gpu_matches_the_twin_and_a_singular_variant_fails_alone() {
         }
     }
     let bb32 = ChainBatch::<f32>::from_systems(&refs_bad);
+    // f32: the two forms give the same bits.
+    for form in [LuForm::Serial, LuForm::Lanes] {
+        let (x, s) = block_lu_gpu_form(ctx, &b32, usize::MAX, form).unwrap();
+        assert_eq!((&x, &s), (&gpu32, &st32), "f32 {form:?}");
+        let (xb, sb) = block_lu_gpu_form(ctx, &bb32, usize::MAX, form).unwrap();
+        assert_eq!((sb[5], sb[9]), (SINGULAR, SINGULAR), "f32 {form:?}");
+        assert_eq!(
+            bb32.unpack(&xb, 0),
+            b32.unpack(&gpu32, 0),
+            "f32 {form:?}: a good variant beside singular ones"
+        );
+    }
     let (gpu_bad, gst_bad) = block_lu_gpu(ctx, &bb32).unwrap();
     assert_eq!((gst_bad[5], gst_bad[9]), (SINGULAR, SINGULAR));
     for j in (0..64).filter(|j| *j != 5 && *j != 9) {

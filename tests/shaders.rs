@@ -125,10 +125,12 @@ fn composer_handles_nesting_else_and_errors() {
 
 #[test]
 fn engine_kernels_validate_in_both_precisions() {
+    use holewall::gpu::block_lu::LuForm;
     use holewall::gpu::dynamics::DynamicsKernel;
     for f64 in [false, true] {
         for wgsl in [
-            holewall::gpu::block_lu::block_lu_wgsl(f64).unwrap(),
+            holewall::gpu::block_lu::block_lu_wgsl(f64, LuForm::Serial).unwrap(),
+            holewall::gpu::block_lu::block_lu_wgsl(f64, LuForm::Lanes).unwrap(),
             holewall::gpu::assemble::assemble_wgsl(f64).unwrap(),
             holewall::gpu::update::update_wgsl(false, f64).unwrap(),
             holewall::gpu::update::update_wgsl(true, f64).unwrap(),

@@ -16,18 +16,69 @@ use crate::kernels::block_lu::ChainBatch;
 /// llvmpipe's 65,535-iteration cut-off (≈ 700 inner iterations per node).
 pub const NODES_PER_PASS: usize = 32;
 
-/// Invocations per variant (`shaders/block_lu.wgsl`: six rows and two idle lanes, eight
-/// variants per workgroup of 64).
+/// Invocations per variant of the lane form (`shaders/block_lu.wgsl`: six rows and two
+/// idle lanes, eight variants per workgroup of 64).
 pub const LANES: usize = 8;
+
+/// Which form of the block solve an adapter runs: the serial form (one invocation per
+/// variant) on CPU-type adapters (lavapipe: its workgroup is one core's SIMD lanes, and
+/// barriers cost more than the rows they split — 2× the time measured there), the lane
+/// form on GPUs (a chain's node costs six lanes a sixth of the time; 8 V invocations keep
+/// an H100's SMs busy where V alone would not). [`force_lu_form`] overrides it for a
+/// process (tests run both forms on lavapipe).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum LuForm {
+    /// One invocation per variant.
+    Serial,
+    /// [`LANES`] invocations per variant.
+    Lanes,
+}
+
+impl LuForm {
+    /// The form for `ctx`'s adapter (or the override).
+    pub fn for_adapter(ctx: &GpuContext) -> LuForm {
+        match FORCED.load(std::sync::atomic::Ordering::Relaxed) {
+            1 => LuForm::Serial,
+            2 => LuForm::Lanes,
+            _ if ctx.info.device_type == wgpu::DeviceType::Cpu => LuForm::Serial,
+            _ => LuForm::Lanes,
+        }
+    }
+
+    /// Invocations per variant.
+    pub fn lanes(self) -> usize {
+        match self {
+            LuForm::Serial => 1,
+            LuForm::Lanes => LANES,
+        }
+    }
+}
+
+/// The forced form: 0 none, 1 serial, 2 lanes.
+static FORCED: std::sync::atomic::AtomicU8 = std::sync::atomic::AtomicU8::new(0);
+
+/// Makes every block solve of this process (kernels built from now on) use `form`, or the
+/// adapter's choice again (`None`). For tests: the lane form on lavapipe.
+pub fn force_lu_form(form: Option<LuForm>) {
+    let code = match form {
+        None => 0,
+        Some(LuForm::Serial) => 1,
+        Some(LuForm::Lanes) => 2,
+    };
+    FORCED.store(code, std::sync::atomic::Ordering::Relaxed);
+}
 
 /// Status a variant's solve starts with; still there afterwards means it did not finish.
 const RUNNING: u32 = 2;
 
-/// The WGSL text of the block solve at a precision.
-pub fn block_lu_wgsl(f64: bool) -> Result<String, GpuError> {
+/// The WGSL text of the block solve at a precision, in a form.
+pub fn block_lu_wgsl(f64: bool, form: LuForm) -> Result<String, GpuError> {
     let mut flags = BTreeSet::new();
     if f64 {
         flags.insert("F64");
+    }
+    if form == LuForm::Serial {
+        flags.insert("SERIAL");
     }
     compose("block_lu.wgsl", &flags, f64)
 }
@@ -91,8 +142,19 @@ pub fn block_lu_gpu_chunked<T: GpuReal>(
     batch: &ChainBatch<T>,
     max_chunk: usize,
 ) -> Result<(Vec<T>, Vec<u32>), GpuError> {
+    block_lu_gpu_form(ctx, batch, max_chunk, LuForm::for_adapter(ctx))
+}
+
+/// As [`block_lu_gpu_chunked`] in a given form (tests: both forms on any adapter).
+pub fn block_lu_gpu_form<T: GpuReal>(
+    ctx: &'static GpuContext,
+    batch: &ChainBatch<T>,
+    max_chunk: usize,
+    form: LuForm,
+) -> Result<(Vec<T>, Vec<u32>), GpuError> {
     crate::gpu::contact::require_precision::<T>(ctx)?;
-    let wgsl = block_lu_wgsl(T::IS_F64)?;
+    let lanes = form.lanes();
+    let wgsl = block_lu_wgsl(T::IS_F64, form)?;
     let pipeline = ctx.pipeline("block_lu", &wgsl)?;
     let size = std::mem::size_of::<T>();
     let (n, v) = (batch.num_nodes, batch.num_variants);
@@ -100,7 +162,7 @@ pub fn block_lu_gpu_chunked<T: GpuReal>(
     let max_binding = ctx.max_binding_bytes() as usize;
     // The largest array per variant is a 36-float block field over n nodes.
     let cap = (max_binding / (36 * n.max(1) * size))
-        .min(ctx.limits.max_compute_workgroups_per_dimension as usize * WORKGROUP / LANES)
+        .min(ctx.limits.max_compute_workgroups_per_dimension as usize * WORKGROUP / lanes)
         .min(max_chunk)
         .max(1);
     let mut x = vec![T::zero(); 6 * n * v];
@@ -145,7 +207,7 @@ pub fn block_lu_gpu_chunked<T: GpuReal>(
                 Out::Empty(x_bytes),
                 Out::From(bytemuck::cast_slice(&running)),
             ],
-            LANES * len,
+            lanes * len,
         )?;
         let xs: &[T] = bytemuck::cast_slice(&out[2]);
         let st: &[u32] = bytemuck::cast_slice(&out[3]);

@@ -16,7 +16,7 @@ use wgpu::util::DeviceExt;
 use crate::engine::Stage;
 use crate::engine::{Ensemble, EnsembleTables};
 use crate::error::GpuError;
-use crate::gpu::block_lu::LANES as LU_LANES;
+use crate::gpu::block_lu::LuForm;
 use crate::gpu::contact::{contact_wgsl, require_precision, GpuReal};
 use crate::gpu::dispatch::WORKGROUP;
 use crate::gpu::layout::{AssembleDims, BeamDims, ChainDims, ContactDims};
@@ -59,7 +59,7 @@ pub fn max_variants(ctx: &GpuContext, model: &Model, size: usize) -> usize {
     let n = model.nodes.len();
     let s = model.sites.len();
     let by_binding = ctx.max_binding_bytes() as usize / largest_binding_per_variant(n, s, size);
-    let widest = n.max(s).max(LU_LANES);
+    let widest = n.max(s).max(LuForm::for_adapter(ctx).lanes());
     let by_groups = ctx.limits.max_compute_workgroups_per_dimension as usize * WORKGROUP / widest;
     by_binding.min(by_groups).max(1)
 }
@@ -98,6 +98,8 @@ pub struct GpuEnsemble<T: GpuReal> {
     slots: [Slot; 2],
     /// Whether each slot's assembled system has its tangent (a trial's has its residual only).
     formed: [bool; 2],
+    /// Invocations per variant of the block solve ([`LuForm`]).
+    lu_lanes: usize,
     current: usize,
     contact: wgpu::BindGroup,
     c: Common,
@@ -474,7 +476,10 @@ impl<T: GpuReal> GpuEnsemble<T> {
             sites: ctx.pipeline("sites", &sites_wgsl(f64)?)?,
             contact: ctx.pipeline("contact", &contact_wgsl(&tables.terms, f64)?)?,
             assemble: ctx.pipeline("assemble", &crate::gpu::assemble::assemble_wgsl(f64)?)?,
-            block_lu: ctx.pipeline("block_lu", &crate::gpu::block_lu::block_lu_wgsl(f64)?)?,
+            block_lu: ctx.pipeline(
+                "block_lu",
+                &crate::gpu::block_lu::block_lu_wgsl(f64, LuForm::for_adapter(ctx))?,
+            )?,
             norms: ctx.pipeline("norms", &crate::gpu::update::update_wgsl(true, f64)?)?,
             update: ctx.pipeline("update", &crate::gpu::update::update_wgsl(false, f64)?)?,
         };
@@ -541,6 +546,7 @@ impl<T: GpuReal> GpuEnsemble<T> {
             p: pipelines,
             slots,
             formed: [false; 2],
+            lu_lanes: LuForm::for_adapter(ctx).lanes(),
             current: 0,
             contact,
             c,
@@ -724,7 +730,7 @@ impl<T: GpuReal> Ensemble<T> for GpuEnsemble<T> {
         {
             let mut pass = encoder.begin_compute_pass(&Default::default());
             for group in &s.lu {
-                dispatch(&mut pass, &self.p.block_lu, group, LU_LANES * v);
+                dispatch(&mut pass, &self.p.block_lu, group, self.lu_lanes * v);
             }
             dispatch(&mut pass, &self.p.norms, &s.norms_solve, v);
         }
@@ -879,6 +885,8 @@ pub struct GpuDynamic<T: GpuReal> {
     num_pairs: usize,
     a0: T,
     c: Common,
+    /// Invocations per variant of the block solve ([`LuForm`]).
+    lu_lanes: usize,
     _keep: Vec<wgpu::Buffer>,
     _real: PhantomData<T>,
 }
@@ -969,7 +977,10 @@ impl<T: GpuReal> GpuDynamic<T> {
                 "assemble",
                 &crate::gpu::assemble::assemble_wgsl_for(true, f64)?,
             )?,
-            block_lu: ctx.pipeline("block_lu", &crate::gpu::block_lu::block_lu_wgsl(f64)?)?,
+            block_lu: ctx.pipeline(
+                "block_lu",
+                &crate::gpu::block_lu::block_lu_wgsl(f64, LuForm::for_adapter(ctx))?,
+            )?,
             norms: ctx.pipeline("norms", &crate::gpu::update::update_wgsl(true, f64)?)?,
         };
         let mass = storage(ctx, "mass", &dynamic.mass);
@@ -1097,6 +1108,7 @@ impl<T: GpuReal> GpuDynamic<T> {
             num_pairs: p,
             a0: T::from_f64_lossy(dynamic.a0),
             c,
+            lu_lanes: LuForm::for_adapter(ctx).lanes(),
             _keep: vec![mass, inertia0, diag, upper, lower, rhs],
             _real: PhantomData,
         })
@@ -1165,7 +1177,7 @@ impl<T: GpuReal> crate::engine::dynamic::DynamicEnsemble<T> for GpuDynamic<T> {
             let mut pass = e.begin_compute_pass(&Default::default());
             self.record_evaluate(&mut pass, false);
             for group in &self.g.lu {
-                dispatch(&mut pass, &self.p.block_lu, group, LU_LANES * v);
+                dispatch(&mut pass, &self.p.block_lu, group, self.lu_lanes * v);
             }
             dispatch(&mut pass, &self.p.norms, &self.g.norms_iterate, v);
             dispatch(&mut pass, &self.p.scale, &self.g.scale, v);
