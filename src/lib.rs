@@ -23,6 +23,7 @@ pub mod plots;
 pub mod selfcheck;
 pub mod solve;
 pub mod units;
+pub mod uq;
 pub mod well;
 
 pub use error::{Error, GpuError, InputError};

@@ -1,0 +1,227 @@
+//! Points in the unit cube `(0, 1)^d` for `N` samples: random, Latin hypercube or
+//! Owen-scrambled Sobol (`sobol_burley`). Point `i` depends only on `(seed, i, N, method)`,
+//! never on the order or the machine that draws it: random numbers come from ChaCha8 with
+//! one stream per sample (portable, unlike `StdRng`), and the Latin hypercube's
+//! permutations from one stream per dimension. So a shard, a resumed run and a whole run
+//! see the same inputs, bit for bit.
+
+use rand::{RngCore, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+
+/// How the unit-cube points are drawn.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Sampling {
+    /// Independent uniform points.
+    Random,
+    /// Latin hypercube: each dimension's N strata hold one point each.
+    Lhs,
+    /// Owen-scrambled Sobol points (at most 2^16 samples, 256 inputs).
+    Sobol,
+}
+
+/// The largest sample count Sobol sampling takes (`sobol_burley`'s index range).
+pub const SOBOL_MAX_SAMPLES: usize = 1 << 16;
+
+/// A number in (0, 1) from 53 random bits, never 0 or 1 (quantile functions diverge there).
+fn open_unit(bits: u64) -> f64 {
+    ((bits >> 11) as f64 + 0.5) * (1.0 / (1u64 << 53) as f64)
+}
+
+/// Sample `i`'s random stream.
+fn sample_stream(seed: u64, i: usize) -> ChaCha8Rng {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    rng.set_stream(i as u64);
+    rng
+}
+
+/// `n` points in `(0, 1)^d` (`[i][k]`: sample `i`, input `k`).
+pub fn unit_samples(
+    n: usize,
+    d: usize,
+    seed: u64,
+    method: Sampling,
+) -> Result<Vec<Vec<f64>>, String> {
+    match method {
+        Sampling::Random => Ok((0..n)
+            .map(|i| {
+                let mut rng = sample_stream(seed, i);
+                (0..d).map(|_| open_unit(rng.next_u64())).collect()
+            })
+            .collect()),
+        Sampling::Lhs => {
+            // One permutation of the strata per input, from a stream of its own.
+            let perms: Vec<Vec<usize>> = (0..d)
+                .map(|k| {
+                    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+                    rng.set_stream((1u64 << 63) + k as u64);
+                    let mut p: Vec<usize> = (0..n).collect();
+                    for j in (1..n).rev() {
+                        let r = (rng.next_u64() % (j as u64 + 1)) as usize;
+                        p.swap(j, r);
+                    }
+                    p
+                })
+                .collect();
+            Ok((0..n)
+                .map(|i| {
+                    let mut rng = sample_stream(seed, i);
+                    (0..d)
+                        .map(|k| (perms[k][i] as f64 + open_unit(rng.next_u64())) / n as f64)
+                        .collect()
+                })
+                .collect())
+        }
+        Sampling::Sobol => {
+            if n > SOBOL_MAX_SAMPLES {
+                return Err(format!(
+                    "Sobol sampling takes at most {SOBOL_MAX_SAMPLES} samples, not {n}"
+                ));
+            }
+            if d > sobol_burley::NUM_DIMENSIONS as usize {
+                return Err(format!(
+                    "Sobol sampling takes at most {} inputs, not {d}",
+                    sobol_burley::NUM_DIMENSIONS
+                ));
+            }
+            let seed32 = (seed ^ (seed >> 32)) as u32;
+            Ok((0..n)
+                .map(|i| {
+                    (0..d)
+                        .map(|k| {
+                            // The 24-bit cell's centre: never 0.
+                            let u = sobol_burley::sample(i as u32, k as u32, seed32);
+                            ((u * (1 << 24) as f32).floor() as f64 + 0.5) / (1 << 24) as f64
+                        })
+                        .collect()
+                })
+                .collect())
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::uq::Distribution;
+
+    #[test]
+    fn sample_moments_within_their_standard_errors() {
+        // N = 1e4 random samples of each law: the sample mean within 4 standard errors of
+        // the law's mean (√(σ²/N)), the sample variance within 4 of its own
+        // (√((μ₄ − σ⁴)/N), μ₄ the sample's fourth central moment about the law's mean).
+        let laws = [
+            Distribution::Uniform { min: 0.2, max: 0.4 },
+            Distribution::Normal {
+                mean: 75e3,
+                sd: 7e3,
+                min: f64::NEG_INFINITY,
+                max: f64::INFINITY,
+            },
+            Distribution::Normal {
+                mean: 75e3,
+                sd: 7e3,
+                min: 65e3,
+                max: 80e3,
+            },
+            Distribution::LogNormal {
+                median: 6e7,
+                sigma: 0.3,
+            },
+            Distribution::Triangular {
+                min: 6.0,
+                mode: 9.0,
+                max: 13.0,
+            },
+            Distribution::Triangular {
+                min: 6.0,
+                mode: 6.0,
+                max: 13.0,
+            },
+            Distribution::Discrete {
+                values: vec![10.0, 15.0, 20.0],
+                weights: vec![1.0, 2.0, 1.0],
+            },
+        ];
+        let n = 10_000;
+        let u = unit_samples(n, laws.len(), 7, Sampling::Random).unwrap();
+        for (k, law) in laws.iter().enumerate() {
+            law.check().unwrap();
+            let x: Vec<f64> = u.iter().map(|p| law.quantile(p[k])).collect();
+            let m = x.iter().sum::<f64>() / n as f64;
+            let v = x.iter().map(|y| (y - m).powi(2)).sum::<f64>() / (n - 1) as f64;
+            let (mu, var) = law.moments();
+            let se_mean = (var / n as f64).sqrt();
+            let fourth = x.iter().map(|y| (y - mu).powi(4)).sum::<f64>() / n as f64;
+            let se_var = ((fourth - var * var) / n as f64).sqrt();
+            eprintln!(
+                "{law:?}: mean {m:.6e} vs {mu:.6e} ({:.2} se), variance {v:.6e} vs {var:.6e} ({:.2} se)",
+                (m - mu) / se_mean,
+                (v - var) / se_var
+            );
+            assert!((m - mu).abs() <= 4.0 * se_mean, "{law:?} mean");
+            assert!((v - var).abs() <= 4.0 * se_var, "{law:?} variance");
+            let (lo, hi) = law.support();
+            assert!(x.iter().all(|y| *y >= lo && *y <= hi), "{law:?} support");
+        }
+    }
+
+    #[test]
+    fn latin_hypercube_puts_one_point_in_each_stratum() {
+        for n in [1, 7, 100, 1000] {
+            let u = unit_samples(n, 5, 42, Sampling::Lhs).unwrap();
+            for k in 0..5 {
+                let mut seen = vec![false; n];
+                for p in &u {
+                    let s = (p[k] * n as f64).floor() as usize;
+                    assert!(!seen[s], "n {n}, input {k}: stratum {s} twice");
+                    seen[s] = true;
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn sobol_points_are_nets() {
+        // Owen-scrambled Sobol points: the first 2^m of them have exactly one point in each
+        // interval [j/2^m, (j+1)/2^m) of every input, and every pair of the first two
+        // inputs has one point in each of the 2^m cells of a 2^a × 2^(m−a) grid (a (0, m, 2)-net).
+        for m in [4u32, 8, 10] {
+            let n = 1usize << m;
+            let u = unit_samples(n, 4, 3, Sampling::Sobol).unwrap();
+            for k in 0..4 {
+                let mut count = vec![0; n];
+                for p in &u {
+                    count[(p[k] * n as f64).floor() as usize] += 1;
+                }
+                assert!(count.iter().all(|&c| c == 1), "m {m}, input {k}");
+            }
+            for a in 0..=m {
+                let (nx, ny) = (1usize << a, 1usize << (m - a));
+                let mut count = vec![0; n];
+                for p in &u {
+                    let (x, y) = ((p[0] * nx as f64) as usize, (p[1] * ny as f64) as usize);
+                    count[x * ny + y] += 1;
+                }
+                assert!(count.iter().all(|&c| c == 1), "m {m}, grid {nx}×{ny}");
+            }
+        }
+        assert!(unit_samples(SOBOL_MAX_SAMPLES + 1, 1, 0, Sampling::Sobol).is_err());
+    }
+
+    #[test]
+    fn a_sample_is_the_same_whoever_draws_it() {
+        for method in [Sampling::Random, Sampling::Lhs, Sampling::Sobol] {
+            let a = unit_samples(64, 3, 11, method).unwrap();
+            let b = unit_samples(64, 3, 11, method).unwrap();
+            assert_eq!(a, b);
+            let c = unit_samples(64, 3, 12, method).unwrap();
+            assert_ne!(a, c, "{method:?}: the seed matters");
+            assert!(a.iter().flatten().all(|x| *x > 0.0 && *x < 1.0));
+        }
+        // Random points do not depend on N (a prefix is the smaller run's points).
+        let small = unit_samples(10, 3, 11, Sampling::Random).unwrap();
+        let big = unit_samples(100, 3, 11, Sampling::Random).unwrap();
+        assert_eq!(small[..], big[..10]);
+    }
+}
