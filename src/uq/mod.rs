@@ -5,6 +5,7 @@
 
 pub mod distribution;
 pub mod sampling;
+pub mod sensitivity;
 pub mod stats;
 
 pub use distribution::Distribution;
