@@ -242,6 +242,44 @@ pub struct EnsembleSpec {
     /// Names of the variants whose full time series are written (grid variants are named
     /// by their index).
     pub series: Option<Vec<String>>,
+    /// Key → distribution of an uncertain input (`holewall ensemble --samples N`).
+    pub uncertain: Option<std::collections::BTreeMap<String, Spanned<UncertainSpec>>>,
+}
+
+/// `[ensemble.uncertain]` entry: the distribution of one variant key, values in SI or
+/// `"<number> <unit>"` as the key's other values.
+///
+/// ```toml
+/// [ensemble.uncertain]
+/// mu = { dist = "uniform", min = 0.2, max = 0.4 }
+/// wob = { dist = "normal", mean = "75 kN", sd = "7 kN", min = "60 kN", max = "90 kN" }
+/// k_e = { dist = "lognormal", median = 6e7, sigma = 0.5 }
+/// rpm = { dist = "triangular", min = "60 rpm", mode = "90 rpm", max = "120 rpm" }
+/// "stab2.from_bit" = { dist = "discrete", values = ["10 m", "15 m"], weights = [1, 2] }
+/// ```
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct UncertainSpec {
+    /// `uniform`, `normal`, `lognormal`, `triangular` or `discrete`.
+    pub dist: String,
+    /// Lower bound (uniform, triangular; truncation of a normal).
+    pub min: Option<Quantity>,
+    /// Upper bound.
+    pub max: Option<Quantity>,
+    /// Mean (normal).
+    pub mean: Option<Quantity>,
+    /// Standard deviation (normal).
+    pub sd: Option<Quantity>,
+    /// Median (lognormal).
+    pub median: Option<Quantity>,
+    /// Standard deviation of the logarithm (lognormal), a pure number.
+    pub sigma: Option<f64>,
+    /// Peak (triangular).
+    pub mode: Option<Quantity>,
+    /// Values (discrete).
+    pub values: Option<Vec<Quantity>>,
+    /// Weights of the values (discrete; default equal).
+    pub weights: Option<Vec<f64>>,
 }
 
 /// What an ensemble runs per variant.
@@ -262,6 +300,8 @@ pub struct EnsembleSettings {
     pub grid: Vec<(crate::ensemble::Key, Vec<f64>)>,
     /// Variants with full time series.
     pub series: Vec<String>,
+    /// Uncertain inputs: (key, distribution), in key order (`[ensemble.uncertain]`).
+    pub uncertain: Vec<(crate::ensemble::Key, crate::uq::Distribution)>,
 }
 
 /// A case read and checked, ready to build a model.
@@ -1027,11 +1067,113 @@ fn ensemble_settings(
         }
         grid.push((key, list));
     }
+    let mut uncertain = Vec::new();
+    for (name, spec) in e.uncertain.iter().flatten() {
+        let key_name = format!("ensemble.uncertain.{name}");
+        let err = |m: String| ctx.err(spec.span(), &key_name, m);
+        let key = crate::ensemble::Key::parse(name).map_err(err)?;
+        uncertain.push((
+            key.clone(),
+            uncertain_distribution(&key, spec.get_ref()).map_err(err)?,
+        ));
+    }
     Ok(EnsembleSettings {
         analysis,
         grid,
         series: e.series.clone().unwrap_or_default(),
+        uncertain,
     })
+}
+
+/// The distribution of `[ensemble.uncertain]` entry `u` of key `key`; every value given is
+/// parsed and range-checked as the key's own values.
+fn uncertain_distribution(
+    key: &crate::ensemble::Key,
+    u: &UncertainSpec,
+) -> Result<crate::uq::Distribution, String> {
+    use crate::uq::Distribution;
+    let text = |q: &Quantity| match q {
+        Quantity::Number(x) => x.to_string(),
+        Quantity::Text(t) => t.clone(),
+    };
+    let value = |q: &Option<Quantity>, field: &str| -> Result<Option<f64>, String> {
+        q.as_ref()
+            .map(|q| key.value(&text(q)).map_err(|m| format!("{field}: {m}")))
+            .transpose()
+    };
+    let need = |x: Option<f64>, field: &str| x.ok_or_else(|| format!("{} needs {field}", u.dist));
+    let (min, max) = (value(&u.min, "min")?, value(&u.max, "max")?);
+    let unused = |fields: &[(&str, bool)]| -> Result<(), String> {
+        match fields.iter().find(|(_, given)| *given) {
+            Some((f, _)) => Err(format!("{} takes no {f}", u.dist)),
+            None => Ok(()),
+        }
+    };
+    let d = match u.dist.as_str() {
+        "uniform" => {
+            unused(&[("mean", u.mean.is_some()), ("sd", u.sd.is_some()), ("median", u.median.is_some()), ("sigma", u.sigma.is_some()), ("mode", u.mode.is_some()), ("values", u.values.is_some()), ("weights", u.weights.is_some())])?;
+            Distribution::Uniform {
+                min: need(min, "min")?,
+                max: need(max, "max")?,
+            }
+        }
+        "normal" => {
+            unused(&[("median", u.median.is_some()), ("sigma", u.sigma.is_some()), ("mode", u.mode.is_some()), ("values", u.values.is_some()), ("weights", u.weights.is_some())])?;
+            let sd = match &u.sd {
+                // A spread: the key's unit, but not its range (σ of a friction factor
+                // may be 0.05, of a WOB 7 kN).
+                Some(q) => {
+                    let t = text(q);
+                    match t.trim().parse::<f64>() {
+                        Ok(x) => x,
+                        Err(_) => key.value(&t).map_err(|m| format!("sd: {m}"))?,
+                    }
+                }
+                None => return Err("normal needs sd".into()),
+            };
+            Distribution::Normal {
+                mean: need(value(&u.mean, "mean")?, "mean")?,
+                sd,
+                min: min.unwrap_or(f64::NEG_INFINITY),
+                max: max.unwrap_or(f64::INFINITY),
+            }
+        }
+        "lognormal" => {
+            unused(&[("min", u.min.is_some()), ("max", u.max.is_some()), ("mean", u.mean.is_some()), ("sd", u.sd.is_some()), ("mode", u.mode.is_some()), ("values", u.values.is_some()), ("weights", u.weights.is_some())])?;
+            Distribution::LogNormal {
+                median: need(value(&u.median, "median")?, "median")?,
+                sigma: u.sigma.ok_or("lognormal needs sigma (of the logarithm)")?,
+            }
+        }
+        "triangular" => {
+            unused(&[("mean", u.mean.is_some()), ("sd", u.sd.is_some()), ("median", u.median.is_some()), ("sigma", u.sigma.is_some()), ("values", u.values.is_some()), ("weights", u.weights.is_some())])?;
+            Distribution::Triangular {
+                min: need(min, "min")?,
+                mode: need(value(&u.mode, "mode")?, "mode")?,
+                max: need(max, "max")?,
+            }
+        }
+        "discrete" => {
+            unused(&[("min", u.min.is_some()), ("max", u.max.is_some()), ("mean", u.mean.is_some()), ("sd", u.sd.is_some()), ("median", u.median.is_some()), ("sigma", u.sigma.is_some()), ("mode", u.mode.is_some())])?;
+            let values = u
+                .values
+                .as_ref()
+                .ok_or("discrete needs values")?
+                .iter()
+                .map(|q| key.value(&text(q)))
+                .collect::<Result<Vec<f64>, String>>()
+                .map_err(|m| format!("values: {m}"))?;
+            let weights = u.weights.clone().unwrap_or_else(|| vec![1.0; values.len()]);
+            Distribution::Discrete { values, weights }
+        }
+        other => {
+            return Err(format!(
+                "unknown distribution {other:?}; allowed: uniform, normal, lognormal, triangular, discrete"
+            ))
+        }
+    };
+    d.check()?;
+    Ok(d)
 }
 
 fn dynamics_settings(ctx: &Ctx, d: &DynamicsSpec) -> Result<DynamicsSettings, InputError> {

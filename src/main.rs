@@ -81,6 +81,22 @@ enum Command {
         /// No progress bar.
         #[arg(long)]
         quiet: bool,
+        /// Monte Carlo: draw this many samples of the case's `[ensemble.uncertain]` inputs.
+        #[arg(long)]
+        samples: Option<usize>,
+        /// Seed of the samples (the same seed gives the same samples, bit for bit).
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+        /// How the samples are drawn.
+        #[arg(long, value_enum, default_value_t = holewall::uq::Sampling::Lhs)]
+        sampling: holewall::uq::Sampling,
+        /// Further percentiles to report (comma-separated, 0–100), beside P10/P50/P90.
+        #[arg(long, value_delimiter = ',')]
+        percentile: Vec<f64>,
+        /// Exceedance probability of a threshold, QOI=VALUE in SI (repeatable), e.g.
+        /// `--exceed stab1_max_side_force_n=20000`.
+        #[arg(long)]
+        exceed: Vec<String>,
     },
     /// Benchmarks (medians over repeats; GPU/CPU ratios from the same run).
     Bench {
@@ -257,14 +273,28 @@ fn main() -> ExitCode {
             precision,
             out,
             quiet,
-        } => print_summary(cli::ensemble_cmd::run(
-            &case,
-            variants.as_deref(),
-            backend,
-            precision,
-            &out,
-            !quiet,
-        )),
+            samples,
+            seed,
+            sampling,
+            percentile,
+            exceed,
+        } => {
+            let mc =
+                match cli::ensemble_cmd::monte_carlo(samples, seed, sampling, &percentile, &exceed)
+                {
+                    Ok(mc) => mc,
+                    Err(e) => return fail(&[e]),
+                };
+            print_summary(cli::ensemble_cmd::run(
+                &case,
+                variants.as_deref(),
+                backend,
+                precision,
+                &out,
+                !quiet,
+                mc.as_ref(),
+            ))
+        }
         Command::GpuInfo { pairs } => match cli::gpu_info::run(pairs) {
             Ok(()) => ExitCode::SUCCESS,
             Err(e) => fail(&[e]),

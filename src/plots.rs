@@ -116,3 +116,271 @@ fn draw(
     root.present()?;
     Ok(())
 }
+
+/// Writes a PNG through a temporary file and a rename (never half-written).
+fn atomic_png(
+    path: &Path,
+    draw: impl FnOnce(&Path) -> Result<(), Box<dyn std::error::Error>>,
+) -> std::io::Result<()> {
+    let tmp = path.with_extension(format!("{}.tmp.png", std::process::id()));
+    match draw(&tmp) {
+        Ok(()) => std::fs::rename(&tmp, path),
+        Err(e) => {
+            let _ = std::fs::remove_file(&tmp);
+            Err(std::io::Error::other(format!(
+                "plot {}: {e}",
+                path.display()
+            )))
+        }
+    }
+}
+
+/// Tick labels of an axis in engineering style: at most 4 significant digits, no
+/// trailing zeros, exponent only beyond 1e6 or below 1e-3.
+pub fn tick(x: &f64) -> String {
+    let a = x.abs();
+    if a == 0.0 {
+        "0".into()
+    } else if !(1e-3..1e6).contains(&a) {
+        format!("{x:.2e}")
+    } else {
+        let s = format!("{:.*}", (3 - a.log10().floor() as i32).max(0) as usize, x);
+        if s.contains('.') {
+            s.trim_end_matches('0').trim_end_matches('.').to_string()
+        } else {
+            s
+        }
+    }
+}
+
+/// A histogram of `values` (already in display units) with vertical lines at `marks`
+/// (label, x), e.g. P10/P50/P90.
+pub fn histogram(
+    path: &Path,
+    title: &str,
+    x_label: &str,
+    values: &[f64],
+    marks: &[(&str, f64)],
+) -> std::io::Result<()> {
+    let v: Vec<f64> = values.iter().copied().filter(|x| x.is_finite()).collect();
+    atomic_png(path, |tmp| {
+        let root = BitMapBackend::new(tmp, (1000, 640)).into_drawing_area();
+        root.fill(&WHITE)?;
+        let (lo, hi) = v
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| {
+                (a.min(*x), b.max(*x))
+            });
+        let (lo, hi) = if !lo.is_finite() {
+            (0.0, 1.0)
+        } else if lo == hi {
+            (lo - 0.5 * lo.abs().max(1.0), hi + 0.5 * hi.abs().max(1.0))
+        } else {
+            (lo, hi)
+        };
+        // Sturges-like bin count, 10 … 40.
+        let bins = ((v.len() as f64).sqrt().ceil() as usize).clamp(10, 40);
+        let w = (hi - lo) / bins as f64;
+        let mut counts = vec![0usize; bins];
+        for x in &v {
+            counts[(((x - lo) / w) as usize).min(bins - 1)] += 1;
+        }
+        let top = counts.iter().copied().max().unwrap_or(1).max(1) as f64 * 1.1;
+        let mut chart = ChartBuilder::on(&root)
+            .caption(title, ("sans-serif", 24))
+            .margin(12)
+            .x_label_area_size(48)
+            .y_label_area_size(70)
+            .build_cartesian_2d(lo - 0.02 * (hi - lo)..hi + 0.02 * (hi - lo), 0.0..top)?;
+        chart
+            .configure_mesh()
+            .x_desc(x_label)
+            .y_desc("samples")
+            .x_label_formatter(&tick)
+            .y_label_formatter(&|y| format!("{y:.0}"))
+            .label_style(("sans-serif", 15))
+            .draw()?;
+        chart.draw_series(counts.iter().enumerate().map(|(k, &c)| {
+            let x0 = lo + k as f64 * w;
+            Rectangle::new([(x0, 0.0), (x0 + w, c as f64)], BLUE.mix(0.5).filled())
+        }))?;
+        for (label, x) in marks {
+            if !x.is_finite() {
+                continue;
+            }
+            chart.draw_series(std::iter::once(PathElement::new(
+                vec![(*x, 0.0), (*x, top)],
+                RED.stroke_width(2),
+            )))?;
+            chart.draw_series(std::iter::once(Text::new(
+                format!("{label} {}", tick(x)),
+                (*x, top * 0.97),
+                ("sans-serif", 15).into_font(),
+            )))?;
+        }
+        root.present()?;
+        Ok(())
+    })
+}
+
+/// A scatter plot of `points` (display units).
+pub fn scatter(
+    path: &Path,
+    title: &str,
+    x_label: &str,
+    y_label: &str,
+    points: &[(f64, f64)],
+) -> std::io::Result<()> {
+    let series = [Series {
+        name: "",
+        points: points.to_vec(),
+    }];
+    let ((x0, x1), (y0, y1)) = bounds(&series);
+    atomic_png(path, |tmp| {
+        let root = BitMapBackend::new(tmp, (900, 640)).into_drawing_area();
+        root.fill(&WHITE)?;
+        let mut chart = ChartBuilder::on(&root)
+            .caption(title, ("sans-serif", 22))
+            .margin(12)
+            .x_label_area_size(48)
+            .y_label_area_size(80)
+            .build_cartesian_2d(x0..x1, y0..y1)?;
+        chart
+            .configure_mesh()
+            .x_desc(x_label)
+            .y_desc(y_label)
+            .x_label_formatter(&tick)
+            .y_label_formatter(&tick)
+            .label_style(("sans-serif", 15))
+            .draw()?;
+        chart.draw_series(
+            points
+                .iter()
+                .filter(|(x, y)| x.is_finite() && y.is_finite())
+                .map(|&p| Circle::new(p, 3, BLUE.mix(0.6).filled())),
+        )?;
+        root.present()?;
+        Ok(())
+    })
+}
+
+/// A tornado chart: one horizontal bar per (label, value) in −1 … 1, largest |value| on top.
+pub fn tornado(
+    path: &Path,
+    title: &str,
+    x_label: &str,
+    bars: &[(String, f64)],
+) -> std::io::Result<()> {
+    let mut bars: Vec<(String, f64)> = bars
+        .iter()
+        .filter(|(_, v)| v.is_finite())
+        .cloned()
+        .collect();
+    bars.sort_by(|a, b| a.1.abs().total_cmp(&b.1.abs()));
+    atomic_png(path, |tmp| {
+        let root =
+            BitMapBackend::new(tmp, (900, 120 + 50 * bars.len().max(1) as u32)).into_drawing_area();
+        root.fill(&WHITE)?;
+        let n = bars.len().max(1);
+        let mut chart = ChartBuilder::on(&root)
+            .caption(title, ("sans-serif", 22))
+            .margin(12)
+            .x_label_area_size(44)
+            .y_label_area_size(160)
+            .build_cartesian_2d(-1.0..1.0, 0.0..n as f64)?;
+        chart
+            .configure_mesh()
+            .x_desc(x_label)
+            .x_label_formatter(&|x| format!("{x:.1}"))
+            .disable_y_mesh()
+            .y_label_formatter(&|_| String::new())
+            .label_style(("sans-serif", 15))
+            .draw()?;
+        chart.draw_series(bars.iter().enumerate().map(|(k, (_, v))| {
+            let c = if *v >= 0.0 { BLUE } else { RED };
+            Rectangle::new(
+                [
+                    (0.0f64.min(*v), k as f64 + 0.15),
+                    (0.0f64.max(*v), k as f64 + 0.85),
+                ],
+                c.mix(0.7).filled(),
+            )
+        }))?;
+        // Each bar's input and value, on the side of zero the bar does not take.
+        chart.draw_series(bars.iter().enumerate().map(|(k, (name, v))| {
+            let x = if *v >= 0.0 { -0.97 } else { 0.03 };
+            Text::new(
+                format!("{name}  {v:+.2}"),
+                (x, k as f64 + 0.6),
+                ("sans-serif", 16).into_font(),
+            )
+        }))?;
+        root.present()?;
+        Ok(())
+    })
+}
+
+/// One point of an estimate's convergence: samples, value, 95 % low and high (NaN where no
+/// bound exists).
+pub type BandPoint = (f64, f64, f64, f64);
+
+/// Estimates against the number of samples, each with its 95 % band: (name, points).
+pub fn convergence_plot(
+    path: &Path,
+    title: &str,
+    y_label: &str,
+    estimates: &[(&str, Vec<BandPoint>)],
+) -> std::io::Result<()> {
+    let all: Vec<(f64, f64)> = estimates
+        .iter()
+        .flat_map(|(_, p)| p.iter().flat_map(|&(n, v, a, b)| [(n, v), (n, a), (n, b)]))
+        .collect();
+    let ((x0, x1), (y0, y1)) = bounds(&[Series {
+        name: "",
+        points: all,
+    }]);
+    atomic_png(path, |tmp| {
+        let root = BitMapBackend::new(tmp, (1000, 640)).into_drawing_area();
+        root.fill(&WHITE)?;
+        let mut chart = ChartBuilder::on(&root)
+            .caption(title, ("sans-serif", 22))
+            .margin(12)
+            .x_label_area_size(48)
+            .y_label_area_size(80)
+            .build_cartesian_2d(x0.max(0.0)..x1, y0..y1)?;
+        chart
+            .configure_mesh()
+            .x_desc("samples")
+            .y_desc(y_label)
+            .x_label_formatter(&|x| format!("{x:.0}"))
+            .y_label_formatter(&tick)
+            .label_style(("sans-serif", 15))
+            .draw()?;
+        let colours = [BLUE, RED, GREEN, MAGENTA];
+        for (k, (name, pts)) in estimates.iter().enumerate() {
+            let c = colours[k % colours.len()];
+            let line: Vec<(f64, f64)> = pts.iter().map(|p| (p.0, p.1)).collect();
+            chart
+                .draw_series(LineSeries::new(line, c.stroke_width(3)))?
+                .label(format!("{name} (band: 95 %)"))
+                .legend(move |(x, y)| {
+                    PathElement::new(vec![(x, y), (x + 20, y)], c.stroke_width(3))
+                });
+            for side in [2usize, 3] {
+                let band: Vec<(f64, f64)> = pts
+                    .iter()
+                    .map(|p| (p.0, if side == 2 { p.2 } else { p.3 }))
+                    .filter(|(_, y)| y.is_finite())
+                    .collect();
+                chart.draw_series(LineSeries::new(band, c.mix(0.4).stroke_width(1)))?;
+            }
+        }
+        chart
+            .configure_series_labels()
+            .background_style(WHITE.mix(0.8))
+            .border_style(BLACK)
+            .draw()?;
+        root.present()?;
+        Ok(())
+    })
+}

@@ -123,6 +123,8 @@ pub struct EnsembleSummary {
     pub solved_by_cpu: usize,
     /// Wall time of the variant runs (s).
     pub seconds: f64,
+    /// Statistics and sensitivities of the quantities of interest (`--samples` runs).
+    pub uncertainty: Option<crate::uq::report::UncertaintyReport>,
     /// Files written.
     pub outputs: Vec<String>,
 }
@@ -691,17 +693,48 @@ pub fn run(
     precision: Precision,
     out: &Path,
     show_progress: bool,
+    monte_carlo: Option<&crate::uq::report::MonteCarlo>,
 ) -> Result<EnsembleSummary, Error> {
     let case = load_case(case_path)?;
     let settings = case.ensemble.clone();
-    let Some(variants) = crate::ensemble::case_variants(&case, variants_file)? else {
-        return Err(InputError {
+    let cli_error = |key: &str, message: String| -> Error {
+        InputError {
             source_name: case_path.display().to_string(),
-            line: 1,
-            key: "ensemble.grid".into(),
-            message: "no variants: give --variants FILE or an [ensemble.grid] table".into(),
+            line: 0,
+            key: key.into(),
+            message,
         }
-        .into());
+        .into()
+    };
+    let variants = match monte_carlo {
+        Some(mc) => {
+            if variants_file.is_some() {
+                return Err(cli_error(
+                    "--samples",
+                    "give --variants FILE or --samples N, not both".into(),
+                ));
+            }
+            let uncertain = settings
+                .as_ref()
+                .map(|s| s.uncertain.clone())
+                .unwrap_or_default();
+            crate::uq::sample_variants(&uncertain, mc.samples, mc.seed, mc.sampling)
+                .map_err(|m| cli_error("ensemble.uncertain", m))?
+        }
+        None => match crate::ensemble::case_variants(&case, variants_file)? {
+            Some(v) => v,
+            None => {
+                return Err(InputError {
+                    source_name: case_path.display().to_string(),
+                    line: 1,
+                    key: "ensemble.grid".into(),
+                    message:
+                        "no variants: give --variants FILE, an [ensemble.grid] table, or --samples N with an [ensemble.uncertain] table"
+                            .into(),
+                }
+                .into())
+            }
+        },
     };
     let analysis = settings
         .as_ref()
@@ -863,6 +896,15 @@ pub fn run(
         &out.join("variants.csv"),
         &variants_csv(&variants, &results, stabs, dynamic)?,
     )?;
+    let uncertainty = match monte_carlo {
+        Some(mc) => {
+            let (report, files) =
+                uncertainty_report(mc, &case, &variants, &results, stabs, dynamic, out)?;
+            outputs.extend(files);
+            Some(report)
+        }
+        None => None,
+    };
     let idx = |f: &dyn Fn(&VariantResult) -> Option<f64>| -> Vec<(f64, f64)> {
         results
             .iter()
@@ -870,56 +912,58 @@ pub fn run(
             .filter_map(|(i, r)| f(r).filter(|x| x.is_finite()).map(|y| (i as f64, y)))
             .collect()
     };
-    line_plot(
-        &out.join("neutral_point.png"),
-        &format!("{}: neutral point over the variants", case.title),
-        "variant",
-        "neutral point from the bit (m)",
-        &[Series {
-            name: "neutral point",
-            points: idx(&|r| r.neutral_point_from_bit_m),
-        }],
-        &[],
-    )?;
-    outputs.push("neutral_point.png".into());
-    let names: Vec<String> = (1..=stabs).map(|k| format!("stab{k}")).collect();
-    // One line per stabilizer of a per-stabilizer quantity over the variants.
-    let per_stabilizer = |file: &str,
-                          title: &str,
-                          y_label: &str,
-                          f: &dyn Fn(&StabilizerQoi) -> Option<f64>|
-     -> Result<(), Error> {
-        let series: Vec<Series> = (0..stabs)
-            .map(|k| Series {
-                name: &names[k],
-                points: idx(&|r| r.stabilizers.get(k).and_then(f)),
-            })
-            .collect();
+    if monte_carlo.is_none() {
         line_plot(
-            &out.join(file),
-            &format!("{}: {title}", case.title),
+            &out.join("neutral_point.png"),
+            &format!("{}: neutral point over the variants", case.title),
             "variant",
-            y_label,
-            &series,
+            "neutral point from the bit (m)",
+            &[Series {
+                name: "neutral point",
+                points: idx(&|r| r.neutral_point_from_bit_m),
+            }],
             &[],
         )?;
-        Ok(())
-    };
-    per_stabilizer(
-        "side_force.png",
-        "largest side force per stabilizer",
-        "side force (N)",
-        &|q| Some(q.max_side_force_n),
-    )?;
-    outputs.push("side_force.png".into());
-    if dynamic {
+        outputs.push("neutral_point.png".into());
+        let names: Vec<String> = (1..=stabs).map(|k| format!("stab{k}")).collect();
+        // One line per stabilizer of a per-stabilizer quantity over the variants.
+        let per_stabilizer = |file: &str,
+                              title: &str,
+                              y_label: &str,
+                              f: &dyn Fn(&StabilizerQoi) -> Option<f64>|
+         -> Result<(), Error> {
+            let series: Vec<Series> = (0..stabs)
+                .map(|k| Series {
+                    name: &names[k],
+                    points: idx(&|r| r.stabilizers.get(k).and_then(f)),
+                })
+                .collect();
+            line_plot(
+                &out.join(file),
+                &format!("{}: {title}", case.title),
+                "variant",
+                y_label,
+                &series,
+                &[],
+            )?;
+            Ok(())
+        };
         per_stabilizer(
-            "whirl.png",
-            "whirl frequency (+ forward, − backward)",
-            "whirl (Hz)",
-            &|q| q.whirl_hz,
+            "side_force.png",
+            "largest side force per stabilizer",
+            "side force (N)",
+            &|q| Some(q.max_side_force_n),
         )?;
-        outputs.push("whirl.png".into());
+        outputs.push("side_force.png".into());
+        if dynamic {
+            per_stabilizer(
+                "whirl.png",
+                "whirl frequency (+ forward, − backward)",
+                "whirl (Hz)",
+                &|q| q.whirl_hz,
+            )?;
+            outputs.push("whirl.png".into());
+        }
         for name in &series {
             let v = variants
                 .iter()
@@ -961,6 +1005,7 @@ pub fn run(
             .filter(|r| r.status != Status::Failed && r.solved_by == SolvedBy::Cpu)
             .count(),
         seconds,
+        uncertainty,
         outputs,
     };
     write_atomic(
@@ -970,4 +1015,151 @@ pub fn run(
             .as_bytes(),
     )?;
     Ok(summary)
+}
+
+/// The quantities of interest of every variant as columns (NaN where a variant has none).
+pub fn qoi_columns(
+    results: &[VariantResult],
+    stabs: usize,
+    dynamic: bool,
+) -> Vec<crate::uq::report::Qoi> {
+    use crate::uq::report::{Qoi, Unit};
+    let col = |name: String, unit: Unit, f: &dyn Fn(&VariantResult) -> Option<f64>| Qoi {
+        name,
+        unit,
+        values: results.iter().map(|r| f(r).unwrap_or(f64::NAN)).collect(),
+    };
+    let mut q = vec![
+        col("neutral_point_from_bit_m".into(), Unit::Length, &|r| {
+            r.neutral_point_from_bit_m
+        }),
+        col("max_surface_torque_nm".into(), Unit::Torque, &|r| {
+            Some(r.max_surface_torque_nm)
+        }),
+    ];
+    for k in 0..stabs {
+        q.push(col(
+            format!("stab{}_max_side_force_n", k + 1),
+            Unit::Force,
+            &|r| r.stabilizers.get(k).map(|s| s.max_side_force_n),
+        ));
+        q.push(col(
+            format!("stab{}_max_lateral_m", k + 1),
+            Unit::Length,
+            &|r| r.stabilizers.get(k).map(|s| s.max_lateral_m),
+        ));
+        if dynamic {
+            q.push(col(
+                format!("stab{}_whirl_hz", k + 1),
+                Unit::Frequency,
+                &|r| r.stabilizers.get(k).and_then(|s| s.whirl_hz),
+            ));
+        }
+    }
+    q
+}
+
+/// Statistics, sensitivities and plots of a `--samples` run.
+fn uncertainty_report(
+    mc: &crate::uq::report::MonteCarlo,
+    case: &Case,
+    variants: &[Variant],
+    results: &[VariantResult],
+    stabs: usize,
+    dynamic: bool,
+    out: &Path,
+) -> Result<(crate::uq::report::UncertaintyReport, Vec<String>), Error> {
+    let qois = qoi_columns(results, stabs, dynamic);
+    for (name, _) in &mc.thresholds {
+        if !qois.iter().any(|q| &q.name == name) {
+            return Err(InputError {
+                source_name: "--exceed".into(),
+                line: 0,
+                key: name.clone(),
+                message: format!(
+                    "no quantity {name:?}; allowed: {}",
+                    qois.iter()
+                        .map(|q| q.name.as_str())
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                ),
+            }
+            .into());
+        }
+    }
+    let keys: Vec<crate::ensemble::Key> = variants
+        .first()
+        .map(|v| v.overrides.iter().map(|(k, _)| k.clone()).collect())
+        .unwrap_or_default();
+    let inputs: Vec<(crate::ensemble::Key, Vec<f64>)> = keys
+        .iter()
+        .enumerate()
+        .map(|(k, key)| {
+            (
+                key.clone(),
+                variants.iter().map(|v| v.overrides[k].1).collect(),
+            )
+        })
+        .collect();
+    let failed: Vec<bool> = results.iter().map(|r| r.status == Status::Failed).collect();
+    let report = crate::uq::report::analyse(mc, &inputs, &qois, &failed);
+    let files = crate::uq::report::plot(&report, &inputs, &qois, out, &case.title)?;
+    Ok((report, files))
+}
+
+/// The Monte Carlo request from the command line (`None` without `--samples`); percentiles
+/// in 0–100 and `QOI=VALUE` thresholds, else an input error (exit 2).
+pub fn monte_carlo(
+    samples: Option<usize>,
+    seed: u64,
+    sampling: crate::uq::Sampling,
+    percentiles: &[f64],
+    exceed: &[String],
+) -> Result<Option<crate::uq::report::MonteCarlo>, Error> {
+    let err = |key: &str, message: String| -> Error {
+        InputError {
+            source_name: "command line".into(),
+            line: 0,
+            key: key.into(),
+            message,
+        }
+        .into()
+    };
+    let Some(samples) = samples else {
+        if !percentiles.is_empty() || !exceed.is_empty() {
+            return Err(err(
+                "--samples",
+                "--percentile and --exceed need --samples N".into(),
+            ));
+        }
+        return Ok(None);
+    };
+    if samples == 0 {
+        return Err(err("--samples", "at least 1".into()));
+    }
+    if let Some(p) = percentiles.iter().find(|p| !(0.0..=100.0).contains(*p)) {
+        return Err(err("--percentile", format!("{p} is outside 0 … 100")));
+    }
+    let thresholds = exceed
+        .iter()
+        .map(|e| {
+            let (name, value) = e
+                .split_once('=')
+                .ok_or_else(|| err("--exceed", format!("{e:?}: expected QOI=VALUE")))?;
+            let v: f64 = value.trim().parse().map_err(|_| {
+                err(
+                    "--exceed",
+                    format!("{e:?}: {value:?} is not a number (SI units)"),
+                )
+            })?;
+            Ok((name.trim().to_string(), v))
+        })
+        .collect::<Result<Vec<_>, Error>>()?;
+    Ok(Some(crate::uq::report::MonteCarlo {
+        samples,
+        seed,
+        sampling,
+        percentiles: percentiles.to_vec(),
+        thresholds,
+    }))
 }

@@ -4,9 +4,57 @@
 //! any program that builds variants of a case.
 
 pub mod distribution;
+pub mod report;
 pub mod sampling;
 pub mod sensitivity;
 pub mod stats;
 
 pub use distribution::Distribution;
 pub use sampling::{unit_samples, Sampling};
+
+use crate::ensemble::{Key, Variant};
+
+/// `n` samples of the uncertain inputs as variants named `s00001`, … (each overriding every
+/// uncertain key), drawn by `sampling` with `seed`: the unit-cube points mapped through each
+/// input's quantile function. Sample `i` is the same whatever `n`'s other samples, the
+/// chunking or the machine (for `random`; `lhs` and `sobol` depend on `n` as a whole). A
+/// sampled value outside the key's allowed range is an error naming it.
+pub fn sample_variants(
+    uncertain: &[(Key, Distribution)],
+    n: usize,
+    seed: u64,
+    sampling: Sampling,
+) -> Result<Vec<Variant>, String> {
+    if uncertain.is_empty() {
+        return Err("no uncertain inputs: add an [ensemble.uncertain] table".into());
+    }
+    if n == 0 {
+        return Err("--samples must be at least 1".into());
+    }
+    let u = unit_samples(n, uncertain.len(), seed, sampling)?;
+    let width = n.to_string().len().max(5);
+    u.iter()
+        .enumerate()
+        .map(|(i, p)| {
+            let overrides = uncertain
+                .iter()
+                .zip(p)
+                .map(|((key, dist), &ui)| {
+                    let v = dist.quantile(ui);
+                    key.value(&v.to_string())
+                        .map(|v| (key.clone(), v))
+                        .map_err(|m| {
+                            format!(
+                                "sample {i}: {} drew {v} from {dist:?}, outside the key's range ({m}); truncate the distribution",
+                                key.name
+                            )
+                        })
+                })
+                .collect::<Result<Vec<_>, String>>()?;
+            Ok(Variant {
+                name: format!("s{:0width$}", i + 1),
+                overrides,
+            })
+        })
+        .collect()
+}

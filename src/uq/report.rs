@@ -1,0 +1,269 @@
+//! A Monte Carlo run's report: statistics and sensitivities of every quantity of interest
+//! over the samples that succeeded (failed samples counted, never silently dropped), and the
+//! plots an engineer reads — histogram with P10/P50/P90, scatter against each input with its
+//! rank correlation, a tornado of partial rank correlations, the running mean and P90 with
+//! their bands — in engineering units.
+
+use std::path::Path;
+
+use serde::Serialize;
+
+use super::sensitivity::{sensitivities, InputSensitivity};
+use super::stats::{qoi_stats, QoiStats};
+use super::Sampling;
+use crate::ensemble::{Key, Param};
+
+/// A quantity's unit, for plots (values stay SI in CSV and JSON).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Unit {
+    /// N, shown in kN.
+    Force,
+    /// N·m, shown in kN·m.
+    Torque,
+    /// m.
+    Length,
+    /// Hz.
+    Frequency,
+    /// Dimensionless.
+    Ratio,
+    /// N/m^m.
+    Stiffness,
+    /// rad/s, shown in rpm.
+    AngularSpeed,
+    /// N·s/m.
+    Damping,
+    /// m/s.
+    Speed,
+}
+
+impl Unit {
+    /// Scale from SI to the display unit, and its label.
+    pub fn display(self) -> (f64, &'static str) {
+        match self {
+            Unit::Force => (1e-3, "kN"),
+            Unit::Torque => (1e-3, "kN·m"),
+            Unit::Length => (1.0, "m"),
+            Unit::Frequency => (1.0, "Hz"),
+            Unit::Ratio => (1.0, "–"),
+            Unit::Stiffness => (1.0, "N/m"),
+            Unit::AngularSpeed => (60.0 / std::f64::consts::TAU, "rpm"),
+            Unit::Damping => (1.0, "N·s/m"),
+            Unit::Speed => (1.0, "m/s"),
+        }
+    }
+
+    /// The unit of a variant key's values.
+    pub fn of_key(key: &Key) -> Unit {
+        match key.param {
+            Param::Mu | Param::MuT | Param::MuL | Param::Exponent => Unit::Ratio,
+            Param::WallStiffness => Unit::Stiffness,
+            Param::WallDamping => Unit::Damping,
+            Param::Eps => Unit::Speed,
+            Param::Rpm => Unit::AngularSpeed,
+            Param::Wob => Unit::Force,
+            Param::Tob => Unit::Torque,
+            Param::Blade | Param::FromBit => Unit::Length,
+        }
+    }
+}
+
+/// What a Monte Carlo run asks for.
+#[derive(Clone, Debug, PartialEq)]
+pub struct MonteCarlo {
+    /// Samples.
+    pub samples: usize,
+    /// Seed.
+    pub seed: u64,
+    /// Sampling method.
+    pub sampling: Sampling,
+    /// Percentiles reported beyond P10/P50/P90.
+    pub percentiles: Vec<f64>,
+    /// Exceedance thresholds: (quantity name, value in SI).
+    pub thresholds: Vec<(String, f64)>,
+}
+
+/// One quantity of interest over the samples (NaN where a sample has no value).
+#[derive(Clone, Debug)]
+pub struct Qoi {
+    /// Name (the `variants.csv` column).
+    pub name: String,
+    /// Unit.
+    pub unit: Unit,
+    /// Value per sample.
+    pub values: Vec<f64>,
+}
+
+/// One quantity's statistics and sensitivities.
+#[derive(Clone, Debug, Serialize)]
+pub struct QoiReport {
+    /// Name.
+    pub name: String,
+    /// Unit of the values (SI).
+    pub unit: Unit,
+    /// Statistics over the samples with a value; `None` when none has one.
+    pub stats: Option<QoiStats>,
+    /// Spearman and PRCC with each input.
+    pub sensitivity: Vec<InputSensitivity>,
+}
+
+/// The uncertainty part of `summary.json`.
+#[derive(Clone, Debug, Serialize)]
+pub struct UncertaintyReport {
+    /// Samples drawn.
+    pub samples: usize,
+    /// Seed.
+    pub seed: u64,
+    /// Method.
+    pub sampling: Sampling,
+    /// Uncertain inputs, in sampling order.
+    pub inputs: Vec<String>,
+    /// Samples that failed (excluded from every statistic; listed in `failures`).
+    pub failed: usize,
+    /// Per quantity.
+    pub qois: Vec<QoiReport>,
+}
+
+/// The report of a run: `inputs` (key, value per sample), `qois`, and which samples failed.
+pub fn analyse(
+    mc: &MonteCarlo,
+    inputs: &[(Key, Vec<f64>)],
+    qois: &[Qoi],
+    failed: &[bool],
+) -> UncertaintyReport {
+    let names: Vec<String> = inputs.iter().map(|(k, _)| k.name.clone()).collect();
+    let cols: Vec<Vec<f64>> = inputs.iter().map(|(_, v)| v.clone()).collect();
+    UncertaintyReport {
+        samples: mc.samples,
+        seed: mc.seed,
+        sampling: mc.sampling,
+        inputs: names.clone(),
+        failed: failed.iter().filter(|f| **f).count(),
+        qois: qois
+            .iter()
+            .map(|q| {
+                let values: Vec<f64> = q
+                    .values
+                    .iter()
+                    .zip(failed)
+                    .map(|(v, f)| if *f { f64::NAN } else { *v })
+                    .collect();
+                let thresholds: Vec<f64> = mc
+                    .thresholds
+                    .iter()
+                    .filter(|(n, _)| n == &q.name)
+                    .map(|(_, t)| *t)
+                    .collect();
+                QoiReport {
+                    name: q.name.clone(),
+                    unit: q.unit,
+                    stats: qoi_stats(&values, &mc.percentiles, &thresholds),
+                    sensitivity: if values.iter().filter(|v| v.is_finite()).count() > 2 {
+                        sensitivities(&names, &cols, &values)
+                    } else {
+                        Vec::new()
+                    },
+                }
+            })
+            .collect(),
+    }
+}
+
+/// Writes the report's plots into `dir`; returns the files written.
+pub fn plot(
+    report: &UncertaintyReport,
+    inputs: &[(Key, Vec<f64>)],
+    qois: &[Qoi],
+    dir: &Path,
+    title: &str,
+) -> std::io::Result<Vec<String>> {
+    use crate::plots::{histogram, scatter, tornado};
+    let mut files = Vec::new();
+    for (q, r) in qois.iter().zip(&report.qois) {
+        let Some(s) = &r.stats else { continue };
+        let (scale, unit) = q.unit.display();
+        let label = format!("{} ({unit})", q.name);
+        let file = format!("hist_{}.png", q.name);
+        let shown: Vec<f64> = q.values.iter().map(|v| v * scale).collect();
+        histogram(
+            &dir.join(&file),
+            &format!("{title}: {} over {} samples", q.name, s.n),
+            &label,
+            &shown,
+            &[
+                ("P10", s.p10 * scale),
+                ("P50", s.p50 * scale),
+                ("P90", s.p90 * scale),
+            ],
+        )?;
+        files.push(file);
+        for ((key, x), sens) in inputs.iter().zip(&r.sensitivity) {
+            let (xs, xu) = Unit::of_key(key).display();
+            let points: Vec<(f64, f64)> = x
+                .iter()
+                .zip(&q.values)
+                .map(|(a, b)| (a * xs, b * scale))
+                .collect();
+            let file = format!("scatter_{}_vs_{}.png", q.name, key.name);
+            scatter(
+                &dir.join(&file),
+                &format!(
+                    "{} against {}: Spearman {:.2}, PRCC {:.2}",
+                    q.name, key.name, sens.spearman, sens.prcc
+                ),
+                &format!("{} ({xu})", key.name),
+                &label,
+                &points,
+            )?;
+            files.push(file);
+        }
+        if !r.sensitivity.is_empty() {
+            let file = format!("tornado_{}.png", q.name);
+            tornado(
+                &dir.join(&file),
+                &format!("{title}: what drives {}", q.name),
+                "partial rank correlation (PRCC)",
+                &r.sensitivity
+                    .iter()
+                    .map(|s| (s.input.clone(), s.prcc))
+                    .collect::<Vec<_>>(),
+            )?;
+            files.push(file);
+        }
+        if s.convergence.len() > 1 {
+            let file = format!("convergence_{}.png", q.name);
+            let c = &s.convergence;
+            crate::plots::convergence_plot(
+                &dir.join(&file),
+                &format!("{}: mean and P90 against the number of samples", q.name),
+                &label,
+                &[
+                    (
+                        "mean",
+                        c.iter()
+                            .map(|r| {
+                                (
+                                    r.n as f64,
+                                    r.mean * scale,
+                                    r.mean_ci95.0 * scale,
+                                    r.mean_ci95.1 * scale,
+                                )
+                            })
+                            .collect(),
+                    ),
+                    (
+                        "P90",
+                        c.iter()
+                            .map(|r| {
+                                let (lo, hi) = r.p90_ci95.unwrap_or((f64::NAN, f64::NAN));
+                                (r.n as f64, r.p90 * scale, lo * scale, hi * scale)
+                            })
+                            .collect(),
+                    ),
+                ],
+            )?;
+            files.push(file);
+        }
+    }
+    Ok(files)
+}
