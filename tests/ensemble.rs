@@ -121,7 +121,16 @@ fn grid_dynamic_ensemble_writes_variants_and_series() {
     let path = dir.join("grid.toml");
     std::fs::write(&path, text).unwrap();
     let out = dir.join("out");
-    let s = run(&path, None, BackendChoice::Cpu, Precision::F64, &out, false).unwrap();
+    let s = run(
+        &path,
+        None,
+        BackendChoice::Cpu,
+        Precision::F64,
+        &out,
+        false,
+        None,
+    )
+    .unwrap();
     assert_eq!((s.variants, s.failed), (2, 0));
     let csv = std::fs::read_to_string(out.join("variants.csv")).unwrap();
     assert!(csv.lines().next().unwrap().contains("stab1_whirl_hz"));
@@ -137,6 +146,7 @@ fn grid_dynamic_ensemble_writes_variants_and_series() {
         Precision::F32,
         &out2,
         false,
+        None,
     )
     .unwrap_err();
     assert_eq!(e.exit_code(), 2);
@@ -150,6 +160,7 @@ fn grid_dynamic_ensemble_writes_variants_and_series() {
             Precision::F64,
             &out3,
             false,
+            None,
         )
         .unwrap();
         assert_eq!(
@@ -220,6 +231,7 @@ fn bad_variant_files_name_file_line_and_key() {
             Precision::F64,
             &out,
             false,
+            None,
         )
         .unwrap_err();
         let msg = e.to_string();
@@ -238,6 +250,7 @@ fn bad_variant_files_name_file_line_and_key() {
         Precision::F64,
         &dir.join("o"),
         false,
+        None,
     )
     .unwrap_err();
     assert_eq!(e.exit_code(), 2);
@@ -273,6 +286,7 @@ fn sixty_four_variant_static_ensemble_on_the_gpu_matches_the_cpu_runs() {
         Precision::F64,
         &dir.join("gpu"),
         false,
+        None,
     )
     .unwrap();
     let t_gpu = t0.elapsed().as_secs_f64();
@@ -284,6 +298,7 @@ fn sixty_four_variant_static_ensemble_on_the_gpu_matches_the_cpu_runs() {
         Precision::F64,
         &dir.join("cpu"),
         false,
+        None,
     )
     .unwrap();
     let t_cpu = t0.elapsed().as_secs_f64();
@@ -360,6 +375,7 @@ fn sixty_four_variant_static_ensemble_on_the_gpu_matches_the_cpu_runs() {
         Precision::F32,
         &dir.join("gpu32"),
         false,
+        None,
     )
     .unwrap();
     let t_32 = t0.elapsed().as_secs_f64();

@@ -804,6 +804,28 @@ pub fn run(
             }
         },
     };
+    // Thresholds must name a quantity this case reports (checked before any work).
+    if let Some(mc) = monte_carlo {
+        let names: Vec<String> = qoi_columns(
+            &[],
+            stabilizer_sites(&case.model).len(),
+            analysis == Analysis::Dynamic,
+        )
+        .into_iter()
+        .map(|q| q.name)
+        .collect();
+        for (name, _) in &mc.thresholds {
+            if !names.contains(name) {
+                return Err(InputError {
+                    source_name: "--exceed".into(),
+                    line: 0,
+                    key: name.clone(),
+                    message: format!("no quantity {name:?}; allowed: {}", names.join(", ")),
+                }
+                .into());
+            }
+        }
+    }
     // Check every variant against the case before any work.
     for v in &variants {
         if let Err(e) = apply(&case, v) {
@@ -1070,23 +1092,6 @@ fn uncertainty_report(
     out: &Path,
 ) -> Result<(crate::uq::report::UncertaintyReport, Vec<String>), Error> {
     let qois = qoi_columns(results, stabs, dynamic);
-    for (name, _) in &mc.thresholds {
-        if !qois.iter().any(|q| &q.name == name) {
-            return Err(InputError {
-                source_name: "--exceed".into(),
-                line: 0,
-                key: name.clone(),
-                message: format!(
-                    "no quantity {name:?}; allowed: {}",
-                    qois.iter()
-                        .map(|q| q.name.as_str())
-                        .collect::<Vec<_>>()
-                        .join(", ")
-                ),
-            }
-            .into());
-        }
-    }
     let keys: Vec<crate::ensemble::Key> = variants
         .first()
         .map(|v| v.overrides.iter().map(|(k, _)| k.clone()).collect())

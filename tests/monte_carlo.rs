@@ -1,0 +1,206 @@
+//! Monte Carlo runs (`holewall ensemble --samples`): the shipped case on the CPU backend
+//! and the GPU engine (P50/P90 within 1 %), the same seed giving the same bits, the
+//! uncertain-input table's errors (file:line: key, exit 2, nothing written).
+
+mod common;
+
+use holewall::backend::{BackendChoice, Precision};
+use holewall::cli::ensemble_cmd::{monte_carlo, run, EnsembleSummary};
+use holewall::uq::Sampling;
+
+fn tmp(name: &str) -> std::path::PathBuf {
+    let d = std::env::temp_dir().join(format!("holewall-mc-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    d
+}
+
+fn case() -> std::path::PathBuf {
+    std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("cases/monte_carlo_two_stabilizers.toml")
+}
+
+fn mc_run(
+    n: usize,
+    seed: u64,
+    backend: BackendChoice,
+    precision: Precision,
+    out: &std::path::Path,
+) -> EnsembleSummary {
+    let mc = monte_carlo(
+        Some(n),
+        seed,
+        Sampling::Lhs,
+        &[95.0],
+        &["stab1_max_side_force_n=10000".to_string()],
+    )
+    .unwrap();
+    run(&case(), None, backend, precision, out, false, mc.as_ref()).unwrap()
+}
+
+#[test]
+fn shipped_case_on_the_cpu_and_the_engine() {
+    let n = 40;
+    let cpu = mc_run(n, 1, BackendChoice::Cpu, Precision::F64, &tmp("cpu"));
+    let u = cpu.uncertainty.as_ref().unwrap();
+    assert_eq!((u.samples, u.failed, cpu.failed), (n, 0, 0));
+    assert_eq!(u.inputs, vec!["k_e", "mu", "stab2.from_bit", "wob"]);
+    for q in &u.qois {
+        let s = q.stats.as_ref().unwrap();
+        assert_eq!(s.n, n, "{}", q.name);
+        assert!(s.p10 <= s.p50 && s.p50 <= s.p90, "{}", q.name);
+        assert_eq!(s.percentiles.len(), 1);
+        assert_eq!(q.sensitivity.len(), 4);
+    }
+    // Physics the sensitivities must show: the surface torque follows friction, the
+    // neutral point follows the weight on bit.
+    let top = |name: &str| {
+        let q = u.qois.iter().find(|q| q.name == name).unwrap();
+        q.sensitivity
+            .iter()
+            .max_by(|a, b| a.prcc.abs().total_cmp(&b.prcc.abs()))
+            .unwrap()
+            .clone()
+    };
+    let torque = top("max_surface_torque_nm");
+    assert_eq!(torque.input, "mu");
+    assert!(torque.prcc > 0.9, "{torque:?}");
+    let np = top("neutral_point_from_bit_m");
+    assert_eq!(np.input, "wob");
+    assert!(np.prcc > 0.9, "{np:?}");
+    let side = u
+        .qois
+        .iter()
+        .find(|q| q.name == "stab1_max_side_force_n")
+        .unwrap();
+    assert_eq!(side.stats.as_ref().unwrap().exceedance.len(), 1);
+    for f in [
+        "hist_stab1_max_side_force_n.png",
+        "tornado_max_surface_torque_nm.png",
+        "scatter_max_surface_torque_nm_vs_mu.png",
+        "convergence_neutral_point_from_bit_m.png",
+    ] {
+        assert!(cpu.outputs.iter().any(|o| o == f), "{f} not written");
+    }
+    // The same seed: the same bits; another seed: other samples.
+    let again = mc_run(n, 1, BackendChoice::Cpu, Precision::F64, &tmp("cpu2"));
+    let stats = |s: &EnsembleSummary| serde_json::to_string(&s.uncertainty).unwrap();
+    assert_eq!(stats(&cpu), stats(&again));
+    let other = mc_run(n, 2, BackendChoice::Cpu, Precision::F64, &tmp("cpu3"));
+    assert_ne!(stats(&cpu), stats(&other));
+    // The GPU engine: P50 and P90 of every quantity within 1 % (f64); f32 reported.
+    let Some(ctx) = common::gpu() else { return };
+    let precisions: &[Precision] = if ctx.has_f64 {
+        &[Precision::F64, Precision::F32]
+    } else {
+        &[Precision::F32]
+    };
+    for &p in precisions {
+        let gpu = mc_run(n, 1, BackendChoice::Gpu, p, &tmp(&format!("gpu{p:?}")));
+        let g = gpu.uncertainty.as_ref().unwrap();
+        assert_eq!(gpu.solved_by_engine, n, "every sample solved by the engine");
+        let mut worst: f64 = 0.0;
+        for (a, b) in g.qois.iter().zip(&u.qois) {
+            let (sa, sb) = (a.stats.as_ref().unwrap(), b.stats.as_ref().unwrap());
+            for (x, y) in [(sa.p50, sb.p50), (sa.p90, sb.p90)] {
+                // Relative to the quantity's spread or size, whichever is larger.
+                let scale = sb.p90.abs().max(sb.p10.abs()).max(1e-300);
+                worst = worst.max((x - y).abs() / scale);
+            }
+        }
+        eprintln!("GPU {p:?} vs CPU: P50/P90 of every quantity within {worst:.2e}");
+        assert!(worst <= 0.01, "{p:?}: {worst:e}");
+    }
+}
+
+#[test]
+fn uncertain_table_errors_name_file_line_and_key() {
+    let dir = tmp("bad");
+    std::fs::create_dir_all(&dir).unwrap();
+    let text = std::fs::read_to_string(case()).unwrap();
+    let table_line = text
+        .lines()
+        .position(|l| l.starts_with("mu = { dist"))
+        .unwrap()
+        + 1;
+    for (bad, needle) in [
+        (
+            "mu = { dist = \"gamma\", min = 0.2, max = 0.4 }",
+            "unknown distribution",
+        ),
+        (
+            "mu = { dist = \"uniform\", min = 0.4, max = 0.2 }",
+            "below max",
+        ),
+        (
+            "mu = { dist = \"uniform\", min = 0.2, max = 3.0 }",
+            "out of range",
+        ),
+        ("mu = { dist = \"normal\", mean = 0.3 }", "needs sd"),
+        (
+            "mu = { dist = \"uniform\", min = 0.2, max = 0.4, sd = 1 }",
+            "takes no sd",
+        ),
+        (
+            "mu = { dist = \"discrete\", values = [0.1, 0.2], weights = [1] }",
+            "1 weights for 2 values",
+        ),
+    ] {
+        let bad_text = text.replace("mu = { dist = \"uniform\", min = 0.2, max = 0.4 }", bad);
+        let path = dir.join("bad.toml");
+        std::fs::write(&path, bad_text).unwrap();
+        let out = dir.join("out");
+        let mc = monte_carlo(Some(4), 1, Sampling::Random, &[], &[]).unwrap();
+        let e = run(
+            &path,
+            None,
+            BackendChoice::Cpu,
+            Precision::F64,
+            &out,
+            false,
+            mc.as_ref(),
+        )
+        .unwrap_err();
+        let msg = e.to_string();
+        assert_eq!(e.exit_code(), 2, "{msg}");
+        assert!(
+            msg.contains(&format!("bad.toml:{table_line}: ensemble.uncertain.mu")),
+            "{msg}"
+        );
+        assert!(msg.contains(needle), "{msg}");
+        assert!(!out.exists());
+    }
+    // A normal law that reaches outside the key's range must be truncated.
+    let wide = text.replace(
+        "mu = { dist = \"uniform\", min = 0.2, max = 0.4 }",
+        "mu = { dist = \"normal\", mean = 0.3, sd = 0.5 }",
+    );
+    let path = dir.join("wide.toml");
+    std::fs::write(&path, wide).unwrap();
+    let mc = monte_carlo(Some(50), 1, Sampling::Random, &[], &[]).unwrap();
+    let e = run(
+        &path,
+        None,
+        BackendChoice::Cpu,
+        Precision::F64,
+        &dir.join("o"),
+        false,
+        mc.as_ref(),
+    )
+    .unwrap_err();
+    assert!(e.to_string().contains("truncate"), "{e}");
+    // Command-line errors.
+    assert!(monte_carlo(None, 1, Sampling::Lhs, &[95.0], &[]).is_err());
+    assert!(monte_carlo(Some(10), 1, Sampling::Lhs, &[120.0], &[]).is_err());
+    assert!(monte_carlo(Some(10), 1, Sampling::Lhs, &[], &["x".into()]).is_err());
+    let mc = monte_carlo(Some(4), 1, Sampling::Lhs, &[], &["nope=1".into()]).unwrap();
+    let e = run(
+        &case(),
+        None,
+        BackendChoice::Cpu,
+        Precision::F64,
+        &dir.join("o2"),
+        false,
+        mc.as_ref(),
+    )
+    .unwrap_err();
+    assert!(e.to_string().contains("no quantity \"nope\""), "{e}");
+}
