@@ -63,6 +63,10 @@ fn shipped_case_on_the_cpu_and_the_engine() {
     let torque = top("max_surface_torque_nm");
     assert_eq!(torque.input, "mu");
     assert!(torque.prcc > 0.9, "{torque:?}");
+    // The hook load falls one for one with the weight on bit.
+    let hook = top("hook_load_n");
+    assert_eq!(hook.input, "wob");
+    assert!(hook.prcc < -0.9, "{hook:?}");
     let np = top("neutral_point_from_bit_m");
     assert_eq!(np.input, "wob");
     assert!(np.prcc > 0.9, "{np:?}");

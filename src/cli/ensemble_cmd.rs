@@ -84,6 +84,9 @@ pub struct VariantResult {
     pub reason: String,
     /// Neutral point from the bit (m): static solution, or the last state of a dynamic run.
     pub neutral_point_from_bit_m: Option<f64>,
+    /// Hook load (N): the top's axial reaction of a static solution; for a dynamic run the
+    /// top element's axial force in the last state.
+    pub hook_load_n: Option<f64>,
     /// Largest surface torque (N·m).
     pub max_surface_torque_nm: f64,
     /// Per stabilizer, nearest the bit first.
@@ -153,6 +156,7 @@ fn failed(name: &str, reason: String, stabs: usize) -> VariantResult {
         solved_by: SolvedBy::Cpu,
         reason,
         neutral_point_from_bit_m: None,
+        hook_load_n: None,
         max_surface_torque_nm: f64::NAN,
         stabilizers: vec![StabilizerQoi::default(); stabs],
         newton_iterations_per_step: f64::NAN,
@@ -166,6 +170,7 @@ fn finished(
     log: &[String],
     iterations: &[usize],
     neutral_point_from_bit_m: Option<f64>,
+    hook_load_n: f64,
     max_surface_torque_nm: f64,
     stabilizers: Vec<StabilizerQoi>,
 ) -> VariantResult {
@@ -180,6 +185,7 @@ fn finished(
         solved_by: SolvedBy::Cpu,
         reason: log.first().cloned().unwrap_or_default(),
         neutral_point_from_bit_m,
+        hook_load_n: hook_load_n.is_finite().then_some(hook_load_n),
         max_surface_torque_nm,
         stabilizers,
         newton_iterations_per_step: iterations.iter().sum::<usize>() as f64
@@ -204,7 +210,7 @@ pub fn static_result(
     sol: &crate::solve::statics::StaticSolution,
 ) -> VariantResult {
     let stabs = stabilizer_sites(model);
-    let (rows, _hook, torque, _wob) = fe_rows(model, sol);
+    let (rows, hook, torque, _wob) = fe_rows(model, sol);
     let stabilizers = stabs
         .iter()
         .map(|&k| {
@@ -221,6 +227,7 @@ pub fn static_result(
         &sol.log,
         &sol.iterations,
         neutral_point(&rows).map(|md| case.bit_md - md),
+        hook,
         torque,
         stabilizers,
     )
@@ -563,6 +570,7 @@ impl DynamicObserver {
             log,
             iterations,
             np.map(|x| case.bit_md - x),
+            axial.first().copied().unwrap_or(f64::NAN),
             self.max_torque,
             self.qoi,
         )
@@ -624,6 +632,7 @@ fn variants_csv(
             "solved_by",
             "reason",
             "neutral_point_from_bit_m",
+            "hook_load_n",
             "max_surface_torque_nm",
         ]
         .map(String::from),
@@ -661,6 +670,7 @@ fn variants_csv(
         row.push(r.solved_by.name().into());
         row.push(r.reason.clone());
         row.push(r.neutral_point_from_bit_m.map(fmt).unwrap_or_default());
+        row.push(r.hook_load_n.map(fmt).unwrap_or_default());
         row.push(fmt(r.max_surface_torque_nm));
         for q in &r.stabilizers {
             row.push(fmt(q.max_side_force_n));
@@ -1055,6 +1065,7 @@ pub fn qoi_columns(
         col("neutral_point_from_bit_m".into(), Unit::Length, &|r| {
             r.neutral_point_from_bit_m
         }),
+        col("hook_load_n".into(), Unit::Force, &|r| r.hook_load_n),
         col("max_surface_torque_nm".into(), Unit::Torque, &|r| {
             Some(r.max_surface_torque_nm)
         }),
