@@ -7,7 +7,10 @@ use crate::kernels::contact::{contact, ContactBatch, ContactOutputs};
 use crate::physics::contact::ContactTerms;
 
 /// `--backend`: where the kernels run.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+#[derive(
+    Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum, serde::Serialize, serde::Deserialize,
+)]
+#[serde(rename_all = "snake_case")]
 pub enum BackendChoice {
     /// The CPU twins (rayon over pairs / variants).
     Cpu,
@@ -18,7 +21,10 @@ pub enum BackendChoice {
 }
 
 /// `--precision`: the float type of the computation.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+#[derive(
+    Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum, serde::Serialize, serde::Deserialize,
+)]
+#[serde(rename_all = "snake_case")]
 pub enum Precision {
     /// 64-bit (the oracle's precision).
     F64,

@@ -97,6 +97,28 @@ enum Command {
         /// `--exceed stab1_max_side_force_n=20000`.
         #[arg(long)]
         exceed: Vec<String>,
+        /// Variants per result chunk (each written atomically; a killed run resumes from
+        /// its chunks when started again with the same command).
+        #[arg(long, default_value_t = cli::ensemble_cmd::DEFAULT_CHUNK)]
+        chunk_size: usize,
+        /// Run only the K-th of N slices of the variants (`holewall merge` joins them).
+        #[arg(long)]
+        shard: Option<String>,
+        /// Replace an earlier run's outputs in --out.
+        #[arg(long)]
+        force: bool,
+    },
+    /// Joins the folders of a run's `--shard K/N` runs into what the run without shards
+    /// would write.
+    Merge {
+        /// Output folder.
+        #[arg(long)]
+        out: PathBuf,
+        /// The shard folders.
+        dirs: Vec<PathBuf>,
+        /// No progress bar.
+        #[arg(long)]
+        quiet: bool,
     },
     /// Benchmarks (medians over repeats; GPU/CPU ratios from the same run).
     Bench {
@@ -278,6 +300,9 @@ fn main() -> ExitCode {
             sampling,
             percentile,
             exceed,
+            chunk_size,
+            shard,
+            force,
         } => {
             let mc =
                 match cli::ensemble_cmd::monte_carlo(samples, seed, sampling, &percentile, &exceed)
@@ -285,6 +310,20 @@ fn main() -> ExitCode {
                     Ok(mc) => mc,
                     Err(e) => return fail(&[e]),
                 };
+            let shard = match shard
+                .as_deref()
+                .map(cli::ensemble_cmd::parse_shard)
+                .transpose()
+            {
+                Ok(s) => s,
+                Err(e) => return fail(&[e]),
+            };
+            let options = cli::ensemble_cmd::EnsembleOptions {
+                monte_carlo: mc,
+                chunk_size,
+                shard,
+                force,
+            };
             print_summary(cli::ensemble_cmd::run(
                 &case,
                 variants.as_deref(),
@@ -292,8 +331,11 @@ fn main() -> ExitCode {
                 precision,
                 &out,
                 !quiet,
-                mc.as_ref(),
+                &options,
             ))
+        }
+        Command::Merge { out, dirs, quiet } => {
+            print_summary(cli::ensemble_cmd::merge(&out, &dirs, !quiet))
         }
         Command::GpuInfo { pairs } => match cli::gpu_info::run(pairs) {
             Ok(()) => ExitCode::SUCCESS,

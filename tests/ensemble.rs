@@ -128,7 +128,7 @@ fn grid_dynamic_ensemble_writes_variants_and_series() {
         Precision::F64,
         &out,
         false,
-        None,
+        &Default::default(),
     )
     .unwrap();
     assert_eq!((s.variants, s.failed), (2, 0));
@@ -146,7 +146,7 @@ fn grid_dynamic_ensemble_writes_variants_and_series() {
         Precision::F32,
         &out2,
         false,
-        None,
+        &Default::default(),
     )
     .unwrap_err();
     assert_eq!(e.exit_code(), 2);
@@ -160,7 +160,7 @@ fn grid_dynamic_ensemble_writes_variants_and_series() {
             Precision::F64,
             &out3,
             false,
-            None,
+            &Default::default(),
         )
         .unwrap();
         assert_eq!(
@@ -231,7 +231,7 @@ fn bad_variant_files_name_file_line_and_key() {
             Precision::F64,
             &out,
             false,
-            None,
+            &Default::default(),
         )
         .unwrap_err();
         let msg = e.to_string();
@@ -250,7 +250,7 @@ fn bad_variant_files_name_file_line_and_key() {
         Precision::F64,
         &dir.join("o"),
         false,
-        None,
+        &Default::default(),
     )
     .unwrap_err();
     assert_eq!(e.exit_code(), 2);
@@ -286,7 +286,7 @@ fn sixty_four_variant_static_ensemble_on_the_gpu_matches_the_cpu_runs() {
         Precision::F64,
         &dir.join("gpu"),
         false,
-        None,
+        &Default::default(),
     )
     .unwrap();
     let t_gpu = t0.elapsed().as_secs_f64();
@@ -298,7 +298,7 @@ fn sixty_four_variant_static_ensemble_on_the_gpu_matches_the_cpu_runs() {
         Precision::F64,
         &dir.join("cpu"),
         false,
-        None,
+        &Default::default(),
     )
     .unwrap();
     let t_cpu = t0.elapsed().as_secs_f64();
@@ -375,7 +375,7 @@ fn sixty_four_variant_static_ensemble_on_the_gpu_matches_the_cpu_runs() {
         Precision::F32,
         &dir.join("gpu32"),
         false,
-        None,
+        &Default::default(),
     )
     .unwrap();
     let t_32 = t0.elapsed().as_secs_f64();

@@ -5,13 +5,20 @@
 mod common;
 
 use holewall::backend::{BackendChoice, Precision};
-use holewall::cli::ensemble_cmd::{monte_carlo, run, EnsembleSummary};
+use holewall::cli::ensemble_cmd::{monte_carlo, run, EnsembleOptions, EnsembleSummary};
 use holewall::uq::Sampling;
 
 fn tmp(name: &str) -> std::path::PathBuf {
     let d = std::env::temp_dir().join(format!("holewall-mc-{}-{name}", std::process::id()));
     let _ = std::fs::remove_dir_all(&d);
     d
+}
+
+fn opts(mc: Option<holewall::uq::report::MonteCarlo>) -> EnsembleOptions {
+    EnsembleOptions {
+        monte_carlo: mc,
+        ..Default::default()
+    }
 }
 
 fn case() -> std::path::PathBuf {
@@ -33,7 +40,7 @@ fn mc_run(
         &["stab1_max_side_force_n=10000".to_string()],
     )
     .unwrap();
-    run(&case(), None, backend, precision, out, false, mc.as_ref()).unwrap()
+    run(&case(), None, backend, precision, out, false, &opts(mc)).unwrap()
 }
 
 #[test]
@@ -160,7 +167,7 @@ fn uncertain_table_errors_name_file_line_and_key() {
             Precision::F64,
             &out,
             false,
-            mc.as_ref(),
+            &opts(mc),
         )
         .unwrap_err();
         let msg = e.to_string();
@@ -187,7 +194,7 @@ fn uncertain_table_errors_name_file_line_and_key() {
         Precision::F64,
         &dir.join("o"),
         false,
-        mc.as_ref(),
+        &opts(mc),
     )
     .unwrap_err();
     assert!(e.to_string().contains("truncate"), "{e}");
@@ -203,7 +210,7 @@ fn uncertain_table_errors_name_file_line_and_key() {
         Precision::F64,
         &dir.join("o2"),
         false,
-        mc.as_ref(),
+        &opts(mc),
     )
     .unwrap_err();
     assert!(e.to_string().contains("no quantity \"nope\""), "{e}");

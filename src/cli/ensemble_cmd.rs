@@ -13,7 +13,7 @@
 use std::path::Path;
 
 use rayon::prelude::*;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use crate::backend::{BackendChoice, Precision};
 use crate::case::{load_case, Analysis, Case};
@@ -28,11 +28,13 @@ use crate::solve::dynamics::{DynamicState, Dynamics};
 use crate::solve::statics::{solve_static, StaticOptions};
 
 /// Per-stabilizer quantities of interest.
-#[derive(Clone, Debug, Default, Serialize)]
+#[derive(Clone, Debug, Default, Serialize, Deserialize, PartialEq)]
 pub struct StabilizerQoi {
     /// Largest normal (side) force (N).
+    #[serde(with = "crate::output::nan_as_null")]
     pub max_side_force_n: f64,
     /// Largest lateral displacement from the hole axis (m).
+    #[serde(with = "crate::output::nan_as_null")]
     pub max_lateral_m: f64,
     /// Whirl frequency over the second half of a dynamic run (Hz), signed: + forward (with
     /// the rotation), − backward; `None` for static runs or a stabilizer that stays put.
@@ -40,7 +42,7 @@ pub struct StabilizerQoi {
 }
 
 /// How a variant ended.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Status {
     /// Converged at the requested steps.
@@ -52,7 +54,7 @@ pub enum Status {
 }
 
 /// Which solver produced a variant's result.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum SolvedBy {
     /// The kernel engine (GPU, or the CPU twins of its kernels).
@@ -72,7 +74,7 @@ impl SolvedBy {
 }
 
 /// One variant's result.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
 pub struct VariantResult {
     /// Variant name.
     pub name: String,
@@ -88,10 +90,12 @@ pub struct VariantResult {
     /// top element's axial force in the last state.
     pub hook_load_n: Option<f64>,
     /// Largest surface torque (N·m).
+    #[serde(with = "crate::output::nan_as_null")]
     pub max_surface_torque_nm: f64,
     /// Per stabilizer, nearest the bit first.
     pub stabilizers: Vec<StabilizerQoi>,
     /// Mean Newton iterations per load or time step.
+    #[serde(with = "crate::output::nan_as_null")]
     pub newton_iterations_per_step: f64,
     /// Step cuts.
     pub step_cuts: usize,
@@ -703,8 +707,9 @@ pub fn run(
     precision: Precision,
     out: &Path,
     show_progress: bool,
-    monte_carlo: Option<&crate::uq::report::MonteCarlo>,
+    options: &EnsembleOptions,
 ) -> Result<EnsembleSummary, Error> {
+    let monte_carlo = options.monte_carlo.as_ref();
     let case = load_case(case_path)?;
     let settings = case.ensemble.clone();
     let cli_error = |key: &str, message: String| -> Error {
@@ -850,8 +855,31 @@ pub fn run(
             .into());
         }
     }
+    // The output folder, checked (and the run's manifest written) before any work.
+    let chunk_size = if options.chunk_size == 0 {
+        DEFAULT_CHUNK
+    } else {
+        options.chunk_size
+    };
+    let manifest = Manifest::new(
+        case_path,
+        variants_file,
+        backend,
+        precision,
+        options,
+        chunk_size,
+        variants.len(),
+    )?;
+    prepare_out(out, &manifest, options.force)?;
+    let nchunks = manifest.chunks;
+    let range = match options.shard {
+        Some((k, n)) => (k - 1) * nchunks / n..k * nchunks / n,
+        None => 0..nchunks,
+    };
+    let chunk_of = |c: usize| c * chunk_size..((c + 1) * chunk_size).min(variants.len());
+    let in_range: usize = range.clone().map(|c| chunk_of(c).len()).sum();
     let bar = if show_progress {
-        indicatif::ProgressBar::new(variants.len() as u64)
+        indicatif::ProgressBar::new(in_range as u64)
     } else {
         indicatif::ProgressBar::hidden()
     };
@@ -861,66 +889,71 @@ pub fn run(
         )
         .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
     );
-    let start = std::time::Instant::now();
-    let mut backend_name = "cpu";
-    let results = match (gpu, analysis) {
-        (Some(ctx), Analysis::Static) => match if precision == Precision::F32 {
-            run_static_gpu::<f32>(&case, &variants, ctx, &bar)?
-        } else {
-            run_static_gpu::<f64>(&case, &variants, ctx, &bar)?
-        } {
-            Some(r) => {
-                backend_name = "gpu";
-                bar.set_position(variants.len() as u64);
-                r
-            }
-            None => {
-                eprintln!("holewall: the variants differ in their number of contact sites; running them on the CPU");
-                run_variants_cpu(&case, analysis, &variants, &bar)
-            }
-        },
-        (Some(ctx), Analysis::Dynamic) => match if precision == Precision::F32 {
-            run_dynamic_gpu::<f32>(&case, &variants, ctx, &bar)?
-        } else {
-            run_dynamic_gpu::<f64>(&case, &variants, ctx, &bar)?
-        } {
-            Ok(r) => {
-                backend_name = "gpu";
-                bar.set_position(variants.len() as u64);
-                r
-            }
-            Err(why) => {
-                if precision == Precision::F32 {
-                    return Err(InputError {
-                        source_name: "--precision".into(),
-                        line: 0,
-                        key: "precision".into(),
-                        message: format!("f32 runs on the GPU engine, which cannot run this case: {why}; use --precision f64"),
-                    }
-                    .into());
-                }
-                eprintln!("holewall: {why}; running the variants on the CPU");
-                run_variants_cpu(&case, analysis, &variants, &bar)
-            }
-        },
-        (None, _) => run_variants_cpu(&case, analysis, &variants, &bar),
-    };
-    let seconds = start.elapsed().as_secs_f64();
-    bar.finish_and_clear();
-    if backend_name == "gpu" {
-        let rerun = results
-            .iter()
-            .filter(|r| r.solved_by == SolvedBy::Cpu)
-            .count();
-        if rerun > 0 {
-            eprintln!(
-                "holewall: the engine failed {rerun} of {} variants; they were re-run on the CPU (variants.csv: solved_by, reason)",
-                results.len()
-            );
+    for c in range.clone() {
+        let path = chunk_path(out, c);
+        if path.exists() {
+            bar.inc(chunk_of(c).len() as u64);
+            continue;
         }
+        let start = std::time::Instant::now();
+        let slice = &variants[chunk_of(c)];
+        let before = bar.position();
+        let (results, backend_name) = compute(&case, analysis, slice, gpu, precision, &bar)?;
+        bar.set_position(before + slice.len() as u64);
+        let chunk = Chunk {
+            first: chunk_of(c).start,
+            backend: backend_name.to_string(),
+            seconds: start.elapsed().as_secs_f64(),
+            results,
+        };
+        let text = serde_json::to_vec(&chunk).map_err(|e| Error::Io(std::io::Error::other(e)))?;
+        write_atomic(&path, &text)?;
     }
-
-    std::fs::create_dir_all(out)?;
+    bar.finish_and_clear();
+    if let Some((k, n)) = options.shard {
+        return Ok(EnsembleSummary {
+            title: case.title.clone(),
+            analysis: format!("{analysis:?}").to_lowercase(),
+            backend: format!("{backend:?}").to_lowercase(),
+            precision: format!("{precision:?}").to_lowercase(),
+            variants: in_range,
+            converged: 0,
+            step_cut: 0,
+            failed: 0,
+            failures: Vec::new(),
+            solved_by_engine: 0,
+            solved_by_cpu: 0,
+            seconds: 0.0,
+            uncertainty: None,
+            outputs: vec![format!(
+                "shard {k}/{n}: chunks {}..{} in {}/chunks; `holewall merge` gives the whole run",
+                range.start,
+                range.end,
+                out.display()
+            )],
+        });
+    }
+    // Every chunk, read back (so a resumed or merged run has exactly these bits).
+    let mut results = Vec::with_capacity(variants.len());
+    let mut backend_name = "cpu";
+    let mut seconds = 0.0;
+    for c in 0..nchunks {
+        let chunk = read_chunk(&chunk_path(out, c))?;
+        if chunk.first != chunk_of(c).start || chunk.results.len() != chunk_of(c).len() {
+            return Err(Error::Io(std::io::Error::other(format!(
+                "{}: holds variants {}.. ({}), not the chunk's {:?}",
+                chunk_path(out, c).display(),
+                chunk.first,
+                chunk.results.len(),
+                chunk_of(c)
+            ))));
+        }
+        if chunk.backend == "gpu" {
+            backend_name = "gpu";
+        }
+        seconds += chunk.seconds;
+        results.extend(chunk.results);
+    }
     let stabs = stabilizer_sites(&case.model).len();
     let dynamic = analysis == Analysis::Dynamic;
     let mut outputs = vec!["variants.csv".to_string()];
@@ -1178,4 +1211,356 @@ pub fn monte_carlo(
         percentiles: percentiles.to_vec(),
         thresholds,
     }))
+}
+
+/// Variants per result chunk unless `--chunk-size` says otherwise.
+pub const DEFAULT_CHUNK: usize = 256;
+
+/// Options of an ensemble run beyond the case, the variants file and the backend.
+#[derive(Clone, Debug, Default)]
+pub struct EnsembleOptions {
+    /// Monte Carlo sampling of `[ensemble.uncertain]` (`--samples`).
+    pub monte_carlo: Option<crate::uq::report::MonteCarlo>,
+    /// Variants per result chunk (0: [`DEFAULT_CHUNK`]).
+    pub chunk_size: usize,
+    /// Run only the K-th (1-based) of N slices of the chunks (`--shard K/N`).
+    pub shard: Option<(usize, usize)>,
+    /// Replace the outputs of another run in the output folder (`--force`).
+    pub force: bool,
+}
+
+/// `run.json`: what a run was asked, to resume it, refuse another run's folder, and merge
+/// shards.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct Manifest {
+    /// FNV-1a 64 of the case text, the variants file's text and every option that changes
+    /// results or the report (hex).
+    pub identity: String,
+    /// The case file.
+    pub case: std::path::PathBuf,
+    /// The variants file, if any.
+    pub variants_file: Option<std::path::PathBuf>,
+    /// `cpu`, `gpu` or `auto`.
+    pub backend: BackendChoice,
+    /// Precision asked for.
+    pub precision: Precision,
+    /// Monte Carlo request.
+    pub monte_carlo: Option<crate::uq::report::MonteCarlo>,
+    /// Variants per chunk.
+    pub chunk_size: usize,
+    /// Variants in the whole run.
+    pub variants: usize,
+    /// Chunks in the whole run.
+    pub chunks: usize,
+    /// This folder's shard (K, N), or the whole run.
+    pub shard: Option<(usize, usize)>,
+}
+
+fn fnv1a(bytes: &[u8], mut h: u64) -> u64 {
+    for b in bytes {
+        h ^= u64::from(*b);
+        h = h.wrapping_mul(0x100000001b3);
+    }
+    h
+}
+
+impl Manifest {
+    fn new(
+        case_path: &Path,
+        variants_file: Option<&Path>,
+        backend: BackendChoice,
+        precision: Precision,
+        options: &EnsembleOptions,
+        chunk_size: usize,
+        variants: usize,
+    ) -> Result<Manifest, Error> {
+        let mut h = 0xcbf29ce484222325u64;
+        h = fnv1a(&std::fs::read(case_path)?, h);
+        if let Some(f) = variants_file {
+            h = fnv1a(b"\0variants\0", h);
+            h = fnv1a(&std::fs::read(f)?, h);
+        }
+        let tail = format!(
+            "\0{backend:?}\0{precision:?}\0{:?}\0{chunk_size}\0{variants}",
+            options.monte_carlo
+        );
+        h = fnv1a(tail.as_bytes(), h);
+        let abs = |p: &Path| std::fs::canonicalize(p).unwrap_or_else(|_| p.to_path_buf());
+        Ok(Manifest {
+            identity: format!("{h:016x}"),
+            case: abs(case_path),
+            variants_file: variants_file.map(abs),
+            backend,
+            precision,
+            monte_carlo: options.monte_carlo.clone(),
+            chunk_size,
+            variants,
+            chunks: variants.div_ceil(chunk_size),
+            shard: options.shard,
+        })
+    }
+}
+
+/// One chunk of results, `chunks/chunk_NNNNNN.json`.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+struct Chunk {
+    /// Index of its first variant.
+    first: usize,
+    /// Where it ran.
+    backend: String,
+    /// Wall time (s).
+    seconds: f64,
+    /// Results in variant order.
+    results: Vec<VariantResult>,
+}
+
+fn chunk_path(out: &Path, c: usize) -> std::path::PathBuf {
+    out.join("chunks").join(format!("chunk_{c:06}.json"))
+}
+
+fn read_chunk(path: &Path) -> Result<Chunk, Error> {
+    let text = std::fs::read(path)
+        .map_err(|e| Error::Io(std::io::Error::other(format!("{}: {e}", path.display()))))?;
+    serde_json::from_slice(&text)
+        .map_err(|e| Error::Io(std::io::Error::other(format!("{}: {e}", path.display()))))
+}
+
+/// The files a run writes into its folder (what `--force` clears).
+fn is_run_output(name: &str) -> bool {
+    matches!(
+        name,
+        "run.json" | "summary.json" | "variants.csv" | "chunks" | "series"
+    ) || name.ends_with(".png")
+}
+
+fn out_error(out: &Path, message: String) -> Error {
+    InputError {
+        source_name: "--out".into(),
+        line: 0,
+        key: out.display().to_string(),
+        message,
+    }
+    .into()
+}
+
+/// Checks the output folder before any work: a fresh or empty folder, or one holding this
+/// very run (resumed: its chunks are kept); another run's folder, or a folder with other
+/// files, is refused unless `force` (which removes the earlier run's files, never others).
+/// Writes `run.json`.
+pub fn prepare_out(out: &Path, manifest: &Manifest, force: bool) -> Result<(), Error> {
+    if out.exists() && !out.is_dir() {
+        return Err(out_error(out, "is a file, not a folder".into()));
+    }
+    if out.is_dir() {
+        let run_json = out.join("run.json");
+        let same = std::fs::read(&run_json)
+            .ok()
+            .and_then(|t| serde_json::from_slice::<Manifest>(&t).ok())
+            .is_some_and(|m| m.identity == manifest.identity && m.shard == manifest.shard);
+        let entries: Vec<String> = std::fs::read_dir(out)?
+            .filter_map(|e| e.ok())
+            .map(|e| e.file_name().to_string_lossy().into_owned())
+            .collect();
+        if !same && !entries.is_empty() {
+            let ours = entries.iter().all(|n| is_run_output(n));
+            if !force {
+                return Err(out_error(
+                    out,
+                    if run_json.exists() {
+                        "holds a run of other inputs; give another --out, or --force to replace it"
+                            .into()
+                    } else {
+                        "is not empty; give an empty or new folder, or --force to replace a run's files there".into()
+                    },
+                ));
+            }
+            if !ours && !run_json.exists() {
+                return Err(out_error(
+                    out,
+                    "holds files that are not a run's outputs; --force replaces only a run's, give an empty folder".into(),
+                ));
+            }
+            for n in entries.iter().filter(|n| is_run_output(n)) {
+                let p = out.join(n);
+                if p.is_dir() {
+                    std::fs::remove_dir_all(&p)?;
+                } else {
+                    std::fs::remove_file(&p)?;
+                }
+            }
+        }
+    }
+    std::fs::create_dir_all(out.join("chunks"))
+        .map_err(|e| out_error(out, format!("cannot create it: {e}")))?;
+    let text =
+        serde_json::to_vec_pretty(manifest).map_err(|e| Error::Io(std::io::Error::other(e)))?;
+    write_atomic(&out.join("run.json"), &text)
+        .map_err(|e| out_error(out, format!("cannot write into it: {e}")))?;
+    Ok(())
+}
+
+/// Runs `variants` on the GPU engine (`gpu`) or the CPU: their results, and where they ran.
+fn compute(
+    case: &Case,
+    analysis: Analysis,
+    variants: &[Variant],
+    gpu: Option<&'static crate::gpu::GpuContext>,
+    precision: Precision,
+    bar: &indicatif::ProgressBar,
+) -> Result<(Vec<VariantResult>, &'static str), Error> {
+    let mut backend_name = "cpu";
+    let results = match (gpu, analysis) {
+        (Some(ctx), Analysis::Static) => match if precision == Precision::F32 {
+            run_static_gpu::<f32>(case, variants, ctx, bar)?
+        } else {
+            run_static_gpu::<f64>(case, variants, ctx, bar)?
+        } {
+            Some(r) => {
+                backend_name = "gpu";
+                r
+            }
+            None => {
+                eprintln!("holewall: the variants differ in their number of contact sites; running them on the CPU");
+                run_variants_cpu(case, analysis, variants, bar)
+            }
+        },
+        (Some(ctx), Analysis::Dynamic) => match if precision == Precision::F32 {
+            run_dynamic_gpu::<f32>(case, variants, ctx, bar)?
+        } else {
+            run_dynamic_gpu::<f64>(case, variants, ctx, bar)?
+        } {
+            Ok(r) => {
+                backend_name = "gpu";
+                r
+            }
+            Err(why) => {
+                if precision == Precision::F32 {
+                    return Err(InputError {
+                        source_name: "--precision".into(),
+                        line: 0,
+                        key: "precision".into(),
+                        message: format!("f32 runs on the GPU engine, which cannot run this case: {why}; use --precision f64"),
+                    }
+                    .into());
+                }
+                eprintln!("holewall: {why}; running the variants on the CPU");
+                run_variants_cpu(case, analysis, variants, bar)
+            }
+        },
+        (None, _) => run_variants_cpu(case, analysis, variants, bar),
+    };
+    if backend_name == "gpu" {
+        let rerun = results
+            .iter()
+            .filter(|r| r.solved_by == SolvedBy::Cpu)
+            .count();
+        if rerun > 0 {
+            eprintln!(
+                "holewall: the engine failed {rerun} of {} variants; they were re-run on the CPU (variants.csv: solved_by, reason)",
+                results.len()
+            );
+        }
+    }
+    Ok((results, backend_name))
+}
+
+/// `holewall merge`: the shards in `dirs` (one run's `--shard K/N` folders, every K once)
+/// into `out`, which then holds exactly what the run without shards would write.
+pub fn merge(
+    out: &Path,
+    dirs: &[std::path::PathBuf],
+    show_progress: bool,
+) -> Result<EnsembleSummary, Error> {
+    let read = |d: &std::path::PathBuf| -> Result<Manifest, Error> {
+        let p = d.join("run.json");
+        let t = std::fs::read(&p)
+            .map_err(|e| out_error(d, format!("no run.json ({e}): not a holewall run folder")))?;
+        serde_json::from_slice(&t).map_err(|e| out_error(d, format!("run.json: {e}")))
+    };
+    let manifests = dirs.iter().map(read).collect::<Result<Vec<_>, Error>>()?;
+    let first = manifests
+        .first()
+        .ok_or_else(|| out_error(out, "no shard folders given".into()))?;
+    let n = match first.shard {
+        Some((_, n)) => n,
+        None => return Err(out_error(&dirs[0], "is a whole run, not a shard".into())),
+    };
+    let mut seen = vec![false; n];
+    for (d, m) in dirs.iter().zip(&manifests) {
+        if m.identity != first.identity {
+            return Err(out_error(
+                d,
+                format!(
+                    "is a shard of another run (identity {} against {})",
+                    m.identity, first.identity
+                ),
+            ));
+        }
+        match m.shard {
+            Some((k, nn)) if nn == n && (1..=n).contains(&k) && !seen[k - 1] => seen[k - 1] = true,
+            other => {
+                return Err(out_error(
+                    d,
+                    format!("shard {other:?} does not fit {n} shards given once each"),
+                ))
+            }
+        }
+    }
+    if let Some(k) = seen.iter().position(|s| !s) {
+        return Err(out_error(out, format!("shard {}/{n} is missing", k + 1)));
+    }
+    let mut whole = first.clone();
+    whole.shard = None;
+    prepare_out(out, &whole, false)?;
+    for (d, m) in dirs.iter().zip(&manifests) {
+        let (k, _) = m.shard.unwrap_or((1, 1));
+        for c in (k - 1) * whole.chunks / n..k * whole.chunks / n {
+            let from = chunk_path(d, c);
+            if !from.exists() {
+                return Err(out_error(
+                    d,
+                    format!("chunk {c} is missing: the shard did not finish; run it again"),
+                ));
+            }
+            let text = std::fs::read(&from)?;
+            write_atomic(&chunk_path(out, c), &text)?;
+        }
+    }
+    let options = EnsembleOptions {
+        monte_carlo: whole.monte_carlo.clone(),
+        chunk_size: whole.chunk_size,
+        shard: None,
+        force: false,
+    };
+    run(
+        &whole.case,
+        whole.variants_file.as_deref(),
+        whole.backend,
+        whole.precision,
+        out,
+        show_progress,
+        &options,
+    )
+}
+
+/// `--shard K/N` (1 ≤ K ≤ N), else an input error.
+pub fn parse_shard(text: &str) -> Result<(usize, usize), Error> {
+    let bad = || -> Error {
+        InputError {
+            source_name: "command line".into(),
+            line: 0,
+            key: "--shard".into(),
+            message: format!("{text:?}: expected K/N with 1 ≤ K ≤ N"),
+        }
+        .into()
+    };
+    let (k, n) = text.split_once('/').ok_or_else(bad)?;
+    let (k, n): (usize, usize) = (
+        k.trim().parse().map_err(|_| bad())?,
+        n.trim().parse().map_err(|_| bad())?,
+    );
+    if k == 0 || n == 0 || k > n {
+        return Err(bad());
+    }
+    Ok((k, n))
 }

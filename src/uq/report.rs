@@ -69,7 +69,7 @@ impl Unit {
 }
 
 /// What a Monte Carlo run asks for.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, Serialize, serde::Deserialize)]
 pub struct MonteCarlo {
     /// Samples.
     pub samples: usize,
