@@ -17,6 +17,8 @@
 //! | `wob`, `tob` | weight and torque on bit | N, N·m | ≥ 0 |
 //! | `stabK.blade` | blade diameter of stabilizer K | m | ≤ hole diameter |
 //! | `stabK.from_bit` | distance of stabilizer K's site from the bit | m | 0 < … < bit MD |
+//! | `depth` | bit depth (MD): the case rebuilt with `well.total_md` there (the string cut at the surface, the hole sections kept) | m | 0 < … ≤ 20 km, within the hole |
+//! | `mode` | operation: `rotating`, `tripping_in`, `tripping_out`, `sliding` (the case rebuilt with it) | – | one of those |
 //!
 //! Stabilizers are numbered from the bit up (`stab1` nearest the bit); a key without
 //! `.stabK` applies to every contact site.
@@ -55,7 +57,14 @@ pub enum Param {
     Blade,
     /// Distance of the stabilizer's site from the bit (m).
     FromBit,
+    /// Bit depth, MD (m): the case rebuilt there.
+    Depth,
+    /// Operation mode (a code of [`MODES`]): the case rebuilt with it.
+    Mode,
 }
+
+/// The operation modes a `mode` key takes, by code (its value is the index).
+pub const MODES: [&str; 4] = ["rotating", "tripping_in", "tripping_out", "sliding"];
 
 /// A parsed column key.
 #[derive(Clone, Debug, PartialEq)]
@@ -69,7 +78,7 @@ pub struct Key {
 }
 
 /// Every key form, for messages.
-pub const KEY_FORMS: &str = "mu, mu_t, mu_l, k_e, c, m, eps (each optionally .stabK), rpm, wob, tob, stabK.blade, stabK.from_bit";
+pub const KEY_FORMS: &str = "mu, mu_t, mu_l, k_e, c, m, eps (each optionally .stabK), rpm, wob, tob, stabK.blade, stabK.from_bit, depth, mode";
 
 impl Key {
     /// Parses a column key.
@@ -98,6 +107,8 @@ impl Key {
             ("rpm", None) => (Param::Rpm, None),
             ("wob", None) => (Param::Wob, None),
             ("tob", None) => (Param::Tob, None),
+            ("depth", None) => (Param::Depth, None),
+            ("mode", None) => (Param::Mode, None),
             (h, None) if law(h).is_some() => (law(h).unwrap_or(Param::Mu), None),
             (h, Some(t)) if law(h).is_some() => (law(h).unwrap_or(Param::Mu), Some(stab_index(t)?)),
             (h, Some("blade")) => (Param::Blade, Some(stab_index(h)?)),
@@ -111,8 +122,33 @@ impl Key {
         })
     }
 
-    /// Parses and range-checks a value of this key (SI number or `"<number> <unit>"`).
+    /// A value as `variants.csv` writes it: the mode's name, else the number.
+    pub fn format(&self, v: f64) -> String {
+        match self.param {
+            Param::Mode => MODES
+                .get(v as usize)
+                .map(|m| m.to_string())
+                .unwrap_or_else(|| format!("{v}")),
+            _ => format!("{v}"),
+        }
+    }
+
+    /// Parses and range-checks a value of this key (SI number or `"<number> <unit>"`; a
+    /// mode's name, or its code).
     pub fn value(&self, text: &str) -> Result<f64, String> {
+        if self.param == Param::Mode {
+            let t = text.trim();
+            return MODES
+                .iter()
+                .position(|m| *m == t)
+                .map(|k| k as f64)
+                .or_else(|| {
+                    t.parse::<f64>()
+                        .ok()
+                        .filter(|x| x.fract() == 0.0 && (0.0..MODES.len() as f64).contains(x))
+                })
+                .ok_or_else(|| format!("unknown mode {t:?}; allowed: {}", MODES.join(", ")));
+        }
         let (dim, ok, range): (Option<Dimension>, fn(f64) -> bool, &str) = match self.param {
             Param::Mu | Param::MuT | Param::MuL => (None, |x| (0.0..=2.0).contains(&x), "0 … 2"),
             Param::WallStiffness => (None, |x| x > 0.0 && x <= 1e12, "0 < k_e ≤ 1e12 N/m^m"),
@@ -148,6 +184,12 @@ impl Key {
                 |x| x > 0.0 && x < 2e4,
                 "0 < from_bit < 20 km",
             ),
+            Param::Depth => (
+                Some(Dimension::Length),
+                |x| x > 0.0 && x <= 2e4,
+                "0 < depth ≤ 20 km",
+            ),
+            Param::Mode => unreachable!("parsed above"),
         };
         let t = text.trim();
         let v = match (t.parse::<f64>(), dim) {
@@ -301,6 +343,14 @@ pub fn stabilizer_sites(model: &Model) -> Vec<usize> {
 /// stabilizer's site goes to the node nearest its new distance from the bit; a pipe-body
 /// site there, if any, takes the old node), then values, in column order.
 pub fn apply(case: &Case, variant: &Variant) -> Result<Model, String> {
+    let rebuilt;
+    let case = match variant_case(case, variant)? {
+        Some(c) => {
+            rebuilt = c;
+            &rebuilt
+        }
+        None => case,
+    };
     let mut model = case.model.clone();
     let stabs = stabilizer_sites(&case.model);
     let stab = |k: usize| -> Result<usize, String> {
@@ -372,7 +422,7 @@ pub fn apply(case: &Case, variant: &Variant) -> Result<Model, String> {
             None => (0..model.sites.len()).collect(),
         };
         match key.param {
-            Param::FromBit => {}
+            Param::FromBit | Param::Depth | Param::Mode => {}
             Param::Rpm => model.rotation_speed = v,
             Param::Wob => {
                 if let crate::model::TopBoundary::HookLoad(_) = model.top {
@@ -415,6 +465,50 @@ pub fn apply(case: &Case, variant: &Variant) -> Result<Model, String> {
     }
     model.sites.sort_by_key(|s| s.node);
     Ok(model)
+}
+
+/// The case rebuilt for a variant's `depth` and `mode`, if it has either: the case file
+/// read again with `well.total_md` and `operation.mode` replaced (every other input and
+/// check as written).
+pub fn variant_case(case: &Case, variant: &Variant) -> Result<Option<Case>, String> {
+    let depth = variant
+        .overrides
+        .iter()
+        .find(|(k, _)| k.param == Param::Depth)
+        .map(|(_, v)| *v);
+    let mode = variant
+        .overrides
+        .iter()
+        .find(|(k, _)| k.param == Param::Mode)
+        .map(|(k, v)| k.format(*v));
+    if depth.is_none() && mode.is_none() {
+        return Ok(None);
+    }
+    let text =
+        std::fs::read_to_string(&case.path).map_err(|e| format!("{}: {e}", case.path.display()))?;
+    let mut table: toml::Table = text
+        .parse()
+        .map_err(|e| format!("{}: {e}", case.path.display()))?;
+    let section = |t: &mut toml::Table, name: &str| -> Result<toml::Table, String> {
+        match t.get(name) {
+            Some(toml::Value::Table(s)) => Ok(s.clone()),
+            _ => Err(format!("the case has no [{name}] table")),
+        }
+    };
+    if let Some(d) = depth {
+        let mut well = section(&mut table, "well")?;
+        well.insert("total_md".into(), toml::Value::Float(d));
+        table.insert("well".into(), toml::Value::Table(well));
+    }
+    if let Some(m) = mode {
+        let mut op = section(&mut table, "operation")?;
+        op.insert("mode".into(), toml::Value::String(m));
+        table.insert("operation".into(), toml::Value::Table(op));
+    }
+    let edited = toml::to_string(&table).map_err(|e| e.to_string())?;
+    crate::case::parse_case(&case.path, &edited)
+        .map(Some)
+        .map_err(|e| format!("depth/mode: {}", e.message))
 }
 
 #[cfg(test)]

@@ -90,11 +90,19 @@ fn draw(
         .configure_mesh()
         .x_desc(x_label)
         .y_desc(y_label)
+        .x_label_formatter(&tick)
+        .y_label_formatter(&tick)
         .label_style(("sans-serif", 15))
         .draw()?;
     let colours = [BLUE, RED, GREEN, MAGENTA, CYAN, BLACK];
     for (k, s) in series.iter().enumerate() {
-        let c = colours[k % colours.len()];
+        // Six strong colours, then plotters' palette of 99 distinct ones.
+        let c: RGBColor = if series.len() <= colours.len() {
+            colours[k]
+        } else {
+            let (r, g, b) = Palette99::pick(k).to_rgba().rgb();
+            RGBColor(r, g, b)
+        };
         chart
             .draw_series(LineSeries::new(s.points.iter().copied(), c.stroke_width(2)))?
             .label(s.name)

@@ -215,3 +215,95 @@ fn uncertain_table_errors_name_file_line_and_key() {
     .unwrap_err();
     assert!(e.to_string().contains("no quantity \"nope\""), "{e}");
 }
+
+#[test]
+fn broomstick_of_the_shipped_case() {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("cases/broomstick.toml");
+    let out = tmp("broom");
+    let s = run(
+        &path,
+        None,
+        BackendChoice::Cpu,
+        Precision::F64,
+        &out,
+        false,
+        &Default::default(),
+    )
+    .unwrap();
+    assert_eq!((s.variants, s.failed), (54, 0));
+    assert!(s.outputs.iter().any(|o| o == "broomstick.png"));
+    // variants.csv: per depth, tripping out above rotating above tripping in (μ > 0), and
+    // every hook load grows with depth.
+    let csv = std::fs::read_to_string(out.join("variants.csv")).unwrap();
+    let mut rdr = csv::Reader::from_reader(csv.as_bytes());
+    let h = rdr.headers().unwrap().clone();
+    let col = |name: &str| h.iter().position(|x| x == name).unwrap();
+    let (cd, cm, cmu, ch) = (col("depth"), col("mode"), col("mu"), col("hook_load_n"));
+    let rows: Vec<(f64, String, f64, f64)> = rdr
+        .records()
+        .map(|r| {
+            let r = r.unwrap();
+            (
+                r[cd].parse().unwrap(),
+                r[cm].to_string(),
+                r[cmu].parse().unwrap(),
+                r[ch].parse().unwrap(),
+            )
+        })
+        .collect();
+    let hook = |d: f64, m: &str, mu: f64| {
+        rows.iter()
+            .find(|r| r.0 == d && r.1 == m && r.2 == mu)
+            .unwrap_or_else(|| panic!("{d} {m} {mu}"))
+            .3
+    };
+    for d in [600.0, 1000.0, 1500.0] {
+        for mu in [0.15, 0.35] {
+            let (i, r, o) = (
+                hook(d, "tripping_in", mu),
+                hook(d, "rotating", mu),
+                hook(d, "tripping_out", mu),
+            );
+            assert!(o > r && r > i, "depth {d}, mu {mu}: {o} {r} {i}");
+        }
+        assert!(hook(d, "tripping_out", 0.35) > hook(d, "tripping_out", 0.15));
+    }
+    assert!(hook(1500.0, "rotating", 0.25) > hook(600.0, "rotating", 0.25));
+    // A depth variant is the case with its depth written in.
+    let text = std::fs::read_to_string(&path)
+        .unwrap()
+        .replace("total_md = \"1500 m\"", "total_md = \"1000 m\"")
+        .replace("mode = \"rotating\"", "mode = \"tripping_out\"");
+    let single = holewall::case::parse_case(&path, &text).unwrap();
+    let via = hook(1000.0, "tripping_out", 0.25);
+    // The variant's model is the case with its depth and mode written in (same mesh, same
+    // nodes), and its result is the ensemble's row.
+    let case = holewall::case::load_case(&path).unwrap();
+    let v = holewall::ensemble::variants_from_csv_text(
+        "v.csv",
+        "depth,mode,mu\n1000 m,tripping_out,0.25\n",
+    )
+    .unwrap();
+    let m = holewall::ensemble::apply(&case, &v[0]).unwrap();
+    assert_eq!(m.nodes.len(), single.model.nodes.len());
+    assert!(m
+        .nodes
+        .iter()
+        .zip(&single.model.nodes)
+        .all(|(a, b)| a.position == b.position));
+    assert_eq!(m.axial_speed, single.model.axial_speed);
+    assert_eq!(m.nodes.last().unwrap().md, 1000.0);
+    let sol2 = holewall::solve::statics::solve_static(&m, &Default::default()).unwrap();
+    let r = holewall::cli::ensemble_cmd::static_result(&case, "v", &m, &sol2);
+    assert_eq!(r.hook_load_n.unwrap(), via);
+    // Bad modes and depths are refused with file, line and key.
+    let e = holewall::ensemble::variants_from_csv_text("v.csv", "mode\nspinning\n").unwrap_err();
+    assert_eq!((e.line, e.key.as_str()), (2, "mode"));
+    let e = holewall::ensemble::variants_from_csv_text("v.csv", "depth\n-5 m\n").unwrap_err();
+    assert_eq!((e.line, e.key.as_str()), (2, "depth"));
+    let deep = holewall::ensemble::variants_from_csv_text("v.csv", "depth\n1600 m\n").unwrap();
+    assert!(
+        holewall::ensemble::apply(&case, &deep[0]).is_err(),
+        "below the hole"
+    );
+}

@@ -230,7 +230,7 @@ pub fn static_result(
         name,
         &sol.log,
         &sol.iterations,
-        neutral_point(&rows).map(|md| case.bit_md - md),
+        neutral_point(&rows).map(|md| bit_md_of(case, model) - md),
         hook,
         torque,
         stabilizers,
@@ -253,10 +253,7 @@ pub fn run_static_gpu<T: crate::gpu::contact::GpuReal>(
         .map(|v| apply(case, v))
         .collect::<Result<_, _>>()
         .map_err(|e| Error::Io(std::io::Error::other(e)))?;
-    let shared = models
-        .iter()
-        .all(|m| m.sites.len() == case.model.sites.len());
-    if !shared {
+    if !models.iter().all(|m| same_mesh(case, m)) {
         return Ok(None);
     }
     let results = solve_static_ensemble_with_progress::<T, _>(
@@ -318,12 +315,9 @@ pub fn run_dynamic_gpu<T: crate::gpu::contact::GpuReal>(
         .map(|v| apply(case, v))
         .collect::<Result<_, _>>()
         .map_err(|e| Error::Io(std::io::Error::other(e)))?;
-    if models
-        .iter()
-        .any(|m| m.sites.len() != case.model.sites.len())
-    {
+    if !models.iter().all(|m| same_mesh(case, m)) {
         return Ok(Err(
-            "the variants differ in their number of contact sites".into()
+            "the variants differ in their mesh or number of contact sites".into(),
         ));
     }
     let path = GpuPath(ctx);
@@ -573,7 +567,7 @@ impl DynamicObserver {
             name,
             log,
             iterations,
-            np.map(|x| case.bit_md - x),
+            np.map(|x| bit_md_of(case, model) - x),
             axial.first().copied().unwrap_or(f64::NAN),
             self.max_torque,
             self.qoi,
@@ -659,7 +653,13 @@ fn variants_csv(
                 v.overrides
                     .iter()
                     .find(|(key, _)| &key.name == k)
-                    .map(|(_, x)| fmt(*x))
+                    .map(|(key, x)| {
+                        if x.is_finite() {
+                            key.format(*x)
+                        } else {
+                            String::new()
+                        }
+                    })
                     .unwrap_or_default(),
             );
         }
@@ -977,6 +977,9 @@ pub fn run(
             .filter_map(|(i, r)| f(r).filter(|x| x.is_finite()).map(|y| (i as f64, y)))
             .collect()
     };
+    if let Some(file) = broomstick(&case, &variants, &results, out)? {
+        outputs.push(file);
+    }
     if monte_carlo.is_none() {
         line_plot(
             &out.join("neutral_point.png"),
@@ -1420,7 +1423,7 @@ fn compute(
                 r
             }
             None => {
-                eprintln!("holewall: the variants differ in their number of contact sites; running them on the CPU");
+                eprintln!("holewall: the variants differ in their mesh or number of contact sites; running them on the CPU");
                 run_variants_cpu(case, analysis, variants, bar)
             }
         },
@@ -1563,4 +1566,81 @@ pub fn parse_shard(text: &str) -> Result<(usize, usize), Error> {
         return Err(bad());
     }
     Ok((k, n))
+}
+
+/// The bit's MD of a variant's model (its own with a `depth` key).
+fn bit_md_of(case: &Case, model: &Model) -> f64 {
+    model.nodes.last().map_or(case.bit_md, |n| n.md)
+}
+
+/// Whether a variant's model shares the case's mesh and number of contact sites (what the
+/// engine needs: a `depth` variant has a mesh of its own).
+fn same_mesh(case: &Case, m: &Model) -> bool {
+    m.sites.len() == case.model.sites.len()
+        && m.nodes.len() == case.model.nodes.len()
+        && m.nodes
+            .iter()
+            .zip(&case.model.nodes)
+            .all(|(a, b)| a.md == b.md)
+}
+
+/// The classic T&D "broomstick" when the variants vary `depth`: hook load against bit
+/// depth, one line per combination of the other keys (mode, friction, …). `None` without a
+/// `depth` key.
+fn broomstick(
+    case: &Case,
+    variants: &[Variant],
+    results: &[VariantResult],
+    out: &Path,
+) -> Result<Option<String>, Error> {
+    use crate::ensemble::Param;
+    let has_depth = |v: &Variant| v.overrides.iter().any(|(k, _)| k.param == Param::Depth);
+    if variants.is_empty() || !variants.iter().all(has_depth) {
+        return Ok(None);
+    }
+    let mut lines: Vec<(String, Vec<(f64, f64)>)> = Vec::new();
+    for (v, r) in variants.iter().zip(results) {
+        let depth = v
+            .overrides
+            .iter()
+            .find(|(k, _)| k.param == Param::Depth)
+            .map(|(_, d)| *d)
+            .unwrap_or(f64::NAN);
+        let label = v
+            .overrides
+            .iter()
+            .filter(|(k, _)| k.param != Param::Depth)
+            .map(|(k, x)| match k.param {
+                Param::Mode => k.format(*x),
+                _ => format!("{} {}", k.name, crate::plots::tick(x)),
+            })
+            .collect::<Vec<_>>()
+            .join(", ");
+        let Some(hook) = r.hook_load_n.filter(|h| h.is_finite()) else {
+            continue;
+        };
+        match lines.iter_mut().find(|(l, _)| *l == label) {
+            Some((_, pts)) => pts.push((depth, hook * 1e-3)),
+            None => lines.push((label, vec![(depth, hook * 1e-3)])),
+        }
+    }
+    for (_, pts) in &mut lines {
+        pts.sort_by(|a, b| a.0.total_cmp(&b.0));
+    }
+    let series: Vec<Series> = lines
+        .iter()
+        .map(|(l, pts)| Series {
+            name: l,
+            points: pts.clone(),
+        })
+        .collect();
+    line_plot(
+        &out.join("broomstick.png"),
+        &format!("{}: hook load against bit depth", case.title),
+        "bit depth, MD (m)",
+        "hook load (kN)",
+        &series,
+        &[],
+    )?;
+    Ok(Some("broomstick.png".into()))
 }

@@ -63,7 +63,8 @@ impl Unit {
             Param::Rpm => Unit::AngularSpeed,
             Param::Wob => Unit::Force,
             Param::Tob => Unit::Torque,
-            Param::Blade | Param::FromBit => Unit::Length,
+            Param::Blade | Param::FromBit | Param::Depth => Unit::Length,
+            Param::Mode => Unit::Ratio,
         }
     }
 }
