@@ -41,15 +41,45 @@ pub enum Backend {
     Gpu(&'static GpuContext),
 }
 
+/// What `--backend auto` optimises.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum AutoRule {
+    /// Any adapter that can run the precision (benchmarks and kernel checks, which are
+    /// there to exercise the GPU path).
+    AnyAdapter,
+    /// The faster path for results: a software renderer (lavapipe: `DeviceType::Cpu`) runs
+    /// the kernels on the same cores, slower than the CPU path, so the CPU runs them.
+    FasterPath,
+}
+
 impl Backend {
     /// Resolves `--backend` for a run at `precision`. `auto` falls back to the CPU, with a
     /// one-line notice on stderr, when no adapter exists or it cannot run `precision`.
     pub fn resolve(choice: BackendChoice, precision: Precision) -> Result<Backend, GpuError> {
+        Backend::resolve_with(
+            choice,
+            precision,
+            &[Precision::F64, Precision::F32],
+            AutoRule::AnyAdapter,
+        )
+    }
+
+    /// The one backend policy: `choice` at `precision` for a computation whose CPU path
+    /// computes in `cpu_precisions`, `auto` by `rule`. `auto` at a precision only the GPU
+    /// computes needs an adapter that has it (an error otherwise); else it falls back to
+    /// the CPU with a one-line notice.
+    pub fn resolve_with(
+        choice: BackendChoice,
+        precision: Precision,
+        cpu_precisions: &[Precision],
+        rule: AutoRule,
+    ) -> Result<Backend, GpuError> {
+        let gpu_can = |ctx: &GpuContext| precision == Precision::F32 || ctx.has_f64;
         match choice {
             BackendChoice::Cpu => Ok(Backend::Cpu),
             BackendChoice::Gpu => {
                 let ctx = GpuContext::shared()?;
-                if precision == Precision::F64 && !ctx.has_f64 {
+                if !gpu_can(ctx) {
                     return Err(GpuError::Unsupported(format!(
                         "adapter {} has no SHADER_F64; use --precision f32 or --backend cpu",
                         ctx.info.name
@@ -57,8 +87,29 @@ impl Backend {
                 }
                 Ok(Backend::Gpu(ctx))
             }
+            BackendChoice::Auto if !cpu_precisions.contains(&precision) => {
+                // Only the GPU computes at this precision, whatever the adapter.
+                let ctx = GpuContext::shared()?;
+                if !gpu_can(ctx) {
+                    return Err(GpuError::Unsupported(format!(
+                        "adapter {} cannot run {precision:?}",
+                        ctx.info.name
+                    )));
+                }
+                Ok(Backend::Gpu(ctx))
+            }
             BackendChoice::Auto => match GpuContext::shared() {
-                Ok(ctx) if precision == Precision::F32 || ctx.has_f64 => Ok(Backend::Gpu(ctx)),
+                Ok(ctx)
+                    if rule == AutoRule::FasterPath
+                        && ctx.info.device_type == wgpu::DeviceType::Cpu =>
+                {
+                    eprintln!(
+                        "holewall: the only adapter ({}) is a software renderer; using the CPU backend, which is faster there",
+                        ctx.info.name
+                    );
+                    Ok(Backend::Cpu)
+                }
+                Ok(ctx) if gpu_can(ctx) => Ok(Backend::Gpu(ctx)),
                 Ok(ctx) => {
                     eprintln!(
                         "holewall: adapter {} has no SHADER_F64; using the CPU backend",

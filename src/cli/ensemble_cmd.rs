@@ -795,29 +795,16 @@ pub fn run(
         }
     }
     // The GPU engine, where asked for (or, with auto, where a hardware adapter has f64).
-    let gpu = match backend {
-        BackendChoice::Cpu => None,
-        BackendChoice::Gpu => Some(crate::gpu::GpuContext::shared()?),
-        // f32 was asked for: only the GPU engine computes in f32, whatever the adapter.
-        BackendChoice::Auto if precision == Precision::F32 => {
-            Some(crate::gpu::GpuContext::shared()?)
-        }
-        BackendChoice::Auto => match crate::gpu::GpuContext::shared() {
-            Ok(ctx) if ctx.info.device_type == wgpu::DeviceType::Cpu => {
-                eprintln!(
-                    "holewall: the only adapter ({}) is a software renderer; running the variants on the CPU (f64), which is faster there",
-                    ctx.info.name
-                );
-                None
-            }
-            Ok(ctx) if ctx.has_f64 => Some(ctx),
-            _ => {
-                eprintln!(
-                    "holewall: no GPU adapter with f64; running the variants on the CPU (f64)"
-                );
-                None
-            }
-        },
+    // The GPU engine where asked for; `auto` takes it on a hardware adapter (the CPU
+    // backend computes in f64 only, so f32 always runs on the engine).
+    let gpu = match crate::backend::Backend::resolve_with(
+        backend,
+        precision,
+        &[Precision::F64],
+        crate::backend::AutoRule::FasterPath,
+    )? {
+        crate::backend::Backend::Gpu(ctx) => Some(ctx),
+        crate::backend::Backend::Cpu => None,
     };
     // Thresholds must name a quantity this case reports (checked before any work).
     if let Some(mc) = monte_carlo {
