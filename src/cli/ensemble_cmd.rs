@@ -41,6 +41,24 @@ pub struct StabilizerQoi {
     pub whirl_hz: Option<f64>,
 }
 
+/// Quantities of interest of the whole string.
+#[derive(Clone, Debug, Default, Serialize, Deserialize, PartialEq)]
+pub struct StringQoi {
+    /// Largest contact (side) force per unit length along the string (N/m): a site's
+    /// normal force over its node's share of the string (half of each adjacent element), so
+    /// it does not depend on the mesh; over the run for dynamics.
+    pub max_side_force_per_length_n_per_m: Option<f64>,
+    /// Where it acts (MD, m).
+    pub max_side_force_md_m: Option<f64>,
+    /// Compression beyond the sinusoidal buckling load anywhere (static).
+    pub sinusoidal_buckling: Option<bool>,
+    /// Beyond the helical buckling load (static).
+    pub helical_buckling: Option<bool>,
+    /// Stick-slip severity over the second half of a dynamic run: (max − min)/mean of the
+    /// bit's spin about the hole axis.
+    pub stick_slip_severity: Option<f64>,
+}
+
 /// How a variant ended.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
@@ -92,6 +110,9 @@ pub struct VariantResult {
     /// Largest surface torque (N·m).
     #[serde(with = "crate::output::nan_as_null")]
     pub max_surface_torque_nm: f64,
+    /// The string's other quantities (side force per length, buckling, stick-slip).
+    #[serde(default)]
+    pub string: StringQoi,
     /// Per stabilizer, nearest the bit first.
     pub stabilizers: Vec<StabilizerQoi>,
     /// Mean Newton iterations per load or time step.
@@ -162,6 +183,7 @@ fn failed(name: &str, reason: String, stabs: usize) -> VariantResult {
         neutral_point_from_bit_m: None,
         hook_load_n: None,
         max_surface_torque_nm: f64::NAN,
+        string: StringQoi::default(),
         stabilizers: vec![StabilizerQoi::default(); stabs],
         newton_iterations_per_step: f64::NAN,
         step_cuts: 0,
@@ -169,6 +191,7 @@ fn failed(name: &str, reason: String, stabs: usize) -> VariantResult {
 }
 
 /// A variant that finished: converged, or with the step cuts its solver log records.
+#[allow(clippy::too_many_arguments)]
 fn finished(
     name: &str,
     log: &[String],
@@ -177,6 +200,7 @@ fn finished(
     hook_load_n: f64,
     max_surface_torque_nm: f64,
     stabilizers: Vec<StabilizerQoi>,
+    string: StringQoi,
 ) -> VariantResult {
     let cuts = log.iter().filter(|l| l.contains("cut")).count();
     VariantResult {
@@ -191,6 +215,7 @@ fn finished(
         neutral_point_from_bit_m,
         hook_load_n: hook_load_n.is_finite().then_some(hook_load_n),
         max_surface_torque_nm,
+        string,
         stabilizers,
         newton_iterations_per_step: iterations.iter().sum::<usize>() as f64
             / iterations.len().max(1) as f64,
@@ -226,6 +251,20 @@ pub fn static_result(
             }
         })
         .collect();
+    let (per_length, md) = (0..model.sites.len())
+        .map(|k| {
+            let node = model.sites[k].node;
+            (sol.contact[k].1.max(0.0) / tributary_length(model, node), model.nodes[node].md)
+        })
+        .fold((0.0f64, f64::NAN), |m, x| if x.0 > m.0 { x } else { m });
+    let (sinusoidal, helical) = crate::cli::static_cmd::buckling(model, &rows, case);
+    let string = StringQoi {
+        max_side_force_per_length_n_per_m: Some(per_length),
+        max_side_force_md_m: md.is_finite().then_some(md),
+        sinusoidal_buckling: Some(sinusoidal),
+        helical_buckling: Some(helical),
+        stick_slip_severity: None,
+    };
     finished(
         name,
         &sol.log,
@@ -234,6 +273,7 @@ pub fn static_result(
         hook,
         torque,
         stabilizers,
+        string,
     )
 }
 
@@ -476,6 +516,10 @@ pub struct DynamicObserver {
     unwrapped: Vec<f64>,
     max_torque: f64,
     half: f64,
+    /// Largest side force per length so far, and its MD.
+    per_length: (f64, f64),
+    /// The bit's spin about its hole axis over the second half.
+    bit_spin: Vec<f64>,
 }
 
 impl DynamicObserver {
@@ -491,6 +535,8 @@ impl DynamicObserver {
             unwrapped: vec![0.0; k],
             max_torque: 0.0,
             half: 0.5 * duration,
+            per_length: (0.0, f64::NAN),
+            bit_spin: Vec::new(),
         }
     }
 
@@ -498,6 +544,27 @@ impl DynamicObserver {
     pub fn observe(&mut self, model: &Model, d: &Dynamics, st: &DynamicState) {
         self.max_torque = self.max_torque.max(element_axial(model, &st.q, 0).1.abs());
         let contact = d.contact_forces(st);
+        for (k, site) in model.sites.iter().enumerate() {
+            let node = site.node;
+            let (x, y) = lateral(model, &st.q, node);
+            let r = x.hypot(y);
+            if r > 0.0 {
+                let g = &contact[k].g;
+                let nd = &model.nodes[node];
+                let dd = sub(&st.q.x[node], &nd.position);
+                let d_t = sub(&dd, &scale(&nd.hole_axis, dot(&dd, &nd.hole_axis)));
+                let normal = dot(&[g[0], g[1], g[2]], &d_t) / r / tributary_length(model, node);
+                if normal > self.per_length.0 {
+                    self.per_length = (normal, nd.md);
+                }
+            }
+        }
+        if st.t >= self.half {
+            let n = model.nodes.len();
+            let axis = model.nodes[n - 1].hole_axis;
+            let w = [st.v[6 * (n - 1) + 3], st.v[6 * (n - 1) + 4], st.v[6 * (n - 1) + 5]];
+            self.bit_spin.push(dot(&w, &axis));
+        }
         for (j, &k) in self.stabs.iter().enumerate() {
             let node = model.sites[k].node;
             let (x, y) = lateral(model, &st.q, node);
@@ -563,6 +630,23 @@ impl DynamicObserver {
             .collect();
         let md: Vec<f64> = model.nodes.iter().map(|n| n.md).collect();
         let np = neutral_point_of(&md, &nodal_axial_forces(&axial));
+        let severity = if self.bit_spin.len() >= 2 {
+            let mean = self.bit_spin.iter().sum::<f64>() / self.bit_spin.len() as f64;
+            let (lo, hi) = self
+                .bit_spin
+                .iter()
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| (a.min(*x), b.max(*x)));
+            (mean.abs() > 1e-9).then(|| (hi - lo) / mean.abs())
+        } else {
+            None
+        };
+        let string = StringQoi {
+            max_side_force_per_length_n_per_m: Some(self.per_length.0),
+            max_side_force_md_m: self.per_length.1.is_finite().then_some(self.per_length.1),
+            sinusoidal_buckling: None,
+            helical_buckling: None,
+            stick_slip_severity: severity,
+        };
         finished(
             name,
             log,
@@ -571,6 +655,7 @@ impl DynamicObserver {
             axial.first().copied().unwrap_or(f64::NAN),
             self.max_torque,
             self.qoi,
+            string,
         )
     }
 }
@@ -611,8 +696,9 @@ fn variants_csv(
     variants: &[Variant],
     results: &[VariantResult],
     stabs: usize,
-    dynamic: bool,
+    whirl_threshold: Option<f64>,
 ) -> Result<Vec<u8>, Error> {
+    let dynamic = whirl_threshold.is_some();
     let io = |e: csv::Error| Error::Io(std::io::Error::other(e));
     let mut keys: Vec<String> = Vec::new();
     for v in variants {
@@ -632,9 +718,16 @@ fn variants_csv(
             "neutral_point_from_bit_m",
             "hook_load_n",
             "max_surface_torque_nm",
+            "max_side_force_per_length_n_per_m",
+            "max_side_force_md_m",
         ]
         .map(String::from),
     );
+    if dynamic {
+        header.push("stick_slip_severity".into());
+    } else {
+        header.extend(["sinusoidal_buckling", "helical_buckling"].map(String::from));
+    }
     for k in 1..=stabs {
         header.push(format!("stab{k}_max_side_force_n"));
         header.push(format!("stab{k}_max_lateral_m"));
@@ -676,15 +769,26 @@ fn variants_csv(
         row.push(r.neutral_point_from_bit_m.map(fmt).unwrap_or_default());
         row.push(r.hook_load_n.map(fmt).unwrap_or_default());
         row.push(fmt(r.max_surface_torque_nm));
+        let opt = |x: Option<f64>| x.map(fmt).unwrap_or_default();
+        let flag = |x: Option<bool>| x.map(|b| b.to_string()).unwrap_or_default();
+        row.push(opt(r.string.max_side_force_per_length_n_per_m));
+        row.push(opt(r.string.max_side_force_md_m));
+        if dynamic {
+            row.push(opt(r.string.stick_slip_severity));
+        } else {
+            row.push(flag(r.string.sinusoidal_buckling));
+            row.push(flag(r.string.helical_buckling));
+        }
         for q in &r.stabilizers {
             row.push(fmt(q.max_side_force_n));
             row.push(fmt(q.max_lateral_m));
             if dynamic {
                 row.push(q.whirl_hz.map(fmt).unwrap_or_default());
                 row.push(
-                    match q.whirl_hz {
-                        Some(h) if h > 0.0 => "forward",
-                        Some(h) if h < 0.0 => "backward",
+                    match (q.whirl_hz, whirl_threshold) {
+                        (Some(h), Some(t)) if h.abs() < t => "none",
+                        (Some(h), _) if h > 0.0 => "forward",
+                        (Some(h), _) if h < 0.0 => "backward",
                         _ => "",
                     }
                     .into(),
@@ -946,7 +1050,14 @@ pub fn run(
     let mut outputs = vec!["variants.csv".to_string()];
     write_atomic(
         &out.join("variants.csv"),
-        &variants_csv(&variants, &results, stabs, dynamic)?,
+        &variants_csv(
+            &variants,
+            &results,
+            stabs,
+            dynamic.then(|| {
+                whirl_threshold_hz(case.dynamics.as_ref().map_or(0.0, |d| d.duration))
+            }),
+        )?,
     )?;
     let uncertainty = match monte_carlo {
         Some(mc) => {
@@ -1092,7 +1203,26 @@ pub fn qoi_columns(
         col("max_surface_torque_nm".into(), Unit::Torque, &|r| {
             Some(r.max_surface_torque_nm)
         }),
+        col(
+            "max_side_force_per_length_n_per_m".into(),
+            Unit::ForcePerLength,
+            &|r| r.string.max_side_force_per_length_n_per_m,
+        ),
     ];
+    // Flags as 0/1: their mean is the probability (e.g. that the string buckles).
+    let as_number = |b: Option<bool>| b.map(|b| if b { 1.0 } else { 0.0 });
+    if dynamic {
+        q.push(col("stick_slip_severity".into(), Unit::Ratio, &|r| {
+            r.string.stick_slip_severity
+        }));
+    } else {
+        q.push(col("sinusoidal_buckling".into(), Unit::Ratio, &|r| {
+            as_number(r.string.sinusoidal_buckling)
+        }));
+        q.push(col("helical_buckling".into(), Unit::Ratio, &|r| {
+            as_number(r.string.helical_buckling)
+        }));
+    }
     for k in 0..stabs {
         q.push(col(
             format!("stab{}_max_side_force_n", k + 1),
@@ -1630,4 +1760,23 @@ fn broomstick(
         &[],
     )?;
     Ok(Some("broomstick.png".into()))
+}
+
+/// A node's share of the string: half of each element beside it (m).
+fn tributary_length(model: &Model, node: usize) -> f64 {
+    let n = model.nodes.len();
+    let mut l = 0.0;
+    if node > 0 {
+        l += 0.5 * model.elements[node - 1].length0;
+    }
+    if node + 1 < n {
+        l += 0.5 * model.elements[node].length0;
+    }
+    l.max(1e-9)
+}
+
+/// A whirl slower than one orbit over the fit window (the second half of the run) is no
+/// whirl: `None` direction below this frequency (Hz).
+pub fn whirl_threshold_hz(duration: f64) -> f64 {
+    1.0 / (0.5 * duration).max(1e-9)
 }

@@ -116,7 +116,9 @@ pub fn nodal_axial_forces(element_axial: &[f64]) -> Vec<f64> {
         .collect()
 }
 
-fn buckling(model: &Model, rows: &[ProfileRow], case: &Case) -> (bool, bool) {
+/// Sinusoidal and helical buckling flags of a static profile: compression beyond the larger of
+/// Dawson–Paslay and Lubinski (sinusoidal), beyond √2 of it (helical), anywhere.
+pub fn buckling(model: &Model, rows: &[ProfileRow], case: &Case) -> (bool, bool) {
     let mut sinusoidal = false;
     let mut helical = false;
     for (i, e) in model.elements.iter().enumerate() {

@@ -21,6 +21,8 @@ pub enum Unit {
     Force,
     /// N·m, shown in kN·m.
     Torque,
+    /// N/m, shown in kN/m.
+    ForcePerLength,
     /// m.
     Length,
     /// Hz.
@@ -43,6 +45,7 @@ impl Unit {
         match self {
             Unit::Force => (1e-3, "kN"),
             Unit::Torque => (1e-3, "kN·m"),
+            Unit::ForcePerLength => (1e-3, "kN/m"),
             Unit::Length => (1.0, "m"),
             Unit::Frequency => (1.0, "Hz"),
             Unit::Ratio => (1.0, "–"),
