@@ -254,7 +254,10 @@ pub fn static_result(
     let (per_length, md) = (0..model.sites.len())
         .map(|k| {
             let node = model.sites[k].node;
-            (sol.contact[k].1.max(0.0) / tributary_length(model, node), model.nodes[node].md)
+            (
+                sol.contact[k].1.max(0.0) / tributary_length(model, node),
+                model.nodes[node].md,
+            )
         })
         .fold((0.0f64, f64::NAN), |m, x| if x.0 > m.0 { x } else { m });
     let (sinusoidal, helical) = crate::cli::static_cmd::buckling(model, &rows, case);
@@ -562,7 +565,11 @@ impl DynamicObserver {
         if st.t >= self.half {
             let n = model.nodes.len();
             let axis = model.nodes[n - 1].hole_axis;
-            let w = [st.v[6 * (n - 1) + 3], st.v[6 * (n - 1) + 4], st.v[6 * (n - 1) + 5]];
+            let w = [
+                st.v[6 * (n - 1) + 3],
+                st.v[6 * (n - 1) + 4],
+                st.v[6 * (n - 1) + 5],
+            ];
             self.bit_spin.push(dot(&w, &axis));
         }
         for (j, &k) in self.stabs.iter().enumerate() {
@@ -635,7 +642,9 @@ impl DynamicObserver {
             let (lo, hi) = self
                 .bit_spin
                 .iter()
-                .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| (a.min(*x), b.max(*x)));
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| {
+                    (a.min(*x), b.max(*x))
+                });
             (mean.abs() > 1e-9).then(|| (hi - lo) / mean.abs())
         } else {
             None
@@ -1054,9 +1063,7 @@ pub fn run(
             &variants,
             &results,
             stabs,
-            dynamic.then(|| {
-                whirl_threshold_hz(case.dynamics.as_ref().map_or(0.0, |d| d.duration))
-            }),
+            dynamic.then(|| whirl_threshold_hz(case.dynamics.as_ref().map_or(0.0, |d| d.duration))),
         )?,
     )?;
     let uncertainty = match monte_carlo {
