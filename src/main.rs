@@ -97,6 +97,10 @@ enum Command {
         /// `--exceed stab1_max_side_force_n=20000`.
         #[arg(long)]
         exceed: Vec<String>,
+        /// First-order and total Sobol indices (a Saltelli design: --samples base points,
+        /// samples × (inputs + 2) runs; needs --sampling sobol).
+        #[arg(long)]
+        sobol_indices: bool,
         /// Variants per result chunk (each written atomically; a killed run resumes from
         /// its chunks when started again with the same command).
         #[arg(long, default_value_t = cli::ensemble_cmd::DEFAULT_CHUNK)]
@@ -300,16 +304,22 @@ fn main() -> ExitCode {
             sampling,
             percentile,
             exceed,
+            sobol_indices,
             chunk_size,
             shard,
             force,
         } => {
-            let mc =
-                match cli::ensemble_cmd::monte_carlo(samples, seed, sampling, &percentile, &exceed)
-                {
-                    Ok(mc) => mc,
-                    Err(e) => return fail(&[e]),
-                };
+            let mc = match cli::ensemble_cmd::monte_carlo(
+                samples,
+                seed,
+                sampling,
+                &percentile,
+                &exceed,
+                sobol_indices,
+            ) {
+                Ok(mc) => mc,
+                Err(e) => return fail(&[e]),
+            };
             let shard = match shard
                 .as_deref()
                 .map(cli::ensemble_cmd::parse_shard)

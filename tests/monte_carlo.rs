@@ -38,6 +38,7 @@ fn mc_run(
         Sampling::Lhs,
         &[95.0],
         &["stab1_max_side_force_n=10000".to_string()],
+        false,
     )
     .unwrap();
     run(&case(), None, backend, precision, out, false, &opts(mc)).unwrap()
@@ -159,7 +160,7 @@ fn uncertain_table_errors_name_file_line_and_key() {
         let path = dir.join("bad.toml");
         std::fs::write(&path, bad_text).unwrap();
         let out = dir.join("out");
-        let mc = monte_carlo(Some(4), 1, Sampling::Random, &[], &[]).unwrap();
+        let mc = monte_carlo(Some(4), 1, Sampling::Random, &[], &[], false).unwrap();
         let e = run(
             &path,
             None,
@@ -186,7 +187,7 @@ fn uncertain_table_errors_name_file_line_and_key() {
     );
     let path = dir.join("wide.toml");
     std::fs::write(&path, wide).unwrap();
-    let mc = monte_carlo(Some(50), 1, Sampling::Random, &[], &[]).unwrap();
+    let mc = monte_carlo(Some(50), 1, Sampling::Random, &[], &[], false).unwrap();
     let e = run(
         &path,
         None,
@@ -199,10 +200,10 @@ fn uncertain_table_errors_name_file_line_and_key() {
     .unwrap_err();
     assert!(e.to_string().contains("truncate"), "{e}");
     // Command-line errors.
-    assert!(monte_carlo(None, 1, Sampling::Lhs, &[95.0], &[]).is_err());
-    assert!(monte_carlo(Some(10), 1, Sampling::Lhs, &[120.0], &[]).is_err());
-    assert!(monte_carlo(Some(10), 1, Sampling::Lhs, &[], &["x".into()]).is_err());
-    let mc = monte_carlo(Some(4), 1, Sampling::Lhs, &[], &["nope=1".into()]).unwrap();
+    assert!(monte_carlo(None, 1, Sampling::Lhs, &[95.0], &[], false).is_err());
+    assert!(monte_carlo(Some(10), 1, Sampling::Lhs, &[120.0], &[], false).is_err());
+    assert!(monte_carlo(Some(10), 1, Sampling::Lhs, &[], &["x".into()], false).is_err());
+    let mc = monte_carlo(Some(4), 1, Sampling::Lhs, &[], &["nope=1".into()], false).unwrap();
     let e = run(
         &case(),
         None,
@@ -306,4 +307,45 @@ fn broomstick_of_the_shipped_case() {
         holewall::ensemble::apply(&case, &deep[0]).is_err(),
         "below the hole"
     );
+}
+
+#[test]
+fn sobol_indices_of_the_shipped_case() {
+    // 32 base points × (4 inputs + 2) = 192 runs: friction drives the surface torque, the
+    // weight on bit the hook load — by their total indices too.
+    let mc = monte_carlo(Some(32), 1, Sampling::Sobol, &[], &[], true).unwrap();
+    let out = tmp("sobol");
+    let s = run(
+        &case(),
+        None,
+        BackendChoice::Cpu,
+        Precision::F64,
+        &out,
+        false,
+        &opts(mc),
+    )
+    .unwrap();
+    assert_eq!(s.variants, 192);
+    let u = s.uncertainty.unwrap();
+    assert_eq!(u.base_samples, 64);
+    let top = |name: &str| {
+        let q = u.qois.iter().find(|q| q.name == name).unwrap();
+        let sob = q.sobol.as_ref().unwrap();
+        for x in sob {
+            eprintln!(
+                "{name}: {} S {:.3} S_T {:.3} [{:.3}, {:.3}]",
+                x.input, x.first, x.total, x.total_ci95.0, x.total_ci95.1
+            );
+        }
+        sob.iter()
+            .max_by(|a, b| a.total.total_cmp(&b.total))
+            .unwrap()
+            .input
+            .clone()
+    };
+    assert_eq!(top("max_surface_torque_nm"), "mu");
+    assert_eq!(top("hook_load_n"), "wob");
+    assert!(s.outputs.iter().any(|o| o == "sobol_hook_load_n.png"));
+    // --sobol-indices without Sobol sampling is refused.
+    assert!(monte_carlo(Some(32), 1, Sampling::Lhs, &[], &[], true).is_err());
 }

@@ -846,7 +846,13 @@ pub fn run(
                 .as_ref()
                 .map(|s| s.uncertain.clone())
                 .unwrap_or_default();
-            crate::uq::sample_variants(&uncertain, mc.samples, mc.seed, mc.sampling)
+            crate::uq::sample_variants(
+                &uncertain,
+                mc.samples,
+                mc.seed,
+                mc.sampling,
+                mc.sobol_indices,
+            )
                 .map_err(|m| cli_error("ensemble.uncertain", m))?
         }
         None => match crate::ensemble::case_variants(&case, variants_file)? {
@@ -1291,6 +1297,7 @@ pub fn monte_carlo(
     sampling: crate::uq::Sampling,
     percentiles: &[f64],
     exceed: &[String],
+    sobol_indices: bool,
 ) -> Result<Option<crate::uq::report::MonteCarlo>, Error> {
     let err = |key: &str, message: String| -> Error {
         InputError {
@@ -1312,6 +1319,12 @@ pub fn monte_carlo(
     };
     if samples == 0 {
         return Err(err("--samples", "at least 1".into()));
+    }
+    if sobol_indices && sampling != crate::uq::Sampling::Sobol {
+        return Err(err(
+            "--sobol-indices",
+            "needs --sampling sobol (the Saltelli design is built on Sobol points)".into(),
+        ));
     }
     if let Some(p) = percentiles.iter().find(|p| !(0.0..=100.0).contains(*p)) {
         return Err(err("--percentile", format!("{p} is outside 0 … 100")));
@@ -1337,6 +1350,7 @@ pub fn monte_carlo(
         sampling,
         percentiles: percentiles.to_vec(),
         thresholds,
+        sobol_indices,
     }))
 }
 

@@ -19,11 +19,16 @@ use crate::ensemble::{Key, Variant};
 /// input's quantile function. Sample `i` is the same whatever `n`'s other samples, the
 /// chunking or the machine (for `random`; `lhs` and `sobol` depend on `n` as a whole). A
 /// sampled value outside the key's allowed range is an error naming it.
+///
+/// With `sobol_indices` the points are a Saltelli design for `n` base samples
+/// ([`sensitivity::saltelli_design`]): `n (d + 2)` variants, the first `2n` of them
+/// independent samples of the inputs (`A` and `B`), the rest `A` with one input from `B`.
 pub fn sample_variants(
     uncertain: &[(Key, Distribution)],
     n: usize,
     seed: u64,
     sampling: Sampling,
+    sobol_indices: bool,
 ) -> Result<Vec<Variant>, String> {
     if uncertain.is_empty() {
         return Err("no uncertain inputs: add an [ensemble.uncertain] table".into());
@@ -31,8 +36,15 @@ pub fn sample_variants(
     if n == 0 {
         return Err("--samples must be at least 1".into());
     }
-    let u = unit_samples(n, uncertain.len(), seed, sampling)?;
-    let width = n.to_string().len().max(5);
+    let u = if sobol_indices {
+        if sampling != Sampling::Sobol {
+            return Err("Sobol indices need --sampling sobol (the Saltelli design is built on Sobol points)".into());
+        }
+        sensitivity::saltelli_design(n, uncertain.len(), seed)?
+    } else {
+        unit_samples(n, uncertain.len(), seed, sampling)?
+    };
+    let width = u.len().to_string().len().max(5);
     u.iter()
         .enumerate()
         .map(|(i, p)| {

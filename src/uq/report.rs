@@ -85,6 +85,10 @@ pub struct MonteCarlo {
     pub percentiles: Vec<f64>,
     /// Exceedance thresholds: (quantity name, value in SI).
     pub thresholds: Vec<(String, f64)>,
+    /// First-order and total Sobol indices from a Saltelli design (`samples` base points,
+    /// `samples (d + 2)` runs; `--sobol-indices`, with `--sampling sobol`).
+    #[serde(default)]
+    pub sobol_indices: bool,
 }
 
 /// One quantity of interest over the samples (NaN where a sample has no value).
@@ -109,6 +113,8 @@ pub struct QoiReport {
     pub stats: Option<QoiStats>,
     /// Spearman and PRCC with each input.
     pub sensitivity: Vec<InputSensitivity>,
+    /// First-order and total Sobol indices with their 95 % intervals (`--sobol-indices`).
+    pub sobol: Option<Vec<super::sensitivity::SobolIndex>>,
 }
 
 /// The uncertainty part of `summary.json`.
@@ -124,6 +130,8 @@ pub struct UncertaintyReport {
     pub inputs: Vec<String>,
     /// Samples that failed (excluded from every statistic; listed in `failures`).
     pub failed: usize,
+    /// Runs the statistics use: every run, or the 2n independent ones of a Saltelli design.
+    pub base_samples: usize,
     /// Per quantity.
     pub qois: Vec<QoiReport>,
 }
@@ -136,13 +144,21 @@ pub fn analyse(
     failed: &[bool],
 ) -> UncertaintyReport {
     let names: Vec<String> = inputs.iter().map(|(k, _)| k.name.clone()).collect();
-    let cols: Vec<Vec<f64>> = inputs.iter().map(|(_, v)| v.clone()).collect();
+    // With a Saltelli design the statistics and rank correlations use its independent
+    // samples, A and B (the first 2n runs); the indices use every run.
+    let base = if mc.sobol_indices {
+        (2 * mc.samples).min(failed.len())
+    } else {
+        failed.len()
+    };
+    let cols: Vec<Vec<f64>> = inputs.iter().map(|(_, v)| v[..base].to_vec()).collect();
     UncertaintyReport {
         samples: mc.samples,
         seed: mc.seed,
         sampling: mc.sampling,
         inputs: names.clone(),
         failed: failed.iter().filter(|f| **f).count(),
+        base_samples: base,
         qois: qois
             .iter()
             .map(|q| {
@@ -158,14 +174,20 @@ pub fn analyse(
                     .filter(|(n, _)| n == &q.name)
                     .map(|(_, t)| *t)
                     .collect();
+                let sample = &values[..base];
                 QoiReport {
                     name: q.name.clone(),
                     unit: q.unit,
-                    stats: qoi_stats(&values, &mc.percentiles, &thresholds),
-                    sensitivity: if values.iter().filter(|v| v.is_finite()).count() > 2 {
-                        sensitivities(&names, &cols, &values)
+                    stats: qoi_stats(sample, &mc.percentiles, &thresholds),
+                    sensitivity: if sample.iter().filter(|v| v.is_finite()).count() > 2 {
+                        sensitivities(&names, &cols, sample)
                     } else {
                         Vec::new()
+                    },
+                    sobol: if mc.sobol_indices {
+                        super::sensitivity::sobol_indices(&names, &values, mc.samples, mc.seed)
+                    } else {
+                        None
                     },
                 }
             })
@@ -183,12 +205,13 @@ pub fn plot(
 ) -> std::io::Result<Vec<String>> {
     use crate::plots::{histogram, scatter, tornado};
     let mut files = Vec::new();
+    let base = report.base_samples;
     for (q, r) in qois.iter().zip(&report.qois) {
         let Some(s) = &r.stats else { continue };
         let (scale, unit) = q.unit.display();
         let label = format!("{} ({unit})", q.name);
         let file = format!("hist_{}.png", q.name);
-        let shown: Vec<f64> = q.values.iter().map(|v| v * scale).collect();
+        let shown: Vec<f64> = q.values[..base].iter().map(|v| v * scale).collect();
         histogram(
             &dir.join(&file),
             &format!("{title}: {} over {} samples", q.name, s.n),
@@ -203,9 +226,9 @@ pub fn plot(
         files.push(file);
         for ((key, x), sens) in inputs.iter().zip(&r.sensitivity) {
             let (xs, xu) = Unit::of_key(key).display();
-            let points: Vec<(f64, f64)> = x
+            let points: Vec<(f64, f64)> = x[..base]
                 .iter()
-                .zip(&q.values)
+                .zip(&q.values[..base])
                 .map(|(a, b)| (a * xs, b * scale))
                 .collect();
             let file = format!("scatter_{}_vs_{}.png", q.name, key.name);
@@ -230,6 +253,19 @@ pub fn plot(
                 &r.sensitivity
                     .iter()
                     .map(|s| (s.input.clone(), s.prcc))
+                    .collect::<Vec<_>>(),
+            )?;
+            files.push(file);
+        }
+        if let Some(sobol) = &r.sobol {
+            let file = format!("sobol_{}.png", q.name);
+            tornado(
+                &dir.join(&file),
+                &format!("{title}: total Sobol indices of {}", q.name),
+                "total Sobol index S_T (share of the variance with its interactions)",
+                &sobol
+                    .iter()
+                    .map(|s| (s.input.clone(), s.total))
                     .collect::<Vec<_>>(),
             )?;
             files.push(file);
