@@ -244,6 +244,8 @@ pub struct EnsembleSpec {
     pub series: Option<Vec<String>>,
     /// Key → distribution of an uncertain input (`holewall ensemble --samples N`).
     pub uncertain: Option<std::collections::BTreeMap<String, Spanned<UncertainSpec>>>,
+    /// Rank correlations between uncertain inputs: `[["mu", "wob", 0.5], …]`.
+    pub correlation: Option<Spanned<Vec<(String, String, f64)>>>,
 }
 
 /// `[ensemble.uncertain]` entry: the distribution of one variant key, values in SI or
@@ -302,6 +304,8 @@ pub struct EnsembleSettings {
     pub series: Vec<String>,
     /// Uncertain inputs: (key, distribution), in key order (`[ensemble.uncertain]`).
     pub uncertain: Vec<(crate::ensemble::Key, crate::uq::Distribution)>,
+    /// Their rank correlation matrix (identity unless `ensemble.correlation` is given).
+    pub correlation: Option<nalgebra::DMatrix<f64>>,
 }
 
 /// A case read and checked, ready to build a model.
@@ -1077,11 +1081,44 @@ fn ensemble_settings(
             uncertain_distribution(&key, spec.get_ref()).map_err(err)?,
         ));
     }
+    let correlation = match &e.correlation {
+        None => None,
+        Some(pairs) => {
+            let err = |m: String| ctx.err(pairs.span(), "ensemble.correlation", m);
+            let d = uncertain.len();
+            let mut c = nalgebra::DMatrix::identity(d, d);
+            let index = |name: &str| {
+                uncertain
+                    .iter()
+                    .position(|(k, _)| k.name == name)
+                    .ok_or_else(|| err(format!("{name:?} is not in [ensemble.uncertain]")))
+            };
+            for (a, b, rho) in pairs.get_ref() {
+                let (i, j) = (index(a)?, index(b)?);
+                if i == j {
+                    return Err(err(format!("{a:?} with itself")));
+                }
+                if !(rho.is_finite() && rho.abs() < 1.0) {
+                    return Err(err(format!("{a} with {b}: {rho} is outside (−1, 1)")));
+                }
+                c[(i, j)] = *rho;
+                c[(j, i)] = *rho;
+            }
+            if c.clone().cholesky().is_none() {
+                return Err(err(
+                    "the correlations are inconsistent (the matrix is not positive definite)"
+                        .into(),
+                ));
+            }
+            Some(c)
+        }
+    };
     Ok(EnsembleSettings {
         analysis,
         grid,
         series: e.series.clone().unwrap_or_default(),
         uncertain,
+        correlation,
     })
 }
 

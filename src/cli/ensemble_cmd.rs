@@ -846,12 +846,14 @@ pub fn run(
                 .as_ref()
                 .map(|s| s.uncertain.clone())
                 .unwrap_or_default();
+            let correlation = settings.as_ref().and_then(|s| s.correlation.clone());
             crate::uq::sample_variants(
                 &uncertain,
                 mc.samples,
                 mc.seed,
                 mc.sampling,
                 mc.sobol_indices,
+                correlation.as_ref(),
             )
                 .map_err(|m| cli_error("ensemble.uncertain", m))?
         }

@@ -29,6 +29,7 @@ pub fn sample_variants(
     seed: u64,
     sampling: Sampling,
     sobol_indices: bool,
+    correlation: Option<&nalgebra::DMatrix<f64>>,
 ) -> Result<Vec<Variant>, String> {
     if uncertain.is_empty() {
         return Err("no uncertain inputs: add an [ensemble.uncertain] table".into());
@@ -36,7 +37,7 @@ pub fn sample_variants(
     if n == 0 {
         return Err("--samples must be at least 1".into());
     }
-    let u = if sobol_indices {
+    let mut u = if sobol_indices {
         if sampling != Sampling::Sobol {
             return Err("Sobol indices need --sampling sobol (the Saltelli design is built on Sobol points)".into());
         }
@@ -44,6 +45,12 @@ pub fn sample_variants(
     } else {
         unit_samples(n, uncertain.len(), seed, sampling)?
     };
+    if let Some(c) = correlation {
+        if sampling == Sampling::Sobol {
+            return Err("ensemble.correlation reorders the samples, which breaks Sobol points' structure: use --sampling lhs or random".into());
+        }
+        sampling::iman_conover(&mut u, c, seed)?;
+    }
     let width = u.len().to_string().len().max(5);
     u.iter()
         .enumerate()
