@@ -103,7 +103,7 @@ enum Command {
         sobol_indices: bool,
         /// Variants per result chunk (each written atomically; a killed run resumes from
         /// its chunks when started again with the same command).
-        #[arg(long, default_value_t = cli::ensemble_cmd::DEFAULT_CHUNK)]
+        #[arg(long, default_value_t = holewall::ensemble::store::DEFAULT_CHUNK)]
         chunk_size: usize,
         /// Run only the K-th of N slices of the variants (`holewall merge` joins them).
         #[arg(long)]
@@ -328,13 +328,13 @@ fn main() -> ExitCode {
                 Ok(s) => s,
                 Err(e) => return fail(&[e]),
             };
-            let options = cli::ensemble_cmd::EnsembleOptions {
+            let options = holewall::ensemble::store::EnsembleOptions {
                 monte_carlo: mc,
                 chunk_size,
                 shard,
                 force,
             };
-            print_summary(cli::ensemble_cmd::run(
+            print_summary(holewall::ensemble::job::run(
                 &case,
                 variants.as_deref(),
                 backend,
@@ -345,7 +345,7 @@ fn main() -> ExitCode {
             ))
         }
         Command::Merge { out, dirs, quiet } => {
-            print_summary(cli::ensemble_cmd::merge(&out, &dirs, !quiet))
+            print_summary(holewall::ensemble::job::merge(&out, &dirs, !quiet))
         }
         Command::GpuInfo { pairs } => match cli::gpu_info::run(pairs) {
             Ok(()) => ExitCode::SUCCESS,

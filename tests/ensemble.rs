@@ -6,7 +6,9 @@ mod common;
 
 use holewall::backend::{BackendChoice, Precision};
 use holewall::case::{parse_case, Analysis};
-use holewall::cli::ensemble_cmd::{run, run_variants_cpu, static_variant, Status};
+use holewall::ensemble::job::run;
+use holewall::ensemble::qoi::{static_variant, Status};
+use holewall::ensemble::runner::run_variants_cpu;
 use holewall::ensemble::{apply, variants_from_csv_text};
 
 /// The 60 m test bed of `tests/extreme.rs` with Table 1 values, written out.

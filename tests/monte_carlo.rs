@@ -5,7 +5,10 @@
 mod common;
 
 use holewall::backend::{BackendChoice, Precision};
-use holewall::cli::ensemble_cmd::{monte_carlo, run, EnsembleOptions, EnsembleSummary};
+use holewall::cli::ensemble_cmd::monte_carlo;
+use holewall::ensemble::job::run;
+use holewall::ensemble::report::EnsembleSummary;
+use holewall::ensemble::store::EnsembleOptions;
 use holewall::uq::Sampling;
 
 fn tmp(name: &str) -> std::path::PathBuf {
@@ -295,7 +298,7 @@ fn broomstick_of_the_shipped_case() {
     assert_eq!(m.axial_speed, single.model.axial_speed);
     assert_eq!(m.nodes.last().unwrap().md, 1000.0);
     let sol2 = holewall::solve::statics::solve_static(&m, &Default::default()).unwrap();
-    let r = holewall::cli::ensemble_cmd::static_result(&case, "v", &m, &sol2);
+    let r = holewall::ensemble::qoi::static_result(&case, "v", &m, &sol2);
     assert_eq!(r.hook_load_n.unwrap(), via);
     // Bad modes and depths are refused with file, line and key.
     let e = holewall::ensemble::variants_from_csv_text("v.csv", "mode\nspinning\n").unwrap_err();

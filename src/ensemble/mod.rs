@@ -23,6 +23,12 @@
 //! Stabilizers are numbered from the bit up (`stab1` nearest the bit); a key without
 //! `.stabK` applies to every contact site.
 
+pub mod job;
+pub mod qoi;
+pub mod report;
+pub mod runner;
+pub mod store;
+
 use std::path::Path;
 
 use crate::case::Case;

@@ -1,0 +1,481 @@
+//! `holewall ensemble` and `holewall merge` as library calls: variants (CSV, grid or
+//! Monte Carlo samples) → checked output folder → chunks (resumable, shardable) → outputs,
+//! `summary.json` last.
+
+use std::path::Path;
+
+use super::qoi::*;
+use super::report::*;
+use super::runner::*;
+use super::store::*;
+use crate::backend::{BackendChoice, Precision};
+use crate::case::{load_case, Analysis};
+use crate::ensemble::{apply, stabilizer_sites};
+use crate::error::{Error, InputError};
+use crate::output::write_atomic;
+use crate::plots::{line_plot, Series};
+
+/// Runs the command.
+pub fn run(
+    case_path: &Path,
+    variants_file: Option<&Path>,
+    backend: BackendChoice,
+    precision: Precision,
+    out: &Path,
+    show_progress: bool,
+    options: &EnsembleOptions,
+) -> Result<EnsembleSummary, Error> {
+    let monte_carlo = options.monte_carlo.as_ref();
+    let case = load_case(case_path)?;
+    let settings = case.ensemble.clone();
+    let cli_error = |key: &str, message: String| -> Error {
+        InputError {
+            source_name: case_path.display().to_string(),
+            line: 0,
+            key: key.into(),
+            message,
+        }
+        .into()
+    };
+    let variants = match monte_carlo {
+        Some(mc) => {
+            if variants_file.is_some() {
+                return Err(cli_error(
+                    "--samples",
+                    "give --variants FILE or --samples N, not both".into(),
+                ));
+            }
+            let uncertain = settings
+                .as_ref()
+                .map(|s| s.uncertain.clone())
+                .unwrap_or_default();
+            let correlation = settings.as_ref().and_then(|s| s.correlation.clone());
+            crate::uq::sample_variants(
+                &uncertain,
+                mc.samples,
+                mc.seed,
+                mc.sampling,
+                mc.sobol_indices,
+                correlation.as_ref(),
+            )
+                .map_err(|m| cli_error("ensemble.uncertain", m))?
+        }
+        None => match crate::ensemble::case_variants(&case, variants_file)? {
+            Some(v) => v,
+            None => {
+                return Err(InputError {
+                    source_name: case_path.display().to_string(),
+                    line: 1,
+                    key: "ensemble.grid".into(),
+                    message:
+                        "no variants: give --variants FILE, an [ensemble.grid] table, or --samples N with an [ensemble.uncertain] table"
+                            .into(),
+                }
+                .into())
+            }
+        },
+    };
+    let analysis = settings
+        .as_ref()
+        .map(|s| s.analysis)
+        .unwrap_or(Analysis::Static);
+    let series: Vec<String> = settings
+        .as_ref()
+        .map(|s| s.series.clone())
+        .unwrap_or_default();
+    for name in &series {
+        if !variants.iter().any(|v| &v.name == name) {
+            return Err(InputError {
+                source_name: case_path.display().to_string(),
+                line: 1,
+                key: "ensemble.series".into(),
+                message: format!("no variant named {name:?}"),
+            }
+            .into());
+        }
+        if analysis == Analysis::Static {
+            return Err(InputError {
+                source_name: case_path.display().to_string(),
+                line: 1,
+                key: "ensemble.series".into(),
+                message: "time series need analysis = \"dynamic\"".into(),
+            }
+            .into());
+        }
+    }
+    if precision == Precision::F32 {
+        let why = match (backend, analysis) {
+            (BackendChoice::Cpu, _) => Some("the CPU backend computes in f64 (it is the oracle the GPU is tested against); f32 runs on --backend gpu or auto"),
+            _ => None,
+        };
+        if let Some(message) = why {
+            return Err(InputError {
+                source_name: "--precision".into(),
+                line: 0,
+                key: "precision".into(),
+                message: message.into(),
+            }
+            .into());
+        }
+    }
+    // The GPU engine, where asked for (or, with auto, where a hardware adapter has f64).
+    // The GPU engine where asked for; `auto` takes it on a hardware adapter (the CPU
+    // backend computes in f64 only, so f32 always runs on the engine).
+    let gpu = match crate::backend::Backend::resolve_with(
+        backend,
+        precision,
+        &[Precision::F64],
+        crate::backend::AutoRule::FasterPath,
+    )? {
+        crate::backend::Backend::Gpu(ctx) => Some(ctx),
+        crate::backend::Backend::Cpu => None,
+    };
+    // Thresholds must name a quantity this case reports (checked before any work).
+    if let Some(mc) = monte_carlo {
+        let names: Vec<String> = qoi_columns(
+            &[],
+            stabilizer_sites(&case.model).len(),
+            analysis == Analysis::Dynamic,
+        )
+        .into_iter()
+        .map(|q| q.name)
+        .collect();
+        for (name, _) in &mc.thresholds {
+            if !names.contains(name) {
+                return Err(InputError {
+                    source_name: "--exceed".into(),
+                    line: 0,
+                    key: name.clone(),
+                    message: format!("no quantity {name:?}; allowed: {}", names.join(", ")),
+                }
+                .into());
+            }
+        }
+    }
+    // Check every variant against the case before any work.
+    for v in &variants {
+        if let Err(e) = apply(&case, v) {
+            return Err(InputError {
+                source_name: variants_file
+                    .map(|p| p.display().to_string())
+                    .unwrap_or_else(|| case_path.display().to_string()),
+                line: 0,
+                key: format!("variant {}", v.name),
+                message: e,
+            }
+            .into());
+        }
+    }
+    // The output folder, checked (and the run's manifest written) before any work.
+    let chunk_size = if options.chunk_size == 0 {
+        DEFAULT_CHUNK
+    } else {
+        options.chunk_size
+    };
+    let manifest = Manifest::new(
+        case_path,
+        variants_file,
+        backend,
+        precision,
+        options,
+        chunk_size,
+        variants.len(),
+    )?;
+    prepare_out(out, &manifest, options.force)?;
+    let nchunks = manifest.chunks;
+    let range = match options.shard {
+        Some((k, n)) => (k - 1) * nchunks / n..k * nchunks / n,
+        None => 0..nchunks,
+    };
+    let chunk_of = |c: usize| c * chunk_size..((c + 1) * chunk_size).min(variants.len());
+    let in_range: usize = range.clone().map(|c| chunk_of(c).len()).sum();
+    let bar = if show_progress {
+        indicatif::ProgressBar::new(in_range as u64)
+    } else {
+        indicatif::ProgressBar::hidden()
+    };
+    bar.set_style(
+        indicatif::ProgressStyle::with_template(
+            "{bar:40} {pos}/{len} variants, {elapsed} elapsed, eta {eta}",
+        )
+        .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+    );
+    for c in range.clone() {
+        let path = chunk_path(out, c);
+        if path.exists() {
+            bar.inc(chunk_of(c).len() as u64);
+            continue;
+        }
+        let start = std::time::Instant::now();
+        let slice = &variants[chunk_of(c)];
+        let before = bar.position();
+        let (results, backend_name) = compute(&case, analysis, slice, gpu, precision, &bar)?;
+        bar.set_position(before + slice.len() as u64);
+        let chunk = Chunk {
+            first: chunk_of(c).start,
+            backend: backend_name.to_string(),
+            seconds: start.elapsed().as_secs_f64(),
+            results,
+        };
+        let text = serde_json::to_vec(&chunk).map_err(|e| Error::Io(std::io::Error::other(e)))?;
+        write_atomic(&path, &text)?;
+    }
+    bar.finish_and_clear();
+    if let Some((k, n)) = options.shard {
+        return Ok(EnsembleSummary {
+            title: case.title.clone(),
+            analysis: format!("{analysis:?}").to_lowercase(),
+            backend: format!("{backend:?}").to_lowercase(),
+            precision: format!("{precision:?}").to_lowercase(),
+            variants: in_range,
+            converged: 0,
+            step_cut: 0,
+            failed: 0,
+            failures: Vec::new(),
+            solved_by_engine: 0,
+            solved_by_cpu: 0,
+            seconds: 0.0,
+            uncertainty: None,
+            outputs: vec![format!(
+                "shard {k}/{n}: chunks {}..{} in {}/chunks; `holewall merge` gives the whole run",
+                range.start,
+                range.end,
+                out.display()
+            )],
+        });
+    }
+    // Every chunk, read back (so a resumed or merged run has exactly these bits).
+    let mut results = Vec::with_capacity(variants.len());
+    let mut backend_name = "cpu";
+    let mut seconds = 0.0;
+    for c in 0..nchunks {
+        let chunk = read_chunk(&chunk_path(out, c))?;
+        if chunk.first != chunk_of(c).start || chunk.results.len() != chunk_of(c).len() {
+            return Err(Error::Io(std::io::Error::other(format!(
+                "{}: holds variants {}.. ({}), not the chunk's {:?}",
+                chunk_path(out, c).display(),
+                chunk.first,
+                chunk.results.len(),
+                chunk_of(c)
+            ))));
+        }
+        if chunk.backend == "gpu" {
+            backend_name = "gpu";
+        }
+        seconds += chunk.seconds;
+        results.extend(chunk.results);
+    }
+    let stabs = stabilizer_sites(&case.model).len();
+    let dynamic = analysis == Analysis::Dynamic;
+    let mut outputs = vec!["variants.csv".to_string()];
+    write_atomic(
+        &out.join("variants.csv"),
+        &variants_csv(
+            &variants,
+            &results,
+            stabs,
+            dynamic.then(|| whirl_threshold_hz(case.dynamics.as_ref().map_or(0.0, |d| d.duration))),
+        )?,
+    )?;
+    let uncertainty = match monte_carlo {
+        Some(mc) => {
+            let (report, files) =
+                uncertainty_report(mc, &case, &variants, &results, stabs, dynamic, out)?;
+            outputs.extend(files);
+            Some(report)
+        }
+        None => None,
+    };
+    let idx = |f: &dyn Fn(&VariantResult) -> Option<f64>| -> Vec<(f64, f64)> {
+        results
+            .iter()
+            .enumerate()
+            .filter_map(|(i, r)| f(r).filter(|x| x.is_finite()).map(|y| (i as f64, y)))
+            .collect()
+    };
+    if let Some(file) = broomstick(&case, &variants, &results, out)? {
+        outputs.push(file);
+    }
+    if monte_carlo.is_none() {
+        line_plot(
+            &out.join("neutral_point.png"),
+            &format!("{}: neutral point over the variants", case.title),
+            "variant",
+            "neutral point from the bit (m)",
+            &[Series {
+                name: "neutral point",
+                points: idx(&|r| r.neutral_point_from_bit_m),
+            }],
+            &[],
+        )?;
+        outputs.push("neutral_point.png".into());
+        let names: Vec<String> = (1..=stabs).map(|k| format!("stab{k}")).collect();
+        // One line per stabilizer of a per-stabilizer quantity over the variants.
+        let per_stabilizer = |file: &str,
+                              title: &str,
+                              y_label: &str,
+                              f: &dyn Fn(&StabilizerQoi) -> Option<f64>|
+         -> Result<(), Error> {
+            let series: Vec<Series> = (0..stabs)
+                .map(|k| Series {
+                    name: &names[k],
+                    points: idx(&|r| r.stabilizers.get(k).and_then(f)),
+                })
+                .collect();
+            line_plot(
+                &out.join(file),
+                &format!("{}: {title}", case.title),
+                "variant",
+                y_label,
+                &series,
+                &[],
+            )?;
+            Ok(())
+        };
+        per_stabilizer(
+            "side_force.png",
+            "largest side force per stabilizer",
+            "side force (N)",
+            &|q| Some(q.max_side_force_n),
+        )?;
+        outputs.push("side_force.png".into());
+        if dynamic {
+            per_stabilizer(
+                "whirl.png",
+                "whirl frequency (+ forward, − backward)",
+                "whirl (Hz)",
+                &|q| q.whirl_hz,
+            )?;
+            outputs.push("whirl.png".into());
+        }
+        for name in &series {
+            let v = variants
+                .iter()
+                .find(|v| &v.name == name)
+                .ok_or_else(|| Error::Io(std::io::Error::other(format!("no variant {name}"))))?;
+            let mut c = case.clone();
+            c.model = apply(&case, v).map_err(|e| Error::Io(std::io::Error::other(e)))?;
+            let dir = out.join("series").join(name);
+            crate::cli::run_cmd::run_case(&c, &dir, false)?;
+            outputs.push(format!("series/{name}/"));
+        }
+    }
+    let count = |s: Status| results.iter().filter(|r| r.status == s).count();
+    let summary = EnsembleSummary {
+        title: case.title.clone(),
+        analysis: if dynamic { "dynamic" } else { "static" }.into(),
+        backend: backend_name.into(),
+        precision: if backend_name == "gpu" && precision == Precision::F32 {
+            "f32"
+        } else {
+            "f64"
+        }
+        .into(),
+        variants: variants.len(),
+        converged: count(Status::Converged),
+        step_cut: count(Status::StepCut),
+        failed: count(Status::Failed),
+        failures: results
+            .iter()
+            .filter(|r| r.status == Status::Failed)
+            .map(|r| (r.name.clone(), r.reason.clone()))
+            .collect(),
+        solved_by_engine: results
+            .iter()
+            .filter(|r| r.status != Status::Failed && r.solved_by == SolvedBy::Engine)
+            .count(),
+        solved_by_cpu: results
+            .iter()
+            .filter(|r| r.status != Status::Failed && r.solved_by == SolvedBy::Cpu)
+            .count(),
+        seconds,
+        uncertainty,
+        outputs,
+    };
+    write_atomic(
+        &out.join("summary.json"),
+        serde_json::to_string_pretty(&summary)
+            .unwrap_or_default()
+            .as_bytes(),
+    )?;
+    Ok(summary)
+}
+
+/// `holewall merge`: the shards in `dirs` (one run's `--shard K/N` folders, every K once)
+/// into `out`, which then holds exactly what the run without shards would write.
+pub fn merge(
+    out: &Path,
+    dirs: &[std::path::PathBuf],
+    show_progress: bool,
+) -> Result<EnsembleSummary, Error> {
+    let read = |d: &std::path::PathBuf| -> Result<Manifest, Error> {
+        let p = d.join("run.json");
+        let t = std::fs::read(&p)
+            .map_err(|e| out_error(d, format!("no run.json ({e}): not a holewall run folder")))?;
+        serde_json::from_slice(&t).map_err(|e| out_error(d, format!("run.json: {e}")))
+    };
+    let manifests = dirs.iter().map(read).collect::<Result<Vec<_>, Error>>()?;
+    let first = manifests
+        .first()
+        .ok_or_else(|| out_error(out, "no shard folders given".into()))?;
+    let n = match first.shard {
+        Some((_, n)) => n,
+        None => return Err(out_error(&dirs[0], "is a whole run, not a shard".into())),
+    };
+    let mut seen = vec![false; n];
+    for (d, m) in dirs.iter().zip(&manifests) {
+        if m.identity != first.identity {
+            return Err(out_error(
+                d,
+                format!(
+                    "is a shard of another run (identity {} against {})",
+                    m.identity, first.identity
+                ),
+            ));
+        }
+        match m.shard {
+            Some((k, nn)) if nn == n && (1..=n).contains(&k) && !seen[k - 1] => seen[k - 1] = true,
+            other => {
+                return Err(out_error(
+                    d,
+                    format!("shard {other:?} does not fit {n} shards given once each"),
+                ))
+            }
+        }
+    }
+    if let Some(k) = seen.iter().position(|s| !s) {
+        return Err(out_error(out, format!("shard {}/{n} is missing", k + 1)));
+    }
+    let mut whole = first.clone();
+    whole.shard = None;
+    prepare_out(out, &whole, false)?;
+    for (d, m) in dirs.iter().zip(&manifests) {
+        let (k, _) = m.shard.unwrap_or((1, 1));
+        for c in (k - 1) * whole.chunks / n..k * whole.chunks / n {
+            let from = chunk_path(d, c);
+            if !from.exists() {
+                return Err(out_error(
+                    d,
+                    format!("chunk {c} is missing: the shard did not finish; run it again"),
+                ));
+            }
+            let text = std::fs::read(&from)?;
+            write_atomic(&chunk_path(out, c), &text)?;
+        }
+    }
+    let options = EnsembleOptions {
+        monte_carlo: whole.monte_carlo.clone(),
+        chunk_size: whole.chunk_size,
+        shard: None,
+        force: false,
+    };
+    run(
+        &whole.case,
+        whole.variants_file.as_deref(),
+        whole.backend,
+        whole.precision,
+        out,
+        show_progress,
+        &options,
+    )
+}

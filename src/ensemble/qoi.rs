@@ -1,0 +1,516 @@
+//! Quantities of interest of a variant (issues 5 and 14): neutral point, hook load, surface
+//! torque, per stabilizer the largest side force, lateral displacement and whirl, the
+//! string's side force per length, buckling flags and stick-slip severity — from a static
+//! solution or observed along a dynamic run — and their columns for statistics.
+
+use serde::{Deserialize, Serialize};
+
+use crate::case::Case;
+use crate::cli::static_cmd::{fe_rows, neutral_point, neutral_point_of, nodal_axial_forces};
+use crate::ensemble::stabilizer_sites;
+use crate::model::Model;
+use crate::physics::vec3::{dot, scale, sub};
+use crate::solve::dynamics::{DynamicState, Dynamics};
+use crate::solve::statics::{solve_static, StaticOptions};
+
+/// Per-stabilizer quantities of interest.
+#[derive(Clone, Debug, Default, Serialize, Deserialize, PartialEq)]
+pub struct StabilizerQoi {
+    /// Largest normal (side) force (N).
+    #[serde(with = "crate::output::nan_as_null")]
+    pub max_side_force_n: f64,
+    /// Largest lateral displacement from the hole axis (m).
+    #[serde(with = "crate::output::nan_as_null")]
+    pub max_lateral_m: f64,
+    /// Whirl frequency over the second half of a dynamic run (Hz), signed: + forward (with
+    /// the rotation), − backward; `None` for static runs or a stabilizer that stays put.
+    pub whirl_hz: Option<f64>,
+}
+
+/// Quantities of interest of the whole string.
+#[derive(Clone, Debug, Default, Serialize, Deserialize, PartialEq)]
+pub struct StringQoi {
+    /// Largest contact (side) force per unit length along the string (N/m): a site's
+    /// normal force over its node's share of the string (half of each adjacent element), so
+    /// it does not depend on the mesh; over the run for dynamics.
+    pub max_side_force_per_length_n_per_m: Option<f64>,
+    /// Where it acts (MD, m).
+    pub max_side_force_md_m: Option<f64>,
+    /// Compression beyond the sinusoidal buckling load anywhere (static).
+    pub sinusoidal_buckling: Option<bool>,
+    /// Beyond the helical buckling load (static).
+    pub helical_buckling: Option<bool>,
+    /// Stick-slip severity over the second half of a dynamic run: (max − min)/mean of the
+    /// bit's spin about the hole axis.
+    pub stick_slip_severity: Option<f64>,
+}
+
+/// How a variant ended.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Status {
+    /// Converged at the requested steps.
+    Converged,
+    /// Converged, with load or time steps cut on the way (see the reason column).
+    StepCut,
+    /// Failed (NaN, Newton divergence, step below the minimum): see the reason.
+    Failed,
+}
+
+/// Which solver produced a variant's result.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SolvedBy {
+    /// The kernel engine (GPU, or the CPU twins of its kernels).
+    Engine,
+    /// The CPU solver (the CPU backend, or a re-run of a variant the engine failed).
+    Cpu,
+}
+
+impl SolvedBy {
+    /// The name in `variants.csv`.
+    pub fn name(self) -> &'static str {
+        match self {
+            SolvedBy::Engine => "engine",
+            SolvedBy::Cpu => "cpu",
+        }
+    }
+}
+
+/// One variant's result.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct VariantResult {
+    /// Variant name.
+    pub name: String,
+    /// Status.
+    pub status: Status,
+    /// Who solved it (a CPU re-run of an engine failure says so in `reason`).
+    pub solved_by: SolvedBy,
+    /// Why it failed, or the first step cut.
+    pub reason: String,
+    /// Neutral point from the bit (m): static solution, or the last state of a dynamic run.
+    pub neutral_point_from_bit_m: Option<f64>,
+    /// Hook load (N): the top's axial reaction of a static solution; for a dynamic run the
+    /// top element's axial force in the last state.
+    pub hook_load_n: Option<f64>,
+    /// Largest surface torque (N·m).
+    #[serde(with = "crate::output::nan_as_null")]
+    pub max_surface_torque_nm: f64,
+    /// The string's other quantities (side force per length, buckling, stick-slip).
+    #[serde(default)]
+    pub string: StringQoi,
+    /// Per stabilizer, nearest the bit first.
+    pub stabilizers: Vec<StabilizerQoi>,
+    /// Mean Newton iterations per load or time step.
+    #[serde(with = "crate::output::nan_as_null")]
+    pub newton_iterations_per_step: f64,
+    /// Step cuts.
+    pub step_cuts: usize,
+}
+
+pub(crate) fn element_axial(
+    model: &Model,
+    q: &crate::solve::statics::StaticState,
+    i: usize,
+) -> (f64, f64) {
+    let f = crate::solve::statics::element_section_forces(model, q, i);
+    (f.axial, f.torque)
+}
+
+/// Lateral offset of a site's node from the hole axis, in the node's frame (x, y).
+pub(crate) fn lateral(
+    model: &Model,
+    q: &crate::solve::statics::StaticState,
+    node: usize,
+) -> (f64, f64) {
+    let nd = &model.nodes[node];
+    let d = sub(&q.x[node], &nd.position);
+    let d_t = sub(&d, &scale(&nd.hole_axis, dot(&d, &nd.hole_axis)));
+    let f = &nd.frame0;
+    (
+        dot(&d_t, &[f[0][1], f[1][1], f[2][1]]),
+        dot(&d_t, &[f[0][2], f[1][2], f[2][2]]),
+    )
+}
+
+pub(crate) fn failed(name: &str, reason: String, stabs: usize) -> VariantResult {
+    VariantResult {
+        name: name.to_string(),
+        status: Status::Failed,
+        solved_by: SolvedBy::Cpu,
+        reason,
+        neutral_point_from_bit_m: None,
+        hook_load_n: None,
+        max_surface_torque_nm: f64::NAN,
+        string: StringQoi::default(),
+        stabilizers: vec![StabilizerQoi::default(); stabs],
+        newton_iterations_per_step: f64::NAN,
+        step_cuts: 0,
+    }
+}
+
+/// A variant that finished: converged, or with the step cuts its solver log records.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn finished(
+    name: &str,
+    log: &[String],
+    iterations: &[usize],
+    neutral_point_from_bit_m: Option<f64>,
+    hook_load_n: f64,
+    max_surface_torque_nm: f64,
+    stabilizers: Vec<StabilizerQoi>,
+    string: StringQoi,
+) -> VariantResult {
+    let cuts = log.iter().filter(|l| l.contains("cut")).count();
+    VariantResult {
+        name: name.to_string(),
+        status: if cuts > 0 {
+            Status::StepCut
+        } else {
+            Status::Converged
+        },
+        solved_by: SolvedBy::Cpu,
+        reason: log.first().cloned().unwrap_or_default(),
+        neutral_point_from_bit_m,
+        hook_load_n: hook_load_n.is_finite().then_some(hook_load_n),
+        max_surface_torque_nm,
+        string,
+        stabilizers,
+        newton_iterations_per_step: iterations.iter().sum::<usize>() as f64
+            / iterations.len().max(1) as f64,
+        step_cuts: cuts,
+    }
+}
+
+/// Static equilibrium of one variant's model.
+pub fn static_variant(case: &Case, name: &str, model: &Model) -> VariantResult {
+    match solve_static(model, &StaticOptions::default()) {
+        Ok(sol) => static_result(case, name, model, &sol),
+        Err(e) => failed(name, e.to_string(), stabilizer_sites(model).len()),
+    }
+}
+
+/// Quantities of interest of a converged static solution.
+pub fn static_result(
+    case: &Case,
+    name: &str,
+    model: &Model,
+    sol: &crate::solve::statics::StaticSolution,
+) -> VariantResult {
+    let stabs = stabilizer_sites(model);
+    let (rows, hook, torque, _wob) = fe_rows(model, sol);
+    let stabilizers = stabs
+        .iter()
+        .map(|&k| {
+            let (x, y) = lateral(model, &sol.state, model.sites[k].node);
+            StabilizerQoi {
+                max_side_force_n: sol.contact[k].1.max(0.0),
+                max_lateral_m: x.hypot(y),
+                whirl_hz: None,
+            }
+        })
+        .collect();
+    let (per_length, md) = (0..model.sites.len())
+        .map(|k| {
+            let node = model.sites[k].node;
+            (
+                sol.contact[k].1.max(0.0) / tributary_length(model, node),
+                model.nodes[node].md,
+            )
+        })
+        .fold((0.0f64, f64::NAN), |m, x| if x.0 > m.0 { x } else { m });
+    let (sinusoidal, helical) = crate::cli::static_cmd::buckling(model, &rows, case);
+    let string = StringQoi {
+        max_side_force_per_length_n_per_m: Some(per_length),
+        max_side_force_md_m: md.is_finite().then_some(md),
+        sinusoidal_buckling: Some(sinusoidal),
+        helical_buckling: Some(helical),
+        stick_slip_severity: None,
+    };
+    finished(
+        name,
+        &sol.log,
+        &sol.iterations,
+        neutral_point(&rows).map(|md| bit_md_of(case, model) - md),
+        hook,
+        torque,
+        stabilizers,
+        string,
+    )
+}
+
+/// The `[dynamics]` run of one variant's model from its static equilibrium.
+pub fn dynamic_variant(case: &Case, name: &str, model: &Model) -> VariantResult {
+    let stabs = stabilizer_sites(model);
+    let Some(settings) = case.dynamics.clone() else {
+        return failed(name, "no [dynamics] table".into(), stabs.len());
+    };
+    let start = match solve_static(model, &StaticOptions::default()) {
+        Ok(s) => s,
+        Err(e) => return failed(name, format!("static start: {e}"), stabs.len()),
+    };
+    let options = crate::cli::run_cmd::options_for(&settings);
+    let density = &case.element_density;
+    let mut dynamics = Dynamics::new(model, options, &|e| density[e]);
+    let mut s = match dynamics.initial_state(start.state) {
+        Ok(s) => s,
+        Err(e) => return failed(name, format!("initial state: {e}"), stabs.len()),
+    };
+    let mut observer = DynamicObserver::new(model, settings.duration);
+    let mut observe = |d: &Dynamics, st: &DynamicState| observer.observe(model, d, st);
+    observe(&dynamics, &s);
+    let result = dynamics.run(&mut s, settings.duration, &mut observe);
+    let cuts = dynamics.log.iter().filter(|l| l.contains("cut to")).count();
+    if let Err(reason) = result {
+        let mut f = failed(name, reason, stabs.len());
+        f.step_cuts = cuts;
+        return f;
+    }
+    observer.finish(case, name, model, &s, &dynamics.log, &dynamics.iterations)
+}
+
+/// The quantities of interest of a dynamic run, accumulated step by step (the CPU
+/// integrator's and the GPU engine's runs feed the same observer).
+pub struct DynamicObserver {
+    stabs: Vec<usize>,
+    qoi: Vec<StabilizerQoi>,
+    angles: Vec<Vec<(f64, f64)>>,
+    last_angle: Vec<Option<f64>>,
+    unwrapped: Vec<f64>,
+    max_torque: f64,
+    half: f64,
+    /// Largest side force per length so far, and its MD.
+    per_length: (f64, f64),
+    /// The bit's spin about its hole axis over the second half.
+    bit_spin: Vec<f64>,
+}
+
+impl DynamicObserver {
+    /// For a run of `duration` seconds (whirl is fitted over its second half).
+    pub fn new(model: &Model, duration: f64) -> Self {
+        let stabs = stabilizer_sites(model);
+        let k = stabs.len();
+        DynamicObserver {
+            stabs,
+            qoi: vec![StabilizerQoi::default(); k],
+            angles: vec![Vec::new(); k],
+            last_angle: vec![None; k],
+            unwrapped: vec![0.0; k],
+            max_torque: 0.0,
+            half: 0.5 * duration,
+            per_length: (0.0, f64::NAN),
+            bit_spin: Vec::new(),
+        }
+    }
+
+    /// Takes one state in.
+    pub fn observe(&mut self, model: &Model, d: &Dynamics, st: &DynamicState) {
+        self.max_torque = self.max_torque.max(element_axial(model, &st.q, 0).1.abs());
+        let contact = d.contact_forces(st);
+        for (k, site) in model.sites.iter().enumerate() {
+            let node = site.node;
+            let (x, y) = lateral(model, &st.q, node);
+            let r = x.hypot(y);
+            if r > 0.0 {
+                let g = &contact[k].g;
+                let nd = &model.nodes[node];
+                let dd = sub(&st.q.x[node], &nd.position);
+                let d_t = sub(&dd, &scale(&nd.hole_axis, dot(&dd, &nd.hole_axis)));
+                let normal = dot(&[g[0], g[1], g[2]], &d_t) / r / tributary_length(model, node);
+                if normal > self.per_length.0 {
+                    self.per_length = (normal, nd.md);
+                }
+            }
+        }
+        if st.t >= self.half {
+            let n = model.nodes.len();
+            let axis = model.nodes[n - 1].hole_axis;
+            let w = [
+                st.v[6 * (n - 1) + 3],
+                st.v[6 * (n - 1) + 4],
+                st.v[6 * (n - 1) + 5],
+            ];
+            self.bit_spin.push(dot(&w, &axis));
+        }
+        for (j, &k) in self.stabs.iter().enumerate() {
+            let node = model.sites[k].node;
+            let (x, y) = lateral(model, &st.q, node);
+            let r = x.hypot(y);
+            let qoi = &mut self.qoi[j];
+            qoi.max_lateral_m = qoi.max_lateral_m.max(r);
+            if r > 0.0 {
+                let g = &contact[k].g;
+                let nd = &model.nodes[node];
+                let d = sub(&st.q.x[node], &nd.position);
+                let d_t = sub(&d, &scale(&nd.hole_axis, dot(&d, &nd.hole_axis)));
+                let normal = dot(&[g[0], g[1], g[2]], &d_t) / r;
+                qoi.max_side_force_n = qoi.max_side_force_n.max(normal);
+            }
+            let a = y.atan2(x);
+            if let Some(l) = self.last_angle[j] {
+                let mut da = a - l;
+                da -= std::f64::consts::TAU * (da / std::f64::consts::TAU).round();
+                self.unwrapped[j] += da;
+            }
+            self.last_angle[j] = Some(a);
+            if st.t >= self.half && r > 1e-6 {
+                self.angles[j].push((st.t, self.unwrapped[j]));
+            }
+        }
+    }
+
+    /// The variant's result from its final state.
+    pub fn finish(
+        mut self,
+        case: &Case,
+        name: &str,
+        model: &Model,
+        last: &DynamicState,
+        log: &[String],
+        iterations: &[usize],
+    ) -> VariantResult {
+        if last.v.iter().any(|x| !x.is_finite()) {
+            return failed(name, "state is not finite".into(), self.stabs.len());
+        }
+        let sign = if model.rotation_speed < 0.0 {
+            -1.0
+        } else {
+            1.0
+        };
+        for (j, pts) in self.angles.iter().enumerate() {
+            if pts.len() >= 3 {
+                let nm = pts.len() as f64;
+                let (mt, ma) = pts
+                    .iter()
+                    .fold((0.0, 0.0), |(a, b), (t, x)| (a + t / nm, b + x / nm));
+                let den: f64 = pts.iter().map(|(t, _)| (t - mt).powi(2)).sum();
+                if den > 0.0 {
+                    let rate = pts.iter().map(|(t, x)| (t - mt) * (x - ma)).sum::<f64>() / den;
+                    // Lateral angles are measured about the node's frame0 (e2, e3) = about
+                    // the hole axis, the direction of a positive rotation speed.
+                    self.qoi[j].whirl_hz = Some(sign * rate / std::f64::consts::TAU);
+                }
+            }
+        }
+        let axial: Vec<f64> = (0..model.elements.len())
+            .map(|i| element_axial(model, &last.q, i).0)
+            .collect();
+        let md: Vec<f64> = model.nodes.iter().map(|n| n.md).collect();
+        let np = neutral_point_of(&md, &nodal_axial_forces(&axial));
+        let severity = if self.bit_spin.len() >= 2 {
+            let mean = self.bit_spin.iter().sum::<f64>() / self.bit_spin.len() as f64;
+            let (lo, hi) = self
+                .bit_spin
+                .iter()
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| {
+                    (a.min(*x), b.max(*x))
+                });
+            (mean.abs() > 1e-9).then(|| (hi - lo) / mean.abs())
+        } else {
+            None
+        };
+        let string = StringQoi {
+            max_side_force_per_length_n_per_m: Some(self.per_length.0),
+            max_side_force_md_m: self.per_length.1.is_finite().then_some(self.per_length.1),
+            sinusoidal_buckling: None,
+            helical_buckling: None,
+            stick_slip_severity: severity,
+        };
+        finished(
+            name,
+            log,
+            iterations,
+            np.map(|x| bit_md_of(case, model) - x),
+            axial.first().copied().unwrap_or(f64::NAN),
+            self.max_torque,
+            self.qoi,
+            string,
+        )
+    }
+}
+
+/// The quantities of interest of every variant as columns (NaN where a variant has none).
+pub fn qoi_columns(
+    results: &[VariantResult],
+    stabs: usize,
+    dynamic: bool,
+) -> Vec<crate::uq::report::Qoi> {
+    use crate::uq::report::{Qoi, Unit};
+    let col = |name: String, unit: Unit, f: &dyn Fn(&VariantResult) -> Option<f64>| Qoi {
+        name,
+        unit,
+        values: results.iter().map(|r| f(r).unwrap_or(f64::NAN)).collect(),
+    };
+    let mut q = vec![
+        col("neutral_point_from_bit_m".into(), Unit::Length, &|r| {
+            r.neutral_point_from_bit_m
+        }),
+        col("hook_load_n".into(), Unit::Force, &|r| r.hook_load_n),
+        col("max_surface_torque_nm".into(), Unit::Torque, &|r| {
+            Some(r.max_surface_torque_nm)
+        }),
+        col(
+            "max_side_force_per_length_n_per_m".into(),
+            Unit::ForcePerLength,
+            &|r| r.string.max_side_force_per_length_n_per_m,
+        ),
+    ];
+    // Flags as 0/1: their mean is the probability (e.g. that the string buckles).
+    let as_number = |b: Option<bool>| b.map(|b| if b { 1.0 } else { 0.0 });
+    if dynamic {
+        q.push(col("stick_slip_severity".into(), Unit::Ratio, &|r| {
+            r.string.stick_slip_severity
+        }));
+    } else {
+        q.push(col("sinusoidal_buckling".into(), Unit::Ratio, &|r| {
+            as_number(r.string.sinusoidal_buckling)
+        }));
+        q.push(col("helical_buckling".into(), Unit::Ratio, &|r| {
+            as_number(r.string.helical_buckling)
+        }));
+    }
+    for k in 0..stabs {
+        q.push(col(
+            format!("stab{}_max_side_force_n", k + 1),
+            Unit::Force,
+            &|r| r.stabilizers.get(k).map(|s| s.max_side_force_n),
+        ));
+        q.push(col(
+            format!("stab{}_max_lateral_m", k + 1),
+            Unit::Length,
+            &|r| r.stabilizers.get(k).map(|s| s.max_lateral_m),
+        ));
+        if dynamic {
+            q.push(col(
+                format!("stab{}_whirl_hz", k + 1),
+                Unit::Frequency,
+                &|r| r.stabilizers.get(k).and_then(|s| s.whirl_hz),
+            ));
+        }
+    }
+    q
+}
+
+/// The bit's MD of a variant's model (its own with a `depth` key).
+pub(crate) fn bit_md_of(case: &Case, model: &Model) -> f64 {
+    model.nodes.last().map_or(case.bit_md, |n| n.md)
+}
+
+/// A node's share of the string: half of each element beside it (m).
+pub(crate) fn tributary_length(model: &Model, node: usize) -> f64 {
+    let n = model.nodes.len();
+    let mut l = 0.0;
+    if node > 0 {
+        l += 0.5 * model.elements[node - 1].length0;
+    }
+    if node + 1 < n {
+        l += 0.5 * model.elements[node].length0;
+    }
+    l.max(1e-9)
+}
+
+/// A whirl slower than one orbit over the fit window (the second half of the run) is no
+/// whirl: `None` direction below this frequency (Hz).
+pub fn whirl_threshold_hz(duration: f64) -> f64 {
+    1.0 / (0.5 * duration).max(1e-9)
+}

@@ -1,0 +1,258 @@
+//! A finished run's outputs: `variants.csv`, the Monte Carlo statistics and plots, the
+//! broomstick, and `summary.json`'s shape.
+
+use std::path::Path;
+
+use serde::Serialize;
+
+use super::qoi::*;
+use crate::case::Case;
+use crate::ensemble::Variant;
+use crate::error::Error;
+use crate::plots::{line_plot, Series};
+
+/// The command's summary.
+#[derive(Clone, Debug, Serialize)]
+pub struct EnsembleSummary {
+    /// Case title.
+    pub title: String,
+    /// `static` or `dynamic`.
+    pub analysis: String,
+    /// Where it ran.
+    pub backend: String,
+    /// Float type of the engine (`f64`, or `f32` on the GPU); failed f32 variants re-run
+    /// on the CPU in f64.
+    pub precision: String,
+    /// Variants run.
+    pub variants: usize,
+    /// Converged without cuts.
+    pub converged: usize,
+    /// Converged with step cuts.
+    pub step_cut: usize,
+    /// Failed.
+    pub failed: usize,
+    /// Names and reasons of the failed variants.
+    pub failures: Vec<(String, String)>,
+    /// Variants the kernel engine solved.
+    pub solved_by_engine: usize,
+    /// Variants the CPU solved: all of them on the CPU backend; on the GPU backend, the
+    /// engine's failures re-run there (each one's reason gives the engine's failure).
+    pub solved_by_cpu: usize,
+    /// Wall time of the variant runs (s).
+    pub seconds: f64,
+    /// Statistics and sensitivities of the quantities of interest (`--samples` runs).
+    pub uncertainty: Option<crate::uq::report::UncertaintyReport>,
+    /// Files written.
+    pub outputs: Vec<String>,
+}
+
+pub(crate) fn fmt(x: f64) -> String {
+    if x.is_finite() {
+        format!("{x}")
+    } else {
+        String::new()
+    }
+}
+
+pub(crate) fn variants_csv(
+    variants: &[Variant],
+    results: &[VariantResult],
+    stabs: usize,
+    whirl_threshold: Option<f64>,
+) -> Result<Vec<u8>, Error> {
+    let dynamic = whirl_threshold.is_some();
+    let io = |e: csv::Error| Error::Io(std::io::Error::other(e));
+    let mut keys: Vec<String> = Vec::new();
+    for v in variants {
+        for (k, _) in &v.overrides {
+            if !keys.contains(&k.name) {
+                keys.push(k.name.clone());
+            }
+        }
+    }
+    let mut header: Vec<String> = vec!["index".into(), "name".into()];
+    header.extend(keys.iter().cloned());
+    header.extend(
+        [
+            "status",
+            "solved_by",
+            "reason",
+            "neutral_point_from_bit_m",
+            "hook_load_n",
+            "max_surface_torque_nm",
+            "max_side_force_per_length_n_per_m",
+            "max_side_force_md_m",
+        ]
+        .map(String::from),
+    );
+    if dynamic {
+        header.push("stick_slip_severity".into());
+    } else {
+        header.extend(["sinusoidal_buckling", "helical_buckling"].map(String::from));
+    }
+    for k in 1..=stabs {
+        header.push(format!("stab{k}_max_side_force_n"));
+        header.push(format!("stab{k}_max_lateral_m"));
+        if dynamic {
+            header.push(format!("stab{k}_whirl_hz"));
+            header.push(format!("stab{k}_whirl"));
+        }
+    }
+    header.extend(["newton_iterations_per_step", "step_cuts"].map(String::from));
+    let mut w = csv::Writer::from_writer(Vec::new());
+    w.write_record(&header).map_err(io)?;
+    for (i, (v, r)) in variants.iter().zip(results).enumerate() {
+        let mut row = vec![i.to_string(), v.name.clone()];
+        for k in &keys {
+            row.push(
+                v.overrides
+                    .iter()
+                    .find(|(key, _)| &key.name == k)
+                    .map(|(key, x)| {
+                        if x.is_finite() {
+                            key.format(*x)
+                        } else {
+                            String::new()
+                        }
+                    })
+                    .unwrap_or_default(),
+            );
+        }
+        row.push(
+            match r.status {
+                Status::Converged => "converged",
+                Status::StepCut => "step_cut",
+                Status::Failed => "failed",
+            }
+            .into(),
+        );
+        row.push(r.solved_by.name().into());
+        row.push(r.reason.clone());
+        row.push(r.neutral_point_from_bit_m.map(fmt).unwrap_or_default());
+        row.push(r.hook_load_n.map(fmt).unwrap_or_default());
+        row.push(fmt(r.max_surface_torque_nm));
+        let opt = |x: Option<f64>| x.map(fmt).unwrap_or_default();
+        let flag = |x: Option<bool>| x.map(|b| b.to_string()).unwrap_or_default();
+        row.push(opt(r.string.max_side_force_per_length_n_per_m));
+        row.push(opt(r.string.max_side_force_md_m));
+        if dynamic {
+            row.push(opt(r.string.stick_slip_severity));
+        } else {
+            row.push(flag(r.string.sinusoidal_buckling));
+            row.push(flag(r.string.helical_buckling));
+        }
+        for q in &r.stabilizers {
+            row.push(fmt(q.max_side_force_n));
+            row.push(fmt(q.max_lateral_m));
+            if dynamic {
+                row.push(q.whirl_hz.map(fmt).unwrap_or_default());
+                row.push(
+                    match (q.whirl_hz, whirl_threshold) {
+                        (Some(h), Some(t)) if h.abs() < t => "none",
+                        (Some(h), _) if h > 0.0 => "forward",
+                        (Some(h), _) if h < 0.0 => "backward",
+                        _ => "",
+                    }
+                    .into(),
+                );
+            }
+        }
+        row.push(fmt(r.newton_iterations_per_step));
+        row.push(r.step_cuts.to_string());
+        w.write_record(&row).map_err(io)?;
+    }
+    w.into_inner()
+        .map_err(|e| Error::Io(std::io::Error::other(e.to_string())))
+}
+
+/// Statistics, sensitivities and plots of a `--samples` run.
+pub(crate) fn uncertainty_report(
+    mc: &crate::uq::report::MonteCarlo,
+    case: &Case,
+    variants: &[Variant],
+    results: &[VariantResult],
+    stabs: usize,
+    dynamic: bool,
+    out: &Path,
+) -> Result<(crate::uq::report::UncertaintyReport, Vec<String>), Error> {
+    let qois = qoi_columns(results, stabs, dynamic);
+    let keys: Vec<crate::ensemble::Key> = variants
+        .first()
+        .map(|v| v.overrides.iter().map(|(k, _)| k.clone()).collect())
+        .unwrap_or_default();
+    let inputs: Vec<(crate::ensemble::Key, Vec<f64>)> = keys
+        .iter()
+        .enumerate()
+        .map(|(k, key)| {
+            (
+                key.clone(),
+                variants.iter().map(|v| v.overrides[k].1).collect(),
+            )
+        })
+        .collect();
+    let failed: Vec<bool> = results.iter().map(|r| r.status == Status::Failed).collect();
+    let report = crate::uq::report::analyse(mc, &inputs, &qois, &failed);
+    let files = crate::uq::report::plot(&report, &inputs, &qois, out, &case.title)?;
+    Ok((report, files))
+}
+
+/// The classic T&D "broomstick" when the variants vary `depth`: hook load against bit
+/// depth, one line per combination of the other keys (mode, friction, …). `None` without a
+/// `depth` key.
+pub(crate) fn broomstick(
+    case: &Case,
+    variants: &[Variant],
+    results: &[VariantResult],
+    out: &Path,
+) -> Result<Option<String>, Error> {
+    use crate::ensemble::Param;
+    let has_depth = |v: &Variant| v.overrides.iter().any(|(k, _)| k.param == Param::Depth);
+    if variants.is_empty() || !variants.iter().all(has_depth) {
+        return Ok(None);
+    }
+    let mut lines: Vec<(String, Vec<(f64, f64)>)> = Vec::new();
+    for (v, r) in variants.iter().zip(results) {
+        let depth = v
+            .overrides
+            .iter()
+            .find(|(k, _)| k.param == Param::Depth)
+            .map(|(_, d)| *d)
+            .unwrap_or(f64::NAN);
+        let label = v
+            .overrides
+            .iter()
+            .filter(|(k, _)| k.param != Param::Depth)
+            .map(|(k, x)| match k.param {
+                Param::Mode => k.format(*x),
+                _ => format!("{} {}", k.name, crate::plots::tick(x)),
+            })
+            .collect::<Vec<_>>()
+            .join(", ");
+        let Some(hook) = r.hook_load_n.filter(|h| h.is_finite()) else {
+            continue;
+        };
+        match lines.iter_mut().find(|(l, _)| *l == label) {
+            Some((_, pts)) => pts.push((depth, hook * 1e-3)),
+            None => lines.push((label, vec![(depth, hook * 1e-3)])),
+        }
+    }
+    for (_, pts) in &mut lines {
+        pts.sort_by(|a, b| a.0.total_cmp(&b.0));
+    }
+    let series: Vec<Series> = lines
+        .iter()
+        .map(|(l, pts)| Series {
+            name: l,
+            points: pts.clone(),
+        })
+        .collect();
+    line_plot(
+        &out.join("broomstick.png"),
+        &format!("{}: hook load against bit depth", case.title),
+        "bit depth, MD (m)",
+        "hook load (kN)",
+        &series,
+        &[],
+    )?;
+    Ok(Some("broomstick.png".into()))
+}

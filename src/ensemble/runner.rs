@@ -1,0 +1,313 @@
+//! Running variants: the CPU solvers (rayon over variants, f64) or the kernel engine (GPU,
+//! f64 or f32; a variant it fails is re-run on the CPU and says so). The backend itself is
+//! chosen by `crate::backend::Backend::resolve_with`, the one policy.
+
+use rayon::prelude::*;
+
+use super::qoi::*;
+use crate::backend::Precision;
+use crate::case::{Analysis, Case};
+use crate::ensemble::{apply, stabilizer_sites, Variant};
+use crate::error::{Error, InputError};
+use crate::model::Model;
+use crate::solve::dynamics::{DynamicState, Dynamics};
+use crate::solve::statics::StaticOptions;
+
+/// Static equilibria of every variant through the GPU kernels (in `T`), the variants that
+/// fail there re-run on the CPU with step control (their reason says so). Stabilizer
+/// moves run there too (each pair carries its node). `None` when the variants do not share
+/// the number of sites: the caller runs the CPU.
+pub fn run_static_gpu<T: crate::gpu::contact::GpuReal>(
+    case: &Case,
+    variants: &[Variant],
+    ctx: &'static crate::gpu::GpuContext,
+    bar: &indicatif::ProgressBar,
+) -> Result<Option<Vec<VariantResult>>, Error> {
+    use crate::engine::{solve_static_ensemble_with_progress, EngineStatus, GpuPath};
+    let models: Vec<Model> = variants
+        .iter()
+        .map(|v| apply(case, v))
+        .collect::<Result<_, _>>()
+        .map_err(|e| Error::Io(std::io::Error::other(e)))?;
+    if !models.iter().all(|m| same_mesh(case, m)) {
+        return Ok(None);
+    }
+    let results = solve_static_ensemble_with_progress::<T, _>(
+        &models,
+        &GpuPath(ctx),
+        &StaticOptions::default(),
+        &mut |f| bar.set_position((f * variants.len() as f64) as u64),
+    )
+    .map_err(|e| Error::Io(std::io::Error::other(format!("GPU engine: {e}"))))?;
+    Ok(Some(
+        results
+            .into_par_iter()
+            .zip(models.par_iter().zip(variants.par_iter()))
+            .map(|(r, (m, v))| match r.status {
+                EngineStatus::Converged => {
+                    let mut sol = crate::solve::statics::solution_at(m, r.state);
+                    sol.iterations = r.iterations;
+                    sol.log = r.log;
+                    let mut done = static_result(case, &v.name, m, &sol);
+                    done.solved_by = SolvedBy::Engine;
+                    done
+                }
+                EngineStatus::Failed(why) => {
+                    let mut again = static_variant(case, &v.name, m);
+                    again.reason = format!("GPU: {why}; re-run on the CPU: {}", again.reason);
+                    if again.status == Status::Converged {
+                        again.status = Status::StepCut;
+                    }
+                    again
+                }
+            })
+            .collect(),
+    ))
+}
+
+/// The `[dynamics]` runs of every variant through the GPU engine (in `T`): static starts
+/// through the static engine, then lockstep generalised-α steps, every step observed for
+/// the quantities of interest. A variant that fails on the GPU (static start or a step)
+/// re-runs on the CPU with step control (its reason says so). `Err` with the reason when
+/// the case needs what only the CPU integrator has (consistent mass, stiffness-
+/// proportional damping): the caller runs the CPU then.
+pub fn run_dynamic_gpu<T: crate::gpu::contact::GpuReal>(
+    case: &Case,
+    variants: &[Variant],
+    ctx: &'static crate::gpu::GpuContext,
+    bar: &indicatif::ProgressBar,
+) -> Result<Result<Vec<VariantResult>, String>, Error> {
+    use crate::engine::dynamic::{run_dynamic_ensemble, unsupported, DynamicStatus};
+    use crate::engine::{solve_static_ensemble, EngineStatus, GpuPath};
+    let Some(settings) = case.dynamics.clone() else {
+        return Ok(Err("no [dynamics] table".into()));
+    };
+    let options = crate::cli::run_cmd::options_for(&settings);
+    if let Some(why) = unsupported(&options) {
+        return Ok(Err(why));
+    }
+    let models: Vec<Model> = variants
+        .iter()
+        .map(|v| apply(case, v))
+        .collect::<Result<_, _>>()
+        .map_err(|e| Error::Io(std::io::Error::other(e)))?;
+    if !models.iter().all(|m| same_mesh(case, m)) {
+        return Ok(Err(
+            "the variants differ in their mesh or number of contact sites".into(),
+        ));
+    }
+    let path = GpuPath(ctx);
+    let statics = solve_static_ensemble::<T, _>(&models, &path, &StaticOptions::default())
+        .map_err(|e| Error::Io(std::io::Error::other(format!("GPU engine: {e}"))))?;
+    // Variants whose static start failed on the GPU run wholly on the CPU.
+    let on_gpu: Vec<usize> = (0..models.len())
+        .filter(|&j| statics[j].status == EngineStatus::Converged)
+        .collect();
+    let gpu_models: Vec<Model> = on_gpu.iter().map(|&j| models[j].clone()).collect();
+    let starts: Vec<_> = on_gpu.iter().map(|&j| statics[j].state.clone()).collect();
+    let density = &case.element_density;
+    let mut cpu: Vec<Dynamics> = gpu_models
+        .iter()
+        .map(|m| Dynamics::new(m, options, &|e| density[e]))
+        .collect();
+    let mut observers: Vec<DynamicObserver> = gpu_models
+        .iter()
+        .map(|m| DynamicObserver::new(m, settings.duration))
+        .collect();
+    let mut last: Vec<Option<DynamicState>> = vec![None; gpu_models.len()];
+    for (j, (d, q)) in cpu.iter_mut().zip(&starts).enumerate() {
+        if let Ok(s) = d.initial_state(q.clone()) {
+            observers[j].observe(&gpu_models[j], d, &s);
+            last[j] = Some(s);
+        }
+    }
+    let results = run_dynamic_ensemble::<T, _>(
+        &gpu_models,
+        &starts,
+        density,
+        &path,
+        &options,
+        settings.duration,
+        1,
+        &mut |first, t, batch| {
+            let (v, n) = (batch.num_variants, batch.num_nodes);
+            for j in 0..v {
+                let g = first + j;
+                let Some(state) = last[g].as_mut() else {
+                    continue;
+                };
+                let m = &gpu_models[g];
+                state.t = t;
+                for i in 0..n {
+                    for k in 0..3 {
+                        state.q.x[i][k] =
+                            m.nodes[i].position[k] + batch.u[(3 * i + k) * v + j].to_f64_lossy();
+                    }
+                    for r in 0..3 {
+                        for c in 0..3 {
+                            state.q.rot[i][r][c] =
+                                batch.rot[(9 * i + 3 * r + c) * v + j].to_f64_lossy();
+                        }
+                    }
+                    for k in 0..6 {
+                        let idx = (6 * i + k) * v + j;
+                        state.v[6 * i + k] = batch.vel[idx].to_f64_lossy();
+                        state.a[6 * i + k] = batch.acc[idx].to_f64_lossy();
+                        state.vdot[6 * i + k] = batch.vdot[idx].to_f64_lossy();
+                    }
+                }
+                observers[g].observe(m, &cpu[g], state);
+            }
+            bar.set_position(((t / settings.duration) * variants.len() as f64) as u64);
+        },
+    )
+    .map_err(|e| Error::Io(std::io::Error::other(format!("GPU engine: {e}"))))?;
+    let mut out: Vec<Option<VariantResult>> = vec![None; models.len()];
+    for (&j, ((r, obs), state)) in on_gpu
+        .iter()
+        .zip(results.into_iter().zip(observers).zip(last))
+    {
+        let name = &variants[j].name;
+        out[j] = Some(match (r.status, state) {
+            (DynamicStatus::Finished, Some(state)) => {
+                // The engine's step cuts, as the CPU integrator's log would give them.
+                let mut done = obs.finish(case, name, &models[j], &state, &r.log, &r.iterations);
+                done.solved_by = SolvedBy::Engine;
+                done
+            }
+            (status, _) => {
+                let why = match status {
+                    DynamicStatus::Failed(t, why) => format!("failed at t = {t:.6} s: {why}"),
+                    DynamicStatus::Finished => "no initial state".into(),
+                };
+                let mut again = dynamic_variant(case, name, &models[j]);
+                again.reason = format!("GPU: {why}; re-run on the CPU: {}", again.reason);
+                if again.status == Status::Converged {
+                    again.status = Status::StepCut;
+                }
+                again
+            }
+        });
+    }
+    Ok(Ok(out
+        .into_iter()
+        .enumerate()
+        .map(|(j, r)| {
+            r.unwrap_or_else(|| {
+                let why = match &statics[j].status {
+                    EngineStatus::Failed(w) => w.clone(),
+                    EngineStatus::Converged => String::new(),
+                };
+                let mut again = dynamic_variant(case, &variants[j].name, &models[j]);
+                again.reason = format!(
+                    "GPU static start: {why}; re-run on the CPU: {}",
+                    again.reason
+                );
+                if again.status == Status::Converged {
+                    again.status = Status::StepCut;
+                }
+                again
+            })
+        })
+        .collect()))
+}
+
+/// Runs every variant on the CPU (rayon over variants); results in variant order.
+pub fn run_variants_cpu(
+    case: &Case,
+    analysis: Analysis,
+    variants: &[Variant],
+    bar: &indicatif::ProgressBar,
+) -> Vec<VariantResult> {
+    variants
+        .par_iter()
+        .map(|v| {
+            let stabs = stabilizer_sites(&case.model).len();
+            let r = match apply(case, v) {
+                Err(e) => failed(&v.name, format!("variant: {e}"), stabs),
+                Ok(model) => match analysis {
+                    Analysis::Static => static_variant(case, &v.name, &model),
+                    Analysis::Dynamic => dynamic_variant(case, &v.name, &model),
+                },
+            };
+            bar.inc(1);
+            r
+        })
+        .collect()
+}
+
+/// Runs `variants` on the GPU engine (`gpu`) or the CPU: their results, and where they ran.
+pub(crate) fn compute(
+    case: &Case,
+    analysis: Analysis,
+    variants: &[Variant],
+    gpu: Option<&'static crate::gpu::GpuContext>,
+    precision: Precision,
+    bar: &indicatif::ProgressBar,
+) -> Result<(Vec<VariantResult>, &'static str), Error> {
+    let mut backend_name = "cpu";
+    let results = match (gpu, analysis) {
+        (Some(ctx), Analysis::Static) => match if precision == Precision::F32 {
+            run_static_gpu::<f32>(case, variants, ctx, bar)?
+        } else {
+            run_static_gpu::<f64>(case, variants, ctx, bar)?
+        } {
+            Some(r) => {
+                backend_name = "gpu";
+                r
+            }
+            None => {
+                eprintln!("holewall: the variants differ in their mesh or number of contact sites; running them on the CPU");
+                run_variants_cpu(case, analysis, variants, bar)
+            }
+        },
+        (Some(ctx), Analysis::Dynamic) => match if precision == Precision::F32 {
+            run_dynamic_gpu::<f32>(case, variants, ctx, bar)?
+        } else {
+            run_dynamic_gpu::<f64>(case, variants, ctx, bar)?
+        } {
+            Ok(r) => {
+                backend_name = "gpu";
+                r
+            }
+            Err(why) => {
+                if precision == Precision::F32 {
+                    return Err(InputError {
+                        source_name: "--precision".into(),
+                        line: 0,
+                        key: "precision".into(),
+                        message: format!("f32 runs on the GPU engine, which cannot run this case: {why}; use --precision f64"),
+                    }
+                    .into());
+                }
+                eprintln!("holewall: {why}; running the variants on the CPU");
+                run_variants_cpu(case, analysis, variants, bar)
+            }
+        },
+        (None, _) => run_variants_cpu(case, analysis, variants, bar),
+    };
+    if backend_name == "gpu" {
+        let rerun = results
+            .iter()
+            .filter(|r| r.solved_by == SolvedBy::Cpu)
+            .count();
+        if rerun > 0 {
+            eprintln!(
+                "holewall: the engine failed {rerun} of {} variants; they were re-run on the CPU (variants.csv: solved_by, reason)",
+                results.len()
+            );
+        }
+    }
+    Ok((results, backend_name))
+}
+
+/// Whether a variant's model shares the case's mesh and number of contact sites (what the
+/// engine needs: a `depth` variant has a mesh of its own).
+pub(crate) fn same_mesh(case: &Case, m: &Model) -> bool {
+    m.sites.len() == case.model.sites.len()
+        && m.nodes.len() == case.model.nodes.len()
+        && m.nodes
+            .iter()
+            .zip(&case.model.nodes)
+            .all(|(a, b)| a.md == b.md)
+}
