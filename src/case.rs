@@ -298,12 +298,12 @@ pub enum Analysis {
 pub struct EnsembleSettings {
     /// What each variant runs.
     pub analysis: Analysis,
-    /// Grid (key, values), in key order.
-    pub grid: Vec<(crate::ensemble::Key, Vec<f64>)>,
+    /// Grid (key, values), in the order written (the first key varies slowest).
+    pub grid: Vec<(crate::keys::Key, Vec<f64>)>,
     /// Variants with full time series.
     pub series: Vec<String>,
-    /// Uncertain inputs: (key, distribution), in key order (`[ensemble.uncertain]`).
-    pub uncertain: Vec<(crate::ensemble::Key, crate::uq::Distribution)>,
+    /// Uncertain inputs: (key, distribution), in the order written (`[ensemble.uncertain]`).
+    pub uncertain: Vec<(crate::keys::Key, crate::uq::Distribution)>,
     /// Their rank correlation matrix (identity unless `ensemble.correlation` is given).
     pub correlation: Option<nalgebra::DMatrix<f64>>,
 }
@@ -1051,10 +1051,13 @@ fn ensemble_settings(
         },
     };
     let mut grid = Vec::new();
-    for (name, values) in e.grid.iter().flatten() {
+    // In the order written (the first key varies slowest), not the map's alphabetical one.
+    let mut written: Vec<_> = e.grid.iter().flatten().collect();
+    written.sort_by_key(|(_, v)| v.span().start);
+    for (name, values) in written {
         let key_name = format!("ensemble.grid.{name}");
         let key =
-            crate::ensemble::Key::parse(name).map_err(|m| ctx.err(values.span(), &key_name, m))?;
+            crate::keys::Key::parse(name).map_err(|m| ctx.err(values.span(), &key_name, m))?;
         if values.get_ref().is_empty() {
             return Err(ctx.err(values.span(), &key_name, "no values"));
         }
@@ -1072,10 +1075,13 @@ fn ensemble_settings(
         grid.push((key, list));
     }
     let mut uncertain = Vec::new();
-    for (name, spec) in e.uncertain.iter().flatten() {
+    // In the order written: input k takes the sampler's dimension k.
+    let mut written: Vec<_> = e.uncertain.iter().flatten().collect();
+    written.sort_by_key(|(_, v)| v.span().start);
+    for (name, spec) in written {
         let key_name = format!("ensemble.uncertain.{name}");
         let err = |m: String| ctx.err(spec.span(), &key_name, m);
-        let key = crate::ensemble::Key::parse(name).map_err(err)?;
+        let key = crate::keys::Key::parse(name).map_err(err)?;
         uncertain.push((
             key.clone(),
             uncertain_distribution(&key, spec.get_ref()).map_err(err)?,
@@ -1125,7 +1131,7 @@ fn ensemble_settings(
 /// The distribution of `[ensemble.uncertain]` entry `u` of key `key`; every value given is
 /// parsed and range-checked as the key's own values.
 fn uncertain_distribution(
-    key: &crate::ensemble::Key,
+    key: &crate::keys::Key,
     u: &UncertainSpec,
 ) -> Result<crate::uq::Distribution, String> {
     use crate::uq::Distribution;

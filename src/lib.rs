@@ -16,6 +16,7 @@ pub mod ensemble;
 pub mod error;
 pub mod gpu;
 pub mod kernels;
+pub mod keys;
 pub mod model;
 pub mod output;
 pub mod physics;

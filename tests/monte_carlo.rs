@@ -53,7 +53,11 @@ fn shipped_case_on_the_cpu_and_the_engine() {
     let cpu = mc_run(n, 1, BackendChoice::Cpu, Precision::F64, &tmp("cpu"));
     let u = cpu.uncertainty.as_ref().unwrap();
     assert_eq!((u.samples, u.failed, cpu.failed), (n, 0, 0));
-    assert_eq!(u.inputs, vec!["k_e", "mu", "stab2.from_bit", "wob"]);
+    assert_eq!(
+        u.inputs,
+        vec!["mu", "wob", "k_e", "stab2.from_bit"],
+        "in the order written"
+    );
     for q in &u.qois {
         let s = q.stats.as_ref().unwrap();
         assert_eq!(s.n, n, "{}", q.name);
@@ -300,6 +304,24 @@ fn broomstick_of_the_shipped_case() {
     let sol2 = holewall::solve::statics::solve_static(&m, &Default::default()).unwrap();
     let r = holewall::ensemble::qoi::static_result(&case, "v", &m, &sol2);
     assert_eq!(r.hook_load_n.unwrap(), via);
+    // The grid's keys in the order written: the first varies slowest.
+    let text = std::fs::read_to_string(&path).unwrap().replace(
+        "depth = [\"600 m\", \"800 m\", \"1000 m\", \"1200 m\", \"1400 m\", \"1500 m\"]\nmode = [\"tripping_in\", \"tripping_out\", \"rotating\"]\nmu = [0.15, 0.25, 0.35]",
+        "mu = [0.15, 0.25]\ndepth = [\"600 m\", \"800 m\"]",
+    );
+    let grid_case = holewall::case::parse_case(&path, &text).unwrap();
+    let grid = &grid_case.ensemble.as_ref().unwrap().grid;
+    assert_eq!(
+        (grid[0].0.name.as_str(), grid[1].0.name.as_str()),
+        ("mu", "depth")
+    );
+    let v = holewall::ensemble::variants_from_grid(grid);
+    assert_eq!(
+        (v[0].overrides[0].1, v[1].overrides[0].1),
+        (0.15, 0.15),
+        "mu slowest"
+    );
+    assert_eq!((v[0].overrides[1].1, v[1].overrides[1].1), (600.0, 800.0));
     // Bad modes and depths are refused with file, line and key.
     let e = holewall::ensemble::variants_from_csv_text("v.csv", "mode\nspinning\n").unwrap_err();
     assert_eq!((e.line, e.key.as_str()), (2, "mode"));
@@ -367,7 +389,7 @@ fn rank_correlated_inputs() {
     std::fs::write(&path, &text).unwrap();
     let case = holewall::case::load_case(&path).unwrap();
     let settings = case.ensemble.unwrap();
-    let variants = holewall::uq::sample_variants(
+    let variants = holewall::ensemble::sample_variants(
         &settings.uncertain,
         400,
         1,
@@ -386,7 +408,7 @@ fn rank_correlated_inputs() {
     let other = holewall::uq::sensitivity::spearman(&col("mu"), &col("k_e"));
     eprintln!("rank correlation mu–wob {rho:.3} (asked 0.6), mu–k_e {other:.3}");
     assert!((rho - 0.6).abs() < 0.07 && other.abs() < 0.1);
-    assert!(holewall::uq::sample_variants(
+    assert!(holewall::ensemble::sample_variants(
         &settings.uncertain,
         64,
         1,

@@ -50,7 +50,7 @@ pub fn run(
                 .map(|s| s.uncertain.clone())
                 .unwrap_or_default();
             let correlation = settings.as_ref().and_then(|s| s.correlation.clone());
-            crate::uq::sample_variants(
+            crate::ensemble::sample_variants(
                 &uncertain,
                 mc.samples,
                 mc.seed,

@@ -33,182 +33,8 @@ use std::path::Path;
 
 use crate::case::Case;
 use crate::error::InputError;
+pub use crate::keys::{Key, Param, KEY_FORMS, MODES};
 use crate::model::Model;
-use crate::units::{parse_quantity, Dimension};
-
-/// What a key overrides.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum Param {
-    /// Both friction coefficients.
-    Mu,
-    /// Circumferential friction.
-    MuT,
-    /// Axial friction.
-    MuL,
-    /// Wall stiffness.
-    WallStiffness,
-    /// Wall damping.
-    WallDamping,
-    /// Spring exponent.
-    Exponent,
-    /// Friction regularisation speed.
-    Eps,
-    /// Rotary speed (rad/s).
-    Rpm,
-    /// Weight on bit (N).
-    Wob,
-    /// Torque on bit (N·m).
-    Tob,
-    /// Blade diameter (m).
-    Blade,
-    /// Distance of the stabilizer's site from the bit (m).
-    FromBit,
-    /// Bit depth, MD (m): the case rebuilt there.
-    Depth,
-    /// Operation mode (a code of [`MODES`]): the case rebuilt with it.
-    Mode,
-}
-
-/// The operation modes a `mode` key takes, by code (its value is the index).
-pub const MODES: [&str; 4] = ["rotating", "tripping_in", "tripping_out", "sliding"];
-
-/// A parsed column key.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Key {
-    /// The text as written.
-    pub name: String,
-    /// What it overrides.
-    pub param: Param,
-    /// Stabilizer (1 = nearest the bit), or every site.
-    pub stabilizer: Option<usize>,
-}
-
-/// Every key form, for messages.
-pub const KEY_FORMS: &str = "mu, mu_t, mu_l, k_e, c, m, eps (each optionally .stabK), rpm, wob, tob, stabK.blade, stabK.from_bit, depth, mode";
-
-impl Key {
-    /// Parses a column key.
-    pub fn parse(name: &str) -> Result<Key, String> {
-        let stab_index = |s: &str| -> Result<usize, String> {
-            s.strip_prefix("stab")
-                .and_then(|k| k.parse::<usize>().ok())
-                .filter(|&k| k >= 1)
-                .ok_or_else(|| format!("unknown key {name:?}; allowed: {KEY_FORMS}"))
-        };
-        let (head, tail) = match name.split_once('.') {
-            Some((h, t)) => (h, Some(t)),
-            None => (name, None),
-        };
-        let law = |p: &str| match p {
-            "mu" => Some(Param::Mu),
-            "mu_t" => Some(Param::MuT),
-            "mu_l" => Some(Param::MuL),
-            "k_e" => Some(Param::WallStiffness),
-            "c" => Some(Param::WallDamping),
-            "m" => Some(Param::Exponent),
-            "eps" => Some(Param::Eps),
-            _ => None,
-        };
-        let (param, stabilizer) = match (head, tail) {
-            ("rpm", None) => (Param::Rpm, None),
-            ("wob", None) => (Param::Wob, None),
-            ("tob", None) => (Param::Tob, None),
-            ("depth", None) => (Param::Depth, None),
-            ("mode", None) => (Param::Mode, None),
-            (h, None) if law(h).is_some() => (law(h).unwrap_or(Param::Mu), None),
-            (h, Some(t)) if law(h).is_some() => (law(h).unwrap_or(Param::Mu), Some(stab_index(t)?)),
-            (h, Some("blade")) => (Param::Blade, Some(stab_index(h)?)),
-            (h, Some("from_bit")) => (Param::FromBit, Some(stab_index(h)?)),
-            _ => return Err(format!("unknown key {name:?}; allowed: {KEY_FORMS}")),
-        };
-        Ok(Key {
-            name: name.to_string(),
-            param,
-            stabilizer,
-        })
-    }
-
-    /// A value as `variants.csv` writes it: the mode's name, else the number.
-    pub fn format(&self, v: f64) -> String {
-        match self.param {
-            Param::Mode => MODES
-                .get(v as usize)
-                .map(|m| m.to_string())
-                .unwrap_or_else(|| format!("{v}")),
-            _ => format!("{v}"),
-        }
-    }
-
-    /// Parses and range-checks a value of this key (SI number or `"<number> <unit>"`; a
-    /// mode's name, or its code).
-    pub fn value(&self, text: &str) -> Result<f64, String> {
-        if self.param == Param::Mode {
-            let t = text.trim();
-            return MODES
-                .iter()
-                .position(|m| *m == t)
-                .map(|k| k as f64)
-                .or_else(|| {
-                    t.parse::<f64>()
-                        .ok()
-                        .filter(|x| x.fract() == 0.0 && (0.0..MODES.len() as f64).contains(x))
-                })
-                .ok_or_else(|| format!("unknown mode {t:?}; allowed: {}", MODES.join(", ")));
-        }
-        let (dim, ok, range): (Option<Dimension>, fn(f64) -> bool, &str) = match self.param {
-            Param::Mu | Param::MuT | Param::MuL => (None, |x| (0.0..=2.0).contains(&x), "0 … 2"),
-            Param::WallStiffness => (None, |x| x > 0.0 && x <= 1e12, "0 < k_e ≤ 1e12 N/m^m"),
-            Param::WallDamping => (Some(Dimension::Damping), |x| x >= 0.0, "≥ 0 N·s/m"),
-            Param::Exponent => (None, |x| x > 0.0 && x <= 3.0, "0 < m ≤ 3"),
-            Param::Eps => (
-                Some(Dimension::Speed),
-                |x| x > 0.0 && x <= 10.0,
-                "0 < eps ≤ 10 m/s",
-            ),
-            Param::Rpm => (
-                Some(Dimension::AngularSpeed),
-                |x| (0.0..=1000.0 * std::f64::consts::TAU / 60.0).contains(&x),
-                "0 … 1000 rpm",
-            ),
-            Param::Wob => (
-                Some(Dimension::Force),
-                |x| (0.0..=1e7).contains(&x),
-                "0 … 1e7 N",
-            ),
-            Param::Tob => (
-                Some(Dimension::Torque),
-                |x| (0.0..=1e6).contains(&x),
-                "0 … 1e6 N·m",
-            ),
-            Param::Blade => (
-                Some(Dimension::Length),
-                |x| x > 0.0 && x < 2.0,
-                "0 < blade < 2 m",
-            ),
-            Param::FromBit => (
-                Some(Dimension::Length),
-                |x| x > 0.0 && x < 2e4,
-                "0 < from_bit < 20 km",
-            ),
-            Param::Depth => (
-                Some(Dimension::Length),
-                |x| x > 0.0 && x <= 2e4,
-                "0 < depth ≤ 20 km",
-            ),
-            Param::Mode => unreachable!("parsed above"),
-        };
-        let t = text.trim();
-        let v = match (t.parse::<f64>(), dim) {
-            (Ok(x), _) => x,
-            (Err(_), Some(d)) => parse_quantity(t, d).map_err(|e| e.to_string())?,
-            (Err(_), None) => return Err(format!("{t:?} is not a number")),
-        };
-        if !v.is_finite() || !ok(v) {
-            return Err(format!("{t} out of range; allowed: {range}"));
-        }
-        Ok(v)
-    }
-}
 
 /// A case's variants: the CSV `file` if given, else its `[ensemble.grid]`; `None` when it
 /// has neither.
@@ -515,6 +341,70 @@ pub fn variant_case(case: &Case, variant: &Variant) -> Result<Option<Case>, Stri
     crate::case::parse_case(&case.path, &edited)
         .map(Some)
         .map_err(|e| format!("depth/mode: {}", e.message))
+}
+
+/// `n` samples of the uncertain inputs as variants named `s00001`, … (each overriding every
+/// uncertain key), drawn by `sampling` with `seed`: the unit-cube points mapped through each
+/// input's quantile function. Sample `i` is the same whatever `n`'s other samples, the
+/// chunking or the machine (for `random`; `lhs` and `sobol` depend on `n` as a whole). A
+/// sampled value outside the key's allowed range is an error naming it.
+///
+/// With `sobol_indices` the points are a Saltelli design for `n` base samples
+/// ([`crate::uq::sensitivity::saltelli_design`]): `n (d + 2)` variants, the first `2n` of them
+/// independent samples of the inputs (`A` and `B`), the rest `A` with one input from `B`.
+pub fn sample_variants(
+    uncertain: &[(Key, crate::uq::Distribution)],
+    n: usize,
+    seed: u64,
+    sampling: crate::uq::Sampling,
+    sobol_indices: bool,
+    correlation: Option<&nalgebra::DMatrix<f64>>,
+) -> Result<Vec<Variant>, String> {
+    if uncertain.is_empty() {
+        return Err("no uncertain inputs: add an [ensemble.uncertain] table".into());
+    }
+    if n == 0 {
+        return Err("--samples must be at least 1".into());
+    }
+    let mut u = if sobol_indices {
+        if sampling != crate::uq::Sampling::Sobol {
+            return Err("Sobol indices need --sampling sobol (the Saltelli design is built on Sobol points)".into());
+        }
+        crate::uq::sensitivity::saltelli_design(n, uncertain.len(), seed)?
+    } else {
+        crate::uq::unit_samples(n, uncertain.len(), seed, sampling)?
+    };
+    if let Some(c) = correlation {
+        if sampling == crate::uq::Sampling::Sobol {
+            return Err("ensemble.correlation reorders the samples, which breaks Sobol points' structure: use --sampling lhs or random".into());
+        }
+        crate::uq::sampling::iman_conover(&mut u, c, seed)?;
+    }
+    let width = u.len().to_string().len().max(5);
+    u.iter()
+        .enumerate()
+        .map(|(i, p)| {
+            let overrides = uncertain
+                .iter()
+                .zip(p)
+                .map(|((key, dist), &ui)| {
+                    let v = dist.quantile(ui);
+                    key.value(&v.to_string())
+                        .map(|v| (key.clone(), v))
+                        .map_err(|m| {
+                            format!(
+                                "sample {i}: {} drew {v} from {dist:?}, outside the key's range ({m}); truncate the distribution",
+                                key.name
+                            )
+                        })
+                })
+                .collect::<Result<Vec<_>, String>>()?;
+            Ok(Variant {
+                name: format!("s{:0width$}", i + 1),
+                overrides,
+            })
+        })
+        .collect()
 }
 
 #[cfg(test)]

@@ -11,7 +11,7 @@ use serde::Serialize;
 use super::sensitivity::{sensitivities, InputSensitivity};
 use super::stats::{qoi_stats, QoiStats};
 use super::Sampling;
-use crate::ensemble::{Key, Param};
+use crate::keys::{Key, Param};
 
 /// A quantity's unit, for plots (values stay SI in CSV and JSON).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]

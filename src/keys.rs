@@ -1,0 +1,180 @@
+//! Variant keys (`mu`, `k_e.stab2`, `wob`, `depth`, `mode`, …): what each overrides, its
+//! unit and allowed range. The table is in `src/ensemble/mod.rs`'s docs. Shared by the case
+//! file (`[ensemble.grid]`, `[ensemble.uncertain]`), variant CSVs, sampling and reports, so
+//! none of them imports another for it.
+
+use crate::units::{parse_quantity, Dimension};
+
+/// What a key overrides.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Param {
+    /// Both friction coefficients.
+    Mu,
+    /// Circumferential friction.
+    MuT,
+    /// Axial friction.
+    MuL,
+    /// Wall stiffness.
+    WallStiffness,
+    /// Wall damping.
+    WallDamping,
+    /// Spring exponent.
+    Exponent,
+    /// Friction regularisation speed.
+    Eps,
+    /// Rotary speed (rad/s).
+    Rpm,
+    /// Weight on bit (N).
+    Wob,
+    /// Torque on bit (N·m).
+    Tob,
+    /// Blade diameter (m).
+    Blade,
+    /// Distance of the stabilizer's site from the bit (m).
+    FromBit,
+    /// Bit depth, MD (m): the case rebuilt there.
+    Depth,
+    /// Operation mode (a code of [`MODES`]): the case rebuilt with it.
+    Mode,
+}
+
+/// The operation modes a `mode` key takes, by code (its value is the index).
+pub const MODES: [&str; 4] = ["rotating", "tripping_in", "tripping_out", "sliding"];
+
+/// A parsed column key.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Key {
+    /// The text as written.
+    pub name: String,
+    /// What it overrides.
+    pub param: Param,
+    /// Stabilizer (1 = nearest the bit), or every site.
+    pub stabilizer: Option<usize>,
+}
+
+/// Every key form, for messages.
+pub const KEY_FORMS: &str = "mu, mu_t, mu_l, k_e, c, m, eps (each optionally .stabK), rpm, wob, tob, stabK.blade, stabK.from_bit, depth, mode";
+
+impl Key {
+    /// Parses a column key.
+    pub fn parse(name: &str) -> Result<Key, String> {
+        let stab_index = |s: &str| -> Result<usize, String> {
+            s.strip_prefix("stab")
+                .and_then(|k| k.parse::<usize>().ok())
+                .filter(|&k| k >= 1)
+                .ok_or_else(|| format!("unknown key {name:?}; allowed: {KEY_FORMS}"))
+        };
+        let (head, tail) = match name.split_once('.') {
+            Some((h, t)) => (h, Some(t)),
+            None => (name, None),
+        };
+        let law = |p: &str| match p {
+            "mu" => Some(Param::Mu),
+            "mu_t" => Some(Param::MuT),
+            "mu_l" => Some(Param::MuL),
+            "k_e" => Some(Param::WallStiffness),
+            "c" => Some(Param::WallDamping),
+            "m" => Some(Param::Exponent),
+            "eps" => Some(Param::Eps),
+            _ => None,
+        };
+        let (param, stabilizer) = match (head, tail) {
+            ("rpm", None) => (Param::Rpm, None),
+            ("wob", None) => (Param::Wob, None),
+            ("tob", None) => (Param::Tob, None),
+            ("depth", None) => (Param::Depth, None),
+            ("mode", None) => (Param::Mode, None),
+            (h, None) if law(h).is_some() => (law(h).unwrap_or(Param::Mu), None),
+            (h, Some(t)) if law(h).is_some() => (law(h).unwrap_or(Param::Mu), Some(stab_index(t)?)),
+            (h, Some("blade")) => (Param::Blade, Some(stab_index(h)?)),
+            (h, Some("from_bit")) => (Param::FromBit, Some(stab_index(h)?)),
+            _ => return Err(format!("unknown key {name:?}; allowed: {KEY_FORMS}")),
+        };
+        Ok(Key {
+            name: name.to_string(),
+            param,
+            stabilizer,
+        })
+    }
+
+    /// A value as `variants.csv` writes it: the mode's name, else the number.
+    pub fn format(&self, v: f64) -> String {
+        match self.param {
+            Param::Mode => MODES
+                .get(v as usize)
+                .map(|m| m.to_string())
+                .unwrap_or_else(|| format!("{v}")),
+            _ => format!("{v}"),
+        }
+    }
+
+    /// Parses and range-checks a value of this key (SI number or `"<number> <unit>"`; a
+    /// mode's name, or its code).
+    pub fn value(&self, text: &str) -> Result<f64, String> {
+        if self.param == Param::Mode {
+            let t = text.trim();
+            return MODES
+                .iter()
+                .position(|m| *m == t)
+                .map(|k| k as f64)
+                .or_else(|| {
+                    t.parse::<f64>()
+                        .ok()
+                        .filter(|x| x.fract() == 0.0 && (0.0..MODES.len() as f64).contains(x))
+                })
+                .ok_or_else(|| format!("unknown mode {t:?}; allowed: {}", MODES.join(", ")));
+        }
+        let (dim, ok, range): (Option<Dimension>, fn(f64) -> bool, &str) = match self.param {
+            Param::Mu | Param::MuT | Param::MuL => (None, |x| (0.0..=2.0).contains(&x), "0 … 2"),
+            Param::WallStiffness => (None, |x| x > 0.0 && x <= 1e12, "0 < k_e ≤ 1e12 N/m^m"),
+            Param::WallDamping => (Some(Dimension::Damping), |x| x >= 0.0, "≥ 0 N·s/m"),
+            Param::Exponent => (None, |x| x > 0.0 && x <= 3.0, "0 < m ≤ 3"),
+            Param::Eps => (
+                Some(Dimension::Speed),
+                |x| x > 0.0 && x <= 10.0,
+                "0 < eps ≤ 10 m/s",
+            ),
+            Param::Rpm => (
+                Some(Dimension::AngularSpeed),
+                |x| (0.0..=1000.0 * std::f64::consts::TAU / 60.0).contains(&x),
+                "0 … 1000 rpm",
+            ),
+            Param::Wob => (
+                Some(Dimension::Force),
+                |x| (0.0..=1e7).contains(&x),
+                "0 … 1e7 N",
+            ),
+            Param::Tob => (
+                Some(Dimension::Torque),
+                |x| (0.0..=1e6).contains(&x),
+                "0 … 1e6 N·m",
+            ),
+            Param::Blade => (
+                Some(Dimension::Length),
+                |x| x > 0.0 && x < 2.0,
+                "0 < blade < 2 m",
+            ),
+            Param::FromBit => (
+                Some(Dimension::Length),
+                |x| x > 0.0 && x < 2e4,
+                "0 < from_bit < 20 km",
+            ),
+            Param::Depth => (
+                Some(Dimension::Length),
+                |x| x > 0.0 && x <= 2e4,
+                "0 < depth ≤ 20 km",
+            ),
+            Param::Mode => unreachable!("parsed above"),
+        };
+        let t = text.trim();
+        let v = match (t.parse::<f64>(), dim) {
+            (Ok(x), _) => x,
+            (Err(_), Some(d)) => parse_quantity(t, d).map_err(|e| e.to_string())?,
+            (Err(_), None) => return Err(format!("{t:?} is not a number")),
+        };
+        if !v.is_finite() || !ok(v) {
+            return Err(format!("{t} out of range; allowed: {range}"));
+        }
+        Ok(v)
+    }
+}
