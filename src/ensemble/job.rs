@@ -271,6 +271,7 @@ pub fn run(
     write_atomic(
         &out.join("variants.csv"),
         &variants_csv(
+            &case,
             &variants,
             &results,
             stabs,

@@ -55,11 +55,13 @@ pub(crate) fn fmt(x: f64) -> String {
 }
 
 pub(crate) fn variants_csv(
+    case: &Case,
     variants: &[Variant],
     results: &[VariantResult],
     stabs: usize,
     whirl_threshold: Option<f64>,
 ) -> Result<Vec<u8>, Error> {
+    let (ran_header, ran_rows) = ran_with(case, variants, stabs);
     let dynamic = whirl_threshold.is_some();
     let io = |e: csv::Error| Error::Io(std::io::Error::other(e));
     let mut keys: Vec<String> = Vec::new();
@@ -72,6 +74,7 @@ pub(crate) fn variants_csv(
     }
     let mut header: Vec<String> = vec!["index".into(), "name".into()];
     header.extend(keys.iter().cloned());
+    header.extend(ran_header);
     header.extend(
         [
             "status",
@@ -101,8 +104,9 @@ pub(crate) fn variants_csv(
     header.extend(["newton_iterations_per_step", "step_cuts"].map(String::from));
     let mut w = csv::Writer::from_writer(Vec::new());
     w.write_record(&header).map_err(io)?;
-    for (i, (v, r)) in variants.iter().zip(results).enumerate() {
+    for (i, ((v, r), ran)) in variants.iter().zip(results).zip(ran_rows).enumerate() {
         let mut row = vec![i.to_string(), v.name.clone()];
+        let overrides_end = row.len() + keys.len();
         for k in &keys {
             row.push(
                 v.overrides
@@ -118,6 +122,8 @@ pub(crate) fn variants_csv(
                     .unwrap_or_default(),
             );
         }
+        debug_assert_eq!(row.len(), overrides_end);
+        row.extend(ran);
         row.push(
             match r.status {
                 Status::Converged => "converged",
@@ -255,4 +261,53 @@ pub(crate) fn broomstick(
         &[],
     )?;
     Ok(Some("broomstick.png".into()))
+}
+
+/// The values every variant ran with (not only its overrides), SI: bit depth, rotary speed,
+/// weight and torque on bit, and per stabilizer its distance from the bit, blade diameter,
+/// friction and wall stiffness — read from the variant's own model.
+fn ran_with(case: &Case, variants: &[Variant], stabs: usize) -> (Vec<String>, Vec<Vec<String>>) {
+    let mut header: Vec<String> = [
+        "ran.bit_md_m",
+        "ran.rotation_speed_rad_s",
+        "ran.wob_n",
+        "ran.tob_nm",
+    ]
+    .map(String::from)
+    .to_vec();
+    for k in 1..=stabs {
+        for f in ["from_bit_m", "blade_m", "mu_t", "mu_l", "k_e"] {
+            header.push(format!("ran.stab{k}.{f}"));
+        }
+    }
+    let rows = variants
+        .iter()
+        .map(|v| match crate::ensemble::apply(case, v) {
+            Err(_) => vec![String::new(); header.len()],
+            Ok(m) => {
+                let bit = m.nodes.last().map_or(f64::NAN, |n| n.md);
+                let mut row = vec![
+                    fmt(bit),
+                    fmt(m.rotation_speed),
+                    fmt(m.weight_on_bit),
+                    fmt(m.torque_on_bit),
+                ];
+                let sites = crate::ensemble::stabilizer_sites(&m);
+                for k in 0..stabs {
+                    match sites.get(k).map(|&s| &m.sites[s]) {
+                        Some(site) => row.extend([
+                            fmt(bit - m.nodes[site.node].md),
+                            fmt(2.0 * site.params.disk_radius),
+                            fmt(site.params.mu_t),
+                            fmt(site.params.mu_l),
+                            fmt(site.params.wall_stiffness),
+                        ]),
+                        None => row.extend(vec![String::new(); 5]),
+                    }
+                }
+                row
+            }
+        })
+        .collect();
+    (header, rows)
 }
