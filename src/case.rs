@@ -246,6 +246,9 @@ pub struct EnsembleSpec {
     pub uncertain: Option<std::collections::BTreeMap<String, Spanned<UncertainSpec>>>,
     /// Rank correlations between uncertain inputs: `[["mu", "wob", 0.5], …]`.
     pub correlation: Option<Spanned<Vec<(String, String, f64)>>>,
+    /// Candidate stabilizer layouts, each `{ "stab1.from_bit" = "1.5 m", "stab2.from_bit" =
+    /// "14 m", … }`: the `layout` key picks one (1-based).
+    pub layouts: Option<Spanned<Vec<std::collections::BTreeMap<String, Quantity>>>>,
 }
 
 /// `[ensemble.uncertain]` entry: the distribution of one variant key, values in SI or
@@ -306,6 +309,8 @@ pub struct EnsembleSettings {
     pub uncertain: Vec<(crate::keys::Key, crate::uq::Distribution)>,
     /// Their rank correlation matrix (identity unless `ensemble.correlation` is given).
     pub correlation: Option<nalgebra::DMatrix<f64>>,
+    /// Candidate stabilizer layouts (`ensemble.layouts`), picked by the `layout` key.
+    pub layouts: Vec<Vec<(crate::keys::Key, f64)>>,
 }
 
 /// A case read and checked, ready to build a model.
@@ -1119,12 +1124,44 @@ fn ensemble_settings(
             Some(c)
         }
     };
+    let mut layouts = Vec::new();
+    if let Some(list) = &e.layouts {
+        for (n, layout) in list.get_ref().iter().enumerate() {
+            let key_name = format!("ensemble.layouts[{}]", n + 1);
+            let err = |m: String| ctx.err(list.span(), &key_name, m);
+            let mut set = Vec::new();
+            for (name, q) in layout {
+                let key = crate::keys::Key::parse(name).map_err(err)?;
+                if !matches!(
+                    key.param,
+                    crate::keys::Param::FromBit | crate::keys::Param::Blade
+                ) {
+                    return Err(err(format!(
+                        "{name}: a layout sets stabK.from_bit and stabK.blade only"
+                    )));
+                }
+                let text = match q {
+                    Quantity::Number(x) => x.to_string(),
+                    Quantity::Text(t) => t.clone(),
+                };
+                set.push((
+                    key.clone(),
+                    key.value(&text).map_err(|m| err(format!("{name}: {m}")))?,
+                ));
+            }
+            if set.is_empty() {
+                return Err(err("an empty layout".into()));
+            }
+            layouts.push(set);
+        }
+    }
     Ok(EnsembleSettings {
         analysis,
         grid,
         series: e.series.clone().unwrap_or_default(),
         uncertain,
         correlation,
+        layouts,
     })
 }
 

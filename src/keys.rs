@@ -36,6 +36,9 @@ pub enum Param {
     Depth,
     /// Operation mode (a code of [`MODES`]): the case rebuilt with it.
     Mode,
+    /// A stabilizer layout: the 1-based index of one of `ensemble.layouts` (each a set of
+    /// `stabK.from_bit` / `stabK.blade` values applied together).
+    Layout,
 }
 
 /// The operation modes a `mode` key takes, by code (its value is the index).
@@ -53,7 +56,7 @@ pub struct Key {
 }
 
 /// Every key form, for messages.
-pub const KEY_FORMS: &str = "mu, mu_t, mu_l, k_e, c, m, eps (each optionally .stabK), rpm, wob, tob, stabK.blade, stabK.from_bit, depth, mode";
+pub const KEY_FORMS: &str = "mu, mu_t, mu_l, k_e, c, m, eps (each optionally .stabK), rpm, wob, tob, stabK.blade, stabK.from_bit, depth, mode, layout";
 
 impl Key {
     /// Parses a column key.
@@ -84,6 +87,7 @@ impl Key {
             ("tob", None) => (Param::Tob, None),
             ("depth", None) => (Param::Depth, None),
             ("mode", None) => (Param::Mode, None),
+            ("layout", None) => (Param::Layout, None),
             (h, None) if law(h).is_some() => (law(h).unwrap_or(Param::Mu), None),
             (h, Some(t)) if law(h).is_some() => (law(h).unwrap_or(Param::Mu), Some(stab_index(t)?)),
             (h, Some("blade")) => (Param::Blade, Some(stab_index(h)?)),
@@ -163,6 +167,11 @@ impl Key {
                 Some(Dimension::Length),
                 |x| x > 0.0 && x <= 2e4,
                 "0 < depth ≤ 20 km",
+            ),
+            Param::Layout => (
+                None,
+                |x| x >= 1.0 && x.fract() == 0.0 && x <= 1e6,
+                "a layout number 1, 2, … of ensemble.layouts",
             ),
             Param::Mode => unreachable!("parsed above"),
         };

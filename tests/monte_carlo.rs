@@ -441,3 +441,70 @@ fn rank_correlated_inputs() {
 fn case_path() -> std::path::PathBuf {
     case()
 }
+
+#[test]
+fn candidate_stabilizer_layouts() {
+    // Two candidate layouts of both stabilizers, drawn as a discrete input: each sample runs
+    // with one layout's places, applied together.
+    let text = std::fs::read_to_string(case()).unwrap().replace(
+        "analysis = \"static\"",
+        "analysis = \"static\"\nlayouts = [{ \"stab1.from_bit\" = \"1.8 m\", \"stab2.from_bit\" = \"14 m\" }, { \"stab1.from_bit\" = \"4.8 m\", \"stab2.from_bit\" = \"20 m\" }]",
+    ).replace(
+        "\"stab2.from_bit\" = { dist = \"discrete\", values = [\"10 m\", \"14 m\", \"20 m\"], weights = [1, 2, 1] }",
+        "layout = { dist = \"discrete\", values = [1, 2] }",
+    );
+    let dir = tmp("layouts");
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("layouts.toml");
+    std::fs::write(&path, &text).unwrap();
+    let mc = monte_carlo(Some(16), 1, Sampling::Lhs, &[], &[], false).unwrap();
+    let out = dir.join("out");
+    let s = run(
+        &path,
+        None,
+        BackendChoice::Cpu,
+        Precision::F64,
+        &out,
+        false,
+        &opts(mc),
+    )
+    .unwrap();
+    assert_eq!((s.variants, s.failed), (16, 0));
+    let csv = std::fs::read_to_string(out.join("variants.csv")).unwrap();
+    let mut rdr = csv::Reader::from_reader(csv.as_bytes());
+    let h = rdr.headers().unwrap().clone();
+    let col = |name: &str| h.iter().position(|x| x == name).unwrap();
+    let (cl, c1, c2) = (
+        col("layout"),
+        col("ran.stab1.from_bit_m"),
+        col("ran.stab2.from_bit_m"),
+    );
+    let mut seen = std::collections::BTreeSet::new();
+    for r in rdr.records() {
+        let r = r.unwrap();
+        let (l, s1, s2): (f64, f64, f64) = (
+            r[cl].parse().unwrap(),
+            r[c1].parse().unwrap(),
+            r[c2].parse().unwrap(),
+        );
+        // Layout 1 puts stab1 near 1.8 m and stab2 near 14 m; layout 2 near 4.8 and 20 m
+        // (to the nearest node of the 1.5 m BHA mesh).
+        let (e1, e2) = if l == 1.0 { (1.8, 14.0) } else { (4.8, 20.0) };
+        assert!(
+            (s1 - e1).abs() <= 0.8 && (s2 - e2).abs() <= 0.8,
+            "layout {l}: {s1} {s2}"
+        );
+        seen.insert(l as i64);
+    }
+    assert_eq!(seen.len(), 2, "both layouts drawn");
+    // A layout number beyond the list, and a layout setting another key, are refused.
+    let case = holewall::case::load_case(&path).unwrap();
+    let v = holewall::ensemble::variants_from_csv_text("v.csv", "layout\n3\n").unwrap();
+    assert!(holewall::ensemble::apply(&case, &v[0])
+        .unwrap_err()
+        .contains("layout 3"));
+    let bad = text.replace("\"stab1.from_bit\" = \"1.8 m\"", "mu = 0.3");
+    std::fs::write(&path, bad).unwrap();
+    let e = holewall::case::load_case(&path).unwrap_err();
+    assert!(e.to_string().contains("ensemble.layouts[1]"), "{e}");
+}

@@ -19,6 +19,7 @@
 //! | `stabK.from_bit` | distance of stabilizer K's site from the bit | m | 0 < … < bit MD |
 //! | `depth` | bit depth (MD): the case rebuilt with `well.total_md` there (the string cut at the surface, the hole sections kept) | m | 0 < … ≤ 20 km, within the hole |
 //! | `mode` | operation: `rotating`, `tripping_in`, `tripping_out`, `sliding` (the case rebuilt with it) | – | one of those |
+//! | `layout` | one of the case's `ensemble.layouts` (1, 2, …): its `stabK.from_bit` / `stabK.blade` values together | – | 1 … number of layouts |
 //!
 //! Stabilizers are numbered from the bit up (`stab1` nearest the bit); a key without
 //! `.stabK` applies to every contact site.
@@ -183,6 +184,42 @@ pub fn apply(case: &Case, variant: &Variant) -> Result<Model, String> {
         }
         None => case,
     };
+    // A layout expands into its stabilizer values, ahead of the variant's own overrides
+    // (which so win over it).
+    let expanded;
+    let variant = match variant
+        .overrides
+        .iter()
+        .find(|(k, _)| k.param == Param::Layout)
+    {
+        None => variant,
+        Some((_, index)) => {
+            let layouts = case
+                .ensemble
+                .as_ref()
+                .map(|e| e.layouts.as_slice())
+                .unwrap_or(&[]);
+            let layout = layouts.get(*index as usize - 1).ok_or_else(|| {
+                format!(
+                    "layout {index}: the case has {} in ensemble.layouts",
+                    layouts.len()
+                )
+            })?;
+            let mut overrides = layout.clone();
+            overrides.extend(
+                variant
+                    .overrides
+                    .iter()
+                    .filter(|(k, _)| k.param != Param::Layout)
+                    .cloned(),
+            );
+            expanded = Variant {
+                name: variant.name.clone(),
+                overrides,
+            };
+            &expanded
+        }
+    };
     let mut model = case.model.clone();
     let stabs = stabilizer_sites(&case.model);
     let stab = |k: usize| -> Result<usize, String> {
@@ -254,7 +291,7 @@ pub fn apply(case: &Case, variant: &Variant) -> Result<Model, String> {
             None => (0..model.sites.len()).collect(),
         };
         match key.param {
-            Param::FromBit | Param::Depth | Param::Mode => {}
+            Param::FromBit | Param::Depth | Param::Mode | Param::Layout => {}
             Param::Rpm => model.rotation_speed = v,
             Param::Wob => {
                 if let crate::model::TopBoundary::HookLoad(_) = model.top {

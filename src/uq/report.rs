@@ -67,7 +67,7 @@ impl Unit {
             Param::Wob => Unit::Force,
             Param::Tob => Unit::Torque,
             Param::Blade | Param::FromBit | Param::Depth => Unit::Length,
-            Param::Mode => Unit::Ratio,
+            Param::Mode | Param::Layout => Unit::Ratio,
         }
     }
 }
