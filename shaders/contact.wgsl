@@ -92,8 +92,9 @@ fn friction_factors(s_t: real, s_l: real, eps: real) -> Friction {
         let pt = s_t / w;
         let pl = s_l / w;
         f.phi = vec2<real>(pt, pl);
-        f.d_dst = vec2<real>((real(1.0) - pt * pt) / w, -pl * pt / w);
-        f.d_dsl = vec2<real>(-pt * pl / w, (real(1.0) - pl * pl) / w);
+        // (1 − φ_t²)/w written φ_l²/w: no cancellation where one slip dominates (f32).
+        f.d_dst = vec2<real>(pl * pl / w, -pl * pt / w);
+        f.d_dsl = vec2<real>(-pt * pl / w, pt * pt / w);
     } else {
         let h = (real(2.0) - w / eps) / eps;
         var q = real(0.0);

@@ -248,13 +248,12 @@ pub fn friction_factors<T: Real>(
             if w >= eps {
                 let pt = s_t / w;
                 let pl = s_l / w;
-                let one = T::one();
+                // ∂(s_t/w)/∂s_t = (1 − φ_t²)/w, written φ_l²/w (φ_t² + φ_l² = 1): the
+                // difference of near-equal terms loses every digit in f32 where one slip
+                // dominates (s_l ≪ s_t gives 0 instead of s_l²/w³).
                 (
                     [pt, pl],
-                    [
-                        [(one - pt * pt) / w, -pt * pl / w],
-                        [-pl * pt / w, (one - pl * pl) / w],
-                    ],
+                    [[pl * pl / w, -pt * pl / w], [-pl * pt / w, pt * pt / w]],
                 )
             } else {
                 let two = T::one() + T::one();

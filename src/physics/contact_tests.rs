@@ -601,3 +601,39 @@ fn specialised_terms_give_the_same_numbers() {
         }
     }
 }
+
+#[test]
+fn coupled_friction_derivatives_keep_their_digits_in_f32() {
+    // Circumferential slip far above ε, a tiny axial slip: ∂φ_t/∂s_t = s_l²/|s|³ exactly. As
+    // (1 − φ_t²)/|s| it cancelled to 0 in f32 (and `c_omega`, N μ_t R_d s_l²/|s|³, with it).
+    let (st, sl, eps) = (1.0f64, 1e-5f64, 1e-3f64);
+    let (_, j64) = friction_factors(st, sl, eps, FrictionModel::Coupled);
+    let (_, j32) = friction_factors(st as f32, sl as f32, eps as f32, FrictionModel::Coupled);
+    let w = (st * st + sl * sl).sqrt();
+    let exact = sl * sl / w.powi(3);
+    assert!((j64[0][0] - exact).abs() <= 1e-15 * exact);
+    let rel = (j32[0][0] as f64 - exact).abs() / exact;
+    eprintln!(
+        "f32 ∂φ_t/∂s_t: {:e} against {exact:e} (relative {rel:.1e})",
+        j32[0][0]
+    );
+    assert!(rel < 1e-6, "{rel:e}");
+    // The same through the element: a node on the wall spinning at 10 rad/s (s_t ≈ 1 m/s at
+    // R_d = 0.1 m) while moving 10 µm/s axially; c_omega in f32 against f64.
+    let p = params(1.0);
+    let d = [p.clearance + 1e-4, 0.0, 0.0];
+    let v = [0.0, 0.0, 1e-5];
+    let terms = ContactTerms::all(FrictionModel::Coupled, ContactMode::Dynamic);
+    let r64 = evaluate(&N_AXIS, &d, &v, 10.0, &p, &terms);
+    let p32: ContactParams<f32> = p.cast();
+    let to32 = |x: [f64; 3]| x.map(|y| y as f32);
+    let r32 = evaluate(&to32(N_AXIS), &to32(d), &to32(v), 10.0f32, &p32, &terms);
+    // Entry 1: the circumferential (t = n × u = y) force's response to the spin, the tiny
+    // N μ_t R_d s_l²/|s|³ itself, to its own size.
+    let (a, b) = (r64.c_omega[1], r32.c_omega[1] as f64);
+    eprintln!("c_omega, circumferential: f32 {b:e} against f64 {a:e}");
+    assert!(
+        a.abs() > 0.0 && (a - b).abs() <= 1e-3 * a.abs(),
+        "{b:e} vs {a:e}"
+    );
+}
