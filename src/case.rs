@@ -506,10 +506,31 @@ pub fn parse_case(path: &Path, text: &str) -> Result<Case, InputError> {
     let ctx = Ctx { path, text };
     let spec: CaseSpec = toml::from_str(text).map_err(|e| {
         let line = e.span().map(|s| ctx.line(s.start)).unwrap_or(0);
+        // The key the error sits on: the text before `=` on its line, qualified by the
+        // table header above it (`operation.rpm`), where there is one.
+        let key = e
+            .span()
+            .and_then(|sp| {
+                let start = text[..sp.start.min(text.len())]
+                    .rfind('\n')
+                    .map_or(0, |k| k + 1);
+                let here = text[start..].lines().next()?;
+                let name = here.split_once('=')?.0.trim().trim_matches('"');
+                let table = text[..start]
+                    .lines()
+                    .rev()
+                    .find(|l| l.trim_start().starts_with('['))
+                    .map(|l| l.trim().trim_matches(|c| c == '[' || c == ']').to_string());
+                Some(match table {
+                    Some(t) if !t.is_empty() => format!("{t}.{name}"),
+                    _ => name.to_string(),
+                })
+            })
+            .unwrap_or_else(|| "-".into());
         InputError {
             source_name: path.display().to_string(),
             line,
-            key: "-".into(),
+            key,
             message: e.message().to_string(),
         }
     })?;
@@ -636,7 +657,11 @@ pub fn parse_case(path: &Path, text: &str) -> Result<Case, InputError> {
         return Err(ctx.err(
             last,
             "hole.bottom_md",
-            format!("the last hole section ends at {previous} m, above the bit at {bit_md} m"),
+            format!(
+                "the last hole section ends at {} m, above the bit at {} m",
+                crate::units::show(previous),
+                crate::units::show(bit_md)
+            ),
         ));
     }
     let hole_at = |md: f64| {
@@ -736,7 +761,7 @@ pub fn parse_case(path: &Path, text: &str) -> Result<Case, InputError> {
             Some(q) => {
                 let md_here = bit_md - tubulars.iter().map(|t: &Tubular| t.length).sum::<f64>();
                 let hole_d = hole_at(md_here).1;
-                Some(ctx.quantity(q, "string.blade_diameter", Dimension::Length, |x| x >= od && x <= hole_d, &format!("od ≤ blade diameter ≤ hole diameter ({hole_d} m): the disk must fit the hole"))?)
+                Some(ctx.quantity(q, "string.blade_diameter", Dimension::Length, |x| x >= od && x <= hole_d, &format!("od ({} m) ≤ blade diameter ≤ hole diameter ({} m): the disk must fit the hole", crate::units::show(od), crate::units::show(hole_d)))?)
             }
             None => None,
         };
@@ -744,7 +769,7 @@ pub fn parse_case(path: &Path, text: &str) -> Result<Case, InputError> {
             return Err(ctx.err(
                 c.od.span(),
                 "string.od",
-                format!("{od} m is wider than the hole"),
+                format!("{} m is wider than the hole", crate::units::show(od)),
             ));
         }
         let bha = kind != "drill_pipe";
@@ -763,7 +788,7 @@ pub fn parse_case(path: &Path, text: &str) -> Result<Case, InputError> {
     let string_length: f64 = tubulars.iter().map(|t| t.length).sum();
     if string_length + 1e-9 < bit_md {
         let last = spec.string.last().map(|c| c.length.span()).unwrap_or(0..0);
-        return Err(ctx.err(last, "string.length", format!("the string is {string_length} m long, shorter than the bit depth {bit_md} m: it must reach the surface")));
+        return Err(ctx.err(last, "string.length", format!("the string is {} m long, shorter than the bit depth {} m: it must reach the surface", crate::units::show(string_length), crate::units::show(bit_md))));
     }
 
     // Operation.

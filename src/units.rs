@@ -326,3 +326,30 @@ mod tests {
         ));
     }
 }
+
+/// A value for a message: six significant digits, no trailing zeros — `0.2159`, not the
+/// `0.21589999999999998` that 8.5 in converts to.
+pub fn show(x: f64) -> String {
+    if x == 0.0 || !x.is_finite() {
+        return format!("{x}");
+    }
+    let digits = (5 - x.abs().log10().floor() as i32).clamp(0, 15) as usize;
+    let s = format!("{x:.digits$}");
+    if s.contains('.') {
+        s.trim_end_matches('0').trim_end_matches('.').to_string()
+    } else {
+        s
+    }
+}
+
+#[cfg(test)]
+mod show_tests {
+    #[test]
+    fn six_significant_digits() {
+        assert_eq!(super::show(8.5 * 0.0254), "0.2159");
+        assert_eq!(super::show(1500.0), "1500");
+        assert_eq!(super::show(1e-9), "0.000000001");
+        assert_eq!(super::show(-2.5), "-2.5");
+        assert_eq!(super::show(123456789.0), "123456789");
+    }
+}

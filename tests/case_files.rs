@@ -373,3 +373,20 @@ fn run_writes_the_requested_time_series_and_plots() {
         "{stderr}"
     );
 }
+
+#[test]
+fn type_errors_name_their_key_and_limits_read_cleanly() {
+    let base = "title = \"x\"\n[well]\nprofile = \"vertical\"\ntotal_md = \"100 m\"\n[[hole]]\nbottom_md = \"100 m\"\ndiameter = \"8.5 in\"\nfriction = \"0.2\"\n";
+    let e = holewall::case::parse_case(std::path::Path::new("q.toml"), base).unwrap_err();
+    assert_eq!((e.line, e.key.as_str()), (8, "hole.friction"), "{e}");
+    // A blade wider than an 8.5 in hole: the limit reads 0.2159 m, not 0.21589999999999998.
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("cases/build_and_hold.toml");
+    let text = std::fs::read_to_string(&path)
+        .unwrap()
+        .replace("blade_diameter = \"8.375 in\"", "blade_diameter = \"9 in\"");
+    let e = holewall::case::parse_case(&path, &text).unwrap_err();
+    assert!(
+        e.message.contains("(0.2159 m)") && !e.message.contains("0.2158999"),
+        "{e}"
+    );
+}
