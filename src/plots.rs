@@ -55,18 +55,9 @@ pub fn line_plot(
     series: &[Series],
     markers: &[Marker],
 ) -> std::io::Result<()> {
-    let tmp = path.with_extension(format!("{}.tmp.png", std::process::id()));
-    let result = draw(&tmp, title, x_label, y_label, series, markers);
-    match result {
-        Ok(()) => std::fs::rename(&tmp, path),
-        Err(e) => {
-            let _ = std::fs::remove_file(&tmp);
-            Err(std::io::Error::other(format!(
-                "plot {}: {e}",
-                path.display()
-            )))
-        }
-    }
+    atomic_png(path, |tmp| {
+        draw(tmp, title, x_label, y_label, series, markers)
+    })
 }
 
 fn draw(

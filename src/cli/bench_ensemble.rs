@@ -287,6 +287,8 @@ pub fn run(
     };
     let adapter = ctx.map(|c| c.describe()).unwrap_or_else(|| "none".into());
     let mut cells: Vec<Cell> = Vec::new();
+    // Counted once: the element's operations do not depend on the cell.
+    let e = super::bench::element_flops();
     let paths: Vec<&str> = if ctx.is_some_and(|c| c.has_f64) {
         vec!["CPU f64", "GPU f64", "GPU f32"]
     } else if ctx.is_some() {
@@ -351,7 +353,6 @@ pub fn run(
                 cell.median_s = Some(t);
                 cell.variant_steps_per_s = Some((v * steps) as f64 / t);
                 cell.newton_iterations_per_step = Some(per_it);
-                let e = super::bench::element_flops();
                 let tangent = if path.starts_with("GPU") {
                     e.by_direction
                 } else {
