@@ -372,7 +372,12 @@ impl Ctx<'_> {
         range: &str,
     ) -> Result<f64, InputError> {
         let v = match q.get_ref() {
-            Quantity::Number(x) if x.is_finite() => *x,
+            Quantity::Number(x) if x.is_finite() => {
+                if let Some(m) = crate::units::bare_number_trap(dim, *x) {
+                    return Err(self.err(q.span(), key, m));
+                }
+                *x
+            }
             Quantity::Number(x) => {
                 return Err(self.err(
                     q.span(),
@@ -380,8 +385,16 @@ impl Ctx<'_> {
                     format!("{x} is not finite; allowed: {range}"),
                 ))
             }
-            Quantity::Text(t) => parse_quantity(t, dim)
-                .map_err(|e| self.err(q.span(), key, format!("{e}; allowed: {range}")))?,
+            Quantity::Text(t) => {
+                let v = parse_quantity(t, dim)
+                    .map_err(|e| self.err(q.span(), key, format!("{e}; allowed: {range}")))?;
+                if t.trim().parse::<f64>().is_ok() {
+                    if let Some(m) = crate::units::bare_number_trap(dim, v) {
+                        return Err(self.err(q.span(), key, m));
+                    }
+                }
+                v
+            }
         };
         if ok(v) {
             Ok(v)
@@ -441,7 +454,7 @@ fn read_survey(
     path: &Path,
     ctx: &Ctx,
     span: std::ops::Range<usize>,
-) -> Result<Vec<SurveyStation>, InputError> {
+) -> Result<Vec<(SurveyStation, usize)>, InputError> {
     let text = std::fs::read_to_string(path).map_err(|e| {
         ctx.err(
             span.clone(),
@@ -481,11 +494,14 @@ fn read_survey(
             s.parse::<f64>()
                 .map_err(|_| bad(format!("{what} {s:?} is not a number")))
         };
-        out.push(SurveyStation {
-            md: parse(fields[0], "md")? * md_factor,
-            inclination_deg: parse(fields[1], "inclination")?,
-            azimuth_deg: parse(fields[2], "azimuth")?,
-        });
+        out.push((
+            SurveyStation {
+                md: parse(fields[0], "md")? * md_factor,
+                inclination_deg: parse(fields[1], "inclination")?,
+                azimuth_deg: parse(fields[2], "azimuth")?,
+            },
+            k + 1,
+        ));
     }
     Ok(out)
 }
@@ -598,14 +614,46 @@ pub fn parse_case(path: &Path, text: &str) -> Result<Case, InputError> {
                 )
             })?;
             let survey_path = path.parent().unwrap_or(Path::new(".")).join(file.get_ref());
-            let stations = read_survey(&survey_path, &ctx, file.span())?;
-            let survey_path_s = survey_path.display().to_string();
-            WellPath::from_survey(&stations, [0.0; 3]).map_err(|e| InputError {
-                source_name: survey_path_s,
-                line: 0,
+            let read = read_survey(&survey_path, &ctx, file.span())?;
+            let survey_err = |line: usize, message: String| InputError {
+                source_name: survey_path.display().to_string(),
+                line,
                 key: "survey".into(),
-                message: e.to_string(),
-            })?
+                message,
+            };
+            let stations: Vec<SurveyStation> = read.iter().map(|(s, _)| *s).collect();
+            let well_path = WellPath::from_survey(&stations, [0.0; 3]).map_err(|e| match e.station() {
+                Some(i) => survey_err(read[i].1, e.detail()),
+                None => survey_err(0, e.to_string()),
+            })?;
+            // The survey must cover the hole: from the surface (MD 0) to the string's depth.
+            if let Some((first, line)) = read.first() {
+                if first.md != 0.0 {
+                    return Err(survey_err(
+                        *line,
+                        format!(
+                            "the first station is at MD {} m; a survey starts at the surface \
+                             (MD 0 m): add a station \"0, 0, 0\" (or the tie-in) above it",
+                            crate::units::show(first.md)
+                        ),
+                    ));
+                }
+            }
+            if let Some((last, line)) = read.last() {
+                if read.len() >= 2 && last.md < bit_md - 1e-6 {
+                    return Err(survey_err(
+                        *line,
+                        format!(
+                            "the last station is at MD {} m, above the bit at {b} m \
+                             (well.total_md); a survey must reach the bit: add stations \
+                             down to {b} m",
+                            crate::units::show(last.md),
+                            b = crate::units::show(bit_md),
+                        ),
+                    ));
+                }
+            }
+            well_path
         }
         other => {
             return Err(ctx.err(
@@ -868,6 +916,36 @@ pub fn parse_case(path: &Path, text: &str) -> Result<Case, InputError> {
             "operation.weight_on_bit",
             "give either weight_on_bit (top clamped) or hook_load (bit on bottom), not both",
         ));
+    }
+    match (op.mode.get_ref().as_str(), &op.rpm) {
+        ("rotating", None) => {
+            return Err(ctx.err(
+                op.mode.span(),
+                "operation.rpm",
+                "mode = \"rotating\" needs the rotary speed: add rpm = \"90 rpm\" (or the \
+                 value you rotate at) to [operation]",
+            ))
+        }
+        ("rotating", Some(q)) if rpm == 0.0 => {
+            return Err(ctx.err(
+                q.span(),
+                "operation.rpm",
+                "mode = \"rotating\" at 0 rpm has no rotation, hence no torque: give the \
+                 rotary speed (> 0), or mode = \"sliding\" / \"tripping_in\" / \"tripping_out\"",
+            ))
+        }
+        ("tripping_in" | "tripping_out" | "sliding", Some(q)) if rpm != 0.0 => {
+            return Err(ctx.err(
+                q.span(),
+                "operation.rpm",
+                format!(
+                    "mode = {:?} does not rotate the string, so this rpm would be ignored: \
+                     remove rpm, or use mode = \"rotating\"",
+                    op.mode.get_ref()
+                ),
+            ))
+        }
+        _ => {}
     }
     let (axial_speed, rotation_speed) = match op.mode.get_ref().as_str() {
         "rotating" => (0.0, rpm),

@@ -20,17 +20,29 @@ pub enum GpuError {
 }
 
 /// An input error: names the source, line, key and the allowed range. Exit code 2.
+/// Shown as `source:line: key: message`, or `source: key: message` where no line applies
+/// (`line` 0: a command-line option, a whole file).
 #[derive(Clone, Debug, Error)]
-#[error("{source_name}:{line}: {key}: {message}")]
 pub struct InputError {
     /// File name, or `<stdin>`.
     pub source_name: String,
-    /// 1-based line number.
+    /// 1-based line number; 0 where no line applies.
     pub line: usize,
     /// The offending key (or `-` where the line as a whole is wrong).
     pub key: String,
     /// What is wrong and what is allowed.
     pub message: String,
+}
+
+impl std::fmt::Display for InputError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        if self.line > 0 {
+            write!(f, "{}:{}: ", self.source_name, self.line)?;
+        } else {
+            write!(f, "{}: ", self.source_name)?;
+        }
+        write!(f, "{}: {}", self.key, self.message)
+    }
 }
 
 /// Top-level error of a command.

@@ -177,7 +177,11 @@ impl Key {
         };
         let t = text.trim();
         let v = match (t.parse::<f64>(), dim) {
-            (Ok(x), _) => x,
+            (Ok(x), Some(d)) => match crate::units::bare_number_trap(d, x) {
+                Some(m) => return Err(m),
+                None => x,
+            },
+            (Ok(x), None) => x,
             (Err(_), Some(d)) => parse_quantity(t, d).map_err(|e| e.to_string())?,
             (Err(_), None) => return Err(format!("{t:?} is not a number")),
         };

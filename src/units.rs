@@ -327,6 +327,52 @@ mod tests {
     }
 }
 
+/// The common traps of a bare number (read as SI) for a key of `dimension`, with the input
+/// the user most likely meant; `None` where a bare number is plainly SI. This is the one
+/// policy for bare numbers: case files and variant values both call it.
+///
+/// - rotary speed: any bare number but 0 is refused (90 would be 90 rad/s = 859 rpm);
+/// - density: a bare number below 500 (kg/m³: lighter than any drilling fluid but gas) is
+///   refused, suggesting `"1.2 sg"` (or `"10 ppg"` for 6 … 25);
+/// - force: a bare number between 0 and 100 (N: the weight of 10 kg) is refused,
+///   suggesting kN or klbf.
+pub fn bare_number_trap(dimension: Dimension, x: f64) -> Option<String> {
+    match dimension {
+        Dimension::AngularSpeed if x != 0.0 => Some(format!(
+            "a bare number is ambiguous for a rotary speed: write the unit, \"{} rpm\" (a bare \
+             {} would be {} rad/s = {} rpm)",
+            show(x),
+            show(x),
+            show(x),
+            show(x * 60.0 / std::f64::consts::TAU)
+        )),
+        Dimension::Density if x > 0.0 && x < 500.0 => {
+            let ppg = if (6.0..=25.0).contains(&x) {
+                format!(" or \"{} ppg\"", show(x))
+            } else {
+                String::new()
+            };
+            Some(format!(
+                "a bare number is kg/m3, and {} kg/m3 is lighter than any drilling fluid but \
+                 gas: did you mean \"{} sg\"{ppg}? (write \"{} kg/m3\" if you mean it)",
+                show(x),
+                show(x),
+                show(x)
+            ))
+        }
+        Dimension::Force if x > 0.0 && x < 100.0 => Some(format!(
+            "a bare number is N, and {} N is the weight of {} kg: did you mean \"{} kN\" or \
+             \"{} klbf\"? (write \"{} N\" if you mean it)",
+            show(x),
+            show(x / 9.806_65),
+            show(x),
+            show(x),
+            show(x)
+        )),
+        _ => None,
+    }
+}
+
 /// A value for a message: six significant digits, no trailing zeros — `0.2159`, not the
 /// `0.21589999999999998` that 8.5 in converts to.
 pub fn show(x: f64) -> String {

@@ -57,6 +57,27 @@ pub enum SurveyError {
     },
 }
 
+impl SurveyError {
+    /// The 0-based station the error is about, if one.
+    pub fn station(&self) -> Option<usize> {
+        match self {
+            SurveyError::TooFewStations(_) => None,
+            SurveyError::MdNotIncreasing { index, .. }
+            | SurveyError::Inclination { index, .. }
+            | SurveyError::NotFinite { index, .. } => Some(*index),
+        }
+    }
+
+    /// The message without its `station N:` prefix (for a message that names the line).
+    pub fn detail(&self) -> String {
+        let s = self.to_string();
+        match self.station() {
+            Some(_) => s.split_once(": ").map_or(s.clone(), |(_, d)| d.to_string()),
+            None => s,
+        }
+    }
+}
+
 /// Unit tangent for inclination and azimuth in radians.
 pub fn tangent(inclination: f64, azimuth: f64) -> Vec3<f64> {
     [

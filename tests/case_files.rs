@@ -390,3 +390,219 @@ fn type_errors_name_their_key_and_limits_read_cleanly() {
         "{e}"
     );
 }
+
+/// Inputs that parse and are wrong (issue 15): each refused with exit 2, the key and line
+/// named, and the input the user most likely meant; nothing written. Prints the table of
+/// docs/validation.md ("Plausible but wrong inputs").
+#[test]
+fn plausible_but_wrong_inputs_are_refused_with_the_likely_intent() {
+    // (what, case text, key, the text on the line named, words the message must hold)
+    let cases: Vec<(&str, String, &str, &str, &str)> = vec![
+        (
+            "bare mud density 1.2",
+            GOOD.replace("density = \"10 ppg\"", "density = 1.2"),
+            "mud.density",
+            "density = 1.2",
+            "\"1.2 sg\"",
+        ),
+        (
+            "bare mud density 10",
+            GOOD.replace("density = \"10 ppg\"", "density = 10"),
+            "mud.density",
+            "density = 10",
+            "\"10 ppg\"",
+        ),
+        (
+            "quoted bare density \"1.2\"",
+            GOOD.replace("density = \"10 ppg\"", "density = \"1.2\""),
+            "mud.density",
+            "density = \"1.2\"",
+            "\"1.2 sg\"",
+        ),
+        (
+            "bare rpm 90",
+            GOOD.replace("rpm = \"120 rpm\"", "rpm = 90"),
+            "operation.rpm",
+            "rpm = 90",
+            "\"90 rpm\"",
+        ),
+        (
+            "rotating without rpm",
+            GOOD.replace("rpm = \"120 rpm\"\n", ""),
+            "operation.rpm",
+            "mode = \"rotating\"",
+            "needs the rotary speed",
+        ),
+        (
+            "rotating at 0 rpm",
+            GOOD.replace("rpm = \"120 rpm\"", "rpm = \"0 rpm\""),
+            "operation.rpm",
+            "rpm = \"0 rpm\"",
+            "no torque",
+        ),
+        (
+            "sliding with rpm",
+            GOOD.replace("mode = \"rotating\"", "mode = \"sliding\""),
+            "operation.rpm",
+            "rpm = \"120 rpm\"",
+            "would be ignored",
+        ),
+        (
+            "bare WOB 20",
+            GOOD.replace("weight_on_bit = \"20 klbf\"", "weight_on_bit = 20"),
+            "operation.weight_on_bit",
+            "weight_on_bit = 20",
+            "\"20 kN\" or \"20 klbf\"",
+        ),
+    ];
+    let mut table = String::new();
+    for (what, text, key, marker, words) in cases {
+        let line = 1 + text[..text.find(marker).unwrap()].matches('\n').count();
+        let dir = scratch(&format!("plausible-{}", what.replace([' ', '"'], "_")));
+        let case = write_case(&dir, &text);
+        let out = dir.join("out");
+        let (code, stdout, stderr) = holewall(&[
+            "static",
+            case.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        assert_eq!(code, 2, "{what}: {stderr}");
+        assert!(stdout.is_empty(), "{what}");
+        assert!(!out.exists(), "{what}: output written");
+        assert!(
+            stderr.contains(&format!("case.toml:{line}: {key}:")),
+            "{what}: line {line} / key {key} not named: {stderr}"
+        );
+        assert!(stderr.contains(words), "{what}: {stderr}");
+        table.push_str(&format!("| {what} | {code} | `{}` |\n", stderr.trim()));
+    }
+    // Explicit units say what the user means: accepted.
+    for (from, to) in [
+        ("density = \"10 ppg\"", "density = \"1.2 kg/m3\""),
+        ("density = \"10 ppg\"", "density = 0"),
+        ("rpm = \"120 rpm\"", "rpm = \"9 rad/s\""),
+        ("weight_on_bit = \"20 klbf\"", "weight_on_bit = \"20 N\""),
+        ("weight_on_bit = \"20 klbf\"", "weight_on_bit = 90000"),
+    ] {
+        let dir = scratch("plausible-ok");
+        let case = write_case(&dir, &GOOD.replace(from, to));
+        assert!(holewall::case::load_case(&case).is_ok(), "{to}");
+    }
+    println!("{table}");
+}
+
+/// A survey must cover the hole; its messages name the CSV's own line (1-based).
+#[test]
+fn survey_messages_name_the_csv_line_and_refuse_a_partial_survey() {
+    let body = "md,inclination,azimuth\n0,0,0\n100,5,10\n";
+    for (what, survey, line, words) in [
+        (
+            "starts below the surface",
+            "md,inclination,azimuth\n100,0,0\n500,5,10\n".to_string(),
+            2,
+            "a survey starts at the surface",
+        ),
+        (
+            "ends above the bit",
+            format!("{body}200,8,10\n"),
+            4,
+            "above the bit at 300 m",
+        ),
+        (
+            "MD not increasing on line 4",
+            format!("{body}100,6,10\n2000,6,10\n"),
+            4,
+            "MD must increase",
+        ),
+        (
+            "inclination on line 3",
+            "md,inclination,azimuth\n0,0,0\n100,190,10\n2000,6,10\n".to_string(),
+            3,
+            "outside [0°, 180°]",
+        ),
+    ] {
+        let dir = scratch(&format!("survey-cover-{}", what.replace(' ', "_")));
+        std::fs::write(dir.join("survey.csv"), survey).unwrap();
+        let text = GOOD.replace(
+            "profile = \"vertical\"",
+            "profile = \"survey\"\nsurvey = \"survey.csv\"",
+        );
+        let case = write_case(&dir, &text);
+        let (code, _, stderr) = holewall(&[
+            "static",
+            case.to_str().unwrap(),
+            "--out",
+            dir.join("out").to_str().unwrap(),
+        ]);
+        assert_eq!(code, 2, "{what}: {stderr}");
+        assert!(
+            stderr.contains(&format!("survey.csv:{line}: survey:")) && stderr.contains(words),
+            "{what}: {stderr}"
+        );
+        assert!(
+            !(0..10).any(|k| stderr.contains(&format!("station {k}"))),
+            "{what}: 0-based station: {stderr}"
+        );
+    }
+}
+
+/// `--out` (issue 15, part 3): checked before computing, the run written whole into a fresh
+/// folder, an earlier run replaced as a whole (no stale files), anything else refused.
+#[test]
+fn output_folder_is_checked_first_and_replaced_whole() {
+    let dir = scratch("outdir");
+    let case = write_case(&dir, GOOD);
+    let out = dir.join("out");
+    let static_into = |o: &Path, model: &str| {
+        holewall(&[
+            "static",
+            case.to_str().unwrap(),
+            "--model",
+            model,
+            "--out",
+            o.to_str().unwrap(),
+        ])
+    };
+    let (code, _, stderr) = static_into(&out, "fe");
+    assert_eq!(code, 0, "{stderr}");
+    assert!(out.join("fe_vs_soft_string.png").is_file());
+    // An earlier run's folder, with a stale plot of some other run: replaced as a whole.
+    std::fs::write(out.join("stale.png"), b"x").unwrap();
+    let (code, _, stderr) = static_into(&out, "soft-string");
+    assert_eq!(code, 0, "{stderr}");
+    assert!(!out.join("stale.png").exists());
+    assert!(!out.join("fe_vs_soft_string.png").exists());
+    assert!(out.join("summary.json").is_file());
+    // No staging folder left beside it.
+    let leftovers: Vec<String> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|n| n.starts_with('.'))
+        .collect();
+    assert!(leftovers.is_empty(), "{leftovers:?}");
+    // A file, and a folder with a user's files: refused before computing, untouched.
+    let file = dir.join("a_file");
+    std::fs::write(&file, b"keep").unwrap();
+    let (code, _, stderr) = static_into(&file, "fe");
+    assert_eq!(code, 2, "{stderr}");
+    assert!(stderr.contains("--out:") && stderr.contains("is a file"), "{stderr}");
+    assert_eq!(std::fs::read(&file).unwrap(), b"keep");
+    let user = dir.join("user");
+    std::fs::create_dir_all(&user).unwrap();
+    std::fs::write(user.join("notes.txt"), b"mine").unwrap();
+    let (code, _, stderr) = static_into(&user, "fe");
+    assert_eq!(code, 2, "{stderr}");
+    assert!(stderr.contains("not the outputs of an earlier holewall run"), "{stderr}");
+    assert_eq!(
+        std::fs::read_dir(&user).unwrap().count(),
+        1,
+        "the user's folder was written into"
+    );
+    // A bad case: nothing written, the earlier run kept as it was.
+    let before = std::fs::read(out.join("summary.json")).unwrap();
+    let bad = write_case(&dir, &GOOD.replace("friction = 0.3", "friction = -1"));
+    let (code, _, _) = holewall(&["static", bad.to_str().unwrap(), "--out", out.to_str().unwrap()]);
+    assert_eq!(code, 2);
+    assert_eq!(std::fs::read(out.join("summary.json")).unwrap(), before);
+}

@@ -8,7 +8,7 @@ use serde::Serialize;
 
 use crate::case::{load_case, Case};
 use crate::error::{Error, InputError};
-use crate::output::write_atomic;
+use crate::output::{write_atomic, RunFolder};
 use crate::physics::vec3::{dot, scale, sub};
 use crate::plots::{line_plot, Series};
 use crate::solve::dynamics::{strain_energy, AlphaParams, DynamicOptions, DynamicState, Dynamics};
@@ -127,11 +127,28 @@ pub fn options_for(settings: &crate::case::DynamicsSettings) -> DynamicOptions {
 /// Runs the command.
 pub fn run(case_path: &Path, out: &Path, show_progress: bool) -> Result<RunSummary, Error> {
     let case = load_case(case_path)?;
-    run_case(&case, out, show_progress)
+    let folder = RunFolder::prepare(out)?;
+    let summary = run_case(&case, folder.path(), show_progress)?;
+    folder.finish(&summary_json(&summary)?)?;
+    Ok(summary)
 }
 
-/// Runs a loaded case (its model may carry an ensemble variant's overrides).
-pub fn run_case(case: &Case, out: &Path, show_progress: bool) -> Result<RunSummary, Error> {
+fn summary_json(summary: &RunSummary) -> Result<Vec<u8>, Error> {
+    Ok(serde_json::to_vec_pretty(summary).map_err(std::io::Error::other)?)
+}
+
+/// Runs a loaded case (its model may carry an ensemble variant's overrides), writing its
+/// files into the folder `out` as it is (the caller checked it) and `summary.json` last.
+pub fn run_case_into(case: &Case, out: &Path, show_progress: bool) -> Result<RunSummary, Error> {
+    std::fs::create_dir_all(out)?;
+    let summary = run_case(case, out, show_progress)?;
+    write_atomic(&out.join("summary.json"), &summary_json(&summary)?)?;
+    Ok(summary)
+}
+
+/// Runs a loaded case and writes every output but `summary.json` into the existing folder
+/// `out`; returns the summary.
+fn run_case(case: &Case, out: &Path, show_progress: bool) -> Result<RunSummary, Error> {
     let case_path = &case.path;
     let settings = case.dynamics.clone().ok_or_else(|| {
         Error::Input(InputError { source_name: case_path.display().to_string(), line: 1, key: "dynamics".into(), message: "holewall run needs a [dynamics] table (duration, time_step, …); see cases/README.md".into() })
@@ -180,7 +197,6 @@ pub fn run_case(case: &Case, out: &Path, show_progress: bool) -> Result<RunSumma
         record(case, &dynamics, st, &mut rec, &want);
     }
 
-    std::fs::create_dir_all(out)?;
     let mut written = Vec::new();
     let t: Vec<f64> = rec.series.iter().map(|r| r[0]).collect();
     let col = |k: usize| -> Vec<(f64, f64)> { rec.series.iter().map(|r| (r[0], r[k])).collect() };
@@ -406,11 +422,5 @@ pub fn run_case(case: &Case, out: &Path, show_progress: bool) -> Result<RunSumma
         log: dynamics.log.clone(),
         outputs: written,
     };
-    write_atomic(
-        &out.join("summary.json"),
-        serde_json::to_string_pretty(&summary)
-            .map_err(std::io::Error::other)?
-            .as_bytes(),
-    )?;
     Ok(summary)
 }

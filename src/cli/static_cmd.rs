@@ -8,7 +8,7 @@ use serde::Serialize;
 use crate::case::{load_case, Case};
 use crate::error::Error;
 use crate::model::Model;
-use crate::output::write_atomic;
+use crate::output::{write_atomic, RunFolder};
 use crate::physics::soft_string::{soft_string_with, Operation};
 use crate::physics::vec3::{dot, scale, sub};
 use crate::solve::statics::{solve_static, StaticOptions};
@@ -233,6 +233,7 @@ pub fn fe_rows(
 /// Runs the command; returns the summary.
 pub fn run(case_path: &Path, which: StaticModel, out: &Path) -> Result<Summary, Error> {
     let case = load_case(case_path)?;
+    let folder = RunFolder::prepare(out)?;
     let model = &case.model;
     let n = model.nodes.len();
     let mut wob = model.weight_on_bit;
@@ -304,7 +305,7 @@ pub fn run(case_path: &Path, which: StaticModel, out: &Path) -> Result<Summary, 
         newton_iterations: its,
         solver_log,
     };
-    std::fs::create_dir_all(out)?;
+    let dir = folder.path();
     let mut w = csv::Writer::from_writer(Vec::new());
     for r in &rows {
         w.serialize(r)
@@ -313,10 +314,10 @@ pub fn run(case_path: &Path, which: StaticModel, out: &Path) -> Result<Summary, 
     let bytes = w
         .into_inner()
         .map_err(|e| Error::Io(std::io::Error::other(e.to_string())))?;
-    write_atomic(&out.join("profile.csv"), &bytes)?;
-    let json = serde_json::to_string_pretty(&summary).map_err(std::io::Error::other)?;
-    write_atomic(&out.join("summary.json"), json.as_bytes())?;
-    write_plots(&case, which, &rows, np, out)?;
+    write_atomic(&dir.join("profile.csv"), &bytes)?;
+    write_plots(&case, which, &rows, np, dir)?;
+    let json = serde_json::to_vec_pretty(&summary).map_err(std::io::Error::other)?;
+    folder.finish(&json)?;
     Ok(summary)
 }
 

@@ -12,7 +12,7 @@ use crate::backend::{BackendChoice, Precision};
 use crate::case::{load_case, Analysis};
 use crate::ensemble::{apply, stabilizer_sites};
 use crate::error::{Error, InputError};
-use crate::output::write_atomic;
+use crate::output::{out_error, write_atomic};
 use crate::plots::{line_plot, Series};
 
 /// Runs the command.
@@ -357,7 +357,7 @@ pub fn run(
             let mut c = case.clone();
             c.model = apply(&case, v).map_err(|e| Error::Io(std::io::Error::other(e)))?;
             let dir = out.join("series").join(name);
-            crate::cli::run_cmd::run_case(&c, &dir, false)?;
+            crate::cli::run_cmd::run_case_into(&c, &dir, false)?;
             outputs.push(format!("series/{name}/"));
         }
     }

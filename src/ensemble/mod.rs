@@ -242,6 +242,17 @@ pub fn apply(case: &Case, variant: &Variant) -> Result<Model, String> {
             continue;
         }
         let k = stab(key.stabilizer.unwrap_or(1))?;
+        let string_length = case.bit_md - model.nodes[0].md;
+        if !(*value > 0.0 && *value < string_length) {
+            return Err(format!(
+                "{}: {} m from the bit is off the string, which is {} m long; allowed: \
+                 0 < from_bit < {} m",
+                key.name,
+                crate::units::show(*value),
+                crate::units::show(string_length),
+                crate::units::show(string_length)
+            ));
+        }
         let md = case.bit_md - value;
         let n = model.nodes.len();
         // Not the clamped top or the laterally held bit.
@@ -371,6 +382,16 @@ pub fn variant_case(case: &Case, variant: &Variant) -> Result<Option<Case>, Stri
     }
     if let Some(m) = mode {
         let mut op = section(&mut table, "operation")?;
+        // The variant chooses the operation: a tripping or sliding variant does not rotate
+        // (the case's rpm belongs to its rotating variants), and a rotating one rotates at
+        // the variant's rpm where it gives one (applied again with the other overrides).
+        if m == "rotating" {
+            if let Some((_, rpm)) = variant.overrides.iter().find(|(k, _)| k.param == Param::Rpm) {
+                op.insert("rpm".into(), toml::Value::String(format!("{rpm} rad/s")));
+            }
+        } else {
+            op.remove("rpm");
+        }
         op.insert("mode".into(), toml::Value::String(m));
         table.insert("operation".into(), toml::Value::Table(op));
     }

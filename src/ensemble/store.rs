@@ -7,8 +7,8 @@ use serde::{Deserialize, Serialize};
 
 use super::qoi::*;
 use crate::backend::{BackendChoice, Precision};
-use crate::error::{Error, InputError};
-use crate::output::write_atomic;
+use crate::error::Error;
+use crate::output::{out_error, write_atomic};
 
 /// Variants per result chunk unless `--chunk-size` says otherwise.
 pub const DEFAULT_CHUNK: usize = 256;
@@ -128,16 +128,6 @@ pub(crate) fn is_run_output(name: &str) -> bool {
         name,
         "run.json" | "summary.json" | "variants.csv" | "chunks" | "series"
     ) || name.ends_with(".png")
-}
-
-pub(crate) fn out_error(out: &Path, message: String) -> Error {
-    InputError {
-        source_name: "--out".into(),
-        line: 0,
-        key: out.display().to_string(),
-        message,
-    }
-    .into()
 }
 
 /// Checks the output folder before any work: a fresh or empty folder, or one holding this
