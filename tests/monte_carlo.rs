@@ -281,7 +281,8 @@ fn broomstick_of_the_shipped_case() {
     let text = std::fs::read_to_string(&path)
         .unwrap()
         .replace("total_md = \"1500 m\"", "total_md = \"1000 m\"")
-        .replace("mode = \"rotating\"", "mode = \"tripping_out\"");
+        .replace("mode = \"rotating\"", "mode = \"tripping_out\"")
+        .replace("rpm = \"120 rpm\"", "");
     let single = holewall::case::parse_case(&path, &text).unwrap();
     let via = hook(1000.0, "tripping_out", 0.25);
     // The variant's model is the case with its depth and mode written in (same mesh, same
