@@ -336,6 +336,42 @@ pub struct Case {
     pub ensemble: Option<EnsembleSettings>,
 }
 
+impl Case {
+    /// The hole section at `md`: (bottom MD, diameter, friction); below the last section,
+    /// the last.
+    pub fn hole_at(&self, md: f64) -> (f64, f64, f64) {
+        self.hole
+            .iter()
+            .find(|h| md <= h.0 + 1e-9)
+            .or(self.hole.last())
+            .copied()
+            .unwrap_or((md, 0.2159, 0.25))
+    }
+
+    /// The hole diameter at `md` (m).
+    pub fn hole_diameter_at(&self, md: f64) -> f64 {
+        self.hole_at(md).1
+    }
+
+    /// The soft-string profile of the case's operation, with each hole section's friction.
+    pub fn soft_string(&self) -> crate::physics::soft_string::SoftStringProfile {
+        use crate::physics::soft_string::{soft_string_with, Operation};
+        let model = &self.model;
+        let friction_at = |md: f64| self.hole_at(md).2;
+        soft_string_with(
+            model,
+            &Operation {
+                axial_speed: model.axial_speed,
+                rotation_speed: model.rotation_speed,
+                weight_on_bit: model.weight_on_bit,
+                torque_on_bit: model.torque_on_bit,
+                friction: friction_at(0.0),
+            },
+            &friction_at,
+        )
+    }
+}
+
 struct Ctx<'a> {
     path: &'a Path,
     text: &'a str,

@@ -48,6 +48,13 @@ enum Command {
         /// Output folder.
         #[arg(long)]
         out: PathBuf,
+        /// No progress bar.
+        #[arg(long)]
+        quiet: bool,
+        /// Stop the FE solve after this many seconds of wall time (it then fails, saying
+        /// how far it got and why it was slow).
+        #[arg(long, value_parser = positive_seconds)]
+        max_seconds: Option<f64>,
     },
     /// Dynamic analysis: spin-up from the static equilibrium, implicit time integration
     /// (time series CSV and plots).
@@ -60,6 +67,10 @@ enum Command {
         /// No progress bar.
         #[arg(long)]
         quiet: bool,
+        /// Wall-time budget (s): the run stops at the next output instant once it is
+        /// spent, writes the outputs of the time it simulated, and says so in summary.json.
+        #[arg(long, value_parser = positive_seconds)]
+        max_seconds: Option<f64>,
     },
     /// One case, many variants (CSV of overrides or the case's [ensemble] grid): statics
     /// or dynamics per variant, quantities of interest and status in variants.csv.
@@ -288,10 +299,34 @@ fn main() -> ExitCode {
                 Err(errs) => fail(&errs),
             }
         }
-        Command::Static { case, model, out } => {
-            print_summary(cli::static_cmd::run(&case, model, &out))
-        }
-        Command::Run { case, out, quiet } => print_summary(cli::run_cmd::run(&case, &out, !quiet)),
+        Command::Static {
+            case,
+            model,
+            out,
+            quiet,
+            max_seconds,
+        } => print_summary(cli::static_cmd::run(
+            &case,
+            model,
+            &out,
+            cli::static_cmd::StaticCommandOptions {
+                show_progress: !quiet,
+                max_seconds,
+            },
+        )),
+        Command::Run {
+            case,
+            out,
+            quiet,
+            max_seconds,
+        } => print_summary(cli::run_cmd::run(
+            &case,
+            &out,
+            cli::run_cmd::RunOptions {
+                show_progress: !quiet,
+                max_seconds,
+            },
+        )),
         Command::Ensemble {
             case,
             variants,
@@ -410,5 +445,13 @@ fn main() -> ExitCode {
                 Err(e) => fail(&[e]),
             },
         },
+    }
+}
+
+/// `--max-seconds`: a finite number of seconds > 0.
+fn positive_seconds(s: &str) -> Result<f64, String> {
+    match s.parse::<f64>() {
+        Ok(x) if x.is_finite() && x > 0.0 => Ok(x),
+        _ => Err(format!("{s:?}: allowed: a number of seconds > 0")),
     }
 }

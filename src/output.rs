@@ -200,3 +200,18 @@ impl Drop for RunFolder {
         }
     }
 }
+
+/// A progress bar on stderr with `template` (indicatif), or a hidden one when `show` is
+/// false; the one style every long command uses.
+pub fn progress_bar(show: bool, len: u64, template: &str) -> indicatif::ProgressBar {
+    let bar = if show {
+        indicatif::ProgressBar::new(len)
+    } else {
+        indicatif::ProgressBar::hidden()
+    };
+    bar.set_style(
+        indicatif::ProgressStyle::with_template(template)
+            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+    );
+    bar
+}

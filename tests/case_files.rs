@@ -606,3 +606,116 @@ fn output_folder_is_checked_first_and_replaced_whole() {
     assert_eq!(code, 2);
     assert_eq!(std::fs::read(out.join("summary.json")).unwrap(), before);
 }
+
+/// Long runs can be bounded (issue 15, part 2): `run --max-seconds` stops at an output
+/// instant, writes the outputs of the time simulated and says so; the static FE solve stops
+/// with how far it got.
+#[test]
+fn runs_can_be_bounded_in_wall_time() {
+    let path = root().join("cases/paper_one_stabilizer.toml");
+    let out = scratch("budget-run");
+    let dir = out.join("r");
+    let (code, stdout, stderr) = holewall(&[
+        "run",
+        path.to_str().unwrap(),
+        "--out",
+        dir.to_str().unwrap(),
+        "--quiet",
+        "--max-seconds",
+        "1.5",
+    ]);
+    assert_eq!(code, 0, "{stderr}");
+    assert!(stderr.contains("--max-seconds budget"), "{stderr}");
+    let summary: serde_json::Value = serde_json::from_str(&stdout).unwrap();
+    let reached = summary["duration_s"].as_f64().unwrap();
+    assert!(reached > 0.0 && reached < 50.0, "{summary}");
+    assert_eq!(summary["requested_duration_s"].as_f64().unwrap(), 50.0);
+    assert!(summary["stopped_early"].as_str().unwrap().contains("budget"));
+    let csv = std::fs::read_to_string(dir.join("timeseries.csv")).unwrap();
+    let last_t: f64 = csv
+        .lines()
+        .last()
+        .unwrap()
+        .split(',')
+        .next()
+        .unwrap()
+        .parse()
+        .unwrap();
+    assert!((last_t - reached).abs() < 1e-9, "{last_t} vs {reached}");
+    // Not a number of seconds: a usage error (exit 2).
+    let (code, _, _) = holewall(&[
+        "static",
+        path.to_str().unwrap(),
+        "--out",
+        out.join("s").to_str().unwrap(),
+        "--max-seconds",
+        "0",
+    ]);
+    assert_eq!(code, 2);
+    // The FE solve's budget: stopped after its first iteration, with how far it got.
+    let case = holewall::case::load_case(&root().join("cases/build_and_hold.toml")).unwrap();
+    let e = holewall::cli::static_cmd::solve_with_progress(
+        &case,
+        holewall::solve::statics::StaticOptions {
+            max_seconds: Some(1e-9),
+            ..Default::default()
+        },
+        false,
+    )
+    .unwrap_err();
+    assert!(e.contains("--max-seconds budget") && e.contains("% of the loads"), "{e}");
+}
+
+/// A WOB far beyond helical buckling: the solve fails quickly and says why (issue 15).
+#[test]
+fn a_failed_static_solve_names_helical_buckling() {
+    let dir = scratch("wob1mn");
+    let text = std::fs::read_to_string(root().join("cases/build_and_hold.toml"))
+        .unwrap()
+        .replace("weight_on_bit = \"15 klbf\"", "weight_on_bit = \"1 MN\"");
+    let case = write_case(&dir, &text);
+    let out = dir.join("out");
+    let (code, stdout, stderr) = holewall(&[
+        "static",
+        case.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--quiet",
+    ]);
+    assert_eq!(code, 1, "{stdout}");
+    assert!(
+        stderr.contains("helical buckling load") && stderr.contains("WOB below"),
+        "{stderr}"
+    );
+    assert!(!out.exists());
+}
+
+/// Soft spring laws (m < 1) on an ordinary two-stabilizer deviated well: solved (they cycled
+/// at the contacts' onset and failed at 59 % of the load before the deep line search), and
+/// the hook load agrees with the linear law's (the penetrations are micrometres).
+#[test]
+fn soft_spring_laws_solve_a_two_stabilizer_deviated_well() {
+    let base = std::fs::read_to_string(root().join("cases/stress_two_stabilizers.toml")).unwrap();
+    let hook = |text: &str, name: &str| -> f64 {
+        let dir = scratch(&format!("soft-{name}"));
+        let case = write_case(&dir, text);
+        let out = dir.join("out");
+        let (code, stdout, stderr) = holewall(&[
+            "static",
+            case.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+            "--quiet",
+        ]);
+        assert_eq!(code, 0, "{name}: {stderr}");
+        let s: serde_json::Value = serde_json::from_str(&stdout).unwrap();
+        s["hook_load_n"].as_f64().unwrap()
+    };
+    let linear = hook(&base, "linear");
+    for m in ["0.6667", "0.1"] {
+        let text = base.replace("[contact]\n", &format!("[contact]\nexponent = {m}\n"));
+        assert!(text.contains("exponent"), "no [contact] table");
+        let h = hook(&text, m);
+        assert!((h / linear - 1.0).abs() < 1e-5, "m = {m}: {h} vs {linear}");
+    }
+}

@@ -12,7 +12,7 @@ use crate::output::{write_atomic, RunFolder};
 use crate::physics::vec3::{dot, scale, sub};
 use crate::plots::{line_plot, Series};
 use crate::solve::dynamics::{strain_energy, AlphaParams, DynamicOptions, DynamicState, Dynamics};
-use crate::solve::statics::{solve_static, StaticOptions};
+use crate::solve::statics::StaticOptions;
 
 /// `summary.json` of a run.
 #[derive(Clone, Debug, Serialize)]
@@ -29,6 +29,20 @@ pub struct RunSummary {
     pub log: Vec<String>,
     /// Outputs written.
     pub outputs: Vec<String>,
+    /// The case's duration (s); `duration_s` is less where the budget stopped the run.
+    pub requested_duration_s: f64,
+    /// Why the run ended before `requested_duration_s` (the `--max-seconds` budget), if it did.
+    pub stopped_early: Option<String>,
+}
+
+/// Options of `holewall run`.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct RunOptions {
+    /// Progress bars on stderr.
+    pub show_progress: bool,
+    /// Wall-clock budget (s) for the static start and the integration together: the run
+    /// stops at the next output instant once it is spent, and writes what it has.
+    pub max_seconds: Option<f64>,
 }
 
 struct Recorder {
@@ -125,10 +139,10 @@ pub fn options_for(settings: &crate::case::DynamicsSettings) -> DynamicOptions {
 }
 
 /// Runs the command.
-pub fn run(case_path: &Path, out: &Path, show_progress: bool) -> Result<RunSummary, Error> {
+pub fn run(case_path: &Path, out: &Path, options: RunOptions) -> Result<RunSummary, Error> {
     let case = load_case(case_path)?;
     let folder = RunFolder::prepare(out)?;
-    let summary = run_case(&case, folder.path(), show_progress)?;
+    let summary = run_case(&case, folder.path(), options)?;
     folder.finish(&summary_json(&summary)?)?;
     Ok(summary)
 }
@@ -141,21 +155,37 @@ fn summary_json(summary: &RunSummary) -> Result<Vec<u8>, Error> {
 /// files into the folder `out` as it is (the caller checked it) and `summary.json` last.
 pub fn run_case_into(case: &Case, out: &Path, show_progress: bool) -> Result<RunSummary, Error> {
     std::fs::create_dir_all(out)?;
-    let summary = run_case(case, out, show_progress)?;
+    let summary = run_case(
+        case,
+        out,
+        RunOptions {
+            show_progress,
+            max_seconds: None,
+        },
+    )?;
     write_atomic(&out.join("summary.json"), &summary_json(&summary)?)?;
     Ok(summary)
 }
 
 /// Runs a loaded case and writes every output but `summary.json` into the existing folder
 /// `out`; returns the summary.
-fn run_case(case: &Case, out: &Path, show_progress: bool) -> Result<RunSummary, Error> {
+fn run_case(case: &Case, out: &Path, run_options: RunOptions) -> Result<RunSummary, Error> {
+    let clock = std::time::Instant::now();
+    let show_progress = run_options.show_progress;
     let case_path = &case.path;
     let settings = case.dynamics.clone().ok_or_else(|| {
         Error::Input(InputError { source_name: case_path.display().to_string(), line: 1, key: "dynamics".into(), message: "holewall run needs a [dynamics] table (duration, time_step, …); see cases/README.md".into() })
     })?;
     let model = &case.model;
-    let start = solve_static(model, &StaticOptions::default())
-        .map_err(|e| Error::Io(std::io::Error::other(format!("static start: {e}"))))?;
+    let start = crate::cli::static_cmd::solve_with_progress(
+        case,
+        StaticOptions {
+            max_seconds: run_options.max_seconds,
+            ..StaticOptions::default()
+        },
+        show_progress,
+    )
+    .map_err(|e| Error::Io(std::io::Error::other(format!("static start: {e}"))))?;
     let options = options_for(&settings);
     let density = case.element_density.clone();
     let mut dynamics = Dynamics::new(model, options, &|e| density[e]);
@@ -169,30 +199,48 @@ fn run_case(case: &Case, out: &Path, show_progress: bool) -> Result<RunSummary, 
         stress: Vec::new(),
     };
     record(case, &dynamics, &s, &mut rec, &want);
-    let bar = if show_progress {
-        indicatif::ProgressBar::new(1000)
-    } else {
-        indicatif::ProgressBar::hidden()
-    };
-    bar.set_style(
-        indicatif::ProgressStyle::with_template(
-            "{bar:40} {percent:>3}% t = {msg} s, {elapsed} elapsed, eta {eta}",
-        )
-        .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+    let bar = crate::output::progress_bar(
+        show_progress,
+        1000,
+        "{bar:40} {percent:>3}% t = {msg} s, {elapsed} elapsed, eta {eta}",
     );
     let mut next_output = settings.output_interval;
     let mut pending: Vec<DynamicState> = Vec::new();
-    dynamics
-        .run(&mut s, settings.duration, &mut |_, st| {
-            bar.set_position((1000.0 * st.t / settings.duration) as u64);
-            bar.set_message(format!("{:.3}", st.t));
-            if st.t >= next_output - 1e-9 {
-                pending.push(st.clone());
-                next_output += settings.output_interval;
+    let mut observe = |_: &Dynamics, st: &DynamicState| {
+        bar.set_position((1000.0 * st.t / settings.duration) as u64);
+        bar.set_message(format!("{:.3}", st.t));
+        if st.t >= next_output - 1e-9 {
+            pending.push(st.clone());
+            next_output += settings.output_interval;
+        }
+    };
+    let mut stopped_early = None;
+    match run_options.max_seconds {
+        // No budget: one call, the steps exactly as the case sets them.
+        None => dynamics
+            .run(&mut s, settings.duration, &mut observe)
+            .map_err(|e| Error::Io(std::io::Error::other(e)))?,
+        // A budget: output interval by output interval, the clock read in between.
+        Some(budget) => {
+            while s.t < settings.duration - 1e-12 {
+                if clock.elapsed().as_secs_f64() > budget {
+                    stopped_early = Some(format!(
+                        "the --max-seconds budget ({budget} s) was spent at t = {:.4} s of {} s",
+                        s.t, settings.duration
+                    ));
+                    break;
+                }
+                let until = (s.t + settings.output_interval).min(settings.duration);
+                dynamics
+                    .run(&mut s, until, &mut observe)
+                    .map_err(|e| Error::Io(std::io::Error::other(e)))?;
             }
-        })
-        .map_err(|e| Error::Io(std::io::Error::other(e)))?;
+        }
+    }
     bar.finish_and_clear();
+    if let Some(why) = &stopped_early {
+        eprintln!("holewall: {why}; the outputs cover the time simulated");
+    }
     for st in &pending {
         record(case, &dynamics, st, &mut rec, &want);
     }
@@ -421,6 +469,8 @@ fn run_case(case: &Case, out: &Path, show_progress: bool) -> Result<RunSummary, 
             / steps.max(1) as f64,
         log: dynamics.log.clone(),
         outputs: written,
+        requested_duration_s: settings.duration,
+        stopped_early,
     };
     Ok(summary)
 }

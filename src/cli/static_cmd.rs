@@ -9,9 +9,8 @@ use crate::case::{load_case, Case};
 use crate::error::Error;
 use crate::model::Model;
 use crate::output::{write_atomic, RunFolder};
-use crate::physics::soft_string::{soft_string_with, Operation};
 use crate::physics::vec3::{dot, scale, sub};
-use crate::solve::statics::{solve_static, StaticOptions};
+use crate::solve::statics::{solve_static_monitored, StaticOptions, StaticState};
 
 /// Which model computes the profile.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
@@ -116,41 +115,10 @@ pub fn nodal_axial_forces(element_axial: &[f64]) -> Vec<f64> {
         .collect()
 }
 
-/// Sinusoidal and helical buckling flags of a static profile: compression beyond the larger of
-/// Dawson–Paslay and Lubinski (sinusoidal), beyond √2 of it (helical), anywhere.
-pub fn buckling(model: &Model, rows: &[ProfileRow], case: &Case) -> (bool, bool) {
-    let mut sinusoidal = false;
-    let mut helical = false;
-    for (i, e) in model.elements.iter().enumerate() {
-        let f = -(0.5 * (rows[i].axial_force_n + rows[i + 1].axial_force_n));
-        if f <= 0.0 {
-            continue;
-        }
-        let md = 0.5 * (model.nodes[i].md + model.nodes[i + 1].md);
-        let hole_d = case
-            .hole
-            .iter()
-            .find(|h| md <= h.0 + 1e-9)
-            .map(|h| h.1)
-            .unwrap_or(case.hole[0].1);
-        let r = 0.5 * (hole_d - e.outer_diameter);
-        let ei = e.section.bending_stiffness();
-        let w = e.buoyed_weight_per_length.max(0.0);
-        let sin_i = {
-            let t = model.nodes[i].hole_axis;
-            (1.0 - t[2] * t[2]).max(0.0).sqrt()
-        };
-        let dp = if r > 0.0 {
-            2.0 * (ei * w * sin_i / r).sqrt()
-        } else {
-            f64::INFINITY
-        };
-        let lubinski = 2.55 * (ei * w * w).cbrt();
-        let critical = dp.max(lubinski);
-        sinusoidal |= f > critical;
-        helical |= f > std::f64::consts::SQRT_2 * critical;
-    }
-    (sinusoidal, helical)
+/// Sinusoidal and helical buckling flags of a static profile ([`crate::diagnose::buckling`]).
+pub fn buckling(case: &Case, rows: &[ProfileRow]) -> (bool, bool) {
+    let axial: Vec<f64> = rows.iter().map(|r| r.axial_force_n).collect();
+    crate::diagnose::buckling(case, &axial)
 }
 
 /// Profile rows, hook load, surface torque and weight on bit of an FE static solution.
@@ -230,8 +198,48 @@ pub fn fe_rows(
     (rows, hook, torque, wob)
 }
 
+/// The FE static solution of a case, with a progress bar (load factor reached) when
+/// `show_progress`, within `options.max_seconds`; a failure says why
+/// ([`crate::diagnose::static_failure`]).
+pub fn solve_with_progress(
+    case: &Case,
+    options: StaticOptions,
+    show_progress: bool,
+) -> Result<crate::solve::statics::StaticSolution, String> {
+    let model = &case.model;
+    let start = if model.sites.is_empty() {
+        StaticState::initial(model)
+    } else {
+        StaticState::on_low_side(model)
+    };
+    let bar = crate::output::progress_bar(
+        show_progress,
+        1000,
+        "{bar:40} {percent:>3}% of the loads (static), {elapsed} elapsed",
+    );
+    let solved = solve_static_monitored(model, start, &options, &mut |lambda| {
+        bar.set_position((1000.0 * lambda) as u64)
+    });
+    bar.finish_and_clear();
+    solved.map_err(|e| crate::diagnose::static_failure(case, &e))
+}
+
+/// Options of `holewall static`.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct StaticCommandOptions {
+    /// Progress bar on stderr.
+    pub show_progress: bool,
+    /// Wall-clock budget of the FE solve (s).
+    pub max_seconds: Option<f64>,
+}
+
 /// Runs the command; returns the summary.
-pub fn run(case_path: &Path, which: StaticModel, out: &Path) -> Result<Summary, Error> {
+pub fn run(
+    case_path: &Path,
+    which: StaticModel,
+    out: &Path,
+    options: StaticCommandOptions,
+) -> Result<Summary, Error> {
     let case = load_case(case_path)?;
     let folder = RunFolder::prepare(out)?;
     let model = &case.model;
@@ -240,8 +248,15 @@ pub fn run(case_path: &Path, which: StaticModel, out: &Path) -> Result<Summary, 
     let mut solver_log = Vec::new();
     let (rows, hook, torque, its) = match which {
         StaticModel::Fe => {
-            let sol = solve_static(model, &StaticOptions::default())
-                .map_err(|e| Error::Io(std::io::Error::other(e.to_string())))?;
+            let sol = solve_with_progress(
+                &case,
+                StaticOptions {
+                    max_seconds: options.max_seconds,
+                    ..StaticOptions::default()
+                },
+                options.show_progress,
+            )
+            .map_err(|e| Error::Io(std::io::Error::other(e)))?;
             let (rows, hook, torque, w) = fe_rows(model, &sol);
             wob = w;
             solver_log = sol.log.clone();
@@ -251,7 +266,7 @@ pub fn run(case_path: &Path, which: StaticModel, out: &Path) -> Result<Summary, 
             if let crate::model::TopBoundary::HookLoad(_) = model.top {
                 return Err(Error::Io(std::io::Error::other("the soft-string model needs the weight on bit; give operation.weight_on_bit instead of hook_load")));
             }
-            let prof = soft_string_for_case(&case);
+            let prof = case.soft_string();
             let rows: Vec<ProfileRow> = (0..n)
                 .map(|i| {
                     let e = i.min(n - 2);
@@ -286,7 +301,7 @@ pub fn run(case_path: &Path, which: StaticModel, out: &Path) -> Result<Summary, 
                 (bk, bv)
             }
         });
-    let (sinusoidal, helical) = buckling(model, &rows, &case);
+    let (sinusoidal, helical) = buckling(&case, &rows);
     let summary = Summary {
         title: case.title.clone(),
         model: match which {
@@ -405,7 +420,7 @@ fn write_plots(
     )?;
     if which == StaticModel::Fe {
         let model = &case.model;
-        let ss = soft_string_for_case(case);
+        let ss = case.soft_string();
         let ss_pts: Vec<(f64, f64)> = model
             .nodes
             .iter()
@@ -431,28 +446,4 @@ fn write_plots(
         )?;
     }
     Ok(())
-}
-
-/// The soft-string profile of a case's operation, with each hole section's friction.
-pub fn soft_string_for_case(case: &Case) -> crate::physics::soft_string::SoftStringProfile {
-    let model = &case.model;
-    let friction_at = |md: f64| {
-        case.hole
-            .iter()
-            .find(|h| md <= h.0 + 1e-9)
-            .or(case.hole.last())
-            .map(|h| h.2)
-            .unwrap_or(0.25)
-    };
-    soft_string_with(
-        model,
-        &Operation {
-            axial_speed: model.axial_speed,
-            rotation_speed: model.rotation_speed,
-            weight_on_bit: model.weight_on_bit,
-            torque_on_bit: model.torque_on_bit,
-            friction: friction_at(0.0),
-        },
-        &friction_at,
-    )
 }

@@ -189,16 +189,10 @@ pub fn run(
     };
     let chunk_of = |c: usize| c * chunk_size..((c + 1) * chunk_size).min(variants.len());
     let in_range: usize = range.clone().map(|c| chunk_of(c).len()).sum();
-    let bar = if show_progress {
-        indicatif::ProgressBar::new(in_range as u64)
-    } else {
-        indicatif::ProgressBar::hidden()
-    };
-    bar.set_style(
-        indicatif::ProgressStyle::with_template(
-            "{bar:40} {pos}/{len} variants, {elapsed} elapsed, eta {eta}",
-        )
-        .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+    let bar = crate::output::progress_bar(
+        show_progress,
+        in_range as u64,
+        "{bar:40} {pos}/{len} variants, {elapsed} elapsed, eta {eta}",
     );
     for c in range.clone() {
         let path = chunk_path(out, c);

@@ -44,8 +44,11 @@ pub struct LineSearch {
     pub slope_test: bool,
     /// Trials after the full step (each halves α).
     pub max_halvings: usize,
-    /// When no trial passes: take the smallest α tried (`true`) or the full step.
+    /// When no trial passes: take the small step `α = 2^−fallback_halvings` (`true`) or the
+    /// full step.
     pub take_smallest: bool,
+    /// The step taken when no trial passes and `take_smallest`.
+    pub fallback_halvings: usize,
 }
 
 /// Newton settings: iterations, tolerances, line search.
@@ -92,9 +95,35 @@ impl NewtonSettings {
                 slope_test: true,
                 max_halvings: 5,
                 take_smallest: true,
+                fallback_halvings: 5,
             },
             noise_band_at_floor: size == 4,
         }
+    }
+
+    /// [`NewtonSettings::statics`] for models of which some have a soft spring law (an
+    /// exponent below 1): the line search goes on to α = 2⁻²⁰ before it takes the 1/32
+    /// step. A soft law's onset stiffness is `(2 − m) k_e δ_b^(m−1)` (60× k_e at m = 2/3 and
+    /// the default blend): near a node's first contact the Newton direction descends only
+    /// until that node crosses it, often far less than 1/32 of the step, and the shallow
+    /// search that then takes 1/32 regardless cycles there (measured: a two-stabilizer well
+    /// at m = 2/3 failed at 59 % of its load; 4 load-step cuts with the deep search). On
+    /// linear and hard laws the shallow search is kept: there a deep one accepts tiny
+    /// steps and crawls where the 1/32 step pushes through (a 1e10 N/m, μ = 0.9 variant
+    /// failed its gravity step with the deep search).
+    pub fn statics_for_law(max_iterations: usize, tolerance: f64, size: usize, soft_law: bool) -> Self {
+        let mut s = NewtonSettings::statics(max_iterations, tolerance, size);
+        if soft_law {
+            s.line_search.max_halvings = 20;
+        }
+        s
+    }
+
+    /// Whether any site of `models` has a soft spring law (exponent below 1).
+    pub fn any_soft_law<'a>(models: impl IntoIterator<Item = &'a crate::model::Model>) -> bool {
+        models
+            .into_iter()
+            .any(|m| m.sites.iter().any(|s| s.params.spring_exponent < 1.0))
     }
 
     /// Dynamics (a time step's correction of the accelerations) in a precision of `size`
@@ -111,6 +140,7 @@ impl NewtonSettings {
                 slope_test: false,
                 max_halvings: 24,
                 take_smallest: false,
+                fallback_halvings: 24,
             },
             noise_band_at_floor: size == 4,
         }
@@ -390,6 +420,7 @@ impl Newton {
         let mut events = Vec::new();
         let mut trial_matches = false;
         let mut last_finite = vec![true; v];
+        let mut fallback_finite = vec![false; v];
         for trial in 0..=s.line_search.max_halvings {
             if !pending.iter().any(|&p| p) {
                 break;
@@ -405,6 +436,9 @@ impl Newton {
                 let a = alpha[j];
                 let finite = r.slope[j].is_finite() && r.norm[j].is_finite();
                 last_finite[j] = finite;
+                if trial == s.line_search.fallback_halvings {
+                    fallback_finite[j] = finite;
+                }
                 let slope_ok = s.line_search.slope_test && r.slope[j].abs() <= probe.slope[j].abs();
                 let norm_ok = r.norm[j] <= (1.0 - 1e-4 * a) * probe.norm[j];
                 let band_ok = at_floor[j] && r.norm[j] <= 2.0 * probe.norm[j];
@@ -414,6 +448,11 @@ impl Newton {
                     pending[j] = false;
                     if !s.line_search.take_smallest {
                         alpha[j] = 1.0;
+                        trial_matches = false;
+                    } else if fallback_finite[j] && trial != s.line_search.fallback_halvings {
+                        // The fallback step (its residual was finite); else the smallest.
+                        alpha[j] = 0.5f64.powi(s.line_search.fallback_halvings as i32);
+                        last_finite[j] = true;
                         trial_matches = false;
                     }
                 } else {

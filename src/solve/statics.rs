@@ -32,6 +32,9 @@ pub struct StaticOptions {
     pub tolerance: f64,
     /// Smallest load-step size before giving up.
     pub min_step: f64,
+    /// Wall-clock budget (s): the solve stops between iterations once it is spent
+    /// ([`StaticError::Budget`]); `None`: no limit.
+    pub max_seconds: Option<f64>,
 }
 
 impl Default for StaticOptions {
@@ -41,6 +44,7 @@ impl Default for StaticOptions {
             max_iterations: 40,
             tolerance: 1e-9,
             min_step: 1e-4,
+            max_seconds: None,
         }
     }
 }
@@ -60,6 +64,24 @@ pub enum StaticError {
         /// The last failure.
         reason: String,
     },
+    /// The wall-clock budget ran out before the full load was reached.
+    #[error("stopped after {seconds:.1} s (the --max-seconds budget) at {:.1} % of the loads", 100.0 * reached)]
+    Budget {
+        /// Seconds spent.
+        seconds: f64,
+        /// Load factor reached.
+        reached: f64,
+    },
+}
+
+impl StaticError {
+    /// The load factor reached before the failure.
+    pub fn reached(&self) -> f64 {
+        match self {
+            StaticError::LoadStep { from, .. } => *from,
+            StaticError::Budget { reached, .. } => *reached,
+        }
+    }
 }
 
 /// Nodal configuration.
@@ -595,12 +617,40 @@ pub fn solve_static_from(
     start: StaticState,
     options: &StaticOptions,
 ) -> Result<StaticSolution, StaticError> {
-    use crate::solve::continuation::{solve_loads, LoadPath};
+    solve_static_monitored(model, start, options, &mut |_| {})
+}
+
+/// As [`solve_static_from`], calling `progress` with the load factor reached (0 … 1) after
+/// every Newton iteration, and stopping once `options.max_seconds` are spent.
+pub fn solve_static_monitored(
+    model: &Model,
+    start: StaticState,
+    options: &StaticOptions,
+    progress: &mut dyn FnMut(f64),
+) -> Result<StaticSolution, StaticError> {
+    use crate::solve::continuation::{solve_loads_from, LoadPath};
     use crate::solve::newton::NewtonSettings;
+    let clock = std::time::Instant::now();
     let mut sys = CpuStatic::new(model, start);
     let mut paths = [LoadPath::for_model(options, model, false)];
-    let settings = NewtonSettings::statics(options.max_iterations, options.tolerance, 8);
-    if let Err(reason) = solve_loads(&mut sys, &mut paths, settings, &mut |_| {}) {
+    let settings = NewtonSettings::statics_for_law(
+        options.max_iterations,
+        options.tolerance,
+        8,
+        NewtonSettings::any_soft_law([model]),
+    );
+    let budget = options.max_seconds.unwrap_or(f64::INFINITY);
+    let over = || clock.elapsed().as_secs_f64() > budget;
+    let mut solves = 0;
+    if let Err(reason) = solve_loads_from(
+        &mut sys,
+        &mut paths,
+        settings,
+        None,
+        &|_, _| over(),
+        &mut solves,
+        progress,
+    ) {
         return Err(StaticError::LoadStep {
             from: 0.0,
             step: 0.0,
@@ -611,6 +661,12 @@ pub fn solve_static_from(
     let [path] = paths;
     if let Some(e) = path.error {
         return Err(e);
+    }
+    if !path.finished() {
+        return Err(StaticError::Budget {
+            seconds: clock.elapsed().as_secs_f64(),
+            reached: path.progress(),
+        });
     }
     Ok(finish(model, sys.state, path.iterations, path.log))
 }

@@ -1,0 +1,128 @@
+//! What a static profile says about buckling, and why a static solve failed: the checks a
+//! drilling engineer makes before trusting (or instead of) a finite-element answer.
+//!
+//! Buckling loads of a string lying in an inclined hole (compression, N):
+//! sinusoidal `F_s = max(2 √(EI w sin θ / r), 2.55 (EI w²)^(1/3))` (Dawson–Paslay; Lubinski's
+//! vertical limit), helical `√2 F_s`, with `w` the buoyed weight per length, `θ` the
+//! inclination and `r` the radial clearance. A helix of compression `F` has the pitch
+//! `p = π √(8 EI / F)` (Lubinski).
+
+use crate::case::Case;
+use crate::model::Model;
+use crate::solve::statics::StaticError;
+
+/// The sinusoidal and helical buckling loads of element `e` (N of compression) in a hole of
+/// diameter `hole_diameter`.
+pub fn critical_loads(model: &Model, e: usize, hole_diameter: f64) -> (f64, f64) {
+    let el = &model.elements[e];
+    let r = 0.5 * (hole_diameter - el.outer_diameter);
+    let ei = el.section.bending_stiffness();
+    let w = el.buoyed_weight_per_length.max(0.0);
+    let t = model.nodes[e].hole_axis;
+    let sin_i = (t[0] * t[0] + t[1] * t[1]).sqrt();
+    let dawson_paslay = if r > 0.0 {
+        2.0 * (ei * w * sin_i / r).sqrt()
+    } else {
+        f64::INFINITY
+    };
+    let sinusoidal = dawson_paslay.max(2.55 * (ei * w * w).cbrt());
+    (sinusoidal, std::f64::consts::SQRT_2 * sinusoidal)
+}
+
+/// Sinusoidal and helical buckling flags of a profile (nodal axial forces, tension +):
+/// an element's compression beyond its sinusoidal (helical) load anywhere.
+pub fn buckling(case: &Case, axial: &[f64]) -> (bool, bool) {
+    let model = &case.model;
+    let mut flags = (false, false);
+    for e in 0..model.elements.len() {
+        let f = -0.5 * (axial[e] + axial[e + 1]);
+        if f <= 0.0 {
+            continue;
+        }
+        let md = 0.5 * (model.nodes[e].md + model.nodes[e + 1].md);
+        let (s, h) = critical_loads(model, e, case.hole_diameter_at(md));
+        flags.0 |= f > s;
+        flags.1 |= f > h;
+    }
+    flags
+}
+
+/// The worst ratio of compression to helical buckling load along a profile: (ratio, MD,
+/// compression, helical load, helix pitch, element length) of the worst element.
+fn worst_helical(case: &Case, axial: &[f64]) -> Option<(f64, f64, f64, f64, f64, f64)> {
+    let model = &case.model;
+    let mut worst: Option<(f64, f64, f64, f64, f64, f64)> = None;
+    for e in 0..model.elements.len() {
+        let f = -0.5 * (axial[e] + axial[e + 1]);
+        if f <= 0.0 {
+            continue;
+        }
+        let md = 0.5 * (model.nodes[e].md + model.nodes[e + 1].md);
+        let (_, h) = critical_loads(model, e, case.hole_diameter_at(md));
+        let ratio = f / h;
+        if worst.is_none_or(|w| ratio > w.0) {
+            let ei = model.elements[e].section.bending_stiffness();
+            let pitch = std::f64::consts::PI * (8.0 * ei / f).sqrt();
+            worst = Some((ratio, md, f, h, pitch, model.elements[e].length0));
+        }
+    }
+    worst
+}
+
+/// The largest WOB that keeps every element below its helical buckling load, if the
+/// compression of each element falls one for one with the WOB (soft string, top clamped).
+fn helical_free_wob(case: &Case, axial: &[f64]) -> f64 {
+    let model = &case.model;
+    (0..model.elements.len())
+        .map(|e| {
+            let f = -0.5 * (axial[e] + axial[e + 1]);
+            let md = 0.5 * (model.nodes[e].md + model.nodes[e + 1].md);
+            let (_, h) = critical_loads(model, e, case.hole_diameter_at(md));
+            model.weight_on_bit - f + h
+        })
+        .fold(f64::INFINITY, f64::min)
+        .max(0.0)
+}
+
+/// A failed static solve's message with the likely reason, from the case's soft-string
+/// profile at full load: compression beyond the helical buckling load (the string winds
+/// into a helix the mesh may not resolve), or the load factor it stopped at.
+pub fn static_failure(case: &Case, error: &StaticError) -> String {
+    let mut msg = format!("the static solve failed: {error}");
+    let from = error.reached();
+    let model = &case.model;
+    msg.push_str(&format!(
+        "\n  it reached {:.1} % of the bit loads (WOB {:.1} kN of {:.1} kN)",
+        100.0 * from,
+        from * model.weight_on_bit / 1e3,
+        model.weight_on_bit / 1e3
+    ));
+    if let crate::model::TopBoundary::Clamped = model.top {
+        let profile = case.soft_string();
+        if let Some((ratio, md, f, h, pitch, length)) = worst_helical(case, &profile.tension) {
+            if ratio > 1.0 {
+                msg.push_str(&format!(
+                    "\n  likely reason: at full load the compression reaches {:.1} kN at MD {:.0} m, \
+                     {ratio:.1}× the helical buckling load there ({:.1} kN, Dawson–Paslay × √2): \
+                     the string winds into a helix of pitch ≈ {pitch:.1} m against the wall",
+                    f / 1e3,
+                    md,
+                    h / 1e3
+                ));
+                if pitch < 4.0 * length {
+                    msg.push_str(&format!(
+                        ", which elements of {length:.1} m cannot follow (a helix needs ≥ 4 per \
+                         pitch: mesh.element_length ≤ {:.1} m)",
+                        pitch / 4.0
+                    ));
+                }
+                msg.push_str(&format!(
+                    "; a WOB below ≈ {:.0} kN keeps the string out of helical buckling \
+                     (soft string: compression falls with the WOB one for one)",
+                    helical_free_wob(case, &profile.tension) / 1e3
+                ));
+            }
+        }
+    }
+    msg
+}
