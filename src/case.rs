@@ -498,6 +498,15 @@ fn read_survey(
             format!("{}: {e}", path.display()),
         )
     })?;
+    survey_from_text(&path.display().to_string(), &text)
+}
+
+/// The stations of a survey CSV (`md, inclination, azimuth`, an optional header naming
+/// `ft` for feet) with their 1-based lines; `source` names it in messages.
+pub fn survey_from_text(
+    source: &str,
+    text: &str,
+) -> Result<Vec<(SurveyStation, usize)>, InputError> {
     let mut out = Vec::new();
     let mut md_factor = 1.0;
     for (k, line) in text.lines().enumerate() {
@@ -506,7 +515,7 @@ fn read_survey(
             continue;
         }
         let bad = |msg: String| InputError {
-            source_name: path.display().to_string(),
+            source_name: source.to_string(),
             line: k + 1,
             key: "survey".into(),
             message: msg,
@@ -541,6 +550,9 @@ fn read_survey(
     }
     Ok(out)
 }
+
+/// The most nodes a case's mesh may have (a 20 km string in 1 m elements).
+pub const MAX_NODES: usize = 20_001;
 
 /// Reads, validates and meshes a case file.
 pub fn load_case(path: &Path) -> Result<Case, InputError> {
@@ -591,8 +603,8 @@ pub fn parse_case(path: &Path, text: &str) -> Result<Case, InputError> {
         &spec.well.total_md,
         "well.total_md",
         Dimension::Length,
-        pos,
-        "> 0",
+        |x| x > 0.0 && x <= 20_000.0,
+        "0 < total_md ≤ 20 km",
     )?;
     let well = match spec.well.profile.get_ref().as_str() {
         "vertical" => WellPath::vertical(bit_md),
@@ -873,6 +885,32 @@ pub fn parse_case(path: &Path, text: &str) -> Result<Case, InputError> {
     if string_length + 1e-9 < bit_md {
         let last = spec.string.last().map(|c| c.length.span()).unwrap_or(0..0);
         return Err(ctx.err(last, "string.length", format!("the string is {} m long, shorter than the bit depth {} m: it must reach the surface", crate::units::show(string_length), crate::units::show(bit_md))));
+    }
+
+    // The mesh's size, before it is built: memory and time grow with the nodes.
+    {
+        let mut remaining = bit_md;
+        let mut nodes = 1.0f64;
+        for t in &tubulars {
+            let covered = t.length.min(remaining).max(0.0);
+            nodes += (covered / t.element_length).ceil();
+            remaining -= covered;
+        }
+        if nodes > MAX_NODES as f64 {
+            let (span, key) = match mesh.as_ref().and_then(|m| m.element_length.clone()) {
+                Some(q) => (q.span(), "mesh.element_length"),
+                None => (spec.well.total_md.span(), "well.total_md"),
+            };
+            return Err(ctx.err(
+                span,
+                key,
+                format!(
+                    "the mesh would have {nodes:.0} nodes, more than the {MAX_NODES} allowed \
+                     (memory and run time grow with them): lengthen mesh.element_length \
+                     (drill pipe) or mesh.bha_element_length"
+                ),
+            ));
+        }
     }
 
     // Operation.

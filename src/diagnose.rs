@@ -29,10 +29,10 @@ pub fn critical_loads(model: &Model, e: usize, hole_diameter: f64) -> (f64, f64)
     (sinusoidal, std::f64::consts::SQRT_2 * sinusoidal)
 }
 
-/// Sinusoidal and helical buckling flags of a profile (nodal axial forces, tension +):
-/// an element's compression beyond its sinusoidal (helical) load anywhere.
-pub fn buckling(case: &Case, axial: &[f64]) -> (bool, bool) {
-    let model = &case.model;
+/// Sinusoidal and helical buckling flags of a profile of `model` (nodal axial forces,
+/// tension +) in the case's hole: an element's compression beyond its sinusoidal (helical)
+/// load anywhere. `model` may be a variant's (another depth) of the case's.
+pub fn buckling(case: &Case, model: &Model, axial: &[f64]) -> (bool, bool) {
     let mut flags = (false, false);
     for e in 0..model.elements.len() {
         let f = -0.5 * (axial[e] + axial[e + 1]);

@@ -116,9 +116,9 @@ pub fn nodal_axial_forces(element_axial: &[f64]) -> Vec<f64> {
 }
 
 /// Sinusoidal and helical buckling flags of a static profile ([`crate::diagnose::buckling`]).
-pub fn buckling(case: &Case, rows: &[ProfileRow]) -> (bool, bool) {
+pub fn buckling(case: &Case, model: &Model, rows: &[ProfileRow]) -> (bool, bool) {
     let axial: Vec<f64> = rows.iter().map(|r| r.axial_force_n).collect();
-    crate::diagnose::buckling(case, &axial)
+    crate::diagnose::buckling(case, model, &axial)
 }
 
 /// Profile rows, hook load, surface torque and weight on bit of an FE static solution.
@@ -301,7 +301,7 @@ pub fn run(
                 (bk, bv)
             }
         });
-    let (sinusoidal, helical) = buckling(&case, &rows);
+    let (sinusoidal, helical) = buckling(&case, model, &rows);
     let summary = Summary {
         title: case.title.clone(),
         model: match which {

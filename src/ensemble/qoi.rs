@@ -219,7 +219,7 @@ pub fn static_result(
             )
         })
         .fold((0.0f64, f64::NAN), |m, x| if x.0 > m.0 { x } else { m });
-    let (sinusoidal, helical) = crate::cli::static_cmd::buckling(case, &rows);
+    let (sinusoidal, helical) = crate::cli::static_cmd::buckling(case, model, &rows);
     let string = StringQoi {
         max_side_force_per_length_n_per_m: Some(per_length),
         max_side_force_md_m: md.is_finite().then_some(md),
