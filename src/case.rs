@@ -326,6 +326,8 @@ pub struct Case {
     pub hole: Vec<(f64, f64, f64)>,
     /// Bit depth (m).
     pub bit_md: f64,
+    /// Length of the BHA (m): the components from the bit up to the first drill pipe.
+    pub bha_length: f64,
     /// Mud density (kg/m³).
     pub mud_density: f64,
     /// Steel density per element (kg/m³).
@@ -670,10 +672,11 @@ pub fn parse_case(path: &Path, text: &str) -> Result<Case, InputError> {
                 message,
             };
             let stations: Vec<SurveyStation> = read.iter().map(|(s, _)| *s).collect();
-            let well_path = WellPath::from_survey(&stations, [0.0; 3]).map_err(|e| match e.station() {
-                Some(i) => survey_err(read[i].1, e.detail()),
-                None => survey_err(0, e.to_string()),
-            })?;
+            let well_path =
+                WellPath::from_survey(&stations, [0.0; 3]).map_err(|e| match e.station() {
+                    Some(i) => survey_err(read[i].1, e.detail()),
+                    None => survey_err(0, e.to_string()),
+                })?;
             // The survey must cover the hole: from the surface (MD 0) to the string's depth.
             if let Some((first, line)) = read.first() {
                 if first.md != 0.0 {
@@ -1193,6 +1196,12 @@ pub fn parse_case(path: &Path, text: &str) -> Result<Case, InputError> {
         None => None,
         Some(e) => Some(ensemble_settings(&ctx, e, dynamics.is_some())?),
     };
+    let bha_length = tubulars
+        .iter()
+        .take_while(|t| t.name != "drill_pipe")
+        .map(|t| t.length)
+        .sum::<f64>()
+        .min(bit_md);
     Ok(Case {
         ensemble,
         title: spec.title.unwrap_or_default(),
@@ -1200,6 +1209,7 @@ pub fn parse_case(path: &Path, text: &str) -> Result<Case, InputError> {
         model,
         hole,
         bit_md,
+        bha_length,
         mud_density: mud,
         element_density,
         dynamics,

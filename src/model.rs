@@ -292,6 +292,19 @@ pub fn add_sites(
 }
 
 impl Model {
+    /// The length of string a node stands for: half of each adjacent element (m); a side
+    /// force over it is the force per unit length.
+    pub fn tributary_length(&self, node: usize) -> f64 {
+        let n = self.nodes.len();
+        let mut l = 0.0;
+        if node > 0 {
+            l += 0.5 * self.elements[node - 1].length0;
+        }
+        if node + 1 < n {
+            l += 0.5 * self.elements[node].length0;
+        }
+        l.max(1e-9)
+    }
     /// A model of the mesh with no contact sites or loads: top clamped, bit held laterally,
     /// split friction, no operation.
     pub fn bare(nodes: Vec<Node>, elements: Vec<Element>) -> Model {

@@ -142,12 +142,8 @@ impl RunFolder {
             std::fs::remove_dir_all(&staging)
                 .map_err(|e| out_error(out, format!("cannot clear {}: {e}", staging.display())))?;
         }
-        std::fs::create_dir(&staging).map_err(|e| {
-            out_error(
-                out,
-                format!("cannot write into {}: {e}", parent.display()),
-            )
-        })?;
+        std::fs::create_dir(&staging)
+            .map_err(|e| out_error(out, format!("cannot write into {}: {e}", parent.display())))?;
         Ok(RunFolder {
             target: out.to_path_buf(),
             staging,

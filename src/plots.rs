@@ -10,6 +10,9 @@ pub struct Series<'a> {
     pub name: &'a str,
     /// Points (x, y).
     pub points: Vec<(f64, f64)>,
+    /// Drawn first as a wide, pale band, so a thin line on top of it stays visible where
+    /// the two coincide (a reference curve: the soft string under the FE).
+    pub wide: bool,
 }
 
 /// A marked point with a label (e.g. the neutral point).
@@ -70,7 +73,11 @@ fn draw(
 ) -> Result<(), Box<dyn std::error::Error>> {
     let root = BitMapBackend::new(path, (1000, 640)).into_drawing_area();
     root.fill(&WHITE)?;
-    let ((x0, x1), (y0, y1)) = bounds(series);
+    let ((x0, x1), (y0, mut y1)) = bounds(series);
+    if !markers.is_empty() {
+        // Head room for the markers' labels above their points.
+        y1 += 0.1 * (y1 - y0);
+    }
     let mut chart = ChartBuilder::on(&root)
         .caption(title, ("sans-serif", 24))
         .margin(12)
@@ -86,26 +93,49 @@ fn draw(
         .label_style(("sans-serif", 15))
         .draw()?;
     let colours = [BLUE, RED, GREEN, MAGENTA, CYAN, BLACK];
-    for (k, s) in series.iter().enumerate() {
+    let colour = |k: usize| -> RGBColor {
         // Six strong colours, then plotters' palette of 99 distinct ones.
-        let c: RGBColor = if series.len() <= colours.len() {
+        if series.len() <= colours.len() {
             colours[k]
         } else {
             let (r, g, b) = Palette99::pick(k).to_rgba().rgb();
             RGBColor(r, g, b)
+        }
+    };
+    // Wide (reference) series first, thin ones on top of them.
+    let order = (0..series.len())
+        .filter(|&k| series[k].wide)
+        .chain((0..series.len()).filter(|&k| !series[k].wide));
+    for k in order {
+        let s = &series[k];
+        let c = colour(k);
+        let style = if s.wide {
+            c.mix(0.35).stroke_width(9)
+        } else {
+            c.stroke_width(2)
         };
         chart
-            .draw_series(LineSeries::new(s.points.iter().copied(), c.stroke_width(2)))?
+            .draw_series(LineSeries::new(s.points.iter().copied(), style))?
             .label(s.name)
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], c.stroke_width(2)));
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], style));
     }
     for m in markers {
-        chart.draw_series(std::iter::once(Circle::new((m.x, m.y), 6, RED.filled())))?;
-        chart.draw_series(std::iter::once(Text::new(
-            m.label.to_string(),
-            (m.x, m.y),
-            ("sans-serif", 16).into_font(),
-        )))?;
+        // The label beside the point, up and to the left, on a white box: it neither
+        // covers the point nor the curve through it.
+        let label = m.label.to_string();
+        chart.draw_series(std::iter::once(
+            EmptyElement::at((m.x, m.y))
+                + Circle::new((0, 0), 6, RED.filled())
+                + Rectangle::new(
+                    [(-12 - 8 * label.chars().count() as i32, -34), (-8, -12)],
+                    WHITE.mix(0.85).filled(),
+                )
+                + Text::new(
+                    label.clone(),
+                    (-10 - 8 * label.chars().count() as i32, -32),
+                    ("sans-serif", 16).into_font(),
+                ),
+        ))?;
     }
     chart
         .configure_series_labels()
@@ -114,6 +144,83 @@ fn draw(
         .draw()?;
     root.present()?;
     Ok(())
+}
+
+/// An orbit: the lateral displacement `points` (x, y, in mm) inside the clearance circle of
+/// radius `clearance_mm`, on equal axes. A string that never left the hole axis gets a
+/// frame that says so rather than an empty one.
+pub fn orbit_plot(
+    path: &Path,
+    title: &str,
+    points: &[(f64, f64)],
+    clearance_mm: f64,
+) -> std::io::Result<()> {
+    let extent = points
+        .iter()
+        .filter(|(x, y)| x.is_finite() && y.is_finite())
+        .fold(0.0f64, |m, (x, y)| m.max(x.hypot(*y)));
+    let r = 1.1 * clearance_mm.max(extent).max(1e-9);
+    atomic_png(path, |tmp| {
+        let root = BitMapBackend::new(tmp, (760, 760)).into_drawing_area();
+        root.fill(&WHITE)?;
+        let mut chart = ChartBuilder::on(&root)
+            .caption(title, ("sans-serif", 20))
+            .margin(12)
+            .x_label_area_size(48)
+            .y_label_area_size(70)
+            .build_cartesian_2d(-r..r, -r..r)?;
+        chart
+            .configure_mesh()
+            .x_desc("lateral x (mm)")
+            .y_desc("lateral y (mm)")
+            .x_label_formatter(&tick)
+            .y_label_formatter(&tick)
+            .label_style(("sans-serif", 15))
+            .draw()?;
+        if clearance_mm > 0.0 {
+            let circle: Vec<(f64, f64)> = (0..=360)
+                .map(|k| {
+                    let a = (k as f64).to_radians();
+                    (clearance_mm * a.cos(), clearance_mm * a.sin())
+                })
+                .collect();
+            chart
+                .draw_series(LineSeries::new(circle, BLACK.stroke_width(2)))?
+                .label(format!("clearance {} mm", tick(&clearance_mm)))
+                .legend(|(x, y)| {
+                    PathElement::new(vec![(x, y), (x + 20, y)], BLACK.stroke_width(2))
+                });
+        }
+        // Motion below a micrometre (or a millionth of the clearance) is no motion.
+        if extent <= 1e-3f64.max(1e-6 * clearance_mm) {
+            chart.draw_series(std::iter::once(Text::new(
+                format!(
+                    "no lateral motion: the string stayed on the hole axis (largest |r| = {} mm)",
+                    tick(&extent)
+                ),
+                (-0.95 * r, 0.5 * r),
+                ("sans-serif", 17).into_font(),
+            )))?;
+        } else {
+            chart
+                .draw_series(LineSeries::new(
+                    points.iter().copied(),
+                    BLUE.stroke_width(1),
+                ))?
+                .label("orbit")
+                .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], BLUE.stroke_width(2)));
+            if let Some(&last) = points.last() {
+                chart.draw_series(std::iter::once(Circle::new(last, 5, RED.filled())))?;
+            }
+        }
+        chart
+            .configure_series_labels()
+            .background_style(WHITE.mix(0.8))
+            .border_style(BLACK)
+            .draw()?;
+        root.present()?;
+        Ok(())
+    })
 }
 
 /// Writes a PNG through a temporary file and a rename (never half-written).
@@ -233,6 +340,7 @@ pub fn scatter(
     let series = [Series {
         name: "",
         points: points.to_vec(),
+        wide: false,
     }];
     let ((x0, x1), (y0, y1)) = bounds(&series);
     atomic_png(path, |tmp| {
@@ -337,6 +445,7 @@ pub fn convergence_plot(
     let ((x0, x1), (y0, y1)) = bounds(&[Series {
         name: "",
         points: all,
+        wide: false,
     }]);
     atomic_png(path, |tmp| {
         let root = BitMapBackend::new(tmp, (1000, 640)).into_drawing_area();

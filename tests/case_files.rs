@@ -103,7 +103,7 @@ fn paper_cases_run_end_to_end_with_both_models() {
             hooks.push(summary["hook_load_n"].as_f64().unwrap());
             let csv = std::fs::read_to_string(out.join("profile.csv")).unwrap();
             let header = csv.lines().next().unwrap();
-            assert_eq!(header, "md_m,x_m,y_m,z_m,axial_force_n,axial_stress_pa,torque_nm,bending_moment_nm,side_force_n,lateral_displacement_m,in_contact");
+            assert_eq!(header, "md_m,x_m,y_m,z_m,axial_force_n,axial_stress_pa,torque_nm,bending_moment_nm,side_force_n,side_force_per_length_n_per_m,lateral_displacement_m,in_contact");
             assert!(csv.lines().count() > 100);
         }
         // Vertical well: both models give buoyed weight − WOB.
@@ -586,14 +586,20 @@ fn output_folder_is_checked_first_and_replaced_whole() {
     std::fs::write(&file, b"keep").unwrap();
     let (code, _, stderr) = static_into(&file, "fe");
     assert_eq!(code, 2, "{stderr}");
-    assert!(stderr.contains("--out:") && stderr.contains("is a file"), "{stderr}");
+    assert!(
+        stderr.contains("--out:") && stderr.contains("is a file"),
+        "{stderr}"
+    );
     assert_eq!(std::fs::read(&file).unwrap(), b"keep");
     let user = dir.join("user");
     std::fs::create_dir_all(&user).unwrap();
     std::fs::write(user.join("notes.txt"), b"mine").unwrap();
     let (code, _, stderr) = static_into(&user, "fe");
     assert_eq!(code, 2, "{stderr}");
-    assert!(stderr.contains("not the outputs of an earlier holewall run"), "{stderr}");
+    assert!(
+        stderr.contains("not the outputs of an earlier holewall run"),
+        "{stderr}"
+    );
     assert_eq!(
         std::fs::read_dir(&user).unwrap().count(),
         1,
@@ -602,7 +608,12 @@ fn output_folder_is_checked_first_and_replaced_whole() {
     // A bad case: nothing written, the earlier run kept as it was.
     let before = std::fs::read(out.join("summary.json")).unwrap();
     let bad = write_case(&dir, &GOOD.replace("friction = 0.3", "friction = -1"));
-    let (code, _, _) = holewall(&["static", bad.to_str().unwrap(), "--out", out.to_str().unwrap()]);
+    let (code, _, _) = holewall(&[
+        "static",
+        bad.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
     assert_eq!(code, 2);
     assert_eq!(std::fs::read(out.join("summary.json")).unwrap(), before);
 }
@@ -630,7 +641,10 @@ fn runs_can_be_bounded_in_wall_time() {
     let reached = summary["duration_s"].as_f64().unwrap();
     assert!(reached > 0.0 && reached < 50.0, "{summary}");
     assert_eq!(summary["requested_duration_s"].as_f64().unwrap(), 50.0);
-    assert!(summary["stopped_early"].as_str().unwrap().contains("budget"));
+    assert!(summary["stopped_early"]
+        .as_str()
+        .unwrap()
+        .contains("budget"));
     let csv = std::fs::read_to_string(dir.join("timeseries.csv")).unwrap();
     let last_t: f64 = csv
         .lines()
@@ -663,7 +677,10 @@ fn runs_can_be_bounded_in_wall_time() {
         false,
     )
     .unwrap_err();
-    assert!(e.contains("--max-seconds budget") && e.contains("% of the loads"), "{e}");
+    assert!(
+        e.contains("--max-seconds budget") && e.contains("% of the loads"),
+        "{e}"
+    );
 }
 
 /// A WOB far beyond helical buckling: the solve fails quickly and says why (issue 15).

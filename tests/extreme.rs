@@ -53,7 +53,8 @@ fn extreme_contact_cases_finish_without_nan() {
         let path = dir.join("case.toml");
         std::fs::write(&path, text).unwrap();
         let out = dir.join("out");
-        let summary = run(&path, &out, Default::default()).unwrap_or_else(|e| panic!("{name}: {e}"));
+        let summary =
+            run(&path, &out, Default::default()).unwrap_or_else(|e| panic!("{name}: {e}"));
         // Every recorded number finite.
         for file in ["timeseries.csv", "contact_sites.csv", "axial_stress.csv"] {
             let body = std::fs::read_to_string(out.join(file)).unwrap();

@@ -32,12 +32,60 @@ fn root() -> PathBuf {
 
 /// Replacement tokens: numbers at and past every edge, units, quotes, TOML syntax.
 const TOKENS: &[&str] = &[
-    "0", "-0", "-1", "1e308", "-1e308", "1e-308", "5e-324", "nan", "inf", "-inf", "NaN",
-    "\"nan m\"", "\"inf N\"", "1e12", "1e-12", "0.1", "2", "3", "999999999999", "\"\"",
-    "\"1.2\"", "\"90\"", "\"90 rpm\"", "\"1 MN\"", "\"-5 m\"", "\"1e400 m\"", "\"5 ft\"",
-    "\"5 furlong\"", "\"5 kN\"", "\"10 ppg\"", "\"1.2 sg\"", "true", "[]", "{}", "[1, 2]",
-    "\"rotating\"", "\"sliding\"", "\"survey\"", "\"all_nodes\"", "\"coupled\"", "=", "[[",
-    "]]", "\"", "#", "\n", ",", "\u{0}", "é", "\u{FEFF}", "0x10", "1_000", "+1", ".5",
+    "0",
+    "-0",
+    "-1",
+    "1e308",
+    "-1e308",
+    "1e-308",
+    "5e-324",
+    "nan",
+    "inf",
+    "-inf",
+    "NaN",
+    "\"nan m\"",
+    "\"inf N\"",
+    "1e12",
+    "1e-12",
+    "0.1",
+    "2",
+    "3",
+    "999999999999",
+    "\"\"",
+    "\"1.2\"",
+    "\"90\"",
+    "\"90 rpm\"",
+    "\"1 MN\"",
+    "\"-5 m\"",
+    "\"1e400 m\"",
+    "\"5 ft\"",
+    "\"5 furlong\"",
+    "\"5 kN\"",
+    "\"10 ppg\"",
+    "\"1.2 sg\"",
+    "true",
+    "[]",
+    "{}",
+    "[1, 2]",
+    "\"rotating\"",
+    "\"sliding\"",
+    "\"survey\"",
+    "\"all_nodes\"",
+    "\"coupled\"",
+    "=",
+    "[[",
+    "]]",
+    "\"",
+    "#",
+    "\n",
+    ",",
+    "\u{0}",
+    "é",
+    "\u{FEFF}",
+    "0x10",
+    "1_000",
+    "+1",
+    ".5",
 ];
 
 /// A mutation of `seed`: `edits` random edits (token swaps, line deletions and
@@ -60,8 +108,7 @@ fn mutate(seed: &str, edits: &[(u8, u32, u32)]) -> String {
                 out[i] = if let Some((k, _)) = line.split_once('=') {
                     format!("{k}= {tok}")
                 } else {
-                    let mut fields: Vec<String> =
-                        line.split(',').map(|f| f.to_string()).collect();
+                    let mut fields: Vec<String> = line.split(',').map(|f| f.to_string()).collect();
                     let j = b as usize % fields.len();
                     fields[j] = tok.to_string();
                     fields.join(",")
@@ -125,7 +172,9 @@ fn guarded(what: &str, input: String, f: fn(&str) -> bool) -> Result<bool, TestC
         }
         Err(std::sync::mpsc::RecvTimeoutError::Disconnected) => {
             PANICS.fetch_add(1, Ordering::Relaxed);
-            Err(TestCaseError::fail(format!("{what}: panicked on input:\n{input}")))
+            Err(TestCaseError::fail(format!(
+                "{what}: panicked on input:\n{input}"
+            )))
         }
     }
 }
@@ -210,8 +259,7 @@ fn fuzz_variants_csv() {
     let seeds = vec![
         std::fs::read_to_string(root().join("cases/stress_two_stabilizers.csv")).unwrap(),
         "mu,wob,k_e,rpm\n0.1,5 kN,6e7,90 rpm\n0.6,30 kN,1e9,120 rpm\n".into(),
-        "depth,mode,mu,stab1.from_bit,stab2.blade\n1000 m,tripping_out,0.25,1.5 m,8.25 in\n"
-            .into(),
+        "depth,mode,mu,stab1.from_bit,stab2.blade\n1000 m,tripping_out,0.25,1.5 m,8.25 in\n".into(),
         "layout,m,eps,c,mu_t.stab1\n1,1.5,1e-3,1e3,0.3\n2,0.6667,1e-2,0,0.1\n".into(),
     ];
     fuzz("variants CSV", &seeds, |text| {
@@ -226,15 +274,17 @@ fn fuzz_survey_csv() {
         "MD (ft),inc,azi\n0,0,0\n1000,5,350\n5000,89.9,10\n".into(),
         "0,0,0\n100,180,0\n200,90,720\n".into(),
     ];
-    fuzz("survey CSV", &seeds, |text| {
-        match holewall::case::survey_from_text("fuzz.csv", text) {
+    fuzz(
+        "survey CSV",
+        &seeds,
+        |text| match holewall::case::survey_from_text("fuzz.csv", text) {
             Ok(read) => {
                 let stations: Vec<_> = read.iter().map(|(s, _)| *s).collect();
                 holewall::well::WellPath::from_survey(&stations, [0.0; 3]).is_ok()
             }
             Err(_) => false,
-        }
-    });
+        },
+    );
 }
 
 #[test]

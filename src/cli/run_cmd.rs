@@ -247,7 +247,10 @@ fn run_case(case: &Case, out: &Path, run_options: RunOptions) -> Result<RunSumma
 
     let mut written = Vec::new();
     let t: Vec<f64> = rec.series.iter().map(|r| r[0]).collect();
-    let col = |k: usize| -> Vec<(f64, f64)> { rec.series.iter().map(|r| (r[0], r[k])).collect() };
+    // A time series in display units (`scale` × SI).
+    let col = |k: usize, scale: f64| -> Vec<(f64, f64)> {
+        rec.series.iter().map(|r| (r[0], scale * r[k])).collect()
+    };
     let mut header = vec!["t_s"];
     let mut cols = vec![0usize];
     for (name, h, k) in [
@@ -279,10 +282,11 @@ fn run_case(case: &Case, out: &Path, run_options: RunOptions) -> Result<RunSumma
             &out.join("bit_displacement.png"),
             &format!("{title}: bit axial displacement (Fig 5)"),
             "t (s)",
-            "displacement along the hole axis, down + (m)",
+            "displacement along the hole axis, down + (mm)",
             &[Series {
                 name: "bit",
-                points: col(1),
+                points: col(1, 1e3),
+                wide: false,
             }],
             &[],
         )?;
@@ -293,10 +297,11 @@ fn run_case(case: &Case, out: &Path, run_options: RunOptions) -> Result<RunSumma
             &out.join("surface_torque.png"),
             &format!("{title}: surface torque"),
             "t (s)",
-            "torque (N·m)",
+            "torque (kN·m)",
             &[Series {
                 name: "top",
-                points: col(2),
+                points: col(2, 1e-3),
+                wide: false,
             }],
             &[],
         )?;
@@ -307,19 +312,22 @@ fn run_case(case: &Case, out: &Path, run_options: RunOptions) -> Result<RunSumma
             &out.join("energy.png"),
             &format!("{title}: energy"),
             "t (s)",
-            "energy (J)",
+            "energy (kJ)",
             &[
                 Series {
                     name: "kinetic",
-                    points: col(3),
+                    points: col(3, 1e-3),
+                    wide: false,
                 },
                 Series {
                     name: "strain",
-                    points: col(4),
+                    points: col(4, 1e-3),
+                    wide: false,
                 },
                 Series {
                     name: "kinetic + strain",
-                    points: col(5),
+                    points: col(5, 1e-3),
+                    wide: false,
                 },
             ],
             &[],
@@ -352,11 +360,11 @@ fn run_case(case: &Case, out: &Path, run_options: RunOptions) -> Result<RunSumma
         write_atomic(&out.join("contact_sites.csv"), &csv_bytes(&header, rows)?)?;
         written.push("contact_sites.csv".into());
         for (k, site) in model.sites.iter().enumerate().filter(|(_, s)| s.stabilizer) {
-            let pts = |j: usize| -> Vec<(f64, f64)> {
+            let pts = |j: usize, scale: f64| -> Vec<(f64, f64)> {
                 rec.sites
                     .iter()
                     .filter(|r| r.1 == k)
-                    .map(|r| (r.0, r.2[j]))
+                    .map(|r| (r.0, scale * r.2[j]))
                     .collect()
             };
             let md = model.nodes[site.node].md;
@@ -365,29 +373,38 @@ fn run_case(case: &Case, out: &Path, run_options: RunOptions) -> Result<RunSumma
                     &out.join(format!("lateral_site{k}.png")),
                     &format!("{title}: lateral displacement at MD {md:.1} m (Fig 6)"),
                     "t (s)",
-                    "radial displacement (m)",
-                    &[Series {
-                        name: "radius",
-                        points: pts(2),
-                    }],
+                    "radial displacement (mm)",
+                    &[
+                        Series {
+                            name: "radial clearance",
+                            points: vec![
+                                (0.0, 1e3 * site.params.clearance),
+                                (
+                                    t.last().copied().unwrap_or(0.0),
+                                    1e3 * site.params.clearance,
+                                ),
+                            ],
+                            wide: true,
+                        },
+                        Series {
+                            name: "radius",
+                            points: pts(2, 1e3),
+                            wide: false,
+                        },
+                    ],
                     &[],
                 )?;
                 let orbit: Vec<(f64, f64)> = rec
                     .sites
                     .iter()
                     .filter(|r| r.1 == k)
-                    .map(|r| (r.2[0], r.2[1]))
+                    .map(|r| (1e3 * r.2[0], 1e3 * r.2[1]))
                     .collect();
-                line_plot(
+                crate::plots::orbit_plot(
                     &out.join(format!("orbit_site{k}.png")),
                     &format!("{title}: orbit at MD {md:.1} m (Fig 7)"),
-                    "x (m)",
-                    "y (m)",
-                    &[Series {
-                        name: "orbit",
-                        points: orbit,
-                    }],
-                    &[],
+                    &orbit,
+                    1e3 * site.params.clearance,
                 )?;
                 written.push(format!("lateral_site{k}.png"));
                 written.push(format!("orbit_site{k}.png"));
@@ -397,10 +414,11 @@ fn run_case(case: &Case, out: &Path, run_options: RunOptions) -> Result<RunSumma
                     &out.join(format!("contact_force_site{k}.png")),
                     &format!("{title}: contact force at MD {md:.1} m"),
                     "t (s)",
-                    "normal force (N)",
+                    "normal force (kN)",
                     &[Series {
                         name: "N",
-                        points: pts(3),
+                        points: pts(3, 1e-3),
+                        wide: false,
                     }],
                     &[],
                 )?;
@@ -411,10 +429,11 @@ fn run_case(case: &Case, out: &Path, run_options: RunOptions) -> Result<RunSumma
                     &out.join(format!("spin_site{k}.png")),
                     &format!("{title}: stabilizer spin rate at MD {md:.1} m"),
                     "t (s)",
-                    "spin rate (rad/s)",
+                    "spin rate (rpm)",
                     &[Series {
                         name: "spin",
-                        points: pts(4),
+                        points: pts(4, 60.0 / std::f64::consts::TAU),
+                        wide: false,
                     }],
                     &[],
                 )?;
@@ -434,7 +453,7 @@ fn run_case(case: &Case, out: &Path, run_options: RunOptions) -> Result<RunSumma
             rec.stress
                 .iter()
                 .filter(|r| (r.0 - time).abs() < 1e-12)
-                .map(|r| (r.1, r.2))
+                .map(|r| (r.1, r.2 / 1e6))
                 .collect()
         };
         let (t0, t1) = (
@@ -445,15 +464,17 @@ fn run_case(case: &Case, out: &Path, run_options: RunOptions) -> Result<RunSumma
             &out.join("axial_stress.png"),
             &format!("{title}: axial stress along the string (Figs 8, 10)"),
             "MD (m)",
-            "axial stress (Pa)",
+            "axial stress, tension + (MPa)",
             &[
                 Series {
                     name: &format!("t = {t0:.2} s"),
                     points: at(t0),
+                    wide: false,
                 },
                 Series {
                     name: &format!("t = {t1:.2} s"),
                     points: at(t1),
+                    wide: false,
                 },
             ],
             &[],

@@ -40,8 +40,12 @@ pub struct ProfileRow {
     pub torque_nm: f64,
     /// Bending moment (N·m).
     pub bending_moment_nm: f64,
-    /// Side (contact normal) force (N).
+    /// Side (contact normal) force (N): FE, the node's contact force; soft string, the
+    /// element's below the node.
     pub side_force_n: f64,
+    /// Side force per unit length (N/m): over the node's tributary length (FE), over the
+    /// element (soft string).
+    pub side_force_per_length_n_per_m: f64,
     /// Lateral displacement from the hole axis (m).
     pub lateral_displacement_m: f64,
     /// In contact with the wall.
@@ -160,6 +164,7 @@ pub fn fe_rows(
                     sol.section_forces[e].bending[if e < i { 1 } else { 0 }]
                 }),
                 side_force_n: side[i],
+                side_force_per_length_n_per_m: side[i] / model.tributary_length(i),
                 lateral_displacement_m: dot(&d_t, &d_t).sqrt(),
                 in_contact: in_contact[i],
             }
@@ -282,6 +287,7 @@ pub fn run(
                         torque_nm: prof.torque[i],
                         bending_moment_nm: 0.0,
                         side_force_n: side,
+                        side_force_per_length_n_per_m: side / model.elements[e].length0,
                         lateral_displacement_m: 0.0,
                         in_contact: side > 0.0,
                     }
@@ -344,6 +350,7 @@ fn write_plots(
     out: &Path,
 ) -> std::io::Result<()> {
     use crate::plots::{line_plot, Marker, Series};
+    let model = &case.model;
     let name = match which {
         StaticModel::Fe => "FE",
         StaticModel::SoftString => "soft string",
@@ -359,35 +366,29 @@ fn write_plots(
         })
         .into_iter()
         .collect();
-    // The profiles along the string: (file, title, y label, column, neutral point marked).
+    // The profiles along the string in engineering units: (file, title, y label, column,
+    // neutral point marked).
     type Column = fn(&ProfileRow) -> f64;
-    let profiles: [(&str, &str, &str, Column, bool); 4] = [
+    let profiles: [(&str, &str, &str, Column, bool); 3] = [
         (
             "axial_force.png",
             "axial force",
-            "effective axial force, tension + (N)",
-            |r| r.axial_force_n,
+            "effective axial force, tension + (kN)",
+            |r| r.axial_force_n / 1e3,
             true,
         ),
         (
             "axial_stress.png",
             "axial stress",
-            "axial stress (Pa)",
-            |r| r.axial_stress_pa,
+            "axial stress, tension + (MPa)",
+            |r| r.axial_stress_pa / 1e6,
             true,
-        ),
-        (
-            "side_force.png",
-            "side force",
-            "side force (N)",
-            |r| r.side_force_n,
-            false,
         ),
         (
             "torque.png",
             "torque",
-            "torque (N·m)",
-            |r| r.torque_nm,
+            "torque (kN·m)",
+            |r| r.torque_nm / 1e3,
             false,
         ),
     ];
@@ -400,46 +401,115 @@ fn write_plots(
             &[Series {
                 name,
                 points: col(&f),
+                wide: false,
             }],
             if marked { &np_marker } else { &[] },
         )?;
     }
-    let bha_top = case.bit_md - 200.0;
-    let bha: Vec<(f64, f64)> = rows
+    // Side force per unit length; each stabilizer's force (a point load) marked.
+    let stab_labels: Vec<(String, f64, f64)> = model
+        .sites
         .iter()
-        .filter(|r| r.md_m >= bha_top)
-        .map(|r| (r.md_m, r.lateral_displacement_m))
+        .filter(|s| s.stabilizer)
+        .enumerate()
+        .filter_map(|(k, s)| {
+            let r = rows.get(s.node)?;
+            Some((
+                format!("stab {}: {:.1} kN", k + 1, r.side_force_n / 1e3),
+                r.md_m,
+                r.side_force_per_length_n_per_m / 1e3,
+            ))
+        })
+        .collect();
+    let stab_markers: Vec<Marker> = stab_labels
+        .iter()
+        .map(|(label, x, y)| Marker {
+            label,
+            x: *x,
+            y: *y,
+        })
+        .collect();
+    line_plot(
+        &out.join("side_force.png"),
+        &format!("{}: side force per unit length ({name})", case.title),
+        "MD (m)",
+        "side force per length (kN/m)",
+        &[Series {
+            name,
+            points: col(&|r| r.side_force_per_length_n_per_m / 1e3),
+            wide: false,
+        }],
+        &stab_markers,
+    )?;
+    // The BHA (bit up to the first drill pipe): lateral displacement against the radial
+    // clearance it has there.
+    let bha_top = case.bit_md - case.bha_length;
+    let in_bha = |k: usize| rows[k].md_m >= bha_top - 1e-9;
+    let bha: Vec<(f64, f64)> = (0..rows.len())
+        .filter(|&k| in_bha(k))
+        .map(|k| (rows[k].md_m, 1e3 * rows[k].lateral_displacement_m))
+        .collect();
+    let clearance: Vec<(f64, f64)> = (0..rows.len())
+        .filter(|&k| in_bha(k))
+        .map(|k| {
+            let e = k.min(model.elements.len() - 1);
+            let od = model
+                .sites
+                .iter()
+                .find(|s| s.node == k)
+                .map(|s| 2.0 * s.params.disk_radius)
+                .unwrap_or(model.elements[e].outer_diameter);
+            (
+                rows[k].md_m,
+                1e3 * 0.5 * (case.hole_diameter_at(rows[k].md_m) - od),
+            )
+        })
         .collect();
     line_plot(
         &out.join("bha_deflection.png"),
-        &format!("{}: BHA lateral deflection ({name})", case.title),
+        &format!(
+            "{}: BHA lateral deflection, {:.0} m above the bit ({name})",
+            case.title, case.bha_length
+        ),
         "MD (m)",
-        "lateral displacement from the hole axis (m)",
-        &[Series { name, points: bha }],
+        "lateral displacement from the hole axis (mm)",
+        &[
+            Series {
+                name: "radial clearance",
+                points: clearance,
+                wide: true,
+            },
+            Series {
+                name,
+                points: bha,
+                wide: false,
+            },
+        ],
         &[],
     )?;
     if which == StaticModel::Fe {
-        let model = &case.model;
         let ss = case.soft_string();
         let ss_pts: Vec<(f64, f64)> = model
             .nodes
             .iter()
             .zip(&ss.tension)
-            .map(|(n, t)| (n.md, *t))
+            .map(|(n, t)| (n.md, *t / 1e3))
             .collect();
         line_plot(
             &out.join("fe_vs_soft_string.png"),
             &format!("{}: axial force, FE vs soft string", case.title),
             "MD (m)",
-            "effective axial force (N)",
+            "effective axial force, tension + (kN)",
             &[
                 Series {
                     name: "FE",
-                    points: col(&|r| r.axial_force_n),
+                    points: col(&|r| r.axial_force_n / 1e3),
+                    wide: false,
                 },
                 Series {
                     name: "soft string",
                     points: ss_pts,
+                    wide: true,
                 },
             ],
             &np_marker,

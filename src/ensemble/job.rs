@@ -300,6 +300,7 @@ pub fn run(
             &[Series {
                 name: "neutral point",
                 points: idx(&|r| r.neutral_point_from_bit_m),
+                wide: false,
             }],
             &[],
         )?;
@@ -315,6 +316,7 @@ pub fn run(
                 .map(|k| Series {
                     name: &names[k],
                     points: idx(&|r| r.stabilizers.get(k).and_then(f)),
+                    wide: false,
                 })
                 .collect();
             line_plot(

@@ -386,7 +386,11 @@ pub fn variant_case(case: &Case, variant: &Variant) -> Result<Option<Case>, Stri
         // (the case's rpm belongs to its rotating variants), and a rotating one rotates at
         // the variant's rpm where it gives one (applied again with the other overrides).
         if m == "rotating" {
-            if let Some((_, rpm)) = variant.overrides.iter().find(|(k, _)| k.param == Param::Rpm) {
+            if let Some((_, rpm)) = variant
+                .overrides
+                .iter()
+                .find(|(k, _)| k.param == Param::Rpm)
+            {
                 op.insert("rpm".into(), toml::Value::String(format!("{rpm} rad/s")));
             }
         } else {

@@ -214,7 +214,7 @@ pub fn static_result(
         .map(|k| {
             let node = model.sites[k].node;
             (
-                sol.contact[k].1.max(0.0) / tributary_length(model, node),
+                sol.contact[k].1.max(0.0) / model.tributary_length(node),
                 model.nodes[node].md,
             )
         })
@@ -316,7 +316,7 @@ impl DynamicObserver {
                 let nd = &model.nodes[node];
                 let dd = sub(&st.q.x[node], &nd.position);
                 let d_t = sub(&dd, &scale(&nd.hole_axis, dot(&dd, &nd.hole_axis)));
-                let normal = dot(&[g[0], g[1], g[2]], &d_t) / r / tributary_length(model, node);
+                let normal = dot(&[g[0], g[1], g[2]], &d_t) / r / model.tributary_length(node);
                 if normal > self.per_length.0 {
                     self.per_length = (normal, nd.md);
                 }
@@ -497,18 +497,6 @@ pub(crate) fn bit_md_of(case: &Case, model: &Model) -> f64 {
 }
 
 /// A node's share of the string: half of each element beside it (m).
-pub(crate) fn tributary_length(model: &Model, node: usize) -> f64 {
-    let n = model.nodes.len();
-    let mut l = 0.0;
-    if node > 0 {
-        l += 0.5 * model.elements[node - 1].length0;
-    }
-    if node + 1 < n {
-        l += 0.5 * model.elements[node].length0;
-    }
-    l.max(1e-9)
-}
-
 /// A whirl slower than one orbit over the fit window (the second half of the run) is no
 /// whirl: `None` direction below this frequency (Hz).
 pub fn whirl_threshold_hz(duration: f64) -> f64 {

@@ -250,6 +250,7 @@ pub(crate) fn broomstick(
         .map(|(l, pts)| Series {
             name: l,
             points: pts.clone(),
+            wide: false,
         })
         .collect();
     line_plot(

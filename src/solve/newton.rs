@@ -111,7 +111,12 @@ impl NewtonSettings {
     /// linear and hard laws the shallow search is kept: there a deep one accepts tiny
     /// steps and crawls where the 1/32 step pushes through (a 1e10 N/m, μ = 0.9 variant
     /// failed its gravity step with the deep search).
-    pub fn statics_for_law(max_iterations: usize, tolerance: f64, size: usize, soft_law: bool) -> Self {
+    pub fn statics_for_law(
+        max_iterations: usize,
+        tolerance: f64,
+        size: usize,
+        soft_law: bool,
+    ) -> Self {
         let mut s = NewtonSettings::statics(max_iterations, tolerance, size);
         if soft_law {
             s.line_search.max_halvings = 20;
