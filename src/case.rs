@@ -597,7 +597,15 @@ pub fn parse_case(path: &Path, text: &str) -> Result<Case, InputError> {
             source_name: path.display().to_string(),
             line,
             key,
-            message: e.message().to_string(),
+            message: {
+                let m = e.message();
+                // A number written as text: say how to write it.
+                if m.starts_with("invalid type: string") && m.contains("expected f64") {
+                    format!("{m}: write the number without quotes (friction = 0.2), or with a unit inside them (\"0.2 m\") where the key has one")
+                } else {
+                    m.to_string()
+                }
+            },
         }
     })?;
     let pos = |x: f64| x > 0.0;

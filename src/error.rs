@@ -57,13 +57,18 @@ pub enum Error {
     /// I/O failure.
     #[error("{0}")]
     Io(#[from] std::io::Error),
+    /// Stopped by the user's budget (`--max-seconds`), resumable: exit code 3.
+    #[error("{0}")]
+    Stopped(String),
 }
 
 impl Error {
-    /// The process exit code for this error: 2 for bad input, 1 otherwise.
+    /// The process exit code for this error: 2 for bad input, 3 for a run stopped by its
+    /// budget (resumable), 1 otherwise.
     pub fn exit_code(&self) -> i32 {
         match self {
             Error::Input(_) => 2,
+            Error::Stopped(_) => 3,
             _ => 1,
         }
     }

@@ -122,6 +122,11 @@ enum Command {
         /// Replace an earlier run's outputs in --out.
         #[arg(long)]
         force: bool,
+        /// Wall-time budget (s): no further chunk starts once it is spent (at least one
+        /// runs); the run stops with exit code 3, and the same command continues from its
+        /// chunks.
+        #[arg(long, value_parser = positive_seconds)]
+        max_seconds: Option<f64>,
     },
     /// Joins the folders of a run's `--shard K/N` runs into what the run without shards
     /// would write.
@@ -343,6 +348,7 @@ fn main() -> ExitCode {
             chunk_size,
             shard,
             force,
+            max_seconds,
         } => {
             let mc = match cli::ensemble_cmd::monte_carlo(
                 samples,
@@ -368,6 +374,7 @@ fn main() -> ExitCode {
                 chunk_size,
                 shard,
                 force,
+                max_seconds,
             };
             print_summary(holewall::ensemble::job::run(
                 &case,

@@ -179,3 +179,37 @@ fn four_shards_merged_are_one_run() {
         );
     }
 }
+
+/// `--max-seconds`: no chunk starts once the budget is spent; the run stops with exit code
+/// 3 and how far it got, no summary; the same command (without the budget) continues to
+/// the bits of an uninterrupted run.
+#[test]
+fn a_budget_stops_a_run_resumably() {
+    let reference = tmp("budget-ref");
+    assert!(bin()
+        .args(args(&reference, 5))
+        .output()
+        .unwrap()
+        .status
+        .success());
+    let (csv, stats) = result_of(&reference);
+    let out = tmp("budget");
+    let mut a = args(&out, 5);
+    a.extend(["--max-seconds".into(), "1e-9".into()]);
+    let o = bin().args(&a).output().unwrap();
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(3), "{stderr}");
+    assert!(
+        stderr.contains("--max-seconds budget") && stderr.contains("continues"),
+        "{stderr}"
+    );
+    assert!(!out.join("summary.json").exists());
+    let chunks = std::fs::read_dir(out.join("chunks")).unwrap().count();
+    assert_eq!(
+        chunks, 1,
+        "one chunk started before the budget was read as spent"
+    );
+    let o = bin().args(args(&out, 5)).output().unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert_eq!(result_of(&out), (csv, stats));
+}

@@ -194,11 +194,29 @@ pub fn run(
         in_range as u64,
         "{bar:40} {pos}/{len} variants, {elapsed} elapsed, eta {eta}",
     );
+    let clock = std::time::Instant::now();
+    let mut computed_here = 0usize;
     for c in range.clone() {
         let path = chunk_path(out, c);
         if path.exists() {
             bar.inc(chunk_of(c).len() as u64);
             continue;
+        }
+        // At least one chunk per invocation, so runs repeated under a budget progress.
+        if let (Some(budget), true) = (options.max_seconds, computed_here > 0) {
+            if clock.elapsed().as_secs_f64() > budget {
+                bar.finish_and_clear();
+                let done = range
+                    .clone()
+                    .filter(|&c| chunk_path(out, c).exists())
+                    .count();
+                return Err(Error::Stopped(format!(
+                    "the --max-seconds budget ({budget} s) is spent: {done} of {} chunks are \
+                     in {}/chunks; the same command continues from them",
+                    range.len(),
+                    out.display()
+                )));
+            }
         }
         let start = std::time::Instant::now();
         let slice = &variants[chunk_of(c)];
@@ -213,6 +231,7 @@ pub fn run(
         };
         let text = serde_json::to_vec(&chunk).map_err(|e| Error::Io(std::io::Error::other(e)))?;
         write_atomic(&path, &text)?;
+        computed_here += 1;
     }
     bar.finish_and_clear();
     if let Some((k, n)) = options.shard {
@@ -465,6 +484,7 @@ pub fn merge(
         chunk_size: whole.chunk_size,
         shard: None,
         force: false,
+        max_seconds: None,
     };
     run(
         &whole.case,

@@ -24,6 +24,9 @@ pub struct EnsembleOptions {
     pub shard: Option<(usize, usize)>,
     /// Replace the outputs of another run in the output folder (`--force`).
     pub force: bool,
+    /// Wall-time budget (s, `--max-seconds`): no chunk is started once it is spent; the
+    /// run stops resumable ([`crate::Error::Stopped`]).
+    pub max_seconds: Option<f64>,
 }
 
 /// `run.json`: what a run was asked, to resume it, refuse another run's folder, and merge
