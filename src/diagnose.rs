@@ -97,6 +97,36 @@ pub fn static_failure(case: &Case, error: &StaticError) -> String {
         from * model.weight_on_bit / 1e3,
         model.weight_on_bit / 1e3
     ));
+    // The stiffest wall against the string's own lateral stiffness at that site (a beam
+    // of the adjacent element's length, centrally loaded: 48 EI / L³).
+    let ratio = model
+        .sites
+        .iter()
+        .map(|site| {
+            let e = site.node.min(model.elements.len() - 1);
+            let el = &model.elements[e];
+            let lateral = 48.0 * el.section.bending_stiffness() / el.length0.powi(3);
+            (
+                site.params.wall_stiffness / lateral,
+                site.params.spring_exponent,
+            )
+        })
+        .fold((0.0f64, 1.0f64), |a, b| if b.0 > a.0 { b } else { a });
+    if ratio.0 > 1e6 || ratio.1 < 1.0 {
+        msg.push_str(&format!(
+            "\n  the wall is stiff against the string: k_e / (48 EI / L³) up to {:.1e}{}; \
+             contacts switching at that stiffness need many small load steps",
+            ratio.0,
+            if ratio.1 < 1.0 {
+                format!(
+                    ", with a soft law (m = {}) stiffer still at first contact",
+                    ratio.1
+                )
+            } else {
+                String::new()
+            }
+        ));
+    }
     if let crate::model::TopBoundary::Clamped = model.top {
         let profile = case.soft_string();
         if let Some((ratio, md, f, h, pitch, length)) = worst_helical(case, &profile.tension) {
