@@ -91,6 +91,12 @@ pub struct ComponentSpec {
     pub poisson_ratio: Option<Spanned<f64>>,
     /// Steel density (default 7850 kg/m³).
     pub density: Option<Q>,
+    /// Offset of the component's centre of mass from the pipe axis (dynamics: a mass
+    /// imbalance turning with the string; default 0).
+    pub mass_eccentricity: Option<Q>,
+    /// The same as a mass imbalance of the whole component (kg·m, g·mm, oz·in): its mass
+    /// times the offset.
+    pub imbalance: Option<Q>,
 }
 
 /// `[operation]`.
@@ -818,6 +824,7 @@ pub fn parse_case(path: &Path, text: &str) -> Result<Case, InputError> {
     }
     let mut tubulars = Vec::new();
     let mut blades = Vec::new();
+    let mut eccentricities: Vec<f64> = Vec::new();
     for c in &spec.string {
         let kind = c.kind.get_ref().clone();
         let length = ctx.quantity(&c.length, "string.length", Dimension::Length, pos, "> 0")?;
@@ -864,6 +871,37 @@ pub fn parse_case(path: &Path, text: &str) -> Result<Case, InputError> {
             )?,
             None => 7850.0,
         };
+        let eccentricity = match (&c.mass_eccentricity, &c.imbalance) {
+            (Some(_), Some(q)) => {
+                return Err(ctx.err(
+                    q.span(),
+                    "string.imbalance",
+                    "give mass_eccentricity or imbalance, not both",
+                ))
+            }
+            (Some(q), None) => ctx.quantity(
+                q,
+                "string.mass_eccentricity",
+                Dimension::Length,
+                |x| (0.0..=0.5 * od).contains(&x),
+                &format!("0 ≤ offset ≤ od/2 ({} m)", crate::units::show(0.5 * od)),
+            )?,
+            (None, Some(q)) => {
+                let mass = rho * std::f64::consts::FRAC_PI_4 * (od * od - id * id) * length;
+                ctx.quantity(
+                    q,
+                    "string.imbalance",
+                    Dimension::MassLength,
+                    |x| (0.0..=0.5 * od * mass).contains(&x),
+                    &format!(
+                        "0 ≤ imbalance ≤ the component's mass × od/2 ({} kg·m)",
+                        crate::units::show(0.5 * od * mass)
+                    ),
+                )? / mass
+            }
+            (None, None) => 0.0,
+        };
+        eccentricities.push(eccentricity);
         let blade = match &c.blade_diameter {
             Some(q) => {
                 let md_here = bit_md - tubulars.iter().map(|t: &Tubular| t.length).sum::<f64>();
@@ -1146,6 +1184,7 @@ pub fn parse_case(path: &Path, text: &str) -> Result<Case, InputError> {
         },
         bit_lateral_fixed: true,
         point_loads: vec![],
+        unbalance: vec![],
     };
     // Stabilizers: a site at the node nearest each stabilizer's middle.
     let mut stab_nodes = Vec::new();
@@ -1191,6 +1230,24 @@ pub fn parse_case(path: &Path, text: &str) -> Result<Case, InputError> {
         );
     }
     model.sites.sort_by_key(|s| s.node);
+    // Mass imbalance: each element's half masses times its component's offset, towards its
+    // frame's first lateral axis (transported along the hole: one side of the component).
+    if eccentricities.iter().any(|e| *e > 0.0) {
+        let mut u = vec![[0.0; 3]; model.nodes.len()];
+        for (i, e) in model.elements.iter().enumerate() {
+            let ecc = eccentricities[e.component];
+            if ecc == 0.0 {
+                continue;
+            }
+            let half = 0.5 * tubulars[e.component].density * e.section.area * e.length0;
+            for node in [i, i + 1] {
+                for (k, uk) in u[node].iter_mut().enumerate() {
+                    *uk += half * ecc * e.frame0[k][1];
+                }
+            }
+        }
+        model.unbalance = u;
+    }
     let element_density = model
         .elements
         .iter()

@@ -104,6 +104,11 @@ pub struct Model {
     pub bit_lateral_fixed: bool,
     /// Further nodal loads (node, [force (N); moment (N·m)]), scaled with the load factor.
     pub point_loads: Vec<(usize, [f64; 6])>,
+    /// Mass imbalance per node (kg·m): the node's mass times the offset of its centre of
+    /// mass from the pipe axis, as a vector in the global axes of the initial configuration;
+    /// it turns with the node (`R U₀`). Empty: none. Dynamics only (a rigid eccentric mass:
+    /// [`crate::solve::dynamics`]).
+    pub unbalance: Vec<Vec3<f64>>,
 }
 
 /// An orthonormal frame whose first column is `e1`.
@@ -320,7 +325,13 @@ impl Model {
             top: TopBoundary::Clamped,
             bit_lateral_fixed: true,
             point_loads: vec![],
+            unbalance: vec![],
         }
+    }
+
+    /// Whether any node carries a mass imbalance.
+    pub fn has_unbalance(&self) -> bool {
+        self.unbalance.iter().any(|u| u.iter().any(|x| *x != 0.0))
     }
 
     /// Outer radius of the pipe at node `i` (largest of its elements).

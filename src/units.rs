@@ -29,6 +29,8 @@ pub enum Dimension {
     Damping,
     /// s
     Time,
+    /// kg·m (a mass imbalance)
+    MassLength,
     /// dimensionless
     Ratio,
 }
@@ -48,6 +50,7 @@ impl Dimension {
             Dimension::Stiffness => "N/m",
             Dimension::Damping => "N.s/m",
             Dimension::Time => "s",
+            Dimension::MassLength => "kg.m",
             Dimension::Ratio => "1",
         }
     }
@@ -108,6 +111,10 @@ const UNITS: &[(&str, Dimension, f64)] = &[
     ("ms", Dimension::Time, 1e-3),
     ("min", Dimension::Time, 60.0),
     ("h", Dimension::Time, 3600.0),
+    ("kg.m", Dimension::MassLength, 1.0),
+    ("g.mm", Dimension::MassLength, 1e-6),
+    ("g.cm", Dimension::MassLength, 1e-5),
+    ("oz.in", Dimension::MassLength, 0.028_349_523_125 * INCH),
     ("%", Dimension::Ratio, 1e-2),
 ];
 

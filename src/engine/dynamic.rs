@@ -116,6 +116,14 @@ pub fn unsupported(options: &DynamicOptions) -> Option<String> {
     None
 }
 
+/// What of the models only the CPU integrator has (a mass imbalance), if any.
+pub fn unsupported_model(models: &[Model]) -> Option<String> {
+    models
+        .iter()
+        .any(Model::has_unbalance)
+        .then(|| "a mass imbalance runs on the CPU integrator".into())
+}
+
 /// A chunk's start: its tables, each variant's force scale, and what moves the top.
 struct Start<T> {
     tables: DynamicTables<T>,
@@ -243,6 +251,9 @@ pub fn run_dynamic_ensemble<T: Real + Send + Sync, P: KernelPath<T>>(
     observe: &mut dyn FnMut(usize, f64, &DynamicBatch<T>),
 ) -> Result<Vec<DynamicResult>, String> {
     if let Some(why) = unsupported(options) {
+        return Err(why);
+    }
+    if let Some(why) = unsupported_model(models) {
         return Err(why);
     }
     super::check_same_mesh(models)?;

@@ -273,8 +273,71 @@ impl<'a> Dynamics<'a> {
             let w: Vec3<f64> = std::array::from_fn(|k| s.v[6 * i + 3 + k]);
             let j = self.spatial_inertia(&s.q, i);
             e += 0.5 * self.mass[i] * dot(&v, &v) + 0.5 * dot(&w, &mat_vec(&j, &w));
+            // An imbalance: ½ M |ẋ + ω × d|² in place of ½ M |ẋ|².
+            if let Some(u0) = self.model.unbalance.get(i).filter(|_| self.mass[i] > 0.0) {
+                let u = mat_vec(&s.q.rot[i], u0);
+                let wxu = cross(&w, &u);
+                e += dot(&v, &wxu) + 0.5 * dot(&wxu, &wxu) / self.mass[i];
+            }
         }
         e
+    }
+
+    /// Node `i`'s mass imbalance as a rigid eccentric mass (its centre of mass at `x + d`,
+    /// `d = R U₀ / M`, `U = R U₀`): the inertial force and moment it adds to the equations,
+    /// `M (ω̇ × d + ω × (ω × d))` and `U × (ẍ + ω̇ × d + ω × (ω × d))` (second order in `d`
+    /// kept), and their derivatives with respect to `v̇` (the mass coupling) and, times `hg`,
+    /// to `ω`; `None` where the node has none. The rotation's own derivative is left out of
+    /// the iteration matrix (first order in a small `d`; Newton converges without it).
+    fn unbalance_terms(
+        &self,
+        s: &DynamicState,
+        i: usize,
+        hg: f64,
+    ) -> Option<([f64; 6], [[f64; 6]; 6])> {
+        let u0 = self.model.unbalance.get(i)?;
+        if u0.iter().all(|x| *x == 0.0) || self.mass[i] <= 0.0 {
+            return None;
+        }
+        let u = mat_vec(&s.q.rot[i], u0);
+        let m = self.mass[i];
+        let d: Vec3<f64> = std::array::from_fn(|k| u[k] / m);
+        let xdd: Vec3<f64> = std::array::from_fn(|k| s.vdot[6 * i + k]);
+        let w: Vec3<f64> = std::array::from_fn(|k| s.v[6 * i + 3 + k]);
+        let wd: Vec3<f64> = std::array::from_fn(|k| s.vdot[6 * i + 3 + k]);
+        let wxd = cross(&w, &d);
+        let a_rel: Vec3<f64> = {
+            let t = cross(&wd, &d);
+            let c = cross(&w, &wxd);
+            std::array::from_fn(|k| t[k] + c[k])
+        };
+        let a_cm: Vec3<f64> = std::array::from_fn(|k| xdd[k] + a_rel[k]);
+        let moment = cross(&u, &a_cm);
+        let mut r = [0.0; 6];
+        for k in 0..3 {
+            r[k] = m * a_rel[k];
+            r[3 + k] = moment[k];
+        }
+        let su = skew(&u);
+        let sd = skew(&d);
+        // ∂(ω × (ω × d))/∂ω = −[ω × d]× − [ω]×[d]×.
+        let swd = skew(&wxd);
+        let sw_sd = mat_mul(&skew(&w), &sd);
+        let dw: Mat3<f64> =
+            std::array::from_fn(|a| std::array::from_fn(|b| -swd[a][b] - sw_sd[a][b]));
+        let su_sd = mat_mul(&su, &sd);
+        let su_dw = mat_mul(&su, &dw);
+        let mut jac = [[0.0; 6]; 6];
+        for a in 0..3 {
+            for b in 0..3 {
+                // Translations: ∂/∂ω̇ = −M [d]× = −[U]×; ∂/∂ω = M dw.
+                jac[a][3 + b] = -su[a][b] + hg * m * dw[a][b];
+                // Moments: ∂/∂ẍ = [U]×, ∂/∂ω̇ = −[U]×[d]×, ∂/∂ω = [U]× dw.
+                jac[3 + a][b] = su[a][b];
+                jac[3 + a][3 + b] = -su_sd[a][b] + hg * su_dw[a][b];
+            }
+        }
+        Some((r, jac))
     }
 
     fn spatial_inertia(&self, q: &StaticState, i: usize) -> Mat3<f64> {
@@ -329,6 +392,15 @@ impl<'a> Dynamics<'a> {
                     mass.diag[i][k][k] = self.mass[i];
                     for c in 0..3 {
                         mass.diag[i][3 + k][3 + c] = j[k][c];
+                    }
+                }
+            }
+        }
+        for i in 0..n {
+            if let Some((_, ju)) = self.unbalance_terms(&s, i, 0.0) {
+                for a in 0..6 {
+                    for b in 0..6 {
+                        mass.diag[i][a][b] += ju[a][b];
                     }
                 }
             }
@@ -411,6 +483,23 @@ impl<'a> Dynamics<'a> {
                     for b in 0..3 {
                         let inertia = if lumped { j[a][b] } else { 0.0 };
                         s_mat.diag[i][3 + a][3 + b] += inertia + hg * (sw[a][b] - sjw[a][b]);
+                    }
+                }
+            }
+        }
+        // Mass imbalance (eccentric centres of mass turning with their nodes).
+        if !self.model.unbalance.is_empty() {
+            for i in 0..n {
+                if let Some((ru, ju)) = self.unbalance_terms(s, i, hg) {
+                    for a in 0..6 {
+                        r[6 * i + a] += ru[a];
+                    }
+                    if with_matrix {
+                        for a in 0..6 {
+                            for b in 0..6 {
+                                s_mat.diag[i][a][b] += ju[a][b];
+                            }
+                        }
                     }
                 }
             }
