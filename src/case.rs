@@ -167,7 +167,7 @@ pub struct DynamicsSpec {
     /// Rayleigh damping `a1` (s, stiffness-proportional; default 0).
     pub rayleigh_stiffness: Option<Spanned<f64>>,
     /// Outputs to record: `bit_displacement`, `lateral`, `contact_forces`, `spin`,
-    /// `surface_torque`, `axial_stress`, `energy` (default: all).
+    /// `surface_torque`, `axial_stress`, `energy`, `whirl` (default: all).
     pub outputs: Option<Vec<Spanned<String>>>,
     /// Mass matrix: `"lumped"` (default) or `"consistent"`.
     pub mass: Option<Spanned<String>>,
@@ -208,6 +208,7 @@ pub const DYNAMIC_OUTPUTS: &[&str] = &[
     "surface_torque",
     "axial_stress",
     "energy",
+    "whirl",
 ];
 
 /// A whole case file.

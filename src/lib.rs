@@ -27,5 +27,6 @@ pub mod solve;
 pub mod units;
 pub mod uq;
 pub mod well;
+pub mod whirl;
 
 pub use error::{Error, GpuError, InputError};

@@ -132,3 +132,112 @@ fn imbalance_spins_up_into_forward_synchronous_whirl_of_jeffcott_amplitude() {
         );
     }
 }
+
+/// A 10 m collar hanging from the rotary table (weightless, bit free), a stabilizer of
+/// radius `R_d` at its end in a hole of clearance `ΔR`: an imbalance throws the spinning
+/// stabilizer to the wall; with high friction it rolls there, whirling backward at
+/// `−Ω R_d/ΔR`. Returns the whirl analysis of its second half and the rolling rate (Hz).
+fn imbalance_against_the_wall(
+    mu: f64,
+    spin: f64,
+    eps: f64,
+    t_end: f64,
+) -> (holewall::whirl::Whirl, f64) {
+    use holewall::model::{add_sites, ContactSettings};
+    let (r_d, clearance) = (0.1, 0.02);
+    let mut m = shaft(10.0, 10);
+    m.bit_lateral_fixed = false;
+    m.rotation_speed = spin;
+    let bit = m.nodes.len() - 1;
+    add_sites(
+        &mut m,
+        &[bit],
+        |_| r_d + clearance,
+        |_| r_d,
+        |_| mu,
+        &ContactSettings {
+            wall_stiffness: 1e8,
+            spring_exponent: 1.0,
+            wall_damping: 2e3,
+            eps: 1e-3,
+            soft_blend: 1e-4,
+        },
+        true,
+    );
+    let (mass, _) = holewall::solve::dynamics::lumped_mass(&m, &|_| RHO);
+    m.unbalance = (0..m.nodes.len())
+        .map(|i| [mass[i] * eps, 0.0, 0.0])
+        .collect();
+    let options = DynamicOptions {
+        dt: 1e-3,
+        alpha: AlphaParams::chung_hulbert(0.8),
+        ramp_time: 0.5,
+        ..Default::default()
+    };
+    let mut d = Dynamics::new(&m, options, &|_| RHO);
+    let mut s = d.initial_state(StaticState::initial(&m)).unwrap();
+    let every = 5;
+    let (mut x, mut y, mut normal) = (Vec::new(), Vec::new(), Vec::new());
+    let mut spins = Vec::new();
+    let mut step = 0usize;
+    d.run(&mut s, t_end, &mut |dd, st| {
+        step += 1;
+        if step % every == 0 && st.t > 0.5 * t_end {
+            x.push(st.q.x[bit][0] - m.nodes[bit].position[0]);
+            y.push(st.q.x[bit][1] - m.nodes[bit].position[1]);
+            spins.push(st.v[6 * bit + 5]);
+            let f = dd.contact_forces(st);
+            normal.push(if f[0].contact { 1.0 } else { 0.0 });
+        }
+    })
+    .unwrap();
+    let mean_spin = spins.iter().sum::<f64>() / spins.len() as f64;
+    let w = holewall::whirl::analyse(
+        &x,
+        &y,
+        &normal,
+        every as f64 * 1e-3,
+        spin / std::f64::consts::TAU,
+        clearance,
+    );
+    (w, -mean_spin * r_d / clearance / std::f64::consts::TAU)
+}
+
+/// The classic friction-driven transition: the same imbalance (1 cm offset, 7 rad/s, 0.86 of
+/// the first natural frequency: a Jeffcott radius past the 2 cm clearance) throws the
+/// stabilizer to the wall; with μ = 0.1 it stays in forward synchronous whirl, touching the
+/// wall now and then; with μ = 0.5 the friction turns it into backward whirl, rolling on
+/// the wall at `−Ω_s R_d/ΔR` (`Ω_s` the stabilizer's own spin), in contact throughout.
+#[test]
+fn imbalance_in_contact_with_high_friction_rolls_into_backward_whirl() {
+    let spin = 7.0;
+    let (w, rolling_hz) = imbalance_against_the_wall(0.5, spin, 10e-3, 12.0);
+    eprintln!(
+        "μ = 0.5: {:?}, dominant {:.3} Hz vs rolling −Ω R_d/ΔR = {rolling_hz:.3} Hz (resolution {:.3} Hz), peak share {:.2}, contact {:.2}, max radius {:.2} mm",
+        w.class,
+        w.dominant_hz,
+        w.resolution_hz,
+        w.peak_share,
+        w.contact_fraction,
+        1e3 * w.max_radius_m
+    );
+    assert_eq!(w.class, holewall::whirl::WhirlClass::Backward);
+    assert!(w.peak_share > 0.9 && w.contact_fraction > 0.95, "{w:?}");
+    // Within a bin, and the 3 % by which the radius exceeds ΔR (the wall's give).
+    assert!(
+        (w.dominant_hz - rolling_hz).abs() <= w.resolution_hz + 0.03 * rolling_hz.abs(),
+        "{} vs {rolling_hz}",
+        w.dominant_hz
+    );
+    let (w, _) = imbalance_against_the_wall(0.1, spin, 10e-3, 12.0);
+    eprintln!(
+        "μ = 0.1: {:?}, dominant {:.3} Hz vs Ω/2π = {:.3} Hz, contact {:.2}",
+        w.class,
+        w.dominant_hz,
+        spin / std::f64::consts::TAU,
+        w.contact_fraction
+    );
+    assert_eq!(w.class, holewall::whirl::WhirlClass::Forward);
+    assert!((w.dominant_hz - spin / std::f64::consts::TAU).abs() <= w.resolution_hz);
+    assert!(w.contact_fraction < 0.5, "{w:?}");
+}

@@ -33,6 +33,20 @@ pub struct RunSummary {
     pub requested_duration_s: f64,
     /// Why the run ended before `requested_duration_s` (the `--max-seconds` budget), if it did.
     pub stopped_early: Option<String>,
+    /// Per stabilizer, its whirl over the run's second half ([`crate::whirl`]), with `whirl`.
+    pub whirl: Vec<SiteWhirl>,
+}
+
+/// A stabilizer's whirl in `summary.json`.
+#[derive(Clone, Debug, Serialize)]
+pub struct SiteWhirl {
+    /// Contact site index.
+    pub site: usize,
+    /// Its MD (m).
+    pub md_m: f64,
+    /// The analysis.
+    #[serde(flatten)]
+    pub whirl: crate::whirl::Whirl,
 }
 
 /// Options of `holewall run`.
@@ -76,7 +90,7 @@ fn record(
         0.0
     };
     rec.series.push([s.t, bit_axial, torque, ke, se, ke + se]);
-    if want("lateral") || want("contact_forces") || want("spin") {
+    if want("lateral") || want("contact_forces") || want("spin") || want("whirl") {
         let contact = dynamics.contact_forces(s);
         for (k, (site, out)) in model.sites.iter().zip(contact).enumerate() {
             let node = &model.nodes[site.node];
@@ -441,6 +455,88 @@ fn run_case(case: &Case, out: &Path, run_options: RunOptions) -> Result<RunSumma
             }
         }
     }
+    let mut whirl = Vec::new();
+    if want("whirl") {
+        let t_end = t.last().copied().unwrap_or(0.0);
+        let mut spectrum_rows: Vec<Vec<f64>> = Vec::new();
+        for (k, site) in model.sites.iter().enumerate().filter(|(_, s)| s.stabilizer) {
+            // The second half of the run, after the spin-up.
+            let late: Vec<&(f64, usize, [f64; 5])> = rec
+                .sites
+                .iter()
+                .filter(|r| r.1 == k && r.0 >= 0.5 * t_end)
+                .collect();
+            let col = |j: usize| -> Vec<f64> { late.iter().map(|r| r.2[j]).collect() };
+            let spin = col(4);
+            let mean_spin = spin.iter().sum::<f64>() / spin.len().max(1) as f64;
+            let rotary_hz = model.rotation_speed.abs() / std::f64::consts::TAU
+                * if mean_spin < 0.0 { -1.0 } else { 1.0 };
+            let w = crate::whirl::analyse(
+                &col(0),
+                &col(1),
+                &col(3),
+                settings.output_interval,
+                rotary_hz,
+                site.params.clearance,
+            );
+            let md = model.nodes[site.node].md;
+            for (f, a) in &w.spectrum {
+                spectrum_rows.push(vec![
+                    k as f64,
+                    md,
+                    *f,
+                    if rotary_hz != 0.0 { f / rotary_hz } else { 0.0 },
+                    1e3 * a,
+                ]);
+            }
+            if w.class != crate::whirl::WhirlClass::None && rotary_hz != 0.0 {
+                // Up to 5 × the rotary frequency, or past the dominant peak (the whole
+                // spectrum is in whirl_spectrum.csv).
+                let span = 5.0f64.max(1.2 * w.ratio_to_rotary.abs());
+                let pts: Vec<(f64, f64)> = w
+                    .spectrum
+                    .iter()
+                    .map(|(f, a)| (f / rotary_hz, 1e3 * a))
+                    .filter(|(r, _)| r.abs() <= span)
+                    .collect();
+                line_plot(
+                    &out.join(format!("whirl_site{k}.png")),
+                    &format!(
+                        "{title}: whirl spectrum at MD {md:.1} m — {:?}, {:.2} × rotary",
+                        w.class, w.ratio_to_rotary
+                    ),
+                    "whirl frequency / rotary frequency (+ forward, − backward)",
+                    "amplitude (mm)",
+                    &[Series {
+                        name: "second half of the run",
+                        points: pts,
+                        wide: false,
+                    }],
+                    &[],
+                )?;
+                written.push(format!("whirl_site{k}.png"));
+            }
+            whirl.push(SiteWhirl {
+                site: k,
+                md_m: md,
+                whirl: w,
+            });
+        }
+        write_atomic(
+            &out.join("whirl_spectrum.csv"),
+            &csv_bytes(
+                &[
+                    "site",
+                    "md_m",
+                    "frequency_hz",
+                    "frequency_over_rotary",
+                    "amplitude_mm",
+                ],
+                spectrum_rows.into_iter(),
+            )?,
+        )?;
+        written.push("whirl_spectrum.csv".into());
+    }
     if want("axial_stress") {
         let rows = rec.stress.iter().map(|(t, md, s)| vec![*t, *md, *s]);
         write_atomic(
@@ -492,6 +588,7 @@ fn run_case(case: &Case, out: &Path, run_options: RunOptions) -> Result<RunSumma
         outputs: written,
         requested_duration_s: settings.duration,
         stopped_early,
+        whirl,
     };
     Ok(summary)
 }
