@@ -182,7 +182,7 @@ fn imbalance_against_the_wall(
     let mut step = 0usize;
     d.run(&mut s, t_end, &mut |dd, st| {
         step += 1;
-        if step % every == 0 && st.t > 0.5 * t_end {
+        if step.is_multiple_of(every) && st.t > 0.5 * t_end {
             x.push(st.q.x[bit][0] - m.nodes[bit].position[0]);
             y.push(st.q.x[bit][1] - m.nodes[bit].position[1]);
             spins.push(st.v[6 * bit + 5]);
