@@ -1231,23 +1231,12 @@ pub fn parse_case(path: &Path, text: &str) -> Result<Case, InputError> {
         );
     }
     model.sites.sort_by_key(|s| s.node);
-    // Mass imbalance: each element's half masses times its component's offset, towards its
-    // frame's first lateral axis (transported along the hole: one side of the component).
+    // Mass imbalance: each component's centre-of-mass offset.
     if eccentricities.iter().any(|e| *e > 0.0) {
-        let mut u = vec![[0.0; 3]; model.nodes.len()];
-        for (i, e) in model.elements.iter().enumerate() {
-            let ecc = eccentricities[e.component];
-            if ecc == 0.0 {
-                continue;
-            }
-            let half = 0.5 * tubulars[e.component].density * e.section.area * e.length0;
-            for node in [i, i + 1] {
-                for (k, uk) in u[node].iter_mut().enumerate() {
-                    *uk += half * ecc * e.frame0[k][1];
-                }
-            }
-        }
-        model.unbalance = u;
+        model.unbalance = model
+            .unbalance_from(&|e| tubulars[model.elements[e].component].density, &|e| {
+                eccentricities[model.elements[e].component]
+            });
     }
     let element_density = model
         .elements

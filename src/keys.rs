@@ -36,6 +36,9 @@ pub enum Param {
     Depth,
     /// Operation mode (a code of [`MODES`]): the case rebuilt with it.
     Mode,
+    /// Centre-of-mass offset of every BHA component (bit to the first drill pipe), m: a mass
+    /// imbalance for dynamics, replacing the case's `mass_eccentricity`/`imbalance`.
+    Eccentricity,
     /// A stabilizer layout: the 1-based index of one of `ensemble.layouts` (each a set of
     /// `stabK.from_bit` / `stabK.blade` values applied together).
     Layout,
@@ -56,7 +59,7 @@ pub struct Key {
 }
 
 /// Every key form, for messages.
-pub const KEY_FORMS: &str = "mu, mu_t, mu_l, k_e, c, m, eps (each optionally .stabK), rpm, wob, tob, stabK.blade, stabK.from_bit, depth, mode, layout";
+pub const KEY_FORMS: &str = "mu, mu_t, mu_l, k_e, c, m, eps (each optionally .stabK), rpm, wob, tob, stabK.blade, stabK.from_bit, depth, mode, layout, ecc";
 
 impl Key {
     /// Parses a column key.
@@ -88,6 +91,7 @@ impl Key {
             ("depth", None) => (Param::Depth, None),
             ("mode", None) => (Param::Mode, None),
             ("layout", None) => (Param::Layout, None),
+            ("ecc", None) => (Param::Eccentricity, None),
             (h, None) if law(h).is_some() => (law(h).unwrap_or(Param::Mu), None),
             (h, Some(t)) if law(h).is_some() => (law(h).unwrap_or(Param::Mu), Some(stab_index(t)?)),
             (h, Some("blade")) => (Param::Blade, Some(stab_index(h)?)),
@@ -167,6 +171,11 @@ impl Key {
                 Some(Dimension::Length),
                 |x| x > 0.0 && x <= 2e4,
                 "0 < depth ≤ 20 km",
+            ),
+            Param::Eccentricity => (
+                Some(Dimension::Length),
+                |x| (0.0..=0.05).contains(&x),
+                "0 … 50 mm",
             ),
             Param::Layout => (
                 None,

@@ -329,6 +329,31 @@ impl Model {
         }
     }
 
+    /// The nodal mass imbalance (kg·m vectors, [`Model::unbalance`]) of elements whose
+    /// centre of mass sits `eccentricity(e)` (m) off the pipe axis, each towards its frame's
+    /// first lateral axis (transported along the hole: one side of a component): half of
+    /// each element's steel mass (`density(e)`) to each of its nodes.
+    pub fn unbalance_from(
+        &self,
+        density: &dyn Fn(usize) -> f64,
+        eccentricity: &dyn Fn(usize) -> f64,
+    ) -> Vec<Vec3<f64>> {
+        let mut u = vec![[0.0; 3]; self.nodes.len()];
+        for (i, e) in self.elements.iter().enumerate() {
+            let ecc = eccentricity(i);
+            if ecc == 0.0 {
+                continue;
+            }
+            let half = 0.5 * density(i) * e.section.area * e.length0;
+            for node in [i, i + 1] {
+                for (k, uk) in u[node].iter_mut().enumerate() {
+                    *uk += half * ecc * e.frame0[k][1];
+                }
+            }
+        }
+        u
+    }
+
     /// Whether any node carries a mass imbalance.
     pub fn has_unbalance(&self) -> bool {
         self.unbalance.iter().any(|u| u.iter().any(|x| *x != 0.0))

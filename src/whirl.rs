@@ -8,21 +8,23 @@
 //! the string's rotation) from backward whirl (negative ones). The amplitude at a
 //! frequency is the radius of that circular component (mm).
 //!
-//! Classification, threshold stated: `none` when the largest radius of the motion about
-//! its mean stays below 1 µm (or 1e-6 of the clearance); otherwise `forward` or `backward`
+//! Classification, thresholds stated: `none` when the largest radius of the motion about
+//! its mean stays below 1 µm (or 1e-6 of the clearance), or when the dominant frequency is
+//! below two bins (fewer than two orbits over the window: a drift, or a site pinned to
+//! the wall, is no whirl); otherwise `forward` or `backward`
 //! when the dominant peak (±2 bins) holds at least half of the spectral energy, its sign
 //! giving the sense, and `chaotic` when no peak does (energy spread over many
 //! frequencies). `synchronous` forward whirl: within 5 % of the rotary frequency;
 //! rolling backward whirl is expected at `−Ω R_d/ΔR`.
 
 use rustfft::{num_complex::Complex, FftPlanner};
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 /// Share of the spectral energy the dominant peak must hold to name a direction.
 pub const PEAK_SHARE: f64 = 0.5;
 
 /// How a site whirls.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum WhirlClass {
     /// No lateral motion worth the name.
@@ -132,7 +134,9 @@ pub fn analyse(
     };
     // Forward means the sense of the string's rotation.
     let sense = if rotary_hz < 0.0 { -1.0 } else { 1.0 };
-    let class = if share < PEAK_SHARE {
+    let class = if dominant_hz.abs() < 2.0 * resolution_hz {
+        WhirlClass::None
+    } else if share < PEAK_SHARE {
         WhirlClass::Chaotic
     } else if sense * dominant_hz > 0.0 {
         WhirlClass::Forward
@@ -201,6 +205,9 @@ mod tests {
         let y: Vec<f64> = (0..n).map(|_| 1e-3 * rnd()).collect();
         let w = analyse(&x, &y, &[], dt, 2.0, 0.01);
         assert_eq!(w.class, WhirlClass::Chaotic, "share {}", w.peak_share);
+        // A slow drift (one orbit over the window): none.
+        let (x, y) = circle(0.1, 1e-3, n, dt);
+        assert_eq!(analyse(&x, &y, &[], dt, 2.0, 0.01).class, WhirlClass::None);
         // At rest: none.
         let w = analyse(&vec![1e-9; n], &vec![0.0; n], &[], dt, 2.0, 0.01);
         assert_eq!(w.class, WhirlClass::None);

@@ -241,3 +241,76 @@ fn imbalance_in_contact_with_high_friction_rolls_into_backward_whirl() {
     assert!((w.dominant_hz - spin / std::f64::consts::TAU).abs() <= w.resolution_hz);
     assert!(w.contact_fraction < 0.5, "{w:?}");
 }
+
+/// The imbalance keys: `mass_eccentricity` (m) and `imbalance` (kg·m) of a component give
+/// the same nodal imbalance; both at once, or an offset beyond the pipe, are refused; the
+/// ensemble key `ecc` sets the BHA's offset and leaves the drill pipe without.
+#[test]
+fn imbalance_keys_agree_and_the_ecc_key_sets_the_bha() {
+    let base = std::fs::read_to_string(
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("cases/spinup_short.toml"),
+    )
+    .unwrap();
+    let dir = std::env::temp_dir().join(format!("holewall-whirl-keys-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let parse = |text: &str| {
+        let p = dir.join("case.toml");
+        std::fs::write(&p, text).unwrap();
+        holewall::case::load_case(&p)
+    };
+    // The first collar: 9.25 m of 6.5 in × 2.8125 in steel.
+    let first = "kind = \"collar\"\nlength = \"9.25 m\"";
+    let mass =
+        7850.0 * std::f64::consts::FRAC_PI_4 * (0.1651f64.powi(2) - 0.071_437_5f64.powi(2)) * 9.25;
+    let by_offset =
+        parse(&base.replacen(first, &format!("{first}\nmass_eccentricity = \"1 mm\""), 1)).unwrap();
+    let by_moment = parse(&base.replacen(
+        first,
+        &format!("{first}\nimbalance = \"{} kg.m\"", mass * 1e-3),
+        1,
+    ))
+    .unwrap();
+    let total = |m: &Model| -> f64 { m.unbalance.iter().map(|u| u[0].hypot(u[1])).sum() };
+    assert!(by_offset.model.has_unbalance());
+    assert!(
+        (total(&by_offset.model) / (mass * 1e-3) - 1.0).abs() < 1e-9,
+        "{}",
+        total(&by_offset.model)
+    );
+    for (a, b) in by_offset
+        .model
+        .unbalance
+        .iter()
+        .zip(&by_moment.model.unbalance)
+    {
+        for k in 0..3 {
+            assert!((a[k] - b[k]).abs() <= 1e-12 * mass);
+        }
+    }
+    let both = parse(&base.replacen(
+        first,
+        &format!("{first}\nmass_eccentricity = \"1 mm\"\nimbalance = \"1 kg.m\""),
+        1,
+    ))
+    .unwrap_err();
+    assert!(both.to_string().contains("not both"), "{both}");
+    let far = parse(&base.replacen(first, &format!("{first}\nmass_eccentricity = \"10 cm\""), 1))
+        .unwrap_err();
+    assert!(far.to_string().contains("od/2"), "{far}");
+    // ecc: the BHA (bit to the first drill pipe) only.
+    let case = parse(&base).unwrap();
+    assert!(!case.model.has_unbalance());
+    let v = holewall::ensemble::variants_from_csv_text("v.csv", "ecc\n0.5 mm\n").unwrap();
+    let m = holewall::ensemble::apply(&case, &v[0]).unwrap();
+    let bha_top = case.bit_md - case.bha_length;
+    for (i, u) in m.unbalance.iter().enumerate() {
+        let on = u[0].hypot(u[1]) > 0.0;
+        assert_eq!(
+            on,
+            m.nodes[i].md >= bha_top - 1e-9,
+            "node {i} at {}",
+            m.nodes[i].md
+        );
+    }
+    assert!(m.has_unbalance());
+}

@@ -283,13 +283,7 @@ pub fn run(
     let mut outputs = vec!["variants.csv".to_string()];
     write_atomic(
         &out.join("variants.csv"),
-        &variants_csv(
-            &case,
-            &variants,
-            &results,
-            stabs,
-            dynamic.then(|| whirl_threshold_hz(case.dynamics.as_ref().map_or(0.0, |d| d.duration))),
-        )?,
+        &variants_csv(&case, &variants, &results, stabs, dynamic)?,
     )?;
     let uncertainty = match monte_carlo {
         Some(mc) => {

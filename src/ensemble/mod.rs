@@ -19,6 +19,7 @@
 //! | `stabK.from_bit` | distance of stabilizer K's site from the bit | m | 0 < … < bit MD |
 //! | `depth` | bit depth (MD): the case rebuilt with `well.total_md` there (the string cut at the surface, the hole sections kept) | m | 0 < … ≤ 20 km, within the hole |
 //! | `mode` | operation: `rotating`, `tripping_in`, `tripping_out`, `sliding` (the case rebuilt with it) | – | one of those |
+//! | `ecc` | centre-of-mass offset of every BHA component (dynamics: a mass imbalance; replaces the case's) | m | 0 … 50 mm |
 //! | `layout` | one of the case's `ensemble.layouts` (1, 2, …): its `stabK.from_bit` / `stabK.blade` values together | – | 1 … number of layouts |
 //!
 //! Stabilizers are numbered from the bit up (`stab1` nearest the bit); a key without
@@ -303,6 +304,20 @@ pub fn apply(case: &Case, variant: &Variant) -> Result<Model, String> {
         };
         match key.param {
             Param::FromBit | Param::Depth | Param::Mode | Param::Layout => {}
+            Param::Eccentricity => {
+                let bha_top = bit_md_of_model(&model) - case.bha_length;
+                let density = &case.element_density;
+                let nodes = &model.nodes;
+                let in_bha = |e: usize| 0.5 * (nodes[e].md + nodes[e + 1].md) >= bha_top;
+                model.unbalance =
+                    model.unbalance_from(&|e| density.get(e).copied().unwrap_or(7850.0), &|e| {
+                        if in_bha(e) {
+                            v
+                        } else {
+                            0.0
+                        }
+                    });
+            }
             Param::Rpm => model.rotation_speed = v,
             Param::Wob => {
                 if let crate::model::TopBoundary::HookLoad(_) = model.top {
@@ -345,6 +360,10 @@ pub fn apply(case: &Case, variant: &Variant) -> Result<Model, String> {
     }
     model.sites.sort_by_key(|s| s.node);
     Ok(model)
+}
+
+fn bit_md_of_model(model: &Model) -> f64 {
+    model.nodes.last().map_or(0.0, |n| n.md)
 }
 
 /// The case rebuilt for a variant's `depth` and `mode`, if it has either: the case file

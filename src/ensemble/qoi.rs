@@ -22,9 +22,16 @@ pub struct StabilizerQoi {
     /// Largest lateral displacement from the hole axis (m).
     #[serde(with = "crate::output::nan_as_null")]
     pub max_lateral_m: f64,
-    /// Whirl frequency over the second half of a dynamic run (Hz), signed: + forward (with
-    /// the rotation), − backward; `None` for static runs or a stabilizer that stays put.
+    /// Dominant whirl frequency over the second half of a dynamic run (Hz), signed
+    /// (positive forward, with the rotation; negative backward; [`crate::whirl`]); `None`
+    /// for static runs or a stabilizer that does not whirl.
     pub whirl_hz: Option<f64>,
+    /// How it whirls ([`crate::whirl::WhirlClass`]); `None` for static runs.
+    #[serde(default)]
+    pub whirl_class: Option<crate::whirl::WhirlClass>,
+    /// Share of the second half in contact with the wall; `None` for static runs.
+    #[serde(default)]
+    pub contact_fraction: Option<f64>,
 }
 
 /// Quantities of interest of the whole string.
@@ -207,6 +214,8 @@ pub fn static_result(
                 max_side_force_n: sol.contact[k].1.max(0.0),
                 max_lateral_m: x.hypot(y),
                 whirl_hz: None,
+                whirl_class: None,
+                contact_fraction: None,
             }
         })
         .collect();
@@ -274,9 +283,8 @@ pub fn dynamic_variant(case: &Case, name: &str, model: &Model) -> VariantResult 
 pub struct DynamicObserver {
     stabs: Vec<usize>,
     qoi: Vec<StabilizerQoi>,
-    angles: Vec<Vec<(f64, f64)>>,
-    last_angle: Vec<Option<f64>>,
-    unwrapped: Vec<f64>,
+    /// Per stabilizer over the second half: (t, x, y, in contact).
+    samples: Vec<Vec<(f64, f64, f64, bool)>>,
     max_torque: f64,
     half: f64,
     /// Largest side force per length so far, and its MD.
@@ -293,9 +301,7 @@ impl DynamicObserver {
         DynamicObserver {
             stabs,
             qoi: vec![StabilizerQoi::default(); k],
-            angles: vec![Vec::new(); k],
-            last_angle: vec![None; k],
-            unwrapped: vec![0.0; k],
+            samples: vec![Vec::new(); k],
             max_torque: 0.0,
             half: 0.5 * duration,
             per_length: (0.0, f64::NAN),
@@ -346,15 +352,8 @@ impl DynamicObserver {
                 let normal = dot(&[g[0], g[1], g[2]], &d_t) / r;
                 qoi.max_side_force_n = qoi.max_side_force_n.max(normal);
             }
-            let a = y.atan2(x);
-            if let Some(l) = self.last_angle[j] {
-                let mut da = a - l;
-                da -= std::f64::consts::TAU * (da / std::f64::consts::TAU).round();
-                self.unwrapped[j] += da;
-            }
-            self.last_angle[j] = Some(a);
-            if st.t >= self.half && r > 1e-6 {
-                self.angles[j].push((st.t, self.unwrapped[j]));
+            if st.t >= self.half {
+                self.samples[j].push((st.t, x, y, contact[k].contact));
             }
         }
     }
@@ -372,25 +371,12 @@ impl DynamicObserver {
         if last.v.iter().any(|x| !x.is_finite()) {
             return failed(name, "state is not finite".into(), self.stabs.len());
         }
-        let sign = if model.rotation_speed < 0.0 {
-            -1.0
-        } else {
-            1.0
-        };
-        for (j, pts) in self.angles.iter().enumerate() {
-            if pts.len() >= 3 {
-                let nm = pts.len() as f64;
-                let (mt, ma) = pts
-                    .iter()
-                    .fold((0.0, 0.0), |(a, b), (t, x)| (a + t / nm, b + x / nm));
-                let den: f64 = pts.iter().map(|(t, _)| (t - mt).powi(2)).sum();
-                if den > 0.0 {
-                    let rate = pts.iter().map(|(t, x)| (t - mt) * (x - ma)).sum::<f64>() / den;
-                    // Lateral angles are measured about the node's frame0 (e2, e3) = about
-                    // the hole axis, the direction of a positive rotation speed.
-                    self.qoi[j].whirl_hz = Some(sign * rate / std::f64::consts::TAU);
-                }
-            }
+        for (j, pts) in self.samples.iter().enumerate() {
+            let w = whirl_of(model, self.stabs[j], pts);
+            self.qoi[j].whirl_hz =
+                (w.class != crate::whirl::WhirlClass::None).then_some(w.dominant_hz);
+            self.qoi[j].whirl_class = Some(w.class);
+            self.qoi[j].contact_fraction = Some(w.contact_fraction);
         }
         let axial: Vec<f64> = (0..model.elements.len())
             .map(|i| element_axial(model, &last.q, i).0)
@@ -497,8 +483,38 @@ pub(crate) fn bit_md_of(case: &Case, model: &Model) -> f64 {
 }
 
 /// A node's share of the string: half of each element beside it (m).
-/// A whirl slower than one orbit over the fit window (the second half of the run) is no
-/// whirl: `None` direction below this frequency (Hz).
-pub fn whirl_threshold_hz(duration: f64) -> f64 {
-    1.0 / (0.5 * duration).max(1e-9)
+/// The whirl of contact site `site` from the second half's samples (t, x, y, in contact)
+/// taken at the integrator's steps: resampled onto a uniform grid (linear, the mean step)
+/// for [`crate::whirl::analyse`].
+fn whirl_of(model: &Model, site: usize, pts: &[(f64, f64, f64, bool)]) -> crate::whirl::Whirl {
+    let n = pts.len();
+    let rotary_hz = model.rotation_speed / std::f64::consts::TAU;
+    let clearance = model.sites[site].params.clearance;
+    if n < 2 {
+        return crate::whirl::analyse(&[], &[], &[], 1.0, rotary_hz, clearance);
+    }
+    let (t0, t1) = (pts[0].0, pts[n - 1].0);
+    let dt = (t1 - t0) / (n - 1) as f64;
+    let (mut x, mut y, mut c) = (
+        Vec::with_capacity(n),
+        Vec::with_capacity(n),
+        Vec::with_capacity(n),
+    );
+    let mut k = 0;
+    for i in 0..n {
+        let t = t0 + i as f64 * dt;
+        while k + 2 < n && pts[k + 1].0 < t {
+            k += 1;
+        }
+        let (a, b) = (&pts[k], &pts[(k + 1).min(n - 1)]);
+        let f = if b.0 > a.0 {
+            ((t - a.0) / (b.0 - a.0)).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        x.push(a.1 + f * (b.1 - a.1));
+        y.push(a.2 + f * (b.2 - a.2));
+        c.push(if a.3 { 1.0 } else { 0.0 });
+    }
+    crate::whirl::analyse(&x, &y, &c, dt, rotary_hz, clearance)
 }

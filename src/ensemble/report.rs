@@ -59,10 +59,9 @@ pub(crate) fn variants_csv(
     variants: &[Variant],
     results: &[VariantResult],
     stabs: usize,
-    whirl_threshold: Option<f64>,
+    dynamic: bool,
 ) -> Result<Vec<u8>, Error> {
     let (ran_header, ran_rows) = ran_with(case, variants, stabs);
-    let dynamic = whirl_threshold.is_some();
     let io = |e: csv::Error| Error::Io(std::io::Error::other(e));
     let mut keys: Vec<String> = Vec::new();
     for v in variants {
@@ -99,6 +98,7 @@ pub(crate) fn variants_csv(
         if dynamic {
             header.push(format!("stab{k}_whirl_hz"));
             header.push(format!("stab{k}_whirl"));
+            header.push(format!("stab{k}_contact_fraction"));
         }
     }
     header.extend(["newton_iterations_per_step", "step_cuts"].map(String::from));
@@ -153,14 +153,16 @@ pub(crate) fn variants_csv(
             if dynamic {
                 row.push(q.whirl_hz.map(fmt).unwrap_or_default());
                 row.push(
-                    match (q.whirl_hz, whirl_threshold) {
-                        (Some(h), Some(t)) if h.abs() < t => "none",
-                        (Some(h), _) if h > 0.0 => "forward",
-                        (Some(h), _) if h < 0.0 => "backward",
-                        _ => "",
+                    match q.whirl_class {
+                        Some(crate::whirl::WhirlClass::None) => "none",
+                        Some(crate::whirl::WhirlClass::Forward) => "forward",
+                        Some(crate::whirl::WhirlClass::Backward) => "backward",
+                        Some(crate::whirl::WhirlClass::Chaotic) => "chaotic",
+                        None => "",
                     }
                     .into(),
                 );
+                row.push(q.contact_fraction.map(fmt).unwrap_or_default());
             }
         }
         row.push(fmt(r.newton_iterations_per_step));

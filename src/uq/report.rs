@@ -66,7 +66,7 @@ impl Unit {
             Param::Rpm => Unit::AngularSpeed,
             Param::Wob => Unit::Force,
             Param::Tob => Unit::Torque,
-            Param::Blade | Param::FromBit | Param::Depth => Unit::Length,
+            Param::Blade | Param::FromBit | Param::Depth | Param::Eccentricity => Unit::Length,
             Param::Mode | Param::Layout => Unit::Ratio,
         }
     }
