@@ -24,6 +24,7 @@ pub mod physics;
 pub mod plots;
 pub mod selfcheck;
 pub mod solve;
+pub mod study;
 pub mod units;
 pub mod uq;
 pub mod well;

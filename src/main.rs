@@ -128,6 +128,11 @@ enum Command {
         #[arg(long, value_parser = positive_seconds)]
         max_seconds: Option<f64>,
     },
+    /// Studies of a case: `precision` (error against run time per path and step).
+    Study {
+        #[command(subcommand)]
+        what: StudyCommand,
+    },
     /// Joins the folders of a run's `--shard K/N` runs into what the run without shards
     /// would write.
     Merge {
@@ -234,6 +239,34 @@ enum BenchCommand {
         /// Also write the results as JSON here.
         #[arg(long)]
         json: Option<PathBuf>,
+    },
+}
+
+#[derive(Subcommand)]
+enum StudyCommand {
+    /// Work-precision diagram of a dynamic case: for the case's time step halved
+    /// `--refinements` times, each path's (CPU f64, GPU f64, GPU f32) largest relative error
+    /// of the quantities of interest against a CPU f64 reference at a 4× finer step than
+    /// the finest tried, beside its run time; precision.csv, precision.png (log–log),
+    /// summary.json with the cheapest run within `--tolerance`.
+    Precision {
+        /// Case file with a [dynamics] table.
+        case: PathBuf,
+        /// Output folder.
+        #[arg(long)]
+        out: PathBuf,
+        /// Halvings of the case's time step tried.
+        #[arg(long, default_value_t = 2)]
+        refinements: usize,
+        /// Simulated time (s) of every run (default: the case's duration).
+        #[arg(long, value_parser = positive_seconds)]
+        duration: Option<f64>,
+        /// Largest acceptable relative error, for the recommendation.
+        #[arg(long, default_value_t = 1e-3)]
+        tolerance: f64,
+        /// No progress bar.
+        #[arg(long)]
+        quiet: bool,
     },
 }
 
@@ -386,6 +419,25 @@ fn main() -> ExitCode {
                 &options,
             ))
         }
+        Command::Study { what } => match what {
+            StudyCommand::Precision {
+                case,
+                out,
+                refinements,
+                duration,
+                tolerance,
+                quiet,
+            } => print_summary(holewall::study::precision(
+                &case,
+                &out,
+                holewall::study::PrecisionOptions {
+                    refinements,
+                    duration,
+                    tolerance,
+                    show_progress: !quiet,
+                },
+            )),
+        },
         Command::Merge { out, dirs, quiet } => {
             print_summary(holewall::ensemble::job::merge(&out, &dirs, !quiet))
         }

@@ -1,0 +1,330 @@
+//! Studies of a user's case (issue 16): `holewall study precision` — the error of each
+//! path (CPU f64, GPU f64, GPU f32) and time step against a fine-step f64 CPU reference,
+//! beside its run time (a work-precision diagram), and the cheapest run within a tolerance.
+//!
+//! The quantities compared are the dynamic run's quantities of interest (the ensemble's,
+//! [`crate::ensemble::qoi`]): the hook load at the end, the largest surface torque, and per
+//! stabilizer its largest side force and lateral displacement. The error of a run is the
+//! largest of their relative errors, each against the reference value or, where that is
+//! near zero, a floor (1 N, 1 N·m, 1 µm). The bit's stick-slip severity is left out: it
+//! is a max − min over the integrator's own instants, which move with the step, so its
+//! change measures the sampling (≈ 1 % on `cases/spinup_short.toml`, not shrinking with
+//! the step), not the integration.
+
+use std::path::Path;
+
+use serde::Serialize;
+
+use crate::backend::{Backend, BackendChoice, Precision};
+use crate::case::{load_case, Case};
+use crate::ensemble::qoi::{Status, VariantResult};
+use crate::ensemble::Variant;
+use crate::error::{Error, InputError};
+use crate::output::{write_atomic, RunFolder};
+
+/// Options of `holewall study precision`.
+#[derive(Clone, Copy, Debug)]
+pub struct PrecisionOptions {
+    /// Time steps tried: the case's, and halved this many times.
+    pub refinements: usize,
+    /// Simulated time (s); `None`: the case's duration.
+    pub duration: Option<f64>,
+    /// Largest acceptable error (relative) for the recommendation.
+    pub tolerance: f64,
+    /// Progress on stderr.
+    pub show_progress: bool,
+}
+
+impl Default for PrecisionOptions {
+    fn default() -> Self {
+        PrecisionOptions {
+            refinements: 2,
+            duration: None,
+            tolerance: 1e-3,
+            show_progress: true,
+        }
+    }
+}
+
+/// One run of the study.
+#[derive(Clone, Debug, Serialize)]
+pub struct PrecisionRow {
+    /// `cpu-f64`, `gpu-f64`, `gpu-f32`.
+    pub path: String,
+    /// Time step (s).
+    pub dt_s: f64,
+    /// Wall time of the run (s).
+    pub seconds: f64,
+    /// Largest relative error against the reference (NaN if the run failed).
+    pub max_error: f64,
+    /// The quantity with the largest error.
+    pub worst: String,
+    /// Every quantity's relative error (summary.json only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub errors: Option<std::collections::BTreeMap<String, f64>>,
+    /// `converged`, `step_cut`, `failed`, or why the path did not run.
+    pub status: String,
+}
+
+/// `summary.json` of the study.
+#[derive(Clone, Debug, Serialize)]
+pub struct PrecisionSummary {
+    /// Case title.
+    pub title: String,
+    /// Simulated time (s).
+    pub duration_s: f64,
+    /// The reference's time step (s) and wall time (s).
+    pub reference_dt_s: f64,
+    /// See `reference_dt_s`.
+    pub reference_seconds: f64,
+    /// Every run.
+    pub runs: Vec<PrecisionRow>,
+    /// The tolerance asked.
+    pub tolerance: f64,
+    /// The cheapest run within it, if any.
+    pub recommendation: Option<PrecisionRow>,
+    /// Paths that could not run, and why.
+    pub notes: Vec<String>,
+}
+
+/// The compared quantities of a result: (name, value, floor).
+fn quantities(r: &VariantResult) -> Vec<(String, f64, f64)> {
+    let mut q = vec![
+        (
+            "hook_load_n".to_string(),
+            r.hook_load_n.unwrap_or(f64::NAN),
+            1.0,
+        ),
+        (
+            "max_surface_torque_nm".to_string(),
+            r.max_surface_torque_nm,
+            1.0,
+        ),
+    ];
+    for (k, s) in r.stabilizers.iter().enumerate() {
+        q.push((
+            format!("stab{}_max_side_force_n", k + 1),
+            s.max_side_force_n,
+            1.0,
+        ));
+        q.push((
+            format!("stab{}_max_lateral_m", k + 1),
+            s.max_lateral_m,
+            1e-6,
+        ));
+    }
+    q
+}
+
+/// Each quantity's relative error of `r` against `reference`.
+fn errors_of(r: &VariantResult, reference: &VariantResult) -> Vec<(String, f64)> {
+    if r.status == Status::Failed {
+        return vec![("failed".into(), f64::NAN)];
+    }
+    quantities(r)
+        .into_iter()
+        .zip(quantities(reference))
+        .map(|((name, a, _), (_, b, floor))| (name, (a - b).abs() / b.abs().max(floor)))
+        .collect()
+}
+
+fn with_step(case: &Case, dt: f64, duration: f64) -> Case {
+    let mut c = case.clone();
+    if let Some(d) = c.dynamics.as_mut() {
+        d.time_step = dt;
+        d.duration = duration;
+        d.output_interval = d.output_interval.max(dt).min(duration);
+    }
+    c
+}
+
+/// One run of `case` on `path`; its result and wall time, or why the path cannot run it.
+fn run_on(
+    case: &Case,
+    path: &str,
+    gpu: Option<&'static crate::gpu::GpuContext>,
+) -> Result<(VariantResult, f64), String> {
+    let variant = Variant {
+        name: "study".into(),
+        overrides: vec![],
+    };
+    let bar = indicatif::ProgressBar::hidden();
+    let clock = std::time::Instant::now();
+    let result = match (path, gpu) {
+        ("cpu-f64", _) => crate::ensemble::qoi::dynamic_variant(case, "study", &case.model),
+        ("gpu-f64", Some(ctx)) if !ctx.has_f64 => return Err("the adapter has no f64".into()),
+        ("gpu-f64", Some(ctx)) => {
+            crate::ensemble::runner::run_dynamic_gpu::<f64>(case, &[variant], ctx, &bar)
+                .map_err(|e| e.to_string())??
+                .remove(0)
+        }
+        ("gpu-f32", Some(ctx)) => {
+            crate::ensemble::runner::run_dynamic_gpu::<f32>(case, &[variant], ctx, &bar)
+                .map_err(|e| e.to_string())??
+                .remove(0)
+        }
+        _ => return Err("no GPU adapter".into()),
+    };
+    if result.solved_by == crate::ensemble::qoi::SolvedBy::Cpu && path != "cpu-f64" {
+        return Err(format!(
+            "the engine failed the run ({}); not a {path} result",
+            result.reason
+        ));
+    }
+    Ok((result, clock.elapsed().as_secs_f64()))
+}
+
+/// Runs the study on `case_path`, writing `precision.csv`, `precision.png` and
+/// `summary.json` into `out`.
+pub fn precision(
+    case_path: &Path,
+    out: &Path,
+    options: PrecisionOptions,
+) -> Result<PrecisionSummary, Error> {
+    let case = load_case(case_path)?;
+    let Some(settings) = case.dynamics.clone() else {
+        return Err(InputError {
+            source_name: case_path.display().to_string(),
+            line: 1,
+            key: "dynamics".into(),
+            message: "holewall study precision needs a [dynamics] table".into(),
+        }
+        .into());
+    };
+    let folder = RunFolder::prepare(out)?;
+    let duration = options.duration.unwrap_or(settings.duration);
+    let dt0 = settings.time_step;
+    let gpu = match Backend::resolve_with(
+        BackendChoice::Gpu,
+        Precision::F32,
+        &[Precision::F64],
+        crate::backend::AutoRule::AnyAdapter,
+    ) {
+        Ok(Backend::Gpu(ctx)) => Some(ctx),
+        _ => None,
+    };
+    let mut notes = Vec::new();
+    if gpu.is_none() {
+        notes.push("no GPU adapter: the GPU paths were not run".to_string());
+    }
+    let steps: Vec<f64> = (0..=options.refinements)
+        .map(|k| dt0 / 2f64.powi(k as i32))
+        .collect();
+    let dt_ref = dt0 / 2f64.powi(options.refinements as i32 + 2);
+    let total = 1 + 3 * steps.len();
+    let bar = crate::output::progress_bar(
+        options.show_progress,
+        total as u64,
+        "{bar:40} {pos}/{len} runs, {elapsed} elapsed  {msg}",
+    );
+    bar.set_message(format!("reference, dt = {dt_ref:.2e} s"));
+    let (reference, reference_seconds) =
+        run_on(&with_step(&case, dt_ref, duration), "cpu-f64", None)
+            .map_err(|e| Error::Io(std::io::Error::other(format!("reference run: {e}"))))?;
+    if reference.status == Status::Failed {
+        return Err(Error::Io(std::io::Error::other(format!(
+            "the reference run (CPU f64, dt = {dt_ref:.3e} s) failed: {}",
+            reference.reason
+        ))));
+    }
+    bar.inc(1);
+    let mut runs = Vec::new();
+    for path in ["cpu-f64", "gpu-f64", "gpu-f32"] {
+        for &dt in &steps {
+            bar.set_message(format!("{path}, dt = {dt:.2e} s"));
+            let row = match run_on(&with_step(&case, dt, duration), path, gpu) {
+                Ok((r, seconds)) => {
+                    let errors = errors_of(&r, &reference);
+                    let (worst, max_error) =
+                        errors.iter().fold((String::new(), 0.0f64), |m, (n, e)| {
+                            if *e > m.1 || e.is_nan() {
+                                (n.clone(), *e)
+                            } else {
+                                m
+                            }
+                        });
+                    PrecisionRow {
+                        path: path.into(),
+                        dt_s: dt,
+                        seconds,
+                        max_error,
+                        worst,
+                        errors: Some(errors.into_iter().collect()),
+                        status: format!("{:?}", r.status).to_lowercase(),
+                    }
+                }
+                Err(why) => {
+                    if !notes.iter().any(|n| n.starts_with(path)) {
+                        notes.push(format!("{path}: {why}"));
+                    }
+                    PrecisionRow {
+                        path: path.into(),
+                        dt_s: dt,
+                        seconds: f64::NAN,
+                        max_error: f64::NAN,
+                        worst: String::new(),
+                        errors: None,
+                        status: format!("not run: {why}"),
+                    }
+                }
+            };
+            runs.push(row);
+            bar.inc(1);
+        }
+    }
+    bar.finish_and_clear();
+    let recommendation = runs
+        .iter()
+        .filter(|r| r.max_error <= options.tolerance && r.seconds.is_finite())
+        .min_by(|a, b| a.seconds.total_cmp(&b.seconds))
+        .cloned();
+    let dir = folder.path();
+    let mut w = csv::Writer::from_writer(Vec::new());
+    for r in &runs {
+        w.serialize(PrecisionRow {
+            errors: None,
+            ..r.clone()
+        })
+        .map_err(|e| Error::Io(std::io::Error::other(e)))?;
+    }
+    let bytes = w
+        .into_inner()
+        .map_err(|e| Error::Io(std::io::Error::other(e.to_string())))?;
+    write_atomic(&dir.join("precision.csv"), &bytes)?;
+    let series: Vec<(String, Vec<(f64, f64)>)> = ["cpu-f64", "gpu-f64", "gpu-f32"]
+        .iter()
+        .map(|p| {
+            (
+                p.to_string(),
+                runs.iter()
+                    .filter(|r| r.path == *p && r.seconds.is_finite() && r.max_error.is_finite())
+                    .map(|r| (r.seconds, r.max_error.max(1e-16)))
+                    .collect(),
+            )
+        })
+        .filter(|(_, pts): &(String, Vec<(f64, f64)>)| !pts.is_empty())
+        .collect();
+    crate::plots::loglog_plot(
+        &dir.join("precision.png"),
+        &format!(
+            "{}: error against run time ({} s simulated; reference dt = {:.2e} s)",
+            case.title, duration, dt_ref
+        ),
+        "run time (s)",
+        "largest relative error of the quantities of interest",
+        &series,
+        options.tolerance,
+    )?;
+    let summary = PrecisionSummary {
+        title: case.title.clone(),
+        duration_s: duration,
+        reference_dt_s: dt_ref,
+        reference_seconds,
+        runs,
+        tolerance: options.tolerance,
+        recommendation,
+        notes,
+    };
+    folder.finish(&serde_json::to_vec_pretty(&summary).map_err(std::io::Error::other)?)?;
+    Ok(summary)
+}
