@@ -128,7 +128,8 @@ enum Command {
         #[arg(long, value_parser = positive_seconds)]
         max_seconds: Option<f64>,
     },
-    /// Studies of a case: `precision` (error against run time per path and step).
+    /// Studies of a case: `precision` (error against run time per path and step),
+    /// `stability` (where the solver works).
     Study {
         #[command(subcommand)]
         what: StudyCommand,
@@ -264,6 +265,24 @@ enum StudyCommand {
         /// Largest acceptable relative error, for the recommendation.
         #[arg(long, default_value_t = 1e-3)]
         tolerance: f64,
+        /// No progress bar.
+        #[arg(long)]
+        quiet: bool,
+    },
+    /// Where the solver works on a case: one parameter at a time around it (wall stiffness
+    /// 1e5…1e11, spring exponent, ε, friction, the first stabilizer's clearance, WOB to 8×,
+    /// time step to 16×) and the wall stiffness × exponent grid; per cell the static solve
+    /// and, with [dynamics], a short run: solved, step cuts, Newton iterations, NaN;
+    /// stability.csv, stability.png (the map), summary.json.
+    Stability {
+        /// Case file.
+        case: PathBuf,
+        /// Output folder.
+        #[arg(long)]
+        out: PathBuf,
+        /// Simulated time of each dynamic cell (s; default the smaller of the case's and 0.5 s).
+        #[arg(long, value_parser = positive_seconds)]
+        duration: Option<f64>,
         /// No progress bar.
         #[arg(long)]
         quiet: bool,
@@ -434,6 +453,19 @@ fn main() -> ExitCode {
                     refinements,
                     duration,
                     tolerance,
+                    show_progress: !quiet,
+                },
+            )),
+            StudyCommand::Stability {
+                case,
+                out,
+                duration,
+                quiet,
+            } => print_summary(holewall::study::stability(
+                &case,
+                &out,
+                holewall::study::StabilityOptions {
+                    duration,
                     show_progress: !quiet,
                 },
             )),

@@ -582,3 +582,76 @@ pub fn loglog_plot(
         Ok(())
     })
 }
+
+/// One tile of a [`tile_map`].
+pub struct Tile {
+    /// Row label.
+    pub row: String,
+    /// Column label (within its row).
+    pub column: String,
+    /// 0 green, 1 amber, 2 red.
+    pub colour: usize,
+    /// Text in the tile.
+    pub text: String,
+}
+
+/// A map of labelled tiles: one row per distinct `row`, its tiles left to right in order,
+/// each coloured and labelled with its column and text.
+pub fn tile_map(path: &Path, title: &str, tiles: &[Tile]) -> std::io::Result<()> {
+    let mut rows: Vec<&str> = Vec::new();
+    for t in tiles {
+        if !rows.contains(&t.row.as_str()) {
+            rows.push(&t.row);
+        }
+    }
+    let cols = rows
+        .iter()
+        .map(|r| tiles.iter().filter(|t| t.row == *r).count())
+        .max()
+        .unwrap_or(1)
+        .max(1);
+    let (cw, rh, left, top) = (120i32, 44i32, 230i32, 50i32);
+    let width = (left + cw * cols as i32 + 20) as u32;
+    let height = (top + rh * rows.len().max(1) as i32 + 20) as u32;
+    atomic_png(path, |tmp| {
+        let root = BitMapBackend::new(tmp, (width.max(600), height)).into_drawing_area();
+        root.fill(&WHITE)?;
+        root.draw(&Text::new(
+            title.to_string(),
+            (10, 12),
+            ("sans-serif", 18).into_font(),
+        ))?;
+        let palette = [
+            RGBColor(120, 200, 120),
+            RGBColor(240, 190, 80),
+            RGBColor(230, 100, 90),
+        ];
+        for (ri, r) in rows.iter().enumerate() {
+            let y = top + ri as i32 * rh;
+            root.draw(&Text::new(
+                r.to_string(),
+                (8, y + 14),
+                ("sans-serif", 14).into_font(),
+            ))?;
+            for (ci, t) in tiles.iter().filter(|t| t.row == *r).enumerate() {
+                let x = left + ci as i32 * cw;
+                root.draw(&Rectangle::new(
+                    [(x, y), (x + cw - 4, y + rh - 4)],
+                    palette[t.colour.min(2)].filled(),
+                ))?;
+                root.draw(&Text::new(
+                    t.column.clone(),
+                    (x + 4, y + 4),
+                    ("sans-serif", 12).into_font(),
+                ))?;
+                root.draw(&Text::new(
+                    t.text.clone(),
+                    (x + 4, y + 22),
+                    ("sans-serif", 12).into_font(),
+                ))?;
+            }
+        }
+        root.present()?;
+        Ok(())
+    })
+}

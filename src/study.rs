@@ -128,6 +128,14 @@ fn errors_of(r: &VariantResult, reference: &VariantResult) -> Vec<(String, f64)>
         .collect()
 }
 
+/// A status as `variants.csv` writes it (`converged`, `step_cut`, `failed`).
+fn status_name(s: Status) -> String {
+    serde_json::to_value(s)
+        .ok()
+        .and_then(|v| v.as_str().map(str::to_string))
+        .unwrap_or_default()
+}
+
 fn with_step(case: &Case, dt: f64, duration: f64) -> Case {
     let mut c = case.clone();
     if let Some(d) = c.dynamics.as_mut() {
@@ -250,7 +258,7 @@ pub fn precision(
                         max_error,
                         worst,
                         errors: Some(errors.into_iter().collect()),
-                        status: format!("{:?}", r.status).to_lowercase(),
+                        status: status_name(r.status),
                     }
                 }
                 Err(why) => {
@@ -324,6 +332,241 @@ pub fn precision(
         tolerance: options.tolerance,
         recommendation,
         notes,
+    };
+    folder.finish(&serde_json::to_vec_pretty(&summary).map_err(std::io::Error::other)?)?;
+    Ok(summary)
+}
+
+/// Options of `holewall study stability`.
+#[derive(Clone, Copy, Debug)]
+pub struct StabilityOptions {
+    /// Simulated time of each dynamic cell (s); `None`: the smaller of the case's and 0.5 s.
+    pub duration: Option<f64>,
+    /// Progress on stderr.
+    pub show_progress: bool,
+}
+
+/// One cell of the stability map.
+#[derive(Clone, Debug, Serialize)]
+pub struct StabilityCell {
+    /// The parameter varied (`k_e at m = …` cells vary both).
+    pub parameter: String,
+    /// Its value as written.
+    pub value: String,
+    /// `static` or `dynamic`.
+    pub analysis: String,
+    /// `converged`, `step_cut`, `failed`.
+    pub status: String,
+    /// Load-step (static) or time-step (dynamic) cuts.
+    pub step_cuts: usize,
+    /// Newton iterations per step.
+    pub newton_iterations: f64,
+    /// Wall time (s).
+    pub seconds: f64,
+    /// A non-finite state or residual.
+    pub nan: bool,
+    /// Why it failed or was cut.
+    pub reason: String,
+}
+
+/// `summary.json` of the stability study.
+#[derive(Clone, Debug, Serialize)]
+pub struct StabilitySummary {
+    /// Case title.
+    pub title: String,
+    /// Cells run.
+    pub cells: usize,
+    /// Cells converged without a cut, with cuts, failed.
+    pub converged: usize,
+    /// See `converged`.
+    pub step_cut: usize,
+    /// See `converged`.
+    pub failed: usize,
+    /// Every cell.
+    pub map: Vec<StabilityCell>,
+}
+
+/// The cells: one parameter at a time around the case (wall stiffness 1e5 … 1e11, spring
+/// exponent 2/3, 1, 3/2, ε 1e-6 … 1e-1, friction 0 … 1, the first stabilizer's clearance
+/// 0 … nominal, WOB ½ … 8 × the case's, the time step 1 … 16 × the case's) and the wall
+/// stiffness × exponent grid. (parameter, value, overrides as a variants-CSV row, dt factor).
+fn stability_cells(case: &Case) -> Vec<(String, String, Vec<(String, String)>, f64)> {
+    let mut cells = Vec::new();
+    let one = |p: &str, v: String| (p.to_string(), v.clone(), vec![(p.to_string(), v)], 1.0);
+    for m in ["0.6667", "1", "1.5"] {
+        for k in ["1e5", "1e6", "1e7", "1e8", "1e9", "1e10", "1e11"] {
+            cells.push((
+                format!("k_e at m = {m}"),
+                format!("{k} N/m^m"),
+                vec![
+                    ("k_e".to_string(), k.to_string()),
+                    ("m".to_string(), m.to_string()),
+                ],
+                1.0,
+            ));
+        }
+    }
+    for e in ["1e-6", "1e-4", "1e-2", "1e-1"] {
+        cells.push(one("eps", e.into()));
+    }
+    for mu in ["0", "0.2", "0.5", "1"] {
+        cells.push(one("mu", mu.into()));
+    }
+    if let Some(site) = case.model.sites.iter().find(|s| s.stabilizer) {
+        let hole = 2.0 * site.hole_radius;
+        for f in [0.0, 0.25, 0.5, 1.0] {
+            let blade = hole - 2.0 * f * site.params.clearance;
+            cells.push((
+                "stab1 clearance".into(),
+                format!("{:.2} mm", 1e3 * f * site.params.clearance),
+                vec![("stab1.blade".into(), format!("{blade}"))],
+                1.0,
+            ));
+        }
+    }
+    let wob = case.model.weight_on_bit;
+    if wob > 0.0 && !matches!(case.model.top, crate::model::TopBoundary::HookLoad(_)) {
+        for f in [0.5, 1.0, 2.0, 4.0, 8.0] {
+            cells.push((
+                "wob".into(),
+                format!("{:.0} kN", f * wob / 1e3),
+                vec![("wob".into(), format!("{}", f * wob))],
+                1.0,
+            ));
+        }
+    }
+    if case.dynamics.is_some() {
+        for f in [1.0, 4.0, 16.0] {
+            cells.push(("time step".into(), format!("{f} × case"), vec![], f));
+        }
+    }
+    cells
+}
+
+/// Runs the stability study on `case_path`: every cell's static solve and, with a
+/// `[dynamics]` table, a short dynamic run; `stability.csv`, `stability.png` (the map) and
+/// `summary.json` into `out`.
+pub fn stability(
+    case_path: &Path,
+    out: &Path,
+    options: StabilityOptions,
+) -> Result<StabilitySummary, Error> {
+    use rayon::prelude::*;
+    let case = load_case(case_path)?;
+    let folder = RunFolder::prepare(out)?;
+    let cells = stability_cells(&case);
+    let analyses: Vec<&str> = if case.dynamics.is_some() {
+        vec!["static", "dynamic"]
+    } else {
+        vec!["static"]
+    };
+    let jobs: Vec<(usize, &str)> = (0..cells.len())
+        .flat_map(|c| analyses.iter().map(move |a| (c, *a)))
+        .filter(|(c, a)| *a == "dynamic" || cells[*c].3 == 1.0)
+        .collect();
+    let bar = crate::output::progress_bar(
+        options.show_progress,
+        jobs.len() as u64,
+        "{bar:40} {pos}/{len} cells, {elapsed} elapsed, eta {eta}",
+    );
+    let map: Vec<StabilityCell> = jobs
+        .par_iter()
+        .map(|&(c, analysis)| {
+            let (parameter, value, overrides, dt_factor) = &cells[c];
+            let mut this = case.clone();
+            if let Some(d) = this.dynamics.as_mut() {
+                let duration = options.duration.unwrap_or(d.duration.min(0.5));
+                d.time_step *= dt_factor;
+                d.duration = duration;
+                d.output_interval = d.output_interval.max(d.time_step).min(duration);
+            }
+            let header: Vec<&str> = overrides.iter().map(|(k, _)| k.as_str()).collect();
+            let row: Vec<&str> = overrides.iter().map(|(_, v)| v.as_str()).collect();
+            let text = format!("{}\n{}\n", header.join(","), row.join(","));
+            let clock = std::time::Instant::now();
+            let result = if overrides.is_empty() {
+                Ok(this.model.clone())
+            } else {
+                crate::ensemble::variants_from_csv_text("stability", &text)
+                    .map_err(|e| e.to_string())
+                    .and_then(|v| crate::ensemble::apply(&this, &v[0]))
+            }
+            .map(|model| match analysis {
+                "static" => crate::ensemble::qoi::static_variant(&this, "cell", &model),
+                _ => crate::ensemble::qoi::dynamic_variant(&this, "cell", &model),
+            });
+            bar.inc(1);
+            let seconds = clock.elapsed().as_secs_f64();
+            match result {
+                Ok(r) => StabilityCell {
+                    parameter: parameter.clone(),
+                    value: value.clone(),
+                    analysis: analysis.into(),
+                    status: status_name(r.status),
+                    step_cuts: r.step_cuts,
+                    newton_iterations: r.newton_iterations_per_step,
+                    seconds,
+                    nan: r.reason.contains("not finite"),
+                    reason: r.reason,
+                },
+                Err(e) => StabilityCell {
+                    parameter: parameter.clone(),
+                    value: value.clone(),
+                    analysis: analysis.into(),
+                    status: "refused".into(),
+                    step_cuts: 0,
+                    newton_iterations: 0.0,
+                    seconds,
+                    nan: false,
+                    reason: e,
+                },
+            }
+        })
+        .collect();
+    bar.finish_and_clear();
+    let dir = folder.path();
+    let mut w = csv::Writer::from_writer(Vec::new());
+    for c in &map {
+        w.serialize(c)
+            .map_err(|e| Error::Io(std::io::Error::other(e)))?;
+    }
+    let bytes = w
+        .into_inner()
+        .map_err(|e| Error::Io(std::io::Error::other(e.to_string())))?;
+    write_atomic(&dir.join("stability.csv"), &bytes)?;
+    let tiles: Vec<crate::plots::Tile> = map
+        .iter()
+        .map(|c| crate::plots::Tile {
+            row: format!("{} ({})", c.parameter, c.analysis),
+            column: c.value.clone(),
+            colour: match c.status.as_str() {
+                "converged" => 0,
+                "step_cut" => 1,
+                _ => 2,
+            },
+            text: if c.status == "failed" || c.status == "refused" {
+                "fail".into()
+            } else {
+                format!("{}c {:.1}it", c.step_cuts, c.newton_iterations)
+            },
+        })
+        .collect();
+    crate::plots::tile_map(
+        &dir.join("stability.png"),
+        &format!(
+            "{}: where the solver works (green: solved; amber: with step cuts; red: failed)",
+            case.title
+        ),
+        &tiles,
+    )?;
+    let count = |s: &str| map.iter().filter(|c| c.status == s).count();
+    let summary = StabilitySummary {
+        title: case.title.clone(),
+        cells: map.len(),
+        converged: count("converged"),
+        step_cut: count("step_cut"),
+        failed: map.len() - count("converged") - count("step_cut"),
+        map,
     };
     folder.finish(&serde_json::to_vec_pretty(&summary).map_err(std::io::Error::other)?)?;
     Ok(summary)

@@ -85,3 +85,49 @@ fn precision_study_of_the_short_spin_up() {
         assert!(out.join(f).is_file(), "{f}");
     }
 }
+
+/// `holewall study stability` on the deviated well without dynamics: every cell solved but
+/// the WOB far past helical buckling, which the map records as failed (not skipped).
+#[test]
+fn stability_map_of_the_build_and_hold_well() {
+    let case = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("cases/build_and_hold.toml");
+    let out = std::env::temp_dir().join(format!("holewall-stability-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&out);
+    let o = Command::new(env!("CARGO_BIN_EXE_holewall"))
+        .args([
+            "study",
+            "stability",
+            case.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+            "--quiet",
+        ])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let s: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let map = s["map"].as_array().unwrap();
+    // 21 k_e × m, 4 eps, 4 mu, 4 clearances, 5 WOBs: static only.
+    assert_eq!(map.len(), 38);
+    let failed: Vec<String> = map
+        .iter()
+        .filter(|c| c["status"] == "failed")
+        .map(|c| format!("{} {}", c["parameter"], c["value"]))
+        .collect();
+    eprintln!("failed: {failed:?}; step cuts: {}", s["step_cut"]);
+    assert!(
+        failed
+            .iter()
+            .any(|f| f.contains("wob") && f.contains("534 kN")),
+        "{failed:?}"
+    );
+    assert_eq!(
+        s["converged"].as_u64().unwrap()
+            + s["step_cut"].as_u64().unwrap()
+            + s["failed"].as_u64().unwrap(),
+        38
+    );
+    for f in ["stability.csv", "stability.png", "summary.json"] {
+        assert!(out.join(f).is_file(), "{f}");
+    }
+}
