@@ -174,6 +174,9 @@ pub struct DynamicsSpec {
     /// Rate at which the hook (the clamped top) is lowered, e.g. `"30 m/h"` (default 0:
     /// hook fixed); ramped with the table.
     pub rop: Option<Q>,
+    /// A lateral kick at the start: every BHA node (bit to the first drill pipe) moving at
+    /// this speed towards its frame's first lateral axis (a whirl trigger; default 0).
+    pub initial_lateral_velocity: Option<Q>,
 }
 
 /// Checked `[dynamics]` settings.
@@ -197,6 +200,8 @@ pub struct DynamicsSettings {
     pub mass: crate::physics::mass::MassKind,
     /// Hook lowering rate (m/s).
     pub rop: f64,
+    /// Initial lateral speed of the BHA (m/s).
+    pub initial_lateral_velocity: f64,
 }
 
 /// Every output `holewall run` can record.
@@ -355,6 +360,31 @@ impl Case {
             .or(self.hole.last())
             .copied()
             .unwrap_or((md, 0.2159, 0.25))
+    }
+
+    /// The initial velocities of a dynamic run of `model` (6 per node): the BHA's lateral
+    /// kick of `[dynamics].initial_lateral_velocity`, towards each element frame's first
+    /// lateral axis; `None` when there is none.
+    pub fn initial_velocity(&self, model: &crate::model::Model) -> Option<Vec<f64>> {
+        let speed = self.dynamics.as_ref()?.initial_lateral_velocity;
+        if speed == 0.0 {
+            return None;
+        }
+        let n = model.nodes.len();
+        let bit_md = model.nodes.last().map_or(self.bit_md, |nd| nd.md);
+        let top = bit_md - self.bha_length;
+        let mut v = vec![0.0; 6 * n];
+        // Not the clamped top, nor the bit when it is held laterally.
+        let last = if model.bit_lateral_fixed { n - 1 } else { n };
+        for (i, node) in model.nodes.iter().enumerate().take(last).skip(1) {
+            if node.md >= top - 1e-9 {
+                let e = &model.elements[i.min(model.elements.len() - 1)];
+                for k in 0..3 {
+                    v[6 * i + k] = speed * e.frame0[k][1];
+                }
+            }
+        }
+        Some(v)
     }
 
     /// The hole diameter at `md` (m).
@@ -1600,6 +1630,16 @@ fn dynamics_settings(ctx: &Ctx, d: &DynamicsSpec) -> Result<DynamicsSettings, In
         )?,
         None => 0.0,
     };
+    let initial_lateral_velocity = match &d.initial_lateral_velocity {
+        Some(q) => ctx.quantity(
+            q,
+            "dynamics.initial_lateral_velocity",
+            Dimension::Speed,
+            |x| (0.0..=10.0).contains(&x),
+            "0 ≤ speed ≤ 10 m/s",
+        )?,
+        None => 0.0,
+    };
     Ok(DynamicsSettings {
         duration,
         time_step,
@@ -1610,5 +1650,6 @@ fn dynamics_settings(ctx: &Ctx, d: &DynamicsSpec) -> Result<DynamicsSettings, In
         outputs,
         mass,
         rop,
+        initial_lateral_velocity,
     })
 }

@@ -314,3 +314,53 @@ fn imbalance_keys_agree_and_the_ecc_key_sets_the_bha() {
     }
     assert!(m.has_unbalance());
 }
+
+/// `[dynamics].initial_lateral_velocity`: the kick moves the BHA of the (otherwise exactly
+/// axisymmetric) short spin-up off the hole axis, against the wall; without it the
+/// stabilizer stays on the axis and the whirl analysis says `none`.
+#[test]
+fn an_initial_lateral_kick_starts_lateral_motion() {
+    let base = std::fs::read_to_string(
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("cases/spinup_short.toml"),
+    )
+    .unwrap();
+    let dir = std::env::temp_dir().join(format!("holewall-whirl-kick-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let run = |text: &str, name: &str| -> serde_json::Value {
+        let p = dir.join(format!("{name}.toml"));
+        std::fs::write(&p, text).unwrap();
+        let o = std::process::Command::new(env!("CARGO_BIN_EXE_holewall"))
+            .args([
+                "run",
+                p.to_str().unwrap(),
+                "--out",
+                dir.join(name).to_str().unwrap(),
+                "--quiet",
+            ])
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        serde_json::from_slice(&o.stdout).unwrap()
+    };
+    let still = run(&base, "still");
+    assert_eq!(still["whirl"][0]["class"], "none");
+    assert_eq!(still["whirl"][0]["max_radius_m"].as_f64().unwrap(), 0.0);
+    let kicked = run(
+        &base.replace(
+            "rho_inf = 0.8",
+            "rho_inf = 0.8\ninitial_lateral_velocity = \"0.05 m/s\"",
+        ),
+        "kicked",
+    );
+    let r = kicked["whirl"][0]["max_radius_m"].as_f64().unwrap();
+    let clearance = 0.5 * (8.5 - 8.25) * 0.0254;
+    eprintln!(
+        "kicked: largest radius {:.3} mm (clearance {:.3} mm), contact {}",
+        1e3 * r,
+        1e3 * clearance,
+        kicked["whirl"][0]["contact_fraction"]
+    );
+    assert!(r > 0.9 * clearance, "{r}");
+    assert!(kicked["whirl"][0]["contact_fraction"].as_f64().unwrap() > 0.0);
+}

@@ -96,6 +96,12 @@ pub fn run_dynamic_gpu<T: crate::gpu::contact::GpuReal>(
     if let Some(why) = unsupported_model(&models) {
         return Ok(Err(why));
     }
+    if settings.initial_lateral_velocity != 0.0 {
+        return Ok(Err(
+            "an initial lateral velocity runs on the CPU integrator (the engine starts at rest)"
+                .into(),
+        ));
+    }
     if !models.iter().all(|m| same_mesh(case, m)) {
         return Ok(Err(
             "the variants differ in their mesh or number of contact sites".into(),
