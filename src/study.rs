@@ -386,11 +386,14 @@ pub struct StabilitySummary {
     pub map: Vec<StabilityCell>,
 }
 
+/// A cell: (parameter, value, overrides as (key, value), time-step factor).
+type Cell = (String, String, Vec<(String, String)>, f64);
+
 /// The cells: one parameter at a time around the case (wall stiffness 1e5 … 1e11, spring
 /// exponent 2/3, 1, 3/2, ε 1e-6 … 1e-1, friction 0 … 1, the first stabilizer's clearance
 /// 0 … nominal, WOB ½ … 8 × the case's, the time step 1 … 16 × the case's) and the wall
 /// stiffness × exponent grid. (parameter, value, overrides as a variants-CSV row, dt factor).
-fn stability_cells(case: &Case) -> Vec<(String, String, Vec<(String, String)>, f64)> {
+fn stability_cells(case: &Case) -> Vec<Cell> {
     let mut cells = Vec::new();
     let one = |p: &str, v: String| (p.to_string(), v.clone(), vec![(p.to_string(), v)], 1.0);
     for m in ["0.6667", "1", "1.5"] {
