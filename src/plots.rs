@@ -655,3 +655,62 @@ pub fn tile_map(path: &Path, title: &str, tiles: &[Tile]) -> std::io::Result<()>
         Ok(())
     })
 }
+
+/// A scatter of classified points: (x, y, class) with one colour and legend entry per
+/// class name (`classes[class]`), e.g. a whirl map over RPM × WOB.
+pub fn class_scatter(
+    path: &Path,
+    title: &str,
+    x_label: &str,
+    y_label: &str,
+    points: &[(f64, f64, usize)],
+    classes: &[&str],
+) -> std::io::Result<()> {
+    let all: Vec<(f64, f64)> = points.iter().map(|p| (p.0, p.1)).collect();
+    let ((x0, x1), (y0, y1)) = bounds(&[Series {
+        name: "",
+        points: all,
+        wide: false,
+    }]);
+    atomic_png(path, |tmp| {
+        let root = BitMapBackend::new(tmp, (900, 660)).into_drawing_area();
+        root.fill(&WHITE)?;
+        let mut chart = ChartBuilder::on(&root)
+            .caption(title, ("sans-serif", 20))
+            .margin(12)
+            .x_label_area_size(48)
+            .y_label_area_size(80)
+            .build_cartesian_2d(x0..x1, y0..y1)?;
+        chart
+            .configure_mesh()
+            .x_desc(x_label)
+            .y_desc(y_label)
+            .x_label_formatter(&tick)
+            .y_label_formatter(&tick)
+            .label_style(("sans-serif", 15))
+            .draw()?;
+        let colours = [RGBColor(150, 150, 150), BLUE, RED, MAGENTA, GREEN, BLACK];
+        for (c, name) in classes.iter().enumerate() {
+            let colour = colours[c % colours.len()];
+            let pts: Vec<(f64, f64)> = points
+                .iter()
+                .filter(|p| p.2 == c && p.0.is_finite() && p.1.is_finite())
+                .map(|p| (p.0, p.1))
+                .collect();
+            if pts.is_empty() {
+                continue;
+            }
+            chart
+                .draw_series(pts.iter().map(|&p| Circle::new(p, 7, colour.filled())))?
+                .label(*name)
+                .legend(move |(x, y)| Circle::new((x + 10, y), 5, colour.filled()));
+        }
+        chart
+            .configure_series_labels()
+            .background_style(WHITE.mix(0.8))
+            .border_style(BLACK)
+            .draw()?;
+        root.present()?;
+        Ok(())
+    })
+}

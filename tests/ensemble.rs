@@ -138,7 +138,7 @@ fn grid_dynamic_ensemble_writes_variants_and_series() {
     assert!(csv.lines().next().unwrap().contains("stab1_whirl_hz"));
     assert_eq!(csv.lines().count(), 3);
     assert!(out.join("series/1/timeseries.csv").exists());
-    assert!(out.join("whirl.png").exists());
+    assert!(out.join("whirl_map_stab1.png").exists());
     // f32 on the CPU backend is refused plainly (it is the f64 oracle), before any output.
     let out2 = dir.join("out2");
     let e = run(

@@ -364,3 +364,53 @@ fn an_initial_lateral_kick_starts_lateral_motion() {
     assert!(r > 0.9 * clearance, "{r}");
     assert!(kicked["whirl"][0]["contact_fraction"].as_f64().unwrap() > 0.0);
 }
+
+/// The shipped whirl map (`cases/whirl_map.toml`: a 3 mm collar imbalance, RPM × WOB ×
+/// friction): with μ = 0.1 the stabilizer whirls forward and synchronously everywhere; with
+/// μ = 0.5 it turns to backward whirl from 180 rpm on; one map per friction value.
+#[test]
+fn the_shipped_whirl_map() {
+    let case = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("cases/whirl_map.toml");
+    let out = std::env::temp_dir().join(format!("holewall-whirl-map-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&out);
+    let s = holewall::ensemble::job::run(
+        &case,
+        None,
+        holewall::backend::BackendChoice::Cpu,
+        holewall::backend::Precision::F64,
+        &out,
+        false,
+        &Default::default(),
+    )
+    .unwrap();
+    assert_eq!((s.variants, s.failed), (16, 0));
+    let csv = std::fs::read_to_string(out.join("variants.csv")).unwrap();
+    let mut rows = csv.lines();
+    let header: Vec<&str> = rows.next().unwrap().split(',').collect();
+    let col = |name: &str| header.iter().position(|h| *h == name).unwrap();
+    let (rpm, mu, whirl, hz) = (
+        col("rpm"),
+        col("mu"),
+        col("stab1_whirl"),
+        col("stab1_whirl_hz"),
+    );
+    for line in rows {
+        let f: Vec<&str> = line.split(',').collect();
+        let rpm_v: f64 = f[rpm].parse::<f64>().unwrap() * 60.0 / std::f64::consts::TAU;
+        let mu_v: f64 = f[mu].parse().unwrap();
+        let expected = if mu_v > 0.3 && rpm_v > 150.0 {
+            "backward"
+        } else {
+            "forward"
+        };
+        assert_eq!(f[whirl], expected, "{line}");
+        if expected == "forward" {
+            // Synchronous: the rotary frequency within a bin (0.5 Hz over the 2 s window).
+            let h: f64 = f[hz].parse().unwrap();
+            assert!((h - rpm_v / 60.0).abs() <= 0.51, "{line}");
+        }
+    }
+    for f in ["whirl_map_stab1_mu0.1.png", "whirl_map_stab1_mu0.5.png"] {
+        assert!(out.join(f).is_file(), "{f}");
+    }
+}

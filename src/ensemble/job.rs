@@ -350,13 +350,7 @@ pub fn run(
         )?;
         outputs.push("side_force.png".into());
         if dynamic {
-            per_stabilizer(
-                "whirl.png",
-                "whirl frequency (+ forward, − backward)",
-                "whirl (Hz)",
-                &|q| q.whirl_hz,
-            )?;
-            outputs.push("whirl.png".into());
+            outputs.extend(whirl_maps(&case, &variants, &results, stabs, out)?);
         }
         for name in &series {
             let v = variants
@@ -489,4 +483,124 @@ pub fn merge(
         show_progress,
         &options,
     )
+}
+
+/// Per stabilizer, how it whirls against the varied inputs (`whirl_map_stabK.png`): a
+/// scatter coloured by class (none, forward, backward, chaotic) over the first two varied
+/// keys (RPM and WOB first: the whirl map), or over the one varied key against the whirl
+/// frequency.
+fn whirl_maps(
+    case: &crate::case::Case,
+    variants: &[crate::ensemble::Variant],
+    results: &[VariantResult],
+    stabs: usize,
+    out: &Path,
+) -> Result<Vec<String>, Error> {
+    use crate::keys::Param;
+    use crate::uq::report::Unit;
+    use crate::whirl::WhirlClass;
+    let mut keys: Vec<crate::keys::Key> = Vec::new();
+    for v in variants {
+        for (k, _) in &v.overrides {
+            if !keys.iter().any(|x| x.name == k.name) && k.param != Param::Mode {
+                keys.push(k.clone());
+            }
+        }
+    }
+    // RPM and WOB first.
+    keys.sort_by_key(|k| match k.param {
+        Param::Rpm => 0,
+        Param::Wob => 1,
+        _ => 2,
+    });
+    let value = |v: &crate::ensemble::Variant, k: &crate::keys::Key| {
+        v.overrides
+            .iter()
+            .find(|(x, _)| x.name == k.name)
+            .map_or(f64::NAN, |(_, x)| *x)
+    };
+    let label = |k: &crate::keys::Key| {
+        let (_, unit) = Unit::of_key(k).display();
+        format!("{} ({unit})", k.name)
+    };
+    let classes = ["none", "forward", "backward", "chaotic"];
+    let class_index = |c: Option<WhirlClass>| match c {
+        Some(WhirlClass::Forward) => 1,
+        Some(WhirlClass::Backward) => 2,
+        Some(WhirlClass::Chaotic) => 3,
+        _ => 0,
+    };
+    let mut written = Vec::new();
+    let Some(kx) = keys.first() else {
+        return Ok(written);
+    };
+    let (sx, _) = Unit::of_key(kx).display();
+    // A third varied key (friction, say): one map per value, so no point hides another.
+    let groups: Vec<Option<f64>> = match keys.get(2) {
+        None => vec![None],
+        Some(kz) => {
+            let mut vals: Vec<f64> = variants.iter().map(|v| value(v, kz)).collect();
+            vals.sort_by(|a, b| a.total_cmp(b));
+            vals.dedup();
+            vals.into_iter().map(Some).collect()
+        }
+    };
+    for k in 0..stabs {
+        for group in &groups {
+            let (file, suffix) = match (group, keys.get(2)) {
+                (Some(z), Some(kz)) => {
+                    let (sz, unit) = Unit::of_key(kz).display();
+                    (
+                        format!(
+                            "whirl_map_stab{}_{}{}.png",
+                            k + 1,
+                            kz.name,
+                            crate::units::show(sz * z)
+                        ),
+                        format!(
+                            ", {} = {}{}",
+                            kz.name,
+                            crate::units::show(sz * z),
+                            if unit == "–" {
+                                String::new()
+                            } else {
+                                format!(" {unit}")
+                            }
+                        ),
+                    )
+                }
+                _ => (format!("whirl_map_stab{}.png", k + 1), String::new()),
+            };
+            let points: Vec<(f64, f64, usize)> = variants
+                .iter()
+                .zip(results)
+                .filter(|(v, _)| match (group, keys.get(2)) {
+                    (Some(z), Some(kz)) => value(v, kz) == *z,
+                    _ => true,
+                })
+                .filter_map(|(v, r)| {
+                    let q = r.stabilizers.get(k)?;
+                    let y = match keys.get(1) {
+                        Some(ky) => Unit::of_key(ky).display().0 * value(v, ky),
+                        None => q.whirl_hz.unwrap_or(0.0),
+                    };
+                    Some((sx * value(v, kx), y, class_index(q.whirl_class)))
+                })
+                .collect();
+            let y_label = keys.get(1).map_or(
+                "dominant whirl frequency (Hz; + forward)".to_string(),
+                label,
+            );
+            crate::plots::class_scatter(
+                &out.join(&file),
+                &format!("{}: how stabilizer {} whirls{suffix}", case.title, k + 1),
+                &label(kx),
+                &y_label,
+                &points,
+                &classes,
+            )?;
+            written.push(file);
+        }
+    }
+    Ok(written)
 }
