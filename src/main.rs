@@ -155,6 +155,20 @@ enum Command {
 
 #[derive(Subcommand)]
 enum BenchCommand {
+    /// Scene-specialised contact kernels against the all-terms kernel on the same scenes
+    /// (frictionless / split friction, static / dynamic): CPU twin f64, GPU f32 and f64
+    /// resident; the gain (all-terms time / specialised time) and the outputs' difference.
+    Specialisation {
+        /// (variant, site) pairs per evaluation.
+        #[arg(long, default_value_t = 200_000)]
+        pairs: usize,
+        /// Timed repeats per kernel (the median is reported).
+        #[arg(long, default_value_t = 7)]
+        repeats: usize,
+        /// Also write the results as JSON here.
+        #[arg(long)]
+        json: Option<PathBuf>,
+    },
     /// Contact evaluations per second: CPU f64 (all cores), GPU f32 and f64.
     Contact {
         /// (variant, site) pairs per evaluation.
@@ -478,6 +492,14 @@ fn main() -> ExitCode {
             Err(e) => fail(&[e]),
         },
         Command::Bench { what } => match what {
+            BenchCommand::Specialisation {
+                pairs,
+                repeats,
+                json,
+            } => match cli::bench::specialisation(pairs, repeats, json.as_deref()) {
+                Ok(()) => ExitCode::SUCCESS,
+                Err(e) => fail(&[e]),
+            },
             BenchCommand::Contact {
                 pairs,
                 repeats,
