@@ -78,20 +78,7 @@ fn draw(
         // Head room for the markers' labels above their points.
         y1 += 0.1 * (y1 - y0);
     }
-    let mut chart = ChartBuilder::on(&root)
-        .caption(title, ("sans-serif", 24))
-        .margin(12)
-        .x_label_area_size(48)
-        .y_label_area_size(90)
-        .build_cartesian_2d(x0..x1, y0..y1)?;
-    chart
-        .configure_mesh()
-        .x_desc(x_label)
-        .y_desc(y_label)
-        .x_label_formatter(&tick)
-        .y_label_formatter(&tick)
-        .label_style(("sans-serif", 15))
-        .draw()?;
+    let mut chart = xy_chart(&root, title, 24, 90, x_label, y_label, (x0, x1), (y0, y1))?;
     let colours = [BLUE, RED, GREEN, MAGENTA, CYAN, BLACK];
     let colour = |k: usize| -> RGBColor {
         // Six strong colours, then plotters' palette of 99 distinct ones.
@@ -223,6 +210,42 @@ pub fn orbit_plot(
     })
 }
 
+/// A cartesian chart on `root` with the house style: caption, label areas, engineering tick
+/// labels on both axes, the mesh drawn.
+type XyChart<'a, 'b> = ChartContext<
+    'a,
+    BitMapBackend<'b>,
+    Cartesian2d<plotters::coord::types::RangedCoordf64, plotters::coord::types::RangedCoordf64>,
+>;
+
+#[allow(clippy::too_many_arguments)]
+fn xy_chart<'a, 'b>(
+    root: &'a DrawingArea<BitMapBackend<'b>, plotters::coord::Shift>,
+    title: &str,
+    caption_size: u32,
+    y_area: u32,
+    x_label: &str,
+    y_label: &str,
+    (x0, x1): (f64, f64),
+    (y0, y1): (f64, f64),
+) -> Result<XyChart<'a, 'b>, Box<dyn std::error::Error>> {
+    let mut chart = ChartBuilder::on(root)
+        .caption(title, ("sans-serif", caption_size))
+        .margin(12)
+        .x_label_area_size(48)
+        .y_label_area_size(y_area)
+        .build_cartesian_2d(x0..x1, y0..y1)?;
+    chart
+        .configure_mesh()
+        .x_desc(x_label)
+        .y_desc(y_label)
+        .x_label_formatter(&tick)
+        .y_label_formatter(&tick)
+        .label_style(("sans-serif", 15))
+        .draw()?;
+    Ok(chart)
+}
+
 /// Writes a PNG through a temporary file and a rename (never half-written).
 fn atomic_png(
     path: &Path,
@@ -346,20 +369,7 @@ pub fn scatter(
     atomic_png(path, |tmp| {
         let root = BitMapBackend::new(tmp, (900, 640)).into_drawing_area();
         root.fill(&WHITE)?;
-        let mut chart = ChartBuilder::on(&root)
-            .caption(title, ("sans-serif", 22))
-            .margin(12)
-            .x_label_area_size(48)
-            .y_label_area_size(80)
-            .build_cartesian_2d(x0..x1, y0..y1)?;
-        chart
-            .configure_mesh()
-            .x_desc(x_label)
-            .y_desc(y_label)
-            .x_label_formatter(&tick)
-            .y_label_formatter(&tick)
-            .label_style(("sans-serif", 15))
-            .draw()?;
+        let mut chart = xy_chart(&root, title, 22, 80, x_label, y_label, (x0, x1), (y0, y1))?;
         chart.draw_series(
             points
                 .iter()
@@ -675,20 +685,7 @@ pub fn class_scatter(
     atomic_png(path, |tmp| {
         let root = BitMapBackend::new(tmp, (900, 660)).into_drawing_area();
         root.fill(&WHITE)?;
-        let mut chart = ChartBuilder::on(&root)
-            .caption(title, ("sans-serif", 20))
-            .margin(12)
-            .x_label_area_size(48)
-            .y_label_area_size(80)
-            .build_cartesian_2d(x0..x1, y0..y1)?;
-        chart
-            .configure_mesh()
-            .x_desc(x_label)
-            .y_desc(y_label)
-            .x_label_formatter(&tick)
-            .y_label_formatter(&tick)
-            .label_style(("sans-serif", 15))
-            .draw()?;
+        let mut chart = xy_chart(&root, title, 20, 80, x_label, y_label, (x0, x1), (y0, y1))?;
         let colours = [RGBColor(150, 150, 150), BLUE, RED, MAGENTA, GREEN, BLACK];
         for (c, name) in classes.iter().enumerate() {
             let colour = colours[c % colours.len()];

@@ -1,33 +1,20 @@
 //! Implicit dynamics (generalised-α on the rotation group) against closed forms.
 
-use holewall::model::{mesh_string, Model, Tubular};
+use holewall::model::Model;
 use holewall::physics::mass::MassKind;
 use holewall::solve::dynamics::{
     strain_energy, AlphaParams, DynamicOptions, DynamicState, Dynamics,
 };
 use holewall::solve::modal::{mass_matrix, modes, participation};
 use holewall::solve::statics::{solve_static, StaticOptions};
-use holewall::well::WellPath;
 
-const RHO: f64 = 7850.0;
+const RHO: f64 = common::STEEL;
 
 /// A weightless vertical cantilever (clamped top, free bit) of 6.5 in collar.
 fn cantilever(l: f64, elements: usize) -> Model {
-    let well = WellPath::vertical(l);
-    let t = Tubular {
-        name: "collar".into(),
-        length: l,
-        outer_diameter: 0.165,
-        inner_diameter: 0.071,
-        youngs_modulus: 2.1e11,
-        poisson_ratio: 0.3,
-        density: RHO,
-        element_length: l / elements as f64,
-    };
-    let (nodes, elements) = mesh_string(&well, &[t], l, RHO);
     Model {
         bit_lateral_fixed: false,
-        ..Model::bare(nodes, elements)
+        ..common::weightless_collar(l, elements)
     }
 }
 

@@ -1,31 +1,20 @@
 //! Whirl from a mass imbalance (issue 16) against closed forms.
 
-use holewall::model::{mesh_string, Model, Tubular};
+use holewall::model::Model;
 use holewall::physics::mass::MassKind;
 use holewall::solve::dynamics::{AlphaParams, DynamicOptions, Dynamics};
 use holewall::solve::modal::{mass_matrix, modes};
 use holewall::solve::statics::StaticState;
-use holewall::well::WellPath;
 
-const RHO: f64 = 7850.0;
+const RHO: f64 = common::STEEL;
+
+#[path = "common/mod.rs"]
+mod common;
 
 /// A weightless vertical 6.5 in collar of length `l`: top clamped to the rotary table, bit
 /// held laterally (a clamped–pinned shaft).
 fn shaft(l: f64, elements: usize) -> Model {
-    let well = WellPath::vertical(l);
-    let t = Tubular {
-        name: "collar".into(),
-        length: l,
-        outer_diameter: 0.165,
-        inner_diameter: 0.071,
-        youngs_modulus: 2.1e11,
-        poisson_ratio: 0.3,
-        density: RHO,
-        element_length: l / elements as f64,
-    };
-    // Mud as dense as steel: no weight, so no axial load changes the lateral stiffness.
-    let (nodes, elements) = mesh_string(&well, &[t], l, RHO);
-    Model::bare(nodes, elements)
+    common::weightless_collar(l, elements)
 }
 
 /// The first lateral mode in x (rad/s) and its x-displacements per node.

@@ -203,11 +203,9 @@ fn run_case(case: &Case, out: &Path, run_options: RunOptions) -> Result<RunSumma
     let options = options_for(&settings);
     let density = case.element_density.clone();
     let mut dynamics = Dynamics::new(model, options, &|e| density[e]);
-    let mut s = match case.initial_velocity(model) {
-        Some(v) => dynamics.initial_state_moving(start.state, v),
-        None => dynamics.initial_state(start.state),
-    }
-    .map_err(|e| Error::Io(std::io::Error::other(e)))?;
+    let mut s = dynamics
+        .initial_state_with(start.state, case.initial_velocity(model))
+        .map_err(|e| Error::Io(std::io::Error::other(e)))?;
     let want = |name: &str| settings.outputs.iter().any(|o| o == name);
     let mut rec = Recorder {
         series: Vec::new(),

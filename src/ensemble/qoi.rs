@@ -261,11 +261,7 @@ pub fn dynamic_variant(case: &Case, name: &str, model: &Model) -> VariantResult 
     let options = crate::cli::run_cmd::options_for(&settings);
     let density = &case.element_density;
     let mut dynamics = Dynamics::new(model, options, &|e| density[e]);
-    let started = match case.initial_velocity(model) {
-        Some(v) => dynamics.initial_state_moving(start.state, v),
-        None => dynamics.initial_state(start.state),
-    };
-    let mut s = match started {
+    let mut s = match dynamics.initial_state_with(start.state, case.initial_velocity(model)) {
         Ok(s) => s,
         Err(e) => return failed(name, format!("initial state: {e}"), stabs.len()),
     };

@@ -353,6 +353,19 @@ impl<'a> Dynamics<'a> {
         self.initial_state_moving(q, vec![0.0; 6 * n])
     }
 
+    /// The initial state in `q`, at rest or, with `v`, moving ([`Self::initial_state`],
+    /// [`Self::initial_state_moving`]).
+    pub fn initial_state_with(
+        &mut self,
+        q: StaticState,
+        v: Option<Vec<f64>>,
+    ) -> Result<DynamicState, String> {
+        match v {
+            Some(v) => self.initial_state_moving(q, v),
+            None => self.initial_state(q),
+        }
+    }
+
     /// The initial state in configuration `q` with velocities `v` (6 per node: ẋ, spatial
     /// ω), with consistent accelerations.
     pub fn initial_state_moving(
