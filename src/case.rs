@@ -97,6 +97,15 @@ pub struct ComponentSpec {
     /// The same as a mass imbalance of the whole component (kg·m, g·mm, oz·in): its mass
     /// times the offset.
     pub imbalance: Option<Q>,
+    /// Bend angle of a bent sub or bent motor housing (degrees by default; 0 … 5°): a
+    /// stress-free kink of the string in this component.
+    pub bend: Option<Q>,
+    /// Where the kink sits above the component's lower end (default: its middle).
+    pub bend_from_bottom: Option<Q>,
+    /// Direction of the bend, clockwise from the high side of the hole looking down-hole
+    /// (degrees by default; default 0: the string below the kink points to the high side).
+    /// In a vertical hole, from the string's reference mark.
+    pub bend_toolface: Option<Q>,
 }
 
 /// `[operation]`.
@@ -856,6 +865,7 @@ pub fn parse_case(path: &Path, text: &str) -> Result<Case, InputError> {
     let mut tubulars = Vec::new();
     let mut blades = Vec::new();
     let mut eccentricities: Vec<f64> = Vec::new();
+    let mut bends = Vec::new();
     for c in &spec.string {
         let kind = c.kind.get_ref().clone();
         let length = ctx.quantity(&c.length, "string.length", Dimension::Length, pos, "> 0")?;
@@ -933,6 +943,52 @@ pub fn parse_case(path: &Path, text: &str) -> Result<Case, InputError> {
             (None, None) => 0.0,
         };
         eccentricities.push(eccentricity);
+        let bend = match &c.bend {
+            Some(q) => {
+                let angle = ctx.angle(q, "string.bend", |x| (0.0..=5.0).contains(&x), "0 … 5°")?;
+                let at = match &c.bend_from_bottom {
+                    Some(b) => ctx.quantity(
+                        b,
+                        "string.bend_from_bottom",
+                        Dimension::Length,
+                        |x| x > 0.0 && x < length,
+                        &format!(
+                            "0 < bend_from_bottom < the component's length ({} m)",
+                            crate::units::show(length)
+                        ),
+                    )?,
+                    None => 0.5 * length,
+                };
+                let toolface = match &c.bend_toolface {
+                    Some(t) => ctx.angle(
+                        t,
+                        "string.bend_toolface",
+                        |x| (-360.0..=360.0).contains(&x),
+                        "-360 … 360°",
+                    )?,
+                    None => 0.0,
+                };
+                let above_bit = tubulars.iter().map(|t: &Tubular| t.length).sum::<f64>() + at;
+                Some((
+                    above_bit,
+                    angle.to_radians(),
+                    toolface.to_radians(),
+                    q.span(),
+                ))
+            }
+            None => {
+                for (k, v) in [
+                    ("string.bend_from_bottom", &c.bend_from_bottom),
+                    ("string.bend_toolface", &c.bend_toolface),
+                ] {
+                    if let Some(v) = v {
+                        return Err(ctx.err(v.span(), k, "needs string.bend (the bend angle)"));
+                    }
+                }
+                None
+            }
+        };
+        bends.extend(bend);
         let blade = match &c.blade_diameter {
             Some(q) => {
                 let md_here = bit_md - tubulars.iter().map(|t: &Tubular| t.length).sum::<f64>();
@@ -1216,6 +1272,7 @@ pub fn parse_case(path: &Path, text: &str) -> Result<Case, InputError> {
         bit_lateral_fixed: true,
         point_loads: vec![],
         unbalance: vec![],
+        bends: vec![],
     };
     // Stabilizers: a site at the node nearest each stabilizer's middle.
     let mut stab_nodes = Vec::new();
@@ -1261,6 +1318,33 @@ pub fn parse_case(path: &Path, text: &str) -> Result<Case, InputError> {
         );
     }
     model.sites.sort_by_key(|s| s.node);
+    // Kinks: at the node nearest each, not the top or the bit.
+    for (above_bit, angle, toolface, span) in bends {
+        let md = bit_md - above_bit;
+        let node = (1..n - 1)
+            .min_by(|&a, &c| {
+                (model.nodes[a].md - md)
+                    .abs()
+                    .total_cmp(&(model.nodes[c].md - md).abs())
+            })
+            .ok_or_else(|| ctx.err(span.clone(), "string.bend", "the mesh has no free node"))?;
+        if model.bends.iter().any(|b| b.node == node) {
+            return Err(ctx.err(
+                span,
+                "string.bend",
+                format!(
+                    "two bends at the node at MD {} m: refine mesh.bha_element_length",
+                    crate::units::show(model.nodes[node].md)
+                ),
+            ));
+        }
+        let toolface = model.toolface_from_high_side(node, toolface);
+        model.bends.push(crate::model::Bend {
+            node,
+            angle,
+            toolface,
+        });
+    }
     // Mass imbalance: each component's centre-of-mass offset.
     if eccentricities.iter().any(|e| *e > 0.0) {
         model.unbalance = model

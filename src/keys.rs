@@ -39,6 +39,8 @@ pub enum Param {
     /// Centre-of-mass offset of every BHA component (bit to the first drill pipe), m: a mass
     /// imbalance for dynamics, replacing the case's `mass_eccentricity`/`imbalance`.
     Eccentricity,
+    /// Angle of every bent sub / bent housing of the case (rad; written in degrees).
+    Bend,
     /// A stabilizer layout: the 1-based index of one of `ensemble.layouts` (each a set of
     /// `stabK.from_bit` / `stabK.blade` values applied together).
     Layout,
@@ -59,7 +61,7 @@ pub struct Key {
 }
 
 /// Every key form, for messages.
-pub const KEY_FORMS: &str = "mu, mu_t, mu_l, k_e, c, m, eps (each optionally .stabK), rpm, wob, tob, stabK.blade, stabK.from_bit, depth, mode, layout, ecc";
+pub const KEY_FORMS: &str = "mu, mu_t, mu_l, k_e, c, m, eps (each optionally .stabK), rpm, wob, tob, stabK.blade, stabK.from_bit, depth, mode, layout, ecc, bend";
 
 impl Key {
     /// Parses a column key.
@@ -92,6 +94,7 @@ impl Key {
             ("mode", None) => (Param::Mode, None),
             ("layout", None) => (Param::Layout, None),
             ("ecc", None) => (Param::Eccentricity, None),
+            ("bend", None) => (Param::Bend, None),
             (h, None) if law(h).is_some() => (law(h).unwrap_or(Param::Mu), None),
             (h, Some(t)) if law(h).is_some() => (law(h).unwrap_or(Param::Mu), Some(stab_index(t)?)),
             (h, Some("blade")) => (Param::Blade, Some(stab_index(h)?)),
@@ -131,6 +134,14 @@ impl Key {
                         .filter(|x| x.fract() == 0.0 && (0.0..MODES.len() as f64).contains(x))
                 })
                 .ok_or_else(|| format!("unknown mode {t:?}; allowed: {}", MODES.join(", ")));
+        }
+        if self.param == Param::Bend {
+            // Degrees unless a unit says otherwise, as the case file's angles.
+            let deg = crate::units::parse_angle_deg(text).map_err(|e| e.to_string())?;
+            if !(0.0..=5.0).contains(&deg) {
+                return Err(format!("{} out of range; allowed: 0 … 5°", text.trim()));
+            }
+            return Ok(deg.to_radians());
         }
         let (dim, ok, range): (Option<Dimension>, fn(f64) -> bool, &str) = match self.param {
             Param::Mu | Param::MuT | Param::MuL => (None, |x| (0.0..=2.0).contains(&x), "0 … 2"),
@@ -182,7 +193,7 @@ impl Key {
                 |x| x >= 1.0 && x.fract() == 0.0 && x <= 1e6,
                 "a layout number 1, 2, … of ensemble.layouts",
             ),
-            Param::Mode => unreachable!("parsed above"),
+            Param::Mode | Param::Bend => unreachable!("parsed above"),
         };
         let t = text.trim();
         let v = match (t.parse::<f64>(), dim) {

@@ -109,6 +109,24 @@ pub struct Model {
     /// it turns with the node (`R U₀`). Empty: none. Dynamics only (a rigid eccentric mass:
     /// [`crate::solve::dynamics`]).
     pub unbalance: Vec<Vec3<f64>>,
+    /// Stress-free kinks (bent subs, bent motor housings). Empty: a straight string.
+    pub bends: Vec<Bend>,
+}
+
+/// A stress-free kink of the string at a node: the string below it is turned by `angle`
+/// from the string above, when unloaded. Carried by the element above the node as its
+/// unstrained rotations ([`crate::physics::beam::kink_rest_rotation`]); it turns with the
+/// string (a bent sub rotating in the hole forces a whirl).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Bend {
+    /// The node at the kink (interior: not the top, not the bit).
+    pub node: usize,
+    /// Bend angle (rad).
+    pub angle: f64,
+    /// Direction of the bend around the pipe, from the node's reference triad's second axis
+    /// towards its third (rad): [`Model::toolface_from_high_side`] converts a toolface
+    /// measured from the high side of the hole.
+    pub toolface: f64,
 }
 
 /// An orthonormal frame whose first column is `e1`.
@@ -326,7 +344,48 @@ impl Model {
             bit_lateral_fixed: true,
             point_loads: vec![],
             unbalance: vec![],
+            bends: vec![],
         }
+    }
+
+    /// Element `i`'s stiffnesses and unstrained rotations (a kink at its lower node, if
+    /// any): what every element evaluation uses.
+    pub fn element_stiffness(&self, i: usize) -> crate::physics::beam::ElementStiffness<f64> {
+        let e = &self.elements[i];
+        let k = crate::physics::beam::ElementStiffness::of(&e.section, e.length0);
+        match self.bends.iter().find(|b| b.node == i + 1) {
+            Some(b) => k.with_rest(crate::physics::beam::kink_rest_rotation(
+                b.angle, b.toolface, e.length0,
+            )),
+            None => k,
+        }
+    }
+
+    /// The unstrained nodal rotations of element `i` (zero but at a kink).
+    pub fn element_rest(&self, i: usize) -> [[f64; 3]; 2] {
+        self.element_stiffness(i).rest
+    }
+
+    /// A toolface measured from the high side of the hole at `node` (clockwise looking
+    /// down-hole; a vertical hole: from the node's reference second axis) as the angle
+    /// [`Bend::toolface`] takes.
+    pub fn toolface_from_high_side(&self, node: usize, from_high_side: f64) -> f64 {
+        let nd = &self.nodes[node];
+        let t = nd.hole_axis;
+        let f = &nd.frame0;
+        let (a2, a3) = ([f[0][1], f[1][1], f[2][1]], [f[0][2], f[1][2], f[2][2]]);
+        // Up (−z) perpendicular to the hole axis.
+        let up = [-t[2] * t[0], -t[2] * t[1], -1.0 + t[2] * t[2]];
+        let n = dot(&up, &up).sqrt();
+        if n < 1e-6 {
+            return from_high_side;
+        }
+        let high = scale(&up, 1.0 / n);
+        // Clockwise looking down the hole axis t: the right-hand turn about t.
+        let right = cross(&t, &high);
+        let (c, s) = (from_high_side.cos(), from_high_side.sin());
+        let d: Vec3<f64> = std::array::from_fn(|k| c * high[k] + s * right[k]);
+        dot(&d, &a3).atan2(dot(&d, &a2))
     }
 
     /// The nodal mass imbalance (kg·m vectors, [`Model::unbalance`]) of elements whose

@@ -531,7 +531,8 @@ pub fn element(states: usize, repeats: usize, json: Option<&Path>) -> Result<(),
     };
     let (mut agree64, mut agree32) = ((0.0f64, 0.0f64), (0.0f64, 0.0f64));
     for (s, (x32, t32, b32)) in list.iter().zip(&f32_inputs) {
-        let (f0, k0) = force_and_tangent_hyperdual(&s.x, &s.triad, &section, l0, false);
+        let (f0, k0) =
+            force_and_tangent_hyperdual(&s.x, &s.triad, &section, l0, &[[0.0; 3]; 2], false);
         let (f, k) = force_and_tangent_closed(&s.x, &s.triad, &form, &k64);
         let w = worst(&f, &k, &f0, &k0);
         agree64 = (agree64.0.max(w.0), agree64.1.max(w.1));
@@ -547,8 +548,8 @@ pub fn element(states: usize, repeats: usize, json: Option<&Path>) -> Result<(),
     let cform = form.map(Counted);
     let ck = k64.map(Counted);
     let counts = [
-        count(|| force_and_tangent_hyperdual(&cx, &ct, &section, l0, false)).1,
-        count(|| force_and_tangent_hyperdual(&cx, &ct, &section, l0, true)).1,
+        count(|| force_and_tangent_hyperdual(&cx, &ct, &section, l0, &[[0.0; 3]; 2], false)).1,
+        count(|| force_and_tangent_hyperdual(&cx, &ct, &section, l0, &[[0.0; 3]; 2], true)).1,
         count(|| element_force(&cx, &ct, &cform, &ck)).1,
         count(|| force_and_tangent_by_direction(&cx, &ct, &cform, &ck)).1,
         count(|| force_and_tangent_closed(&cx, &ct, &cform, &ck)).1,
@@ -565,13 +566,21 @@ pub fn element(states: usize, repeats: usize, json: Option<&Path>) -> Result<(),
     let times = [
         per(&mut || {
             for s in &list {
-                let r = force_and_tangent_hyperdual(&s.x, &s.triad, &section, l0, false);
+                let r = force_and_tangent_hyperdual(
+                    &s.x,
+                    &s.triad,
+                    &section,
+                    l0,
+                    &[[0.0; 3]; 2],
+                    false,
+                );
                 sink.set(sink.get() + r.1[3][4]);
             }
         })?,
         per(&mut || {
             for s in &list {
-                let r = force_and_tangent_hyperdual(&s.x, &s.triad, &section, l0, true);
+                let r =
+                    force_and_tangent_hyperdual(&s.x, &s.triad, &section, l0, &[[0.0; 3]; 2], true);
                 sink.set(sink.get() + r.1[3][4]);
             }
         })?,

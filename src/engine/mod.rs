@@ -1013,3 +1013,11 @@ impl<T, P: KernelPath<T>> KernelPath<T> for Chunked<P> {
 }
 
 pub mod dynamic;
+/// What of the models only the CPU static solver has (a bent sub or bent housing: the
+/// beam kernel has no unstrained rotations), if any.
+pub fn unsupported_static(models: &[crate::model::Model]) -> Option<String> {
+    models
+        .iter()
+        .any(|m| !m.bends.is_empty())
+        .then(|| "a bent sub or bent housing runs on the CPU solvers".into())
+}

@@ -20,6 +20,7 @@
 //! | `depth` | bit depth (MD): the case rebuilt with `well.total_md` there (the string cut at the surface, the hole sections kept) | m | 0 < … ≤ 20 km, within the hole |
 //! | `mode` | operation: `rotating`, `tripping_in`, `tripping_out`, `sliding` (the case rebuilt with it) | – | one of those |
 //! | `ecc` | centre-of-mass offset of every BHA component (dynamics: a mass imbalance; replaces the case's) | m | 0 … 50 mm |
+//! | `bend` | angle of every bent sub / bent housing of the case (`[[string]].bend`) | degrees unless a unit is given | 0 … 5° |
 //! | `layout` | one of the case's `ensemble.layouts` (1, 2, …): its `stabK.from_bit` / `stabK.blade` values together | – | 1 … number of layouts |
 //!
 //! Stabilizers are numbered from the bit up (`stab1` nearest the bit); a key without
@@ -317,6 +318,17 @@ pub fn apply(case: &Case, variant: &Variant) -> Result<Model, String> {
                             0.0
                         }
                     });
+            }
+            Param::Bend => {
+                if model.bends.is_empty() {
+                    return Err(format!(
+                        "{}: the case has no bent sub or bent housing (give [[string]].bend)",
+                        key.name
+                    ));
+                }
+                for b in &mut model.bends {
+                    b.angle = v;
+                }
             }
             Param::Rpm => model.rotation_speed = v,
             Param::Wob => {

@@ -15,14 +15,15 @@ use crate::solve::statics::StaticOptions;
 
 /// Static equilibria of every variant through the GPU kernels (in `T`), the variants that
 /// fail there re-run on the CPU with step control (their reason says so). Stabilizer
-/// moves run there too (each pair carries its node). `None` when the variants do not share
-/// the number of sites: the caller runs the CPU.
+/// moves run there too (each pair carries its node). `Err` with the reason when the
+/// variants do not share the number of sites, or need what only the CPU has: the caller
+/// runs the CPU and says why.
 pub fn run_static_gpu<T: crate::gpu::contact::GpuReal>(
     case: &Case,
     variants: &[Variant],
     ctx: &'static crate::gpu::GpuContext,
     bar: &indicatif::ProgressBar,
-) -> Result<Option<Vec<VariantResult>>, Error> {
+) -> Result<Result<Vec<VariantResult>, String>, Error> {
     use crate::engine::{solve_static_ensemble_with_progress, EngineStatus, GpuPath};
     let models: Vec<Model> = variants
         .iter()
@@ -30,7 +31,12 @@ pub fn run_static_gpu<T: crate::gpu::contact::GpuReal>(
         .collect::<Result<_, _>>()
         .map_err(|e| Error::Io(std::io::Error::other(e)))?;
     if !models.iter().all(|m| same_mesh(case, m)) {
-        return Ok(None);
+        return Ok(Err(
+            "the variants differ in their mesh or number of contact sites".into(),
+        ));
+    }
+    if let Some(why) = crate::engine::unsupported_static(&models) {
+        return Ok(Err(why));
     }
     let results = solve_static_ensemble_with_progress::<T, _>(
         &models,
@@ -39,30 +45,28 @@ pub fn run_static_gpu<T: crate::gpu::contact::GpuReal>(
         &mut |f| bar.set_position((f * variants.len() as f64) as u64),
     )
     .map_err(|e| Error::Io(std::io::Error::other(format!("GPU engine: {e}"))))?;
-    Ok(Some(
-        results
-            .into_par_iter()
-            .zip(models.par_iter().zip(variants.par_iter()))
-            .map(|(r, (m, v))| match r.status {
-                EngineStatus::Converged => {
-                    let mut sol = crate::solve::statics::solution_at(m, r.state);
-                    sol.iterations = r.iterations;
-                    sol.log = r.log;
-                    let mut done = static_result(case, &v.name, m, &sol);
-                    done.solved_by = SolvedBy::Engine;
-                    done
+    Ok(Ok(results
+        .into_par_iter()
+        .zip(models.par_iter().zip(variants.par_iter()))
+        .map(|(r, (m, v))| match r.status {
+            EngineStatus::Converged => {
+                let mut sol = crate::solve::statics::solution_at(m, r.state);
+                sol.iterations = r.iterations;
+                sol.log = r.log;
+                let mut done = static_result(case, &v.name, m, &sol);
+                done.solved_by = SolvedBy::Engine;
+                done
+            }
+            EngineStatus::Failed(why) => {
+                let mut again = static_variant(case, &v.name, m);
+                again.reason = format!("GPU: {why}; re-run on the CPU: {}", again.reason);
+                if again.status == Status::Converged {
+                    again.status = Status::StepCut;
                 }
-                EngineStatus::Failed(why) => {
-                    let mut again = static_variant(case, &v.name, m);
-                    again.reason = format!("GPU: {why}; re-run on the CPU: {}", again.reason);
-                    if again.status == Status::Converged {
-                        again.status = Status::StepCut;
-                    }
-                    again
-                }
-            })
-            .collect(),
-    ))
+                again
+            }
+        })
+        .collect()))
 }
 
 /// The `[dynamics]` runs of every variant through the GPU engine (in `T`): static starts
@@ -263,12 +267,12 @@ pub(crate) fn compute(
         } else {
             run_static_gpu::<f64>(case, variants, ctx, bar)?
         } {
-            Some(r) => {
+            Ok(r) => {
                 backend_name = "gpu";
                 r
             }
-            None => {
-                eprintln!("holewall: the variants differ in their mesh or number of contact sites; running them on the CPU");
+            Err(why) => {
+                eprintln!("holewall: {why}; running the variants on the CPU");
                 run_variants_cpu(case, analysis, variants, bar)
             }
         },

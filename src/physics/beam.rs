@@ -18,6 +18,11 @@
 //! geometric stiffness: an axial force `N` adds `N/l` to the lateral stiffness, so
 //! compression softens the string and buckling appears. The oracle is the energy itself,
 //! differentiated twice by hyper-dual numbers ([`force_and_tangent_hyperdual`]).
+//!
+//! A **stress-free kink** (bent sub, bent motor housing) is an element whose unstrained
+//! state has nodal rotations `θ̄⁰_i ≠ 0` in its frame: the energy above is written in
+//! `θ̄_i − θ̄⁰_i` ([`ElementStiffness::rest`], [`kink_rest_rotation`]). The straight pipe
+//! has `θ̄⁰ = 0`.
 
 use super::dual::{Dual, DualN};
 use super::Real;
@@ -195,6 +200,34 @@ pub struct LocalDeformation<T> {
     pub theta2: [T; 3],
 }
 
+impl<T: Real> LocalDeformation<T> {
+    /// The deformation measured from an unstrained state with nodal rotations `rest`
+    /// (`θ̄_i − θ̄⁰_i`; a kink's [`kink_rest_rotation`]): what the energy and the section
+    /// forces see.
+    pub fn minus_rest(mut self, rest: &[[f64; 3]; 2]) -> Self {
+        for k in 0..3 {
+            self.theta1[k] = self.theta1[k] - T::from_f64_lossy(rest[0][k]);
+            self.theta2[k] = self.theta2[k] - T::from_f64_lossy(rest[1][k]);
+        }
+        self
+    }
+}
+
+/// The unstrained nodal rotations `[θ̄⁰₁, θ̄⁰₂]` of an element of length `l0` whose second
+/// node's triad is turned by `angle` (rad) from the first's: a kink at the element's lower
+/// end, bending the string below it towards the direction at `toolface` (rad) from the
+/// first node triad's second axis, turning towards its third. Measured by
+/// [`local_deformation`] on that geometry (chord along the first triad's first axis), so the
+/// element's frame is the one the force uses and the kinked state is exactly force free.
+pub fn kink_rest_rotation(angle: f64, toolface: f64, length0: f64) -> [[f64; 3]; 2] {
+    let identity: Mat3<f64> = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+    // The bend towards d = cos φ e2 + sin φ e3: a rotation about e1 × d.
+    let axis = [0.0, -toolface.sin(), toolface.cos()];
+    let turned = rotation_exp(&[0.0, angle * axis[1], angle * axis[2]]);
+    let def = local_deformation(&[0.0; 3], &[length0, 0.0, 0.0], &identity, &turned, length0);
+    [def.theta1, def.theta2]
+}
+
 /// Local deformation of an element with nodes at `x1`, `x2` and nodal triads `t1 = R1 Q0`,
 /// `t2 = R2 Q0` (columns: the element's initial axes carried by each node's rotation).
 pub fn local_deformation<T: Trig>(
@@ -279,7 +312,8 @@ pub fn section_forces(
 }
 
 /// The element's stiffnesses over its length: `EA/l0`, `GJ/l0`, `EI/l0` (the beam kernel's
-/// `section` binding holds them, with `l0`).
+/// `section` binding holds them, with `l0`), and its unstrained nodal rotations (zero but
+/// for a kink).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ElementStiffness<T> {
     /// `EA/l0` (N/m).
@@ -288,16 +322,26 @@ pub struct ElementStiffness<T> {
     pub torsion: T,
     /// `EI/l0` (N·m).
     pub bending: T,
+    /// Unstrained nodal rotations `θ̄⁰₁, θ̄⁰₂` in the element frame (rad;
+    /// [`kink_rest_rotation`]).
+    pub rest: [[T; 3]; 2],
 }
 
 impl ElementStiffness<f64> {
-    /// Of a section over a length `l0`.
+    /// Of a straight section over a length `l0`.
     pub fn of(section: &BeamSection, length0: f64) -> Self {
         ElementStiffness {
             axial: section.youngs_modulus * section.area / length0,
             torsion: section.shear_modulus * section.polar_moment / length0,
             bending: section.bending_stiffness() / length0,
+            rest: [[0.0; 3]; 2],
         }
+    }
+
+    /// The same element unstrained at the nodal rotations `rest` (a kink).
+    pub fn with_rest(mut self, rest: [[f64; 3]; 2]) -> Self {
+        self.rest = rest;
+        self
     }
 }
 
@@ -308,6 +352,7 @@ impl<T: Copy> ElementStiffness<T> {
             axial: f(self.axial),
             torsion: f(self.torsion),
             bending: f(self.bending),
+            rest: self.rest.map(|r| r.map(&f)),
         }
     }
 }
@@ -424,12 +469,14 @@ pub fn element_force<T: Trig>(
     ];
     let (th1, c1) = rotation_log_and_jacobian(&mat_tmul(&rr, &triad[0]));
     let (th2, c2) = rotation_log_and_jacobian(&mat_tmul(&rr, &triad[1]));
-    // Local moments m̄_i = ∂E/∂θ̄_i.
-    let twist = k.torsion * (th2[0] - th1[0]);
+    // Local moments m̄_i = ∂E/∂θ̄_i, of the rotations from the unstrained state.
+    let s1: [T; 3] = std::array::from_fn(|r| th1[r] - k.rest[0][r]);
+    let s2: [T; 3] = std::array::from_fn(|r| th2[r] - k.rest[1][r]);
+    let twist = k.torsion * (s2[0] - s1[0]);
     let (two, four) = (T::from_f64_lossy(2.0), T::from_f64_lossy(4.0));
     let bend = |a: T, b: T| k.bending * (four * a + two * b);
-    let m1 = [-twist, bend(th1[1], th2[1]), bend(th1[2], th2[2])];
-    let m2 = [twist, bend(th2[1], th1[1]), bend(th2[2], th1[2])];
+    let m1 = [-twist, bend(s1[1], s2[1]), bend(s1[2], s2[2])];
+    let m2 = [twist, bend(s2[1], s1[1]), bend(s2[2], s1[2])];
     // v̄ = J⁻ᵀ(θ) m̄ = m̄ + ½ θ × m̄ + c θ × (θ × m̄).
     let jt = |th: &[T; 3], c: T, m: &[T; 3]| -> [T; 3] {
         let tm = cross(th, m);
@@ -598,6 +645,7 @@ pub fn force_and_tangent_hyperdual<T: Trig>(
     triad: &[Mat3<T>; 2],
     section: &BeamSection,
     length0: f64,
+    rest: &[[f64; 3]; 2],
     symmetric: bool,
 ) -> ([T; 12], [[T; 12]; 12]) {
     let lift = |v: T| Dual::constant(Dual::constant(v));
@@ -614,7 +662,7 @@ pub fn force_and_tangent_hyperdual<T: Trig>(
         for j in js {
             let (mut xj, mut tj) = (xk, tk);
             perturb(&mut xj, &mut tj, j, eps1);
-            let def = local_deformation(&xj[0], &xj[1], &tj[0], &tj[1], length0);
+            let def = local_deformation(&xj[0], &xj[1], &tj[0], &tj[1], length0).minus_rest(rest);
             let e = strain_energy(&def, section, length0);
             tangent[j][k] = e.d.d;
             if k == 11 || (!symmetric && k == 0) {
@@ -659,7 +707,14 @@ pub fn force_and_tangent_full(
     section: &BeamSection,
     length0: f64,
 ) -> ([f64; 12], [[f64; 12]; 12]) {
-    force_and_tangent_hyperdual(&state.x, &state.triad, section, length0, false)
+    force_and_tangent_hyperdual(
+        &state.x,
+        &state.triad,
+        section,
+        length0,
+        &[[0.0; 3]; 2],
+        false,
+    )
 }
 
 #[cfg(test)]
@@ -858,7 +913,8 @@ mod tests {
     fn half_the_hyper_dual_evaluations_give_the_whole_tangent() {
         let mut worst: f64 = 0.0;
         for s in random_states(40, 2.5, 12345) {
-            let (f, k) = force_and_tangent_hyperdual(&s.x, &s.triad, &section(), 9.0, true);
+            let (f, k) =
+                force_and_tangent_hyperdual(&s.x, &s.triad, &section(), 9.0, &[[0.0; 3]; 2], true);
             let (f0, k0) = force_and_tangent_full(&s, &section(), 9.0);
             let scale = k0.iter().flatten().fold(0.0f64, |m, x| m.max(x.abs()));
             let fscale = f0.iter().fold(0.0f64, |m, x| m.max(x.abs()));
@@ -929,5 +985,85 @@ mod tests {
             worst.0, worst.1
         );
         assert!(worst.0 < 1e-3 && worst.1 < 1e-4, "{worst:?}");
+    }
+
+    #[test]
+    fn a_kinked_element_is_force_free_in_its_kinked_state() {
+        // 1.5° at toolfaces 0, 70°, 200°: the geometry the rest rotations came from, then
+        // spun and moved rigidly, carries no force; the straight element does.
+        let l = 2.0;
+        for toolface in [0.0f64, 70f64.to_radians(), 200f64.to_radians()] {
+            let angle = 1.5f64.to_radians();
+            let rest = kink_rest_rotation(angle, toolface, l);
+            let k = ElementStiffness::of(&section(), l).with_rest(rest);
+            let r = mat_mul(
+                &rotation_exp(&[0.4, -0.9, 1.7]),
+                &rotation_exp(&[250.0, 0.0, 0.0]),
+            );
+            let turned = rotation_exp(&[0.0, -angle * toolface.sin(), angle * toolface.cos()]);
+            let x2 = [r[0][0] * l + 3.0, r[1][0] * l - 1.0, r[2][0] * l + 900.0];
+            let x = [[3.0, -1.0, 900.0], x2];
+            let triad = [r, mat_mul(&r, &turned)];
+            let f = element_force(&x, &triad, &Chord::Positions { length0: l }, &k);
+            let scale = k.bending * angle;
+            let worst = f.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+            assert!(
+                worst <= 1e-9 * scale,
+                "toolface {toolface}: {worst:e} vs {scale:e}"
+            );
+            let straight = element_force(
+                &x,
+                &triad,
+                &Chord::Positions { length0: l },
+                &ElementStiffness::of(&section(), l),
+            );
+            let bent = straight.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+            assert!(bent > scale, "a straight element there is bent: {bent:e}");
+            // The rest rotation is the angle, split as the frame sees it, nearly all bending.
+            let total: f64 = (0..3)
+                .map(|c| (rest[1][c] - rest[0][c]).powi(2))
+                .sum::<f64>()
+                .sqrt();
+            assert!((total - angle).abs() < 1e-6 * angle, "{total} vs {angle}");
+        }
+    }
+
+    #[test]
+    fn a_kinked_elements_force_and_tangent_are_the_energys_derivatives() {
+        // Force and tangent of kinked elements against the hyper-dual oracle of the energy
+        // in θ̄ − θ̄⁰, and the tangent against central differences of the force.
+        let l = 9.0;
+        let rest = kink_rest_rotation(2f64.to_radians(), 1.1, l);
+        let k = ElementStiffness::of(&section(), l).with_rest(rest);
+        let (mut wf, mut wk, mut wd) = (0.0f64, 0.0f64, 0.0f64);
+        for s in random_states(20, 0.5, 31) {
+            let form = Chord::Positions { length0: l };
+            let (f, kk) = force_and_tangent_closed(&s.x, &s.triad, &form, &k);
+            let (f0, k0) = force_and_tangent_hyperdual(&s.x, &s.triad, &section(), l, &rest, false);
+            let fs = f0.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+            let ks = k0.iter().flatten().fold(0.0f64, |m, x| m.max(x.abs()));
+            for a in 0..12 {
+                wf = wf.max((f[a] - f0[a]).abs() / fs);
+                for b in 0..12 {
+                    wk = wk.max((kk[a][b] - k0[a][b]).abs() / ks);
+                }
+            }
+            let h = 1e-6;
+            for col in 0..12 {
+                let mut dq = [0.0; 12];
+                dq[col] = h;
+                let p = apply(&s, &dq);
+                dq[col] = -h;
+                let m = apply(&s, &dq);
+                let fp = element_force(&p.x, &p.triad, &form, &k);
+                let fm = element_force(&m.x, &m.triad, &form, &k);
+                for a in 0..12 {
+                    wd = wd.max(((fp[a] - fm[a]) / (2.0 * h) - kk[a][col]).abs() / ks);
+                }
+            }
+        }
+        eprintln!("kinked element: force {wf:.1e}, tangent {wk:.1e} vs hyper-dual; {wd:.1e} vs central differences");
+        assert!(wf <= 1e-12 && wk <= 1e-12, "{wf:e} {wk:e}");
+        assert!(wd <= 1e-6, "{wd:e}");
     }
 }

@@ -12,8 +12,8 @@ use thiserror::Error;
 
 use crate::model::{Model, TopBoundary};
 use crate::physics::beam::{
-    force_and_tangent, internal_force, local_deformation, rotation_exp, section_forces,
-    ElementState, Mat3, SectionForces,
+    element_force, force_and_tangent_closed, local_deformation, rotation_exp, section_forces,
+    Chord, ElementState, Mat3, SectionForces,
 };
 use crate::physics::contact::{evaluate, ContactMode, ContactResponse, ContactTerms, SpringLaw};
 use crate::physics::vec3::{cross, dot, scale, sub, Vec3};
@@ -359,11 +359,13 @@ pub(crate) fn element_responses(
                     mat_mul(&state.rot[i + 1], &model.nodes[i + 1].frame0),
                 ],
             };
+            let k = model.element_stiffness(i);
+            let form = Chord::Positions { length0: e.length0 };
             if with_tangent {
-                let (f, k) = force_and_tangent(&es, &e.section, e.length0);
-                (f, Some(k))
+                let (f, t) = force_and_tangent_closed(&es.x, &es.triad, &form, &k);
+                (f, Some(t))
             } else {
-                (internal_force(&es, &e.section, e.length0), None)
+                (element_force(&es.x, &es.triad, &form, &k), None)
             }
         })
         .collect()
@@ -517,8 +519,17 @@ fn residual_measure(r: &[f64], f_ref: f64) -> f64 {
     r.iter().fold(0.0f64, |m, x| m.max(x.abs())) / f_ref
 }
 
-/// Total weight and WOB scale: the reference force of the convergence test.
+/// Total weight and WOB scale — and a kink's moment held straight, `6 EI α / l0` (N·m per
+/// m) — : the reference force of the convergence test.
 pub fn reference_force(model: &Model) -> f64 {
+    let kink = model
+        .bends
+        .iter()
+        .map(|b| {
+            let e = &model.elements[b.node - 1];
+            6.0 * e.section.bending_stiffness() / e.length0 * b.angle.abs()
+        })
+        .fold(0.0f64, f64::max);
     let weight: f64 = model
         .elements
         .iter()
@@ -533,6 +544,7 @@ pub fn reference_force(model: &Model) -> f64 {
         .max(model.weight_on_bit.abs())
         .max(model.torque_on_bit.abs())
         .max(point)
+        .max(kink)
         .max(1.0)
 }
 
@@ -827,6 +839,10 @@ pub fn loaded_model(model: &Model, target: &crate::solve::continuation::LoadTarg
     for site in &mut m.sites {
         site.params = loaded_params(&site.params, target);
     }
+    // Kinks grow with the bit loads (from the straight string laid in the hole).
+    for b in &mut m.bends {
+        b.angle *= target.lambda;
+    }
     m
 }
 
@@ -871,6 +887,7 @@ pub fn element_deformation(
         &t2,
         model.elements[i].length0,
     )
+    .minus_rest(&model.element_rest(i))
 }
 
 /// Section forces of element `i` at a configuration.

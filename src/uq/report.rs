@@ -37,6 +37,8 @@ pub enum Unit {
     Damping,
     /// m/s.
     Speed,
+    /// rad, shown in degrees.
+    Angle,
 }
 
 impl Unit {
@@ -53,6 +55,7 @@ impl Unit {
             Unit::AngularSpeed => (60.0 / std::f64::consts::TAU, "rpm"),
             Unit::Damping => (1.0, "N·s/m"),
             Unit::Speed => (1.0, "m/s"),
+            Unit::Angle => (180.0 / std::f64::consts::PI, "°"),
         }
     }
 
@@ -68,6 +71,7 @@ impl Unit {
             Param::Tob => Unit::Torque,
             Param::Blade | Param::FromBit | Param::Depth | Param::Eccentricity => Unit::Length,
             Param::Mode | Param::Layout => Unit::Ratio,
+            Param::Bend => Unit::Angle,
         }
     }
 }
