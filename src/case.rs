@@ -186,6 +186,11 @@ pub struct DynamicsSpec {
     /// A lateral kick at the start: every BHA node (bit to the first drill pipe) moving at
     /// this speed towards its frame's first lateral axis (a whirl trigger; default 0).
     pub initial_lateral_velocity: Option<Q>,
+    /// A lateral offset at the start: the BHA displaced from its static equilibrium as a
+    /// half sine from the bit to the first drill pipe, this much at its middle, towards the
+    /// frames' first lateral axis, and let go (a whirl trigger; default 0; at most the
+    /// BHA's largest radial clearance).
+    pub initial_lateral_offset: Option<Q>,
 }
 
 /// Checked `[dynamics]` settings.
@@ -211,6 +216,8 @@ pub struct DynamicsSettings {
     pub rop: f64,
     /// Initial lateral speed of the BHA (m/s).
     pub initial_lateral_velocity: f64,
+    /// Initial lateral offset of the BHA's middle (m).
+    pub initial_lateral_offset: f64,
 }
 
 /// Every output `holewall run` can record.
@@ -371,29 +378,52 @@ impl Case {
             .unwrap_or((md, 0.2159, 0.25))
     }
 
-    /// The initial velocities of a dynamic run of `model` (6 per node): the BHA's lateral
-    /// kick of `[dynamics].initial_lateral_velocity`, towards each element frame's first
-    /// lateral axis; `None` when there is none.
-    pub fn initial_velocity(&self, model: &crate::model::Model) -> Option<Vec<f64>> {
-        let speed = self.dynamics.as_ref()?.initial_lateral_velocity;
-        if speed == 0.0 {
-            return None;
-        }
+    /// The start of a dynamic run of `model` from its static equilibrium `q`: the BHA's
+    /// initial lateral offset (`[dynamics].initial_lateral_offset`: a half sine from the bit
+    /// to the first drill pipe, towards each node frame's first lateral axis) applied to
+    /// `q`, and the initial velocities (6 per node) of the BHA's lateral kick
+    /// (`initial_lateral_velocity`, the same direction, uniform), `None` without one. Every
+    /// dynamic run (`holewall run`, the ensemble's CPU runs) starts here.
+    pub fn dynamic_start(
+        &self,
+        model: &crate::model::Model,
+        mut q: crate::solve::statics::StaticState,
+    ) -> (crate::solve::statics::StaticState, Option<Vec<f64>>) {
+        let Some(d) = self.dynamics.as_ref() else {
+            return (q, None);
+        };
         let n = model.nodes.len();
         let bit_md = model.nodes.last().map_or(self.bit_md, |nd| nd.md);
-        let top = bit_md - self.bha_length;
-        let mut v = vec![0.0; 6 * n];
+        let bha = self.bha_length.max(1e-9);
+        let top = bit_md - bha;
         // Not the clamped top, nor the bit when it is held laterally.
         let last = if model.bit_lateral_fixed { n - 1 } else { n };
-        for (i, node) in model.nodes.iter().enumerate().take(last).skip(1) {
-            if node.md >= top - 1e-9 {
-                let e = &model.elements[i.min(model.elements.len() - 1)];
+        let lateral = |i: usize| -> [f64; 3] {
+            let f = &model.nodes[i].frame0;
+            [f[0][1], f[1][1], f[2][1]]
+        };
+        let in_bha = |i: usize| i > 0 && i < last && model.nodes[i].md >= top - 1e-9;
+        if d.initial_lateral_offset != 0.0 {
+            for i in (0..n).filter(|&i| in_bha(i)) {
+                let s = (bit_md - model.nodes[i].md) / bha;
+                let w = d.initial_lateral_offset * (std::f64::consts::PI * s).sin();
+                let a = lateral(i);
                 for k in 0..3 {
-                    v[6 * i + k] = speed * e.frame0[k][1];
+                    q.x[i][k] += w * a[k];
                 }
             }
         }
-        Some(v)
+        if d.initial_lateral_velocity == 0.0 {
+            return (q, None);
+        }
+        let mut v = vec![0.0; 6 * n];
+        for i in (0..n).filter(|&i| in_bha(i)) {
+            let a = lateral(i);
+            for k in 0..3 {
+                v[6 * i + k] = d.initial_lateral_velocity * a[k];
+            }
+        }
+        (q, Some(v))
     }
 
     /// The hole diameter at `md` (m).
@@ -1371,6 +1401,30 @@ pub fn parse_case(path: &Path, text: &str) -> Result<Case, InputError> {
         .map(|t| t.length)
         .sum::<f64>()
         .min(bit_md);
+    if let (Some(d), Some(spec_d)) = (&dynamics, &spec.dynamics) {
+        if let Some(q) = &spec_d.initial_lateral_offset {
+            let bha_top = bit_md - bha_length;
+            let widest = model
+                .nodes
+                .iter()
+                .enumerate()
+                .filter(|(_, nd)| nd.md >= bha_top - 1e-9)
+                .map(|(i, nd)| 0.5 * hole_at(nd.md).1 - model.pipe_radius_at(i))
+                .fold(0.0f64, f64::max);
+            if d.initial_lateral_offset > widest {
+                return Err(ctx.err(
+                    q.span(),
+                    "dynamics.initial_lateral_offset",
+                    format!(
+                        "{} m is wider than the BHA's largest radial clearance ({} m): the \
+                         string would start inside the wall",
+                        crate::units::show(d.initial_lateral_offset),
+                        crate::units::show(widest)
+                    ),
+                ));
+            }
+        }
+    }
     Ok(Case {
         ensemble,
         title: spec.title.unwrap_or_default(),
@@ -1724,6 +1778,16 @@ fn dynamics_settings(ctx: &Ctx, d: &DynamicsSpec) -> Result<DynamicsSettings, In
         )?,
         None => 0.0,
     };
+    let initial_lateral_offset = match &d.initial_lateral_offset {
+        Some(q) => ctx.quantity(
+            q,
+            "dynamics.initial_lateral_offset",
+            Dimension::Length,
+            |x| (0.0..=0.5).contains(&x),
+            "0 ≤ offset ≤ 0.5 m (and within the BHA's clearance)",
+        )?,
+        None => 0.0,
+    };
     Ok(DynamicsSettings {
         duration,
         time_step,
@@ -1735,5 +1799,6 @@ fn dynamics_settings(ctx: &Ctx, d: &DynamicsSpec) -> Result<DynamicsSettings, In
         mass,
         rop,
         initial_lateral_velocity,
+        initial_lateral_offset,
     })
 }

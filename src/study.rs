@@ -365,6 +365,10 @@ pub struct StabilityCell {
     pub seconds: f64,
     /// A non-finite state or residual.
     pub nan: bool,
+    /// Dynamic cells: growth of the energy of motion over the second half,
+    /// `max E(t)/E(t½) − 1` (kinetic plus strain energy above the static start's;
+    /// `crate::ensemble::qoi::dynamic_variant_tracked`). Empty for static cells.
+    pub energy_growth: Option<f64>,
     /// Why it failed or was cut.
     pub reason: String,
 }
@@ -495,13 +499,16 @@ pub fn stability(
                     .and_then(|v| crate::ensemble::apply(&this, &v[0]))
             }
             .map(|model| match analysis {
-                "static" => crate::ensemble::qoi::static_variant(&this, "cell", &model),
-                _ => crate::ensemble::qoi::dynamic_variant(&this, "cell", &model),
+                "static" => (
+                    crate::ensemble::qoi::static_variant(&this, "cell", &model),
+                    None,
+                ),
+                _ => crate::ensemble::qoi::dynamic_variant_tracked(&this, "cell", &model, true),
             });
             bar.inc(1);
             let seconds = clock.elapsed().as_secs_f64();
             match result {
-                Ok(r) => StabilityCell {
+                Ok((r, energy_growth)) => StabilityCell {
                     parameter: parameter.clone(),
                     value: value.clone(),
                     analysis: analysis.into(),
@@ -510,6 +517,7 @@ pub fn stability(
                     newton_iterations: r.newton_iterations_per_step,
                     seconds,
                     nan: r.reason.contains("not finite"),
+                    energy_growth,
                     reason: r.reason,
                 },
                 Err(e) => StabilityCell {
@@ -521,6 +529,7 @@ pub fn stability(
                     newton_iterations: 0.0,
                     seconds,
                     nan: false,
+                    energy_growth: None,
                     reason: e,
                 },
             }
@@ -550,7 +559,15 @@ pub fn stability(
             text: if c.status == "failed" || c.status == "refused" {
                 "fail".into()
             } else {
-                format!("{}c {:.1}it", c.step_cuts, c.newton_iterations)
+                match c.energy_growth {
+                    Some(g) => format!(
+                        "{}c {:.1}it {:+.0}%E",
+                        c.step_cuts,
+                        c.newton_iterations,
+                        100.0 * g
+                    ),
+                    None => format!("{}c {:.1}it", c.step_cuts, c.newton_iterations),
+                }
             },
         })
         .collect();

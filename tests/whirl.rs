@@ -352,6 +352,85 @@ fn an_initial_lateral_kick_starts_lateral_motion() {
     );
     assert!(r > 0.9 * clearance, "{r}");
     assert!(kicked["whirl"][0]["contact_fraction"].as_f64().unwrap() > 0.0);
+    // `initial_lateral_offset`: the BHA let go from a half sine 2 mm off the axis at its
+    // middle: the stabilizer starts at 2 mm × sin(π s) (s its height over the BHA's) and
+    // moves back towards the axis.
+    let offset = 2e-3;
+    let _ = run(
+        &base.replace(
+            "rho_inf = 0.8",
+            "rho_inf = 0.8\ninitial_lateral_offset = \"2 mm\"",
+        ),
+        "offset",
+    );
+    let csv = std::fs::read_to_string(dir.join("offset").join("contact_sites.csv")).unwrap();
+    let rows: Vec<Vec<f64>> = csv
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').map(|x| x.parse().unwrap()).collect())
+        .collect();
+    let (md, r0, r_end) = (rows[0][2], rows[0][5], rows.last().unwrap()[5]);
+    let s = (60.0 - md) / 30.75;
+    let expect = offset * (std::f64::consts::PI * s).sin();
+    eprintln!(
+        "released from a {:.1} mm offset: stabilizer starts at {:.4} mm (half sine {:.4} mm), ends at {:.4} mm",
+        1e3 * offset,
+        1e3 * r0,
+        1e3 * expect,
+        1e3 * r_end
+    );
+    assert!((r0 / expect - 1.0).abs() < 1e-9, "{r0} vs {expect}");
+    assert!(r_end < 0.8 * r0, "let go: {r_end} vs {r0}");
+}
+
+/// `[dynamics].initial_lateral_offset`: a half sine over the BHA (zero at the bit and at the
+/// first drill pipe, the offset at its middle) applied to the static start, the drill pipe
+/// untouched; wider than the BHA's clearance is refused with the key and the clearance.
+#[test]
+fn the_initial_offset_is_a_half_sine_over_the_bha_within_its_clearance() {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("cases/spinup_short.toml");
+    let base = std::fs::read_to_string(&path).unwrap();
+    let text = base.replace(
+        "rho_inf = 0.8",
+        "rho_inf = 0.8\ninitial_lateral_offset = \"3 mm\"",
+    );
+    let case = holewall::case::parse_case(std::path::Path::new("offset.toml"), &text).unwrap();
+    let m = &case.model;
+    let q0 = StaticState::initial(m);
+    let (q, v) = case.dynamic_start(m, q0.clone());
+    assert!(v.is_none());
+    let bit_md = m.nodes.last().unwrap().md;
+    let mut largest = 0.0f64;
+    for (i, nd) in m.nodes.iter().enumerate() {
+        let d: Vec<f64> = (0..3).map(|k| q.x[i][k] - q0.x[i][k]).collect();
+        let w = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+        let s = (bit_md - nd.md) / case.bha_length;
+        let expect = if s <= 1.0 && i + 1 < m.nodes.len() {
+            3e-3 * (std::f64::consts::PI * s).sin()
+        } else {
+            0.0
+        };
+        assert!(
+            (w - expect.abs()).abs() < 1e-12,
+            "node {i} at s = {s}: {w} vs {expect}"
+        );
+        let axial: f64 = (0..3).map(|k| d[k] * nd.hole_axis[k]).sum();
+        assert!(axial.abs() < 1e-15, "lateral only");
+        largest = largest.max(w);
+    }
+    assert!(largest > 2.9e-3, "{largest}");
+    let wide = base.replace(
+        "rho_inf = 0.8",
+        "rho_inf = 0.8\ninitial_lateral_offset = \"5 cm\"",
+    );
+    let e = holewall::case::parse_case(std::path::Path::new("wide.toml"), &wide)
+        .unwrap_err()
+        .to_string();
+    eprintln!("{e}");
+    assert!(
+        e.contains("dynamics.initial_lateral_offset") && e.contains("clearance"),
+        "{e}"
+    );
 }
 
 /// The shipped whirl map (`cases/whirl_map.toml`: a 3 mm collar imbalance, RPM × WOB ×

@@ -203,8 +203,9 @@ fn run_case(case: &Case, out: &Path, run_options: RunOptions) -> Result<RunSumma
     let options = options_for(&settings);
     let density = case.element_density.clone();
     let mut dynamics = Dynamics::new(model, options, &|e| density[e]);
+    let (q0, v0) = case.dynamic_start(model, start.state);
     let mut s = dynamics
-        .initial_state_with(start.state, case.initial_velocity(model))
+        .initial_state_with(q0, v0)
         .map_err(|e| Error::Io(std::io::Error::other(e)))?;
     let want = |name: &str| settings.outputs.iter().any(|o| o == name);
     let mut rec = Recorder {

@@ -250,32 +250,76 @@ pub fn static_result(
 
 /// The `[dynamics]` run of one variant's model from its static equilibrium.
 pub fn dynamic_variant(case: &Case, name: &str, model: &Model) -> VariantResult {
+    dynamic_variant_tracked(case, name, model, false).0
+}
+
+/// [`dynamic_variant`], and with `track_energy` the growth of the energy of motion over the
+/// run's second half: `max E(t) / E(t½) − 1` for `t ≥ t½`, with `E` the kinetic energy plus
+/// the strain energy above the static start's (a run that blows up grows by orders; a
+/// steadily turning string stays near 0). `None` without tracking or when `E(t½)` is 0.
+pub fn dynamic_variant_tracked(
+    case: &Case,
+    name: &str,
+    model: &Model,
+    track_energy: bool,
+) -> (VariantResult, Option<f64>) {
     let stabs = stabilizer_sites(model);
     let Some(settings) = case.dynamics.clone() else {
-        return failed(name, "no [dynamics] table".into(), stabs.len());
+        return (
+            failed(name, "no [dynamics] table".into(), stabs.len()),
+            None,
+        );
     };
     let start = match solve_static(model, &StaticOptions::default()) {
         Ok(s) => s,
-        Err(e) => return failed(name, format!("static start: {e}"), stabs.len()),
+        Err(e) => {
+            return (
+                failed(name, format!("static start: {e}"), stabs.len()),
+                None,
+            )
+        }
     };
+    let strain0 = track_energy.then(|| crate::solve::dynamics::strain_energy(model, &start.state));
     let options = crate::cli::run_cmd::options_for(&settings);
     let density = &case.element_density;
     let mut dynamics = Dynamics::new(model, options, &|e| density[e]);
-    let mut s = match dynamics.initial_state_with(start.state, case.initial_velocity(model)) {
+    let (q0, v0) = case.dynamic_start(model, start.state);
+    let mut s = match dynamics.initial_state_with(q0, v0) {
         Ok(s) => s,
-        Err(e) => return failed(name, format!("initial state: {e}"), stabs.len()),
+        Err(e) => {
+            return (
+                failed(name, format!("initial state: {e}"), stabs.len()),
+                None,
+            )
+        }
     };
     let mut observer = DynamicObserver::new(model, settings.duration);
-    let mut observe = |d: &Dynamics, st: &DynamicState| observer.observe(model, d, st);
+    let half = 0.5 * settings.duration;
+    let (mut e_half, mut growth) = (None::<f64>, 0.0f64);
+    let mut observe = |d: &Dynamics, st: &DynamicState| {
+        observer.observe(model, d, st);
+        if let (Some(e0), true) = (strain0, st.t >= half) {
+            let e = d.kinetic_energy(st) + crate::solve::dynamics::strain_energy(model, &st.q) - e0;
+            match e_half {
+                None => e_half = Some(e),
+                Some(h) if h > 0.0 => growth = growth.max(e / h - 1.0),
+                Some(_) => {}
+            }
+        }
+    };
     observe(&dynamics, &s);
     let result = dynamics.run(&mut s, settings.duration, &mut observe);
+    let energy_growth = e_half.filter(|h| *h > 0.0).map(|_| growth);
     let cuts = dynamics.log.iter().filter(|l| l.contains("cut to")).count();
     if let Err(reason) = result {
         let mut f = failed(name, reason, stabs.len());
         f.step_cuts = cuts;
-        return f;
+        return (f, energy_growth);
     }
-    observer.finish(case, name, model, &s, &dynamics.log, &dynamics.iterations)
+    (
+        observer.finish(case, name, model, &s, &dynamics.log, &dynamics.iterations),
+        energy_growth,
+    )
 }
 
 /// The quantities of interest of a dynamic run, accumulated step by step (the CPU

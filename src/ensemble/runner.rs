@@ -100,9 +100,10 @@ pub fn run_dynamic_gpu<T: crate::gpu::contact::GpuReal>(
     if let Some(why) = unsupported_model(&models) {
         return Ok(Err(why));
     }
-    if settings.initial_lateral_velocity != 0.0 {
+    if settings.initial_lateral_velocity != 0.0 || settings.initial_lateral_offset != 0.0 {
         return Ok(Err(
-            "an initial lateral velocity runs on the CPU integrator (the engine starts at rest)"
+            "an initial lateral velocity or offset runs on the CPU integrator (the engine \
+             starts at rest from the static equilibrium)"
                 .into(),
         ));
     }
