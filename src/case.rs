@@ -407,9 +407,8 @@ impl Case {
             for i in (0..n).filter(|&i| in_bha(i)) {
                 let s = (bit_md - model.nodes[i].md) / bha;
                 let w = d.initial_lateral_offset * (std::f64::consts::PI * s).sin();
-                let a = lateral(i);
-                for k in 0..3 {
-                    q.x[i][k] += w * a[k];
+                for (x, a) in q.x[i].iter_mut().zip(lateral(i)) {
+                    *x += w * a;
                 }
             }
         }

@@ -205,10 +205,8 @@ impl<T: Real> LocalDeformation<T> {
     /// (`θ̄_i − θ̄⁰_i`; a kink's [`kink_rest_rotation`]): what the energy and the section
     /// forces see.
     pub fn minus_rest(mut self, rest: &[[f64; 3]; 2]) -> Self {
-        for k in 0..3 {
-            self.theta1[k] = self.theta1[k] - T::from_f64_lossy(rest[0][k]);
-            self.theta2[k] = self.theta2[k] - T::from_f64_lossy(rest[1][k]);
-        }
+        self.theta1 = std::array::from_fn(|k| self.theta1[k] - T::from_f64_lossy(rest[0][k]));
+        self.theta2 = std::array::from_fn(|k| self.theta2[k] - T::from_f64_lossy(rest[1][k]));
         self
     }
 }
