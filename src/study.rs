@@ -365,8 +365,8 @@ pub struct StabilityCell {
     pub seconds: f64,
     /// A non-finite state or residual.
     pub nan: bool,
-    /// Dynamic cells: growth of the energy of motion over the second half,
-    /// `max E(t)/E(t½) − 1` (kinetic plus strain energy above the static start's;
+    /// Dynamic cells: growth of the lateral kinetic energy, the second half's peak over the
+    /// first half's minus 1 (≫ 0: blowing up; ≈ 0 steady; < 0 decaying;
     /// `crate::ensemble::qoi::dynamic_variant_tracked`). Empty for static cells.
     pub energy_growth: Option<f64>,
     /// Why it failed or was cut.
