@@ -26,7 +26,7 @@ fn pow_pos(x: f32, m: f32) -> f32 {
 @group(0) @binding(2) var<storage, read> pair_params: array<real>;
 // d (3) = x − x0, v (3), omega.
 @group(0) @binding(3) var<storage, read> pair_state: array<real>;
-// g (6), K (6×3 row-major), C (6×3), c_omega (6).
+// g (6), K (6×3 row-major), and in dynamics C (6×3), c_omega (6): OUT_FIELDS fields.
 @group(0) @binding(4) var<storage, read_write> out_values: array<real>;
 // 1 where delta > 0.
 @group(0) @binding(5) var<storage, read_write> out_contact: array<u32>;
@@ -49,9 +49,17 @@ fn put3(field: u32, i: u32, x: vec3<real>) {
     put(field + 2u, i, x.z);
 }
 
+// Output fields of the scene: g (6), K (18) and, in dynamics, C (18), c_omega (6). A
+// static scene's buffer holds only the first 24 (src/kernels/contact.rs `output_fields`).
+#if DYNAMIC
+const OUT_FIELDS: u32 = 48u;
+#else
+const OUT_FIELDS: u32 = 24u;
+#endif
+
 // Zero outputs (no contact, or no force). Every output is written exactly once per pair.
 fn clear(i: u32) {
-    for (var k = 0u; k < 48u; k = k + 1u) {
+    for (var k = 0u; k < OUT_FIELDS; k = k + 1u) {
         put(k, i, real(0.0));
     }
 }
@@ -252,9 +260,5 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     put3(42u, i, vec3<real>(real(0.0)));
     put3(45u, i, vec3<real>(real(0.0)));
 #endif
-#else
-    for (var k = 24u; k < 48u; k = k + 1u) {
-        put(k, i, real(0.0));
-    }
 #endif
 }

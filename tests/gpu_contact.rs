@@ -354,3 +354,37 @@ fn batches_larger_than_one_binding_are_chunked_and_exact() {
     let whole = contact_gpu(ctx, &terms, &batch).unwrap();
     assert_eq!(chunked, whole);
 }
+
+/// A static scene's kernel writes `g` and `K` only and its output buffers hold just those
+/// 24 of the 48 fields (no memory for the damping matrices it never uses), chunked or not;
+/// read back, the missing fields are zero and everything equals the CPU twin's.
+#[test]
+fn static_scenes_allocate_no_damping_outputs() {
+    let Some(ctx) = common::gpu() else { return };
+    let batch = random_batch(5, 9, 13, FrictionModel::Split);
+    let p = batch.num_pairs();
+    for (mode, fields) in [(ContactMode::Static, 24), (ContactMode::Dynamic, 48)] {
+        let terms = ContactTerms::all(FrictionModel::Split, mode);
+        assert_eq!(holewall::kernels::contact::output_fields(&terms), fields);
+        for limit in [usize::MAX, 10] {
+            let run =
+                holewall::gpu::contact::GpuContactRun::with_chunk_limit(ctx, &terms, &batch, limit)
+                    .unwrap();
+            assert_eq!(run.output_bytes(), (fields * p * 8) as u64, "{mode:?}");
+            run.dispatch().unwrap();
+            let gpu = run.read().unwrap();
+            let mut twin = ContactOutputs::new(p);
+            contact(&terms, &batch, &mut twin);
+            assert_eq!(gpu.contact, twin.contact);
+            for i in 0..p {
+                let (g, t) = (gpu.fields(i), twin.fields(i));
+                if mode == ContactMode::Static {
+                    assert!(t[24..].iter().all(|x| *x == 0.0), "twin's static C is zero");
+                    assert!(g[24..].iter().all(|x| *x == 0.0));
+                }
+                let e = quantity_errors(&g, &t);
+                assert!(e.iter().all(|x| *x <= 1e-12), "{mode:?} pair {i}: {e:?}");
+            }
+        }
+    }
+}

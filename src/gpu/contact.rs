@@ -11,7 +11,7 @@ use crate::error::GpuError;
 use crate::gpu::compose::compose;
 use crate::gpu::layout::ContactDims;
 use crate::gpu::GpuContext;
-use crate::kernels::contact::{ContactBatch, ContactOutputs, OUTPUT_LEN, STATE_LEN};
+use crate::kernels::contact::{output_fields, ContactBatch, ContactOutputs, STATE_LEN};
 use crate::physics::contact::{ContactMode, ContactTerms, FrictionModel, SpringLaw, PARAMS_LEN};
 use crate::physics::Real;
 
@@ -100,6 +100,8 @@ pub struct GpuContactRun<T: GpuReal> {
     pipeline: Arc<wgpu::ComputePipeline>,
     chunks: Vec<Chunk>,
     num_pairs: usize,
+    /// Output fields the kernel writes ([`output_fields`]).
+    fields: usize,
     _real: PhantomData<T>,
 }
 
@@ -133,7 +135,8 @@ impl<T: GpuReal> GpuContactRun<T> {
         let size = std::mem::size_of::<T>();
         let max_binding = ctx.max_binding_bytes() as usize;
         let max_groups = ctx.limits.max_compute_workgroups_per_dimension as usize;
-        let cap = (max_binding / (OUTPUT_LEN * size))
+        let fields = output_fields(terms);
+        let cap = (max_binding / (fields * size))
             .min(max_groups * WORKGROUP)
             .min(max_chunk_pairs)
             .max(1);
@@ -175,7 +178,7 @@ impl<T: GpuReal> GpuContactRun<T> {
             };
             let params = storage("pair_params", &gather(&batch.pair_params, PARAMS_LEN));
             let state = storage("pair_state", &gather(&batch.pair_state, STATE_LEN));
-            let values_bytes = bytes_of_len::<T>(OUTPUT_LEN * len);
+            let values_bytes = bytes_of_len::<T>(fields * len);
             let contact_bytes = bytes_of_len::<u32>(len);
             let values = device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("out_values"),
@@ -253,8 +256,18 @@ impl<T: GpuReal> GpuContactRun<T> {
             pipeline,
             chunks,
             num_pairs,
+            fields,
             _real: PhantomData,
         })
+    }
+
+    /// Bytes of the output buffers on the device (every chunk): `fields × pairs × size`,
+    /// with [`output_fields`] of the scene — half for a static scene.
+    pub fn output_bytes(&self) -> u64 {
+        self.chunks
+            .iter()
+            .map(|c| bytes_of_len::<T>(self.fields * c.len))
+            .sum()
     }
 
     /// Number of chunks the batch was split into.
@@ -309,7 +322,8 @@ impl<T: GpuReal> GpuContactRun<T> {
             .map_err(|e| GpuError::Device(e.to_string()))
     }
 
-    /// Copies the results back into the CPU twin's layout.
+    /// Copies the results back into the CPU twin's layout (the fields a static scene does
+    /// not write are zero there).
     pub fn read(&self) -> Result<ContactOutputs<T>, GpuError> {
         let p = self.num_pairs;
         let mut out = ContactOutputs::new(p);
@@ -320,7 +334,7 @@ impl<T: GpuReal> GpuContactRun<T> {
                 label: Some("contact_read"),
             });
         for chunk in &self.chunks {
-            let values_bytes = bytes_of_len::<T>(OUTPUT_LEN * chunk.len);
+            let values_bytes = bytes_of_len::<T>(self.fields * chunk.len);
             encoder.copy_buffer_to_buffer(&chunk.values, 0, &chunk.staging, 0, values_bytes);
             encoder.copy_buffer_to_buffer(
                 &chunk.contact,
@@ -339,7 +353,7 @@ impl<T: GpuReal> GpuContactRun<T> {
         }
         self.wait()?;
         for chunk in &self.chunks {
-            let values_bytes = bytes_of_len::<T>(OUTPUT_LEN * chunk.len) as usize;
+            let values_bytes = bytes_of_len::<T>(self.fields * chunk.len) as usize;
             {
                 let view = chunk
                     .staging
@@ -348,7 +362,8 @@ impl<T: GpuReal> GpuContactRun<T> {
                     .map_err(|e| GpuError::Device(format!("map: {e}")))?;
                 let values: &[T] = bytemuck::cast_slice(&view[..values_bytes]);
                 let flags: &[u32] = bytemuck::cast_slice(&view[values_bytes..]);
-                for k in 0..OUTPUT_LEN {
+                // Fields a static scene leaves out stay zero, as the twin's.
+                for k in 0..self.fields {
                     out.values[k * p + chunk.offset..k * p + chunk.offset + chunk.len]
                         .copy_from_slice(&values[k * chunk.len..(k + 1) * chunk.len]);
                 }

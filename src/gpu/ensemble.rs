@@ -31,9 +31,11 @@ const RUNNING: u32 = 2;
 
 /// Bytes per variant of every buffer of a chunk, for a chain of `n` nodes with `s` sites
 /// at `size`-byte floats: two configurations and two assembled systems, the base and its
-/// chords, element forces and tangents, contact inputs and outputs, loads, the
-/// factorisation workspace, the step, and the per-variant scalars. (The shared tables —
-/// translation bases, sections, frames — are per chunk.)
+/// chords, element forces and tangents, contact inputs and outputs (all
+/// [`OUTPUT_LEN`] fields: the dynamic engine's; a static chunk holds
+/// [`crate::kernels::contact::output_fields`]), loads, the factorisation workspace, the
+/// step, and the per-variant scalars. (The shared tables — translation bases, sections,
+/// frames — are per chunk.)
 pub fn bytes_per_variant(n: usize, s: usize, size: usize) -> usize {
     let m = n.saturating_sub(1);
     let reals = 2 * 12 * n            // x, rot: two slots
@@ -388,7 +390,11 @@ impl Common {
             f_ext: given("f_ext", f_ext, 6 * n * v),
             elem_force: empty(ctx, "elem_force", 12 * m * v * size),
             elem_tangent: empty(ctx, "elem_tangent", 144 * m * v * size),
-            values: empty(ctx, "contact_values", OUTPUT_LEN * p * size),
+            values: empty(
+                ctx,
+                "contact_values",
+                crate::kernels::contact::output_fields(&tables.terms) * p * size,
+            ),
             flags: empty(ctx, "contact_flags", 4 * p),
             work_x: empty(ctx, "lu_work", 36 * m.max(1) * v * size),
             work_z: empty(ctx, "lu_work_z", 6 * n * v * size),

@@ -25,6 +25,18 @@ pub const OUT_C: usize = 24;
 /// Offset of `c_omega`.
 pub const OUT_C_OMEGA: usize = 42;
 
+/// The output fields a scene's kernel writes and its buffers hold: all [`OUTPUT_LEN`] in
+/// dynamics, only `g` and `K` (the first [`OUT_C`]) in statics — the damping matrices `C`
+/// and `c_omega` of a static scene are zero and never read, so no memory is allocated for
+/// them (`shaders/contact.wgsl` `OUT_FIELDS`). The layout `[field · P + i]` is the same
+/// either way.
+pub fn output_fields(terms: &ContactTerms) -> usize {
+    match terms.mode {
+        ContactMode::Dynamic => OUTPUT_LEN,
+        ContactMode::Static => OUT_C,
+    }
+}
+
 /// Inputs of one contact evaluation over V variants × S sites.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ContactBatch<T> {
