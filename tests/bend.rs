@@ -211,3 +211,77 @@ fn a_rotating_bent_collar_whirls_forward_synchronously_with_the_kink_offset() {
     // Measured −1.0e-5.
     assert!((r0 / closed - 1.0).abs() < 1e-4, "{r0} vs {closed}");
 }
+
+/// The `bend` ensemble key on a case it was not built around (the two-stabilizer 45° well,
+/// a 1.5° bend in its 12 m collar, toolface 90°): 0 … 5° × two frictions all solve (with
+/// load-step cuts counted, never silently); on the GPU backend the engine cannot take a
+/// bend and the summary says so (`backend_note`), with the CPU's numbers; a case without a
+/// bend refuses the key.
+#[test]
+fn bend_ensembles_on_a_two_stabilizer_well() {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let text = std::fs::read_to_string(root.join("cases/stress_two_stabilizers.toml")).unwrap();
+    let text = text.replacen(
+        "length = \"12 m\"\nod = \"6.5 in\"\nid = \"2.8125 in\"",
+        "length = \"12 m\"\nod = \"6.5 in\"\nid = \"2.8125 in\"\nbend = \"1.5 deg\"\nbend_from_bottom = \"2 m\"\nbend_toolface = \"90 deg\"",
+        1,
+    );
+    assert!(text.contains("bend ="));
+    let base = &text[..text.find("[ensemble]").unwrap()];
+    let grid = "[ensemble]\nanalysis = \"static\"\n\n[ensemble.grid]\nbend = [0, 0.5, 1, 2, 3, 5]\nmu = [0.2, 0.5]\n";
+    let dir = std::env::temp_dir().join(format!("holewall-bend-ens-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let case = dir.join("bent.toml");
+    std::fs::write(&case, format!("{base}{grid}")).unwrap();
+    let run = |backend, out: &str| {
+        holewall::ensemble::job::run(
+            &case,
+            None,
+            backend,
+            holewall::backend::Precision::F64,
+            &dir.join(out),
+            false,
+            &Default::default(),
+        )
+        .unwrap()
+    };
+    let cpu = run(holewall::backend::BackendChoice::Cpu, "cpu");
+    eprintln!(
+        "bend ensemble: {} variants, {} converged, {} with step cuts, {} failed",
+        cpu.variants, cpu.converged, cpu.step_cut, cpu.failed
+    );
+    assert_eq!((cpu.variants, cpu.failed), (12, 0));
+    assert_eq!(cpu.converged + cpu.step_cut, 12);
+    assert!(cpu.backend_note.is_none());
+    let csv_cpu = std::fs::read_to_string(dir.join("cpu/variants.csv")).unwrap();
+    if common::gpu().is_some() {
+        let gpu = run(holewall::backend::BackendChoice::Gpu, "gpu");
+        assert_eq!(gpu.backend, "cpu");
+        let note = gpu.backend_note.unwrap();
+        assert!(note.contains("bent sub"), "{note}");
+        let csv_gpu = std::fs::read_to_string(dir.join("gpu/variants.csv")).unwrap();
+        assert_eq!(csv_cpu, csv_gpu);
+    }
+    // Without a bend in the case, the key is refused by name.
+    let plain = dir.join("plain.toml");
+    let straight = base.replace(
+        "bend = \"1.5 deg\"\nbend_from_bottom = \"2 m\"\nbend_toolface = \"90 deg\"\n",
+        "",
+    );
+    std::fs::write(&plain, format!("{straight}{grid}")).unwrap();
+    let s = holewall::ensemble::job::run(
+        &plain,
+        None,
+        holewall::backend::BackendChoice::Cpu,
+        holewall::backend::Precision::F64,
+        &dir.join("plain"),
+        false,
+        &Default::default(),
+    );
+    let message = match s {
+        Err(e) => e.to_string(),
+        Ok(s) => format!("{:?}", s.failures),
+    };
+    assert!(message.contains("no bent sub"), "{message}");
+}

@@ -221,11 +221,13 @@ pub fn run(
         let start = std::time::Instant::now();
         let slice = &variants[chunk_of(c)];
         let before = bar.position();
-        let (results, backend_name) = compute(&case, analysis, slice, gpu, precision, &bar)?;
+        let (results, backend_name, backend_note) =
+            compute(&case, analysis, slice, gpu, precision, &bar)?;
         bar.set_position(before + slice.len() as u64);
         let chunk = Chunk {
             first: chunk_of(c).start,
             backend: backend_name.to_string(),
+            backend_note,
             seconds: start.elapsed().as_secs_f64(),
             results,
         };
@@ -239,6 +241,7 @@ pub fn run(
             title: case.title.clone(),
             analysis: format!("{analysis:?}").to_lowercase(),
             backend: format!("{backend:?}").to_lowercase(),
+            backend_note: None,
             precision: format!("{precision:?}").to_lowercase(),
             variants: in_range,
             converged: 0,
@@ -260,6 +263,7 @@ pub fn run(
     // Every chunk, read back (so a resumed or merged run has exactly these bits).
     let mut results = Vec::with_capacity(variants.len());
     let mut backend_name = "cpu";
+    let mut backend_notes: Vec<String> = Vec::new();
     let mut seconds = 0.0;
     for c in 0..nchunks {
         let chunk = read_chunk(&chunk_path(out, c))?;
@@ -274,6 +278,11 @@ pub fn run(
         }
         if chunk.backend == "gpu" {
             backend_name = "gpu";
+        }
+        if let Some(n) = chunk.backend_note {
+            if !backend_notes.contains(&n) {
+                backend_notes.push(n);
+            }
         }
         seconds += chunk.seconds;
         results.extend(chunk.results);
@@ -369,6 +378,7 @@ pub fn run(
         title: case.title.clone(),
         analysis: if dynamic { "dynamic" } else { "static" }.into(),
         backend: backend_name.into(),
+        backend_note: (!backend_notes.is_empty()).then(|| backend_notes.join("; ")),
         precision: if backend_name == "gpu" && precision == Precision::F32 {
             "f32"
         } else {

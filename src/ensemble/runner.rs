@@ -252,7 +252,8 @@ pub fn run_variants_cpu(
         .collect()
 }
 
-/// Runs `variants` on the GPU engine (`gpu`) or the CPU: their results, and where they ran.
+/// Runs `variants` on the GPU engine (`gpu`) or the CPU: their results, where they ran,
+/// and why on the CPU when the engine was chosen but could not take them.
 pub(crate) fn compute(
     case: &Case,
     analysis: Analysis,
@@ -260,8 +261,9 @@ pub(crate) fn compute(
     gpu: Option<&'static crate::gpu::GpuContext>,
     precision: Precision,
     bar: &indicatif::ProgressBar,
-) -> Result<(Vec<VariantResult>, &'static str), Error> {
+) -> Result<(Vec<VariantResult>, &'static str, Option<String>), Error> {
     let mut backend_name = "cpu";
+    let mut note = None;
     let results = match (gpu, analysis) {
         (Some(ctx), Analysis::Static) => match if precision == Precision::F32 {
             run_static_gpu::<f32>(case, variants, ctx, bar)?
@@ -274,6 +276,7 @@ pub(crate) fn compute(
             }
             Err(why) => {
                 eprintln!("holewall: {why}; running the variants on the CPU");
+                note = Some(format!("{why}: run on the CPU"));
                 run_variants_cpu(case, analysis, variants, bar)
             }
         },
@@ -297,6 +300,7 @@ pub(crate) fn compute(
                     .into());
                 }
                 eprintln!("holewall: {why}; running the variants on the CPU");
+                note = Some(format!("{why}: run on the CPU"));
                 run_variants_cpu(case, analysis, variants, bar)
             }
         },
@@ -314,7 +318,7 @@ pub(crate) fn compute(
             );
         }
     }
-    Ok((results, backend_name))
+    Ok((results, backend_name, note))
 }
 
 /// Whether a variant's model shares the case's mesh and number of contact sites (what the

@@ -108,6 +108,9 @@ pub(crate) struct Chunk {
     pub(crate) first: usize,
     /// Where it ran.
     pub(crate) backend: String,
+    /// Why it ran on the CPU when the GPU engine was chosen (none otherwise).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub(crate) backend_note: Option<String>,
     /// Wall time (s).
     pub(crate) seconds: f64,
     /// Results in variant order.
