@@ -150,8 +150,9 @@ pub fn orbit_plot(
     atomic_png(path, |tmp| {
         let root = BitMapBackend::new(tmp, (760, 760)).into_drawing_area();
         root.fill(&WHITE)?;
+        let caption = fitted_caption(&root, title, 20);
         let mut chart = ChartBuilder::on(&root)
-            .caption(title, ("sans-serif", 20))
+            .caption(&caption.0, ("sans-serif", caption.1))
             .margin(12)
             .x_label_area_size(48)
             .y_label_area_size(70)
@@ -210,6 +211,30 @@ pub fn orbit_plot(
     })
 }
 
+/// A caption that fits the width of `root`: the preferred font size, smaller (to 11 px) for a
+/// long title, and cut with "…" if even that does not fit (a case's long title would
+/// otherwise run off both edges).
+fn fitted_caption<DB: DrawingBackend>(
+    root: &DrawingArea<DB, plotters::coord::Shift>,
+    title: &str,
+    preferred: u32,
+) -> (String, u32) {
+    // DejaVu Sans averages ≈ 0.55 em per character.
+    let width = root.dim_in_pixel().0 as f64 * 0.96;
+    let chars = title.chars().count().max(1) as f64;
+    let size = (width / (0.55 * chars))
+        .floor()
+        .min(preferred as f64)
+        .max(11.0) as u32;
+    let fits = (width / (0.55 * size as f64)) as usize;
+    if title.chars().count() <= fits {
+        (title.to_string(), size)
+    } else {
+        let cut: String = title.chars().take(fits.saturating_sub(1)).collect();
+        (format!("{cut}…"), size)
+    }
+}
+
 /// A cartesian chart on `root` with the house style: caption, label areas, engineering tick
 /// labels on both axes, the mesh drawn.
 type XyChart<'a, 'b> = ChartContext<
@@ -229,8 +254,9 @@ fn xy_chart<'a, 'b>(
     (x0, x1): (f64, f64),
     (y0, y1): (f64, f64),
 ) -> Result<XyChart<'a, 'b>, Box<dyn std::error::Error>> {
+    let caption = fitted_caption(root, title, caption_size);
     let mut chart = ChartBuilder::on(root)
-        .caption(title, ("sans-serif", caption_size))
+        .caption(&caption.0, ("sans-serif", caption.1))
         .margin(12)
         .x_label_area_size(48)
         .y_label_area_size(y_area)
@@ -315,8 +341,9 @@ pub fn histogram(
             counts[(((x - lo) / w) as usize).min(bins - 1)] += 1;
         }
         let top = counts.iter().copied().max().unwrap_or(1).max(1) as f64 * 1.1;
+        let caption = fitted_caption(&root, title, 24);
         let mut chart = ChartBuilder::on(&root)
-            .caption(title, ("sans-serif", 24))
+            .caption(&caption.0, ("sans-serif", caption.1))
             .margin(12)
             .x_label_area_size(48)
             .y_label_area_size(70)
@@ -399,8 +426,9 @@ pub fn tornado(
             BitMapBackend::new(tmp, (900, 120 + 50 * bars.len().max(1) as u32)).into_drawing_area();
         root.fill(&WHITE)?;
         let n = bars.len().max(1);
+        let caption = fitted_caption(&root, title, 22);
         let mut chart = ChartBuilder::on(&root)
-            .caption(title, ("sans-serif", 22))
+            .caption(&caption.0, ("sans-serif", caption.1))
             .margin(12)
             .x_label_area_size(44)
             .y_label_area_size(160)
@@ -460,8 +488,9 @@ pub fn convergence_plot(
     atomic_png(path, |tmp| {
         let root = BitMapBackend::new(tmp, (1000, 640)).into_drawing_area();
         root.fill(&WHITE)?;
+        let caption = fitted_caption(&root, title, 22);
         let mut chart = ChartBuilder::on(&root)
-            .caption(title, ("sans-serif", 22))
+            .caption(&caption.0, ("sans-serif", caption.1))
             .margin(12)
             .x_label_area_size(48)
             .y_label_area_size(80)
@@ -540,8 +569,9 @@ pub fn loglog_plot(
     atomic_png(path, |tmp| {
         let root = BitMapBackend::new(tmp, (1000, 680)).into_drawing_area();
         root.fill(&WHITE)?;
+        let caption = fitted_caption(&root, title, 20);
         let mut chart = ChartBuilder::on(&root)
-            .caption(title, ("sans-serif", 20))
+            .caption(&caption.0, ("sans-serif", caption.1))
             .margin(12)
             .x_label_area_size(48)
             .y_label_area_size(90)
