@@ -20,7 +20,7 @@ use crate::case::{load_case, Case};
 use crate::ensemble::qoi::{Status, VariantResult};
 use crate::ensemble::Variant;
 use crate::error::{Error, InputError};
-use crate::output::{write_atomic, RunFolder};
+use crate::output::RunFolder;
 
 /// Options of `holewall study precision`.
 #[derive(Clone, Copy, Debug)]
@@ -287,18 +287,13 @@ pub fn precision(
         .min_by(|a, b| a.seconds.total_cmp(&b.seconds))
         .cloned();
     let dir = folder.path();
-    let mut w = csv::Writer::from_writer(Vec::new());
-    for r in &runs {
-        w.serialize(PrecisionRow {
+    crate::output::write_csv_rows(
+        &dir.join("precision.csv"),
+        runs.iter().map(|r| PrecisionRow {
             errors: None,
             ..r.clone()
-        })
-        .map_err(|e| Error::Io(std::io::Error::other(e)))?;
-    }
-    let bytes = w
-        .into_inner()
-        .map_err(|e| Error::Io(std::io::Error::other(e.to_string())))?;
-    write_atomic(&dir.join("precision.csv"), &bytes)?;
+        }),
+    )?;
     let series: Vec<(String, Vec<(f64, f64)>)> = ["cpu-f64", "gpu-f64", "gpu-f32"]
         .iter()
         .map(|p| {
@@ -537,15 +532,7 @@ pub fn stability(
         .collect();
     bar.finish_and_clear();
     let dir = folder.path();
-    let mut w = csv::Writer::from_writer(Vec::new());
-    for c in &map {
-        w.serialize(c)
-            .map_err(|e| Error::Io(std::io::Error::other(e)))?;
-    }
-    let bytes = w
-        .into_inner()
-        .map_err(|e| Error::Io(std::io::Error::other(e.to_string())))?;
-    write_atomic(&dir.join("stability.csv"), &bytes)?;
+    crate::output::write_csv_rows(&dir.join("stability.csv"), &map)?;
     let tiles: Vec<crate::plots::Tile> = map
         .iter()
         .map(|c| crate::plots::Tile {

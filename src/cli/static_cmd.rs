@@ -8,7 +8,7 @@ use serde::Serialize;
 use crate::case::{load_case, Case};
 use crate::error::Error;
 use crate::model::Model;
-use crate::output::{write_atomic, RunFolder};
+use crate::output::RunFolder;
 use crate::physics::vec3::{dot, scale, sub};
 use crate::solve::statics::{solve_static_monitored, StaticOptions, StaticState};
 
@@ -327,15 +327,7 @@ pub fn run(
         solver_log,
     };
     let dir = folder.path();
-    let mut w = csv::Writer::from_writer(Vec::new());
-    for r in &rows {
-        w.serialize(r)
-            .map_err(|e| Error::Io(std::io::Error::other(e)))?;
-    }
-    let bytes = w
-        .into_inner()
-        .map_err(|e| Error::Io(std::io::Error::other(e.to_string())))?;
-    write_atomic(&dir.join("profile.csv"), &bytes)?;
+    crate::output::write_csv_rows(&dir.join("profile.csv"), &rows)?;
     write_plots(&case, which, &rows, np, dir)?;
     let json = serde_json::to_vec_pretty(&summary).map_err(std::io::Error::other)?;
     folder.finish(&json)?;

@@ -526,6 +526,10 @@ pub fn ensemble_tables_from<T: Real>(
     start: Option<(Vec<T>, Vec<T>)>,
 ) -> Result<EnsembleTables<T>, String> {
     check_same_mesh(models)?;
+    // The kernels' tables have no unstrained rotations: a kink cannot be represented.
+    if let Some(why) = unsupported_static(models) {
+        return Err(why);
+    }
     let t = |x: f64| T::from_f64_lossy(x);
     let base = &models[0];
     let (v, n, s_count) = (models.len(), base.nodes.len(), base.sites.len());

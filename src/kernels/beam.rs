@@ -17,9 +17,7 @@
 use rayon::prelude::*;
 
 use crate::model::Model;
-use crate::physics::beam::{
-    element_force, force_and_tangent_closed, Chord, ElementStiffness, Mat3,
-};
+use crate::physics::beam::{element_force, force_and_tangent_closed, Chord, Mat3};
 
 /// Per element: `EA/l0, GJ/l0, EI/l0, l0` (the kernel's `section` binding).
 pub fn section_table(model: &Model) -> Vec<f64> {
@@ -117,7 +115,9 @@ pub fn beam(
             let form = Chord::Positions {
                 length0: el.length0,
             };
-            let k = ElementStiffness::of(&el.section, el.length0);
+            // The model's element (with a kink's rest rotations: the twin is exact for a bent
+            // string, though the GPU kernel and so the engine take none).
+            let k = model.element_stiffness(e);
             if tangent {
                 force_and_tangent_closed(&x, &t, &form, &k)
             } else {
