@@ -23,6 +23,9 @@
 // (Chord::Base) the elongation is s + (2 c·Δw + Δw·Δw)/(l + |c|), without the cancellation
 // of l − l0 (a strain of 1e-5 would keep two digits) and without the metres the base has
 // moved.
+//
+// Built with KINK the moments act on the rotations from each element's unstrained ones
+// (a bent sub: physics::beam::ElementStiffness::rest), read per (element, variant).
 #include "shared/layout.wgsl"
 
 @group(0) @binding(0) var<storage, read> dims: BeamDims;
@@ -36,9 +39,20 @@
 // Base chord and stretch per element and variant: [(4 e + k) V + v], k = 0–2 the chord,
 // 3 the stretch |c| − l0.
 @group(0) @binding(5) var<storage, read> chord: array<real>;
+#if KINK
+// Unstrained rotations per element and variant (a bent sub's kink; zero elsewhere):
+// [(6 e + k) V + v], k = 0–2 θ̄⁰₁, 3–5 θ̄⁰₂ (kernels::beam::rest_table). Built only for a
+// scene with a kink.
+@group(0) @binding(6) var<storage, read> rest: array<real>;
+@group(0) @binding(7) var<storage, read_write> elem_force: array<real>;
+#if !FORCE_ONLY
+@group(0) @binding(8) var<storage, read_write> elem_tangent: array<real>;
+#endif
+#else
 @group(0) @binding(6) var<storage, read_write> elem_force: array<real>;
 #if !FORCE_ONLY
 @group(0) @binding(7) var<storage, read_write> elem_tangent: array<real>;
+#endif
 #endif
 
 // A dual number (value, derivative) and a dual 3-vector.
@@ -204,7 +218,8 @@ fn jt(l: LogJ, m: DV) -> DV {
 }
 
 // The force (12, as dual numbers) of the element with chord d, elongation u and triads t1,
-// t2; stiffness k = (EA/l0, GJ/l0, EI/l0).
+// t2; stiffness k = (EA/l0, GJ/l0, EI/l0); unstrained rotations r1, r2 (the moments act on
+// θ̄ − θ̄⁰: constants, so the derivative parts are θ̄'s).
 struct Force {
     x1: DV,
     t1: DV,
@@ -212,7 +227,7 @@ struct Force {
     t2: DV,
 }
 
-fn element_force(d: DV, u: dl, t1: Triad, t2: Triad, k: vec3<real>) -> Force {
+fn element_force(d: DV, u: dl, t1: Triad, t2: Triad, k: vec3<real>, r1: vec3<real>, r2: vec3<real>) -> Force {
     let half = dc(real(0.5));
     let l = vnorm(d);
     let e1 = vdivs(d, l);
@@ -224,13 +239,15 @@ fn element_force(d: DV, u: dl, t1: Triad, t2: Triad, k: vec3<real>) -> Force {
     let eta = ddiv(vdot(p, e1), n);
     let l1 = rel_log(e1, e2, e3, t1);
     let l2 = rel_log(e1, e2, e3, t2);
-    let twist = dmul(dc(k.y), dl(l2.th.v.x - l1.th.v.x, l2.th.d.x - l1.th.d.x));
+    let s1 = l1.th.v - r1;
+    let s2 = l2.th.v - r2;
+    let twist = dmul(dc(k.y), dl(s2.x - s1.x, l2.th.d.x - l1.th.d.x));
     let four = dc(real(4.0) * k.z);
     let two = dc(real(2.0) * k.z);
-    let t1y = dl(l1.th.v.y, l1.th.d.y);
-    let t1z = dl(l1.th.v.z, l1.th.d.z);
-    let t2y = dl(l2.th.v.y, l2.th.d.y);
-    let t2z = dl(l2.th.v.z, l2.th.d.z);
+    let t1y = dl(s1.y, l1.th.d.y);
+    let t1z = dl(s1.z, l1.th.d.z);
+    let t2y = dl(s2.y, l2.th.d.y);
+    let t2z = dl(s2.z, l2.th.d.z);
     let m1y = dmul(four, t1y) + dmul(two, t2y);
     let m1z = dmul(four, t1z) + dmul(two, t2z);
     let m2y = dmul(four, t2y) + dmul(two, t1y);
@@ -277,6 +294,13 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let stretch = chord[(4u * e + 3u) * nv + v];
     let k = vec3<real>(section[4u * e], section[4u * e + 1u], section[4u * e + 2u]);
     let l0 = section[4u * e + 3u];
+#if KINK
+    let r1 = vec3<real>(rest[(6u * e) * nv + v], rest[(6u * e + 1u) * nv + v], rest[(6u * e + 2u) * nv + v]);
+    let r2 = vec3<real>(rest[(6u * e + 3u) * nv + v], rest[(6u * e + 4u) * nv + v], rest[(6u * e + 5u) * nv + v]);
+#else
+    let r1 = vec3<real>(real(0.0));
+    let r2 = r1;
+#endif
     var w: array<vec3<real>, 2>;
     var tri: array<Triad, 2>;
     for (var node = 0u; node < 2u; node = node + 1u) {
@@ -333,7 +357,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         let num = dmul(dc(real(2.0)), vdot(bd, dwd)) + vdot(dwd, dwd);
         let u = dc(stretch) + ddiv(num, vnorm(d) + dc(lc));
 #endif
-        let f = element_force(d, u, spun(tri[0], spin[0]), spun(tri[1], spin[1]), k);
+        let f = element_force(d, u, spun(tri[0], spin[0]), spun(tri[1], spin[1]), k, r1, r2);
         let out = array<DV, 4>(f.x1, f.t1, f.x2, f.t2);
         for (var j = 0u; j < 12u; j = j + 1u) {
             let part = out[j / 3u];

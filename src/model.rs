@@ -349,16 +349,32 @@ impl Model {
     }
 
     /// Element `i`'s stiffnesses and unstrained rotations (a kink at its lower node, if
-    /// any): what every element evaluation uses.
+    /// any): what every CPU element evaluation uses.
     pub fn element_stiffness(&self, i: usize) -> crate::physics::beam::ElementStiffness<f64> {
         let e = &self.elements[i];
         let k = crate::physics::beam::ElementStiffness::of(&e.section, e.length0);
-        match self.bends.iter().find(|b| b.node == i + 1) {
-            Some(b) => k.with_rest(crate::physics::beam::kink_rest_rotation(
-                b.angle, b.toolface, e.length0,
-            )),
+        match self.kinks(1.0).into_iter().find(|(el, _)| *el == i) {
+            Some((_, rest)) => k.with_rest(rest),
             None => k,
         }
+    }
+
+    /// The kinked elements and their unstrained rotations, the bends' angles scaled by
+    /// `scale` (the static load factor; 1: in full): the one place a [`Bend`] becomes an
+    /// element's rest state, for the CPU solvers and the kernels' `rest` table alike.
+    pub fn kinks(&self, scale: f64) -> Vec<(usize, [[f64; 3]; 2])> {
+        self.bends
+            .iter()
+            .map(|b| {
+                let e = b.node - 1;
+                let rest = crate::physics::beam::kink_rest_rotation(
+                    scale * b.angle,
+                    b.toolface,
+                    self.elements[e].length0,
+                );
+                (e, rest)
+            })
+            .collect()
     }
 
     /// The unstrained nodal rotations of element `i` (zero but at a kink).

@@ -116,12 +116,12 @@ pub fn unsupported(options: &DynamicOptions) -> Option<String> {
     None
 }
 
-/// What of the models only the CPU solvers have (a mass imbalance, a bent sub), if any.
+/// What of the models only the CPU integrator has (a mass imbalance), if any.
 pub fn unsupported_model(models: &[Model]) -> Option<String> {
-    if models.iter().any(Model::has_unbalance) {
-        return Some("a mass imbalance runs on the CPU integrator".into());
-    }
-    crate::engine::unsupported_static(models)
+    models
+        .iter()
+        .any(Model::has_unbalance)
+        .then(|| "a mass imbalance runs on the CPU integrator".into())
 }
 
 /// A chunk's start: its tables, each variant's force scale, and what moves the top.

@@ -76,6 +76,11 @@ pub struct EnsembleTables<T> {
     /// Base chords and stretches per element and variant, `4 (n − 1) V`
     /// ([`crate::kernels::beam::base_chords`] of `base`).
     pub chords: Vec<T>,
+    /// Unstrained rotations per element and variant, `6 (n − 1) V`
+    /// ([`crate::kernels::beam::rest_table`]: the kinks of bent subs, in full; the static
+    /// engine scales each variant's with its load factor). Empty without a kink (the beam
+    /// kernel is then built without it).
+    pub rest: Vec<T>,
     /// Contact terms the scene uses (the contact kernel is compiled for these only).
     pub terms: ContactTerms,
 }
@@ -102,9 +107,10 @@ impl<T: Real> EnsembleTables<T> {
 /// A chunk of variants held by a kernel path: a current configuration with its assembled
 /// system, a step `Δ`, and one trial configuration.
 pub trait Ensemble<T> {
-    /// Sets the external loads (`6 n V`) and the pairs' law parameters (`PARAMS_LEN · P`,
-    /// field-major) of a load step.
-    fn set_loads(&mut self, f_ext: &[T], pair_params: &[T]) -> Result<(), String>;
+    /// Sets the external loads (`6 n V`), the pairs' law parameters (`PARAMS_LEN · P`,
+    /// field-major) and the elements' unstrained rotations (`6 (n − 1) V`, empty without a
+    /// kink) of a load step.
+    fn set_loads(&mut self, f_ext: &[T], pair_params: &[T], rest: &[T]) -> Result<(), String>;
     /// Residual and constrained tangent at the current configuration.
     fn evaluate(&mut self) -> Result<(), String>;
     /// Solves the current system for `Δ`; the norms of its residual and `Δ` (α = 1) and
@@ -220,7 +226,7 @@ pub(crate) fn twin_evaluate(
             Stage::Predict => {}
             Stage::Beam => {
                 elements = Some(crate::kernels::beam::beam(
-                    model, v, x, rot, &t.chords, tangent,
+                    model, v, x, rot, &t.chords, &t.rest, tangent,
                 ))
             }
             Stage::Sites => match &dynamic {
@@ -336,8 +342,14 @@ impl TwinEnsemble<'_> {
 }
 
 impl Ensemble<f64> for TwinEnsemble<'_> {
-    fn set_loads(&mut self, f_ext: &[f64], pair_params: &[f64]) -> Result<(), String> {
+    fn set_loads(
+        &mut self,
+        f_ext: &[f64],
+        pair_params: &[f64],
+        rest: &[f64],
+    ) -> Result<(), String> {
         self.f_ext = f_ext.to_vec();
+        self.tables.rest = rest.to_vec();
         self.contact.pair_params = pair_params.to_vec();
         self.system = [None, None];
         self.refresh_walls();
@@ -526,10 +538,6 @@ pub fn ensemble_tables_from<T: Real>(
     start: Option<(Vec<T>, Vec<T>)>,
 ) -> Result<EnsembleTables<T>, String> {
     check_same_mesh(models)?;
-    // The kernels' tables have no unstrained rotations: a kink cannot be represented.
-    if let Some(why) = unsupported_static(models) {
-        return Err(why);
-    }
     let t = |x: f64| T::from_f64_lossy(x);
     let base = &models[0];
     let (v, n, s_count) = (models.len(), base.nodes.len(), base.sites.len());
@@ -603,6 +611,10 @@ pub fn ensemble_tables_from<T: Real>(
         base: Vec::new(),
         pair_base: Vec::new(),
         chords: Vec::new(),
+        rest: crate::kernels::beam::rest_table(models, &|_| 1.0)
+            .into_iter()
+            .map(|x| T::from_f64_lossy(x))
+            .collect(),
         terms,
     };
     // The static solve starts from the reference as base.
@@ -870,7 +882,8 @@ impl<'a, T: Real> EngineStatic<'a, T> {
             }
         }
         if self.loads_changed {
-            self.ensemble.set_loads(&self.f_ext, &self.params)?;
+            self.ensemble
+                .set_loads(&self.f_ext, &self.params, &self.tables.rest)?;
             self.loads_changed = false;
             self.evaluated = false;
         }
@@ -957,6 +970,16 @@ impl<T: Real> StaticSystem for EngineStatic<'_, T> {
                 self.params[f * p + k * v + j] = T::from_f64_lossy(x);
             }
         }
+        // Kinks grow with the bit loads, as in `loaded_model` (the CPU solve's).
+        if !self.tables.rest.is_empty() {
+            crate::kernels::beam::set_rest_column(
+                &mut self.tables.rest,
+                v,
+                j,
+                self.models[j],
+                target.lambda,
+            );
+        }
         self.loads_changed = true;
         Ok(())
     }
@@ -1017,11 +1040,3 @@ impl<T, P: KernelPath<T>> KernelPath<T> for Chunked<P> {
 }
 
 pub mod dynamic;
-/// What of the models only the CPU static solver has (a bent sub or bent housing: the
-/// beam kernel has no unstrained rotations), if any.
-pub fn unsupported_static(models: &[crate::model::Model]) -> Option<String> {
-    models
-        .iter()
-        .any(|m| !m.bends.is_empty())
-        .then(|| "a bent sub or bent housing runs on the CPU solvers".into())
-}

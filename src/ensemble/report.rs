@@ -21,7 +21,7 @@ pub struct EnsembleSummary {
     /// Where it ran.
     pub backend: String,
     /// Why variants ran on the CPU although the GPU engine was chosen (the case needs what
-    /// only the CPU solvers have, or the variants' meshes differ); absent otherwise.
+    /// only the CPU integrator has, or the variants' meshes differ); absent otherwise.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub backend_note: Option<String>,
     /// Float type of the engine (`f64`, or `f32` on the GPU); failed f32 variants re-run

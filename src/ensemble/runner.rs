@@ -35,9 +35,6 @@ pub fn run_static_gpu<T: crate::gpu::contact::GpuReal>(
             "the variants differ in their mesh or number of contact sites".into(),
         ));
     }
-    if let Some(why) = crate::engine::unsupported_static(&models) {
-        return Ok(Err(why));
-    }
     let results = solve_static_ensemble_with_progress::<T, _>(
         &models,
         &GpuPath(ctx),

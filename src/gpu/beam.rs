@@ -12,9 +12,13 @@ use crate::kernels::beam::{frame_table, section_table};
 use crate::model::Model;
 
 /// The WGSL text of the beam kernel at a precision: force and tangent, or (`force_only`)
-/// the force alone, without the tangent binding (7).
-pub fn beam_wgsl(f64: bool, force_only: bool) -> Result<String, GpuError> {
+/// the force alone, without the tangent binding; with `kink` the unstrained-rotation
+/// binding (6) before the outputs (a scene with a bent sub; none otherwise).
+pub fn beam_wgsl(f64: bool, force_only: bool, kink: bool) -> Result<String, GpuError> {
     let mut flags = BTreeSet::new();
+    if kink {
+        flags.insert("KINK");
+    }
     if f64 {
         flags.insert("F64");
     }
@@ -25,8 +29,10 @@ pub fn beam_wgsl(f64: bool, force_only: bool) -> Result<String, GpuError> {
 }
 
 /// Element forces and tangents of V variants on the GPU at displacements `u` from the base
-/// whose chords are `chords` ([`crate::kernels::beam::base_chords`]), laid out as the twin's;
-/// with `tangent` false the forces alone (an empty tangent).
+/// whose chords are `chords` ([`crate::kernels::beam::base_chords`]) and unstrained rotations
+/// `rest` ([`crate::kernels::beam::rest_table`], empty: none), laid out as the twin's; with
+/// `tangent` false the forces alone (an empty tangent).
+#[allow(clippy::too_many_arguments)]
 pub fn beam_gpu<T: GpuReal>(
     ctx: &'static GpuContext,
     model: &Model,
@@ -34,6 +40,7 @@ pub fn beam_gpu<T: GpuReal>(
     u: &[T],
     rot: &[T],
     chords: &[f64],
+    rest: &[f64],
     tangent: bool,
 ) -> Result<(Vec<T>, Vec<T>), GpuError> {
     crate::gpu::contact::require_precision::<T>(ctx)?;
@@ -44,11 +51,13 @@ pub fn beam_gpu<T: GpuReal>(
             "element tangents exceed one binding; split the variants".into(),
         ));
     }
-    let pipeline = ctx.pipeline("beam", &beam_wgsl(T::IS_F64, !tangent)?)?;
+    let kink = !rest.is_empty();
+    let pipeline = ctx.pipeline("beam", &beam_wgsl(T::IS_F64, !tangent, kink)?)?;
     let cast = |v: Vec<f64>| -> Vec<T> { v.into_iter().map(T::from_f64_lossy).collect() };
     let sections = cast(section_table(model));
     let frames = cast(frame_table(model));
     let chords = cast(chords.to_vec());
+    let rest = cast(rest.to_vec());
     let dims = BeamDims {
         num_variants: num_variants as u32,
         num_elements: ne as u32,
@@ -59,18 +68,20 @@ pub fn beam_gpu<T: GpuReal>(
         Out::Empty(12 * ne * num_variants * size),
         Out::Empty(144 * ne * num_variants * size),
     ];
+    let inputs: [&[u8]; 6] = [
+        bytemuck::cast_slice(u),
+        bytemuck::cast_slice(rot),
+        bytemuck::cast_slice(&frames),
+        bytemuck::cast_slice(&sections),
+        bytemuck::cast_slice(&chords),
+        bytemuck::cast_slice(&rest),
+    ];
     let out = run_once(
         ctx,
         &pipeline,
         "beam",
         bytemuck::bytes_of(&dims),
-        &[
-            bytemuck::cast_slice(u),
-            bytemuck::cast_slice(rot),
-            bytemuck::cast_slice(&frames),
-            bytemuck::cast_slice(&sections),
-            bytemuck::cast_slice(&chords),
-        ],
+        &inputs[..5 + usize::from(kink)],
         &outputs[..1 + usize::from(tangent)],
         ne * num_variants,
     )?;

@@ -200,6 +200,8 @@ struct Common {
     sections: wgpu::Buffer,
     frames: wgpu::Buffer,
     chords: wgpu::Buffer,
+    /// Unstrained rotations per element and variant (a scene with a kink only).
+    rest: Option<wgpu::Buffer>,
     /// The base at every pair across its hole axis, `3 P` (the sites kernel's `b`).
     pair_base: wgpu::Buffer,
     basis: wgpu::Buffer,
@@ -242,22 +244,20 @@ impl Common {
         rot: &wgpu::Buffer,
         force_only: bool,
     ) -> wgpu::BindGroup {
-        let all = [
+        let mut all = vec![
             &self.beam_dims,
             x,
             rot,
             &self.frames,
             &self.sections,
             &self.chords,
-            &self.elem_force,
-            &self.elem_tangent,
         ];
-        bind(
-            ctx,
-            pipeline,
-            "beam",
-            &all[..all.len() - usize::from(force_only)],
-        )
+        all.extend(&self.rest);
+        all.push(&self.elem_force);
+        if !force_only {
+            all.push(&self.elem_tangent);
+        }
+        bind(ctx, pipeline, "beam", &all)
     }
 
     /// The contact kernel's bind group.
@@ -379,6 +379,7 @@ impl Common {
             sections: table("sections", crate::kernels::beam::section_table(model)),
             frames: table("frames", crate::kernels::beam::frame_table(model)),
             chords: storage(ctx, "chords", &tables.chords),
+            rest: (!tables.rest.is_empty()).then(|| storage(ctx, "rest", &tables.rest)),
             pair_base: storage(ctx, "pair_base", &tables.pair_base),
             basis: storage(ctx, "basis", &tables.basis),
             fixed: storage(ctx, "fixed", &tables.fixed),
@@ -472,13 +473,15 @@ impl<T: GpuReal> GpuEnsemble<T> {
         tables: &EnsembleTables<T>,
     ) -> Result<Self, GpuError> {
         let f64 = T::IS_F64;
+        let kink = !tables.rest.is_empty();
         let (v, n) = (tables.num_variants, tables.num_nodes);
         let (m, p) = (n.saturating_sub(1), tables.pair_node.len());
         let size = std::mem::size_of::<T>();
         let c = Common::new(ctx, model, tables, None, None)?;
         let pipelines = Pipelines {
-            beam: ctx.pipeline("beam", &crate::gpu::beam::beam_wgsl(f64, false)?)?,
-            beam_force: ctx.pipeline("beam_force", &crate::gpu::beam::beam_wgsl(f64, true)?)?,
+            beam: ctx.pipeline("beam", &crate::gpu::beam::beam_wgsl(f64, false, kink)?)?,
+            beam_force: ctx
+                .pipeline("beam_force", &crate::gpu::beam::beam_wgsl(f64, true, kink)?)?,
             sites: ctx.pipeline("sites", &sites_wgsl(f64)?)?,
             contact: ctx.pipeline("contact", &contact_wgsl(&tables.terms, f64)?)?,
             assemble: ctx.pipeline("assemble", &crate::gpu::assemble::assemble_wgsl(f64)?)?,
@@ -705,9 +708,12 @@ pub fn sites_wgsl_for(dynamic: bool, f64: bool) -> Result<String, GpuError> {
 }
 
 impl<T: GpuReal> Ensemble<T> for GpuEnsemble<T> {
-    fn set_loads(&mut self, f_ext: &[T], pair_params: &[T]) -> Result<(), String> {
+    fn set_loads(&mut self, f_ext: &[T], pair_params: &[T], rest: &[T]) -> Result<(), String> {
         let q = &self.ctx.queue;
         q.write_buffer(&self.c.f_ext, 0, bytemuck::cast_slice(f_ext));
+        if let Some(b) = &self.c.rest {
+            q.write_buffer(b, 0, bytemuck::cast_slice(rest));
+        }
         if !pair_params.is_empty() {
             q.write_buffer(&self.c.params, 0, bytemuck::cast_slice(pair_params));
         }
@@ -958,6 +964,7 @@ impl<T: GpuReal> GpuDynamic<T> {
     ) -> Result<Self, GpuError> {
         use crate::gpu::dynamics::{dynamics_wgsl, DynamicsKernel};
         let f64 = T::IS_F64;
+        let kink = !tables.rest.is_empty();
         let (v, n) = (tables.num_variants, tables.num_nodes);
         let (m, p) = (n.saturating_sub(1), tables.pair_node.len());
         let size = std::mem::size_of::<T>();
@@ -975,8 +982,9 @@ impl<T: GpuReal> GpuDynamic<T> {
                 &dynamics_wgsl(DynamicsKernel::Accelerate, f64)?,
             )?,
             scale: ctx.pipeline("scale", &dynamics_wgsl(DynamicsKernel::Scale, f64)?)?,
-            beam: ctx.pipeline("beam", &crate::gpu::beam::beam_wgsl(f64, false)?)?,
-            beam_force: ctx.pipeline("beam_force", &crate::gpu::beam::beam_wgsl(f64, true)?)?,
+            beam: ctx.pipeline("beam", &crate::gpu::beam::beam_wgsl(f64, false, kink)?)?,
+            beam_force: ctx
+                .pipeline("beam_force", &crate::gpu::beam::beam_wgsl(f64, true, kink)?)?,
             sites: ctx.pipeline("sites", &sites_wgsl_for(true, f64)?)?,
             contact: ctx.pipeline("contact", &contact_wgsl(&tables.terms, f64)?)?,
             assemble: ctx.pipeline(

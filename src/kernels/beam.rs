@@ -17,7 +17,9 @@
 use rayon::prelude::*;
 
 use crate::model::Model;
-use crate::physics::beam::{element_force, force_and_tangent_closed, Chord, Mat3};
+use crate::physics::beam::{
+    element_force, force_and_tangent_closed, Chord, ElementStiffness, Mat3,
+};
 
 /// Per element: `EA/l0, GJ/l0, EI/l0, l0` (the kernel's `section` binding).
 pub fn section_table(model: &Model) -> Vec<f64> {
@@ -74,16 +76,54 @@ pub fn base_chords(model: &Model, base: &[f64], num_variants: usize) -> Vec<f64>
     out
 }
 
+/// Values per (element, variant) in [`rest_table`]: `θ̄⁰₁` and `θ̄⁰₂`.
+pub const REST_LEN: usize = 6;
+
+/// The kernel's `rest` binding, `[(6 e + k) V + v]`: element `e`'s unstrained rotations in
+/// variant `v` (`k` 0–2 at node 1, 3–5 at node 2; zero but at a kink), each model's kinks at
+/// `scale(v)` of their angle ([`Model::kinks`]). Empty when no model has a kink: the kernel
+/// is then built without the binding.
+pub fn rest_table(models: &[Model], scale: &dyn Fn(usize) -> f64) -> Vec<f64> {
+    if models.iter().all(|m| m.bends.is_empty()) {
+        return Vec::new();
+    }
+    let nv = models.len();
+    let ne = models[0].elements.len();
+    let mut out = vec![0.0; REST_LEN * ne * nv];
+    for (v, m) in models.iter().enumerate() {
+        set_rest_column(&mut out, nv, v, m, scale(v));
+    }
+    out
+}
+
+/// Writes variant `v`'s column of a [`rest_table`] of `nv` variants: `model`'s kinks at
+/// `scale` of their angle.
+pub fn set_rest_column<T: crate::physics::Real>(
+    table: &mut [T],
+    nv: usize,
+    v: usize,
+    model: &Model,
+    scale: f64,
+) {
+    for (e, rest) in model.kinks(scale) {
+        for k in 0..REST_LEN {
+            table[(REST_LEN * e + k) * nv + v] = T::from_f64_lossy(rest[k / 3][k % 3]);
+        }
+    }
+}
+
 /// Element forces and tangents of V variants (rayon over elements × variants) at
 /// displacements `u` from the base whose chords are `chords` ([`base_chords`]) and
-/// rotations `rot`; with `tangent` false the forces alone (the tangents returned are
-/// zeros, as the force-only kernel leaves its tangent binding out).
+/// rotations `rot`, with the unstrained rotations `rest` ([`rest_table`]; empty: none);
+/// with `tangent` false the forces alone (the tangents returned are zeros, as the
+/// force-only kernel leaves its tangent binding out).
 pub fn beam(
     model: &Model,
     num_variants: usize,
     u: &[f64],
     rot: &[f64],
     chords: &[f64],
+    rest: &[f64],
     tangent: bool,
 ) -> (Vec<f64>, Vec<f64>) {
     let nv = num_variants;
@@ -115,9 +155,12 @@ pub fn beam(
             let form = Chord::Positions {
                 length0: el.length0,
             };
-            // The model's element (with a kink's rest rotations: the twin is exact for a bent
-            // string, though the GPU kernel and so the engine take none).
-            let k = model.element_stiffness(e);
+            let mut k = ElementStiffness::of(&el.section, el.length0);
+            if !rest.is_empty() {
+                k.rest = std::array::from_fn(|node| {
+                    std::array::from_fn(|c| rest[(REST_LEN * e + 3 * node + c) * nv + v])
+                });
+            }
             if tangent {
                 force_and_tangent_closed(&x, &t, &form, &k)
             } else {
