@@ -5,6 +5,13 @@
 
 mod common;
 
+/// Starts at rest (no initial kick) from static equilibria, as the engine takes them.
+fn at_rest(
+    starts: &[holewall::solve::statics::StaticState],
+) -> Vec<holewall::engine::dynamic::DynamicStart> {
+    starts.iter().map(|q| (q.clone(), None)).collect()
+}
+
 use holewall::engine::dynamic::{run_dynamic_ensemble, DynamicStatus};
 use holewall::engine::{GpuPath, TwinPath};
 use holewall::ensemble::{apply, variants_from_csv_text};
@@ -128,7 +135,7 @@ fn dynamic_ensemble_matches_the_cpu_integrator_step_for_step() {
     let mut seen = Vec::new();
     let twin = run_dynamic_ensemble(
         &models,
-        &starts,
+        &at_rest(&starts),
         &case.element_density,
         &TwinPath,
         &options,
@@ -152,7 +159,7 @@ fn dynamic_ensemble_matches_the_cpu_integrator_step_for_step() {
         let mut seen_gpu = Vec::new();
         let gpu = run_dynamic_ensemble::<f64, _>(
             &models,
-            &starts,
+            &at_rest(&starts),
             &case.element_density,
             &GpuPath(ctx),
             &options,
@@ -172,7 +179,7 @@ fn dynamic_ensemble_matches_the_cpu_integrator_step_for_step() {
     let mut seen32 = Vec::new();
     let r32 = run_dynamic_ensemble::<f32, _>(
         &models,
-        &starts,
+        &at_rest(&starts),
         &case.element_density,
         &GpuPath(ctx),
         &options,
@@ -464,7 +471,7 @@ fn collect<P: holewall::engine::KernelPath<f64>>(
     let mut last = None;
     let status = run_dynamic_ensemble(
         models,
-        starts,
+        &at_rest(starts),
         density,
         path,
         options,
@@ -521,7 +528,7 @@ fn paper_case_sixteen_variants_match_the_cpu_integrator() {
             if f32_too {
                 run_dynamic_ensemble::<f32, _>(
                     &models,
-                    &starts,
+                    &at_rest(&starts),
                     &case.element_density,
                     &GpuPath(ctx),
                     &options,
@@ -533,7 +540,7 @@ fn paper_case_sixteen_variants_match_the_cpu_integrator() {
             } else {
                 run_dynamic_ensemble::<f64, _>(
                     &models,
-                    &starts,
+                    &at_rest(&starts),
                     &case.element_density,
                     &GpuPath(ctx),
                     &options,
@@ -546,7 +553,7 @@ fn paper_case_sixteen_variants_match_the_cpu_integrator() {
         } else {
             run_dynamic_ensemble(
                 &models,
-                &starts,
+                &at_rest(&starts),
                 &case.element_density,
                 &TwinPath,
                 &options,
@@ -662,7 +669,7 @@ fn a_variant_whose_step_fails_is_cut_on_its_own_in_the_engine() {
         let mut last = None;
         let r = run_dynamic_ensemble(
             &models,
-            &starts,
+            &at_rest(&starts),
             &density,
             &common::Counting::new(path),
             &options,

@@ -61,7 +61,7 @@ fn engines_with_the_lane_form_match_the_twin_path() {
     // Dynamic: 10 steps of the first two variants from their static equilibria.
     let starts: Vec<_> = models[..2]
         .iter()
-        .map(|m| solve_static(m, &options).unwrap().state)
+        .map(|m| (solve_static(m, &options).unwrap().state, None))
         .collect();
     let settings = case.dynamics.clone().unwrap();
     let dyn_options = holewall::cli::run_cmd::options_for(&settings);

@@ -212,7 +212,7 @@ fn run_gpu<T: GpuReal>(
     t_end: f64,
 ) -> Result<RunOutcome, Error> {
     use crate::engine::dynamic::run_dynamic_ensemble;
-    let starts = vec![start.clone(); models.len()];
+    let starts = vec![(start.clone(), None); models.len()];
     let steps = (t_end / options.dt).round() as usize;
     let mut last = None;
     let r = run_dynamic_ensemble::<T, _>(

@@ -134,11 +134,16 @@ struct Start<T> {
     lowered: bool,
 }
 
+/// A variant's start: its configuration (the static equilibrium, or that with the case's
+/// initial offset: `crate::case::Case::dynamic_start`) and initial velocities (6 per node;
+/// `None`: at rest).
+pub type DynamicStart = (StaticState, Option<Vec<f64>>);
+
 /// The start of every variant: the CPU integrator's initial state (consistent
-/// accelerations) from its static equilibrium, and its force scale.
+/// accelerations) from its start configuration and velocities, and its force scale.
 fn dynamic_tables<T: Real>(
     models: &[Model],
-    starts: &[StaticState],
+    starts: &[DynamicStart],
     density: &[f64],
     options: &DynamicOptions,
 ) -> Result<Start<T>, String> {
@@ -161,9 +166,9 @@ fn dynamic_tables<T: Real>(
     let mut mass = Vec::new();
     let mut inertia0 = Vec::new();
     let mut top = (false, false);
-    for (j, (m, q)) in models.iter().zip(starts).enumerate() {
+    for (j, (m, (q, vel))) in models.iter().zip(starts).enumerate() {
         let mut d = Dynamics::new(m, *options, &|e| density[e]);
-        let s = d.initial_state(q.clone())?;
+        let s = d.initial_state_with(q.clone(), vel.clone())?;
         f_ref.push(d.reference_force());
         if j == 0 {
             let (ms, js) = d.lumped();
@@ -229,7 +234,7 @@ pub struct DynamicResult {
     pub log: Vec<String>,
 }
 
-/// Runs every variant from its static equilibrium `starts[j]` to `t_end` in steps of
+/// Runs every variant from its start `starts[j]` (configuration and velocities) to `t_end` in steps of
 /// `options.dt` on `path`, calling `observe(first_variant, t, state)` for each chunk after
 /// every `every`-th step (0: never). `density` gives each element's steel density.
 ///
@@ -242,7 +247,7 @@ pub struct DynamicResult {
 #[allow(clippy::too_many_arguments)]
 pub fn run_dynamic_ensemble<T: Real + Send + Sync, P: KernelPath<T>>(
     models: &[Model],
-    starts: &[StaticState],
+    starts: &[DynamicStart],
     density: &[f64],
     path: &P,
     options: &DynamicOptions,
@@ -330,7 +335,7 @@ struct Chunk<'a, T, P> {
 #[allow(clippy::too_many_arguments)]
 fn run_chunk<T: Real + Send + Sync, P: KernelPath<T>>(
     models: &[Model],
-    starts: &[StaticState],
+    starts: &[DynamicStart],
     density: &[f64],
     path: &P,
     options: &DynamicOptions,

@@ -97,13 +97,6 @@ pub fn run_dynamic_gpu<T: crate::gpu::contact::GpuReal>(
     if let Some(why) = unsupported_model(&models) {
         return Ok(Err(why));
     }
-    if settings.initial_lateral_velocity != 0.0 || settings.initial_lateral_offset != 0.0 {
-        return Ok(Err(
-            "an initial lateral velocity or offset runs on the CPU integrator (the engine \
-             starts at rest from the static equilibrium)"
-                .into(),
-        ));
-    }
     if !models.iter().all(|m| same_mesh(case, m)) {
         return Ok(Err(
             "the variants differ in their mesh or number of contact sites".into(),
@@ -117,7 +110,11 @@ pub fn run_dynamic_gpu<T: crate::gpu::contact::GpuReal>(
         .filter(|&j| statics[j].status == EngineStatus::Converged)
         .collect();
     let gpu_models: Vec<Model> = on_gpu.iter().map(|&j| models[j].clone()).collect();
-    let starts: Vec<_> = on_gpu.iter().map(|&j| statics[j].state.clone()).collect();
+    // The case's initial offset and kick on each static equilibrium, as the CPU runs do.
+    let starts: Vec<_> = on_gpu
+        .iter()
+        .map(|&j| case.dynamic_start(&models[j], statics[j].state.clone()))
+        .collect();
     let density = &case.element_density;
     let mut cpu: Vec<Dynamics> = gpu_models
         .iter()
@@ -128,8 +125,8 @@ pub fn run_dynamic_gpu<T: crate::gpu::contact::GpuReal>(
         .map(|m| DynamicObserver::new(m, settings.duration))
         .collect();
     let mut last: Vec<Option<DynamicState>> = vec![None; gpu_models.len()];
-    for (j, (d, q)) in cpu.iter_mut().zip(&starts).enumerate() {
-        if let Ok(s) = d.initial_state(q.clone()) {
+    for (j, (d, (q, vel))) in cpu.iter_mut().zip(&starts).enumerate() {
+        if let Ok(s) = d.initial_state_with(q.clone(), vel.clone()) {
             observers[j].observe(&gpu_models[j], d, &s);
             last[j] = Some(s);
         }
