@@ -96,6 +96,70 @@ pub fn to_global(local: &[[f64; 12]; 12], frame: &Mat3<f64>) -> [[f64; 12]; 12] 
     out
 }
 
+/// A node's mass imbalance as a rigid eccentric mass: its centre of mass at `x + d`,
+/// `d = U/M` with `U = R U₀` the imbalance (kg·m) turned with the node. The inertial force
+/// and moment it adds to the node's equations, `M (ω̇ × d + ω × (ω × d))` and
+/// `U × (ẍ + ω̇ × d + ω × (ω × d))` (second order in `d` kept), and their derivatives with
+/// respect to `v̇ = (ẍ, ω̇)` (the mass coupling) and, times `hg`, to `ω`. The rotation's own
+/// derivative is left out of the iteration matrix (first order in a small `d`; Newton
+/// converges without it). One formula for the CPU integrator, the assembly twin and
+/// `shaders/assemble.wgsl` (`UNBALANCE`).
+pub fn unbalance_terms<T: crate::physics::Real>(
+    u: [T; 3],
+    mass: T,
+    xdd: [T; 3],
+    w: [T; 3],
+    wd: [T; 3],
+    hg: T,
+) -> ([T; 6], [[T; 6]; 6]) {
+    let cross = |a: [T; 3], b: [T; 3]| -> [T; 3] {
+        [
+            a[1] * b[2] - a[2] * b[1],
+            a[2] * b[0] - a[0] * b[2],
+            a[0] * b[1] - a[1] * b[0],
+        ]
+    };
+    let skew = |x: [T; 3]| -> [[T; 3]; 3] {
+        let z = T::zero();
+        [[z, -x[2], x[1]], [x[2], z, -x[0]], [-x[1], x[0], z]]
+    };
+    let mul = |a: &[[T; 3]; 3], b: &[[T; 3]; 3]| -> [[T; 3]; 3] {
+        std::array::from_fn(|r| {
+            std::array::from_fn(|c| a[r][0] * b[0][c] + a[r][1] * b[1][c] + a[r][2] * b[2][c])
+        })
+    };
+    let d = u.map(|x| x / mass);
+    let wxd = cross(w, d);
+    let t = cross(wd, d);
+    let c = cross(w, wxd);
+    let a_rel: [T; 3] = std::array::from_fn(|k| t[k] + c[k]);
+    let a_cm: [T; 3] = std::array::from_fn(|k| xdd[k] + a_rel[k]);
+    let moment = cross(u, a_cm);
+    let mut r = [T::zero(); 6];
+    for k in 0..3 {
+        r[k] = mass * a_rel[k];
+        r[3 + k] = moment[k];
+    }
+    let (su, sd) = (skew(u), skew(d));
+    // ∂(ω × (ω × d))/∂ω = −[ω × d]× − [ω]×[d]×.
+    let swd = skew(wxd);
+    let sw_sd = mul(&skew(w), &sd);
+    let dw: [[T; 3]; 3] = std::array::from_fn(|a| std::array::from_fn(|b| -swd[a][b] - sw_sd[a][b]));
+    let su_sd = mul(&su, &sd);
+    let su_dw = mul(&su, &dw);
+    let mut jac = [[T::zero(); 6]; 6];
+    for a in 0..3 {
+        for b in 0..3 {
+            // Translations: ∂/∂ω̇ = −M [d]× = −[U]×; ∂/∂ω = M dw.
+            jac[a][3 + b] = -su[a][b] + hg * mass * dw[a][b];
+            // Moments: ∂/∂ẍ = [U]×, ∂/∂ω̇ = −[U]×[d]×, ∂/∂ω = [U]× dw.
+            jac[3 + a][b] = su[a][b];
+            jac[3 + a][3 + b] = -su_sd[a][b] + hg * su_dw[a][b];
+        }
+    }
+    (r, jac)
+}
+
 #[cfg(test)]
 #[allow(clippy::needless_range_loop)]
 mod tests {

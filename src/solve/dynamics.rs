@@ -283,12 +283,8 @@ impl<'a> Dynamics<'a> {
         e
     }
 
-    /// Node `i`'s mass imbalance as a rigid eccentric mass (its centre of mass at `x + d`,
-    /// `d = R U₀ / M`, `U = R U₀`): the inertial force and moment it adds to the equations,
-    /// `M (ω̇ × d + ω × (ω × d))` and `U × (ẍ + ω̇ × d + ω × (ω × d))` (second order in `d`
-    /// kept), and their derivatives with respect to `v̇` (the mass coupling) and, times `hg`,
-    /// to `ω`; `None` where the node has none. The rotation's own derivative is left out of
-    /// the iteration matrix (first order in a small `d`; Newton converges without it).
+    /// Node `i`'s mass imbalance as a rigid eccentric mass
+    /// ([`crate::physics::mass::unbalance_terms`]); `None` where the node has none.
     fn unbalance_terms(
         &self,
         s: &DynamicState,
@@ -299,45 +295,15 @@ impl<'a> Dynamics<'a> {
         if u0.iter().all(|x| *x == 0.0) || self.mass[i] <= 0.0 {
             return None;
         }
-        let u = mat_vec(&s.q.rot[i], u0);
-        let m = self.mass[i];
-        let d: Vec3<f64> = std::array::from_fn(|k| u[k] / m);
-        let xdd: Vec3<f64> = std::array::from_fn(|k| s.vdot[6 * i + k]);
-        let w: Vec3<f64> = std::array::from_fn(|k| s.v[6 * i + 3 + k]);
-        let wd: Vec3<f64> = std::array::from_fn(|k| s.vdot[6 * i + 3 + k]);
-        let wxd = cross(&w, &d);
-        let a_rel: Vec3<f64> = {
-            let t = cross(&wd, &d);
-            let c = cross(&w, &wxd);
-            std::array::from_fn(|k| t[k] + c[k])
-        };
-        let a_cm: Vec3<f64> = std::array::from_fn(|k| xdd[k] + a_rel[k]);
-        let moment = cross(&u, &a_cm);
-        let mut r = [0.0; 6];
-        for k in 0..3 {
-            r[k] = m * a_rel[k];
-            r[3 + k] = moment[k];
-        }
-        let su = skew(&u);
-        let sd = skew(&d);
-        // ∂(ω × (ω × d))/∂ω = −[ω × d]× − [ω]×[d]×.
-        let swd = skew(&wxd);
-        let sw_sd = mat_mul(&skew(&w), &sd);
-        let dw: Mat3<f64> =
-            std::array::from_fn(|a| std::array::from_fn(|b| -swd[a][b] - sw_sd[a][b]));
-        let su_sd = mat_mul(&su, &sd);
-        let su_dw = mat_mul(&su, &dw);
-        let mut jac = [[0.0; 6]; 6];
-        for a in 0..3 {
-            for b in 0..3 {
-                // Translations: ∂/∂ω̇ = −M [d]× = −[U]×; ∂/∂ω = M dw.
-                jac[a][3 + b] = -su[a][b] + hg * m * dw[a][b];
-                // Moments: ∂/∂ẍ = [U]×, ∂/∂ω̇ = −[U]×[d]×, ∂/∂ω = [U]× dw.
-                jac[3 + a][b] = su[a][b];
-                jac[3 + a][3 + b] = -su_sd[a][b] + hg * su_dw[a][b];
-            }
-        }
-        Some((r, jac))
+        let at = |k: usize| -> Vec3<f64> { std::array::from_fn(|c| s.vdot[6 * i + k + c]) };
+        Some(crate::physics::mass::unbalance_terms(
+            mat_vec(&s.q.rot[i], u0),
+            self.mass[i],
+            at(0),
+            std::array::from_fn(|c| s.v[6 * i + 3 + c]),
+            at(3),
+            hg,
+        ))
     }
 
     fn spatial_inertia(&self, q: &StaticState, i: usize) -> Mat3<f64> {
