@@ -1,7 +1,9 @@
 // Twin: src/kernels/assemble.rs (static residual and block-tridiagonal tangent per variant).
 //
 // With DYNAMIC: the generalised-α iteration matrix M + hγ' C_t + h²β' K_t and the inertial
-// residual (lumped mass, gyroscopic moments, mass-proportional Rayleigh damping).
+// residual (lumped mass, gyroscopic moments, mass-proportional Rayleigh damping); with
+// UNBALANCE also each node's mass imbalance as a rigid eccentric mass
+// (physics::mass::unbalance_terms).
 //
 // One invocation per (node, variant), index = node · V + variant; each gathers the halves of
 // its two elements and its contact site, so no two invocations write the same entry, then
@@ -29,10 +31,19 @@
 @group(0) @binding(14) var<storage, read> vdot: array<real>;
 // Hole axis per contact pair.
 @group(0) @binding(15) var<storage, read> pair_normals: array<real>;
+#if UNBALANCE
+// Mass imbalance per node and variant at the reference orientation (kg·m): [(3 i + k) V + v].
+@group(0) @binding(16) var<storage, read> unbalance: array<real>;
+@group(0) @binding(17) var<storage, read_write> out_diag: array<real>;
+@group(0) @binding(18) var<storage, read_write> out_upper: array<real>;
+@group(0) @binding(19) var<storage, read_write> out_lower: array<real>;
+@group(0) @binding(20) var<storage, read_write> out_rhs: array<real>;
+#else
 @group(0) @binding(16) var<storage, read_write> out_diag: array<real>;
 @group(0) @binding(17) var<storage, read_write> out_upper: array<real>;
 @group(0) @binding(18) var<storage, read_write> out_lower: array<real>;
 @group(0) @binding(19) var<storage, read_write> out_rhs: array<real>;
+#endif
 const OUT_C: u32 = 24u;
 const OUT_C_OMEGA: u32 = 42u;
 #else
@@ -46,6 +57,26 @@ const OUT_C_OMEGA: u32 = 42u;
 const OUT_G: u32 = 0u;
 const OUT_K: u32 = 6u;
 const NO_SITE: u32 = 0xffffffffu;
+
+#if UNBALANCE
+// Rows of [x]×.
+fn skew3(x: vec3<real>) -> array<vec3<real>, 3> {
+    return array<vec3<real>, 3>(
+        vec3<real>(real(0.0), -x.z, x.y),
+        vec3<real>(x.z, real(0.0), -x.x),
+        vec3<real>(-x.y, x.x, real(0.0)),
+    );
+}
+
+// a · b for matrices by rows.
+fn mul3(a: array<vec3<real>, 3>, b: array<vec3<real>, 3>) -> array<vec3<real>, 3> {
+    var out: array<vec3<real>, 3>;
+    for (var r = 0u; r < 3u; r = r + 1u) {
+        out[r] = a[r].x * b[0] + a[r].y * b[1] + a[r].z * b[2];
+    }
+    return out;
+}
+#endif
 
 // block ← diag(B_a, I)ᵀ · block · diag(B_b, I): rows of node a, then columns of node b.
 fn transform(blk: ptr<function, array<real, 36>>, a: u32, b: u32) {
@@ -220,6 +251,44 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
             d[6u * (3u + k) + 3u + c] = d[6u * (3u + k) + 3u + c] + jm[k][c] + hg * (swj - sjw[k][c]);
         }
     }
+#if UNBALANCE
+    // U = R U0; d = U/M: M (ω̇ × d + ω × (ω × d)) and U × (ẍ + ω̇ × d + ω × (ω × d)), with
+    // their derivatives by v̇ and (times hγ') by ω.
+    let u0 = vec3<real>(unbalance[(3u * i) * nv + v], unbalance[(3u * i + 1u) * nv + v],
+                        unbalance[(3u * i + 2u) * nv + v]);
+    if (m > real(0.0) && (u0.x != real(0.0) || u0.y != real(0.0) || u0.z != real(0.0))) {
+        var uu = vec3<real>(real(0.0), real(0.0), real(0.0));
+        for (var a = 0u; a < 3u; a = a + 1u) {
+            uu[a] = rot[(9u * i + 3u * a) * nv + v] * u0.x + rot[(9u * i + 3u * a + 1u) * nv + v] * u0.y
+                + rot[(9u * i + 3u * a + 2u) * nv + v] * u0.z;
+        }
+        let dd = uu / m;
+        let xdd = vec3<real>(vdot[(6u * i) * nv + v], vdot[(6u * i + 1u) * nv + v], vdot[(6u * i + 2u) * nv + v]);
+        let wd = vec3<real>(vdot[(6u * i + 3u) * nv + v], vdot[(6u * i + 4u) * nv + v], vdot[(6u * i + 5u) * nv + v]);
+        let wxd = cross(w, dd);
+        let a_rel = cross(wd, dd) + cross(w, wxd);
+        let moment = cross(uu, xdd + a_rel);
+        let su = skew3(uu);
+        let sd = skew3(dd);
+        let swd = skew3(wxd);
+        let sw_sd = mul3(skew3(w), sd);
+        var dw: array<vec3<real>, 3>;
+        for (var a = 0u; a < 3u; a = a + 1u) {
+            dw[a] = -swd[a] - sw_sd[a];
+        }
+        let su_sd = mul3(su, sd);
+        let su_dw = mul3(su, dw);
+        for (var a = 0u; a < 3u; a = a + 1u) {
+            r[a] = r[a] + m * a_rel[a];
+            r[3u + a] = r[3u + a] + moment[a];
+            for (var b = 0u; b < 3u; b = b + 1u) {
+                d[6u * a + 3u + b] = d[6u * a + 3u + b] - su[a][b] + hg * m * dw[a][b];
+                d[6u * (3u + a) + b] = d[6u * (3u + a) + b] + su[a][b];
+                d[6u * (3u + a) + 3u + b] = d[6u * (3u + a) + 3u + b] - su_sd[a][b] + hg * su_dw[a][b];
+            }
+        }
+    }
+#endif
 #endif
     // Constraints (as statics::constrain): bases, then fixed DOFs.
     transform(&d, i, i);

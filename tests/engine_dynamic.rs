@@ -339,9 +339,61 @@ fn dynamic_kernels_equal_their_twins() {
             vel: state.vel.clone(),
             vdot: vdot.clone(),
             pair_normals: pair_normals.clone(),
+            unbalance: Vec::new(),
         }),
     };
     let asm_twin = assemble(&a);
+    // With a mass imbalance at every other node (the kernel built UNBALANCE): the twin
+    // adds exactly `physics::mass::unbalance_terms`, the GPU the same numbers.
+    let mut a_u = a.clone();
+    let unbalance: Vec<f64> = r(-0.5, 0.5, 3 * n * v)
+        .into_iter()
+        .enumerate()
+        .map(|(k, x)| if (k / (3 * v)) % 2 == 0 { x } else { 0.0 })
+        .collect();
+    a_u.dynamic.as_mut().unwrap().unbalance = unbalance.clone();
+    let asm_u = assemble(&a_u);
+    {
+        // One node by hand: the difference of the residuals is the imbalance's force.
+        let (i, j) = (4usize, 1usize);
+        let dy = a_u.dynamic.as_ref().unwrap();
+        let rot = |rr: usize, c: usize| dy.rot[(9 * i + 3 * rr + c) * v + j];
+        let u0: [f64; 3] = std::array::from_fn(|k| unbalance[(3 * i + k) * v + j]);
+        let u: [f64; 3] = std::array::from_fn(|rr| (0..3).map(|c| rot(rr, c) * u0[c]).sum());
+        let at = |k: usize| dy.vdot[(6 * i + k) * v + j];
+        let w = [
+            dy.vel[(6 * i + 3) * v + j],
+            dy.vel[(6 * i + 4) * v + j],
+            dy.vel[(6 * i + 5) * v + j],
+        ];
+        let (ru, _) = holewall::physics::mass::unbalance_terms(
+            u,
+            mass[i],
+            [at(0), at(1), at(2)],
+            w,
+            [at(3), at(4), at(5)],
+            dy.coefficients[0],
+        );
+        // Node 4 has no fixed DOF; its force rows are taken into its translation basis B
+        // (Bᵀ f), its moment rows as they are.
+        let b = &a_u.basis[9 * i..9 * i + 9];
+        let want: [f64; 6] = std::array::from_fn(|k| {
+            if k < 3 {
+                (0..3).map(|c| b[3 * c + k] * ru[c]).sum()
+            } else {
+                ru[k]
+            }
+        });
+        for k in 0..6 {
+            let idx = (6 * i + k) * v + j;
+            let diff = asm_u.rhs[idx] - asm_twin.rhs[idx];
+            assert!(
+                (diff - want[k]).abs() <= 1e-9 * want[k].abs().max(1.0),
+                "{k}: {diff} vs {}",
+                want[k]
+            );
+        }
+    }
     let Some(ctx) = common::gpu() else { return };
     if !ctx.has_f64 {
         return;
@@ -386,6 +438,13 @@ fn dynamic_kernels_equal_their_twins() {
     assert!(d_pred.iter().chain(&d_asm).all(|&d| d <= 1e-12) && d_acc <= 1e-15);
     assert_eq!(scale_gpu, scale_twin);
     assert_eq!(sites_gpu, pair_state);
+    let asm_u_gpu = assemble_gpu(ctx, &a_u).unwrap();
+    let d_u = [
+        rel(&asm_u_gpu.diag, &asm_u.diag),
+        rel(&asm_u_gpu.rhs, &asm_u.rhs),
+    ];
+    eprintln!("GPU f64 vs twin, dynamic assembly with a mass imbalance: {d_u:?}");
+    assert!(d_u.iter().all(|&d| d <= 1e-12), "{d_u:?}");
 }
 
 #[test]

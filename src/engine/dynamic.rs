@@ -48,6 +48,10 @@ pub struct DynamicTables<T> {
     pub f_ext: Vec<T>,
     /// Law parameters per pair, `PARAMS_LEN · P`.
     pub pair_params: Vec<T>,
+    /// Mass imbalance per node and variant at the reference orientation (kg·m), `3 n V`
+    /// ([`Model::unbalance`]); empty when no variant has one (the assembly is then built
+    /// without it).
+    pub unbalance: Vec<T>,
     /// The state at t = 0 (displacements from the base, [`EnsembleTables::base`]: each
     /// variant's static equilibrium).
     pub start: DynamicBatch<T>,
@@ -114,14 +118,6 @@ pub fn unsupported(options: &DynamicOptions) -> Option<String> {
         return Some("load factors in time run on the CPU integrator".into());
     }
     None
-}
-
-/// What of the models only the CPU integrator has (a mass imbalance), if any.
-pub fn unsupported_model(models: &[Model]) -> Option<String> {
-    models
-        .iter()
-        .any(Model::has_unbalance)
-        .then(|| "a mass imbalance runs on the CPU integrator".into())
 }
 
 /// A chunk's start: its tables, each variant's force scale, and what moves the top.
@@ -207,6 +203,19 @@ fn dynamic_tables<T: Real>(
             }
         }
     }
+    let unbalance = if models.iter().any(Model::has_unbalance) {
+        let mut u = vec![T::zero(); 3 * n * v];
+        for (j, m) in models.iter().enumerate() {
+            for (i, ui) in m.unbalance.iter().enumerate().take(n) {
+                for k in 0..3 {
+                    u[(3 * i + k) * v + j] = t(ui[k]);
+                }
+            }
+        }
+        u
+    } else {
+        Vec::new()
+    };
     Ok(Start {
         tables: DynamicTables {
             mass,
@@ -214,6 +223,7 @@ fn dynamic_tables<T: Real>(
             a0: options.rayleigh.0,
             f_ext,
             pair_params,
+            unbalance,
             start,
         },
         base,
@@ -256,9 +266,6 @@ pub fn run_dynamic_ensemble<T: Real + Send + Sync, P: KernelPath<T>>(
     observe: &mut dyn FnMut(usize, f64, &DynamicBatch<T>),
 ) -> Result<Vec<DynamicResult>, String> {
     if let Some(why) = unsupported(options) {
-        return Err(why);
-    }
-    if let Some(why) = unsupported_model(models) {
         return Err(why);
     }
     super::check_same_mesh(models)?;
@@ -669,6 +676,7 @@ fn open_subset<'c, T: Real + Send + Sync, P: KernelPath<T>>(
         a0: d.a0,
         f_ext: columns(&d.f_ext, v, members),
         pair_params: columns(&d.pair_params, v, members),
+        unbalance: columns(&d.unbalance, v, members),
         start: start.clone(),
     };
     let path: &'c P = chunk.path;
@@ -798,6 +806,7 @@ impl<'a> TwinDynamic<'a> {
                     coefficients: [p.0, p.1, self.dynamic.a0],
                     mass: &self.dynamic.mass,
                     inertia0: &self.dynamic.inertia0,
+                    unbalance: &self.dynamic.unbalance,
                 },
             )),
         ))

@@ -269,6 +269,7 @@ pub(crate) fn twin_evaluate(
                             vel: trial.vel.clone(),
                             vdot: trial.vdot.clone(),
                             pair_normals: t.pair_normals.clone(),
+                            unbalance: d.unbalance.to_vec(),
                         }
                     }),
                 }));
@@ -286,6 +287,8 @@ pub(crate) struct AssemblyDynamic<'a> {
     pub mass: &'a [f64],
     /// Rotary inertia at the reference orientation, `9 n`.
     pub inertia0: &'a [f64],
+    /// Mass imbalance per node and variant, `3 n V` (empty: none).
+    pub unbalance: &'a [f64],
 }
 
 /// The CPU twins, f64.

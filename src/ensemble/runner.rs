@@ -78,9 +78,7 @@ pub fn run_dynamic_gpu<T: crate::gpu::contact::GpuReal>(
     ctx: &'static crate::gpu::GpuContext,
     bar: &indicatif::ProgressBar,
 ) -> Result<Result<Vec<VariantResult>, String>, Error> {
-    use crate::engine::dynamic::{
-        run_dynamic_ensemble, unsupported, unsupported_model, DynamicStatus,
-    };
+    use crate::engine::dynamic::{run_dynamic_ensemble, unsupported, DynamicStatus};
     use crate::engine::{solve_static_ensemble, EngineStatus, GpuPath};
     let Some(settings) = case.dynamics.clone() else {
         return Ok(Err("no [dynamics] table".into()));
@@ -94,9 +92,6 @@ pub fn run_dynamic_gpu<T: crate::gpu::contact::GpuReal>(
         .map(|v| apply(case, v))
         .collect::<Result<_, _>>()
         .map_err(|e| Error::Io(std::io::Error::other(e)))?;
-    if let Some(why) = unsupported_model(&models) {
-        return Ok(Err(why));
-    }
     if !models.iter().all(|m| same_mesh(case, m)) {
         return Ok(Err(
             "the variants differ in their mesh or number of contact sites".into(),

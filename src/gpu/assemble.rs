@@ -18,7 +18,16 @@ pub fn assemble_wgsl(f64: bool) -> Result<String, GpuError> {
 
 /// The WGSL text of the static or dynamic assembly at a precision.
 pub fn assemble_wgsl_for(dynamic: bool, f64: bool) -> Result<String, GpuError> {
+    assemble_wgsl_with(dynamic, false, f64)
+}
+
+/// The WGSL text of the assembly: static or dynamic, with (`unbalance`, dynamic only) the
+/// mass-imbalance binding and terms, at a precision.
+pub fn assemble_wgsl_with(dynamic: bool, unbalance: bool, f64: bool) -> Result<String, GpuError> {
     let mut flags = BTreeSet::new();
+    if dynamic && unbalance {
+        flags.insert("UNBALANCE");
+    }
     if f64 {
         flags.insert("F64");
     }
@@ -47,9 +56,10 @@ pub fn assemble_gpu<T: GpuReal>(
             ctx.max_binding_bytes()
         )));
     }
+    let unbalance = a.dynamic.as_ref().is_some_and(|d| !d.unbalance.is_empty());
     let pipeline = ctx.pipeline(
         "assemble",
-        &assemble_wgsl_for(a.dynamic.is_some(), T::IS_F64)?,
+        &assemble_wgsl_with(a.dynamic.is_some(), unbalance, T::IS_F64)?,
     )?;
     let dims = AssembleDims {
         num_variants: nv as u32,
@@ -77,6 +87,9 @@ pub fn assemble_gpu<T: GpuReal>(
             bytemuck::cast_slice(&dy.vdot),
             bytemuck::cast_slice(&dy.pair_normals),
         ]);
+        if unbalance {
+            inputs.push(bytemuck::cast_slice(&dy.unbalance));
+        }
     }
     let out = run_once(
         ctx,

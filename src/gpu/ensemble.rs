@@ -989,7 +989,11 @@ impl<T: GpuReal> GpuDynamic<T> {
             contact: ctx.pipeline("contact", &contact_wgsl(&tables.terms, f64)?)?,
             assemble: ctx.pipeline(
                 "assemble",
-                &crate::gpu::assemble::assemble_wgsl_for(true, f64)?,
+                &crate::gpu::assemble::assemble_wgsl_with(
+                    true,
+                    !dynamic.unbalance.is_empty(),
+                    f64,
+                )?,
             )?,
             block_lu: ctx.pipeline(
                 "block_lu",
@@ -999,6 +1003,8 @@ impl<T: GpuReal> GpuDynamic<T> {
         };
         let mass = storage(ctx, "mass", &dynamic.mass);
         let inertia0 = storage(ctx, "inertia0", &dynamic.inertia0);
+        let unbalance =
+            (!dynamic.unbalance.is_empty()).then(|| storage(ctx, "unbalance", &dynamic.unbalance));
         let diag = empty(ctx, "diag", 36 * n * v * size);
         let upper = empty(ctx, "upper", 36 * m.max(1) * v * size);
         let lower = empty(ctx, "lower", 36 * m.max(1) * v * size);
@@ -1047,7 +1053,7 @@ impl<T: GpuReal> GpuDynamic<T> {
         };
         let inputs = c.assembly_inputs();
         let assemble = |vdot: &wgpu::Buffer| {
-            let dynamic_inputs = [
+            let mut dynamic_inputs = vec![
                 &b.dyn_coef,
                 &mass,
                 &inertia0,
@@ -1055,11 +1061,9 @@ impl<T: GpuReal> GpuDynamic<T> {
                 &b.vel_1,
                 vdot,
                 &c.normals,
-                &diag,
-                &upper,
-                &lower,
-                &rhs,
             ];
+            dynamic_inputs.extend(&unbalance);
+            dynamic_inputs.extend([&diag, &upper, &lower, &rhs]);
             bind(
                 ctx,
                 &pl.assemble,
@@ -1123,7 +1127,10 @@ impl<T: GpuReal> GpuDynamic<T> {
             a0: T::from_f64_lossy(dynamic.a0),
             c,
             lu_lanes: LuForm::for_adapter(ctx).lanes(),
-            _keep: vec![mass, inertia0, diag, upper, lower, rhs],
+            _keep: [mass, inertia0, diag, upper, lower, rhs]
+                .into_iter()
+                .chain(unbalance)
+                .collect(),
             _real: PhantomData,
         })
     }

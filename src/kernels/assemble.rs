@@ -80,6 +80,9 @@ pub struct DynamicInputs<T> {
     pub vdot: Vec<T>,
     /// Hole axis per contact pair, `3 S V` (for the spin's damping column `c_ω nᵀ`).
     pub pair_normals: Vec<T>,
+    /// Mass imbalance per node and variant at the reference orientation (kg·m),
+    /// `3 n V`; empty: none (the kernel is then built without it).
+    pub unbalance: Vec<T>,
 }
 
 /// `block ← diag(B_a, I)ᵀ · block · diag(B_b, I)`: rows of node `a`, then columns of node `b`.
@@ -246,6 +249,29 @@ fn node_blocks<T: Real>(
                     swj = swj + sw[k][q] * j[q][c];
                 }
                 d[6 * (3 + k) + 3 + c] = d[6 * (3 + k) + 3 + c] + j[k][c] + hg * (swj - sjw[k][c]);
+            }
+        }
+        // Mass imbalance: a rigid eccentric mass turning with the node.
+        if !dy.unbalance.is_empty() {
+            let u0: [T; 3] = std::array::from_fn(|k| dy.unbalance[(3 * i + k) * nv + v]);
+            if m > T::zero() && u0.iter().any(|x| *x != T::zero()) {
+                let u: [T; 3] = std::array::from_fn(|r| {
+                    rot(r, 0) * u0[0] + rot(r, 1) * u0[1] + rot(r, 2) * u0[2]
+                });
+                let (ru, ju) = crate::physics::mass::unbalance_terms(
+                    u,
+                    m,
+                    [acc(0), acc(1), acc(2)],
+                    w,
+                    [acc(3), acc(4), acc(5)],
+                    hg,
+                );
+                for a in 0..6 {
+                    r[a] = r[a] + ru[a];
+                    for b in 0..6 {
+                        d[6 * a + b] = d[6 * a + b] + ju[a][b];
+                    }
+                }
             }
         }
     }

@@ -144,7 +144,8 @@ pub fn unbalance_terms<T: crate::physics::Real>(
     // ∂(ω × (ω × d))/∂ω = −[ω × d]× − [ω]×[d]×.
     let swd = skew(wxd);
     let sw_sd = mul(&skew(w), &sd);
-    let dw: [[T; 3]; 3] = std::array::from_fn(|a| std::array::from_fn(|b| -swd[a][b] - sw_sd[a][b]));
+    let dw: [[T; 3]; 3] =
+        std::array::from_fn(|a| std::array::from_fn(|b| -swd[a][b] - sw_sd[a][b]));
     let su_sd = mul(&su, &sd);
     let su_dw = mul(&su, &dw);
     let mut jac = [[T::zero(); 6]; 6];
