@@ -259,14 +259,7 @@ fn bend_ensembles_on_a_two_stabilizer_well() {
     assert_eq!((cpu.variants, cpu.failed), (12, 0));
     assert_eq!(cpu.converged + cpu.step_cut, 12);
     assert!(cpu.backend_note.is_none());
-    let column = |out: &str, name: &str| -> Vec<f64> {
-        let csv = std::fs::read_to_string(dir.join(out).join("variants.csv")).unwrap();
-        let mut rows = csv.lines();
-        let header: Vec<&str> = rows.next().unwrap().split(',').collect();
-        let k = header.iter().position(|h| *h == name).unwrap();
-        rows.map(|r| r.split(',').nth(k).unwrap().parse().unwrap())
-            .collect()
-    };
+    let column = |out: &str, name: &str| common::variants_column(&dir.join(out), name);
     if common::gpu().is_some() {
         let gpu = run(holewall::backend::BackendChoice::Gpu, "gpu");
         eprintln!(
@@ -398,49 +391,8 @@ fn the_dynamic_engine_runs_a_bent_collar_as_the_cpu_does() {
         .replace("ramp_time = \"0.5 s\"", "ramp_time = \"0.1 s\"");
     assert!(text.contains("bend ="));
     let grid = "\n[ensemble]\nanalysis = \"dynamic\"\n\n[ensemble.grid]\nbend = [0.5, 1]\n";
-    let dir = std::env::temp_dir().join(format!("holewall-bend-dyn-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    let case = dir.join("bent_spinup.toml");
-    std::fs::write(&case, format!("{text}{grid}")).unwrap();
-    let run = |backend, out: &str| {
-        holewall::ensemble::job::run(
-            &case,
-            None,
-            backend,
-            holewall::backend::Precision::F64,
-            &dir.join(out),
-            false,
-            &Default::default(),
-        )
-        .unwrap()
-    };
-    let cpu = run(holewall::backend::BackendChoice::Cpu, "cpu");
-    let gpu = run(holewall::backend::BackendChoice::Gpu, "gpu");
-    assert_eq!((cpu.failed, gpu.failed), (0, 0));
-    assert_eq!(gpu.backend, "gpu");
-    assert_eq!(gpu.solved_by_engine, 2, "{:?}", gpu.backend_note);
-    let column = |out: &str, name: &str| -> Vec<f64> {
-        let csv = std::fs::read_to_string(dir.join(out).join("variants.csv")).unwrap();
-        let mut rows = csv.lines();
-        let header: Vec<&str> = rows.next().unwrap().split(',').collect();
-        let k = header.iter().position(|h| *h == name).unwrap();
-        rows.map(|r| r.split(',').nth(k).unwrap().parse().unwrap())
-            .collect()
-    };
-    let mut worst: f64 = 0.0;
-    for q in [
-        "stab1_max_lateral_m",
-        "stab1_max_side_force_n",
-        "max_surface_torque_nm",
-    ] {
-        let (a, b) = (column("gpu", q), column("cpu", q));
-        eprintln!("{q}: GPU engine {a:?}, CPU {b:?}");
-        for (x, y) in a.iter().zip(&b) {
-            worst = worst.max((x - y).abs() / y.abs().max(1e-9));
-        }
-    }
-    let lateral = column("cpu", "stab1_max_lateral_m");
+    let (dir, worst) = common::engine_against_cpu("bend-dyn", &format!("{text}{grid}"));
+    let lateral = common::variants_column(&dir.join("cpu"), "stab1_max_lateral_m");
     assert!(
         lateral[1] > lateral[0] && lateral[0] > 0.0,
         "the bend moves the stabilizer: {lateral:?}"

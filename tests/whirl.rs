@@ -502,53 +502,16 @@ fn the_dynamic_engine_starts_from_the_offset_and_kick() {
         .replace("duration = \"1 s\"", "duration = \"0.3 s\"")
         .replace("ramp_time = \"0.5 s\"", "ramp_time = \"0.1 s\"");
     let grid = "\n[ensemble]\nanalysis = \"dynamic\"\n\n[ensemble.grid]\nrpm = [\"60 rpm\", \"120 rpm\"]\n";
-    let dir = std::env::temp_dir().join(format!("holewall-kick-engine-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    let case = dir.join("kicked.toml");
-    std::fs::write(&case, format!("{text}{grid}")).unwrap();
-    let run = |backend, out: &str| {
-        holewall::ensemble::job::run(
-            &case,
-            None,
-            backend,
-            holewall::backend::Precision::F64,
-            &dir.join(out),
-            false,
-            &Default::default(),
-        )
-        .unwrap()
-    };
-    let cpu = run(holewall::backend::BackendChoice::Cpu, "cpu");
-    let gpu = run(holewall::backend::BackendChoice::Gpu, "gpu");
-    assert_eq!((cpu.failed, gpu.failed), (0, 0));
-    assert_eq!(gpu.backend, "gpu");
-    assert_eq!(gpu.solved_by_engine, 2, "{:?}", gpu.backend_note);
-    let column = |out: &str, name: &str| -> Vec<f64> {
-        let csv = std::fs::read_to_string(dir.join(out).join("variants.csv")).unwrap();
-        let mut rows = csv.lines();
-        let header: Vec<&str> = rows.next().unwrap().split(',').collect();
-        let k = header.iter().position(|h| *h == name).unwrap();
-        rows.map(|r| r.split(',').nth(k).unwrap().parse().unwrap())
-            .collect()
-    };
-    let mut worst: f64 = 0.0;
-    for q in [
-        "stab1_max_lateral_m",
-        "stab1_max_side_force_n",
-        "max_surface_torque_nm",
-    ] {
-        let (a, b) = (column("gpu", q), column("cpu", q));
-        eprintln!("{q}: GPU engine {a:?}, CPU {b:?}");
-        for (x, y) in a.iter().zip(&b) {
-            worst = worst.max((x - y).abs() / y.abs().max(1e-9));
-        }
-    }
+    let (dir, worst) = common::engine_against_cpu("kick-engine", &format!("{text}{grid}"));
     // The start moved the stabilizer (1.78 mm at rest before the run: the half sine).
-    assert!(column("cpu", "stab1_max_lateral_m")
-        .iter()
-        .all(|r| *r > 1.5e-3));
-    eprintln!("offset and kick, GPU dynamic engine vs CPU integrator: worst relative difference {worst:.1e}");
+    assert!(
+        common::variants_column(&dir.join("cpu"), "stab1_max_lateral_m")
+            .iter()
+            .all(|r| *r > 1.5e-3)
+    );
+    eprintln!(
+        "offset and kick, GPU dynamic engine vs CPU integrator: worst relative difference {worst:.1e}"
+    );
     assert!(worst <= 1e-6, "{worst:e}");
 }
 
@@ -568,49 +531,8 @@ fn the_dynamic_engine_runs_a_mass_imbalance_as_the_cpu_does() {
         .replace("ramp_time = \"0.5 s\"", "ramp_time = \"0.1 s\"");
     let grid =
         "\n[ensemble]\nanalysis = \"dynamic\"\n\n[ensemble.grid]\necc = [\"0.5 mm\", \"3 mm\"]\n";
-    let dir = std::env::temp_dir().join(format!("holewall-ecc-engine-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    let case = dir.join("ecc.toml");
-    std::fs::write(&case, format!("{text}{grid}")).unwrap();
-    let run = |backend, out: &str| {
-        holewall::ensemble::job::run(
-            &case,
-            None,
-            backend,
-            holewall::backend::Precision::F64,
-            &dir.join(out),
-            false,
-            &Default::default(),
-        )
-        .unwrap()
-    };
-    let cpu = run(holewall::backend::BackendChoice::Cpu, "cpu");
-    let gpu = run(holewall::backend::BackendChoice::Gpu, "gpu");
-    assert_eq!((cpu.failed, gpu.failed), (0, 0));
-    assert_eq!(gpu.backend, "gpu");
-    assert_eq!(gpu.solved_by_engine, 2, "{:?}", gpu.backend_note);
-    let column = |out: &str, name: &str| -> Vec<f64> {
-        let csv = std::fs::read_to_string(dir.join(out).join("variants.csv")).unwrap();
-        let mut rows = csv.lines();
-        let header: Vec<&str> = rows.next().unwrap().split(',').collect();
-        let k = header.iter().position(|h| *h == name).unwrap();
-        rows.map(|r| r.split(',').nth(k).unwrap().parse().unwrap())
-            .collect()
-    };
-    let mut worst: f64 = 0.0;
-    for q in [
-        "stab1_max_lateral_m",
-        "stab1_max_side_force_n",
-        "max_surface_torque_nm",
-    ] {
-        let (a, b) = (column("gpu", q), column("cpu", q));
-        eprintln!("{q}: GPU engine {a:?}, CPU {b:?}");
-        for (x, y) in a.iter().zip(&b) {
-            worst = worst.max((x - y).abs() / y.abs().max(1e-9));
-        }
-    }
-    let lateral = column("cpu", "stab1_max_lateral_m");
+    let (dir, worst) = common::engine_against_cpu("ecc-engine", &format!("{text}{grid}"));
+    let lateral = common::variants_column(&dir.join("cpu"), "stab1_max_lateral_m");
     assert!(
         lateral[1] > lateral[0] && lateral[0] > 0.0,
         "the imbalance moves the stabilizer: {lateral:?}"

@@ -126,3 +126,64 @@ pub fn weightless_collar(l: f64, elements: usize) -> holewall::model::Model {
     let (nodes, elements) = holewall::model::mesh_string(&well, &[t], l, STEEL);
     holewall::model::Model::bare(nodes, elements)
 }
+
+/// A column of an ensemble's `variants.csv` in `out`, as numbers.
+#[allow(dead_code)]
+pub fn variants_column(out: &std::path::Path, name: &str) -> Vec<f64> {
+    let csv = std::fs::read_to_string(out.join("variants.csv")).unwrap();
+    let mut rows = csv.lines();
+    let header: Vec<&str> = rows.next().unwrap().split(',').collect();
+    let k = header
+        .iter()
+        .position(|h| *h == name)
+        .unwrap_or_else(|| panic!("no column {name}"));
+    rows.map(|r| r.split(',').nth(k).unwrap().parse().unwrap())
+        .collect()
+}
+
+/// Runs the case `text` (with its `[ensemble]` table) on the CPU and on the GPU engine in
+/// f64, in a fresh folder named after `label`; asserts that nothing failed and that the
+/// engine ran every variant itself (no CPU fallback). Returns the folder, the CPU's and the
+/// engine's `stabilizer 1 lateral, side force, surface torque` columns' worst relative
+/// difference, printed with each column.
+#[allow(dead_code)]
+pub fn engine_against_cpu(label: &str, text: &str) -> (std::path::PathBuf, f64) {
+    let dir = std::env::temp_dir().join(format!("holewall-{label}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let case = dir.join(format!("{label}.toml"));
+    std::fs::write(&case, text).unwrap();
+    let run = |backend, out: &str| {
+        holewall::ensemble::job::run(
+            &case,
+            None,
+            backend,
+            holewall::backend::Precision::F64,
+            &dir.join(out),
+            false,
+            &Default::default(),
+        )
+        .unwrap()
+    };
+    let cpu = run(holewall::backend::BackendChoice::Cpu, "cpu");
+    let gpu = run(holewall::backend::BackendChoice::Gpu, "gpu");
+    assert_eq!((cpu.failed, gpu.failed), (0, 0));
+    assert_eq!(gpu.backend, "gpu");
+    assert_eq!(gpu.solved_by_engine, gpu.variants, "{:?}", gpu.backend_note);
+    let mut worst: f64 = 0.0;
+    for q in [
+        "stab1_max_lateral_m",
+        "stab1_max_side_force_n",
+        "max_surface_torque_nm",
+    ] {
+        let (a, b) = (
+            variants_column(&dir.join("gpu"), q),
+            variants_column(&dir.join("cpu"), q),
+        );
+        eprintln!("{label}, {q}: GPU engine {a:?}, CPU {b:?}");
+        for (x, y) in a.iter().zip(&b) {
+            worst = worst.max((x - y).abs() / y.abs().max(1e-9));
+        }
+    }
+    (dir, worst)
+}
