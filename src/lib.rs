@@ -11,6 +11,7 @@
 pub mod backend;
 pub mod case;
 pub mod cli;
+pub mod corpus;
 pub mod diagnose;
 pub mod engine;
 pub mod ensemble;

@@ -241,6 +241,30 @@ enum BenchCommand {
         #[arg(long)]
         json: Option<PathBuf>,
     },
+    /// The FE static solve on a corpus of ordinary wells drawn from seeds (issue 22):
+    /// solved / total, load steps, cuts, iterations and time per well, FE/soft-string
+    /// hook-load and torque ratios (corpus.csv, summary.json, plots); the first
+    /// `--engine-sample` wells also through the ensemble engine (twin f64, GPU f64, f32).
+    Corpus {
+        /// Wells (seeds first-seed, first-seed + 1, …).
+        #[arg(long, default_value_t = 500)]
+        wells: usize,
+        /// First seed.
+        #[arg(long, default_value_t = 0)]
+        first_seed: u64,
+        /// Wells also run through the engine.
+        #[arg(long, default_value_t = 0)]
+        engine_sample: usize,
+        /// Start no new well after this many seconds (the rest are reported as not run).
+        #[arg(long, value_parser = positive_seconds)]
+        max_seconds: Option<f64>,
+        /// Output folder (created; wells/ holds each well's case and survey).
+        #[arg(long)]
+        out: PathBuf,
+        /// No progress bar.
+        #[arg(long)]
+        quiet: bool,
+    },
     /// Time steps per second and Newton iterations per step of `holewall run` (CPU f64).
     Dynamics {
         /// Case file with a `[dynamics]` table.
@@ -546,6 +570,41 @@ fn main() -> ExitCode {
                 json,
             } => match cli::bench::element(states, repeats, json.as_deref()) {
                 Ok(()) => ExitCode::SUCCESS,
+                Err(e) => fail(&[e]),
+            },
+            BenchCommand::Corpus {
+                wells,
+                first_seed,
+                engine_sample,
+                max_seconds,
+                out,
+                quiet,
+            } => match cli::bench_corpus::run(
+                &out,
+                &cli::bench_corpus::CorpusOptions {
+                    wells,
+                    first_seed,
+                    engine_sample,
+                    max_seconds,
+                    show_progress: !quiet,
+                },
+            ) {
+                Ok(s) => {
+                    println!(
+                        "{} of {} wells solved ({} not run); time per well median {:.2} s, worst {:.2} s (seed {:?}); at 10 m elements median {:.2} s, worst {:.2} s; engine {:?}; {}",
+                        s.solved,
+                        s.wells,
+                        s.not_run,
+                        s.seconds.median,
+                        s.seconds.worst,
+                        s.seconds.worst_seed,
+                        s.seconds_10m.median,
+                        s.seconds_10m.worst,
+                        s.engine,
+                        out.join("summary.json").display()
+                    );
+                    ExitCode::SUCCESS
+                }
                 Err(e) => fail(&[e]),
             },
             BenchCommand::Dynamics {

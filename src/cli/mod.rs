@@ -1,6 +1,7 @@
 //! The commands behind the `holewall` binary (argument parsing stays in `src/main.rs`).
 
 pub mod bench;
+pub mod bench_corpus;
 pub mod bench_ensemble;
 pub mod contact;
 pub mod ensemble_cmd;

@@ -1,0 +1,274 @@
+//! `holewall bench corpus`: the FE static solve on a corpus of ordinary wells drawn from
+//! seeds ([`crate::corpus`]) — solved / total, load steps, cuts, iterations and time per
+//! well, FE/soft-string hook-load and torque ratios — as `corpus.csv`, `summary.json` and
+//! plots; a sample through the ensemble engine (twin f64, GPU f64 and f32).
+
+use std::collections::BTreeMap;
+use std::path::Path;
+
+use serde::Serialize;
+
+use crate::corpus::{run_well, run_well_engine, write_well, EngineOutcome, EnginePath, WellResult};
+use crate::error::Error;
+use crate::solve::statics::StaticOptions;
+
+/// Options of the command.
+#[derive(Clone, Debug)]
+pub struct CorpusOptions {
+    /// Wells (seeds `first_seed …`).
+    pub wells: usize,
+    /// First seed.
+    pub first_seed: u64,
+    /// Wells of the corpus also run through the engine (the first ones).
+    pub engine_sample: usize,
+    /// Stop starting wells after this many seconds.
+    pub max_seconds: Option<f64>,
+    /// Progress bar.
+    pub show_progress: bool,
+}
+
+/// Median and worst of a figure, with the seed of the worst.
+#[derive(Clone, Debug, Serialize)]
+pub struct Spread {
+    /// Median.
+    pub median: f64,
+    /// Largest.
+    pub worst: f64,
+    /// Seed of the largest.
+    pub worst_seed: Option<u64>,
+}
+
+fn spread(values: &[(u64, f64)]) -> Spread {
+    let mut v: Vec<(u64, f64)> = values.iter().copied().filter(|x| x.1.is_finite()).collect();
+    v.sort_by(|a, b| a.1.total_cmp(&b.1));
+    if v.is_empty() {
+        return Spread {
+            median: f64::NAN,
+            worst: f64::NAN,
+            worst_seed: None,
+        };
+    }
+    Spread {
+        median: v[v.len() / 2].1,
+        worst: v[v.len() - 1].1,
+        worst_seed: Some(v[v.len() - 1].0),
+    }
+}
+
+/// `summary.json` of the benchmark.
+#[derive(Clone, Debug, Serialize)]
+pub struct CorpusSummary {
+    /// Wells run.
+    pub wells: usize,
+    /// Wells drawn but not run (the time budget ran out).
+    pub not_run: usize,
+    /// Solved at full load.
+    pub solved: usize,
+    /// Seeds of the wells that failed, with the first line of why.
+    pub failed: Vec<(u64, String)>,
+    /// Solved / total per trajectory kind.
+    pub by_trajectory: BTreeMap<String, (usize, usize)>,
+    /// Solved / total per pipe element length (m).
+    pub by_element_length: BTreeMap<String, (usize, usize)>,
+    /// Solved / total per operation.
+    pub by_mode: BTreeMap<String, (usize, usize)>,
+    /// Solved wells whose load path cut a step or changed stage (reported, not a pass).
+    pub solved_with_cuts: usize,
+    /// Time per well (s), every well.
+    pub seconds: Spread,
+    /// Time per well (s), wells meshed with 10 m pipe elements.
+    pub seconds_10m: Spread,
+    /// Newton iterations per solved well.
+    pub iterations: Spread,
+    /// FE / soft-string hook load, solved wells (median; worst = largest |ratio − 1|).
+    pub hook_load_ratio: (f64, f64, f64),
+    /// FE / soft-string surface torque, solved rotating wells (min, median, max).
+    pub torque_ratio: (f64, f64, f64),
+    /// The engine sample: solved / run per path (paths that cannot run here say why).
+    pub engine: BTreeMap<String, String>,
+    /// The engine's hook load against the CPU FE's, largest relative difference per path.
+    pub engine_hook_difference: BTreeMap<String, f64>,
+    /// Total wall time (s).
+    pub wall_seconds: f64,
+}
+
+fn min_med_max(mut v: Vec<f64>) -> (f64, f64, f64) {
+    v.retain(|x| x.is_finite());
+    v.sort_by(f64::total_cmp);
+    if v.is_empty() {
+        return (f64::NAN, f64::NAN, f64::NAN);
+    }
+    (v[0], v[v.len() / 2], v[v.len() - 1])
+}
+
+/// Runs the benchmark into `out` (created; `wells/` holds every well's case and survey).
+pub fn run(out: &Path, options: &CorpusOptions) -> Result<CorpusSummary, Error> {
+    let io = |e: String| Error::Io(std::io::Error::other(e));
+    let clock = std::time::Instant::now();
+    let wells_dir = out.join("wells");
+    std::fs::create_dir_all(&wells_dir)?;
+    let bar = crate::output::progress_bar(
+        options.show_progress,
+        options.wells as u64,
+        "{bar:40} {pos}/{len} wells, {elapsed} elapsed, {msg}",
+    );
+    let mut results: Vec<WellResult> = Vec::new();
+    let mut drawn = Vec::new();
+    let static_options = StaticOptions::default();
+    for k in 0..options.wells {
+        if options
+            .max_seconds
+            .is_some_and(|s| clock.elapsed().as_secs_f64() > s)
+        {
+            break;
+        }
+        let seed = options.first_seed + k as u64;
+        let well = write_well(seed, &wells_dir).map_err(io)?;
+        let r = run_well(&well, &static_options).map_err(io)?;
+        drawn.push(well);
+        results.push(r);
+        let solved = results.iter().filter(|r| r.solved).count();
+        bar.set_message(format!("{solved} solved"));
+        bar.inc(1);
+    }
+    bar.finish_and_clear();
+
+    // The engine sample.
+    let mut engine_rows: Vec<EngineOutcome> = Vec::new();
+    let mut engine = BTreeMap::new();
+    let mut engine_hook_difference = BTreeMap::new();
+    for path in [EnginePath::Twin, EnginePath::GpuF64, EnginePath::GpuF32] {
+        let name = format!("{path:?}").to_lowercase();
+        let mut run = 0;
+        let mut ok = 0;
+        let mut worst: f64 = 0.0;
+        let mut why = None;
+        for (well, cpu) in drawn.iter().zip(&results).take(options.engine_sample) {
+            match run_well_engine(well, path) {
+                Ok(o) => {
+                    run += 1;
+                    if o.solved {
+                        ok += 1;
+                        if cpu.solved {
+                            worst = worst.max(
+                                ((o.hook_load_n - cpu.fe_hook_load_n) / cpu.fe_hook_load_n).abs(),
+                            );
+                        }
+                    }
+                    engine_rows.push(o);
+                }
+                Err(e) => {
+                    why = Some(e);
+                    break;
+                }
+            }
+        }
+        if options.engine_sample > 0 {
+            engine.insert(
+                name.clone(),
+                match why {
+                    Some(e) if run == 0 => format!("not run: {e}"),
+                    _ => format!("{ok}/{run}"),
+                },
+            );
+            engine_hook_difference.insert(name, worst);
+        }
+    }
+
+    let count = |f: &dyn Fn(&WellResult) -> String| {
+        let mut m: BTreeMap<String, (usize, usize)> = BTreeMap::new();
+        for r in &results {
+            let e = m.entry(f(r)).or_default();
+            e.0 += usize::from(r.solved);
+            e.1 += 1;
+        }
+        m
+    };
+    let solved: Vec<&WellResult> = results.iter().filter(|r| r.solved).collect();
+    let hook: Vec<f64> = solved.iter().map(|r| r.hook_load_ratio).collect();
+    let summary = CorpusSummary {
+        wells: results.len(),
+        not_run: options.wells - results.len(),
+        solved: solved.len(),
+        failed: results
+            .iter()
+            .filter(|r| !r.solved)
+            .map(|r| {
+                (
+                    r.spec.seed,
+                    r.error.lines().next().unwrap_or_default().to_string(),
+                )
+            })
+            .collect(),
+        by_trajectory: count(&|r| r.spec.trajectory.name().to_string()),
+        by_element_length: count(&|r| format!("{:>4} m", r.spec.element_m)),
+        by_mode: count(&|r| r.spec.mode.clone()),
+        solved_with_cuts: solved.iter().filter(|r| r.step_cuts > 0).count(),
+        seconds: spread(
+            &results
+                .iter()
+                .map(|r| (r.spec.seed, r.seconds))
+                .collect::<Vec<_>>(),
+        ),
+        seconds_10m: spread(
+            &results
+                .iter()
+                .filter(|r| r.spec.element_m == 10.0)
+                .map(|r| (r.spec.seed, r.seconds))
+                .collect::<Vec<_>>(),
+        ),
+        iterations: spread(
+            &solved
+                .iter()
+                .map(|r| (r.spec.seed, r.iterations as f64))
+                .collect::<Vec<_>>(),
+        ),
+        hook_load_ratio: min_med_max(hook),
+        torque_ratio: min_med_max(solved.iter().map(|r| r.torque_ratio).collect()),
+        engine,
+        engine_hook_difference,
+        wall_seconds: clock.elapsed().as_secs_f64(),
+    };
+
+    crate::output::write_csv_rows(&out.join("corpus.csv"), results.iter().map(WellResult::row))?;
+    if !engine_rows.is_empty() {
+        crate::output::write_csv_rows(&out.join("engine.csv"), &engine_rows)?;
+    }
+    let classes = ["solved", "failed"];
+    let class = |r: &WellResult| usize::from(!r.solved);
+    crate::plots::class_scatter(
+        &out.join("corpus_time.png"),
+        &format!(
+            "FE static solve, {} of {} corpus wells solved: time per well",
+            summary.solved, summary.wells
+        ),
+        "nodes of the mesh",
+        "wall time (s)",
+        &results
+            .iter()
+            .map(|r| (r.nodes as f64, r.seconds, class(r)))
+            .collect::<Vec<_>>(),
+        &classes,
+    )?;
+    crate::plots::class_scatter(
+        &out.join("corpus_map.png"),
+        "Where the FE static solve fails: pipe element length against measured depth",
+        "measured depth (m)",
+        "pipe element length (m)",
+        &results
+            .iter()
+            .map(|r| (r.spec.total_md, r.spec.element_m, class(r)))
+            .collect::<Vec<_>>(),
+        &classes,
+    )?;
+    crate::plots::histogram(
+        &out.join("corpus_hook_ratio.png"),
+        "FE / soft-string hook load, solved corpus wells",
+        "hook load ratio FE / soft string (–)",
+        &solved.iter().map(|r| r.hook_load_ratio).collect::<Vec<_>>(),
+        &[("median", summary.hook_load_ratio.1)],
+    )?;
+    let json = serde_json::to_vec_pretty(&summary).map_err(|e| io(e.to_string()))?;
+    crate::output::write_atomic(&out.join("summary.json"), &json)?;
+    Ok(summary)
+}

@@ -1,0 +1,748 @@
+//! A corpus of ordinary wells drawn from seeds (issue 22): what drilling engineers bring to
+//! a static solve, to measure whether the solver works on it rather than on the wells it
+//! was tuned on.
+//!
+//! Each seed gives one well as a case file and a survey CSV — written to a folder and read
+//! back through the case parser, exactly as a user's files are:
+//! - **trajectory**: vertical, build-and-hold, S-shaped (build, hold, drop) or horizontal
+//!   (build to 86–92°, then a lateral), each possibly with a turn; stations every 30 m with
+//!   dogleg noise (σ 0.05–0.4° per station in inclination and azimuth); 1,000–4,500 m MD;
+//! - **hole**: 6, 6⅛, 8½, 8¾, 9⅞ or 12¼ in open hole below a casing of the size above it
+//!   (shoe at 20–70 % of MD), friction 0.15–0.25 cased, 0.2–0.4 open; mud 1.0–1.8 sg;
+//! - **string**: drill pipe, 0–300 m of HWDP, 30–250 m of collars sized to the hole, 0–4
+//!   stabilizers (near-bit and 5–30 m apart, blades up to ½ in under gauge), a bent motor
+//!   housing (0.5–2°) in one well in eight;
+//! - **operation**: rotating off bottom, drilling (rotating on bottom), sliding, tripping in
+//!   or out; the weight on bit drawn up to the soft-string sinusoidal-buckling limit of the
+//!   string (capped at 150 kN), the torque on bit with it;
+//! - **mesh**: pipe elements of 0.5–30 m, BHA elements of 0.25–2 m; contact at every node
+//!   (at the stabilizers only in a vertical well with stabilizers);
+//! - **wall**: stiffness 1e6–1e9 N/m log-uniform, a linear law (a hard m = 3/2 or soft
+//!   m = 2/3 law in one well in ten each, its stiffness giving the same force at 1 mm).
+//!
+//! [`run_well`] solves one well with the FE static solve and the soft string and reports
+//! what a user would see: solved or not (with the message), load steps and cuts, Newton
+//! iterations, time, and the FE/soft-string hook-load and torque ratios.
+
+use std::path::{Path, PathBuf};
+
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use serde::Serialize;
+
+/// Kinds of trajectory in the corpus.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Trajectory {
+    /// Vertical (with survey noise).
+    Vertical,
+    /// Kick-off, build, hold.
+    BuildAndHold,
+    /// Kick-off, build, hold, drop, hold.
+    SShaped,
+    /// Kick-off, build to about 90°, lateral.
+    Horizontal,
+}
+
+impl Trajectory {
+    /// Name as in the CSV.
+    pub fn name(self) -> &'static str {
+        match self {
+            Trajectory::Vertical => "vertical",
+            Trajectory::BuildAndHold => "build_and_hold",
+            Trajectory::SShaped => "s_shaped",
+            Trajectory::Horizontal => "horizontal",
+        }
+    }
+}
+
+/// What a corpus well is (for the table).
+#[derive(Clone, Debug, Serialize)]
+pub struct WellSpec {
+    /// Seed it was drawn from.
+    pub seed: u64,
+    /// Trajectory kind.
+    pub trajectory: Trajectory,
+    /// Whether the azimuth turns.
+    pub turn: bool,
+    /// Bit depth (m).
+    pub total_md: f64,
+    /// Largest inclination (deg).
+    pub max_inclination_deg: f64,
+    /// Open-hole diameter (in).
+    pub hole_in: f64,
+    /// Operation: `rotating`, `drilling`, `sliding`, `tripping_in`, `tripping_out`.
+    pub mode: String,
+    /// Weight on bit (N).
+    pub wob_n: f64,
+    /// Pipe element length (m).
+    pub element_m: f64,
+    /// BHA element length (m).
+    pub bha_element_m: f64,
+    /// Stabilizers.
+    pub stabilizers: usize,
+    /// Bent housing angle (deg), 0 for none.
+    pub bend_deg: f64,
+    /// Contact sites: `all_nodes` or `stabilizers`.
+    pub sites: String,
+    /// Wall stiffness (N/m^m).
+    pub wall_stiffness: f64,
+    /// Spring exponent.
+    pub exponent: f64,
+}
+
+/// A drawn well, written out.
+#[derive(Clone, Debug)]
+pub struct CorpusWell {
+    /// What it is.
+    pub spec: WellSpec,
+    /// The case file.
+    pub case_path: PathBuf,
+}
+
+struct HoleSize {
+    hole_in: f64,
+    casing_id_in: f64,
+    pipe: (f64, f64),
+    hwdp: (f64, f64),
+    collars: &'static [(f64, f64)],
+}
+
+const SIZES: [HoleSize; 6] = [
+    HoleSize {
+        hole_in: 6.0,
+        casing_id_in: 6.276,
+        pipe: (3.5, 2.764),
+        hwdp: (3.5, 2.25),
+        collars: &[(4.75, 2.25)],
+    },
+    HoleSize {
+        hole_in: 6.125,
+        casing_id_in: 6.276,
+        pipe: (4.0, 3.34),
+        hwdp: (4.0, 2.5625),
+        collars: &[(4.75, 2.25), (5.0, 2.25)],
+    },
+    HoleSize {
+        hole_in: 8.5,
+        casing_id_in: 8.835,
+        pipe: (5.0, 4.276),
+        hwdp: (5.0, 3.0),
+        collars: &[(6.5, 2.8125), (6.75, 2.8125)],
+    },
+    HoleSize {
+        hole_in: 8.75,
+        casing_id_in: 8.835,
+        pipe: (5.0, 4.276),
+        hwdp: (5.0, 3.0),
+        collars: &[(6.5, 2.8125), (6.75, 2.8125)],
+    },
+    HoleSize {
+        hole_in: 9.875,
+        casing_id_in: 10.05,
+        pipe: (5.0, 4.276),
+        hwdp: (5.0, 3.0),
+        collars: &[(7.0, 2.8125), (6.75, 2.8125)],
+    },
+    HoleSize {
+        hole_in: 12.25,
+        casing_id_in: 12.415,
+        pipe: (5.5, 4.778),
+        hwdp: (5.5, 3.375),
+        collars: &[(8.0, 2.8125), (9.5, 3.0)],
+    },
+];
+
+const INCH: f64 = 0.0254;
+
+/// Survey stations (md, inclination, azimuth; deg) every 30 m of a trajectory with noise.
+fn survey(rng: &mut ChaCha8Rng, kind: Trajectory, total_md: f64) -> (Vec<[f64; 3]>, bool) {
+    // Piecewise plan: (md where a rate starts, inclination rate °/30 m, target inclination).
+    let azimuth0 = rng.random_range(0.0..360.0);
+    let kop = match kind {
+        Trajectory::Vertical => total_md,
+        Trajectory::Horizontal => rng.random_range(0.15..0.45) * total_md,
+        _ => rng.random_range(0.1..0.5) * total_md,
+    };
+    let build = match kind {
+        Trajectory::Horizontal => rng.random_range(3.0..8.0),
+        _ => rng.random_range(1.0..4.0),
+    };
+    let hold_inc = match kind {
+        Trajectory::Vertical => 0.0,
+        Trajectory::BuildAndHold => rng.random_range(15.0..70.0),
+        Trajectory::SShaped => rng.random_range(20.0..45.0),
+        Trajectory::Horizontal => rng.random_range(86.0..92.0),
+    };
+    let drop_at = kop
+        + 30.0 * hold_inc / build
+        + rng.random_range(0.1..0.4) * (total_md - kop - 30.0 * hold_inc / build).max(0.0);
+    let drop = rng.random_range(1.0..3.0);
+    let final_inc = rng.random_range(0.0..10.0);
+    let turn = kind != Trajectory::Vertical && rng.random_bool(0.4);
+    let (turn_from, turn_to, turn_rate) = if turn {
+        let a = rng.random_range(kop..total_md);
+        let b = rng.random_range(a..total_md);
+        let rate = rng.random_range(0.5..3.0) * if rng.random_bool(0.5) { 1.0 } else { -1.0 };
+        (a, b, rate)
+    } else {
+        (0.0, 0.0, 0.0)
+    };
+    let sigma = rng.random_range(0.05..0.4);
+    let mut out = Vec::new();
+    let (mut inc, mut az) = (0.0f64, azimuth0);
+    let mut md = 0.0;
+    let noise = |rng: &mut ChaCha8Rng| {
+        // Box–Muller: normal noise without another crate.
+        let u1: f64 = rng.random_range(1e-12..1.0);
+        let u2: f64 = rng.random();
+        sigma * (-2.0 * u1.ln()).sqrt() * (std::f64::consts::TAU * u2).cos()
+    };
+    loop {
+        let (ni, na) = (noise(rng), noise(rng));
+        let inc_out = if inc < 1e-9 {
+            ni.abs()
+        } else {
+            (inc + ni).clamp(0.0, 179.0)
+        };
+        let az_noise = na / (inc_out.to_radians().sin()).max(0.1);
+        out.push([md, inc_out, (az + az_noise).rem_euclid(360.0)]);
+        if md >= total_md {
+            break;
+        }
+        let next = (md + 30.0).min(total_md + 30.0);
+        // Inclination plan at the next station.
+        if next > kop {
+            if kind == Trajectory::SShaped && next > drop_at {
+                inc = (inc - drop).max(final_inc);
+            } else {
+                inc = (inc + build).min(hold_inc);
+            }
+        }
+        if turn && next > turn_from && next <= turn_to {
+            az += turn_rate;
+        }
+        md = next;
+    }
+    (out, turn)
+}
+
+fn pick<T: Copy>(rng: &mut ChaCha8Rng, items: &[(T, f64)]) -> T {
+    let total: f64 = items.iter().map(|x| x.1).sum();
+    let mut r = rng.random_range(0.0..total);
+    for &(x, w) in items {
+        if r < w {
+            return x;
+        }
+        r -= w;
+    }
+    items[items.len() - 1].0
+}
+
+/// Draws well `seed` and writes it into `dir` (`well_<seed>.toml` and `.csv`). The weight on
+/// bit is drawn up to the soft-string sinusoidal-buckling limit of the string as meshed,
+/// so the case is read once without it first.
+pub fn write_well(seed: u64, dir: &Path) -> Result<CorpusWell, String> {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let trajectory = pick(
+        &mut rng,
+        &[
+            (Trajectory::Vertical, 0.1),
+            (Trajectory::BuildAndHold, 0.35),
+            (Trajectory::SShaped, 0.25),
+            (Trajectory::Horizontal, 0.3),
+        ],
+    );
+    let total_md = rng.random_range(1000.0f64..4500.0).round();
+    let (stations, turn) = survey(&mut rng, trajectory, total_md);
+    let size = &SIZES[rng.random_range(0..SIZES.len())];
+    let shoe = (rng.random_range(0.2..0.7) * total_md).round();
+    let mu_cased = rng.random_range(0.15..0.25);
+    let mu_open = rng.random_range(0.2..0.4);
+    let sg = rng.random_range(1.0..1.8);
+    let collar = size.collars[rng.random_range(0..size.collars.len())];
+    let collar_len = rng.random_range(30.0f64..250.0).round();
+    let hwdp_len = if rng.random_bool(0.6) {
+        rng.random_range(50.0f64..300.0).round()
+    } else {
+        0.0
+    };
+    let stabilizers = pick(
+        &mut rng,
+        &[(0usize, 0.2), (1, 0.3), (2, 0.25), (3, 0.15), (4, 0.1)],
+    );
+    let bend = if rng.random_bool(0.125) {
+        rng.random_range(0.5f64..2.0)
+    } else {
+        0.0
+    };
+    let mode = pick(
+        &mut rng,
+        &[
+            ("rotating", 0.2),
+            ("drilling", 0.3),
+            ("sliding", 0.15),
+            ("tripping_in", 0.175),
+            ("tripping_out", 0.175),
+        ],
+    );
+    let wob_fraction: f64 = rng.random();
+    let rpm = rng.random_range(40.0f64..180.0).round();
+    let element: f64 = pick(
+        &mut rng,
+        &[
+            (0.5, 0.05),
+            (1.0, 0.1),
+            (2.0, 0.1),
+            (5.0, 0.2),
+            (10.0, 0.25),
+            (15.0, 0.05),
+            (20.0, 0.15),
+            (30.0, 0.1),
+        ],
+    );
+    let bha_element: f64 = pick(
+        &mut rng,
+        &[
+            (0.25f64, 0.1),
+            (0.5, 0.25),
+            (1.0, 0.35),
+            (1.5, 0.15),
+            (2.0, 0.15),
+        ],
+    )
+    .min(element);
+    let sites = if trajectory == Trajectory::Vertical && stabilizers > 0 && rng.random_bool(0.5) {
+        "stabilizers"
+    } else {
+        "all_nodes"
+    };
+    let exponent = pick(&mut rng, &[(1.0, 0.8), (1.5, 0.1), (2.0 / 3.0, 0.1)]);
+    let k_linear = 10f64.powf(rng.random_range(6.0..9.0));
+    let wall_stiffness = k_linear * 1e-3f64.powf(1.0 - exponent);
+    let under_gauge: Vec<f64> = (0..stabilizers)
+        .map(|_| rng.random_range(0.0..0.5))
+        .collect();
+    let spacing: Vec<f64> = (0..stabilizers)
+        .map(|_| rng.random_range(5.0f64..30.0).round())
+        .collect();
+
+    // The string from the bit up.
+    let mut comps: Vec<String> = Vec::new();
+    let tube = |kind: &str, len: f64, od: f64, id: f64, extra: &str| {
+        format!(
+            "[[string]]\nkind = \"{kind}\"\nlength = \"{len} m\"\nod = \"{od} in\"\nid = \"{id} in\"\n{extra}"
+        )
+    };
+    let (cod, cid) = collar;
+    comps.push(tube("bit", 0.3, cod, cid, ""));
+    let mut used = 0.3;
+    let motor_len = if bend > 0.0 {
+        rng.random_range(6.0f64..9.0).round()
+    } else {
+        0.0
+    };
+    if bend > 0.0 {
+        comps.push(tube(
+            "motor",
+            motor_len,
+            cod,
+            cid,
+            &format!(
+                "bend = \"{bend:.2} deg\"\nbend_from_bottom = \"{:.1} m\"\n",
+                rng.random_range(1.0..2.5)
+            ),
+        ));
+        used += motor_len;
+    }
+    for (k, (ug, gap)) in under_gauge.iter().zip(&spacing).enumerate() {
+        let gap = if k == 0 { 0.0 } else { *gap };
+        if gap > 0.0 {
+            comps.push(tube("collar", gap, cod, cid, ""));
+            used += gap;
+        }
+        let blade = size.hole_in - ug;
+        comps.push(tube(
+            "stabilizer",
+            1.5,
+            cod,
+            cid,
+            &format!("blade_diameter = \"{blade:.4} in\"\n"),
+        ));
+        used += 1.5;
+    }
+    let rest = (collar_len - used).max(9.0);
+    comps.push(tube("collar", rest, cod, cid, ""));
+    used += rest;
+    if hwdp_len > 0.0 {
+        comps.push(tube("hwdp", hwdp_len, size.hwdp.0, size.hwdp.1, ""));
+        used += hwdp_len;
+    }
+    comps.push(tube(
+        "drill_pipe",
+        (total_md - used + 1.0).max(1.0).round(),
+        size.pipe.0,
+        size.pipe.1,
+        "",
+    ));
+
+    let name = format!("well_{seed}");
+    let csv_name = format!("{name}.csv");
+    let mut csv = String::from("md_m, inclination_deg, azimuth_deg\n");
+    for s in &stations {
+        csv.push_str(&format!("{:.2}, {:.4}, {:.4}\n", s[0], s[1], s[2]));
+    }
+    std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    std::fs::write(dir.join(&csv_name), csv).map_err(|e| e.to_string())?;
+    let max_inc = stations.iter().map(|s| s[1]).fold(0.0, f64::max);
+    let (op_mode, rotating) = match mode {
+        "drilling" => ("rotating", true),
+        "rotating" => ("rotating", true),
+        m => (m, false),
+    };
+    let on_bottom = matches!(mode, "drilling" | "sliding");
+    let case_text = |wob: f64| {
+        let mut t = format!(
+            "title = \"corpus well {seed}: {} {}{}, {total_md} m, {} in hole, {mode}\"\n",
+            trajectory.name(),
+            if turn { "with turn" } else { "" },
+            if bend > 0.0 { ", bent housing" } else { "" },
+            size.hole_in
+        );
+        t.push_str(&format!(
+            "[well]\nprofile = \"survey\"\nsurvey = \"{csv_name}\"\ntotal_md = \"{total_md} m\"\n"
+        ));
+        t.push_str(&format!(
+            "[[hole]]\nbottom_md = \"{shoe} m\"\ndiameter = \"{} in\"\ncased = true\nfriction = {mu_cased:.3}\n",
+            size.casing_id_in
+        ));
+        t.push_str(&format!(
+            "[[hole]]\nbottom_md = \"{total_md} m\"\ndiameter = \"{} in\"\nfriction = {mu_open:.3}\n",
+            size.hole_in
+        ));
+        t.push_str(&format!("[mud]\ndensity = \"{sg:.3} sg\"\n"));
+        for c in &comps {
+            t.push_str(c);
+        }
+        t.push_str(&format!("[operation]\nmode = \"{op_mode}\"\n"));
+        if rotating {
+            t.push_str(&format!("rpm = \"{rpm} rpm\"\n"));
+        }
+        if on_bottom && wob > 0.0 {
+            t.push_str(&format!(
+                "weight_on_bit = \"{:.3} kN\"\ntorque_on_bit = \"{:.3} kN.m\"\n",
+                wob / 1e3,
+                if rotating {
+                    0.02 * wob / 1e3 * size.hole_in * INCH / 0.2159
+                } else {
+                    0.0
+                }
+            ));
+        }
+        t.push_str(&format!(
+            "[contact]\nsites = \"{sites}\"\nwall_stiffness = {wall_stiffness:.6e}\nexponent = {exponent:.6}\n"
+        ));
+        t.push_str(&format!(
+            "[mesh]\nelement_length = \"{element} m\"\nbha_element_length = \"{bha_element} m\"\n"
+        ));
+        t
+    };
+    let case_path = dir.join(format!("{name}.toml"));
+    let mut wob = 0.0;
+    if on_bottom {
+        let text = case_text(0.0);
+        let case = crate::case::parse_case(&case_path, &text).map_err(|e| e.to_string())?;
+        let limit = buckling_limited_wob(&case, mode == "sliding").min(150e3);
+        wob = (wob_fraction * limit / 100.0).round() * 100.0;
+    }
+    let text = case_text(wob);
+    crate::output::write_atomic(&case_path, text.as_bytes()).map_err(|e| e.to_string())?;
+    Ok(CorpusWell {
+        spec: WellSpec {
+            seed,
+            trajectory,
+            turn,
+            total_md,
+            max_inclination_deg: max_inc,
+            hole_in: size.hole_in,
+            mode: mode.to_string(),
+            wob_n: wob,
+            element_m: element,
+            bha_element_m: bha_element,
+            stabilizers,
+            bend_deg: bend,
+            sites: sites.to_string(),
+            wall_stiffness,
+            exponent,
+        },
+        case_path,
+    })
+}
+
+/// The largest weight on bit (N) at which the soft-string compression stays below the
+/// sinusoidal-buckling load of every element (bisection; friction of the operation).
+pub fn buckling_limited_wob(case: &crate::case::Case, sliding: bool) -> f64 {
+    use crate::physics::soft_string::{soft_string_with, Operation};
+    let model = &case.model;
+    let ok = |wob: f64| {
+        let op = Operation {
+            axial_speed: if sliding { 0.01 } else { 0.0 },
+            rotation_speed: if sliding { 0.0 } else { 1.0 },
+            weight_on_bit: wob,
+            torque_on_bit: 0.0,
+            friction: 0.0,
+        };
+        let prof = soft_string_with(model, &op, &|md| case.hole_at(md).2);
+        (0..model.elements.len()).all(|e| {
+            let f = -0.5 * (prof.tension[e] + prof.tension[e + 1]);
+            let md = 0.5 * (model.nodes[e].md + model.nodes[e + 1].md);
+            f <= 0.0 || f <= crate::diagnose::critical_loads(model, e, case.hole_diameter_at(md)).0
+        })
+    };
+    let (mut lo, mut hi) = (0.0, 1e6);
+    if !ok(lo) {
+        return 0.0;
+    }
+    for _ in 0..40 {
+        let mid = 0.5 * (lo + hi);
+        if ok(mid) {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    lo
+}
+
+/// One well's outcome (a row of `corpus.csv`).
+#[derive(Clone, Debug, Serialize)]
+pub struct WellResult {
+    /// The well.
+    #[serde(skip)]
+    pub spec: WellSpec,
+    /// Nodes of the mesh.
+    pub nodes: usize,
+    /// Whether the FE static solve converged at full load.
+    pub solved: bool,
+    /// Load steps completed (the gravity stage included).
+    pub load_steps: usize,
+    /// Load-step cuts and stage changes (each a result to report, not a pass).
+    pub step_cuts: usize,
+    /// Newton iterations over all steps.
+    pub iterations: usize,
+    /// Wall time of the FE solve (s).
+    pub seconds: f64,
+    /// FE hook load (N).
+    pub fe_hook_load_n: f64,
+    /// Soft-string hook load (N).
+    pub soft_hook_load_n: f64,
+    /// FE / soft-string hook load.
+    pub hook_load_ratio: f64,
+    /// FE surface torque (N·m).
+    pub fe_torque_nm: f64,
+    /// Soft-string surface torque (N·m).
+    pub soft_torque_nm: f64,
+    /// FE / soft-string surface torque (rotating modes; NaN otherwise).
+    pub torque_ratio: f64,
+    /// The failure's message (empty when solved).
+    pub error: String,
+}
+
+/// Solves a corpus well with the FE static solve (on the CPU, f64) and the soft string.
+pub fn run_well(
+    well: &CorpusWell,
+    options: &crate::solve::statics::StaticOptions,
+) -> Result<WellResult, String> {
+    let case = crate::case::load_case(&well.case_path).map_err(|e| e.to_string())?;
+    let model = &case.model;
+    let soft = case.soft_string();
+    let clock = std::time::Instant::now();
+    let solved = crate::solve::statics::solve_static(model, options);
+    let seconds = clock.elapsed().as_secs_f64();
+    let rotating = model.rotation_speed != 0.0;
+    let mut r = WellResult {
+        spec: well.spec.clone(),
+        nodes: model.nodes.len(),
+        solved: false,
+        load_steps: 0,
+        step_cuts: 0,
+        iterations: 0,
+        seconds,
+        fe_hook_load_n: f64::NAN,
+        soft_hook_load_n: soft.hook_load(),
+        hook_load_ratio: f64::NAN,
+        fe_torque_nm: f64::NAN,
+        soft_torque_nm: soft.surface_torque(),
+        torque_ratio: f64::NAN,
+        error: String::new(),
+    };
+    match solved {
+        Ok(sol) => {
+            let (_, hook, torque, _) = crate::cli::static_cmd::fe_rows(model, &sol);
+            r.solved = true;
+            r.load_steps = sol.iterations.len();
+            r.step_cuts = sol.log.len();
+            r.iterations = sol.iterations.iter().sum();
+            r.fe_hook_load_n = hook;
+            r.hook_load_ratio = hook / r.soft_hook_load_n;
+            r.fe_torque_nm = torque;
+            if rotating {
+                r.torque_ratio = torque / r.soft_torque_nm;
+            }
+        }
+        Err(e) => {
+            r.error = crate::diagnose::static_failure(&case, &e);
+        }
+    }
+    Ok(r)
+}
+
+/// Which engine path [`run_well_engine`] takes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum EnginePath {
+    /// The kernels' CPU twins (f64).
+    Twin,
+    /// The WGSL kernels in f64.
+    GpuF64,
+    /// The WGSL kernels in f32.
+    GpuF32,
+}
+
+/// One well through the ensemble engine (a chunk of one variant).
+#[derive(Clone, Debug, Serialize)]
+pub struct EngineOutcome {
+    /// Seed of the well.
+    pub seed: u64,
+    /// Path.
+    pub path: EnginePath,
+    /// Converged at full load.
+    pub solved: bool,
+    /// Newton iterations over all steps.
+    pub iterations: usize,
+    /// Load-step cuts and stage changes.
+    pub step_cuts: usize,
+    /// Wall time (s).
+    pub seconds: f64,
+    /// Engine hook load (N).
+    pub hook_load_n: f64,
+    /// Why it failed (empty when solved).
+    pub error: String,
+}
+
+/// Solves a corpus well through the ensemble engine on `path` (the same load path and
+/// Newton as the CPU solve, [`crate::solve::continuation`]). `Err` where the path cannot
+/// run here (no adapter, no f64).
+pub fn run_well_engine(well: &CorpusWell, path: EnginePath) -> Result<EngineOutcome, String> {
+    use crate::engine::{solve_static_ensemble, EngineStatus, GpuPath, TwinPath};
+    let case = crate::case::load_case(&well.case_path).map_err(|e| e.to_string())?;
+    let models = [case.model.clone()];
+    let options = crate::solve::statics::StaticOptions::default();
+    let clock = std::time::Instant::now();
+    let results = match path {
+        EnginePath::Twin => solve_static_ensemble(&models, &TwinPath, &options)?,
+        EnginePath::GpuF64 | EnginePath::GpuF32 => {
+            let ctx = crate::gpu::context::GpuContext::shared().map_err(|e| e.to_string())?;
+            if path == EnginePath::GpuF64 {
+                if !ctx.has_f64 {
+                    return Err(format!("{} has no f64 in shaders", ctx.describe()));
+                }
+                solve_static_ensemble::<f64, _>(&models, &GpuPath(ctx), &options)?
+            } else {
+                solve_static_ensemble::<f32, _>(&models, &GpuPath(ctx), &options)?
+            }
+        }
+    };
+    let seconds = clock.elapsed().as_secs_f64();
+    let r = results.into_iter().next().ok_or("no result")?;
+    let (solved, error) = match &r.status {
+        EngineStatus::Converged => (true, String::new()),
+        EngineStatus::Failed(why) => (false, why.clone()),
+    };
+    let hook_load_n = if solved {
+        let sol = crate::solve::statics::solution_at(&case.model, r.state.clone());
+        crate::cli::static_cmd::fe_rows(&case.model, &sol).1
+    } else {
+        f64::NAN
+    };
+    Ok(EngineOutcome {
+        seed: well.spec.seed,
+        path,
+        solved,
+        iterations: r.iterations.iter().sum(),
+        step_cuts: r.log.len(),
+        seconds,
+        hook_load_n,
+        error,
+    })
+}
+
+/// A flat row of `corpus.csv`: the well, then its outcome.
+#[derive(Clone, Debug, Serialize)]
+pub struct WellRow {
+    seed: u64,
+    trajectory: &'static str,
+    turn: bool,
+    total_md_m: f64,
+    max_inclination_deg: f64,
+    hole_in: f64,
+    mode: String,
+    wob_n: f64,
+    element_m: f64,
+    bha_element_m: f64,
+    stabilizers: usize,
+    bend_deg: f64,
+    sites: String,
+    wall_stiffness: f64,
+    exponent: f64,
+    nodes: usize,
+    solved: bool,
+    load_steps: usize,
+    step_cuts: usize,
+    iterations: usize,
+    seconds: f64,
+    fe_hook_load_n: f64,
+    soft_hook_load_n: f64,
+    hook_load_ratio: f64,
+    fe_torque_nm: f64,
+    soft_torque_nm: f64,
+    torque_ratio: f64,
+    error: String,
+}
+
+impl WellResult {
+    /// The row of `corpus.csv`.
+    pub fn row(&self) -> WellRow {
+        let s = &self.spec;
+        WellRow {
+            seed: s.seed,
+            trajectory: s.trajectory.name(),
+            turn: s.turn,
+            total_md_m: s.total_md,
+            max_inclination_deg: s.max_inclination_deg,
+            hole_in: s.hole_in,
+            mode: s.mode.clone(),
+            wob_n: s.wob_n,
+            element_m: s.element_m,
+            bha_element_m: s.bha_element_m,
+            stabilizers: s.stabilizers,
+            bend_deg: s.bend_deg,
+            sites: s.sites.clone(),
+            wall_stiffness: s.wall_stiffness,
+            exponent: s.exponent,
+            nodes: self.nodes,
+            solved: self.solved,
+            load_steps: self.load_steps,
+            step_cuts: self.step_cuts,
+            iterations: self.iterations,
+            seconds: self.seconds,
+            fe_hook_load_n: self.fe_hook_load_n,
+            soft_hook_load_n: self.soft_hook_load_n,
+            hook_load_ratio: self.hook_load_ratio,
+            fe_torque_nm: self.fe_torque_nm,
+            soft_torque_nm: self.soft_torque_nm,
+            torque_ratio: self.torque_ratio,
+            error: self.error.lines().next().unwrap_or_default().to_string(),
+        }
+    }
+}
