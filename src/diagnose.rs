@@ -91,12 +91,45 @@ pub fn static_failure(case: &Case, error: &StaticError) -> String {
     let mut msg = format!("the static solve failed: {error}");
     let from = error.reached();
     let model = &case.model;
-    msg.push_str(&format!(
-        "\n  it reached {:.1} % of the bit loads (WOB {:.1} kN of {:.1} kN)",
-        100.0 * from,
-        from * model.weight_on_bit / 1e3,
-        model.weight_on_bit / 1e3
-    ));
+    let gravity = matches!(error, StaticError::LoadStep { step, .. } if *step == 0.0);
+    if gravity {
+        msg.push_str(
+            "\n  the string found no equilibrium under its own weight: the bit loads and \
+             friction were not applied yet",
+        );
+    } else if model.weight_on_bit > 0.0 {
+        msg.push_str(&format!(
+            "\n  it reached {:.1} % of the bit loads and friction (WOB {:.1} kN of {:.1} kN)",
+            100.0 * from,
+            from * model.weight_on_bit / 1e3,
+            model.weight_on_bit / 1e3
+        ));
+    } else {
+        msg.push_str(&format!(
+            "\n  it reached {:.1} % of the friction (and other loads) of the operation",
+            100.0 * from
+        ));
+    }
+    if matches!(error, StaticError::LoadStep { .. }) {
+        let finest = model
+            .elements
+            .iter()
+            .filter(|e| {
+                model
+                    .elements
+                    .first()
+                    .is_some_and(|f| f.component == e.component)
+            })
+            .map(|e| e.length0)
+            .fold(f64::INFINITY, f64::min);
+        msg.push_str(&format!(
+            "\n  what to try: another mesh.element_length (now {:.1} m at the top; contacts \
+             that change along many short elements take the Newton one node per iteration), \
+             a softer contact.wall_stiffness, or `--model soft-string` for torque and drag \
+             alone",
+            finest
+        ));
+    }
     // The stiffest wall against the string's own lateral stiffness at that site (a beam
     // of the adjacent element's length, centrally loaded: 48 EI / L³).
     let ratio = model

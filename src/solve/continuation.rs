@@ -231,12 +231,32 @@ impl LoadPath {
     /// The step failed (`reason`): what follows, from the last converged state
     /// ([`Next::Failed`]: the variant has failed, [`LoadPath::error`] says why).
     pub fn failed(&mut self, reason: String) -> Next {
+        self.failed_at(reason, None)
+    }
+
+    /// As [`LoadPath::failed`], with where the residual force was largest (MD, m).
+    pub fn failed_at(&mut self, reason: String, at_md: Option<f64>) -> Next {
         let fail = |p: &mut LoadPath, step: f64, reason: String| {
+            let stage = match p.stage {
+                Stage::Gravity | Stage::Exponent { .. } => {
+                    "laying the string in the hole under its own weight (stage 1 of the load \
+                     path: gravity in full, no bit loads, no friction)"
+                        .to_string()
+                }
+                _ => format!(
+                    "applying the bit loads and friction (stage 2), the step λ {:.4} → {:.4}",
+                    p.lambda,
+                    (p.lambda + step).min(1.0)
+                ),
+            };
+            let gravity = matches!(p.stage, Stage::Gravity | Stage::Exponent { .. });
             p.error = Some(StaticError::LoadStep {
+                stage,
                 from: p.lambda,
-                step,
+                step: if gravity { 0.0 } else { step },
                 min: p.min_step,
                 reason,
+                at_md,
             });
             p.stage = Stage::Failed;
             Next::Failed
@@ -303,6 +323,11 @@ pub trait StaticSystem: NewtonSystem {
     fn restore(&mut self, j: usize) -> Result<(), String>;
     /// The rounding floor of a step of variant `j` ([`NewtonSettings::step_floor`]).
     fn step_floor(&mut self, j: usize) -> Result<f64, String>;
+    /// Where variant `j`'s residual force is largest now (MD, m), for a failure's
+    /// message; `None` where the system does not keep it at hand.
+    fn worst_residual_md(&mut self, _j: usize) -> Option<f64> {
+        None
+    }
 }
 
 /// Runs every variant's load path to its end through one [`Newton`]; `progress` gets the
@@ -382,7 +407,10 @@ fn next_steps(
         let path = &mut paths[j];
         let (next, converged) = match event {
             Event::Converged(its) => (path.converged(its), true),
-            Event::Failed(reason) => (path.failed(reason), false),
+            Event::Failed(reason) => {
+                let at = sys.worst_residual_md(j);
+                (path.failed_at(reason, at), false)
+            }
         };
         match (next, converged) {
             (Next::Step, true) => sys.save(j)?,

@@ -55,17 +55,23 @@ impl Default for StaticOptions {
 /// Why a static solve failed.
 #[derive(Clone, Debug, Error)]
 pub enum StaticError {
-    /// A load step could not be completed even at the smallest step size.
-    #[error("load step from λ = {from:.6} failed at step {step:.2e} (below the minimum {min:.2e}): {reason}")]
+    /// A stage of the load path could not be completed (a load step even at the smallest
+    /// step size).
+    #[error("{stage} failed{}: {reason}{}", if *step > 0.0 { format!(" (step {step:.2e}, the smallest allowed {min:.2e})") } else { String::new() }, at_md.map(|md| format!("; the largest residual force was at MD {md:.1} m")).unwrap_or_default())]
     LoadStep {
+        /// Which stage: laying the string under gravity, the spring-exponent continuation,
+        /// or a step of the bit loads and friction (with its λ).
+        stage: String,
         /// Load factor reached.
         from: f64,
-        /// Step tried last.
+        /// Step tried last (0: a stage without steps).
         step: f64,
         /// Minimum step.
         min: f64,
         /// The last failure.
         reason: String,
+        /// Where the residual force was largest when it failed (MD, m), where known.
+        at_md: Option<f64>,
     },
     /// The wall-clock budget ran out before the full load was reached.
     #[error("stopped after {seconds:.1} s (the --max-seconds budget) at {:.1} % of the loads", 100.0 * reached)]
@@ -757,10 +763,12 @@ pub fn solve_static_monitored(
         progress,
     ) {
         return Err(StaticError::LoadStep {
+            stage: "the static solve".into(),
             from: 0.0,
             step: 0.0,
             min: options.min_step,
             reason,
+            at_md: None,
         });
     }
     let [path] = paths;
@@ -909,6 +917,12 @@ impl crate::solve::continuation::StaticSystem for CpuStatic<'_> {
         self.state = self.saved.clone();
         self.evaluated = false;
         Ok(())
+    }
+    fn worst_residual_md(&mut self, _j: usize) -> Option<f64> {
+        let k = (0..self.residual.len())
+            .filter(|k| k % 6 < 3)
+            .max_by(|&a, &b| self.residual[a].abs().total_cmp(&self.residual[b].abs()))?;
+        Some(self.model.nodes[k / 6].md)
     }
     fn step_floor(&mut self, _j: usize) -> Result<f64, String> {
         let largest = self
