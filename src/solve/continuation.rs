@@ -114,6 +114,16 @@ impl LoadPath {
         p
     }
 
+    /// A path that solves the full loads in one step from the state it is given (a
+    /// polish of a nearby equilibrium; cut like any load step where that fails).
+    pub fn at_full_load(options: &StaticOptions) -> Self {
+        let mut p = LoadPath::new(options, true, true, false);
+        p.stage = Stage::Load;
+        p.step = 1.0;
+        p.set_target();
+        p
+    }
+
     /// A model's path ([`LoadPath::new`] with its sites and spring laws).
     pub fn for_model(options: &StaticOptions, model: &crate::model::Model, refine: bool) -> Self {
         let linear = model.sites.iter().all(|s| s.params.spring_exponent == 1.0);

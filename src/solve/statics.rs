@@ -784,6 +784,47 @@ pub fn solve_static_monitored(
     Ok(finish(model, sys.state, path.iterations, path.log))
 }
 
+/// The largest residual of a configuration at full load over the force scale (the
+/// convergence test's measure), in f64.
+pub fn residual_measure_at(model: &Model, state: &StaticState) -> f64 {
+    let (r, _) = constrained_system(model, state, 1.0);
+    residual_measure(&r, reference_force(model))
+}
+
+/// Newton at full load from `state` (an equilibrium found in another precision, say), on
+/// the CPU in f64, with the load path's step cuts where the full step fails.
+pub fn polish_static(
+    model: &Model,
+    state: StaticState,
+    options: &StaticOptions,
+) -> Result<StaticSolution, StaticError> {
+    use crate::solve::continuation::{solve_loads, LoadPath};
+    use crate::solve::newton::NewtonSettings;
+    let mut sys = CpuStatic::new(model, state);
+    let mut paths = [LoadPath::at_full_load(options)];
+    let settings = NewtonSettings::statics_for_law(
+        options.max_iterations,
+        options.tolerance,
+        8,
+        NewtonSettings::any_soft_law([model]),
+    );
+    solve_loads(&mut sys, &mut paths, settings, &mut |_| {}).map_err(|reason| {
+        StaticError::LoadStep {
+            stage: "the f64 polish".into(),
+            from: 0.0,
+            step: 0.0,
+            min: options.min_step,
+            reason,
+            at_md: None,
+        }
+    })?;
+    let [path] = paths;
+    if let Some(e) = path.error {
+        return Err(e);
+    }
+    Ok(finish(model, sys.state, path.iterations, path.log))
+}
+
 /// One model's static Newton system on the CPU (faer), for [`solve_static_from`].
 struct CpuStatic<'a> {
     model: &'a Model,
