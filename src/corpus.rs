@@ -546,6 +546,12 @@ pub struct WellResult {
     pub torque_ratio: f64,
     /// The failure's message (empty when solved).
     pub error: String,
+    /// Largest contact (side) force, FE (N).
+    pub max_side_force_n: f64,
+    /// Where it acts (MD, m).
+    pub max_side_force_md_m: f64,
+    /// Each stabilizer's contact force, nearest the bit first (N).
+    pub stabilizer_forces_n: Vec<f64>,
 }
 
 /// Solves a corpus well with the FE static solve (on the CPU, f64) and the soft string.
@@ -575,6 +581,9 @@ pub fn run_well(
         soft_torque_nm: soft.surface_torque(),
         torque_ratio: f64::NAN,
         error: String::new(),
+        max_side_force_n: f64::NAN,
+        max_side_force_md_m: f64::NAN,
+        stabilizer_forces_n: Vec::new(),
     };
     match solved {
         Ok(sol) => {
@@ -586,6 +595,19 @@ pub fn run_well(
             r.fe_hook_load_n = hook;
             r.hook_load_ratio = hook / r.soft_hook_load_n;
             r.fe_torque_nm = torque;
+            let mut stabs: Vec<(f64, f64)> = Vec::new();
+            for (site, c) in model.sites.iter().zip(&sol.contact) {
+                let md = model.nodes[site.node].md;
+                if c.1.abs() > r.max_side_force_n.abs() || r.max_side_force_n.is_nan() {
+                    r.max_side_force_n = c.1.abs();
+                    r.max_side_force_md_m = md;
+                }
+                if site.stabilizer {
+                    stabs.push((-md, c.1.abs()));
+                }
+            }
+            stabs.sort_by(|a, b| a.0.total_cmp(&b.0));
+            r.stabilizer_forces_n = stabs.into_iter().map(|s| s.1).collect();
             if rotating {
                 r.torque_ratio = torque / r.soft_torque_nm;
             }
@@ -745,4 +767,66 @@ impl WellResult {
             error: self.error.lines().next().unwrap_or_default().to_string(),
         }
     }
+}
+
+/// The same well meshed anew: pipe elements of `element` m, BHA elements of `bha_element`
+/// m (the case file rewritten beside the original as `well_<seed>_<element>m.toml`).
+pub fn remesh(well: &CorpusWell, element: f64, bha_element: f64) -> Result<CorpusWell, String> {
+    let text = std::fs::read_to_string(&well.case_path).map_err(|e| e.to_string())?;
+    let head = text
+        .split("[mesh]")
+        .next()
+        .ok_or("no [mesh] table")?
+        .to_string();
+    let text = format!(
+        "{head}[mesh]\nelement_length = \"{element} m\"\nbha_element_length = \"{bha_element} m\"\n"
+    );
+    let path = well
+        .case_path
+        .with_file_name(format!("well_{}_{element}m.toml", well.spec.seed));
+    crate::output::write_atomic(&path, text.as_bytes()).map_err(|e| e.to_string())?;
+    let mut spec = well.spec.clone();
+    spec.element_m = element;
+    spec.bha_element_m = bha_element;
+    Ok(CorpusWell {
+        spec,
+        case_path: path,
+    })
+}
+
+/// The meshes of the mesh-convergence study: (pipe, BHA) element lengths, coarse to fine.
+pub const MESHES: [(f64, f64); 7] = [
+    (30.0, 2.0),
+    (20.0, 2.0),
+    (10.0, 1.0),
+    (5.0, 1.0),
+    (2.0, 0.5),
+    (1.0, 0.5),
+    (0.5, 0.25),
+];
+
+/// The wells of the mesh-convergence study: from seed 0 on, the first build-and-hold, the
+/// first S-shaped and the first horizontal well drilling or rotating with a stabilizer
+/// and contact at every node (chosen by rule, not by outcome).
+pub fn mesh_study_seeds(dir: &Path) -> Result<Vec<u64>, String> {
+    let mut out = Vec::new();
+    for kind in [
+        Trajectory::BuildAndHold,
+        Trajectory::SShaped,
+        Trajectory::Horizontal,
+    ] {
+        for seed in 0..10_000u64 {
+            let w = write_well(seed, dir)?;
+            let s = &w.spec;
+            if s.trajectory == kind
+                && s.stabilizers > 0
+                && s.sites == "all_nodes"
+                && matches!(s.mode.as_str(), "drilling" | "rotating")
+            {
+                out.push(seed);
+                break;
+            }
+        }
+    }
+    Ok(out)
 }

@@ -265,6 +265,20 @@ enum BenchCommand {
         #[arg(long)]
         quiet: bool,
     },
+    /// Mesh convergence on corpus wells: hook load, torque, the largest side force and the
+    /// stabilizer forces as the pipe elements shrink from 30 m to 0.5 m (mesh.csv, mesh.md).
+    Mesh {
+        /// Corpus seeds (default: the first build-and-hold, S-shaped and horizontal well
+        /// drilling or rotating with a stabilizer).
+        #[arg(long, value_delimiter = ',')]
+        seeds: Option<Vec<u64>>,
+        /// Output folder.
+        #[arg(long)]
+        out: PathBuf,
+        /// No progress bar.
+        #[arg(long)]
+        quiet: bool,
+    },
     /// Time steps per second and Newton iterations per step of `holewall run` (CPU f64).
     Dynamics {
         /// Case file with a `[dynamics]` table.
@@ -607,6 +621,12 @@ fn main() -> ExitCode {
                 }
                 Err(e) => fail(&[e]),
             },
+            BenchCommand::Mesh { seeds, out, quiet } => {
+                match cli::bench_corpus::mesh(&out, seeds, !quiet) {
+                    Ok(_) => ExitCode::SUCCESS,
+                    Err(e) => fail(&[e]),
+                }
+            }
             BenchCommand::Dynamics {
                 case,
                 steps,

@@ -272,3 +272,108 @@ pub fn run(out: &Path, options: &CorpusOptions) -> Result<CorpusSummary, Error> 
     crate::output::write_atomic(&out.join("summary.json"), &json)?;
     Ok(summary)
 }
+
+/// One row of the mesh-convergence table.
+#[derive(Clone, Debug, Serialize)]
+pub struct MeshRow {
+    /// Seed of the corpus well.
+    pub seed: u64,
+    /// Trajectory.
+    pub trajectory: String,
+    /// Pipe element length (m).
+    pub element_m: f64,
+    /// BHA element length (m).
+    pub bha_element_m: f64,
+    /// Nodes.
+    pub nodes: usize,
+    /// Solved.
+    pub solved: bool,
+    /// Wall time (s).
+    pub seconds: f64,
+    /// Hook load (kN).
+    pub hook_load_kn: f64,
+    /// Surface torque (kN·m).
+    pub torque_knm: f64,
+    /// Largest side force (kN).
+    pub max_side_force_kn: f64,
+    /// Where (MD, m).
+    pub max_side_force_md_m: f64,
+    /// Stabilizer forces, nearest the bit first (kN), `;`-separated.
+    pub stabilizer_forces_kn: String,
+}
+
+/// `holewall bench mesh`: hook load, torque, the largest side force and the stabilizer
+/// forces of corpus wells as the elements shrink ([`crate::corpus::MESHES`]); `seeds`
+/// default to [`crate::corpus::mesh_study_seeds`]. Writes `mesh.csv` and `mesh.md`.
+pub fn mesh(
+    out: &Path,
+    seeds: Option<Vec<u64>>,
+    show_progress: bool,
+) -> Result<Vec<MeshRow>, Error> {
+    use crate::corpus::{mesh_study_seeds, remesh, MESHES};
+    let io = |e: String| Error::Io(std::io::Error::other(e));
+    let dir = out.join("wells");
+    std::fs::create_dir_all(&dir)?;
+    let seeds = match seeds {
+        Some(s) => s,
+        None => mesh_study_seeds(&dir).map_err(io)?,
+    };
+    let bar = crate::output::progress_bar(
+        show_progress,
+        (seeds.len() * MESHES.len()) as u64,
+        "{bar:40} {pos}/{len} meshes, {elapsed} elapsed",
+    );
+    let mut rows = Vec::new();
+    for &seed in &seeds {
+        let well = write_well(seed, &dir).map_err(io)?;
+        for &(el, bha) in &MESHES {
+            let w = remesh(&well, el, bha).map_err(io)?;
+            let r = run_well(&w, &StaticOptions::default()).map_err(io)?;
+            rows.push(MeshRow {
+                seed,
+                trajectory: w.spec.trajectory.name().to_string(),
+                element_m: el,
+                bha_element_m: bha,
+                nodes: r.nodes,
+                solved: r.solved,
+                seconds: r.seconds,
+                hook_load_kn: r.fe_hook_load_n / 1e3,
+                torque_knm: r.fe_torque_nm / 1e3,
+                max_side_force_kn: r.max_side_force_n / 1e3,
+                max_side_force_md_m: r.max_side_force_md_m,
+                stabilizer_forces_kn: r
+                    .stabilizer_forces_n
+                    .iter()
+                    .map(|f| format!("{:.2}", f / 1e3))
+                    .collect::<Vec<_>>()
+                    .join("; "),
+            });
+            bar.inc(1);
+        }
+    }
+    bar.finish_and_clear();
+    crate::output::write_csv_rows(&out.join("mesh.csv"), &rows)?;
+    let mut md = String::from(
+        "| seed | well | pipe / BHA element (m) | nodes | solved | time (s) | hook load (kN) | torque (kN·m) | largest side force (kN) at MD (m) | stabilizer forces from the bit (kN) |\n|---|---|---|---|---|---|---|---|---|---|\n",
+    );
+    for r in &rows {
+        md.push_str(&format!(
+            "| {} | {} | {} / {} | {} | {} | {:.2} | {:.1} | {:.2} | {:.2} at {:.0} | {} |\n",
+            r.seed,
+            r.trajectory,
+            r.element_m,
+            r.bha_element_m,
+            r.nodes,
+            if r.solved { "yes" } else { "**no**" },
+            r.seconds,
+            r.hook_load_kn,
+            r.torque_knm,
+            r.max_side_force_kn,
+            r.max_side_force_md_m,
+            r.stabilizer_forces_kn
+        ));
+    }
+    crate::output::write_atomic(&out.join("mesh.md"), md.as_bytes())?;
+    print!("{md}");
+    Ok(rows)
+}
