@@ -4,10 +4,11 @@
 //!
 //! Each variant carries its own load factor λ and step Δλ ([`LoadPath`]):
 //! 1. With contact sites, gravity acts in full from the start (the string laid on the wall,
-//!    [`crate::solve::statics::StaticState::on_low_side`]) with bit loads and friction off
-//!    (λ = 0). If that fails and some spring law is not linear, the same state is reached by
-//!    continuation of the spring exponent from 1 to its own value (adaptive steps).
-//!    Without sites every load ramps with λ.
+//!    prestressed, [`crate::solve::statics::StaticState::on_low_side`]) with bit loads and
+//!    friction off (λ = 0). If that fails and some spring law is not linear, the same state
+//!    is reached by continuation of the spring exponent from 1 to its own value (adaptive
+//!    steps); with linear laws, by continuation in gravity γ from the laid start (steps of
+//!    1/4 grown after easy steps, cut down to 1/64). Without sites every load ramps with λ.
 //! 2. λ → 1 in steps (bit loads, point loads and friction scaled by λ): a step that fails
 //!    is cut in half from the last converged state; a step taken in at most 6 iterations
 //!    grows the next by 1.5. Below `min_step` the variant fails.
@@ -50,6 +51,7 @@ pub enum Next {
 #[derive(Clone, Copy, Debug, PartialEq)]
 enum Stage {
     Gravity,
+    GravityRamp,
     Exponent { first: bool },
     Load,
     Refine,
@@ -68,6 +70,8 @@ pub struct LoadPath {
     step: f64,
     s: f64,
     s_step: f64,
+    g: f64,
+    g_step: f64,
     target: LoadTarget,
     min_step: f64,
     gravity_reason: String,
@@ -98,6 +102,8 @@ impl LoadPath {
             step,
             s: 0.0,
             s_step: 1.0,
+            g: 0.0,
+            g_step: 0.25,
             target: LoadTarget {
                 gravity: 1.0,
                 lambda: 0.0,
@@ -134,6 +140,12 @@ impl LoadPath {
         self.target = match self.stage {
             Stage::Gravity => LoadTarget {
                 gravity: 1.0,
+                lambda: 0.0,
+                friction: 0.0,
+                exponent: 1.0,
+            },
+            Stage::GravityRamp => LoadTarget {
+                gravity: (self.g + self.g_step).min(1.0),
                 lambda: 0.0,
                 friction: 0.0,
                 exponent: 1.0,
@@ -199,6 +211,18 @@ impl LoadPath {
         self.iterations.push(iterations);
         match self.stage {
             Stage::Gravity => self.stage = Stage::Load,
+            Stage::GravityRamp => {
+                self.g = self.target.gravity;
+                if self.g >= 1.0 {
+                    self.log.push(format!(
+                        "gravity step failed directly ({}); reached by continuation in gravity",
+                        self.gravity_reason
+                    ));
+                    self.stage = Stage::Load;
+                } else if iterations <= 6 {
+                    self.g_step = (1.5 * self.g_step).min(1.0);
+                }
+            }
             Stage::Exponent { .. } => {
                 self.s = self.target.exponent;
                 if self.s >= 1.0 {
@@ -248,7 +272,7 @@ impl LoadPath {
     pub fn failed_at(&mut self, reason: String, at_md: Option<f64>) -> Next {
         let fail = |p: &mut LoadPath, step: f64, reason: String| {
             let stage = match p.stage {
-                Stage::Gravity | Stage::Exponent { .. } => {
+                Stage::Gravity | Stage::GravityRamp | Stage::Exponent { .. } => {
                     "laying the string in the hole under its own weight (stage 1 of the load \
                      path: gravity in full, no bit loads, no friction)"
                         .to_string()
@@ -259,7 +283,10 @@ impl LoadPath {
                     (p.lambda + step).min(1.0)
                 ),
             };
-            let gravity = matches!(p.stage, Stage::Gravity | Stage::Exponent { .. });
+            let gravity = matches!(
+                p.stage,
+                Stage::Gravity | Stage::GravityRamp | Stage::Exponent { .. }
+            );
             p.error = Some(StaticError::LoadStep {
                 stage,
                 from: p.lambda,
@@ -274,7 +301,11 @@ impl LoadPath {
         match self.stage {
             Stage::Gravity => {
                 if self.linear_law {
-                    return fail(self, self.step, reason);
+                    // Continuation in gravity from the laid start.
+                    self.gravity_reason = reason;
+                    self.stage = Stage::GravityRamp;
+                    self.set_target();
+                    return Next::Step;
                 }
                 // A soft law's onset stiffness is huge and contacts cycle in and out:
                 // continue from the linear law to the case's exponent.
@@ -294,6 +325,22 @@ impl LoadPath {
                 self.log.push(format!(
                     "exponent continuation {:.4} → {:.4} failed ({reason}); step cut to {:.3e}",
                     self.s, self.target.exponent, self.s_step
+                ));
+            }
+            Stage::GravityRamp => {
+                // Gravity steps below 1/64 have not been seen to help (corpus): give up there.
+                if self.g_step / 2.0 < self.min_step.max(1.0 / 64.0) {
+                    self.log.push(format!(
+                        "continuation in gravity failed at γ = {:.4}: {reason}",
+                        self.g
+                    ));
+                    let why = std::mem::take(&mut self.gravity_reason);
+                    return fail(self, self.step, why);
+                }
+                self.g_step /= 2.0;
+                self.log.push(format!(
+                    "gravity step γ {:.4} → {:.4} failed ({reason}); step cut to {:.3e}",
+                    self.g, self.target.gravity, self.g_step
                 ));
             }
             Stage::Refine => {
