@@ -170,3 +170,107 @@ fn corpus_wells_through_the_engine_match_the_cpu() {
     }
     assert_eq!(checked, 3);
 }
+
+/// `cases/build_and_hold_2500.toml` with its operation and mesh replaced.
+fn reproducer(mode: &str, element: f64) -> holewall::case::Case {
+    let text = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/cases/build_and_hold_2500.toml"
+    ))
+    .unwrap();
+    let op = match mode {
+        "drilling" => "mode = \"rotating\"\nrpm = \"120 rpm\"\nweight_on_bit = \"89 kN\"\n",
+        "rotating" => "mode = \"rotating\"\nrpm = \"120 rpm\"\n",
+        "tripping_in" => "mode = \"tripping_in\"\n",
+        _ => "mode = \"tripping_out\"\n",
+    };
+    let head = text.split("[operation]").next().unwrap();
+    let text = format!(
+        "{head}[operation]\n{op}[contact]\nsites = \"all_nodes\"\n[mesh]\nelement_length = \"{element} m\"\nbha_element_length = \"1 m\"\n"
+    );
+    holewall::case::parse_case(
+        std::path::Path::new("cases/build_and_hold_2500.toml"),
+        &text,
+    )
+    .unwrap()
+}
+
+#[test]
+fn issue_reproducer_solves_in_four_modes_at_four_meshes() {
+    // Before issue 22 every 10 m and 5 m mesh of this well failed, in every mode.
+    for mode in ["rotating", "tripping_in", "tripping_out", "drilling"] {
+        let mut hooks = Vec::new();
+        for element in [20.0, 10.0, 5.0, 1.0] {
+            let case = reproducer(mode, element);
+            let sol = holewall::solve::statics::solve_static(&case.model, &Default::default())
+                .unwrap_or_else(|e| panic!("{mode} at {element} m: {e}"));
+            let (_, hook, torque, _) = holewall::cli::static_cmd::fe_rows(&case.model, &sol);
+            let soft = case.soft_string().hook_load();
+            eprintln!(
+                "{mode:>12} {element:>4} m: {} load steps, {} iterations, {} cuts; hook load {:.1} kN (soft string {:.1} kN), torque {:.2} kN·m",
+                sol.iterations.len(),
+                sol.iterations.iter().sum::<usize>(),
+                sol.log.len(),
+                hook / 1e3,
+                soft / 1e3,
+                torque / 1e3
+            );
+            assert!((hook / soft - 1.0).abs() < 0.03, "{mode} {element} m");
+            hooks.push(hook);
+        }
+        // The hook load converges with the mesh (20 m → 1 m within 0.5 %).
+        let spread = hooks
+            .iter()
+            .fold(0.0f64, |m, h| m.max((h / hooks[3] - 1.0).abs()));
+        assert!(spread < 5e-3, "{mode}: hook loads {hooks:?}");
+    }
+}
+
+#[test]
+fn slick_pendulum_tangency_matches_the_closed_form_on_fine_meshes() {
+    // A slick 6.5 in assembly in a straight horizontal 8.5 in hole at zero WOB, no friction:
+    // a pinned beam (the bit held on the axis) lifting off the low side, tangent to it at
+    // L = (24 EI c / w)^¼ from the bit, where the wall's concentrated reaction sits. Issue
+    // 22: the FE solve failed with 0.1 m BHA elements.
+    let dir = std::env::temp_dir().join(format!("holewall_slick_{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(
+        dir.join("h.csv"),
+        "md, inclination, azimuth\n0, 90, 0\n300, 90, 0\n",
+    )
+    .unwrap();
+    for bha in [0.25, 0.1, 0.05] {
+        let text = format!(
+            "[well]\nprofile = \"survey\"\nsurvey = \"h.csv\"\ntotal_md = \"200 m\"\n\
+             [[hole]]\nbottom_md = \"200 m\"\ndiameter = \"8.5 in\"\nfriction = 0.0\n\
+             [mud]\ndensity = \"1.2 sg\"\n\
+             [[string]]\nkind = \"collar\"\nlength = \"200 m\"\nod = \"6.5 in\"\nid = \"2.8125 in\"\n\
+             [operation]\nmode = \"rotating\"\nrpm = \"60 rpm\"\n\
+             [contact]\nsites = \"all_nodes\"\n\
+             [mesh]\nelement_length = \"1 m\"\nbha_element_length = \"{bha} m\"\n"
+        );
+        let case = holewall::case::parse_case(&dir.join("slick.toml"), &text).unwrap();
+        let m = &case.model;
+        let sol = holewall::solve::statics::solve_static(m, &Default::default())
+            .unwrap_or_else(|e| panic!("{bha} m: {e}"));
+        let el = &m.elements[m.elements.len() - 1];
+        let site = m.sites.last().unwrap();
+        let l = (24.0 * el.section.bending_stiffness() * site.params.clearance
+            / el.buoyed_weight_per_length)
+            .powf(0.25);
+        let bit = m.nodes.last().unwrap().md;
+        let (_, at) = m
+            .sites
+            .iter()
+            .zip(&sol.contact)
+            .filter(|(s, _)| bit - m.nodes[s.node].md < 2.0 * l)
+            .map(|(s, c)| (c.1.abs(), bit - m.nodes[s.node].md))
+            .fold((0.0, f64::NAN), |a, b| if b.0 > a.0 { b } else { a });
+        eprintln!("BHA elements {bha} m: tangency {at:.3} m from the bit, closed form {l:.3} m");
+        assert!(
+            (at - l).abs() <= (0.02 * l).max(bha),
+            "{bha} m: {at} vs {l}"
+        );
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
