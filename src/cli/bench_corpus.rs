@@ -112,25 +112,35 @@ pub fn run(out: &Path, options: &CorpusOptions) -> Result<CorpusSummary, Error> 
         options.wells as u64,
         "{bar:40} {pos}/{len} wells, {elapsed} elapsed, {msg}",
     );
-    let mut results: Vec<WellResult> = Vec::new();
-    let mut drawn = Vec::new();
+    // Wells in parallel (rayon, one well per core): each well's time is measured with the
+    // other cores busy with other wells.
+    use rayon::prelude::*;
     let static_options = StaticOptions::default();
-    for k in 0..options.wells {
-        if options
-            .max_seconds
-            .is_some_and(|s| clock.elapsed().as_secs_f64() > s)
-        {
-            break;
-        }
-        let seed = options.first_seed + k as u64;
-        let well = write_well(seed, &wells_dir).map_err(io)?;
-        let r = run_well(&well, &static_options).map_err(io)?;
-        drawn.push(well);
-        results.push(r);
-        let solved = results.iter().filter(|r| r.solved).count();
-        bar.set_message(format!("{solved} solved"));
-        bar.inc(1);
-    }
+    let done = std::sync::atomic::AtomicUsize::new(0);
+    let outcomes: Vec<Option<(crate::corpus::CorpusWell, WellResult)>> = (0..options.wells)
+        .into_par_iter()
+        .map(|k| {
+            if options
+                .max_seconds
+                .is_some_and(|s| clock.elapsed().as_secs_f64() > s)
+            {
+                return Ok(None);
+            }
+            let seed = options.first_seed + k as u64;
+            let well = write_well(seed, &wells_dir).map_err(io)?;
+            let r = run_well(&well, &static_options).map_err(io)?;
+            if r.solved {
+                done.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+            }
+            bar.set_message(format!(
+                "{} solved",
+                done.load(std::sync::atomic::Ordering::Relaxed)
+            ));
+            bar.inc(1);
+            Ok(Some((well, r)))
+        })
+        .collect::<Result<_, Error>>()?;
+    let (drawn, results): (Vec<_>, Vec<_>) = outcomes.into_iter().flatten().unzip();
     bar.finish_and_clear();
 
     // The engine sample.

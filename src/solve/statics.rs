@@ -150,10 +150,9 @@ impl StaticState {
                 u[e] = u[e + 1] - stretch[e];
             }
         }
-        for (i, ui) in u.iter().enumerate() {
-            let t = model.nodes[i].hole_axis;
-            for k in 0..3 {
-                s.x[i][k] += ui * t[k];
+        for ((x, ui), node) in s.x.iter_mut().zip(&u).zip(&model.nodes) {
+            for (xk, tk) in x.iter_mut().zip(node.hole_axis) {
+                *xk += ui * tk;
             }
         }
         // Lateral: each contact node towards its lateral load, at the depth where the wall
