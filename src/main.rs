@@ -252,9 +252,12 @@ enum BenchCommand {
         /// First seed.
         #[arg(long, default_value_t = 0)]
         first_seed: u64,
-        /// Wells also run through the engine.
+        /// Wells also run through the engine (the first ones of at most --engine-max-nodes).
         #[arg(long, default_value_t = 0)]
         engine_sample: usize,
+        /// Largest mesh (nodes) of the engine sample.
+        #[arg(long, default_value_t = 1000)]
+        engine_max_nodes: usize,
         /// Start no new well after this many seconds (the rest are reported as not run).
         #[arg(long, value_parser = positive_seconds)]
         max_seconds: Option<f64>,
@@ -590,6 +593,7 @@ fn main() -> ExitCode {
                 wells,
                 first_seed,
                 engine_sample,
+                engine_max_nodes,
                 max_seconds,
                 out,
                 quiet,
@@ -599,6 +603,7 @@ fn main() -> ExitCode {
                     wells,
                     first_seed,
                     engine_sample,
+                    engine_max_nodes,
                     max_seconds,
                     show_progress: !quiet,
                 },

@@ -19,8 +19,11 @@ pub struct CorpusOptions {
     pub wells: usize,
     /// First seed.
     pub first_seed: u64,
-    /// Wells of the corpus also run through the engine (the first ones).
+    /// Wells of the corpus also run through the engine: the first ones with at most
+    /// `engine_max_nodes` nodes (lavapipe runs the kernels on the CPU).
     pub engine_sample: usize,
+    /// Largest mesh of the engine sample (nodes).
+    pub engine_max_nodes: usize,
     /// Stop starting wells after this many seconds.
     pub max_seconds: Option<f64>,
     /// Progress bar.
@@ -153,7 +156,12 @@ pub fn run(out: &Path, options: &CorpusOptions) -> Result<CorpusSummary, Error> 
         let mut ok = 0;
         let mut worst: f64 = 0.0;
         let mut why = None;
-        for (well, cpu) in drawn.iter().zip(&results).take(options.engine_sample) {
+        for (well, cpu) in drawn
+            .iter()
+            .zip(&results)
+            .filter(|(_, r)| r.nodes <= options.engine_max_nodes)
+            .take(options.engine_sample)
+        {
             match run_well_engine(well, path) {
                 Ok(o) => {
                     run += 1;
@@ -172,6 +180,9 @@ pub fn run(out: &Path, options: &CorpusOptions) -> Result<CorpusSummary, Error> 
                     break;
                 }
             }
+        }
+        if !options.show_progress && options.engine_sample > 0 {
+            eprintln!("engine sample, {name}: {ok} of {run} solved");
         }
         if options.engine_sample > 0 {
             engine.insert(
