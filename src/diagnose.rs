@@ -111,7 +111,7 @@ pub fn static_failure(case: &Case, error: &StaticError) -> String {
         ));
     }
     if matches!(error, StaticError::LoadStep { .. }) {
-        let finest = model
+        let top_element = model
             .elements
             .iter()
             .filter(|e| {
@@ -127,7 +127,7 @@ pub fn static_failure(case: &Case, error: &StaticError) -> String {
              that change along many short elements take the Newton one node per iteration), \
              a softer contact.wall_stiffness, or `--model soft-string` for torque and drag \
              alone",
-            finest
+            top_element
         ));
     }
     // The stiffest wall against the string's own lateral stiffness at that site (a beam

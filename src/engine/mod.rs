@@ -676,12 +676,7 @@ fn solve_chunk<T: Real + Send + Sync, P: KernelPath<T>>(
         .iter()
         .map(|m| LoadPath::for_model(options, m, size == 4))
         .collect();
-    let settings = NewtonSettings::statics_for_law(
-        options.max_iterations,
-        options.tolerance,
-        size,
-        NewtonSettings::any_soft_law(models),
-    );
+    let settings = options.newton(size, models);
     // Compaction: once no more than half of a chunk's variants are still running, the
     // others (finished) leave it — the running ones go on in a chunk of their own, each
     // exactly where it stands (state, restart point, Newton state), so no kernel works on

@@ -271,22 +271,21 @@ impl LoadPath {
     /// As [`LoadPath::failed`], with where the residual force was largest (MD, m).
     pub fn failed_at(&mut self, reason: String, at_md: Option<f64>) -> Next {
         let fail = |p: &mut LoadPath, step: f64, reason: String| {
-            let stage = match p.stage {
-                Stage::Gravity | Stage::GravityRamp | Stage::Exponent { .. } => {
-                    "laying the string in the hole under its own weight (stage 1 of the load \
-                     path: gravity in full, no bit loads, no friction)"
-                        .to_string()
-                }
-                _ => format!(
-                    "applying the bit loads and friction (stage 2), the step λ {:.4} → {:.4}",
-                    p.lambda,
-                    (p.lambda + step).min(1.0)
-                ),
-            };
             let gravity = matches!(
                 p.stage,
                 Stage::Gravity | Stage::GravityRamp | Stage::Exponent { .. }
             );
+            let stage = if gravity {
+                "laying the string in the hole under its own weight (stage 1 of the load \
+                 path: gravity in full, no bit loads, no friction)"
+                    .to_string()
+            } else {
+                format!(
+                    "applying the bit loads and friction (stage 2), the step λ {:.4} → {:.4}",
+                    p.lambda,
+                    (p.lambda + step).min(1.0)
+                )
+            };
             p.error = Some(StaticError::LoadStep {
                 stage,
                 from: p.lambda,

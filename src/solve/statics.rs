@@ -52,6 +52,25 @@ impl Default for StaticOptions {
     }
 }
 
+impl StaticOptions {
+    /// The Newton settings of a static solve in a precision of `size` bytes for `models`
+    /// (the deep line search where any has a soft law): the one place `solve_static`, the
+    /// f64 polish and the ensemble engine take them from.
+    pub fn newton<'a>(
+        &self,
+        size: usize,
+        models: impl IntoIterator<Item = &'a Model>,
+    ) -> crate::solve::newton::NewtonSettings {
+        use crate::solve::newton::NewtonSettings;
+        NewtonSettings::statics_for_law(
+            self.max_iterations,
+            self.tolerance,
+            size,
+            NewtonSettings::any_soft_law(models),
+        )
+    }
+}
+
 /// Why a static solve failed.
 #[derive(Clone, Debug, Error)]
 pub enum StaticError {
@@ -739,16 +758,10 @@ pub fn solve_static_monitored(
     progress: &mut dyn FnMut(f64),
 ) -> Result<StaticSolution, StaticError> {
     use crate::solve::continuation::{solve_loads_from, LoadPath};
-    use crate::solve::newton::NewtonSettings;
     let clock = std::time::Instant::now();
     let mut sys = CpuStatic::new(model, start);
     let mut paths = [LoadPath::for_model(options, model, false)];
-    let settings = NewtonSettings::statics_for_law(
-        options.max_iterations,
-        options.tolerance,
-        8,
-        NewtonSettings::any_soft_law([model]),
-    );
+    let settings = options.newton(8, [model]);
     let budget = options.max_seconds.unwrap_or(f64::INFINITY);
     let over = || clock.elapsed().as_secs_f64() > budget;
     let mut solves = 0;
@@ -786,7 +799,9 @@ pub fn solve_static_monitored(
 /// The largest residual of a configuration at full load over the force scale (the
 /// convergence test's measure), in f64.
 pub fn residual_measure_at(model: &Model, state: &StaticState) -> f64 {
-    let (r, _) = constrained_system(model, state, 1.0);
+    let mut r = vec![0.0; 6 * model.nodes.len()];
+    assemble(model, state, 1.0, &external_loads(model), &mut r, None);
+    constrain_residual(&constraints(model), &mut r);
     residual_measure(&r, reference_force(model))
 }
 
@@ -798,15 +813,9 @@ pub fn polish_static(
     options: &StaticOptions,
 ) -> Result<StaticSolution, StaticError> {
     use crate::solve::continuation::{solve_loads, LoadPath};
-    use crate::solve::newton::NewtonSettings;
     let mut sys = CpuStatic::new(model, state);
     let mut paths = [LoadPath::at_full_load(options)];
-    let settings = NewtonSettings::statics_for_law(
-        options.max_iterations,
-        options.tolerance,
-        8,
-        NewtonSettings::any_soft_law([model]),
-    );
+    let settings = options.newton(8, [model]);
     solve_loads(&mut sys, &mut paths, settings, &mut |_| {}).map_err(|reason| {
         StaticError::LoadStep {
             stage: "the f64 polish".into(),
