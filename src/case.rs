@@ -46,6 +46,9 @@ pub struct WellSpec {
     pub hold_inclination: Option<Q>,
     /// Azimuth in degrees (build_and_hold).
     pub azimuth: Option<Q>,
+    /// Largest dogleg severity a survey may hold, in degrees per 30 m (default
+    /// [`crate::units::DOGLEG_LIMIT_DEG_PER_30M`]); raise it for a short-radius well.
+    pub max_dogleg_deg_per_30m: Option<Spanned<f64>>,
 }
 
 /// `[[hole]]`: a hole section from the previous section's bottom (or the surface).
@@ -364,6 +367,9 @@ pub struct Case {
     pub dynamics: Option<DynamicsSettings>,
     /// `[ensemble]`, if given.
     pub ensemble: Option<EnsembleSettings>,
+    /// What the case holds that is allowed but unusual (a sharp dogleg …): printed by every
+    /// command that reads the case and written into its `summary.json`.
+    pub warnings: Vec<String>,
 }
 
 impl Case {
@@ -620,7 +626,17 @@ pub fn survey_from_text(
             SurveyStation {
                 md: parse(fields[0], "md")? * md_factor,
                 inclination_deg: parse(fields[1], "inclination")?,
-                azimuth_deg: parse(fields[2], "azimuth")?,
+                azimuth_deg: {
+                    let a = parse(fields[2], "azimuth")?;
+                    if !(0.0..=360.0).contains(&a) {
+                        return Err(bad(format!(
+                            "azimuth {}° is outside 0 … 360° (did you mean {}°?)",
+                            crate::units::show(a),
+                            crate::units::show(a.rem_euclid(360.0))
+                        )));
+                    }
+                    a
+                },
             },
             k + 1,
         ));
@@ -691,6 +707,8 @@ pub fn parse_case(path: &Path, text: &str) -> Result<Case, InputError> {
         |x| x > 0.0 && x <= 20_000.0,
         "0 < total_md ≤ 20 km",
     )?;
+    let mut warnings: Vec<String> = Vec::new();
+    let mut survey_read: Option<(PathBuf, Vec<(SurveyStation, usize)>)> = None;
     let well = match spec.well.profile.get_ref().as_str() {
         "vertical" => WellPath::vertical(bit_md),
         "build_and_hold" => {
@@ -732,8 +750,8 @@ pub fn parse_case(path: &Path, text: &str) -> Result<Case, InputError> {
             let azi = ctx.angle(
                 &need(&spec.well.azimuth, "well.azimuth")?,
                 "well.azimuth",
-                |_| true,
-                "any angle",
+                |x| (0.0..=360.0).contains(&x),
+                "0° … 360°",
             )?;
             WellPath::build_and_hold(kop, rate, inc, azi, bit_md)
                 .map_err(|e| ctx.err(spec.well.profile.span(), "well", e.to_string()))?
@@ -787,6 +805,7 @@ pub fn parse_case(path: &Path, text: &str) -> Result<Case, InputError> {
                     ));
                 }
             }
+            survey_read = Some((survey_path, read));
             well_path
         }
         other => {
@@ -853,13 +872,38 @@ pub fn parse_case(path: &Path, text: &str) -> Result<Case, InputError> {
             .unwrap_or(hole.last().unwrap_or(&(0.0, 0.2159, 0.25)))
     };
 
+    if let Some((survey_path, read)) = &survey_read {
+        let deepest = hole.iter().map(|h| h.0).fold(bit_md, f64::max);
+        let limit = match &spec.well.max_dogleg_deg_per_30m {
+            Some(q) => ctx.number(
+                q,
+                "well.max_dogleg_deg_per_30m",
+                |x| x > 0.0 && x <= 300.0,
+                "0 < max_dogleg ≤ 300 °/30 m",
+            )?,
+            None => crate::units::DOGLEG_LIMIT_DEG_PER_30M,
+        };
+        warnings.extend(survey_plausibility(
+            &survey_path.display().to_string(),
+            read,
+            deepest,
+            limit,
+        )?);
+    }
     let mud = ctx.quantity(
         &spec.mud.density,
         "mud.density",
         Dimension::Density,
-        |x| (0.0..5000.0).contains(&x),
-        "0 ≤ density < 5000 kg/m3",
+        |x| x >= 0.0,
+        "0 (a dry string) or 0.5 … 3.0 sg",
     )?;
+    let written = match spec.mud.density.get_ref() {
+        Quantity::Text(t) => t.clone(),
+        Quantity::Number(x) => crate::units::show(*x),
+    };
+    if let Some(m) = crate::units::fluid_density_trap(mud, &written) {
+        return Err(ctx.err(spec.mud.density.span(), "mud.density", m));
+    }
     let mesh = spec.mesh.clone();
     let el_pipe = match mesh.as_ref().and_then(|m| m.element_length.clone()) {
         Some(q) => ctx.quantity(
@@ -1435,7 +1479,97 @@ pub fn parse_case(path: &Path, text: &str) -> Result<Case, InputError> {
         mud_density: mud,
         element_density,
         dynamics,
+        warnings,
     })
+}
+
+/// The plausibility of a survey's stations (issue 23), one policy with
+/// [`crate::units::bare_number_trap`]'s: an error where a unit mix-up or a typo is far
+/// likelier than the well, a warning where the well is merely unusual.
+/// - the last station past `SURVEY_PAST_CASE_FACTOR` × the deepest MD the case uses
+///   (`deepest`: the bit, the hole sections): MD in feet read as metres, most likely;
+/// - a dogleg severity between two stations above `limit` °/30 m: refused (a typo in a
+///   station); above [`crate::units::DOGLEG_WARNING_DEG_PER_30M`]: a warning.
+pub fn survey_plausibility(
+    source: &str,
+    read: &[(SurveyStation, usize)],
+    deepest: f64,
+    limit: f64,
+) -> Result<Vec<String>, InputError> {
+    use crate::units::show;
+    let err = |line: usize, message: String| InputError {
+        source_name: source.to_string(),
+        line,
+        key: "survey".into(),
+        message,
+    };
+    let mut warnings = Vec::new();
+    if let Some((last, line)) = read.last() {
+        let ratio = last.md / deepest;
+        if ratio > crate::units::SURVEY_PAST_CASE_FACTOR {
+            let feet = if (3.0..=3.6).contains(&ratio) {
+                " — that is the ratio of a foot to a metre: is the survey's MD in feet? \
+                 Name the unit in the header (`md_ft, inclination_deg, azimuth_deg`)"
+                    .to_string()
+            } else {
+                String::new()
+            };
+            return Err(err(
+                *line,
+                format!(
+                    "the survey runs to MD {} m, {:.2}× the deepest MD of the case ({} m: \
+                     well.total_md and the [[hole]] sections){feet}; a survey longer than \
+                     the hole on purpose: end it within {}× of it",
+                    show(last.md),
+                    ratio,
+                    show(deepest),
+                    crate::units::SURVEY_PAST_CASE_FACTOR
+                ),
+            ));
+        }
+    }
+    for w in read.windows(2) {
+        let ((a, _), (b, line)) = (&w[0], &w[1]);
+        let (i1, i2) = (
+            a.inclination_deg.to_radians(),
+            b.inclination_deg.to_radians(),
+        );
+        let da = (b.azimuth_deg - a.azimuth_deg).to_radians();
+        let cos = (i1.cos() * i2.cos() + i1.sin() * i2.sin() * da.cos()).clamp(-1.0, 1.0);
+        let dogleg = cos.acos().to_degrees();
+        let dls = dogleg / (b.md - a.md) * 30.0;
+        let what = format!(
+            "a dogleg of {:.1}° over {} m (MD {} → {} m, inclination {} → {}°, azimuth {} → \
+             {}°) is {:.1}°/30 m",
+            dogleg,
+            show(b.md - a.md),
+            show(a.md),
+            show(b.md),
+            show(a.inclination_deg),
+            show(b.inclination_deg),
+            show(a.azimuth_deg),
+            show(b.azimuth_deg),
+            dls
+        );
+        if dls > limit {
+            return Err(err(
+                *line,
+                format!(
+                    "{what}, above the limit of {}°/30 m: a typo in a station? (for a \
+                     short-radius well, raise well.max_dogleg_deg_per_30m)",
+                    show(limit)
+                ),
+            ));
+        }
+        if dls > crate::units::DOGLEG_WARNING_DEG_PER_30M {
+            warnings.push(format!(
+                "{source}:{line}: {what}, sharper than long- and medium-radius builds \
+                 ({}°/30 m): check the station",
+                show(crate::units::DOGLEG_WARNING_DEG_PER_30M)
+            ));
+        }
+    }
+    Ok(warnings)
 }
 
 fn ensemble_settings(

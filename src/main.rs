@@ -114,8 +114,9 @@ enum Command {
         sobol_indices: bool,
         /// Variants per result chunk (each written atomically; a killed run resumes from
         /// its chunks when started again with the same command).
-        #[arg(long, default_value_t = holewall::ensemble::store::DEFAULT_CHUNK)]
-        chunk_size: usize,
+        #[arg(long, default_value_t = holewall::ensemble::store::DEFAULT_CHUNK as u64,
+              value_parser = clap::value_parser!(u64).range(1..=1_000_000))]
+        chunk_size: u64,
         /// Run only the K-th of N slices of the variants (`holewall merge` joins them).
         #[arg(long)]
         shard: Option<String>,
@@ -366,6 +367,24 @@ fn print_summary<T: serde::Serialize>(result: Result<T, holewall::Error>) -> Exi
     }
 }
 
+/// An ensemble's outcome on stdout: a few lines (the whole of it is `OUT/summary.json`,
+/// tens of kB for a Monte Carlo run), nothing with `--quiet`.
+fn print_ensemble_summary(
+    result: Result<holewall::ensemble::report::EnsembleSummary, holewall::Error>,
+    out: &std::path::Path,
+    quiet: bool,
+) -> ExitCode {
+    match result {
+        Ok(s) => {
+            if !quiet {
+                println!("{}", s.digest(out));
+            }
+            ExitCode::SUCCESS
+        }
+        Err(e) => fail(&[e]),
+    }
+}
+
 fn main() -> ExitCode {
     let args = Args::parse();
     match args.command {
@@ -478,20 +497,24 @@ fn main() -> ExitCode {
             };
             let options = holewall::ensemble::store::EnsembleOptions {
                 monte_carlo: mc,
-                chunk_size,
+                chunk_size: chunk_size as usize,
                 shard,
                 force,
                 max_seconds,
             };
-            print_summary(holewall::ensemble::job::run(
-                &case,
-                variants.as_deref(),
-                backend,
-                precision,
+            print_ensemble_summary(
+                holewall::ensemble::job::run(
+                    &case,
+                    variants.as_deref(),
+                    backend,
+                    precision,
+                    &out,
+                    !quiet,
+                    &options,
+                ),
                 &out,
-                !quiet,
-                &options,
-            ))
+                quiet,
+            )
         }
         Command::Study { what } => match what {
             StudyCommand::Precision {
@@ -525,9 +548,11 @@ fn main() -> ExitCode {
                 },
             )),
         },
-        Command::Merge { out, dirs, quiet } => {
-            print_summary(holewall::ensemble::job::merge(&out, &dirs, !quiet))
-        }
+        Command::Merge { out, dirs, quiet } => print_ensemble_summary(
+            holewall::ensemble::job::merge(&out, &dirs, !quiet),
+            &out,
+            quiet,
+        ),
         Command::GpuInfo { pairs } => match cli::gpu_info::run(pairs) {
             Ok(()) => ExitCode::SUCCESS,
             Err(e) => fail(&[e]),

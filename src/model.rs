@@ -314,7 +314,32 @@ pub fn add_sites(
     }
 }
 
+/// The one name of stabilizer `number` (1 = nearest the bit) in every output: plot labels,
+/// file names, CSV columns, ensemble keys (`stab1.from_bit`) and messages.
+pub fn stabilizer_name(number: usize) -> String {
+    format!("stab{number}")
+}
+
 impl Model {
+    /// The stabilizer sites (indices into `sites`), **nearest the bit first**: stabilizer
+    /// number `k` (1-based, as in [`stabilizer_name`]) is entry `k − 1`. The one numbering
+    /// every output uses.
+    pub fn stabilizer_sites(&self) -> Vec<usize> {
+        let mut s: Vec<usize> = (0..self.sites.len())
+            .filter(|&k| self.sites[k].stabilizer)
+            .collect();
+        s.sort_by_key(|&k| std::cmp::Reverse(self.sites[k].node));
+        s
+    }
+
+    /// The stabilizer number (1 = nearest the bit) of contact site `site`, if it is one.
+    pub fn stabilizer_number(&self, site: usize) -> Option<usize> {
+        self.stabilizer_sites()
+            .iter()
+            .position(|&k| k == site)
+            .map(|p| p + 1)
+    }
+
     /// The length of string a node stands for: half of each adjacent element (m); a side
     /// force over it is the force per unit length.
     pub fn tributary_length(&self, node: usize) -> f64 {

@@ -308,6 +308,21 @@ pub fn tick(x: &f64) -> String {
     }
 }
 
+/// The labels of a histogram's marks (`P10 12.3`): marks at the same value share one
+/// label (`P10 = P50 12.3`); finite marks only, in the order given.
+pub fn mark_labels(marks: &[(&str, f64)]) -> Vec<(String, f64)> {
+    let mut out: Vec<(Vec<&str>, f64)> = Vec::new();
+    for (label, x) in marks.iter().filter(|m| m.1.is_finite()) {
+        match out.iter_mut().find(|(_, y)| tick(y) == tick(x)) {
+            Some((names, _)) => names.push(label),
+            None => out.push((vec![label], *x)),
+        }
+    }
+    out.into_iter()
+        .map(|(names, x)| (format!("{} {}", names.join(" = "), tick(&x)), x))
+        .collect()
+}
+
 /// A histogram of `values` (already in display units) with vertical lines at `marks`
 /// (label, x), e.g. P10/P50/P90.
 pub fn histogram(
@@ -360,17 +375,15 @@ pub fn histogram(
             let x0 = lo + k as f64 * w;
             Rectangle::new([(x0, 0.0), (x0 + w, c as f64)], BLUE.mix(0.5).filled())
         }))?;
-        for (label, x) in marks {
-            if !x.is_finite() {
-                continue;
-            }
+        for (k, (label, x)) in mark_labels(marks).into_iter().enumerate() {
             chart.draw_series(std::iter::once(PathElement::new(
-                vec![(*x, 0.0), (*x, top)],
+                vec![(x, 0.0), (x, top)],
                 RED.stroke_width(2),
             )))?;
+            // Labels of nearby marks step down so they do not overprint.
             chart.draw_series(std::iter::once(Text::new(
-                format!("{label} {}", tick(x)),
-                (*x, top * 0.97),
+                label,
+                (x, top * (0.97 - 0.06 * k as f64)),
                 ("sans-serif", 15).into_font(),
             )))?;
         }
@@ -532,6 +545,24 @@ pub fn convergence_plot(
     })
 }
 
+/// Ticks of a log axis over `lo … hi`: every decade, and 2 and 5 times each where fewer
+/// than three decades fall inside (a range within one decade still gets ticks).
+pub fn log_ticks(lo: f64, hi: f64) -> Vec<f64> {
+    if !(lo > 0.0 && hi > lo && hi.is_finite()) {
+        return Vec::new();
+    }
+    let (a, b) = (lo.log10().floor() as i32, hi.log10().ceil() as i32);
+    let inside = |v: &f64| *v >= lo && *v <= hi;
+    let decades: Vec<f64> = (a..=b).map(|k| 10f64.powi(k)).filter(inside).collect();
+    if decades.len() >= 3 {
+        return decades;
+    }
+    (a..=b)
+        .flat_map(|k| [1.0, 2.0, 5.0].map(|m| m * 10f64.powi(k)))
+        .filter(inside)
+        .collect()
+}
+
 /// A log–log plot of `series` (name, points (x, y), all > 0), markers on the points, and a
 /// dashed horizontal line at `y_line` (a tolerance).
 pub fn loglog_plot(
@@ -575,7 +606,10 @@ pub fn loglog_plot(
             .margin(12)
             .x_label_area_size(48)
             .y_label_area_size(90)
-            .build_cartesian_2d((x0..x1).log_scale(), (y0..y1).log_scale())?;
+            .build_cartesian_2d(
+                (x0..x1).log_scale().with_key_points(log_ticks(x0, x1)),
+                (y0..y1).log_scale().with_key_points(log_ticks(y0, y1)),
+            )?;
         chart
             .configure_mesh()
             .x_desc(x_label)
@@ -740,4 +774,19 @@ pub fn class_scatter(
         root.present()?;
         Ok(())
     })
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn equal_marks_share_a_label_and_log_axes_tick_each_decade() {
+        let l = super::mark_labels(&[("P10", 12.0), ("P50", 12.0), ("P90", 15.0)]);
+        assert_eq!(l.len(), 2);
+        assert!(l[0].0.starts_with("P10 = P50 "), "{l:?}");
+        assert!(l[1].0.starts_with("P90 "), "{l:?}");
+        // 0.3 … 7 s: one decade inside, so 1, 2, 5 ticks.
+        assert_eq!(super::log_ticks(0.3, 7.0), vec![0.5, 1.0, 2.0, 5.0]);
+        // 1e-9 … 1e-2: every decade.
+        assert_eq!(super::log_ticks(1e-9, 1e-2).len(), 8);
+    }
 }

@@ -83,7 +83,8 @@ pub struct PrecisionSummary {
     pub tolerance: f64,
     /// The cheapest run within it, if any.
     pub recommendation: Option<PrecisionRow>,
-    /// Paths that could not run, and why.
+    /// Paths that could not run and why; why nothing is recommended (and what step would
+    /// be); quantities left out of the errors.
     pub notes: Vec<String>,
 }
 
@@ -103,12 +104,12 @@ fn quantities(r: &VariantResult) -> Vec<(String, f64, f64)> {
     ];
     for (k, s) in r.stabilizers.iter().enumerate() {
         q.push((
-            format!("stab{}_max_side_force_n", k + 1),
+            format!("{}_max_side_force_n", crate::model::stabilizer_name(k + 1)),
             s.max_side_force_n,
             1.0,
         ));
         q.push((
-            format!("stab{}_max_lateral_m", k + 1),
+            format!("{}_max_lateral_m", crate::model::stabilizer_name(k + 1)),
             s.max_lateral_m,
             1e-6,
         ));
@@ -124,8 +125,60 @@ fn errors_of(r: &VariantResult, reference: &VariantResult) -> Vec<(String, f64)>
     quantities(r)
         .into_iter()
         .zip(quantities(reference))
+        .filter(|((_, a, _), (_, b, floor))| a.abs() >= *floor || b.abs() >= *floor)
         .map(|((name, a, _), (_, b, floor))| (name, (a - b).abs() / b.abs().max(floor)))
         .collect()
+}
+
+/// The quantities that stay at zero (below their floor) in the reference run — a
+/// stabilizer that never touches the wall has no side force — named for the summary:
+/// they are left out of the errors where the run has them at zero too (an error of 0
+/// there would read as "perfect").
+fn zero_in_reference(reference: &VariantResult) -> Vec<String> {
+    quantities(reference)
+        .into_iter()
+        .filter(|(_, b, floor)| b.abs() < *floor)
+        .map(|(name, _, _)| name)
+        .collect()
+}
+
+/// Why no run is within `tolerance`, and what time step would be, from the observed
+/// order of the CPU runs' errors at successive halvings (`rows`: the study's runs).
+fn no_recommendation_note(rows: &[PrecisionRow], tolerance: f64) -> String {
+    let best = rows
+        .iter()
+        .filter(|r| r.max_error.is_finite())
+        .min_by(|a, b| a.max_error.total_cmp(&b.max_error));
+    let Some(best) = best else {
+        return format!("no run finished, so none is within the tolerance {tolerance:.1e}");
+    };
+    let mut text = format!(
+        "no run is within the tolerance {tolerance:.1e}: the smallest error is {:.2e} ({}, \
+         dt = {:.2e} s, {})",
+        best.max_error, best.path, best.dt_s, best.worst
+    );
+    let cpu: Vec<&PrecisionRow> = rows
+        .iter()
+        .filter(|r| r.path == "cpu-f64" && r.max_error.is_finite() && r.max_error > 0.0)
+        .collect();
+    if let [.., a, b] = cpu.as_slice() {
+        let order = (a.max_error / b.max_error).log2() / (a.dt_s / b.dt_s).log2();
+        if order > 0.2 {
+            let dt = b.dt_s * (tolerance / b.max_error).powf(1.0 / order);
+            text.push_str(&format!(
+                "; the CPU errors fall with order {order:.2} in the step, so dt ≈ {dt:.2e} s \
+                 would reach it (--refinements, or a smaller [dynamics].time_step)"
+            ));
+        } else {
+            text.push_str(&format!(
+                "; the CPU errors do not fall with the step (observed order {order:.2}): the \
+                 error is not the time step's — the tolerance may be below the reference's \
+                 own error, or the quantity is chaotic over this duration; ask a looser \
+                 --tolerance or a shorter --duration"
+            ));
+        }
+    }
+    text
 }
 
 /// A status as `variants.csv` writes it (`converged`, `step_cut`, `failed`).
@@ -286,6 +339,15 @@ pub fn precision(
         .filter(|r| r.max_error <= options.tolerance && r.seconds.is_finite())
         .min_by(|a, b| a.seconds.total_cmp(&b.seconds))
         .cloned();
+    if recommendation.is_none() {
+        notes.push(no_recommendation_note(&runs, options.tolerance));
+    }
+    for name in zero_in_reference(&reference) {
+        notes.push(format!(
+            "{name} is 0 in the reference run (a stabilizer that never touches the wall): \
+             left out of the errors where a run has it at 0 too"
+        ));
+    }
     let dir = folder.path();
     crate::output::write_csv_rows(
         &dir.join("precision.csv"),
@@ -577,4 +639,37 @@ pub fn stability(
     };
     folder.finish(&serde_json::to_vec_pretty(&summary).map_err(std::io::Error::other)?)?;
     Ok(summary)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn row(path: &str, dt: f64, e: f64) -> PrecisionRow {
+        PrecisionRow {
+            path: path.into(),
+            dt_s: dt,
+            seconds: 1.0,
+            max_error: e,
+            worst: "hook_load_n".into(),
+            errors: None,
+            status: "converged".into(),
+        }
+    }
+
+    #[test]
+    fn no_recommendation_says_why_and_which_step_would_do() {
+        // Second order: 4e-4, 1e-4 at 2 ms, 1 ms → 1e-6 needs 0.1 ms.
+        let rows = [row("cpu-f64", 2e-3, 4e-4), row("cpu-f64", 1e-3, 1e-4)];
+        let n = no_recommendation_note(&rows, 1e-6);
+        assert!(n.contains("smallest error is 1.00e-4"), "{n}");
+        assert!(
+            n.contains("order 2.00") && n.contains("dt ≈ 1.00e-4 s"),
+            "{n}"
+        );
+        // Errors that do not fall with the step.
+        let rows = [row("cpu-f64", 2e-3, 1e-4), row("cpu-f64", 1e-3, 1.1e-4)];
+        let n = no_recommendation_note(&rows, 1e-6);
+        assert!(n.contains("do not fall with the step"), "{n}");
+    }
 }

@@ -361,8 +361,7 @@ pub fn bare_number_trap(dimension: Dimension, x: f64) -> Option<String> {
             };
             Some(format!(
                 "a bare number is kg/m3, and {} kg/m3 is lighter than any drilling fluid but \
-                 gas: did you mean \"{} sg\"{ppg}? (write \"{} kg/m3\" if you mean it)",
-                show(x),
+                 gas: did you mean \"{} sg\"{ppg}?",
                 show(x),
                 show(x)
             ))
@@ -404,5 +403,83 @@ mod show_tests {
         assert_eq!(super::show(1e-9), "0.000000001");
         assert_eq!(super::show(-2.5), "-2.5");
         assert_eq!(super::show(123456789.0), "123456789");
+    }
+}
+
+/// Drilling-fluid densities a case may hold (kg/m³): 0.5 … 3.0 sg (4.2 … 25 ppg), or 0 for
+/// a dry string (no buoyancy). Outside, a unit mix-up is far likelier than the fluid.
+pub const FLUID_DENSITY_RANGE: (f64, f64) = (500.0, 3000.0);
+
+/// The plausibility trap of a mud density `si` (kg/m³) written as `written`: `None` within
+/// [`FLUID_DENSITY_RANGE`] (or 0), else what it is in sg and ppg and what the user likely
+/// meant — the number written read as sg or as ppg, whichever is a drilling fluid. The same
+/// policy as [`bare_number_trap`], for values that carry a unit (`"1.3 ppg"` is 156 kg/m³).
+pub fn fluid_density_trap(si: f64, written: &str) -> Option<String> {
+    let (lo, hi) = FLUID_DENSITY_RANGE;
+    if si == 0.0 || (lo..=hi).contains(&si) {
+        return None;
+    }
+    let sg = si / 1000.0;
+    let ppg = si / 119.826_427;
+    let number = written
+        .split_whitespace()
+        .next()
+        .and_then(|n| n.parse::<f64>().ok());
+    let intent = match number {
+        Some(n) if (lo / 1000.0..=hi / 1000.0).contains(&n) => {
+            format!(": did you mean \"{} sg\"?", show(n))
+        }
+        Some(n) if (lo / 119.826_427..=hi / 119.826_427).contains(&n) => {
+            format!(": did you mean \"{} ppg\"?", show(n))
+        }
+        _ => String::new(),
+    };
+    Some(format!(
+        "{} is {} kg/m3 ({} sg, {} ppg), {} any drilling fluid (0.5 … 3.0 sg, 4.2 … 25 ppg; \
+         0 for a dry string){intent}",
+        written.trim(),
+        show(si),
+        show(sg),
+        show(ppg),
+        if si < lo {
+            "lighter than"
+        } else {
+            "heavier than"
+        }
+    ))
+}
+
+/// Dogleg severity (°/30 m) above which a survey gets a warning: sharper than motor and
+/// rotary-steerable builds of long- and medium-radius wells.
+pub const DOGLEG_WARNING_DEG_PER_30M: f64 = 15.0;
+
+/// Dogleg severity (°/30 m) above which a survey is refused unless `well.max_dogleg` raises
+/// the limit (short-radius wells): more likely a typo in a station than a hole.
+pub const DOGLEG_LIMIT_DEG_PER_30M: f64 = 30.0;
+
+/// A survey that runs past the deepest MD of its case by more than this factor is refused:
+/// the likeliest reason is MD in feet read as metres (3.28×).
+pub const SURVEY_PAST_CASE_FACTOR: f64 = 1.5;
+
+#[cfg(test)]
+mod plausibility_tests {
+    use super::*;
+
+    #[test]
+    fn mud_densities_outside_drilling_fluids_are_trapped_with_the_intent() {
+        // "1.3 ppg" (156 kg/m3): meant 1.3 sg.
+        let si = parse_quantity("1.3 ppg", Dimension::Density).unwrap();
+        let m = fluid_density_trap(si, "1.3 ppg").unwrap();
+        assert!(m.contains("did you mean \"1.3 sg\""), "{m}");
+        assert!(m.contains("lighter than"), "{m}");
+        // "12 sg" (12,000 kg/m3): meant 12 ppg.
+        let m = fluid_density_trap(12_000.0, "12 sg").unwrap();
+        assert!(m.contains("did you mean \"12 ppg\""), "{m}");
+        // Ordinary fluids and a dry string pass.
+        for t in ["1.2 sg", "10 ppg", "1500 kg/m3", "0.5 sg", "25 ppg"] {
+            let si = parse_quantity(t, Dimension::Density).unwrap();
+            assert_eq!(fluid_density_trap(si, t), None, "{t}");
+        }
+        assert_eq!(fluid_density_trap(0.0, "0 sg"), None);
     }
 }

@@ -160,6 +160,90 @@ pub fn analyse(
     }
 }
 
+/// Finest spectrum resolution, as a share of the rotary frequency, at which a whirl is
+/// named: coarser, forward synchronous (1×) and half-synchronous (0.5×) whirl fall one
+/// bin apart or in the same one.
+pub const RESOLUTION_SHARE: f64 = 0.25;
+
+/// Largest change of a mean, as a share of its scale, over an analysis window that is
+/// called steady.
+pub const STEADY_SHARE: f64 = 0.05;
+
+/// The means of the first and the last quarter of `values`.
+pub fn quarter_means(values: &[f64]) -> (f64, f64) {
+    let q = (values.len() / 4).max(1);
+    let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len().max(1) as f64;
+    if values.is_empty() {
+        return (0.0, 0.0);
+    }
+    (
+        mean(&values[..q.min(values.len())]),
+        mean(&values[values.len().saturating_sub(q)..]),
+    )
+}
+
+/// Why the whirl of a site over an analysis window of `window_s` seconds cannot be read
+/// as a steady whirl (empty: it can): the site's spin rate (rad/s, sampled over the
+/// window) still changes by more than [`STEADY_SHARE`] of the table's `rotary_hz`, or the
+/// spectrum's resolution `1/window` is coarser than [`RESOLUTION_SHARE`] × rotary (with
+/// the duration a run would need).
+pub fn window_notes(spin: &[f64], rotary_hz: f64, window_s: f64, run_s: f64) -> Vec<String> {
+    let mut notes = Vec::new();
+    let omega = std::f64::consts::TAU * rotary_hz.abs();
+    if omega == 0.0 {
+        return notes;
+    }
+    let (first, last) = quarter_means(spin);
+    let rpm = 60.0 / std::f64::consts::TAU;
+    if (last - first).abs() > STEADY_SHARE * omega {
+        notes.push(format!(
+            "not at steady state: the stabilizer's spin goes from {:.1} to {:.1} rpm over the \
+             analysis window (the run's second half; table {:.1} rpm): run longer or ramp \
+             the table faster",
+            first * rpm,
+            last * rpm,
+            omega * rpm
+        ));
+    }
+    let resolution = 1.0 / window_s;
+    if resolution > RESOLUTION_SHARE * rotary_hz.abs() {
+        notes.push(format!(
+            "the spectrum's resolution {:.3} Hz is {:.2} × the rotary frequency, too coarse \
+             to name a whirl (≤ {RESOLUTION_SHARE} × needed): run at least {:.1} s (now {:.1} s)",
+            resolution,
+            resolution / rotary_hz.abs(),
+            2.0 / (RESOLUTION_SHARE * rotary_hz.abs()),
+            run_s
+        ));
+    }
+    notes
+}
+
+/// Why a run's analysis window (its second half, from `window_start` to the end) is not
+/// a steady state (empty: it is): the table still ramping (`ramp_time` past the window's
+/// start), or the surface torque's mean changing by more than [`STEADY_SHARE`] of its
+/// scale over the window (`torque` sampled over it).
+pub fn run_notes(ramp_time: f64, window_start: f64, torque: &[f64]) -> Vec<String> {
+    let mut notes = Vec::new();
+    if ramp_time > window_start {
+        notes.push(format!(
+            "not at steady state: the rotary table reaches its speed at t = {ramp_time:.2} s, \
+             after the analysis window starts (t = {window_start:.2} s)"
+        ));
+    }
+    let (first, last) = quarter_means(torque);
+    let scale = first.abs().max(last.abs());
+    if scale > 0.0 && (last - first).abs() > STEADY_SHARE * scale {
+        notes.push(format!(
+            "not at steady state: the surface torque's mean goes from {:.2} to {:.2} kN·m \
+             over the analysis window",
+            first / 1e3,
+            last / 1e3
+        ));
+    }
+    notes
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -211,5 +295,38 @@ mod tests {
         // At rest: none.
         let w = analyse(&vec![1e-9; n], &vec![0.0; n], &[], dt, 2.0, 0.01);
         assert_eq!(w.class, WhirlClass::None);
+    }
+}
+
+#[cfg(test)]
+mod window_tests {
+    use super::*;
+
+    #[test]
+    fn a_spin_up_and_a_short_window_are_named() {
+        let rotary_hz = 2.0; // 120 rpm
+        let omega = std::f64::consts::TAU * rotary_hz;
+        // Steady: no notes over a 4 s window (0.25 Hz = 0.125 × rotary).
+        let steady = vec![omega; 400];
+        assert!(window_notes(&steady, rotary_hz, 4.0, 8.0).is_empty());
+        // Spinning up from 0.8 to 1.0 × Ω over the window.
+        let ramp: Vec<f64> = (0..400)
+            .map(|k| omega * (0.8 + 0.2 * k as f64 / 399.0))
+            .collect();
+        let n = window_notes(&ramp, rotary_hz, 4.0, 8.0);
+        assert_eq!(n.len(), 1);
+        assert!(n[0].contains("not at steady state"), "{n:?}");
+        // A 1 s window: 1 Hz = 0.5 × rotary.
+        let n = window_notes(&steady, rotary_hz, 1.0, 2.0);
+        assert_eq!(n.len(), 1);
+        assert!(
+            n[0].contains("too coarse") && n[0].contains("run at least 4.0 s"),
+            "{n:?}"
+        );
+        // The run: the table ramping into the window, a torque still rising.
+        assert_eq!(run_notes(1.5, 1.0, &[10.0; 100]).len(), 1);
+        let rising: Vec<f64> = (0..100).map(|k| 10e3 + 30.0 * k as f64).collect();
+        assert_eq!(run_notes(0.5, 1.0, &rising).len(), 1);
+        assert!(run_notes(0.5, 1.0, &[10e3; 100]).is_empty());
     }
 }

@@ -299,8 +299,8 @@ fn run_writes_the_requested_time_series_and_plots() {
         "contact_sites.csv",
         "axial_stress.csv",
         "bit_displacement.png",
-        "orbit_site0.png",
-        "spin_site0.png",
+        "orbit_stab1.png",
+        "spin_stab1.png",
         "energy.png",
     ] {
         assert!(out.join(f).is_file(), "{f} missing");
@@ -312,7 +312,7 @@ fn run_writes_the_requested_time_series_and_plots() {
         .skip(1)
         .filter_map(|l| {
             let f: Vec<f64> = l.split(',').map(|x| x.parse().unwrap()).collect();
-            (f[0] >= 0.7).then_some(f[7])
+            (f[0] >= 0.7).then_some(f[8])
         })
         .collect();
     let mean = spins.iter().sum::<f64>() / spins.len() as f64;
@@ -477,9 +477,10 @@ fn plausible_but_wrong_inputs_are_refused_with_the_likely_intent() {
         assert!(stderr.contains(words), "{what}: {stderr}");
         table.push_str(&format!("| {what} | {code} | `{}` |\n", stderr.trim()));
     }
-    // Explicit units say what the user means: accepted.
+    // Explicit units say what the user means: accepted (a density also has to be a
+    // drilling fluid's in any unit, issue 23: `tests/plausibility.rs`).
     for (from, to) in [
-        ("density = \"10 ppg\"", "density = \"1.2 kg/m3\""),
+        ("density = \"10 ppg\"", "density = \"1200 kg/m3\""),
         ("density = \"10 ppg\"", "density = 0"),
         ("rpm = \"120 rpm\"", "rpm = \"9 rad/s\""),
         ("weight_on_bit = \"20 klbf\"", "weight_on_bit = \"20 N\""),

@@ -63,6 +63,10 @@ const TOKENS: &[&str] = &[
     "\"5 kN\"",
     "\"10 ppg\"",
     "\"1.2 sg\"",
+    "\"1.3 ppg\"",
+    "\"12 sg\"",
+    "400",
+    "-10",
     "true",
     "[]",
     "{}",
@@ -281,6 +285,7 @@ fn fuzz_survey_csv() {
             Ok(read) => {
                 let stations: Vec<_> = read.iter().map(|(s, _)| *s).collect();
                 holewall::well::WellPath::from_survey(&stations, [0.0; 3]).is_ok()
+                    && holewall::case::survey_plausibility("fuzz.csv", &read, 1500.0, 30.0).is_ok()
             }
             Err(_) => false,
         },

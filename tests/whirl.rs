@@ -369,7 +369,7 @@ fn an_initial_lateral_kick_starts_lateral_motion() {
         .skip(1)
         .map(|l| l.split(',').map(|x| x.parse().unwrap()).collect())
         .collect();
-    let (md, r0, r_end) = (rows[0][2], rows[0][5], rows.last().unwrap()[5]);
+    let (md, r0, r_end) = (rows[0][3], rows[0][6], rows.last().unwrap()[6]);
     let s = (60.0 - md) / 30.75;
     let expect = offset * (std::f64::consts::PI * s).sin();
     eprintln!(

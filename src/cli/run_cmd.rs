@@ -35,18 +35,30 @@ pub struct RunSummary {
     pub stopped_early: Option<String>,
     /// Per stabilizer, its whirl over the run's second half ([`crate::whirl`]), with `whirl`.
     pub whirl: Vec<SiteWhirl>,
+    /// Why the run's second half (where whirl is analysed) is not a steady state
+    /// ([`crate::whirl::run_notes`]); also on stderr.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub analysis_notes: Vec<String>,
+    /// What the case holds that is allowed but unusual ([`crate::case::Case::warnings`]).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub warnings: Vec<String>,
 }
 
 /// A stabilizer's whirl in `summary.json`.
 #[derive(Clone, Debug, Serialize)]
 pub struct SiteWhirl {
-    /// Contact site index.
+    /// The stabilizer's name, `stab1` nearest the bit ([`crate::model::stabilizer_name`]).
+    pub stabilizer: String,
+    /// Contact site index (the `site` column of `contact_sites.csv`).
     pub site: usize,
     /// Its MD (m).
     pub md_m: f64,
     /// The analysis.
     #[serde(flatten)]
     pub whirl: crate::whirl::Whirl,
+    /// Why this whirl is not to be read as steady ([`crate::whirl::window_notes`]).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub notes: Vec<String>,
 }
 
 /// Options of `holewall run`.
@@ -155,6 +167,7 @@ pub fn options_for(settings: &crate::case::DynamicsSettings) -> DynamicOptions {
 /// Runs the command.
 pub fn run(case_path: &Path, out: &Path, options: RunOptions) -> Result<RunSummary, Error> {
     let case = load_case(case_path)?;
+    super::print_warnings(&case);
     let folder = RunFolder::prepare(out)?;
     let summary = run_case(&case, folder.path(), options)?;
     folder.finish(&summary_json(&summary)?)?;
@@ -353,6 +366,7 @@ fn run_case(case: &Case, out: &Path, run_options: RunOptions) -> Result<RunSumma
         let header = [
             "t_s",
             "site",
+            "stabilizer",
             "md_m",
             "lateral_x_m",
             "lateral_y_m",
@@ -364,6 +378,7 @@ fn run_case(case: &Case, out: &Path, run_options: RunOptions) -> Result<RunSumma
             vec![
                 *t,
                 *k as f64,
+                model.stabilizer_number(*k).unwrap_or(0) as f64,
                 model.nodes[model.sites[*k].node].md,
                 v[0],
                 v[1],
@@ -374,7 +389,9 @@ fn run_case(case: &Case, out: &Path, run_options: RunOptions) -> Result<RunSumma
         });
         write_atomic(&out.join("contact_sites.csv"), &csv_bytes(&header, rows)?)?;
         written.push("contact_sites.csv".into());
-        for (k, site) in model.sites.iter().enumerate().filter(|(_, s)| s.stabilizer) {
+        for (number, &k) in model.stabilizer_sites().iter().enumerate() {
+            let site = &model.sites[k];
+            let stab = crate::model::stabilizer_name(number + 1);
             let pts = |j: usize, scale: f64| -> Vec<(f64, f64)> {
                 rec.sites
                     .iter()
@@ -385,8 +402,8 @@ fn run_case(case: &Case, out: &Path, run_options: RunOptions) -> Result<RunSumma
             let md = model.nodes[site.node].md;
             if want("lateral") {
                 line_plot(
-                    &out.join(format!("lateral_site{k}.png")),
-                    &format!("{title}: lateral displacement at MD {md:.1} m (Fig 6)"),
+                    &out.join(format!("lateral_{stab}.png")),
+                    &format!("{title}: lateral displacement of {stab} (MD {md:.1} m, Fig 6)"),
                     "t (s)",
                     "radial displacement (mm)",
                     &[
@@ -416,18 +433,18 @@ fn run_case(case: &Case, out: &Path, run_options: RunOptions) -> Result<RunSumma
                     .map(|r| (1e3 * r.2[0], 1e3 * r.2[1]))
                     .collect();
                 crate::plots::orbit_plot(
-                    &out.join(format!("orbit_site{k}.png")),
-                    &format!("{title}: orbit at MD {md:.1} m (Fig 7)"),
+                    &out.join(format!("orbit_{stab}.png")),
+                    &format!("{title}: orbit of {stab} (MD {md:.1} m, Fig 7)"),
                     &orbit,
                     1e3 * site.params.clearance,
                 )?;
-                written.push(format!("lateral_site{k}.png"));
-                written.push(format!("orbit_site{k}.png"));
+                written.push(format!("lateral_{stab}.png"));
+                written.push(format!("orbit_{stab}.png"));
             }
             if want("contact_forces") {
                 line_plot(
-                    &out.join(format!("contact_force_site{k}.png")),
-                    &format!("{title}: contact force at MD {md:.1} m"),
+                    &out.join(format!("contact_force_{stab}.png")),
+                    &format!("{title}: contact force on {stab} (MD {md:.1} m)"),
                     "t (s)",
                     "normal force (kN)",
                     &[Series {
@@ -437,12 +454,12 @@ fn run_case(case: &Case, out: &Path, run_options: RunOptions) -> Result<RunSumma
                     }],
                     &[],
                 )?;
-                written.push(format!("contact_force_site{k}.png"));
+                written.push(format!("contact_force_{stab}.png"));
             }
             if want("spin") {
                 line_plot(
-                    &out.join(format!("spin_site{k}.png")),
-                    &format!("{title}: stabilizer spin rate at MD {md:.1} m"),
+                    &out.join(format!("spin_{stab}.png")),
+                    &format!("{title}: spin rate of {stab} (MD {md:.1} m)"),
                     "t (s)",
                     "spin rate (rpm)",
                     &[Series {
@@ -452,7 +469,7 @@ fn run_case(case: &Case, out: &Path, run_options: RunOptions) -> Result<RunSumma
                     }],
                     &[],
                 )?;
-                written.push(format!("spin_site{k}.png"));
+                written.push(format!("spin_{stab}.png"));
             }
         }
     }
@@ -460,7 +477,9 @@ fn run_case(case: &Case, out: &Path, run_options: RunOptions) -> Result<RunSumma
     if want("whirl") {
         let t_end = t.last().copied().unwrap_or(0.0);
         let mut spectrum_rows: Vec<Vec<f64>> = Vec::new();
-        for (k, site) in model.sites.iter().enumerate().filter(|(_, s)| s.stabilizer) {
+        for (number, &k) in model.stabilizer_sites().iter().enumerate() {
+            let site = &model.sites[k];
+            let stab = crate::model::stabilizer_name(number + 1);
             // The second half of the run, after the spin-up.
             let late: Vec<&(f64, usize, [f64; 5])> = rec
                 .sites
@@ -483,7 +502,7 @@ fn run_case(case: &Case, out: &Path, run_options: RunOptions) -> Result<RunSumma
             let md = model.nodes[site.node].md;
             for (f, a) in &w.spectrum {
                 spectrum_rows.push(vec![
-                    k as f64,
+                    (number + 1) as f64,
                     md,
                     *f,
                     if rotary_hz != 0.0 { f / rotary_hz } else { 0.0 },
@@ -501,9 +520,9 @@ fn run_case(case: &Case, out: &Path, run_options: RunOptions) -> Result<RunSumma
                     .filter(|(r, _)| r.abs() <= span)
                     .collect();
                 line_plot(
-                    &out.join(format!("whirl_site{k}.png")),
+                    &out.join(format!("whirl_{stab}.png")),
                     &format!(
-                        "{title}: whirl spectrum at MD {md:.1} m — {:?}, {:.2} × rotary",
+                        "{title}: whirl spectrum of {stab} (MD {md:.1} m) — {:?}, {:.2} × rotary",
                         w.class, w.ratio_to_rotary
                     ),
                     "whirl frequency / rotary frequency (+ forward, − backward)",
@@ -515,19 +534,25 @@ fn run_case(case: &Case, out: &Path, run_options: RunOptions) -> Result<RunSumma
                     }],
                     &[],
                 )?;
-                written.push(format!("whirl_site{k}.png"));
+                written.push(format!("whirl_{stab}.png"));
+            }
+            let notes = crate::whirl::window_notes(&spin, rotary_hz, 0.5 * t_end, t_end);
+            for n in &notes {
+                eprintln!("holewall: note: {stab}: {n}");
             }
             whirl.push(SiteWhirl {
+                stabilizer: stab.clone(),
                 site: k,
                 md_m: md,
                 whirl: w,
+                notes,
             });
         }
         write_atomic(
             &out.join("whirl_spectrum.csv"),
             &csv_bytes(
                 &[
-                    "site",
+                    "stabilizer",
                     "md_m",
                     "frequency_hz",
                     "frequency_over_rotary",
@@ -579,7 +604,20 @@ fn run_case(case: &Case, out: &Path, run_options: RunOptions) -> Result<RunSumma
         written.push("axial_stress.png".into());
     }
     let steps = dynamics.iterations.len();
+    let t_end = t.last().copied().unwrap_or(0.0);
+    let late_torque: Vec<f64> = rec
+        .series
+        .iter()
+        .filter(|r| r[0] >= 0.5 * t_end)
+        .map(|r| r[2])
+        .collect();
+    let analysis_notes = crate::whirl::run_notes(settings.ramp_time, 0.5 * t_end, &late_torque);
+    for n in &analysis_notes {
+        eprintln!("holewall: note: {n}");
+    }
     let summary = RunSummary {
+        analysis_notes,
+        warnings: case.warnings.clone(),
         title: case.title.clone(),
         duration_s: s.t,
         steps,

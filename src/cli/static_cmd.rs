@@ -82,6 +82,9 @@ pub struct Summary {
     pub newton_iterations: Vec<usize>,
     /// Load-step cuts and why (FE).
     pub solver_log: Vec<String>,
+    /// What the case holds that is allowed but unusual ([`crate::case::Case::warnings`]).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub warnings: Vec<String>,
 }
 
 /// Neutral point: the first MD, going up from the bit, where the axial force turns from
@@ -246,6 +249,7 @@ pub fn run(
     options: StaticCommandOptions,
 ) -> Result<Summary, Error> {
     let case = load_case(case_path)?;
+    super::print_warnings(&case);
     let folder = RunFolder::prepare(out)?;
     let model = &case.model;
     let n = model.nodes.len();
@@ -309,6 +313,7 @@ pub fn run(
         });
     let (sinusoidal, helical) = buckling(&case, model, &rows);
     let summary = Summary {
+        warnings: case.warnings.clone(),
         title: case.title.clone(),
         model: match which {
             StaticModel::Fe => "fe".into(),
@@ -399,20 +404,7 @@ fn write_plots(
         )?;
     }
     // Side force per unit length; each stabilizer's force (a point load) marked.
-    let stab_labels: Vec<(String, f64, f64)> = model
-        .sites
-        .iter()
-        .filter(|s| s.stabilizer)
-        .enumerate()
-        .filter_map(|(k, s)| {
-            let r = rows.get(s.node)?;
-            Some((
-                format!("stab {}: {:.1} kN", k + 1, r.side_force_n / 1e3),
-                r.md_m,
-                r.side_force_per_length_n_per_m / 1e3,
-            ))
-        })
-        .collect();
+    let stab_labels = stabilizer_labels(model, rows);
     let stab_markers: Vec<Marker> = stab_labels
         .iter()
         .map(|(label, x, y)| Marker {
@@ -508,4 +500,27 @@ fn write_plots(
         )?;
     }
     Ok(())
+}
+
+/// The side-force plot's stabilizer labels: `(label, MD, side force per length kN/m)`, in
+/// the one numbering ([`Model::stabilizer_sites`]: stab1 nearest the bit), e.g.
+/// `stab1: 4.2 kN`.
+pub fn stabilizer_labels(model: &Model, rows: &[ProfileRow]) -> Vec<(String, f64, f64)> {
+    model
+        .stabilizer_sites()
+        .iter()
+        .enumerate()
+        .filter_map(|(k, &site)| {
+            let r = rows.get(model.sites[site].node)?;
+            Some((
+                format!(
+                    "{}: {:.1} kN",
+                    crate::model::stabilizer_name(k + 1),
+                    r.side_force_n / 1e3
+                ),
+                r.md_m,
+                r.side_force_per_length_n_per_m / 1e3,
+            ))
+        })
+        .collect()
 }

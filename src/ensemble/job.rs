@@ -10,7 +10,7 @@ use super::runner::*;
 use super::store::*;
 use crate::backend::{BackendChoice, Precision};
 use crate::case::{load_case, Analysis};
-use crate::ensemble::{apply, stabilizer_sites};
+use crate::ensemble::apply;
 use crate::error::{Error, InputError};
 use crate::output::{out_error, write_atomic};
 use crate::plots::{line_plot, Series};
@@ -27,6 +27,9 @@ pub fn run(
 ) -> Result<EnsembleSummary, Error> {
     let monte_carlo = options.monte_carlo.as_ref();
     let case = load_case(case_path)?;
+    if show_progress {
+        crate::cli::print_warnings(&case);
+    }
     let settings = case.ensemble.clone();
     let cli_error = |key: &str, message: String| -> Error {
         InputError {
@@ -134,7 +137,7 @@ pub fn run(
     if let Some(mc) = monte_carlo {
         let names: Vec<String> = qoi_columns(
             &[],
-            stabilizer_sites(&case.model).len(),
+            case.model.stabilizer_sites().len(),
             analysis == Analysis::Dynamic,
         )
         .into_iter()
@@ -167,11 +170,13 @@ pub fn run(
         }
     }
     // The output folder, checked (and the run's manifest written) before any work.
-    let chunk_size = if options.chunk_size == 0 {
-        DEFAULT_CHUNK
-    } else {
-        options.chunk_size
-    };
+    if options.chunk_size == 0 {
+        return Err(cli_error(
+            "--chunk-size",
+            format!("0 variants per chunk; allowed: 1 … 1000000 (default {DEFAULT_CHUNK})"),
+        ));
+    }
+    let chunk_size = options.chunk_size;
     let manifest = Manifest::new(
         case_path,
         variants_file,
@@ -238,6 +243,7 @@ pub fn run(
     bar.finish_and_clear();
     if let Some((k, n)) = options.shard {
         return Ok(EnsembleSummary {
+            warnings: case.warnings.clone(),
             title: case.title.clone(),
             analysis: format!("{analysis:?}").to_lowercase(),
             backend: format!("{backend:?}").to_lowercase(),
@@ -269,11 +275,12 @@ pub fn run(
         let chunk = read_chunk(&chunk_path(out, c))?;
         if chunk.first != chunk_of(c).start || chunk.results.len() != chunk_of(c).len() {
             return Err(Error::Io(std::io::Error::other(format!(
-                "{}: holds variants {}.. ({}), not the chunk's {:?}",
+                "{}: holds {} variants from {}, not the chunk's {} from {}",
                 chunk_path(out, c).display(),
-                chunk.first,
                 chunk.results.len(),
-                chunk_of(c)
+                chunk.first,
+                chunk_of(c).len(),
+                chunk_of(c).start
             ))));
         }
         if chunk.backend == "gpu" {
@@ -287,7 +294,7 @@ pub fn run(
         seconds += chunk.seconds;
         results.extend(chunk.results);
     }
-    let stabs = stabilizer_sites(&case.model).len();
+    let stabs = case.model.stabilizer_sites().len();
     let dynamic = analysis == Analysis::Dynamic;
     let mut outputs = vec!["variants.csv".to_string()];
     write_atomic(
@@ -327,7 +334,7 @@ pub fn run(
             &[],
         )?;
         outputs.push("neutral_point.png".into());
-        let names: Vec<String> = (1..=stabs).map(|k| format!("stab{k}")).collect();
+        let names: Vec<String> = (1..=stabs).map(crate::model::stabilizer_name).collect();
         // One line per stabilizer of a per-stabilizer quantity over the variants.
         let per_stabilizer = |file: &str,
                               title: &str,
@@ -375,6 +382,7 @@ pub fn run(
     }
     let count = |s: Status| results.iter().filter(|r| r.status == s).count();
     let summary = EnsembleSummary {
+        warnings: case.warnings.clone(),
         title: case.title.clone(),
         analysis: if dynamic { "dynamic" } else { "static" }.into(),
         backend: backend_name.into(),
@@ -415,6 +423,17 @@ pub fn run(
     Ok(summary)
 }
 
+/// An error about one of `holewall merge`'s shard folders (an input, not `--out`).
+fn shard_folder_error(dir: &Path, message: String) -> Error {
+    InputError {
+        source_name: "shard folder".into(),
+        line: 0,
+        key: dir.display().to_string(),
+        message,
+    }
+    .into()
+}
+
 /// `holewall merge`: the shards in `dirs` (one run's `--shard K/N` folders, every K once)
 /// into `out`, which then holds exactly what the run without shards would write.
 pub fn merge(
@@ -424,9 +443,10 @@ pub fn merge(
 ) -> Result<EnsembleSummary, Error> {
     let read = |d: &std::path::PathBuf| -> Result<Manifest, Error> {
         let p = d.join("run.json");
-        let t = std::fs::read(&p)
-            .map_err(|e| out_error(d, format!("no run.json ({e}): not a holewall run folder")))?;
-        serde_json::from_slice(&t).map_err(|e| out_error(d, format!("run.json: {e}")))
+        let t = std::fs::read(&p).map_err(|e| {
+            shard_folder_error(d, format!("no run.json ({e}): not a holewall run folder"))
+        })?;
+        serde_json::from_slice(&t).map_err(|e| shard_folder_error(d, format!("run.json: {e}")))
     };
     let manifests = dirs.iter().map(read).collect::<Result<Vec<_>, Error>>()?;
     let first = manifests
@@ -434,12 +454,17 @@ pub fn merge(
         .ok_or_else(|| out_error(out, "no shard folders given".into()))?;
     let n = match first.shard {
         Some((_, n)) => n,
-        None => return Err(out_error(&dirs[0], "is a whole run, not a shard".into())),
+        None => {
+            return Err(shard_folder_error(
+                &dirs[0],
+                "is a whole run, not a shard".into(),
+            ))
+        }
     };
     let mut seen = vec![false; n];
     for (d, m) in dirs.iter().zip(&manifests) {
         if m.identity != first.identity {
-            return Err(out_error(
+            return Err(shard_folder_error(
                 d,
                 format!(
                     "is a shard of another run (identity {} against {})",
@@ -450,10 +475,14 @@ pub fn merge(
         match m.shard {
             Some((k, nn)) if nn == n && (1..=n).contains(&k) && !seen[k - 1] => seen[k - 1] = true,
             other => {
-                return Err(out_error(
+                let which = match other {
+                    Some((k, nn)) => format!("shard {k}/{nn}"),
+                    None => "a whole run (not a shard)".to_string(),
+                };
+                return Err(shard_folder_error(
                     d,
-                    format!("shard {other:?} does not fit {n} shards given once each"),
-                ))
+                    format!("{which} does not fit {n} shards given once each"),
+                ));
             }
         }
     }
@@ -468,7 +497,7 @@ pub fn merge(
         for c in (k - 1) * whole.chunks / n..k * whole.chunks / n {
             let from = chunk_path(d, c);
             if !from.exists() {
-                return Err(out_error(
+                return Err(shard_folder_error(
                     d,
                     format!("chunk {c} is missing: the shard did not finish; run it again"),
                 ));

@@ -165,15 +165,6 @@ pub fn variants_from_grid(grid: &[(Key, Vec<f64>)]) -> Vec<Variant> {
         .collect()
 }
 
-/// Indices into `model.sites` of the stabilizers, nearest the bit first.
-pub fn stabilizer_sites(model: &Model) -> Vec<usize> {
-    let mut s: Vec<usize> = (0..model.sites.len())
-        .filter(|&k| model.sites[k].stabilizer)
-        .collect();
-    s.sort_by_key(|&k| std::cmp::Reverse(model.sites[k].node));
-    s
-}
-
 /// The case's model with a variant's overrides applied. Layout moves come first (a
 /// stabilizer's site goes to the node nearest its new distance from the bit; a pipe-body
 /// site there, if any, takes the old node), then values, in column order.
@@ -223,12 +214,15 @@ pub fn apply(case: &Case, variant: &Variant) -> Result<Model, String> {
         }
     };
     let mut model = case.model.clone();
-    let stabs = stabilizer_sites(&case.model);
+    let stabs = case.model.stabilizer_sites();
     let stab = |k: usize| -> Result<usize, String> {
-        stabs
-            .get(k - 1)
-            .copied()
-            .ok_or_else(|| format!("stab{k}: the case has {} stabilizer site(s)", stabs.len()))
+        stabs.get(k - 1).copied().ok_or_else(|| {
+            format!(
+                "{}: the case has {} stabilizer site(s)",
+                crate::model::stabilizer_name(k),
+                stabs.len()
+            )
+        })
     };
     let hole_radius_at = |md: f64| {
         0.5 * case
@@ -486,7 +480,7 @@ pub fn sample_variants(
                         .map(|v| (key.clone(), v))
                         .map_err(|m| {
                             format!(
-                                "sample {i}: {} drew {v} from {dist:?}, outside the key's range ({m}); truncate the distribution",
+                                "sample {i}: {} drew {v} from a {dist}, outside the key's range ({m}); truncate the distribution",
                                 key.name
                             )
                         })

@@ -7,7 +7,6 @@ use serde::{Deserialize, Serialize};
 
 use crate::case::Case;
 use crate::cli::static_cmd::{fe_rows, neutral_point, neutral_point_of, nodal_axial_forces};
-use crate::ensemble::stabilizer_sites;
 use crate::model::Model;
 use crate::physics::vec3::{dot, scale, sub};
 use crate::solve::dynamics::{DynamicState, Dynamics};
@@ -193,7 +192,7 @@ pub(crate) fn finished(
 pub fn static_variant(case: &Case, name: &str, model: &Model) -> VariantResult {
     match solve_static(model, &StaticOptions::default()) {
         Ok(sol) => static_result(case, name, model, &sol),
-        Err(e) => failed(name, e.to_string(), stabilizer_sites(model).len()),
+        Err(e) => failed(name, e.to_string(), model.stabilizer_sites().len()),
     }
 }
 
@@ -204,7 +203,7 @@ pub fn static_result(
     model: &Model,
     sol: &crate::solve::statics::StaticSolution,
 ) -> VariantResult {
-    let stabs = stabilizer_sites(model);
+    let stabs = model.stabilizer_sites();
     let (rows, hook, torque, _wob) = fe_rows(model, sol);
     let stabilizers = stabs
         .iter()
@@ -266,7 +265,7 @@ pub fn dynamic_variant_tracked(
     model: &Model,
     track_energy: bool,
 ) -> (VariantResult, Option<f64>) {
-    let stabs = stabilizer_sites(model);
+    let stabs = model.stabilizer_sites();
     let Some(settings) = case.dynamics.clone() else {
         return (
             failed(name, "no [dynamics] table".into(), stabs.len()),
@@ -354,7 +353,7 @@ pub struct DynamicObserver {
 impl DynamicObserver {
     /// For a run of `duration` seconds (whirl is fitted over its second half).
     pub fn new(model: &Model, duration: f64) -> Self {
-        let stabs = stabilizer_sites(model);
+        let stabs = model.stabilizer_sites();
         let k = stabs.len();
         DynamicObserver {
             stabs,
@@ -515,18 +514,18 @@ pub fn qoi_columns(
     }
     for k in 0..stabs {
         q.push(col(
-            format!("stab{}_max_side_force_n", k + 1),
+            format!("{}_max_side_force_n", crate::model::stabilizer_name(k + 1)),
             Unit::Force,
             &|r| r.stabilizers.get(k).map(|s| s.max_side_force_n),
         ));
         q.push(col(
-            format!("stab{}_max_lateral_m", k + 1),
+            format!("{}_max_lateral_m", crate::model::stabilizer_name(k + 1)),
             Unit::Length,
             &|r| r.stabilizers.get(k).map(|s| s.max_lateral_m),
         ));
         if dynamic {
             q.push(col(
-                format!("stab{}_whirl_hz", k + 1),
+                format!("{}_whirl_hz", crate::model::stabilizer_name(k + 1)),
                 Unit::Frequency,
                 &|r| r.stabilizers.get(k).and_then(|s| s.whirl_hz),
             ));

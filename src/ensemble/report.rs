@@ -16,6 +16,9 @@ use crate::plots::{line_plot, Series};
 pub struct EnsembleSummary {
     /// Case title.
     pub title: String,
+    /// What the case holds that is allowed but unusual ([`crate::case::Case::warnings`]).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub warnings: Vec<String>,
     /// `static` or `dynamic`.
     pub analysis: String,
     /// Where it ran.
@@ -31,7 +34,8 @@ pub struct EnsembleSummary {
     pub variants: usize,
     /// Converged without cuts.
     pub converged: usize,
-    /// Converged with step cuts.
+    /// Converged with step cuts: the variants whose `step_cuts` column in `variants.csv`
+    /// is above 0 (a re-run on the CPU is counted in `solved_by_cpu`, not here).
     pub step_cut: usize,
     /// Failed.
     pub failed: usize,
@@ -48,6 +52,42 @@ pub struct EnsembleSummary {
     pub uncertainty: Option<crate::uq::report::UncertaintyReport>,
     /// Files written.
     pub outputs: Vec<String>,
+}
+
+impl EnsembleSummary {
+    /// A few lines for the terminal: counts, who solved what, the first failures, where
+    /// the rest is.
+    pub fn digest(&self, out: &std::path::Path) -> String {
+        let mut t = format!(
+            "{}: {} variants ({}, {} {}) in {:.1} s — {} converged, {} with step cuts, {} failed; \
+             solved by the engine {}, by the CPU {}",
+            self.title,
+            self.variants,
+            self.analysis,
+            self.backend,
+            self.precision,
+            self.seconds,
+            self.converged,
+            self.step_cut,
+            self.failed,
+            self.solved_by_engine,
+            self.solved_by_cpu
+        );
+        if let Some(note) = &self.backend_note {
+            t.push_str(&format!("\n  note: {note}"));
+        }
+        for (name, why) in self.failures.iter().take(3) {
+            t.push_str(&format!("\n  failed {name}: {why}"));
+        }
+        if self.failures.len() > 3 {
+            t.push_str(&format!("\n  … {} more failures", self.failures.len() - 3));
+        }
+        t.push_str(&format!(
+            "\n  everything else: {}",
+            out.join("summary.json").display()
+        ));
+        t
+    }
 }
 
 pub(crate) fn fmt(x: f64) -> String {
@@ -97,12 +137,21 @@ pub(crate) fn variants_csv(
         header.extend(["sinusoidal_buckling", "helical_buckling"].map(String::from));
     }
     for k in 1..=stabs {
-        header.push(format!("stab{k}_max_side_force_n"));
-        header.push(format!("stab{k}_max_lateral_m"));
+        header.push(format!(
+            "{}_max_side_force_n",
+            crate::model::stabilizer_name(k)
+        ));
+        header.push(format!(
+            "{}_max_lateral_m",
+            crate::model::stabilizer_name(k)
+        ));
         if dynamic {
-            header.push(format!("stab{k}_whirl_hz"));
-            header.push(format!("stab{k}_whirl"));
-            header.push(format!("stab{k}_contact_fraction"));
+            header.push(format!("{}_whirl_hz", crate::model::stabilizer_name(k)));
+            header.push(format!("{}_whirl", crate::model::stabilizer_name(k)));
+            header.push(format!(
+                "{}_contact_fraction",
+                crate::model::stabilizer_name(k)
+            ));
         }
     }
     header.extend(["newton_iterations_per_step", "step_cuts"].map(String::from));
@@ -299,7 +348,7 @@ fn ran_with(case: &Case, variants: &[Variant], stabs: usize) -> (Vec<String>, Ve
                     fmt(m.weight_on_bit),
                     fmt(m.torque_on_bit),
                 ];
-                let sites = crate::ensemble::stabilizer_sites(&m);
+                let sites = m.stabilizer_sites();
                 for k in 0..stabs {
                     match sites.get(k).map(|&s| &m.sites[s]) {
                         Some(site) => row.extend([

@@ -7,7 +7,7 @@ use rayon::prelude::*;
 use super::qoi::*;
 use crate::backend::Precision;
 use crate::case::{Analysis, Case};
-use crate::ensemble::{apply, stabilizer_sites, Variant};
+use crate::ensemble::{apply, Variant};
 use crate::error::{Error, InputError};
 use crate::model::Model;
 use crate::solve::dynamics::{DynamicState, Dynamics};
@@ -57,9 +57,6 @@ pub fn run_static_gpu<T: crate::gpu::contact::GpuReal>(
             EngineStatus::Failed(why) => {
                 let mut again = static_variant(case, &v.name, m);
                 again.reason = format!("GPU: {why}; re-run on the CPU: {}", again.reason);
-                if again.status == Status::Converged {
-                    again.status = Status::StepCut;
-                }
                 again
             }
         })
@@ -187,9 +184,6 @@ pub fn run_dynamic_gpu<T: crate::gpu::contact::GpuReal>(
                 };
                 let mut again = dynamic_variant(case, name, &models[j]);
                 again.reason = format!("GPU: {why}; re-run on the CPU: {}", again.reason);
-                if again.status == Status::Converged {
-                    again.status = Status::StepCut;
-                }
                 again
             }
         });
@@ -208,9 +202,6 @@ pub fn run_dynamic_gpu<T: crate::gpu::contact::GpuReal>(
                     "GPU static start: {why}; re-run on the CPU: {}",
                     again.reason
                 );
-                if again.status == Status::Converged {
-                    again.status = Status::StepCut;
-                }
                 again
             })
         })
@@ -227,7 +218,7 @@ pub fn run_variants_cpu(
     variants
         .par_iter()
         .map(|v| {
-            let stabs = stabilizer_sites(&case.model).len();
+            let stabs = case.model.stabilizer_sites().len();
             let r = match apply(case, v) {
                 Err(e) => failed(&v.name, format!("variant: {e}"), stabs),
                 Ok(model) => match analysis {

@@ -14,11 +14,11 @@ use crate::output::{out_error, write_atomic};
 pub const DEFAULT_CHUNK: usize = 256;
 
 /// Options of an ensemble run beyond the case, the variants file and the backend.
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug)]
 pub struct EnsembleOptions {
     /// Monte Carlo sampling of `[ensemble.uncertain]` (`--samples`).
     pub monte_carlo: Option<crate::uq::report::MonteCarlo>,
-    /// Variants per result chunk (0: [`DEFAULT_CHUNK`]).
+    /// Variants per result chunk, ≥ 1 (default [`DEFAULT_CHUNK`]; 0 is refused).
     pub chunk_size: usize,
     /// Run only the K-th (1-based) of N slices of the chunks (`--shard K/N`).
     pub shard: Option<(usize, usize)>,
@@ -27,6 +27,18 @@ pub struct EnsembleOptions {
     /// Wall-time budget (s, `--max-seconds`): no chunk is started once it is spent; the
     /// run stops resumable ([`crate::Error::Stopped`]).
     pub max_seconds: Option<f64>,
+}
+
+impl Default for EnsembleOptions {
+    fn default() -> Self {
+        EnsembleOptions {
+            monte_carlo: None,
+            chunk_size: DEFAULT_CHUNK,
+            shard: None,
+            force: false,
+            max_seconds: None,
+        }
+    }
 }
 
 /// `run.json`: what a run was asked, to resume it, refuse another run's folder, and merge

@@ -52,6 +52,53 @@ pub enum Distribution {
     },
 }
 
+/// In words, for messages: `normal (mean 20000, sd 5000)`, `uniform on [0.2, 0.4]`.
+impl std::fmt::Display for Distribution {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        use crate::units::show;
+        let bounds = |min: f64, max: f64| match (min.is_finite(), max.is_finite()) {
+            (true, true) => format!(", truncated to [{}, {}]", show(min), show(max)),
+            (true, false) => format!(", truncated below at {}", show(min)),
+            (false, true) => format!(", truncated above at {}", show(max)),
+            (false, false) => String::new(),
+        };
+        match self {
+            Distribution::Uniform { min, max } => {
+                write!(f, "uniform on [{}, {}]", show(*min), show(*max))
+            }
+            Distribution::Normal { mean, sd, min, max } => write!(
+                f,
+                "normal (mean {}, sd {}{})",
+                show(*mean),
+                show(*sd),
+                bounds(*min, *max)
+            ),
+            Distribution::LogNormal { median, sigma } => write!(
+                f,
+                "lognormal (median {}, sd of ln x {})",
+                show(*median),
+                show(*sigma)
+            ),
+            Distribution::Triangular { min, mode, max } => write!(
+                f,
+                "triangular (min {}, mode {}, max {})",
+                show(*min),
+                show(*mode),
+                show(*max)
+            ),
+            Distribution::Discrete { values, .. } => write!(
+                f,
+                "discrete over [{}]",
+                values
+                    .iter()
+                    .map(|v| show(*v))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ),
+        }
+    }
+}
+
 impl Distribution {
     /// Checks the parameters; the message names what is wrong.
     pub fn check(&self) -> Result<(), String> {

@@ -41,6 +41,38 @@ pub enum Unit {
     Angle,
 }
 
+/// A quantity's column name in words for plot titles and axes: the SI suffix dropped (the
+/// axis carries the display unit), `max` read as "largest", the flags as probabilities —
+/// `max_surface_torque_nm` → "largest surface torque", `stab1_max_side_force_n` → "stab1:
+/// largest side force", `sinusoidal_buckling` → "sinusoidal buckling (1 = buckled)".
+pub fn quantity_words(name: &str) -> String {
+    let mut n = name.to_string();
+    for suffix in ["_n_per_m", "_nm", "_n", "_m", "_hz", "_pa", "_s"] {
+        if let Some(stem) = n.strip_suffix(suffix) {
+            n = stem.to_string();
+            break;
+        }
+    }
+    let (stab, rest) = match n.split_once('_') {
+        Some((head, rest)) if head.starts_with("stab") && head[4..].parse::<usize>().is_ok() => {
+            (Some(head.to_string()), rest.to_string())
+        }
+        _ => (None, n),
+    };
+    let words = rest
+        .replace("max_", "largest ")
+        .replace("per_length", "per unit length")
+        .replace('_', " ");
+    let words = match words.as_str() {
+        "sinusoidal buckling" | "helical buckling" => format!("{words} (1 = buckled)"),
+        _ => words,
+    };
+    match stab {
+        Some(s) => format!("{s}: {words}"),
+        None => words,
+    }
+}
+
 impl Unit {
     /// Scale from SI to the display unit, and its label.
     pub fn display(self) -> (f64, &'static str) {
@@ -213,12 +245,17 @@ pub fn plot(
     for (q, r) in qois.iter().zip(&report.qois) {
         let Some(s) = &r.stats else { continue };
         let (scale, unit) = q.unit.display();
-        let label = format!("{} ({unit})", q.name);
+        let words = quantity_words(&q.name);
+        let label = if unit.is_empty() {
+            words.clone()
+        } else {
+            format!("{words} ({unit})")
+        };
         let file = format!("hist_{}.png", q.name);
         let shown: Vec<f64> = q.values[..base].iter().map(|v| v * scale).collect();
         histogram(
             &dir.join(&file),
-            &format!("{title}: {} over {} samples", q.name, s.n),
+            &format!("{title}: {words} over {} samples", s.n),
             &label,
             &shown,
             &[
@@ -239,8 +276,8 @@ pub fn plot(
             scatter(
                 &dir.join(&file),
                 &format!(
-                    "{} against {}: Spearman {:.2}, PRCC {:.2}",
-                    q.name, key.name, sens.spearman, sens.prcc
+                    "{words} against {}: Spearman {:.2}, PRCC {:.2}",
+                    key.name, sens.spearman, sens.prcc
                 ),
                 &format!("{} ({xu})", key.name),
                 &label,
@@ -252,7 +289,7 @@ pub fn plot(
             let file = format!("tornado_{}.png", q.name);
             tornado(
                 &dir.join(&file),
-                &format!("{title}: what drives {}", q.name),
+                &format!("{title}: what drives the {words}"),
                 "partial rank correlation (PRCC)",
                 &r.sensitivity
                     .iter()
@@ -265,7 +302,7 @@ pub fn plot(
             let file = format!("sobol_{}.png", q.name);
             tornado(
                 &dir.join(&file),
-                &format!("{title}: total Sobol indices of {}", q.name),
+                &format!("{title}: total Sobol indices of the {words}"),
                 "total Sobol index S_T (share of the variance with its interactions)",
                 &sobol
                     .iter()
@@ -279,7 +316,7 @@ pub fn plot(
             let c = &s.convergence;
             crate::plots::convergence_plot(
                 &dir.join(&file),
-                &format!("{}: mean and P90 against the number of samples", q.name),
+                &format!("{words}: mean and P90 against the number of samples"),
                 &label,
                 &[
                     (
@@ -310,4 +347,21 @@ pub fn plot(
         }
     }
     Ok(files)
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn quantity_names_read_as_words() {
+        use super::quantity_words as w;
+        assert_eq!(w("max_surface_torque_nm"), "largest surface torque");
+        assert_eq!(w("hook_load_n"), "hook load");
+        assert_eq!(w("stab1_max_side_force_n"), "stab1: largest side force");
+        assert_eq!(w("stab2_whirl_hz"), "stab2: whirl");
+        assert_eq!(
+            w("max_side_force_per_length_n_per_m"),
+            "largest side force per unit length"
+        );
+        assert_eq!(w("helical_buckling"), "helical buckling (1 = buckled)");
+    }
 }
