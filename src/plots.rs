@@ -101,8 +101,14 @@ fn draw(
         } else {
             c.stroke_width(2)
         };
+        // Segment by segment: a thick polyline's miter joins spike far past a sharp turn
+        // (a side-force peak at a stabilizer drew a line below zero at the bit).
         chart
-            .draw_series(LineSeries::new(s.points.iter().copied(), style))?
+            .draw_series(
+                s.points
+                    .windows(2)
+                    .map(|w| PathElement::new(vec![w[0], w[1]], style)),
+            )?
             .label(s.name)
             .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], style));
     }

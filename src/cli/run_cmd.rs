@@ -584,9 +584,9 @@ fn run_case(case: &Case, out: &Path, run_options: RunOptions) -> Result<RunSumma
         );
         line_plot(
             &out.join("axial_stress.png"),
-            &format!("{title}: axial stress along the string (Figs 8, 10)"),
+            &format!("{title}: effective axial stress along the string (Figs 8, 10)"),
             "MD (m)",
-            "axial stress, tension + (MPa)",
+            "effective axial stress F_eff/A, tension + (MPa)",
             &[
                 Series {
                     name: &format!("t = {t0:.2} s"),

@@ -34,7 +34,9 @@ pub struct ProfileRow {
     pub z_m: f64,
     /// Effective axial force, tension positive (N).
     pub axial_force_n: f64,
-    /// Axial stress `F/A` (Pa).
+    /// Effective axial stress `F_eff/A` (Pa): the effective force (buoyancy as a
+    /// distributed load, the buoyed-weight model) over the steel area — not the true steel
+    /// stress, which differs by the mud pressure's share.
     pub axial_stress_pa: f64,
     /// Torque (N·m).
     pub torque_nm: f64,
@@ -376,8 +378,8 @@ fn write_plots(
         ),
         (
             "axial_stress.png",
-            "axial stress",
-            "axial stress, tension + (MPa)",
+            "effective axial stress",
+            "effective axial stress F_eff/A, tension + (MPa)",
             |r| r.axial_stress_pa / 1e6,
             true,
         ),
@@ -433,22 +435,7 @@ fn write_plots(
         .filter(|&k| in_bha(k))
         .map(|k| (rows[k].md_m, 1e3 * rows[k].lateral_displacement_m))
         .collect();
-    let clearance: Vec<(f64, f64)> = (0..rows.len())
-        .filter(|&k| in_bha(k))
-        .map(|k| {
-            let e = k.min(model.elements.len() - 1);
-            let od = model
-                .sites
-                .iter()
-                .find(|s| s.node == k)
-                .map(|s| 2.0 * s.params.disk_radius)
-                .unwrap_or(model.elements[e].outer_diameter);
-            (
-                rows[k].md_m,
-                1e3 * 0.5 * (case.hole_diameter_at(rows[k].md_m) - od),
-            )
-        })
-        .collect();
+    let clearance = bha_clearance_band(case, model, bha_top);
     line_plot(
         &out.join("bha_deflection.png"),
         &format!(
@@ -500,6 +487,45 @@ fn write_plots(
         )?;
     }
     Ok(())
+}
+
+/// The BHA plot's radial-clearance band (MD, mm) from `bha_top` to the bit, as steps: each
+/// element's body clearance over its length, a stabilizer's blade clearance over the half
+/// elements either side of its node — vertical edges where the diameter changes, not
+/// sloped lines from a stabilizer node to the collar nodes beside it.
+pub fn bha_clearance_band(case: &Case, model: &Model, bha_top: f64) -> Vec<(f64, f64)> {
+    let md = |k: usize| model.nodes[k].md;
+    let clearance = |at: f64, od: f64| 1e3 * 0.5 * (case.hole_diameter_at(at) - od);
+    let blade = |k: usize| {
+        model
+            .sites
+            .iter()
+            .find(|s| s.node == k && s.stabilizer)
+            .map(|s| 2.0 * s.params.disk_radius)
+    };
+    let mut out: Vec<(f64, f64)> = Vec::new();
+    for (e, el) in model.elements.iter().enumerate() {
+        let (a, b) = (md(e), md(e + 1));
+        if a < bha_top - 1e-9 {
+            continue;
+        }
+        let mid = 0.5 * (a + b);
+        let body = clearance(mid, el.outer_diameter);
+        // The element's halves: the blade's clearance on the half at a stabilizer node.
+        let first = blade(e).map_or(body, |d| clearance(a, d));
+        let second = blade(e + 1).map_or(body, |d| clearance(b, d));
+        for p in [(a, first), (mid, first), (mid, second), (b, second)] {
+            // A point on a level run is left out: one segment per level, so the wide band
+            // has no joints along it.
+            let n = out.len();
+            if n >= 2 && out[n - 1].1 == p.1 && out[n - 2].1 == p.1 {
+                out[n - 1] = p;
+            } else {
+                out.push(p);
+            }
+        }
+    }
+    out
 }
 
 /// The side-force plot's stabilizer labels: `(label, MD, side force per length kN/m)`, in
