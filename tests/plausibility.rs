@@ -2,26 +2,13 @@
 //! numbers is refused with the likely intent (exit 2, file, line, key); an unusual but
 //! possible input runs with a warning on stderr and in `summary.json`.
 
-use std::path::{Path, PathBuf};
-use std::process::Command;
+mod common;
 
-fn holewall(args: &[&str]) -> (i32, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_holewall"))
-        .args(args)
-        .output()
-        .unwrap();
-    (
-        out.status.code().unwrap_or(-1),
-        String::from_utf8_lossy(&out.stdout).to_string(),
-        String::from_utf8_lossy(&out.stderr).to_string(),
-    )
-}
+use common::holewall;
+use std::path::{Path, PathBuf};
 
 fn scratch(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("holewall-plaus-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
+    common::scratch_dir("plaus", name)
 }
 
 /// The shipped build-and-hold case (1,500 m; KOP 300 m, 2°/30 m to 30°) on a survey:

@@ -187,3 +187,24 @@ pub fn engine_against_cpu(label: &str, text: &str) -> (std::path::PathBuf, f64) 
     }
     (dir, worst)
 }
+
+/// Runs the `holewall` binary with `args`: (exit code, stdout, stderr).
+pub fn holewall(args: &[&str]) -> (i32, String, String) {
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_holewall"))
+        .args(args)
+        .output()
+        .unwrap();
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stdout).to_string(),
+        String::from_utf8_lossy(&out.stderr).to_string(),
+    )
+}
+
+/// A fresh, empty scratch folder `holewall-<tag>-<pid>-<name>` under the temp dir.
+pub fn scratch_dir(tag: &str, name: &str) -> std::path::PathBuf {
+    let d = std::env::temp_dir().join(format!("holewall-{tag}-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
