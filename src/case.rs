@@ -372,6 +372,23 @@ pub struct Case {
     pub warnings: Vec<String>,
 }
 
+impl DynamicsSettings {
+    /// The integrator's options for these settings (time step, generalised-α from
+    /// `rho_inf`, Rayleigh damping, ramp, mass, rate of penetration): one mapping for the
+    /// `run` command, the ensemble and the studies.
+    pub fn integrator_options(&self) -> crate::solve::dynamics::DynamicOptions {
+        crate::solve::dynamics::DynamicOptions {
+            dt: self.time_step,
+            alpha: crate::solve::dynamics::AlphaParams::chung_hulbert(self.rho_inf),
+            rayleigh: self.rayleigh,
+            ramp_time: self.ramp_time,
+            mass: self.mass,
+            rop: self.rop,
+            ..Default::default()
+        }
+    }
+}
+
 impl Case {
     /// The hole section at `md`: (bottom MD, diameter, friction); below the last section,
     /// the last.

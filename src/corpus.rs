@@ -587,7 +587,7 @@ pub fn run_well(
     };
     match solved {
         Ok(sol) => {
-            let (_, hook, torque, _) = crate::cli::static_cmd::fe_rows(model, &sol);
+            let (_, hook, torque, _) = crate::profile::fe_rows(model, &sol);
             r.solved = true;
             r.load_steps = sol.iterations.len();
             r.step_cuts = sol.log.len();
@@ -683,7 +683,7 @@ pub fn run_well_engine(well: &CorpusWell, path: EnginePath) -> Result<EngineOutc
     };
     let hook_load_n = if solved {
         let sol = crate::solve::statics::solution_at(&case.model, r.state.clone());
-        crate::cli::static_cmd::fe_rows(&case.model, &sol).1
+        crate::profile::fe_rows(&case.model, &sol).1
     } else {
         f64::NAN
     };

@@ -23,6 +23,8 @@ pub mod model;
 pub mod output;
 pub mod physics;
 pub mod plots;
+pub mod profile;
+pub mod run;
 pub mod selfcheck;
 pub mod solve;
 pub mod study;

@@ -376,6 +376,10 @@ fn print_ensemble_summary(
 ) -> ExitCode {
     match result {
         Ok(s) => {
+            // The case's warnings come back in the summary: the library prints nothing.
+            for w in &s.warnings {
+                eprintln!("holewall: warning: {w}");
+            }
             if !quiet {
                 println!("{}", s.digest(out));
             }

@@ -204,7 +204,7 @@ fn issue_reproducer_solves_in_four_modes_at_four_meshes() {
             let case = reproducer(mode, element);
             let sol = holewall::solve::statics::solve_static(&case.model, &Default::default())
                 .unwrap_or_else(|e| panic!("{mode} at {element} m: {e}"));
-            let (_, hook, torque, _) = holewall::cli::static_cmd::fe_rows(&case.model, &sol);
+            let (_, hook, torque, _) = holewall::profile::fe_rows(&case.model, &sol);
             let soft = case.soft_string().hook_load();
             eprintln!(
                 "{mode:>12} {element:>4} m: {} load steps, {} iterations, {} cuts; hook load {:.1} kN (soft string {:.1} kN), torque {:.2} kN·m",

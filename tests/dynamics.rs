@@ -549,7 +549,7 @@ fn bit_held_laterally_in_an_inclined_hole() {
     let model = &case.model;
     let start = solve_static(model, &StaticOptions::default()).unwrap();
     let density = case.element_density.clone();
-    let options = holewall::cli::run_cmd::options_for(case.dynamics.as_ref().unwrap());
+    let options = case.dynamics.as_ref().unwrap().integrator_options();
     let mut dynamics = Dynamics::new(model, options, &|e| density[e]);
     let mut s = dynamics.initial_state(start.state).unwrap();
     let bit = model.nodes.len() - 1;

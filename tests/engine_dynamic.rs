@@ -127,7 +127,7 @@ fn dynamic_ensemble_matches_the_cpu_integrator_step_for_step() {
         "mu,wob,rpm,k_e\n0.3,20 kN,120 rpm,6e7\n0.2,15 kN,90 rpm,1e8\n0.4,25 kN,150 rpm,6e7\n",
     );
     let settings = case.dynamics.clone().unwrap();
-    let mut options = holewall::cli::run_cmd::options_for(&settings);
+    let mut options = settings.integrator_options();
     options.rayleigh = (0.5, 0.0);
     let t_end = 0.04;
     let cpu = cpu_runs(&models, &starts, &case.element_density, &options, t_end);
@@ -471,7 +471,7 @@ fn a_failing_variant_fails_alone_in_the_dynamic_engine() {
     }
     starts[1] = pushed;
     let settings = case.dynamics.clone().unwrap();
-    let mut options = holewall::cli::run_cmd::options_for(&settings);
+    let mut options = settings.integrator_options();
     // The good variants converge in 3–10 iterations; fewer for the bad one to spend (each
     // with up to 24 line-search trials) keeps the test short.
     options.max_iterations = 12;
@@ -574,7 +574,7 @@ fn paper_case_sixteen_variants_match_the_cpu_integrator() {
         }
     }
     let (models, starts) = with_starts(&case, &csv);
-    let options = holewall::cli::run_cmd::options_for(case.dynamics.as_ref().unwrap());
+    let options = case.dynamics.as_ref().unwrap().integrator_options();
     let t0 = std::time::Instant::now();
     let cpu = cpu_runs(&models, &starts, &case.element_density, &options, seconds);
     let t_cpu = t0.elapsed().as_secs_f64();
@@ -684,7 +684,7 @@ fn a_variant_whose_step_fails_is_cut_on_its_own_in_the_engine() {
         .replace("time_step = \"2 ms\"", "time_step = \"10 ms\"");
     let case = holewall::case::parse_case(std::path::Path::new("bed.toml"), &text).unwrap();
     let (models, starts) = with_starts(&case, "eps\n1e-3\n1e-6\n");
-    let options = holewall::cli::run_cmd::options_for(case.dynamics.as_ref().unwrap());
+    let options = case.dynamics.as_ref().unwrap().integrator_options();
     let density = case.element_density.clone();
     let t_end = 0.05;
     // The CPU integrator on the variant that needs cuts.
@@ -763,7 +763,7 @@ fn stragglers_compacted_within_a_step_go_on_bit_for_bit() {
         "mu,wob,rpm\n0.1,10 kN,60 rpm\n0.4,25 kN,150 rpm\n0.2,15 kN,90 rpm\n0.5,30 kN,180 rpm\n0.3,20 kN,120 rpm\n0.05,5 kN,30 rpm\n",
     );
     let settings = case.dynamics.clone().unwrap();
-    let options = holewall::cli::run_cmd::options_for(&settings);
+    let options = settings.integrator_options();
     let density = case.element_density.clone();
     let t_end = 0.02;
     let bits = |b: &DynamicBatch<f64>, j: usize| -> Vec<u64> {

@@ -64,7 +64,7 @@ fn engines_with_the_lane_form_match_the_twin_path() {
         .map(|m| (solve_static(m, &options).unwrap().state, None))
         .collect();
     let settings = case.dynamics.clone().unwrap();
-    let dyn_options = holewall::cli::run_cmd::options_for(&settings);
+    let dyn_options = settings.integrator_options();
     let t_end = 10.0 * dyn_options.dt;
     let run = |path_f64: bool| -> Vec<DynamicBatch<f64>> {
         let mut seen = Vec::new();

@@ -165,6 +165,7 @@ fn grid_dynamic_ensemble_writes_variants_and_series() {
             &Default::default(),
         )
         .unwrap();
+        common::summary_agrees_with_csv(&g, &out3);
         assert_eq!(
             (
                 g.backend.as_str(),
@@ -304,6 +305,8 @@ fn sixty_four_variant_static_ensemble_on_the_gpu_matches_the_cpu_runs() {
     )
     .unwrap();
     let t_cpu = t0.elapsed().as_secs_f64();
+    common::summary_agrees_with_csv(&gpu, &dir.join("gpu"));
+    common::summary_agrees_with_csv(&cpu, &dir.join("cpu"));
     assert_eq!((gpu.backend.as_str(), cpu.backend.as_str()), ("gpu", "cpu"));
     assert_eq!(gpu.variants, 64);
     let read = |p: &std::path::Path| -> Vec<Vec<String>> {
@@ -381,6 +384,7 @@ fn sixty_four_variant_static_ensemble_on_the_gpu_matches_the_cpu_runs() {
     )
     .unwrap();
     let t_32 = t0.elapsed().as_secs_f64();
+    common::summary_agrees_with_csv(&g32, &dir.join("gpu32"));
     assert_eq!(
         (g32.backend.as_str(), g32.precision.as_str()),
         ("gpu", "f32")

@@ -28,7 +28,7 @@ fn plot_labels_and_ensemble_keys_name_the_same_stabilizer() {
 
     // The side-force plot's labels.
     let sol = holewall::solve::statics::solve_static(model, &Default::default()).unwrap();
-    let (rows, ..) = holewall::cli::static_cmd::fe_rows(model, &sol);
+    let (rows, ..) = holewall::profile::fe_rows(model, &sol);
     let labels = holewall::cli::static_cmd::stabilizer_labels(model, &rows);
     assert_eq!(labels.len(), 3);
     for (k, (label, label_md, _)) in labels.iter().enumerate() {

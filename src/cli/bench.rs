@@ -181,7 +181,7 @@ pub fn dynamics(
     let model = &case.model;
     let start = solve_static(model, &StaticOptions::default())
         .map_err(|e| Error::Io(std::io::Error::other(format!("static start: {e}"))))?;
-    let options = super::run_cmd::options_for(&settings);
+    let options = settings.integrator_options();
     let density = case.element_density.clone();
     let mut its = (0usize, 0usize, 0usize);
     let t = median_seconds::<Error>(repeats, || {

@@ -304,8 +304,11 @@ pub fn run(
         let start = solve_static(base, &StaticOptions::default())
             .map_err(io)?
             .state;
-        let options =
-            super::run_cmd::options_for(case.dynamics.as_ref().ok_or_else(|| io("no [dynamics]"))?);
+        let options = case
+            .dynamics
+            .as_ref()
+            .ok_or_else(|| io("no [dynamics]"))?
+            .integrator_options();
         let t_end = steps as f64 * options.dt;
         let density = case.element_density.clone();
         let mut rate: std::collections::HashMap<&str, f64> = Default::default();
@@ -388,8 +391,11 @@ pub fn run(
             .state;
         let models = variants(base, 16);
         let density = case.element_density.clone();
-        let mut options =
-            super::run_cmd::options_for(case.dynamics.as_ref().ok_or_else(|| io("no [dynamics]"))?);
+        let mut options = case
+            .dynamics
+            .as_ref()
+            .ok_or_else(|| io("no [dynamics]"))?
+            .integrator_options();
         let t_end = 0.02;
         options.dt = 0.5e-3 / 8.0;
         let (_, reference) = run_cpu(&models, &start, &density, &options, t_end)?;

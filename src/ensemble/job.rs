@@ -27,9 +27,6 @@ pub fn run(
 ) -> Result<EnsembleSummary, Error> {
     let monte_carlo = options.monte_carlo.as_ref();
     let case = load_case(case_path)?;
-    if show_progress {
-        crate::cli::print_warnings(&case);
-    }
     let settings = case.ensemble.clone();
     let cli_error = |key: &str, message: String| -> Error {
         InputError {
@@ -376,7 +373,7 @@ pub fn run(
             let mut c = case.clone();
             c.model = apply(&case, v).map_err(|e| Error::Io(std::io::Error::other(e)))?;
             let dir = out.join("series").join(name);
-            crate::cli::run_cmd::run_case_into(&c, &dir, false)?;
+            crate::run::run_case_into(&c, &dir, false)?;
             outputs.push(format!("series/{name}/"));
         }
     }

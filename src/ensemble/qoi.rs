@@ -6,9 +6,9 @@
 use serde::{Deserialize, Serialize};
 
 use crate::case::Case;
-use crate::cli::static_cmd::{fe_rows, neutral_point, neutral_point_of, nodal_axial_forces};
 use crate::model::Model;
 use crate::physics::vec3::{dot, scale, sub};
+use crate::profile::{fe_rows, neutral_point, neutral_point_of, nodal_axial_forces};
 use crate::solve::dynamics::{DynamicState, Dynamics};
 use crate::solve::statics::{solve_static, StaticOptions};
 
@@ -227,7 +227,7 @@ pub fn static_result(
             )
         })
         .fold((0.0f64, f64::NAN), |m, x| if x.0 > m.0 { x } else { m });
-    let (sinusoidal, helical) = crate::cli::static_cmd::buckling(case, model, &rows);
+    let (sinusoidal, helical) = crate::profile::buckling(case, model, &rows);
     let string = StringQoi {
         max_side_force_per_length_n_per_m: Some(per_length),
         max_side_force_md_m: md.is_finite().then_some(md),
@@ -283,7 +283,7 @@ pub fn dynamic_variant_tracked(
     };
     let mass = track_energy
         .then(|| crate::solve::dynamics::lumped_mass(model, &|e| case.element_density[e]).0);
-    let options = crate::cli::run_cmd::options_for(&settings);
+    let options = settings.integrator_options();
     let density = &case.element_density;
     let mut dynamics = Dynamics::new(model, options, &|e| density[e]);
     let (q0, v0) = case.dynamic_start(model, start.state);

@@ -80,7 +80,7 @@ pub fn run_dynamic_gpu<T: crate::gpu::contact::GpuReal>(
     let Some(settings) = case.dynamics.clone() else {
         return Ok(Err("no [dynamics] table".into()));
     };
-    let options = crate::cli::run_cmd::options_for(&settings);
+    let options = settings.integrator_options();
     if let Some(why) = unsupported(&options) {
         return Ok(Err(why));
     }

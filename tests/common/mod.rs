@@ -50,7 +50,7 @@ pub fn static_qois(
     sol: &holewall::solve::statics::StaticSolution,
     bit_md: f64,
 ) -> [f64; 4] {
-    use holewall::cli::static_cmd::{fe_rows, neutral_point};
+    use holewall::profile::{fe_rows, neutral_point};
     let (rows, hook, torque, _) = fe_rows(model, sol);
     let side = sol.contact.iter().map(|c| c.1).fold(0.0f64, f64::max);
     [
@@ -207,4 +207,48 @@ pub fn scratch_dir(tag: &str, name: &str) -> std::path::PathBuf {
     let _ = std::fs::remove_dir_all(&d);
     std::fs::create_dir_all(&d).unwrap();
     d
+}
+
+/// An ensemble's `summary.json` counts agree with its `variants.csv` (issue 23): `step_cut`
+/// is the rows with `step_cuts > 0`, `converged`/`failed` the statuses, `solved_by_engine`
+/// and `solved_by_cpu` the `solved_by` column of the rows that did not fail.
+pub fn summary_agrees_with_csv(
+    s: &holewall::ensemble::report::EnsembleSummary,
+    out: &std::path::Path,
+) {
+    let text = std::fs::read_to_string(out.join("variants.csv")).unwrap();
+    let mut rows = csv::Reader::from_reader(text.as_bytes());
+    let header = rows.headers().unwrap().clone();
+    let col = |name: &str| header.iter().position(|h| h == name).unwrap();
+    let (status, cuts, by) = (col("status"), col("step_cuts"), col("solved_by"));
+    let (mut converged, mut failed, mut cut, mut engine, mut cpu) = (0, 0, 0, 0, 0);
+    for r in rows.records() {
+        let r = r.unwrap();
+        match &r[status] {
+            "converged" => converged += 1,
+            "failed" => failed += 1,
+            _ => {}
+        }
+        if r[status] != *"failed" {
+            if r[cuts].parse::<usize>().unwrap() > 0 {
+                cut += 1;
+            }
+            match &r[by] {
+                "engine" => engine += 1,
+                _ => cpu += 1,
+            }
+        }
+    }
+    assert_eq!(
+        (
+            s.converged,
+            s.step_cut,
+            s.failed,
+            s.solved_by_engine,
+            s.solved_by_cpu
+        ),
+        (converged, cut, failed, engine, cpu),
+        "summary.json against variants.csv in {}",
+        out.display()
+    );
 }

@@ -1,0 +1,190 @@
+//! The static profile along the string — the rows of `profile.csv` (axial force and
+//! stress, torque, bending moment, side forces, lateral displacement), hook load, surface
+//! torque, neutral point and buckling flags — from an FE static solution: what the
+//! `static` command writes and the ensemble's quantities of interest read (the library's,
+//! below the CLI).
+
+use serde::Serialize;
+
+use crate::case::Case;
+use crate::model::Model;
+use crate::physics::vec3::{dot, scale, sub};
+
+/// One row of `profile.csv`.
+#[derive(Clone, Debug, Serialize)]
+pub struct ProfileRow {
+    /// Measured depth (m).
+    pub md_m: f64,
+    /// Position (m): north, east, TVD.
+    pub x_m: f64,
+    /// See `x_m`.
+    pub y_m: f64,
+    /// See `x_m`.
+    pub z_m: f64,
+    /// Effective axial force, tension positive (N).
+    pub axial_force_n: f64,
+    /// Effective axial stress `F_eff/A` (Pa): the effective force (buoyancy as a
+    /// distributed load, the buoyed-weight model) over the steel area — not the true steel
+    /// stress, which differs by the mud pressure's share.
+    pub axial_stress_pa: f64,
+    /// Torque (N·m).
+    pub torque_nm: f64,
+    /// Bending moment (N·m).
+    pub bending_moment_nm: f64,
+    /// Side (contact normal) force (N): FE, the node's contact force; soft string, the
+    /// element's below the node.
+    pub side_force_n: f64,
+    /// Side force per unit length (N/m): over the node's tributary length (FE), over the
+    /// element (soft string).
+    pub side_force_per_length_n_per_m: f64,
+    /// Lateral displacement from the hole axis (m).
+    pub lateral_displacement_m: f64,
+    /// In contact with the wall.
+    pub in_contact: bool,
+}
+
+/// Neutral point: the first MD, going up from the bit, where the axial force turns from
+/// compression to tension (linear interpolation between nodes).
+pub fn neutral_point(rows: &[ProfileRow]) -> Option<f64> {
+    let md: Vec<f64> = rows.iter().map(|r| r.md_m).collect();
+    let axial: Vec<f64> = rows.iter().map(|r| r.axial_force_n).collect();
+    neutral_point_of(&md, &axial)
+}
+
+/// [`neutral_point`] from nodal MDs and axial forces (tension +).
+pub fn neutral_point_of(md: &[f64], axial: &[f64]) -> Option<f64> {
+    for k in (1..md.len()).rev() {
+        let (lo, hi) = (axial[k], axial[k - 1]);
+        if lo <= 0.0 && hi > 0.0 {
+            let f = lo / (lo - hi);
+            return Some(md[k] + f * (md[k - 1] - md[k]));
+        }
+    }
+    None
+}
+
+/// Nodal axial forces: the mean of the adjacent elements' (as in `profile.csv`).
+pub fn nodal_axial_forces(element_axial: &[f64]) -> Vec<f64> {
+    let n = element_axial.len() + 1;
+    (0..n)
+        .map(|i| {
+            let adj: Vec<f64> = [i.checked_sub(1), (i < n - 1).then_some(i)]
+                .into_iter()
+                .flatten()
+                .map(|e| element_axial[e])
+                .collect();
+            adj.iter().sum::<f64>() / adj.len() as f64
+        })
+        .collect()
+}
+
+/// Sinusoidal and helical buckling flags of a static profile ([`crate::diagnose::buckling`]).
+pub fn buckling(case: &Case, model: &Model, rows: &[ProfileRow]) -> (bool, bool) {
+    let axial: Vec<f64> = rows.iter().map(|r| r.axial_force_n).collect();
+    crate::diagnose::buckling(case, model, &axial)
+}
+
+/// Profile rows, hook load, surface torque and weight on bit of an FE static solution.
+pub fn fe_rows(
+    model: &Model,
+    sol: &crate::solve::statics::StaticSolution,
+) -> (Vec<ProfileRow>, f64, f64, f64) {
+    let n = model.nodes.len();
+    let mut wob = model.weight_on_bit;
+    let mut side = vec![0.0; n];
+    let mut in_contact = vec![false; n];
+    for (site, (c, normal, _)) in model.sites.iter().zip(&sol.contact) {
+        side[site.node] = *normal;
+        in_contact[site.node] = *c && *normal > 0.0;
+    }
+    let rows: Vec<ProfileRow> = (0..n)
+        .map(|i| {
+            let adj: Vec<usize> = [i.checked_sub(1), (i < n - 1).then_some(i)]
+                .into_iter()
+                .flatten()
+                .collect();
+            let avg = |f: &dyn Fn(usize) -> f64| {
+                adj.iter().map(|&e| f(e)).sum::<f64>() / adj.len() as f64
+            };
+            let axial = avg(&|e| sol.section_forces[e].axial);
+            let area = avg(&|e| model.elements[e].section.area);
+            let d = sub(&sol.state.x[i], &model.nodes[i].position);
+            let t = model.nodes[i].hole_axis;
+            let d_t = sub(&d, &scale(&t, dot(&d, &t)));
+            ProfileRow {
+                md_m: model.nodes[i].md,
+                x_m: sol.state.x[i][0],
+                y_m: sol.state.x[i][1],
+                z_m: sol.state.x[i][2],
+                axial_force_n: axial,
+                axial_stress_pa: axial / area,
+                torque_nm: avg(&|e| sol.section_forces[e].torque).abs(),
+                bending_moment_nm: avg(&|e| {
+                    sol.section_forces[e].bending[if e < i { 1 } else { 0 }]
+                }),
+                side_force_n: side[i],
+                side_force_per_length_n_per_m: side[i] / model.tributary_length(i),
+                lateral_displacement_m: dot(&d_t, &d_t).sqrt(),
+                in_contact: in_contact[i],
+            }
+        })
+        .collect();
+    let t0 = model.nodes[0].hole_axis;
+    let mut hook = -dot(
+        &[
+            sol.top_reaction[0],
+            sol.top_reaction[1],
+            sol.top_reaction[2],
+        ],
+        &t0,
+    );
+    if let crate::model::TopBoundary::HookLoad(h) = model.top {
+        hook = h;
+        let tb = model.nodes[n - 1].hole_axis;
+        wob = -dot(
+            &[
+                sol.bit_reaction[0],
+                sol.bit_reaction[1],
+                sol.bit_reaction[2],
+            ],
+            &tb,
+        );
+    }
+    let torque = dot(
+        &[
+            sol.top_reaction[3],
+            sol.top_reaction[4],
+            sol.top_reaction[5],
+        ],
+        &t0,
+    )
+    .abs();
+    (rows, hook, torque, wob)
+}
+
+/// The FE static solution of a case, with a progress bar (load factor reached) when
+/// `show_progress`, within `options.max_seconds`; a failure says why
+/// ([`crate::diagnose::static_failure`]).
+pub fn solve_with_progress(
+    case: &Case,
+    options: crate::solve::statics::StaticOptions,
+    show_progress: bool,
+) -> Result<crate::solve::statics::StaticSolution, String> {
+    let model = &case.model;
+    let start = if model.sites.is_empty() {
+        crate::solve::statics::StaticState::initial(model)
+    } else {
+        crate::solve::statics::StaticState::on_low_side(model)
+    };
+    let bar = crate::output::progress_bar(
+        show_progress,
+        1000,
+        "{bar:40} {percent:>3}% of the loads (static), {elapsed} elapsed",
+    );
+    let solved =
+        crate::solve::statics::solve_static_monitored(model, start, &options, &mut |lambda| {
+            bar.set_position((1000.0 * lambda) as u64)
+        });
+    bar.finish_and_clear();
+    solved.map_err(|e| crate::diagnose::static_failure(case, &e))
+}
