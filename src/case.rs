@@ -354,7 +354,7 @@ pub struct Case {
     /// Model (mesh, sites, loads, boundary conditions).
     pub model: Model,
     /// Hole sections: (bottom MD, diameter, friction).
-    pub hole: Vec<(f64, f64, f64)>,
+    pub hole: Vec<HoleSection>,
     /// Bit depth (m).
     pub bit_md: f64,
     /// Length of the BHA (m): the components from the bit up to the first drill pipe.
@@ -370,6 +370,29 @@ pub struct Case {
     /// What the case holds that is allowed but unusual (a sharp dogleg …): printed by every
     /// command that reads the case and written into its `summary.json`.
     pub warnings: Vec<String>,
+}
+
+/// A hole section (`[[hole]]`): from the previous section's bottom (or the surface) down to
+/// `bottom_md`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct HoleSection {
+    /// Bottom of the section (MD, m).
+    pub bottom_md: f64,
+    /// Hole or casing inner diameter (m).
+    pub diameter: f64,
+    /// Friction coefficient against the string.
+    pub friction: f64,
+}
+
+/// The one lookup of a hole section: the section holding `md` (a section includes its
+/// bottom); below the last section, the last. `hole` is a case's, never empty (the parser
+/// requires a section).
+pub fn hole_section_at(hole: &[HoleSection], md: f64) -> HoleSection {
+    *hole
+        .iter()
+        .find(|h| md <= h.bottom_md + 1e-9)
+        .or(hole.last())
+        .expect("a case has at least one [[hole]] section")
 }
 
 impl DynamicsSettings {
@@ -390,15 +413,9 @@ impl DynamicsSettings {
 }
 
 impl Case {
-    /// The hole section at `md`: (bottom MD, diameter, friction); below the last section,
-    /// the last.
-    pub fn hole_at(&self, md: f64) -> (f64, f64, f64) {
-        self.hole
-            .iter()
-            .find(|h| md <= h.0 + 1e-9)
-            .or(self.hole.last())
-            .copied()
-            .unwrap_or((md, 0.2159, 0.25))
+    /// The hole section at `md` ([`hole_section_at`]).
+    pub fn hole_at(&self, md: f64) -> HoleSection {
+        hole_section_at(&self.hole, md)
     }
 
     /// The start of a dynamic run of `model` from its static equilibrium `q`: the BHA's
@@ -450,14 +467,14 @@ impl Case {
 
     /// The hole diameter at `md` (m).
     pub fn hole_diameter_at(&self, md: f64) -> f64 {
-        self.hole_at(md).1
+        self.hole_at(md).diameter
     }
 
     /// The soft-string profile of the case's operation, with each hole section's friction.
     pub fn soft_string(&self) -> crate::physics::soft_string::SoftStringProfile {
         use crate::physics::soft_string::{soft_string_with, Operation};
         let model = &self.model;
-        let friction_at = |md: f64| self.hole_at(md).2;
+        let friction_at = |md: f64| self.hole_at(md).friction;
         soft_string_with(
             model,
             &Operation {
@@ -859,7 +876,11 @@ pub fn parse_case(path: &Path, text: &str) -> Result<Case, InputError> {
             |x| (0.0..=2.0).contains(&x),
             "0 ≤ friction ≤ 2",
         )?;
-        hole.push((bottom, d, mu));
+        hole.push(HoleSection {
+            bottom_md: bottom,
+            diameter: d,
+            friction: mu,
+        });
         previous = bottom;
     }
     if hole.is_empty() {
@@ -882,15 +903,10 @@ pub fn parse_case(path: &Path, text: &str) -> Result<Case, InputError> {
             ),
         ));
     }
-    let hole_at = |md: f64| {
-        *hole
-            .iter()
-            .find(|(b, _, _)| md <= *b + 1e-9)
-            .unwrap_or(hole.last().unwrap_or(&(0.0, 0.2159, 0.25)))
-    };
+    let hole_at = |md: f64| hole_section_at(&hole, md);
 
     if let Some((survey_path, read)) = &survey_read {
-        let deepest = hole.iter().map(|h| h.0).fold(bit_md, f64::max);
+        let deepest = hole.iter().map(|h| h.bottom_md).fold(bit_md, f64::max);
         let limit = match &spec.well.max_dogleg_deg_per_30m {
             Some(q) => ctx.number(
                 q,
@@ -1082,12 +1098,13 @@ pub fn parse_case(path: &Path, text: &str) -> Result<Case, InputError> {
         let blade = match &c.blade_diameter {
             Some(q) => {
                 let md_here = bit_md - tubulars.iter().map(|t: &Tubular| t.length).sum::<f64>();
-                let hole_d = hole_at(md_here).1;
+                let hole_d = hole_at(md_here).diameter;
                 Some(ctx.quantity(q, "string.blade_diameter", Dimension::Length, |x| x >= od && x <= hole_d, &format!("od ({} m) ≤ blade diameter ≤ hole diameter ({} m): the disk must fit the hole", crate::units::show(od), crate::units::show(hole_d)))?)
             }
             None => None,
         };
-        if od > hole_at(bit_md - tubulars.iter().map(|t: &Tubular| t.length).sum::<f64>()).1 {
+        if od > hole_at(bit_md - tubulars.iter().map(|t: &Tubular| t.length).sum::<f64>()).diameter
+        {
             return Err(ctx.err(
                 c.od.span(),
                 "string.od",
@@ -1385,9 +1402,9 @@ pub fn parse_case(path: &Path, text: &str) -> Result<Case, InputError> {
         add_sites(
             &mut model,
             &[*node],
-            |md| 0.5 * hole_at(md).1,
+            |md| 0.5 * hole_at(md).diameter,
             |_| *radius,
-            |md| hole_at(md).2,
+            |md| hole_at(md).friction,
             &settings,
             true,
         );
@@ -1400,9 +1417,9 @@ pub fn parse_case(path: &Path, text: &str) -> Result<Case, InputError> {
         add_sites(
             &mut model,
             &others,
-            |md| 0.5 * hole_at(md).1,
+            |md| 0.5 * hole_at(md).diameter,
             |i| radii[i],
-            |md| hole_at(md).2,
+            |md| hole_at(md).friction,
             &settings,
             false,
         );
@@ -1469,7 +1486,7 @@ pub fn parse_case(path: &Path, text: &str) -> Result<Case, InputError> {
                 .iter()
                 .enumerate()
                 .filter(|(_, nd)| nd.md >= bha_top - 1e-9)
-                .map(|(i, nd)| 0.5 * hole_at(nd.md).1 - model.pipe_radius_at(i))
+                .map(|(i, nd)| 0.5 * hole_at(nd.md).diameter - model.pipe_radius_at(i))
                 .fold(0.0f64, f64::max);
             if d.initial_lateral_offset > widest {
                 return Err(ctx.err(

@@ -492,7 +492,7 @@ pub fn buckling_limited_wob(case: &crate::case::Case, sliding: bool) -> f64 {
             torque_on_bit: 0.0,
             friction: 0.0,
         };
-        let prof = soft_string_with(model, &op, &|md| case.hole_at(md).2);
+        let prof = soft_string_with(model, &op, &|md| case.hole_at(md).friction);
         (0..model.elements.len()).all(|e| {
             let f = -0.5 * (prof.tension[e] + prof.tension[e + 1]);
             let md = 0.5 * (model.nodes[e].md + model.nodes[e + 1].md);

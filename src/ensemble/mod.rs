@@ -224,15 +224,7 @@ pub fn apply(case: &Case, variant: &Variant) -> Result<Model, String> {
             )
         })
     };
-    let hole_radius_at = |md: f64| {
-        0.5 * case
-            .hole
-            .iter()
-            .find(|h| md <= h.0 + 1e-9)
-            .or(case.hole.last())
-            .map(|h| h.1)
-            .unwrap_or(0.0)
-    };
+    let hole_radius_at = |md: f64| 0.5 * case.hole_diameter_at(md);
     for (key, value) in &variant.overrides {
         if key.param != Param::FromBit {
             continue;
