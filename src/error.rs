@@ -57,12 +57,21 @@ pub enum Error {
     /// I/O failure.
     #[error("{0}")]
     Io(#[from] std::io::Error),
+    /// A solve, a run or an engine that failed on valid input (a static solve that did not
+    /// converge, a time step that failed, the GPU engine's error): exit code 1.
+    #[error("{0}")]
+    Failed(String),
     /// Stopped by the user's budget (`--max-seconds`), resumable: exit code 3.
     #[error("{0}")]
     Stopped(String),
 }
 
 impl Error {
+    /// [`Error::Failed`] from any message.
+    pub fn failed(message: impl std::fmt::Display) -> Self {
+        Error::Failed(message.to_string())
+    }
+
     /// The process exit code for this error: 2 for bad input, 3 for a run stopped by its
     /// budget (resumable), 1 otherwise.
     pub fn exit_code(&self) -> i32 {

@@ -192,14 +192,14 @@ pub fn run_case(case: &Case, out: &Path, run_options: RunOptions) -> Result<RunS
         },
         show_progress,
     )
-    .map_err(|e| Error::Io(std::io::Error::other(format!("static start: {e}"))))?;
+    .map_err(|e| Error::failed(format!("static start: {e}")))?;
     let options = settings.integrator_options();
     let density = case.element_density.clone();
     let mut dynamics = Dynamics::new(model, options, &|e| density[e]);
     let (q0, v0) = case.dynamic_start(model, start.state);
     let mut s = dynamics
         .initial_state_with(q0, v0)
-        .map_err(|e| Error::Io(std::io::Error::other(e)))?;
+        .map_err(Error::failed)?;
     let want = |name: &str| settings.outputs.iter().any(|o| o == name);
     let mut rec = Recorder {
         series: Vec::new(),
@@ -227,7 +227,7 @@ pub fn run_case(case: &Case, out: &Path, run_options: RunOptions) -> Result<RunS
         // No budget: one call, the steps exactly as the case sets them.
         None => dynamics
             .run(&mut s, settings.duration, &mut observe)
-            .map_err(|e| Error::Io(std::io::Error::other(e)))?,
+            .map_err(Error::failed)?,
         // A budget: output interval by output interval, the clock read in between.
         Some(budget) => {
             while s.t < settings.duration - 1e-12 {
@@ -241,7 +241,7 @@ pub fn run_case(case: &Case, out: &Path, run_options: RunOptions) -> Result<RunS
                 let until = (s.t + settings.output_interval).min(settings.duration);
                 dynamics
                     .run(&mut s, until, &mut observe)
-                    .map_err(|e| Error::Io(std::io::Error::other(e)))?;
+                    .map_err(Error::failed)?;
             }
         }
     }

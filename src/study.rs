@@ -281,12 +281,12 @@ pub fn precision(
     bar.set_message(format!("reference, dt = {dt_ref:.2e} s"));
     let (reference, reference_seconds) =
         run_on(&with_step(&case, dt_ref, duration), "cpu-f64", None)
-            .map_err(|e| Error::Io(std::io::Error::other(format!("reference run: {e}"))))?;
+            .map_err(|e| Error::failed(format!("reference run: {e}")))?;
     if reference.status == Status::Failed {
-        return Err(Error::Io(std::io::Error::other(format!(
+        return Err(Error::failed(format!(
             "the reference run (CPU f64, dt = {dt_ref:.3e} s) failed: {}",
             reference.reason
-        ))));
+        )));
     }
     bar.inc(1);
     let mut runs = Vec::new();

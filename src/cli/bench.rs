@@ -180,7 +180,7 @@ pub fn dynamics(
     })?;
     let model = &case.model;
     let start = solve_static(model, &StaticOptions::default())
-        .map_err(|e| Error::Io(std::io::Error::other(format!("static start: {e}"))))?;
+        .map_err(|e| Error::failed(format!("static start: {e}")))?;
     let options = settings.integrator_options();
     let density = case.element_density.clone();
     let mut its = (0usize, 0usize, 0usize);
@@ -188,9 +188,9 @@ pub fn dynamics(
         let mut d = Dynamics::new(model, options, &|e| density[e]);
         let mut s = d
             .initial_state(start.state.clone())
-            .map_err(|e| Error::Io(std::io::Error::other(e)))?;
+            .map_err(Error::failed)?;
         d.run(&mut s, steps as f64 * options.dt, &mut |_, _| {})
-            .map_err(|e| Error::Io(std::io::Error::other(e)))?;
+            .map_err(Error::failed)?;
         its = (
             d.iterations.len(),
             d.iterations.iter().sum(),

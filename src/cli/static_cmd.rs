@@ -90,7 +90,7 @@ pub fn run(
                 },
                 options.show_progress,
             )
-            .map_err(|e| Error::Io(std::io::Error::other(e)))?;
+            .map_err(Error::failed)?;
             let (rows, hook, torque, w) = fe_rows(model, &sol);
             wob = w;
             solver_log = sol.log.clone();
@@ -98,7 +98,15 @@ pub fn run(
         }
         StaticModel::SoftString => {
             if let crate::model::TopBoundary::HookLoad(_) = model.top {
-                return Err(Error::Io(std::io::Error::other("the soft-string model needs the weight on bit; give operation.weight_on_bit instead of hook_load")));
+                return Err(crate::error::InputError {
+                    source_name: case_path.display().to_string(),
+                    line: 0,
+                    key: "operation.hook_load".into(),
+                    message: "the soft-string model needs the weight on bit: give \
+                              operation.weight_on_bit instead of hook_load (or --model fe)"
+                        .into(),
+                }
+                .into());
             }
             let prof = case.soft_string();
             let rows: Vec<ProfileRow> = (0..n)

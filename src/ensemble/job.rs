@@ -369,9 +369,9 @@ pub fn run(
             let v = variants
                 .iter()
                 .find(|v| &v.name == name)
-                .ok_or_else(|| Error::Io(std::io::Error::other(format!("no variant {name}"))))?;
+                .ok_or_else(|| Error::failed(format!("no variant {name}")))?;
             let mut c = case.clone();
-            c.model = apply(&case, v).map_err(|e| Error::Io(std::io::Error::other(e)))?;
+            c.model = apply(&case, v).map_err(Error::failed)?;
             let dir = out.join("series").join(name);
             crate::run::run_case_into(&c, &dir, false)?;
             outputs.push(format!("series/{name}/"));

@@ -29,7 +29,7 @@ pub fn run_static_gpu<T: crate::gpu::contact::GpuReal>(
         .iter()
         .map(|v| apply(case, v))
         .collect::<Result<_, _>>()
-        .map_err(|e| Error::Io(std::io::Error::other(e)))?;
+        .map_err(Error::failed)?;
     if !models.iter().all(|m| same_mesh(case, m)) {
         return Ok(Err(
             "the variants differ in their mesh or number of contact sites".into(),
@@ -41,7 +41,7 @@ pub fn run_static_gpu<T: crate::gpu::contact::GpuReal>(
         &StaticOptions::default(),
         &mut |f| bar.set_position((f * variants.len() as f64) as u64),
     )
-    .map_err(|e| Error::Io(std::io::Error::other(format!("GPU engine: {e}"))))?;
+    .map_err(|e| Error::failed(format!("GPU engine: {e}")))?;
     Ok(Ok(results
         .into_par_iter()
         .zip(models.par_iter().zip(variants.par_iter()))
@@ -88,7 +88,7 @@ pub fn run_dynamic_gpu<T: crate::gpu::contact::GpuReal>(
         .iter()
         .map(|v| apply(case, v))
         .collect::<Result<_, _>>()
-        .map_err(|e| Error::Io(std::io::Error::other(e)))?;
+        .map_err(Error::failed)?;
     if !models.iter().all(|m| same_mesh(case, m)) {
         return Ok(Err(
             "the variants differ in their mesh or number of contact sites".into(),
@@ -96,7 +96,7 @@ pub fn run_dynamic_gpu<T: crate::gpu::contact::GpuReal>(
     }
     let path = GpuPath(ctx);
     let statics = solve_static_ensemble::<T, _>(&models, &path, &StaticOptions::default())
-        .map_err(|e| Error::Io(std::io::Error::other(format!("GPU engine: {e}"))))?;
+        .map_err(|e| Error::failed(format!("GPU engine: {e}")))?;
     // Variants whose static start failed on the GPU run wholly on the CPU.
     let on_gpu: Vec<usize> = (0..models.len())
         .filter(|&j| statics[j].status == EngineStatus::Converged)
@@ -163,7 +163,7 @@ pub fn run_dynamic_gpu<T: crate::gpu::contact::GpuReal>(
             bar.set_position(((t / settings.duration) * variants.len() as f64) as u64);
         },
     )
-    .map_err(|e| Error::Io(std::io::Error::other(format!("GPU engine: {e}"))))?;
+    .map_err(|e| Error::failed(format!("GPU engine: {e}")))?;
     let mut out: Vec<Option<VariantResult>> = vec![None; models.len()];
     for (&j, ((r, obs), state)) in on_gpu
         .iter()
