@@ -197,9 +197,7 @@ pub fn run_case(case: &Case, out: &Path, run_options: RunOptions) -> Result<RunS
     let density = case.element_density.clone();
     let mut dynamics = Dynamics::new(model, options, &|e| density[e]);
     let (q0, v0) = case.dynamic_start(model, start.state);
-    let mut s = dynamics
-        .initial_state_with(q0, v0)
-        .map_err(Error::failed)?;
+    let mut s = dynamics.initial_state_with(q0, v0).map_err(Error::failed)?;
     let want = |name: &str| settings.outputs.iter().any(|o| o == name);
     let mut rec = Recorder {
         series: Vec::new(),

@@ -1,0 +1,118 @@
+//! The reading context: the file's path and text, and the checked readers of a value
+//! (quantity with units, number, angle) that name the file, line, key and allowed range.
+
+use super::*;
+
+pub(super) struct Ctx<'a> {
+    pub(super) path: &'a Path,
+    pub(super) text: &'a str,
+}
+
+impl Ctx<'_> {
+    pub(super) fn line(&self, offset: usize) -> usize {
+        self.text[..offset.min(self.text.len())]
+            .matches('\n')
+            .count()
+            + 1
+    }
+
+    pub(super) fn err(
+        &self,
+        span: std::ops::Range<usize>,
+        key: &str,
+        message: impl Into<String>,
+    ) -> InputError {
+        InputError {
+            source_name: self.path.display().to_string(),
+            line: self.line(span.start),
+            key: key.into(),
+            message: message.into(),
+        }
+    }
+
+    pub(super) fn quantity(
+        &self,
+        q: &Q,
+        key: &str,
+        dim: Dimension,
+        ok: impl Fn(f64) -> bool,
+        range: &str,
+    ) -> Result<f64, InputError> {
+        let v = match q.get_ref() {
+            Quantity::Number(x) if x.is_finite() => {
+                if let Some(m) = crate::units::bare_number_trap(dim, *x) {
+                    return Err(self.err(q.span(), key, m));
+                }
+                *x
+            }
+            Quantity::Number(x) => {
+                return Err(self.err(
+                    q.span(),
+                    key,
+                    format!("{x} is not finite; allowed: {range}"),
+                ))
+            }
+            Quantity::Text(t) => {
+                let v = parse_quantity(t, dim)
+                    .map_err(|e| self.err(q.span(), key, format!("{e}; allowed: {range}")))?;
+                if t.trim().parse::<f64>().is_ok() {
+                    if let Some(m) = crate::units::bare_number_trap(dim, v) {
+                        return Err(self.err(q.span(), key, m));
+                    }
+                }
+                v
+            }
+        };
+        if ok(v) {
+            Ok(v)
+        } else {
+            Err(self.err(
+                q.span(),
+                key,
+                format!("{v} {} is out of range; allowed: {range}", dim.si()),
+            ))
+        }
+    }
+
+    pub(super) fn angle(
+        &self,
+        q: &Q,
+        key: &str,
+        ok: impl Fn(f64) -> bool,
+        range: &str,
+    ) -> Result<f64, InputError> {
+        let v = match q.get_ref() {
+            Quantity::Number(x) => *x,
+            Quantity::Text(t) => parse_angle_deg(t)
+                .map_err(|e| self.err(q.span(), key, format!("{e}; allowed: {range}")))?,
+        };
+        if v.is_finite() && ok(v) {
+            Ok(v)
+        } else {
+            Err(self.err(
+                q.span(),
+                key,
+                format!("{v}° is out of range; allowed: {range}"),
+            ))
+        }
+    }
+
+    pub(super) fn number(
+        &self,
+        q: &Spanned<f64>,
+        key: &str,
+        ok: impl Fn(f64) -> bool,
+        range: &str,
+    ) -> Result<f64, InputError> {
+        let v = *q.get_ref();
+        if v.is_finite() && ok(v) {
+            Ok(v)
+        } else {
+            Err(self.err(
+                q.span(),
+                key,
+                format!("{v} is out of range; allowed: {range}"),
+            ))
+        }
+    }
+}

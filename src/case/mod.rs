@@ -1,0 +1,494 @@
+//! Case files (TOML): well, hole sections, mud, the string from the bit up, the operation,
+//! contact and mesh settings. Numbers are SI; a string `"<number> <unit>"` is accepted where
+//! engineers think in field units (`src/units.rs`). Every key is documented in
+//! `cases/README.md`. Unknown keys and bad values are rejected naming the file, line, key
+//! and allowed range.
+
+use std::path::{Path, PathBuf};
+
+use serde::Deserialize;
+use toml::Spanned;
+
+use crate::error::InputError;
+use crate::model::{add_sites, mesh_string, ContactSettings, Model, TopBoundary, Tubular};
+use crate::physics::contact::FrictionModel;
+use crate::units::{parse_angle_deg, parse_quantity, Dimension};
+use crate::well::{SurveyStation, WellPath};
+
+mod ctx;
+mod settings;
+mod spec;
+mod survey;
+mod tables;
+
+use ctx::Ctx;
+use settings::{dynamics_settings, ensemble_settings};
+pub use spec::*;
+use survey::read_well;
+pub use survey::{survey_from_text, survey_plausibility};
+use tables::{read_contact, read_hole, read_operation, read_string, Operation, StringRead};
+
+/// A case read and checked, ready to build a model.
+#[derive(Clone, Debug)]
+pub struct Case {
+    /// Title.
+    pub title: String,
+    /// The file it came from.
+    pub path: PathBuf,
+    /// Model (mesh, sites, loads, boundary conditions).
+    pub model: Model,
+    /// Hole sections: (bottom MD, diameter, friction).
+    pub hole: Vec<HoleSection>,
+    /// Bit depth (m).
+    pub bit_md: f64,
+    /// Length of the BHA (m): the components from the bit up to the first drill pipe.
+    pub bha_length: f64,
+    /// Mud density (kg/m³).
+    pub mud_density: f64,
+    /// Steel density per element (kg/m³).
+    pub element_density: Vec<f64>,
+    /// `[dynamics]`, if given.
+    pub dynamics: Option<DynamicsSettings>,
+    /// `[ensemble]`, if given.
+    pub ensemble: Option<EnsembleSettings>,
+    /// What the case holds that is allowed but unusual (a sharp dogleg …): printed by every
+    /// command that reads the case and written into its `summary.json`.
+    pub warnings: Vec<String>,
+}
+
+/// A hole section (`[[hole]]`): from the previous section's bottom (or the surface) down to
+/// `bottom_md`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct HoleSection {
+    /// Bottom of the section (MD, m).
+    pub bottom_md: f64,
+    /// Hole or casing inner diameter (m).
+    pub diameter: f64,
+    /// Friction coefficient against the string.
+    pub friction: f64,
+}
+
+/// The one lookup of a hole section: the section holding `md` (a section includes its
+/// bottom); below the last section, the last. `hole` is a case's, never empty (the parser
+/// requires a section).
+pub fn hole_section_at(hole: &[HoleSection], md: f64) -> HoleSection {
+    *hole
+        .iter()
+        .find(|h| md <= h.bottom_md + 1e-9)
+        .or(hole.last())
+        .expect("a case has at least one [[hole]] section")
+}
+
+impl DynamicsSettings {
+    /// The integrator's options for these settings (time step, generalised-α from
+    /// `rho_inf`, Rayleigh damping, ramp, mass, rate of penetration): one mapping for the
+    /// `run` command, the ensemble and the studies.
+    pub fn integrator_options(&self) -> crate::solve::dynamics::DynamicOptions {
+        crate::solve::dynamics::DynamicOptions {
+            dt: self.time_step,
+            alpha: crate::solve::dynamics::AlphaParams::chung_hulbert(self.rho_inf),
+            rayleigh: self.rayleigh,
+            ramp_time: self.ramp_time,
+            mass: self.mass,
+            rop: self.rop,
+            ..Default::default()
+        }
+    }
+}
+
+impl Case {
+    /// The hole section at `md` ([`hole_section_at`]).
+    pub fn hole_at(&self, md: f64) -> HoleSection {
+        hole_section_at(&self.hole, md)
+    }
+
+    /// The start of a dynamic run of `model` from its static equilibrium `q`: the BHA's
+    /// initial lateral offset (`[dynamics].initial_lateral_offset`: a half sine from the bit
+    /// to the first drill pipe, towards each node frame's first lateral axis) applied to
+    /// `q`, and the initial velocities (6 per node) of the BHA's lateral kick
+    /// (`initial_lateral_velocity`, the same direction, uniform), `None` without one. Every
+    /// dynamic run (`holewall run`, the ensemble's CPU runs) starts here.
+    pub fn dynamic_start(
+        &self,
+        model: &crate::model::Model,
+        mut q: crate::solve::statics::StaticState,
+    ) -> (crate::solve::statics::StaticState, Option<Vec<f64>>) {
+        let Some(d) = self.dynamics.as_ref() else {
+            return (q, None);
+        };
+        let n = model.nodes.len();
+        let bit_md = model.nodes.last().map_or(self.bit_md, |nd| nd.md);
+        let bha = self.bha_length.max(1e-9);
+        let top = bit_md - bha;
+        // Not the clamped top, nor the bit when it is held laterally.
+        let last = if model.bit_lateral_fixed { n - 1 } else { n };
+        let lateral = |i: usize| -> [f64; 3] {
+            let f = &model.nodes[i].frame0;
+            [f[0][1], f[1][1], f[2][1]]
+        };
+        let in_bha = |i: usize| i > 0 && i < last && model.nodes[i].md >= top - 1e-9;
+        if d.initial_lateral_offset != 0.0 {
+            for i in (0..n).filter(|&i| in_bha(i)) {
+                let s = (bit_md - model.nodes[i].md) / bha;
+                let w = d.initial_lateral_offset * (std::f64::consts::PI * s).sin();
+                for (x, a) in q.x[i].iter_mut().zip(lateral(i)) {
+                    *x += w * a;
+                }
+            }
+        }
+        if d.initial_lateral_velocity == 0.0 {
+            return (q, None);
+        }
+        let mut v = vec![0.0; 6 * n];
+        for i in (0..n).filter(|&i| in_bha(i)) {
+            let a = lateral(i);
+            for k in 0..3 {
+                v[6 * i + k] = d.initial_lateral_velocity * a[k];
+            }
+        }
+        (q, Some(v))
+    }
+
+    /// The hole diameter at `md` (m).
+    pub fn hole_diameter_at(&self, md: f64) -> f64 {
+        self.hole_at(md).diameter
+    }
+
+    /// The soft-string profile of the case's operation, with each hole section's friction.
+    pub fn soft_string(&self) -> crate::physics::soft_string::SoftStringProfile {
+        use crate::physics::soft_string::{soft_string_with, Operation};
+        let model = &self.model;
+        let friction_at = |md: f64| self.hole_at(md).friction;
+        soft_string_with(
+            model,
+            &Operation {
+                axial_speed: model.axial_speed,
+                rotation_speed: model.rotation_speed,
+                weight_on_bit: model.weight_on_bit,
+                torque_on_bit: model.torque_on_bit,
+                friction: friction_at(0.0),
+            },
+            &friction_at,
+        )
+    }
+}
+
+/// The most nodes a case's mesh may have (a 20 km string in 1 m elements).
+pub const MAX_NODES: usize = 20_001;
+
+/// Reads, validates and meshes a case file.
+pub fn load_case(path: &Path) -> Result<Case, InputError> {
+    let text = std::fs::read_to_string(path).map_err(|e| InputError {
+        source_name: path.display().to_string(),
+        line: 0,
+        key: "-".into(),
+        message: e.to_string(),
+    })?;
+    parse_case(path, &text)
+}
+
+/// Parses a case from its text (`path` names it in messages and anchors relative paths).
+pub fn parse_case(path: &Path, text: &str) -> Result<Case, InputError> {
+    let ctx = Ctx { path, text };
+    let spec: CaseSpec = toml::from_str(text).map_err(|e| {
+        let line = e.span().map(|s| ctx.line(s.start)).unwrap_or(0);
+        // The key the error sits on: the text before `=` on its line, qualified by the
+        // table header above it (`operation.rpm`), where there is one.
+        let key = e
+            .span()
+            .and_then(|sp| {
+                let start = text[..sp.start.min(text.len())]
+                    .rfind('\n')
+                    .map_or(0, |k| k + 1);
+                let here = text[start..].lines().next()?;
+                let name = here.split_once('=')?.0.trim().trim_matches('"');
+                let table = text[..start]
+                    .lines()
+                    .rev()
+                    .find(|l| l.trim_start().starts_with('['))
+                    .map(|l| l.trim().trim_matches(|c| c == '[' || c == ']').to_string());
+                Some(match table {
+                    Some(t) if !t.is_empty() => format!("{t}.{name}"),
+                    _ => name.to_string(),
+                })
+            })
+            .unwrap_or_else(|| "-".into());
+        InputError {
+            source_name: path.display().to_string(),
+            line,
+            key,
+            message: {
+                let m = e.message();
+                // A number written as text: say how to write it.
+                if m.starts_with("invalid type: string") && m.contains("expected f64") {
+                    format!("{m}: write the number without quotes (friction = 0.2), or with a unit inside them (\"0.2 m\") where the key has one")
+                } else {
+                    m.to_string()
+                }
+            },
+        }
+    })?;
+    let bit_md = ctx.quantity(
+        &spec.well.total_md,
+        "well.total_md",
+        Dimension::Length,
+        |x| x > 0.0 && x <= 20_000.0,
+        "0 < total_md ≤ 20 km",
+    )?;
+    let mut warnings: Vec<String> = Vec::new();
+    let (well, survey_read) = read_well(&ctx, &spec, path, bit_md)?;
+    // Below a survey's last station the path goes on along its last tangent.
+
+    let hole = read_hole(&ctx, &spec, path, bit_md)?;
+    let hole_at = |md: f64| hole_section_at(&hole, md);
+
+    if let Some((survey_path, read)) = &survey_read {
+        let deepest = hole.iter().map(|h| h.bottom_md).fold(bit_md, f64::max);
+        let limit = match &spec.well.max_dogleg_deg_per_30m {
+            Some(q) => ctx.number(
+                q,
+                "well.max_dogleg_deg_per_30m",
+                |x| x > 0.0 && x <= 300.0,
+                "0 < max_dogleg ≤ 300 °/30 m",
+            )?,
+            None => crate::units::DOGLEG_LIMIT_DEG_PER_30M,
+        };
+        warnings.extend(survey_plausibility(
+            &survey_path.display().to_string(),
+            read,
+            deepest,
+            limit,
+        )?);
+    }
+    let mud = ctx.quantity(
+        &spec.mud.density,
+        "mud.density",
+        Dimension::Density,
+        |x| x >= 0.0,
+        "0 (a dry string) or 0.5 … 3.0 sg",
+    )?;
+    let written = match spec.mud.density.get_ref() {
+        Quantity::Text(t) => t.clone(),
+        Quantity::Number(x) => crate::units::show(*x),
+    };
+    if let Some(m) = crate::units::fluid_density_trap(mud, &written) {
+        return Err(ctx.err(spec.mud.density.span(), "mud.density", m));
+    }
+    let mesh = spec.mesh.clone();
+    let el_pipe = match mesh.as_ref().and_then(|m| m.element_length.clone()) {
+        Some(q) => ctx.quantity(
+            &q,
+            "mesh.element_length",
+            Dimension::Length,
+            |x| x > 0.0 && x <= 100.0,
+            "0 < length ≤ 100 m",
+        )?,
+        None => 10.0,
+    };
+    let el_bha = match mesh.as_ref().and_then(|m| m.bha_element_length.clone()) {
+        Some(q) => ctx.quantity(
+            &q,
+            "mesh.bha_element_length",
+            Dimension::Length,
+            |x| x > 0.0 && x <= 100.0,
+            "0 < length ≤ 100 m",
+        )?,
+        None => 1.0,
+    };
+
+    let StringRead {
+        tubulars,
+        blades,
+        eccentricities,
+        bends,
+    } = read_string(&ctx, &spec, &hole, bit_md, (el_pipe, el_bha))?;
+
+    // The mesh's size, before it is built: memory and time grow with the nodes.
+    {
+        let mut remaining = bit_md;
+        let mut nodes = 1.0f64;
+        for t in &tubulars {
+            let covered = t.length.min(remaining).max(0.0);
+            nodes += (covered / t.element_length).ceil();
+            remaining -= covered;
+        }
+        if nodes > MAX_NODES as f64 {
+            let (span, key) = match mesh.as_ref().and_then(|m| m.element_length.clone()) {
+                Some(q) => (q.span(), "mesh.element_length"),
+                None => (spec.well.total_md.span(), "well.total_md"),
+            };
+            return Err(ctx.err(
+                span,
+                key,
+                format!(
+                    "the mesh would have {nodes:.0} nodes, more than the {MAX_NODES} allowed \
+                     (memory and run time grow with them): lengthen mesh.element_length \
+                     (drill pipe) or mesh.bha_element_length"
+                ),
+            ));
+        }
+    }
+
+    let Operation {
+        wob,
+        tob,
+        hook,
+        axial_speed,
+        rotation_speed,
+    } = read_operation(&ctx, &spec)?;
+    let (settings, friction, all_nodes) = read_contact(&ctx, &spec)?;
+    let (nodes, elements) = mesh_string(&well, &tubulars, bit_md, mud);
+    let n = nodes.len();
+    let mut model = Model {
+        nodes,
+        elements,
+        sites: vec![],
+        friction,
+        weight_on_bit: wob,
+        torque_on_bit: tob,
+        axial_speed,
+        rotation_speed,
+        top: match hook {
+            Some(h) => TopBoundary::HookLoad(h),
+            None => TopBoundary::Clamped,
+        },
+        bit_lateral_fixed: true,
+        point_loads: vec![],
+        unbalance: vec![],
+        bends: vec![],
+    };
+    // Stabilizers: a site at the node nearest each stabilizer's middle.
+    let mut stab_nodes = Vec::new();
+    let mut bottom = bit_md;
+    for (t, blade) in tubulars.iter().zip(&blades) {
+        if let Some(b) = blade {
+            let mid = bottom - 0.5 * t.length;
+            let node = (0..n)
+                .min_by(|&a, &c| {
+                    (model.nodes[a].md - mid)
+                        .abs()
+                        .total_cmp(&(model.nodes[c].md - mid).abs())
+                })
+                .unwrap_or(n - 1);
+            stab_nodes.push((node, 0.5 * b));
+        }
+        bottom -= t.length;
+    }
+    for (node, radius) in &stab_nodes {
+        add_sites(
+            &mut model,
+            &[*node],
+            |md| 0.5 * hole_at(md).diameter,
+            |_| *radius,
+            |md| hole_at(md).friction,
+            &settings,
+            true,
+        );
+    }
+    if all_nodes {
+        let others: Vec<usize> = (1..n)
+            .filter(|i| !stab_nodes.iter().any(|(s, _)| s == i))
+            .collect();
+        let radii: Vec<f64> = (0..n).map(|i| model.pipe_radius_at(i)).collect();
+        add_sites(
+            &mut model,
+            &others,
+            |md| 0.5 * hole_at(md).diameter,
+            |i| radii[i],
+            |md| hole_at(md).friction,
+            &settings,
+            false,
+        );
+    }
+    model.sites.sort_by_key(|s| s.node);
+    // Kinks: at the node nearest each, not the top or the bit.
+    for (above_bit, angle, toolface, span) in bends {
+        let md = bit_md - above_bit;
+        let node = (1..n - 1)
+            .min_by(|&a, &c| {
+                (model.nodes[a].md - md)
+                    .abs()
+                    .total_cmp(&(model.nodes[c].md - md).abs())
+            })
+            .ok_or_else(|| ctx.err(span.clone(), "string.bend", "the mesh has no free node"))?;
+        if model.bends.iter().any(|b| b.node == node) {
+            return Err(ctx.err(
+                span,
+                "string.bend",
+                format!(
+                    "two bends at the node at MD {} m: refine mesh.bha_element_length",
+                    crate::units::show(model.nodes[node].md)
+                ),
+            ));
+        }
+        let toolface = model.toolface_from_high_side(node, toolface);
+        model.bends.push(crate::model::Bend {
+            node,
+            angle,
+            toolface,
+        });
+    }
+    // Mass imbalance: each component's centre-of-mass offset.
+    if eccentricities.iter().any(|e| *e > 0.0) {
+        model.unbalance = model
+            .unbalance_from(&|e| tubulars[model.elements[e].component].density, &|e| {
+                eccentricities[model.elements[e].component]
+            });
+    }
+    let element_density = model
+        .elements
+        .iter()
+        .map(|e| tubulars[e.component].density)
+        .collect();
+    let dynamics = match &spec.dynamics {
+        None => None,
+        Some(d) => Some(dynamics_settings(&ctx, d)?),
+    };
+    let ensemble = match &spec.ensemble {
+        None => None,
+        Some(e) => Some(ensemble_settings(&ctx, e, dynamics.is_some())?),
+    };
+    let bha_length = tubulars
+        .iter()
+        .take_while(|t| t.name != "drill_pipe")
+        .map(|t| t.length)
+        .sum::<f64>()
+        .min(bit_md);
+    if let (Some(d), Some(spec_d)) = (&dynamics, &spec.dynamics) {
+        if let Some(q) = &spec_d.initial_lateral_offset {
+            let bha_top = bit_md - bha_length;
+            let widest = model
+                .nodes
+                .iter()
+                .enumerate()
+                .filter(|(_, nd)| nd.md >= bha_top - 1e-9)
+                .map(|(i, nd)| 0.5 * hole_at(nd.md).diameter - model.pipe_radius_at(i))
+                .fold(0.0f64, f64::max);
+            if d.initial_lateral_offset > widest {
+                return Err(ctx.err(
+                    q.span(),
+                    "dynamics.initial_lateral_offset",
+                    format!(
+                        "{} m is wider than the BHA's largest radial clearance ({} m): the \
+                         string would start inside the wall",
+                        crate::units::show(d.initial_lateral_offset),
+                        crate::units::show(widest)
+                    ),
+                ));
+            }
+        }
+    }
+    Ok(Case {
+        ensemble,
+        title: spec.title.unwrap_or_default(),
+        path: path.to_path_buf(),
+        model,
+        hole,
+        bit_md,
+        bha_length,
+        mud_density: mud,
+        element_density,
+        dynamics,
+        warnings,
+    })
+}

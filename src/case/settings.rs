@@ -1,0 +1,370 @@
+//! The readers of `[dynamics]` and `[ensemble]` (with its uncertain inputs).
+
+use super::*;
+
+pub(super) fn ensemble_settings(
+    ctx: &Ctx,
+    e: &EnsembleSpec,
+    has_dynamics: bool,
+) -> Result<EnsembleSettings, InputError> {
+    let analysis = match &e.analysis {
+        None => Analysis::Static,
+        Some(a) => match a.get_ref().as_str() {
+            "static" => Analysis::Static,
+            "dynamic" if has_dynamics => Analysis::Dynamic,
+            "dynamic" => {
+                return Err(ctx.err(
+                    a.span(),
+                    "ensemble.analysis",
+                    "\"dynamic\" needs a [dynamics] table",
+                ))
+            }
+            other => {
+                return Err(ctx.err(
+                    a.span(),
+                    "ensemble.analysis",
+                    format!("unknown analysis {other:?}; allowed: static, dynamic"),
+                ))
+            }
+        },
+    };
+    let mut grid = Vec::new();
+    // In the order written (the first key varies slowest), not the map's alphabetical one.
+    let mut written: Vec<_> = e.grid.iter().flatten().collect();
+    written.sort_by_key(|(_, v)| v.span().start);
+    for (name, values) in written {
+        let key_name = format!("ensemble.grid.{name}");
+        let key =
+            crate::keys::Key::parse(name).map_err(|m| ctx.err(values.span(), &key_name, m))?;
+        if values.get_ref().is_empty() {
+            return Err(ctx.err(values.span(), &key_name, "no values"));
+        }
+        let mut list = Vec::new();
+        for q in values.get_ref() {
+            let text = match q {
+                Quantity::Number(x) => x.to_string(),
+                Quantity::Text(t) => t.clone(),
+            };
+            list.push(
+                key.value(&text)
+                    .map_err(|m| ctx.err(values.span(), &key_name, m))?,
+            );
+        }
+        grid.push((key, list));
+    }
+    let mut uncertain = Vec::new();
+    // In the order written: input k takes the sampler's dimension k.
+    let mut written: Vec<_> = e.uncertain.iter().flatten().collect();
+    written.sort_by_key(|(_, v)| v.span().start);
+    for (name, spec) in written {
+        let key_name = format!("ensemble.uncertain.{name}");
+        let err = |m: String| ctx.err(spec.span(), &key_name, m);
+        let key = crate::keys::Key::parse(name).map_err(err)?;
+        uncertain.push((
+            key.clone(),
+            uncertain_distribution(&key, spec.get_ref()).map_err(err)?,
+        ));
+    }
+    let correlation = match &e.correlation {
+        None => None,
+        Some(pairs) => {
+            let err = |m: String| ctx.err(pairs.span(), "ensemble.correlation", m);
+            let d = uncertain.len();
+            let mut c = nalgebra::DMatrix::identity(d, d);
+            let index = |name: &str| {
+                uncertain
+                    .iter()
+                    .position(|(k, _)| k.name == name)
+                    .ok_or_else(|| err(format!("{name:?} is not in [ensemble.uncertain]")))
+            };
+            for (a, b, rho) in pairs.get_ref() {
+                let (i, j) = (index(a)?, index(b)?);
+                if i == j {
+                    return Err(err(format!("{a:?} with itself")));
+                }
+                if !(rho.is_finite() && rho.abs() < 1.0) {
+                    return Err(err(format!("{a} with {b}: {rho} is outside (−1, 1)")));
+                }
+                c[(i, j)] = *rho;
+                c[(j, i)] = *rho;
+            }
+            if c.clone().cholesky().is_none() {
+                return Err(err(
+                    "the correlations are inconsistent (the matrix is not positive definite)"
+                        .into(),
+                ));
+            }
+            Some(c)
+        }
+    };
+    let mut layouts = Vec::new();
+    if let Some(list) = &e.layouts {
+        for (n, layout) in list.get_ref().iter().enumerate() {
+            let key_name = format!("ensemble.layouts[{}]", n + 1);
+            let err = |m: String| ctx.err(list.span(), &key_name, m);
+            let mut set = Vec::new();
+            for (name, q) in layout {
+                let key = crate::keys::Key::parse(name).map_err(err)?;
+                if !matches!(
+                    key.param,
+                    crate::keys::Param::FromBit | crate::keys::Param::Blade
+                ) {
+                    return Err(err(format!(
+                        "{name}: a layout sets stabK.from_bit and stabK.blade only"
+                    )));
+                }
+                let text = match q {
+                    Quantity::Number(x) => x.to_string(),
+                    Quantity::Text(t) => t.clone(),
+                };
+                set.push((
+                    key.clone(),
+                    key.value(&text).map_err(|m| err(format!("{name}: {m}")))?,
+                ));
+            }
+            if set.is_empty() {
+                return Err(err("an empty layout".into()));
+            }
+            layouts.push(set);
+        }
+    }
+    Ok(EnsembleSettings {
+        analysis,
+        grid,
+        series: e.series.clone().unwrap_or_default(),
+        uncertain,
+        correlation,
+        layouts,
+    })
+}
+
+/// The distribution of `[ensemble.uncertain]` entry `u` of key `key`; every value given is
+/// parsed and range-checked as the key's own values.
+pub(super) fn uncertain_distribution(
+    key: &crate::keys::Key,
+    u: &UncertainSpec,
+) -> Result<crate::uq::Distribution, String> {
+    use crate::uq::Distribution;
+    let text = |q: &Quantity| match q {
+        Quantity::Number(x) => x.to_string(),
+        Quantity::Text(t) => t.clone(),
+    };
+    let value = |q: &Option<Quantity>, field: &str| -> Result<Option<f64>, String> {
+        q.as_ref()
+            .map(|q| key.value(&text(q)).map_err(|m| format!("{field}: {m}")))
+            .transpose()
+    };
+    let need = |x: Option<f64>, field: &str| x.ok_or_else(|| format!("{} needs {field}", u.dist));
+    let (min, max) = (value(&u.min, "min")?, value(&u.max, "max")?);
+    let unused = |fields: &[(&str, bool)]| -> Result<(), String> {
+        match fields.iter().find(|(_, given)| *given) {
+            Some((f, _)) => Err(format!("{} takes no {f}", u.dist)),
+            None => Ok(()),
+        }
+    };
+    let d = match u.dist.as_str() {
+        "uniform" => {
+            unused(&[("mean", u.mean.is_some()), ("sd", u.sd.is_some()), ("median", u.median.is_some()), ("sigma", u.sigma.is_some()), ("mode", u.mode.is_some()), ("values", u.values.is_some()), ("weights", u.weights.is_some())])?;
+            Distribution::Uniform {
+                min: need(min, "min")?,
+                max: need(max, "max")?,
+            }
+        }
+        "normal" => {
+            unused(&[("median", u.median.is_some()), ("sigma", u.sigma.is_some()), ("mode", u.mode.is_some()), ("values", u.values.is_some()), ("weights", u.weights.is_some())])?;
+            let sd = match &u.sd {
+                // A spread: the key's unit, but not its range (σ of a friction factor
+                // may be 0.05, of a WOB 7 kN).
+                Some(q) => {
+                    let t = text(q);
+                    match t.trim().parse::<f64>() {
+                        Ok(x) => x,
+                        Err(_) => key.value(&t).map_err(|m| format!("sd: {m}"))?,
+                    }
+                }
+                None => return Err("normal needs sd".into()),
+            };
+            Distribution::Normal {
+                mean: need(value(&u.mean, "mean")?, "mean")?,
+                sd,
+                min: min.unwrap_or(f64::NEG_INFINITY),
+                max: max.unwrap_or(f64::INFINITY),
+            }
+        }
+        "lognormal" => {
+            unused(&[("min", u.min.is_some()), ("max", u.max.is_some()), ("mean", u.mean.is_some()), ("sd", u.sd.is_some()), ("mode", u.mode.is_some()), ("values", u.values.is_some()), ("weights", u.weights.is_some())])?;
+            Distribution::LogNormal {
+                median: need(value(&u.median, "median")?, "median")?,
+                sigma: u.sigma.ok_or("lognormal needs sigma (of the logarithm)")?,
+            }
+        }
+        "triangular" => {
+            unused(&[("mean", u.mean.is_some()), ("sd", u.sd.is_some()), ("median", u.median.is_some()), ("sigma", u.sigma.is_some()), ("values", u.values.is_some()), ("weights", u.weights.is_some())])?;
+            Distribution::Triangular {
+                min: need(min, "min")?,
+                mode: need(value(&u.mode, "mode")?, "mode")?,
+                max: need(max, "max")?,
+            }
+        }
+        "discrete" => {
+            unused(&[("min", u.min.is_some()), ("max", u.max.is_some()), ("mean", u.mean.is_some()), ("sd", u.sd.is_some()), ("median", u.median.is_some()), ("sigma", u.sigma.is_some()), ("mode", u.mode.is_some())])?;
+            let values = u
+                .values
+                .as_ref()
+                .ok_or("discrete needs values")?
+                .iter()
+                .map(|q| key.value(&text(q)))
+                .collect::<Result<Vec<f64>, String>>()
+                .map_err(|m| format!("values: {m}"))?;
+            let weights = u.weights.clone().unwrap_or_else(|| vec![1.0; values.len()]);
+            Distribution::Discrete { values, weights }
+        }
+        other => {
+            return Err(format!(
+                "unknown distribution {other:?}; allowed: uniform, normal, lognormal, triangular, discrete"
+            ))
+        }
+    };
+    d.check()?;
+    Ok(d)
+}
+
+pub(super) fn dynamics_settings(
+    ctx: &Ctx,
+    d: &DynamicsSpec,
+) -> Result<DynamicsSettings, InputError> {
+    let duration = ctx.quantity(
+        &d.duration,
+        "dynamics.duration",
+        Dimension::Time,
+        |x| x > 0.0 && x <= 1e5,
+        "0 < duration ≤ 1e5 s",
+    )?;
+    let opt = |q: &Option<Q>,
+               key: &str,
+               default: f64,
+               ok: &dyn Fn(f64) -> bool,
+               range: &str|
+     -> Result<f64, InputError> {
+        match q {
+            Some(q) => ctx.quantity(q, key, Dimension::Time, ok, range),
+            None => Ok(default),
+        }
+    };
+    let time_step = opt(
+        &d.time_step,
+        "dynamics.time_step",
+        1e-3,
+        &|x| x > 0.0 && x <= duration,
+        "0 < time_step ≤ duration",
+    )?;
+    let output_interval = opt(
+        &d.output_interval,
+        "dynamics.output_interval",
+        1e-2_f64.max(time_step),
+        &|x| x >= time_step && x <= duration,
+        "time_step ≤ interval ≤ duration",
+    )?;
+    let ramp_time = opt(
+        &d.ramp_time,
+        "dynamics.ramp_time",
+        0.0,
+        &|x| x >= 0.0,
+        "≥ 0",
+    )?;
+    let rho_inf = match &d.rho_inf {
+        Some(q) => ctx.number(
+            q,
+            "dynamics.rho_inf",
+            |x| (0.0..=1.0).contains(&x),
+            "0 ≤ ρ∞ ≤ 1",
+        )?,
+        None => 0.8,
+    };
+    let a0 = match &d.rayleigh_mass {
+        Some(q) => ctx.number(q, "dynamics.rayleigh_mass", |x| x >= 0.0, "≥ 0 (1/s)")?,
+        None => 0.0,
+    };
+    let a1 = match &d.rayleigh_stiffness {
+        Some(q) => ctx.number(q, "dynamics.rayleigh_stiffness", |x| x >= 0.0, "≥ 0 (s)")?,
+        None => 0.0,
+    };
+    let outputs = match &d.outputs {
+        None => DYNAMIC_OUTPUTS.iter().map(|s| s.to_string()).collect(),
+        Some(list) => {
+            let mut out = Vec::new();
+            for o in list {
+                if !DYNAMIC_OUTPUTS.contains(&o.get_ref().as_str()) {
+                    return Err(ctx.err(
+                        o.span(),
+                        "dynamics.outputs",
+                        format!(
+                            "unknown output {:?}; allowed: {}",
+                            o.get_ref(),
+                            DYNAMIC_OUTPUTS.join(", ")
+                        ),
+                    ));
+                }
+                out.push(o.get_ref().clone());
+            }
+            out
+        }
+    };
+    let mass = match &d.mass {
+        None => crate::physics::mass::MassKind::Lumped,
+        Some(m) => match m.get_ref().as_str() {
+            "lumped" => crate::physics::mass::MassKind::Lumped,
+            "consistent" => crate::physics::mass::MassKind::Consistent,
+            other => {
+                return Err(ctx.err(
+                    m.span(),
+                    "dynamics.mass",
+                    format!("unknown mass {other:?}; allowed: lumped, consistent"),
+                ))
+            }
+        },
+    };
+    let rop = match &d.rop {
+        Some(q) => ctx.quantity(
+            q,
+            "dynamics.rop",
+            Dimension::Speed,
+            |x| (0.0..=0.1).contains(&x),
+            "0 ≤ rop ≤ 0.1 m/s (360 m/h)",
+        )?,
+        None => 0.0,
+    };
+    let initial_lateral_velocity = match &d.initial_lateral_velocity {
+        Some(q) => ctx.quantity(
+            q,
+            "dynamics.initial_lateral_velocity",
+            Dimension::Speed,
+            |x| (0.0..=10.0).contains(&x),
+            "0 ≤ speed ≤ 10 m/s",
+        )?,
+        None => 0.0,
+    };
+    let initial_lateral_offset = match &d.initial_lateral_offset {
+        Some(q) => ctx.quantity(
+            q,
+            "dynamics.initial_lateral_offset",
+            Dimension::Length,
+            |x| (0.0..=0.5).contains(&x),
+            "0 ≤ offset ≤ 0.5 m (and within the BHA's clearance)",
+        )?,
+        None => 0.0,
+    };
+    Ok(DynamicsSettings {
+        duration,
+        time_step,
+        output_interval,
+        ramp_time,
+        rho_inf,
+        rayleigh: (a0, a1),
+        outputs,
+        mass,
+        rop,
+        initial_lateral_velocity,
+        initial_lateral_offset,
+    })
+}

@@ -1,0 +1,497 @@
+//! The readers of `[[hole]]`, `[[string]]`, `[operation]` and `[contact]`.
+
+use super::*;
+
+/// What `[[string]]` gives: the tubulars from the bit up, each stabilizer's blade
+/// diameter, each component's centre-of-mass offset, and the kinks of bent subs/housings
+/// (MD above the bit, angle, toolface, and the key's span for messages).
+pub(super) struct StringRead {
+    pub(super) tubulars: Vec<Tubular>,
+    pub(super) blades: Vec<Option<f64>>,
+    pub(super) eccentricities: Vec<f64>,
+    pub(super) bends: Vec<(f64, f64, f64, std::ops::Range<usize>)>,
+}
+
+/// `[[string]]`: the components from the bit up, read and checked against the hole
+/// (`elements`: the drill-pipe and BHA element lengths).
+pub(super) fn read_string(
+    ctx: &Ctx,
+    spec: &CaseSpec,
+    hole: &[HoleSection],
+    bit_md: f64,
+    elements: (f64, f64),
+) -> Result<StringRead, InputError> {
+    let (el_pipe, el_bha) = elements;
+    let pos = |x: f64| x > 0.0;
+    let hole_at = |md: f64| hole_section_at(hole, md);
+    // String, from the bit up.
+    if spec.string.is_empty() {
+        return Err(InputError {
+            source_name: ctx.path.display().to_string(),
+            line: 1,
+            key: "string".into(),
+            message: "at least one [[string]] component is required".into(),
+        });
+    }
+    let mut tubulars = Vec::new();
+    let mut blades = Vec::new();
+    let mut eccentricities: Vec<f64> = Vec::new();
+    let mut bends = Vec::new();
+    for c in &spec.string {
+        let kind = c.kind.get_ref().clone();
+        let length = ctx.quantity(&c.length, "string.length", Dimension::Length, pos, "> 0")?;
+        let od = ctx.quantity(
+            &c.od,
+            "string.od",
+            Dimension::Length,
+            |x| x > 0.0 && x < 1.0,
+            "0 < od < 1 m",
+        )?;
+        let id = ctx.quantity(
+            &c.id,
+            "string.id",
+            Dimension::Length,
+            |x| (0.0..od).contains(&x),
+            &format!("0 ≤ id < od ({od} m)"),
+        )?;
+        let e = match &c.youngs_modulus {
+            Some(q) => ctx.quantity(
+                q,
+                "string.youngs_modulus",
+                Dimension::Pressure,
+                |x| x > 1e9 && x < 1e12,
+                "1 GPa … 1000 GPa",
+            )?,
+            None => 207e9,
+        };
+        let nu = match &c.poisson_ratio {
+            Some(q) => ctx.number(
+                q,
+                "string.poisson_ratio",
+                |x| (0.0..0.5).contains(&x),
+                "0 ≤ ν < 0.5",
+            )?,
+            None => 0.3,
+        };
+        let rho = match &c.density {
+            Some(q) => ctx.quantity(
+                q,
+                "string.density",
+                Dimension::Density,
+                |x| x > 1000.0 && x < 20000.0,
+                "1000 … 20000 kg/m3",
+            )?,
+            None => 7850.0,
+        };
+        let eccentricity = match (&c.mass_eccentricity, &c.imbalance) {
+            (Some(_), Some(q)) => {
+                return Err(ctx.err(
+                    q.span(),
+                    "string.imbalance",
+                    "give mass_eccentricity or imbalance, not both",
+                ))
+            }
+            (Some(q), None) => ctx.quantity(
+                q,
+                "string.mass_eccentricity",
+                Dimension::Length,
+                |x| (0.0..=0.5 * od).contains(&x),
+                &format!("0 ≤ offset ≤ od/2 ({} m)", crate::units::show(0.5 * od)),
+            )?,
+            (None, Some(q)) => {
+                let mass = rho * std::f64::consts::FRAC_PI_4 * (od * od - id * id) * length;
+                ctx.quantity(
+                    q,
+                    "string.imbalance",
+                    Dimension::MassLength,
+                    |x| (0.0..=0.5 * od * mass).contains(&x),
+                    &format!(
+                        "0 ≤ imbalance ≤ the component's mass × od/2 ({} kg·m)",
+                        crate::units::show(0.5 * od * mass)
+                    ),
+                )? / mass
+            }
+            (None, None) => 0.0,
+        };
+        eccentricities.push(eccentricity);
+        let bend = match &c.bend {
+            Some(q) => {
+                let angle = ctx.angle(q, "string.bend", |x| (0.0..=5.0).contains(&x), "0 … 5°")?;
+                let at = match &c.bend_from_bottom {
+                    Some(b) => ctx.quantity(
+                        b,
+                        "string.bend_from_bottom",
+                        Dimension::Length,
+                        |x| x > 0.0 && x < length,
+                        &format!(
+                            "0 < bend_from_bottom < the component's length ({} m)",
+                            crate::units::show(length)
+                        ),
+                    )?,
+                    None => 0.5 * length,
+                };
+                let toolface = match &c.bend_toolface {
+                    Some(t) => ctx.angle(
+                        t,
+                        "string.bend_toolface",
+                        |x| (-360.0..=360.0).contains(&x),
+                        "-360 … 360°",
+                    )?,
+                    None => 0.0,
+                };
+                let above_bit = tubulars.iter().map(|t: &Tubular| t.length).sum::<f64>() + at;
+                Some((
+                    above_bit,
+                    angle.to_radians(),
+                    toolface.to_radians(),
+                    q.span(),
+                ))
+            }
+            None => {
+                for (k, v) in [
+                    ("string.bend_from_bottom", &c.bend_from_bottom),
+                    ("string.bend_toolface", &c.bend_toolface),
+                ] {
+                    if let Some(v) = v {
+                        return Err(ctx.err(v.span(), k, "needs string.bend (the bend angle)"));
+                    }
+                }
+                None
+            }
+        };
+        bends.extend(bend);
+        let blade = match &c.blade_diameter {
+            Some(q) => {
+                let md_here = bit_md - tubulars.iter().map(|t: &Tubular| t.length).sum::<f64>();
+                let hole_d = hole_at(md_here).diameter;
+                Some(ctx.quantity(q, "string.blade_diameter", Dimension::Length, |x| x >= od && x <= hole_d, &format!("od ({} m) ≤ blade diameter ≤ hole diameter ({} m): the disk must fit the hole", crate::units::show(od), crate::units::show(hole_d)))?)
+            }
+            None => None,
+        };
+        if od > hole_at(bit_md - tubulars.iter().map(|t: &Tubular| t.length).sum::<f64>()).diameter
+        {
+            return Err(ctx.err(
+                c.od.span(),
+                "string.od",
+                format!("{} m is wider than the hole", crate::units::show(od)),
+            ));
+        }
+        let bha = kind != "drill_pipe";
+        blades.push(blade);
+        tubulars.push(Tubular {
+            name: kind,
+            length,
+            outer_diameter: od,
+            inner_diameter: id,
+            youngs_modulus: e,
+            poisson_ratio: nu,
+            density: rho,
+            element_length: if bha { el_bha } else { el_pipe },
+        });
+    }
+    let string_length: f64 = tubulars.iter().map(|t| t.length).sum();
+    if string_length + 1e-9 < bit_md {
+        let last = spec.string.last().map(|c| c.length.span()).unwrap_or(0..0);
+        return Err(ctx.err(last, "string.length", format!("the string is {} m long, shorter than the bit depth {} m: it must reach the surface", crate::units::show(string_length), crate::units::show(bit_md))));
+    }
+    Ok(StringRead {
+        tubulars,
+        blades,
+        eccentricities,
+        bends,
+    })
+}
+
+/// What `[operation]` sets on the model.
+pub(super) struct Operation {
+    pub(super) wob: f64,
+    pub(super) tob: f64,
+    pub(super) hook: Option<f64>,
+    pub(super) axial_speed: f64,
+    pub(super) rotation_speed: f64,
+}
+
+/// `[operation]`: weight and torque on bit, hook load, the mode and its speeds.
+pub(super) fn read_operation(ctx: &Ctx, spec: &CaseSpec) -> Result<Operation, InputError> {
+    // Operation.
+    let op = &spec.operation;
+    let wob = op
+        .weight_on_bit
+        .as_ref()
+        .map(|q| {
+            ctx.quantity(
+                q,
+                "operation.weight_on_bit",
+                Dimension::Force,
+                |x| x >= 0.0,
+                "≥ 0",
+            )
+        })
+        .transpose()?
+        .unwrap_or(0.0);
+    let tob = op
+        .torque_on_bit
+        .as_ref()
+        .map(|q| {
+            ctx.quantity(
+                q,
+                "operation.torque_on_bit",
+                Dimension::Torque,
+                |x| x >= 0.0,
+                "≥ 0",
+            )
+        })
+        .transpose()?
+        .unwrap_or(0.0);
+    let rpm = op
+        .rpm
+        .as_ref()
+        .map(|q| {
+            ctx.quantity(
+                q,
+                "operation.rpm",
+                Dimension::AngularSpeed,
+                |x| (0.0..100.0).contains(&x),
+                "0 … 955 rpm",
+            )
+        })
+        .transpose()?
+        .unwrap_or(0.0);
+    let speed = op
+        .axial_speed
+        .as_ref()
+        .map(|q| {
+            ctx.quantity(
+                q,
+                "operation.axial_speed",
+                Dimension::Speed,
+                |x| (0.0..10.0).contains(&x),
+                "0 ≤ speed < 10 m/s",
+            )
+        })
+        .transpose()?
+        .unwrap_or(0.5);
+    let hook = op
+        .hook_load
+        .as_ref()
+        .map(|q| {
+            ctx.quantity(
+                q,
+                "operation.hook_load",
+                Dimension::Force,
+                |x| x > 0.0,
+                "> 0",
+            )
+        })
+        .transpose()?;
+    if let (Some(_), Some(w)) = (hook, &op.weight_on_bit) {
+        return Err(ctx.err(
+            w.span(),
+            "operation.weight_on_bit",
+            "give either weight_on_bit (top clamped) or hook_load (bit on bottom), not both",
+        ));
+    }
+    match (op.mode.get_ref().as_str(), &op.rpm) {
+        ("rotating", None) => {
+            return Err(ctx.err(
+                op.mode.span(),
+                "operation.rpm",
+                "mode = \"rotating\" needs the rotary speed: add rpm = \"90 rpm\" (or the \
+                 value you rotate at) to [operation]",
+            ))
+        }
+        ("rotating", Some(q)) if rpm == 0.0 => {
+            return Err(ctx.err(
+                q.span(),
+                "operation.rpm",
+                "mode = \"rotating\" at 0 rpm has no rotation, hence no torque: give the \
+                 rotary speed (> 0), or mode = \"sliding\" / \"tripping_in\" / \"tripping_out\"",
+            ))
+        }
+        ("tripping_in" | "tripping_out" | "sliding", Some(q)) if rpm != 0.0 => {
+            return Err(ctx.err(
+                q.span(),
+                "operation.rpm",
+                format!(
+                    "mode = {:?} does not rotate the string, so this rpm would be ignored: \
+                     remove rpm, or use mode = \"rotating\"",
+                    op.mode.get_ref()
+                ),
+            ))
+        }
+        _ => {}
+    }
+    let (axial_speed, rotation_speed) = match op.mode.get_ref().as_str() {
+        "rotating" => (0.0, rpm),
+        "tripping_in" => (speed, 0.0),
+        "tripping_out" => (-speed, 0.0),
+        "sliding" => (speed, 0.0),
+        other => {
+            return Err(ctx.err(
+                op.mode.span(),
+                "operation.mode",
+                format!(
+                    "unknown mode {other:?}; allowed: rotating, tripping_in, tripping_out, sliding"
+                ),
+            ))
+        }
+    };
+    Ok(Operation {
+        wob,
+        tob,
+        hook,
+        axial_speed,
+        rotation_speed,
+    })
+}
+
+/// `[contact]`: the contact law's settings, the friction model and whether every node is
+/// a contact site.
+pub(super) fn read_contact(
+    ctx: &Ctx,
+    spec: &CaseSpec,
+) -> Result<(ContactSettings, FrictionModel, bool), InputError> {
+    // Contact.
+    let cs = spec.contact.clone();
+    let q_or = |q: Option<Q>,
+                key: &str,
+                dim: Dimension,
+                default: f64,
+                ok: &dyn Fn(f64) -> bool,
+                range: &str|
+     -> Result<f64, InputError> {
+        match q {
+            Some(q) => ctx.quantity(&q, key, dim, ok, range),
+            None => Ok(default),
+        }
+    };
+    let settings = ContactSettings {
+        wall_stiffness: q_or(
+            cs.as_ref().and_then(|c| c.wall_stiffness.clone()),
+            "contact.wall_stiffness",
+            Dimension::Stiffness,
+            6e7,
+            &|x| x > 0.0 && x <= 1e12,
+            "0 < k_e ≤ 1e12 N/m",
+        )?,
+        spring_exponent: match cs.as_ref().and_then(|c| c.exponent.clone()) {
+            Some(q) => ctx.number(&q, "contact.exponent", |x| x > 0.0 && x <= 3.0, "0 < m ≤ 3")?,
+            None => 1.0,
+        },
+        wall_damping: q_or(
+            cs.as_ref().and_then(|c| c.damping.clone()),
+            "contact.damping",
+            Dimension::Damping,
+            8e3,
+            &|x| x >= 0.0,
+            "≥ 0",
+        )?,
+        eps: q_or(
+            cs.as_ref().and_then(|c| c.eps.clone()),
+            "contact.eps",
+            Dimension::Speed,
+            1e-3,
+            &|x| x > 0.0,
+            "> 0",
+        )?,
+        soft_blend: q_or(
+            cs.as_ref().and_then(|c| c.soft_blend.clone()),
+            "contact.soft_blend",
+            Dimension::Length,
+            1e-5,
+            &|x| x > 0.0,
+            "> 0",
+        )?,
+    };
+    let friction = match cs.as_ref().and_then(|c| c.friction_model.clone()) {
+        None => FrictionModel::Split,
+        Some(s) => match s.get_ref().as_str() {
+            "split" => FrictionModel::Split,
+            "coupled" => FrictionModel::Coupled,
+            other => {
+                return Err(ctx.err(
+                    s.span(),
+                    "contact.friction_model",
+                    format!("unknown model {other:?}; allowed: split, coupled"),
+                ))
+            }
+        },
+    };
+    let all_nodes = match cs.as_ref().and_then(|c| c.sites.clone()) {
+        None => false,
+        Some(s) => match s.get_ref().as_str() {
+            "stabilizers" => false,
+            "all_nodes" => true,
+            other => {
+                return Err(ctx.err(
+                    s.span(),
+                    "contact.sites",
+                    format!("unknown value {other:?}; allowed: stabilizers, all_nodes"),
+                ))
+            }
+        },
+    };
+    Ok((settings, friction, all_nodes))
+}
+
+/// `[[hole]]`: the hole sections from the surface down, each below the one before, the
+/// last reaching the bit.
+pub(super) fn read_hole(
+    ctx: &Ctx,
+    spec: &CaseSpec,
+    path: &Path,
+    bit_md: f64,
+) -> Result<Vec<HoleSection>, InputError> {
+    // Hole sections.
+    let mut hole = Vec::new();
+    let mut previous = 0.0;
+    for h in &spec.hole {
+        let bottom = ctx.quantity(
+            &h.bottom_md,
+            "hole.bottom_md",
+            Dimension::Length,
+            |x| x > previous,
+            &format!("> the previous section's bottom ({previous} m)"),
+        )?;
+        let d = ctx.quantity(
+            &h.diameter,
+            "hole.diameter",
+            Dimension::Length,
+            |x| x > 0.0 && x < 2.0,
+            "0 < diameter < 2 m",
+        )?;
+        let mu = ctx.number(
+            &h.friction,
+            "hole.friction",
+            |x| (0.0..=2.0).contains(&x),
+            "0 ≤ friction ≤ 2",
+        )?;
+        hole.push(HoleSection {
+            bottom_md: bottom,
+            diameter: d,
+            friction: mu,
+        });
+        previous = bottom;
+    }
+    if hole.is_empty() {
+        return Err(InputError {
+            source_name: path.display().to_string(),
+            line: 1,
+            key: "hole".into(),
+            message: "at least one [[hole]] section is required".into(),
+        });
+    }
+    if previous + 1e-9 < bit_md {
+        let last = spec.hole.last().map(|h| h.bottom_md.span()).unwrap_or(0..0);
+        return Err(ctx.err(
+            last,
+            "hole.bottom_md",
+            format!(
+                "the last hole section ends at {} m, above the bit at {} m",
+                crate::units::show(previous),
+                crate::units::show(bit_md)
+            ),
+        ));
+    }
+    Ok(hole)
+}
