@@ -376,9 +376,9 @@ fn print_ensemble_summary(
 ) -> ExitCode {
     match result {
         Ok(s) => {
-            // The case's warnings come back in the summary: the library prints nothing.
-            for w in &s.warnings {
-                eprintln!("holewall: warning: {w}");
+            // The library prints nothing: its notices come back in the summary.
+            for n in s.notices() {
+                eprintln!("holewall: {n}");
             }
             if !quiet {
                 println!("{}", s.digest(out));

@@ -55,6 +55,28 @@ pub struct EnsembleSummary {
 }
 
 impl EnsembleSummary {
+    /// What a user should read even with `--quiet` (the library prints nothing): the case's
+    /// warnings, why the engine was not used, how many variants the engine failed and the
+    /// CPU re-ran.
+    pub fn notices(&self) -> Vec<String> {
+        let mut n: Vec<String> = self
+            .warnings
+            .iter()
+            .map(|w| format!("warning: {w}"))
+            .collect();
+        if let Some(note) = &self.backend_note {
+            n.push(format!("note: {note}"));
+        }
+        if self.backend == "gpu" && self.solved_by_cpu > 0 {
+            n.push(format!(
+                "the engine failed {} of {} variants; they were re-run on the CPU \
+                 (variants.csv: solved_by, reason)",
+                self.solved_by_cpu, self.variants
+            ));
+        }
+        n
+    }
+
     /// A few lines for the terminal: counts, who solved what, the first failures, where
     /// the rest is.
     pub fn digest(&self, out: &std::path::Path) -> String {
@@ -73,9 +95,6 @@ impl EnsembleSummary {
             self.solved_by_engine,
             self.solved_by_cpu
         );
-        if let Some(note) = &self.backend_note {
-            t.push_str(&format!("\n  note: {note}"));
-        }
         for (name, why) in self.failures.iter().take(3) {
             t.push_str(&format!("\n  failed {name}: {why}"));
         }

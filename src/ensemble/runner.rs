@@ -255,7 +255,6 @@ pub(crate) fn compute(
                 r
             }
             Err(why) => {
-                eprintln!("holewall: {why}; running the variants on the CPU");
                 note = Some(format!("{why}: run on the CPU"));
                 run_variants_cpu(case, analysis, variants, bar)
             }
@@ -279,25 +278,12 @@ pub(crate) fn compute(
                     }
                     .into());
                 }
-                eprintln!("holewall: {why}; running the variants on the CPU");
                 note = Some(format!("{why}: run on the CPU"));
                 run_variants_cpu(case, analysis, variants, bar)
             }
         },
         (None, _) => run_variants_cpu(case, analysis, variants, bar),
     };
-    if backend_name == "gpu" {
-        let rerun = results
-            .iter()
-            .filter(|r| r.solved_by == SolvedBy::Cpu)
-            .count();
-        if rerun > 0 {
-            eprintln!(
-                "holewall: the engine failed {rerun} of {} variants; they were re-run on the CPU (variants.csv: solved_by, reason)",
-                results.len()
-            );
-        }
-    }
     Ok((results, backend_name, note))
 }
 
