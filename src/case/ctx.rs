@@ -86,15 +86,7 @@ impl Ctx<'_> {
             Quantity::Text(t) => parse_angle_deg(t)
                 .map_err(|e| self.err(q.span(), key, format!("{e}; allowed: {range}")))?,
         };
-        if v.is_finite() && ok(v) {
-            Ok(v)
-        } else {
-            Err(self.err(
-                q.span(),
-                key,
-                format!("{v}° is out of range; allowed: {range}"),
-            ))
-        }
+        self.in_range(v, q.span(), key, ok, range, "°")
     }
 
     pub(super) fn number(
@@ -104,14 +96,26 @@ impl Ctx<'_> {
         ok: impl Fn(f64) -> bool,
         range: &str,
     ) -> Result<f64, InputError> {
-        let v = *q.get_ref();
+        self.in_range(*q.get_ref(), q.span(), key, ok, range, "")
+    }
+
+    /// `v` if finite and `ok`, else the out-of-range error (`unit` written after the value).
+    fn in_range(
+        &self,
+        v: f64,
+        span: std::ops::Range<usize>,
+        key: &str,
+        ok: impl Fn(f64) -> bool,
+        range: &str,
+        unit: &str,
+    ) -> Result<f64, InputError> {
         if v.is_finite() && ok(v) {
             Ok(v)
         } else {
             Err(self.err(
-                q.span(),
+                span,
                 key,
-                format!("{v} is out of range; allowed: {range}"),
+                format!("{v}{unit} is out of range; allowed: {range}"),
             ))
         }
     }
