@@ -2,7 +2,7 @@
 //! Newton system, one variant per invocation (here: per rayon task).
 //!
 //! A chain of `n` nodes gives `A = tridiag(L_{i-1}, D_i, U_i)` with 6×6 blocks
-//! ([`crate::solve::chain::BlockTridiagonal`]). Block LU without pivoting between blocks
+//! ([`crate::kernels::tridiagonal::BlockTridiagonal`]). Block LU without pivoting between blocks
 //! (the tangents are block-diagonally dominant once the mass or the constraints enter),
 //! with partial pivoting inside each 6×6 block:
 //!
@@ -21,8 +21,8 @@
 #![allow(clippy::needless_range_loop)]
 use rayon::prelude::*;
 
+use crate::kernels::tridiagonal::BlockTridiagonal;
 use crate::physics::Real;
-use crate::solve::chain::BlockTridiagonal;
 
 /// Status of a variant's solve: solved.
 pub const SOLVED: u32 = 0;

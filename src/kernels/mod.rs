@@ -11,6 +11,8 @@
 //! | `shaders/beam.wgsl` | [`beam`] |
 //! | `shaders/sites.wgsl` | [`sites`] |
 //! | `shaders/dynamics.wgsl` | [`dynamics`] |
+//!
+//! [`tridiagonal`] holds the block-tridiagonal matrix they and the solvers share.
 
 pub mod assemble;
 pub mod beam;
@@ -18,6 +20,7 @@ pub mod block_lu;
 pub mod contact;
 pub mod dynamics;
 pub mod sites;
+pub mod tridiagonal;
 pub mod update;
 
 /// Every (shader, twin) pair; a test fails if a shader under `shaders/` is missing here.

@@ -1,0 +1,132 @@
+//! The block-tridiagonal matrix of a chain of 6-DOF nodes (element `i` couples nodes `i`
+//! and `i+1`; a contact element sits on one node's diagonal block): the layout the block
+//! LU ([`crate::kernels::block_lu`]) and the GPU block solve work on, and what
+//! [`crate::solve::chain`] solves.
+
+use faer::sparse::Triplet;
+
+/// A 6×6 block.
+pub type Block6 = [[f64; 6]; 6];
+
+/// Block-tridiagonal matrix over `n` nodes.
+#[derive(Clone, Debug)]
+pub struct BlockTridiagonal {
+    /// Diagonal blocks (n).
+    pub diag: Vec<Block6>,
+    /// `upper[i]` couples row node `i` to column node `i+1` (n−1).
+    pub upper: Vec<Block6>,
+    /// `lower[i]` couples row node `i+1` to column node `i` (n−1).
+    pub lower: Vec<Block6>,
+}
+
+impl BlockTridiagonal {
+    /// Zeros for `n` nodes.
+    pub fn zeros(n: usize) -> Self {
+        BlockTridiagonal {
+            diag: vec![[[0.0; 6]; 6]; n],
+            upper: vec![[[0.0; 6]; 6]; n.saturating_sub(1)],
+            lower: vec![[[0.0; 6]; 6]; n.saturating_sub(1)],
+        }
+    }
+
+    /// Number of nodes.
+    pub fn nodes(&self) -> usize {
+        self.diag.len()
+    }
+
+    /// Clears every entry.
+    pub fn clear(&mut self) {
+        for b in self
+            .diag
+            .iter_mut()
+            .chain(self.upper.iter_mut())
+            .chain(self.lower.iter_mut())
+        {
+            *b = [[0.0; 6]; 6];
+        }
+    }
+
+    /// Adds a 12×12 element matrix coupling nodes `i` and `i+1`.
+    pub fn add_element(&mut self, i: usize, k: &[[f64; 12]; 12]) {
+        for r in 0..6 {
+            for c in 0..6 {
+                self.diag[i][r][c] += k[r][c];
+                self.upper[i][r][c] += k[r][c + 6];
+                self.lower[i][r][c] += k[r + 6][c];
+                self.diag[i + 1][r][c] += k[r + 6][c + 6];
+            }
+        }
+    }
+
+    /// `y = A x`.
+    pub fn mul(&self, x: &[f64]) -> Vec<f64> {
+        let n = self.nodes();
+        let mut y = vec![0.0; 6 * n];
+        for i in 0..n {
+            for r in 0..6 {
+                let mut s = 0.0;
+                for c in 0..6 {
+                    s += self.diag[i][r][c] * x[6 * i + c];
+                    if i + 1 < n {
+                        s += self.upper[i][r][c] * x[6 * (i + 1) + c];
+                    }
+                    if i > 0 {
+                        s += self.lower[i - 1][r][c] * x[6 * (i - 1) + c];
+                    }
+                }
+                y[6 * i + r] = s;
+            }
+        }
+        y
+    }
+
+    /// Dense copy (small systems: stability checks, tests).
+    pub fn to_dense(&self) -> nalgebra::DMatrix<f64> {
+        let n = self.nodes();
+        let mut a = nalgebra::DMatrix::<f64>::zeros(6 * n, 6 * n);
+        for i in 0..n {
+            for r in 0..6 {
+                for c in 0..6 {
+                    a[(6 * i + r, 6 * i + c)] += self.diag[i][r][c];
+                    if i + 1 < n {
+                        a[(6 * i + r, 6 * (i + 1) + c)] += self.upper[i][r][c];
+                        a[(6 * (i + 1) + r, 6 * i + c)] += self.lower[i][r][c];
+                    }
+                }
+            }
+        }
+        a
+    }
+
+    /// Whether the symmetric part is positive definite (a stable equilibrium when this is
+    /// a constrained tangent).
+    pub fn symmetric_part_positive_definite(&self) -> bool {
+        let a = self.to_dense();
+        nalgebra::linalg::Cholesky::new((&a + a.transpose()) * 0.5).is_some()
+    }
+
+    pub(crate) fn triplets(&self) -> Vec<Triplet<usize, usize, f64>> {
+        let n = self.nodes();
+        let mut t = Vec::with_capacity(36 * (3 * n));
+        for i in 0..n {
+            for r in 0..6 {
+                for c in 0..6 {
+                    t.push(Triplet::new(6 * i + r, 6 * i + c, self.diag[i][r][c]));
+                    if i + 1 < n {
+                        t.push(Triplet::new(
+                            6 * i + r,
+                            6 * (i + 1) + c,
+                            self.upper[i][r][c],
+                        ));
+                        t.push(Triplet::new(
+                            6 * (i + 1) + r,
+                            6 * i + c,
+                            self.lower[i][r][c],
+                        ));
+                    }
+                }
+            }
+        }
+        t
+    }
+}
