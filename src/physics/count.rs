@@ -9,7 +9,7 @@
 use std::cell::Cell;
 use std::ops::{Add, Div, Mul, Neg, Sub};
 
-use super::beam::Trig;
+use super::rotation::Trig;
 use super::Real;
 
 /// Operations counted, by kind.

@@ -9,7 +9,7 @@
 
 use std::ops::{Add, Div, Mul, Neg, Sub};
 
-use super::beam::Trig;
+use super::rotation::Trig;
 use super::Real;
 
 /// A dual number over `T`.

@@ -8,6 +8,7 @@ pub mod contact;
 pub mod count;
 pub mod dual;
 pub mod mass;
+pub mod rotation;
 pub mod soft_string;
 pub mod vec3;
 
