@@ -22,7 +22,7 @@
 //! restart point, and a finished one stops costing line searches.
 
 use super::newton::{Event, Newton, NewtonSettings, NewtonState, NewtonSystem};
-use super::statics::{StaticError, StaticOptions};
+use super::static_options::{StaticError, StaticOptions};
 
 /// The loads a variant is solved for: each a factor of the full value.
 #[derive(Clone, Copy, Debug, PartialEq)]

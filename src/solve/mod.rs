@@ -5,4 +5,5 @@ pub mod continuation;
 pub mod dynamics;
 pub mod modal;
 pub mod newton;
+pub mod static_options;
 pub mod statics;

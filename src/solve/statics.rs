@@ -8,8 +8,6 @@
 //! the torque on bit `−TOB·t` (`t` the down-hole axis); buoyed self-weight as consistent
 //! nodal loads. All external loads are scaled by the load factor `λ ∈ [0, 1]`.
 
-use thiserror::Error;
-
 use crate::model::{Model, TopBoundary};
 use crate::physics::beam::{
     element_force, force_and_tangent_closed, local_deformation, rotation_exp, section_forces,
@@ -19,98 +17,7 @@ use crate::physics::contact::{evaluate, ContactMode, ContactResponse, ContactTer
 use crate::physics::vec3::{cross, dot, scale, sub, Vec3};
 use crate::solve::chain::{BlockTridiagonal, ChainSolver};
 
-/// Solver settings.
-#[derive(Clone, Copy, Debug)]
-pub struct StaticOptions {
-    /// Load steps to start with (grown after easy steps, cut on failure).
-    pub initial_steps: usize,
-    /// Newton iterations per load step.
-    pub max_iterations: usize,
-    /// Converged when the largest residual force is below `tolerance` × the reference
-    /// force (largest of total weight and WOB) and the largest moment below `tolerance` ×
-    /// reference force × 1 m.
-    pub tolerance: f64,
-    /// Smallest load-step size before giving up.
-    pub min_step: f64,
-    /// Wall-clock budget (s): the solve stops between iterations once it is spent
-    /// ([`StaticError::Budget`]); `None`: no limit.
-    pub max_seconds: Option<f64>,
-}
-
-impl Default for StaticOptions {
-    fn default() -> Self {
-        StaticOptions {
-            initial_steps: 4,
-            // Contact statics converge slowly where many nodes leave or reach the wall in one
-            // step (one node per iteration along a string): 200 solves 137 of the first 150
-            // corpus wells, 100 solves 127 and 40 solved 109 (`holewall bench corpus`).
-            max_iterations: 200,
-            tolerance: 1e-9,
-            min_step: 1e-4,
-            max_seconds: None,
-        }
-    }
-}
-
-impl StaticOptions {
-    /// The Newton settings of a static solve in a precision of `size` bytes for `models`
-    /// (the deep line search where any has a soft law): the one place `solve_static`, the
-    /// f64 polish and the ensemble engine take them from.
-    pub fn newton<'a>(
-        &self,
-        size: usize,
-        models: impl IntoIterator<Item = &'a Model>,
-    ) -> crate::solve::newton::NewtonSettings {
-        use crate::solve::newton::NewtonSettings;
-        NewtonSettings::statics_for_law(
-            self.max_iterations,
-            self.tolerance,
-            size,
-            NewtonSettings::any_soft_law(models),
-        )
-    }
-}
-
-/// Why a static solve failed.
-#[derive(Clone, Debug, Error)]
-pub enum StaticError {
-    /// A stage of the load path could not be completed (a load step even at the smallest
-    /// step size).
-    #[error("{stage} failed{}: {reason}{}", if *step > 0.0 { format!(" (step {step:.2e}, the smallest allowed {min:.2e})") } else { String::new() }, at_md.map(|md| format!("; the largest residual force was at MD {md:.1} m")).unwrap_or_default())]
-    LoadStep {
-        /// Which stage: laying the string under gravity, the spring-exponent continuation,
-        /// or a step of the bit loads and friction (with its λ).
-        stage: String,
-        /// Load factor reached.
-        from: f64,
-        /// Step tried last (0: a stage without steps).
-        step: f64,
-        /// Minimum step.
-        min: f64,
-        /// The last failure.
-        reason: String,
-        /// Where the residual force was largest when it failed (MD, m), where known.
-        at_md: Option<f64>,
-    },
-    /// The wall-clock budget ran out before the full load was reached.
-    #[error("stopped after {seconds:.1} s (the --max-seconds budget) at {:.1} % of the loads", 100.0 * reached)]
-    Budget {
-        /// Seconds spent.
-        seconds: f64,
-        /// Load factor reached.
-        reached: f64,
-    },
-}
-
-impl StaticError {
-    /// The load factor reached before the failure.
-    pub fn reached(&self) -> f64 {
-        match self {
-            StaticError::LoadStep { from, .. } => *from,
-            StaticError::Budget { reached, .. } => *reached,
-        }
-    }
-}
+pub use super::static_options::{StaticError, StaticOptions};
 
 /// Nodal configuration.
 #[derive(Clone, Debug)]
