@@ -656,7 +656,8 @@ pub struct EngineOutcome {
 /// Newton as the CPU solve, [`crate::solve::continuation`]). `Err` where the path cannot
 /// run here (no adapter, no f64).
 pub fn run_well_engine(well: &CorpusWell, path: EnginePath) -> Result<EngineOutcome, String> {
-    use crate::engine::{solve_static_ensemble, EngineStatus, GpuPath, TwinPath};
+    use crate::engine::{solve_static_ensemble, EngineStatus, TwinPath};
+    use crate::gpu::GpuPath;
     let case = crate::case::load_case(&well.case_path).map_err(|e| e.to_string())?;
     let models = [case.model.clone()];
     let options = crate::solve::statics::StaticOptions::default();

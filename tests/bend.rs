@@ -312,7 +312,8 @@ fn bend_ensembles_on_a_two_stabilizer_well() {
 /// (chunk compaction included: variants finish at different load steps).
 #[test]
 fn the_engine_solves_bent_strings_as_the_cpu_does() {
-    use holewall::engine::{solve_static_ensemble, EngineStatus, GpuPath, TwinPath};
+    use holewall::engine::{solve_static_ensemble, EngineStatus, TwinPath};
+    use holewall::gpu::GpuPath;
     let path = std::path::Path::new("bent.toml");
     let case = holewall::case::parse_case(path, &two_stabilizer_bent_text()).unwrap();
     let models: Vec<_> = [0.0, 0.5, 1.0, 1.5, 2.0, 3.0]

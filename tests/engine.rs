@@ -3,8 +3,10 @@
 
 mod common;
 
-use holewall::engine::{solve_static_ensemble, EngineStatus, GpuPath, TwinPath};
+use holewall::engine::{solve_static_ensemble, EngineStatus, TwinPath};
+
 use holewall::ensemble::{apply, variants_from_csv_text};
+use holewall::gpu::GpuPath;
 use holewall::solve::statics::{solution_at, solve_static, StaticOptions};
 
 /// Neutral point, surface torque, largest side force.

@@ -13,8 +13,9 @@ fn at_rest(
 }
 
 use holewall::engine::dynamic::{run_dynamic_ensemble, DynamicStatus};
-use holewall::engine::{GpuPath, TwinPath};
+use holewall::engine::TwinPath;
 use holewall::ensemble::{apply, variants_from_csv_text};
+use holewall::gpu::GpuPath;
 use holewall::kernels::dynamics::DynamicBatch;
 use holewall::model::Model;
 use holewall::solve::dynamics::Dynamics;

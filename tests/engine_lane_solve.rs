@@ -6,9 +6,10 @@
 mod common;
 
 use holewall::engine::dynamic::{run_dynamic_ensemble, DynamicStatus};
-use holewall::engine::{solve_static_ensemble, EngineStatus, GpuPath, TwinPath};
+use holewall::engine::{solve_static_ensemble, EngineStatus, TwinPath};
 use holewall::ensemble::{apply, variants_from_csv_text};
 use holewall::gpu::block_lu::{force_lu_form, LuForm};
+use holewall::gpu::GpuPath;
 use holewall::kernels::dynamics::DynamicBatch;
 use holewall::solve::statics::{solve_static, StaticOptions};
 

@@ -15,8 +15,10 @@
 
 mod common;
 
-use holewall::engine::{solve_static_ensemble, EngineResult, EngineStatus, GpuPath, TwinPath};
+use holewall::engine::{solve_static_ensemble, EngineResult, EngineStatus, TwinPath};
+
 use holewall::ensemble::{apply, variants_from_csv_text};
+use holewall::gpu::GpuPath;
 use holewall::model::Model;
 use holewall::solve::statics::{solution_at, solve_static, StaticOptions, StaticSolution};
 

@@ -256,7 +256,8 @@ pub fn statics(
     repeats: usize,
     json: Option<&Path>,
 ) -> Result<(), Error> {
-    use crate::engine::{solve_static_ensemble, EngineResult, EngineStatus, GpuPath, TwinPath};
+    use crate::engine::{solve_static_ensemble, EngineResult, EngineStatus, TwinPath};
+    use crate::gpu::GpuPath;
     use crate::solve::statics::{solve_static, StaticOptions};
     use rayon::prelude::*;
     let case = crate::case::load_case(case_path)?;

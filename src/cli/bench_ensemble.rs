@@ -219,7 +219,7 @@ fn run_gpu<T: GpuReal>(
         models,
         &starts,
         density,
-        &crate::engine::GpuPath(ctx),
+        &crate::gpu::GpuPath(ctx),
         options,
         t_end,
         steps,

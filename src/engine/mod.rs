@@ -1,7 +1,7 @@
 //! The ensemble Newton iteration through the kernels (issue 5): one static solve for V
 //! variants of one mesh, every iteration made of the kernels — beam, sites, contact,
 //! assembly (with constraints), block LU, norms, update — on either kernel path: the CPU
-//! twins ([`TwinPath`], f64) or the WGSL kernels ([`GpuPath`], f32 or f64).
+//! twins ([`TwinPath`], f64) or the WGSL kernels ([`crate::gpu::GpuPath`], f32 or f64).
 //!
 //! Each variant follows its own load path, the one `statics::solve_static` follows
 //! ([`crate::solve::continuation::LoadPath`]: gravity in full from the low-side start,
@@ -459,35 +459,6 @@ impl KernelPath<f64> for TwinPath {
         dynamic: &dynamic::DynamicTables<f64>,
     ) -> Result<Box<dyn dynamic::DynamicEnsemble<f64> + 'a>, String> {
         Ok(Box::new(self.dynamic(model, tables, dynamic)))
-    }
-}
-
-/// The WGSL kernels on the shared GPU context, resident per chunk
-/// ([`crate::gpu::ensemble::GpuEnsemble`]).
-pub struct GpuPath(pub &'static crate::gpu::GpuContext);
-
-impl<T: crate::gpu::contact::GpuReal> KernelPath<T> for GpuPath {
-    fn max_chunk(&self, model: &Model) -> usize {
-        crate::gpu::ensemble::max_variants(self.0, model, std::mem::size_of::<T>())
-    }
-    fn open<'a>(
-        &'a self,
-        model: &'a Model,
-        tables: &EnsembleTables<T>,
-    ) -> Result<Box<dyn Ensemble<T> + 'a>, String> {
-        crate::gpu::ensemble::GpuEnsemble::new(self.0, model, tables)
-            .map(|e| Box::new(e) as Box<dyn Ensemble<T> + 'a>)
-            .map_err(|e| e.to_string())
-    }
-    fn open_dynamic<'a>(
-        &'a self,
-        model: &'a Model,
-        tables: &EnsembleTables<T>,
-        dynamic: &dynamic::DynamicTables<T>,
-    ) -> Result<Box<dyn dynamic::DynamicEnsemble<T> + 'a>, String> {
-        crate::gpu::ensemble::GpuDynamic::new(self.0, model, tables, dynamic)
-            .map(|e| Box::new(e) as Box<dyn dynamic::DynamicEnsemble<T> + 'a>)
-            .map_err(|e| e.to_string())
     }
 }
 

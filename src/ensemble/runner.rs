@@ -24,7 +24,8 @@ pub fn run_static_gpu<T: crate::gpu::contact::GpuReal>(
     ctx: &'static crate::gpu::GpuContext,
     bar: &indicatif::ProgressBar,
 ) -> Result<Result<Vec<VariantResult>, String>, Error> {
-    use crate::engine::{solve_static_ensemble_with_progress, EngineStatus, GpuPath};
+    use crate::engine::{solve_static_ensemble_with_progress, EngineStatus};
+    use crate::gpu::GpuPath;
     let models: Vec<Model> = variants
         .iter()
         .map(|v| apply(case, v))
@@ -76,7 +77,8 @@ pub fn run_dynamic_gpu<T: crate::gpu::contact::GpuReal>(
     bar: &indicatif::ProgressBar,
 ) -> Result<Result<Vec<VariantResult>, String>, Error> {
     use crate::engine::dynamic::{run_dynamic_ensemble, unsupported, DynamicStatus};
-    use crate::engine::{solve_static_ensemble, EngineStatus, GpuPath};
+    use crate::engine::{solve_static_ensemble, EngineStatus};
+    use crate::gpu::GpuPath;
     let Some(settings) = case.dynamics.clone() else {
         return Ok(Err("no [dynamics] table".into()));
     };

@@ -10,6 +10,8 @@ pub mod dispatch;
 pub mod dynamics;
 pub mod ensemble;
 pub mod layout;
+pub mod path;
 pub mod update;
 
 pub use context::{list_adapters, AdapterSummary, GpuContext};
+pub use path::GpuPath;
