@@ -119,31 +119,56 @@ impl Key {
         }
     }
 
-    /// Parses and range-checks a value of this key (SI number or `"<number> <unit>"`; a
-    /// mode's name, or its code).
+    /// The SI value of `text` for this key (a number with its unit, a mode name, a bend in
+    /// degrees), checked against the key's range ([`Key::check`]).
     pub fn value(&self, text: &str) -> Result<f64, String> {
-        if self.param == Param::Mode {
-            let t = text.trim();
-            return MODES
+        let t = text.trim();
+        let v = match self.param {
+            Param::Mode => MODES
                 .iter()
                 .position(|m| *m == t)
                 .map(|k| k as f64)
-                .or_else(|| {
-                    t.parse::<f64>()
-                        .ok()
-                        .filter(|x| x.fract() == 0.0 && (0.0..MODES.len() as f64).contains(x))
-                })
-                .ok_or_else(|| format!("unknown mode {t:?}; allowed: {}", MODES.join(", ")));
-        }
-        if self.param == Param::Bend {
+                .or_else(|| t.parse::<f64>().ok())
+                .ok_or_else(|| format!("unknown mode {t:?}; allowed: {}", MODES.join(", ")))?,
             // Degrees unless a unit says otherwise, as the case file's angles.
-            let deg = crate::units::parse_angle_deg(text).map_err(|e| e.to_string())?;
-            if !(0.0..=5.0).contains(&deg) {
-                return Err(format!("{} out of range; allowed: 0 … 5°", text.trim()));
-            }
-            return Ok(deg.to_radians());
+            Param::Bend => crate::units::parse_angle_deg(t)
+                .map_err(|e| e.to_string())?
+                .to_radians(),
+            _ => match (t.parse::<f64>(), self.range().0) {
+                (Ok(x), Some(d)) => match crate::units::bare_number_trap(d, x) {
+                    Some(m) => return Err(m),
+                    None => x,
+                },
+                (Ok(x), None) => x,
+                (Err(_), Some(d)) => parse_quantity(t, d).map_err(|e| e.to_string())?,
+                (Err(_), None) => return Err(format!("{t:?} is not a number")),
+            },
+        };
+        self.check(v)
+            .map_err(|range| format!("{t} out of range; allowed: {range}"))
+    }
+
+    /// An SI value (a sample drawn from a distribution, already in SI) checked against the
+    /// key's range, with no text in between: `Err` names the allowed range.
+    pub fn check(&self, v: f64) -> Result<f64, String> {
+        let (_, ok, range) = self.range();
+        if v.is_finite() && ok(v) {
+            Ok(v)
+        } else {
+            Err(range.to_string())
         }
-        let (dim, ok, range): (Option<Dimension>, fn(f64) -> bool, &str) = match self.param {
+    }
+
+    /// The key's unit dimension (for parsing a number written with a unit), its range in SI
+    /// and the range in words.
+    fn range(&self) -> (Option<Dimension>, fn(f64) -> bool, &'static str) {
+        match self.param {
+            Param::Mode => (
+                None,
+                |x| x.fract() == 0.0 && (0.0..MODES.len() as f64).contains(&x),
+                "rotating, tripping_in, tripping_out, sliding",
+            ),
+            Param::Bend => (None, |x| (0.0..=5f64.to_radians()).contains(&x), "0 … 5°"),
             Param::Mu | Param::MuT | Param::MuL => (None, |x| (0.0..=2.0).contains(&x), "0 … 2"),
             Param::WallStiffness => (None, |x| x > 0.0 && x <= 1e12, "0 < k_e ≤ 1e12 N/m^m"),
             Param::WallDamping => (Some(Dimension::Damping), |x| x >= 0.0, "≥ 0 N·s/m"),
@@ -193,21 +218,6 @@ impl Key {
                 |x| x >= 1.0 && x.fract() == 0.0 && x <= 1e6,
                 "a layout number 1, 2, … of ensemble.layouts",
             ),
-            Param::Mode | Param::Bend => unreachable!("parsed above"),
-        };
-        let t = text.trim();
-        let v = match (t.parse::<f64>(), dim) {
-            (Ok(x), Some(d)) => match crate::units::bare_number_trap(d, x) {
-                Some(m) => return Err(m),
-                None => x,
-            },
-            (Ok(x), None) => x,
-            (Err(_), Some(d)) => parse_quantity(t, d).map_err(|e| e.to_string())?,
-            (Err(_), None) => return Err(format!("{t:?} is not a number")),
-        };
-        if !v.is_finite() || !ok(v) {
-            return Err(format!("{t} out of range; allowed: {range}"));
         }
-        Ok(v)
     }
 }

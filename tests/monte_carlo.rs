@@ -509,3 +509,41 @@ fn candidate_stabilizer_layouts() {
     let e = holewall::case::load_case(&path).unwrap_err();
     assert!(e.to_string().contains("ensemble.layouts[1]"), "{e}");
 }
+
+/// Samples are SI numbers checked against each key's range with no text in between (issue
+/// 24): an uncertain rpm was refused ("a bare number is ambiguous for a rotary speed") and
+/// an uncertain bend was read as degrees a second time (2° became 0.035°).
+#[test]
+fn sampled_rpm_and_bend_stay_in_si() {
+    let base = std::fs::read_to_string(
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("cases/bent_housing.toml"),
+    )
+    .unwrap();
+    let dir = tmp("si-samples");
+    std::fs::create_dir_all(&dir).unwrap();
+    let text = format!(
+        "{base}\n[ensemble]\nanalysis = \"static\"\n[ensemble.uncertain]\n\
+         rpm = {{ dist = \"uniform\", min = \"80 rpm\", max = \"120 rpm\" }}\n\
+         bend = {{ dist = \"uniform\", min = \"1 deg\", max = \"2 deg\" }}\n"
+    );
+    let path = dir.join("case.toml");
+    std::fs::write(&path, text).unwrap();
+    let case = holewall::case::load_case(&path).unwrap();
+    let uncertain = &case.ensemble.as_ref().unwrap().uncertain;
+    let variants =
+        holewall::ensemble::sample_variants(uncertain, 64, 7, Sampling::Lhs, false, None).unwrap();
+    let rpm = std::f64::consts::TAU / 60.0;
+    for v in &variants {
+        for (key, value) in &v.overrides {
+            match key.name.as_str() {
+                "rpm" => assert!((80.0 * rpm..=120.0 * rpm).contains(value), "{value}"),
+                "bend" => assert!(
+                    (1f64.to_radians()..=2f64.to_radians()).contains(value),
+                    "{value} rad"
+                ),
+                other => panic!("{other}"),
+            }
+        }
+        holewall::ensemble::apply(&case, v).unwrap();
+    }
+}

@@ -468,7 +468,7 @@ pub fn sample_variants(
                 .zip(p)
                 .map(|((key, dist), &ui)| {
                     let v = dist.quantile(ui);
-                    key.value(&v.to_string())
+                    key.check(v)
                         .map(|v| (key.clone(), v))
                         .map_err(|m| {
                             format!(
