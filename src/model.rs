@@ -332,12 +332,14 @@ impl Model {
         s
     }
 
-    /// The stabilizer number (1 = nearest the bit) of contact site `site`, if it is one.
-    pub fn stabilizer_number(&self, site: usize) -> Option<usize> {
-        self.stabilizer_sites()
-            .iter()
-            .position(|&k| k == site)
-            .map(|p| p + 1)
+    /// Each contact site's stabilizer number (1 = nearest the bit; 0 for a pipe-body
+    /// site), indexed like `sites`: computed once for a table of many rows.
+    pub fn stabilizer_numbers(&self) -> Vec<usize> {
+        let mut numbers = vec![0; self.sites.len()];
+        for (k, &site) in self.stabilizer_sites().iter().enumerate() {
+            numbers[site] = k + 1;
+        }
+        numbers
     }
 
     /// The length of string a node stands for: half of each adjacent element (m); a side

@@ -349,11 +349,12 @@ pub fn run_case(case: &Case, out: &Path, run_options: RunOptions) -> Result<RunS
             "normal_force_n",
             "spin_rate_rad_s",
         ];
+        let numbers = model.stabilizer_numbers();
         let rows = rec.sites.iter().map(|(t, k, v)| {
             vec![
                 *t,
                 *k as f64,
-                model.stabilizer_number(*k).unwrap_or(0) as f64,
+                numbers[*k] as f64,
                 model.nodes[model.sites[*k].node].md,
                 v[0],
                 v[1],

@@ -56,8 +56,13 @@ fn plot_labels_and_ensemble_keys_name_the_same_stabilizer() {
         );
     }
     // The number of a site, and back.
+    let numbers = model.stabilizer_numbers();
     for (k, &s) in sites.iter().enumerate() {
-        assert_eq!(model.stabilizer_number(s), Some(k + 1));
+        assert_eq!(numbers[s], k + 1);
     }
+    assert_eq!(
+        numbers.iter().filter(|&&n| n == 0).count(),
+        model.sites.len() - 3
+    );
     assert_eq!(holewall::model::stabilizer_name(2), "stab2");
 }

@@ -327,13 +327,12 @@ fn write_plots(
 pub fn bha_clearance_band(case: &Case, model: &Model, bha_top: f64) -> Vec<(f64, f64)> {
     let md = |k: usize| model.nodes[k].md;
     let clearance = |at: f64, od: f64| 1e3 * 0.5 * (case.hole_diameter_at(at) - od);
-    let blade = |k: usize| {
-        model
-            .sites
-            .iter()
-            .find(|s| s.node == k && s.stabilizer)
-            .map(|s| 2.0 * s.params.disk_radius)
-    };
+    // Blade diameter per node, looked up once (not a search over the sites per element).
+    let mut blades: Vec<Option<f64>> = vec![None; model.nodes.len()];
+    for s in model.sites.iter().filter(|s| s.stabilizer) {
+        blades[s.node] = Some(2.0 * s.params.disk_radius);
+    }
+    let blade = |k: usize| blades[k];
     let mut out: Vec<(f64, f64)> = Vec::new();
     for (e, el) in model.elements.iter().enumerate() {
         let (a, b) = (md(e), md(e + 1));
