@@ -183,3 +183,35 @@ fn a_chunk_size_of_zero_is_refused() {
     assert_eq!(code, 2, "{stderr}");
     assert!(stderr.contains("--chunk-size"), "{stderr}");
 }
+
+/// The plausibility checks on the corpus of ordinary wells (`holewall::corpus`, first 100
+/// seeds): every well loads with no refusal and no warning; the same surveys written in
+/// feet without saying so are all refused as feet, and all load with an `md_ft` header.
+#[test]
+fn corpus_wells_pass_and_their_feet_surveys_are_caught() {
+    let dir = scratch("corpus");
+    for seed in 0..100u64 {
+        let w = holewall::corpus::write_well(seed, &dir).unwrap();
+        let case = holewall::case::load_case(&w.case_path)
+            .unwrap_or_else(|e| panic!("seed {seed} refused: {e}"));
+        assert!(case.warnings.is_empty(), "seed {seed}: {:?}", case.warnings);
+        let csv = w.case_path.with_extension("csv");
+        let rows: Vec<String> = std::fs::read_to_string(&csv)
+            .unwrap()
+            .lines()
+            .skip(1)
+            .map(|l| {
+                let f: Vec<f64> = l.split(',').map(|x| x.trim().parse().unwrap()).collect();
+                format!("{}, {}, {}", f[0] * 3.280_84, f[1], f[2])
+            })
+            .collect();
+        std::fs::write(&csv, rows.join("\n") + "\n").unwrap();
+        let e = holewall::case::load_case(&w.case_path).unwrap_err();
+        assert!(e.message.contains("feet"), "seed {seed}: {e}");
+        std::fs::write(&csv, format!("md_ft, inc, azi\n{}\n", rows.join("\n"))).unwrap();
+        assert!(
+            holewall::case::load_case(&w.case_path).is_ok(),
+            "seed {seed}"
+        );
+    }
+}
