@@ -114,9 +114,8 @@ enum Command {
         sobol_indices: bool,
         /// Variants per result chunk (each written atomically; a killed run resumes from
         /// its chunks when started again with the same command).
-        #[arg(long, default_value_t = holewall::ensemble::store::DEFAULT_CHUNK as u64,
-              value_parser = clap::value_parser!(u64).range(1..=1_000_000))]
-        chunk_size: u64,
+        #[arg(long, default_value_t = holewall::ensemble::store::DEFAULT_CHUNK)]
+        chunk_size: usize,
         /// Run only the K-th of N slices of the variants (`holewall merge` joins them).
         #[arg(long)]
         shard: Option<String>,
@@ -501,7 +500,7 @@ fn main() -> ExitCode {
             };
             let options = holewall::ensemble::store::EnsembleOptions {
                 monte_carlo: mc,
-                chunk_size: chunk_size as usize,
+                chunk_size,
                 shard,
                 force,
                 max_seconds,

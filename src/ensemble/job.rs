@@ -167,10 +167,14 @@ pub fn run(
         }
     }
     // The output folder, checked (and the run's manifest written) before any work.
-    if options.chunk_size == 0 {
+    // The one range check of the chunk size (the command line passes it through).
+    if !(1..=1_000_000).contains(&options.chunk_size) {
         return Err(cli_error(
             "--chunk-size",
-            format!("0 variants per chunk; allowed: 1 … 1000000 (default {DEFAULT_CHUNK})"),
+            format!(
+                "{} variants per chunk; allowed: 1 … 1000000 (default {DEFAULT_CHUNK})",
+                options.chunk_size
+            ),
         ));
     }
     let chunk_size = options.chunk_size;
