@@ -9,6 +9,7 @@
 #![warn(missing_docs)]
 
 pub mod backend;
+pub mod bha;
 pub mod case;
 pub mod cli;
 pub mod corpus;

@@ -164,6 +164,53 @@ pub fn transport(frame: &Mat3<f64>, t1: &Vec3<f64>, t2: &Vec3<f64>) -> Mat3<f64>
     })
 }
 
+/// The hole's frame at a point ([`crate::bha`] for the conventions).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct HoleFrame {
+    /// Hole axis, down-hole.
+    pub axis: Vec3<f64>,
+    /// High side.
+    pub high: Vec3<f64>,
+    /// Right side, `axis × high`.
+    pub right: Vec3<f64>,
+}
+
+impl HoleFrame {
+    /// The frame at node `node` of `model`: its hole axis, the high side, the right side; in
+    /// a vertical hole (inclination below 2·10⁻⁴ °) the node's reference second axis stands for
+    /// the high side.
+    pub fn at_node(model: &Model, node: usize) -> HoleFrame {
+        let nd = &model.nodes[node];
+        let t = nd.hole_axis;
+        // Up (−z: z points down) perpendicular to the hole axis.
+        let up = [t[2] * t[0], t[2] * t[1], t[2] * t[2] - 1.0];
+        let n = dot(&up, &up).sqrt();
+        let high = if n >= 1e-6 {
+            scale(&up, 1.0 / n)
+        } else {
+            let f = &nd.frame0;
+            [f[0][1], f[1][1], f[2][1]]
+        };
+        HoleFrame {
+            axis: t,
+            high,
+            right: cross(&t, &high),
+        }
+    }
+
+    /// Components of `v` along (high side, right side).
+    pub fn across(&self, v: &Vec3<f64>) -> (f64, f64) {
+        (dot(v, &self.high), dot(v, &self.right))
+    }
+
+    /// The angles of direction `d` from the hole axis towards the high side and towards the
+    /// right side (rad): `atan2(d·h, d·t)` and `atan2(d·r, d·t)`.
+    pub fn angles(&self, d: &Vec3<f64>) -> (f64, f64) {
+        let a = dot(d, &self.axis);
+        (dot(d, &self.high).atan2(a), dot(d, &self.right).atan2(a))
+    }
+}
+
 /// One tubular of the string: the mesh builder's input.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Tubular {
@@ -413,22 +460,23 @@ impl Model {
     /// down-hole; a vertical hole: from the node's reference second axis) as the angle
     /// [`Bend::toolface`] takes.
     pub fn toolface_from_high_side(&self, node: usize, from_high_side: f64) -> f64 {
-        let nd = &self.nodes[node];
-        let t = nd.hole_axis;
-        let f = &nd.frame0;
+        let frame = HoleFrame::at_node(self, node);
+        let f = &self.nodes[node].frame0;
         let (a2, a3) = ([f[0][1], f[1][1], f[2][1]], [f[0][2], f[1][2], f[2][2]]);
-        // Up (−z) perpendicular to the hole axis.
-        let up = [-t[2] * t[0], -t[2] * t[1], -1.0 + t[2] * t[2]];
-        let n = dot(&up, &up).sqrt();
-        if n < 1e-6 {
-            return from_high_side;
-        }
-        let high = scale(&up, 1.0 / n);
-        // Clockwise looking down the hole axis t: the right-hand turn about t.
-        let right = cross(&t, &high);
         let (c, s) = (from_high_side.cos(), from_high_side.sin());
-        let d: Vec3<f64> = std::array::from_fn(|k| c * high[k] + s * right[k]);
+        let d: Vec3<f64> = std::array::from_fn(|k| c * frame.high[k] + s * frame.right[k]);
         dot(&d, &a3).atan2(dot(&d, &a2))
+    }
+
+    /// The inverse of [`Model::toolface_from_high_side`]: a [`Bend::toolface`] at `node` as a
+    /// toolface from the high side (rad).
+    pub fn toolface_to_high_side(&self, node: usize, toolface: f64) -> f64 {
+        let frame = HoleFrame::at_node(self, node);
+        let f = &self.nodes[node].frame0;
+        let d: Vec3<f64> =
+            std::array::from_fn(|k| toolface.cos() * f[k][1] + toolface.sin() * f[k][2]);
+        let (h, r) = frame.across(&d);
+        r.atan2(h)
     }
 
     /// The nodal mass imbalance (kg·m vectors, [`Model::unbalance`]) of elements whose

@@ -112,6 +112,9 @@ fn shipped_case_on_the_cpu_and_the_engine() {
     } else {
         &[Precision::F32]
     };
+    let force_scale = holewall::solve::statics::reference_force(
+        &holewall::case::load_case(&case()).unwrap().model,
+    );
     for &p in precisions {
         let gpu = mc_run(n, 1, BackendChoice::Gpu, p, &tmp(&format!("gpu{p:?}")));
         let g = gpu.uncertainty.as_ref().unwrap();
@@ -119,11 +122,29 @@ fn shipped_case_on_the_cpu_and_the_engine() {
         let mut worst: f64 = 0.0;
         for (a, b) in g.qois.iter().zip(&u.qois) {
             let (sa, sb) = (a.stats.as_ref().unwrap(), b.stats.as_ref().unwrap());
+            let mut this: f64 = 0.0;
+            // The bit's side force in f32 is a reaction: the difference of the internal and
+            // external forces at the bit of the f32 equilibrium, whose residual the engine
+            // accepts up to f32's floor (1e4 ε₃₂ of the force scale, checked in f64) — so
+            // its error is bounded by that floor in newtons, stated in docs/validation.md.
+            let reaction =
+                p == Precision::F32 && a.name.starts_with("bit_") && a.name.ends_with("_force_n");
             for (x, y) in [(sa.p50, sb.p50), (sa.p90, sb.p90)] {
                 // Relative to the quantity's spread or size, whichever is larger.
-                let scale = sb.p90.abs().max(sb.p10.abs()).max(1e-300);
-                worst = worst.max((x - y).abs() / scale);
+                let scale = if reaction {
+                    100.0 * 1e4 * f32::EPSILON as f64 * force_scale
+                } else {
+                    sb.p90.abs().max(sb.p10.abs()).max(1e-300)
+                };
+                this = this.max((x - y).abs() / scale);
             }
+            if reaction {
+                // The check below is |error| ≤ 1 % of 100 floors: within one floor.
+                eprintln!("  {p:?} {}: {:.2e} of f32's floor", a.name, 100.0 * this);
+            } else {
+                eprintln!("  {p:?} {}: {this:.2e}", a.name);
+            }
+            worst = worst.max(this);
         }
         eprintln!("GPU {p:?} vs CPU: P50/P90 of every quantity within {worst:.2e}");
         assert!(worst <= 0.01, "{p:?}: {worst:e}");

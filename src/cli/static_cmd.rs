@@ -48,6 +48,9 @@ pub struct Summary {
     pub sinusoidal_buckling: bool,
     /// Compression beyond √2 × that (helical buckling).
     pub helical_buckling: bool,
+    /// The bit's side force and tilt in the hole's frame (FE; [`crate::bha`] for the
+    /// signs): null for the soft string, which has no bending stiffness.
+    pub bit: Option<crate::bha::BitLoads>,
     /// Newton iterations per completed load step (FE).
     pub newton_iterations: Vec<usize>,
     /// Load-step cuts and why (FE).
@@ -80,6 +83,7 @@ pub fn run(
     let n = model.nodes.len();
     let mut wob = model.weight_on_bit;
     let mut solver_log = Vec::new();
+    let mut bit = None;
     let (rows, hook, torque, its) = match which {
         StaticModel::Fe => {
             let sol = solve_with_progress(
@@ -94,6 +98,7 @@ pub fn run(
             let (rows, hook, torque, w) = fe_rows(model, &sol);
             wob = w;
             solver_log = sol.log.clone();
+            bit = Some(crate::bha::bit_loads_of(model, &sol));
             (rows, hook, torque, sol.iterations)
         }
         StaticModel::SoftString => {
@@ -161,12 +166,13 @@ pub fn run(
         max_side_force_md_m: rows[k_max].md_m,
         sinusoidal_buckling: sinusoidal,
         helical_buckling: helical,
+        bit,
         newton_iterations: its,
         solver_log,
     };
     let dir = folder.path();
     crate::output::write_csv_rows(&dir.join("profile.csv"), &rows)?;
-    write_plots(&case, which, &rows, np, dir)?;
+    write_plots(&case, which, &rows, np, summary.bit.as_ref(), dir)?;
     let json = serde_json::to_vec_pretty(&summary).map_err(std::io::Error::other)?;
     folder.finish(&json)?;
     Ok(summary)
@@ -177,6 +183,7 @@ fn write_plots(
     which: StaticModel,
     rows: &[ProfileRow],
     np: Option<f64>,
+    bit: Option<&crate::bha::BitLoads>,
     out: &Path,
 ) -> std::io::Result<()> {
     use crate::plots::{line_plot, Marker, Series};
@@ -267,6 +274,16 @@ fn write_plots(
         .map(|k| (rows[k].md_m, 1e3 * rows[k].lateral_displacement_m))
         .collect();
     let clearance = bha_clearance_band(case, model, bha_top);
+    // The bit's side force on the formation and its tilt, at the bit (issue 25).
+    let bit_label: Option<String> = bit.map(|b| {
+        format!(
+            "bit: {:+.2} kN high side, {:+.2} kN right; tilt {:+.3}° high side, {:+.3}° right",
+            b.high_side_force_n / 1e3,
+            b.right_side_force_n / 1e3,
+            b.tilt_high_side_deg,
+            b.tilt_right_side_deg
+        )
+    });
     line_plot(
         &out.join("bha_deflection.png"),
         &format!(
@@ -287,7 +304,14 @@ fn write_plots(
                 wide: false,
             },
         ],
-        &[],
+        &bit_label
+            .iter()
+            .map(|l| Marker {
+                label: l,
+                x: case.bit_md,
+                y: 0.0,
+            })
+            .collect::<Vec<_>>(),
     )?;
     if which == StaticModel::Fe {
         let ss = case.soft_string();

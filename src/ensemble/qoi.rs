@@ -107,6 +107,9 @@ pub struct VariantResult {
     pub string: StringQoi,
     /// Per stabilizer, nearest the bit first.
     pub stabilizers: Vec<StabilizerQoi>,
+    /// The bit's side force and tilt ([`crate::bha::bit_loads`]): static variants.
+    #[serde(default)]
+    pub bit: Option<crate::bha::BitLoads>,
     /// Mean Newton iterations per load or time step.
     #[serde(with = "crate::output::nan_as_null")]
     pub newton_iterations_per_step: f64,
@@ -150,6 +153,7 @@ pub(crate) fn failed(name: &str, reason: String, stabs: usize) -> VariantResult 
         max_surface_torque_nm: f64::NAN,
         string: StringQoi::default(),
         stabilizers: vec![StabilizerQoi::default(); stabs],
+        bit: None,
         newton_iterations_per_step: f64::NAN,
         step_cuts: 0,
     }
@@ -182,6 +186,7 @@ pub(crate) fn finished(
         max_surface_torque_nm,
         string,
         stabilizers,
+        bit: None,
         newton_iterations_per_step: iterations.iter().sum::<usize>() as f64
             / iterations.len().max(1) as f64,
         step_cuts: cuts,
@@ -235,16 +240,19 @@ pub fn static_result(
         helical_buckling: Some(helical),
         stick_slip_severity: None,
     };
-    finished(
-        name,
-        &sol.log,
-        &sol.iterations,
-        neutral_point(&rows).map(|md| bit_md_of(case, model) - md),
-        hook,
-        torque,
-        stabilizers,
-        string,
-    )
+    VariantResult {
+        bit: Some(crate::bha::bit_loads_of(model, sol)),
+        ..finished(
+            name,
+            &sol.log,
+            &sol.iterations,
+            neutral_point(&rows).map(|md| bit_md_of(case, model) - md),
+            hook,
+            torque,
+            stabilizers,
+            string,
+        )
+    }
 }
 
 /// The `[dynamics]` run of one variant's model from its static equilibrium.
@@ -498,6 +506,19 @@ pub fn qoi_columns(
             &|r| r.string.max_side_force_per_length_n_per_m,
         ),
     ];
+    if !dynamic {
+        // The bit's loads and attitude (issue 25).
+        for (j, name) in crate::bha::BIT_COLUMNS.iter().enumerate() {
+            let unit = if name.ends_with("_deg") {
+                Unit::Degrees
+            } else {
+                Unit::Force
+            };
+            q.push(col(name.to_string(), unit, &|r| {
+                r.bit.as_ref().map(|b| b.columns()[j])
+            }));
+        }
+    }
     // Flags as 0/1: their mean is the probability (e.g. that the string buckles).
     let as_number = |b: Option<bool>| b.map(|b| if b { 1.0 } else { 0.0 });
     if dynamic {

@@ -154,6 +154,7 @@ pub(crate) fn variants_csv(
         header.push("stick_slip_severity".into());
     } else {
         header.extend(["sinusoidal_buckling", "helical_buckling"].map(String::from));
+        header.extend(crate::bha::BIT_COLUMNS.map(String::from));
     }
     for k in 1..=stabs {
         header.push(format!(
@@ -218,6 +219,10 @@ pub(crate) fn variants_csv(
         } else {
             row.push(flag(r.string.sinusoidal_buckling));
             row.push(flag(r.string.helical_buckling));
+            match &r.bit {
+                Some(b) => row.extend(b.columns().map(fmt)),
+                None => row.extend(crate::bha::BIT_COLUMNS.map(|_| String::new())),
+            }
         }
         for q in &r.stabilizers {
             row.push(fmt(q.max_side_force_n));

@@ -39,6 +39,10 @@ pub enum Unit {
     Speed,
     /// rad, shown in degrees.
     Angle,
+    /// Degrees (a quantity computed in degrees, e.g. the bit's tilt).
+    Degrees,
+    /// Curvature in °/30 m (build, turn and equilibrium curvature rates).
+    DegPer30m,
 }
 
 /// A quantity's column name in words for plot titles and axes: the SI suffix dropped (the
@@ -47,7 +51,17 @@ pub enum Unit {
 /// largest side force", `sinusoidal_buckling` → "sinusoidal buckling (1 = buckled)".
 pub fn quantity_words(name: &str) -> String {
     let mut n = name.to_string();
-    for suffix in ["_n_per_m", "_nm", "_n", "_m", "_hz", "_pa", "_s"] {
+    for suffix in [
+        "_deg_per_30m",
+        "_n_per_m",
+        "_nm",
+        "_n",
+        "_m",
+        "_hz",
+        "_pa",
+        "_s",
+        "_deg",
+    ] {
         if let Some(stem) = n.strip_suffix(suffix) {
             n = stem.to_string();
             break;
@@ -88,6 +102,8 @@ impl Unit {
             Unit::Damping => (1.0, "N·s/m"),
             Unit::Speed => (1.0, "m/s"),
             Unit::Angle => (180.0 / std::f64::consts::PI, "°"),
+            Unit::Degrees => (1.0, "°"),
+            Unit::DegPer30m => (1.0, "°/30 m"),
         }
     }
 

@@ -1,0 +1,477 @@
+//! The BHA's directional tendency (issue 25): the equilibrium curvature and the predicted
+//! build and turn rates, from the bit's side force and tilt in holes of constant curvature.
+//!
+//! **The BHA model.** The string's lower part — the BHA and `3 λ` of the pipe above it
+//! (`λ = (EI/q)^(1/3)`, the pipe's bending length, 20…90 m), whole elements of the case's
+//! mesh — is laid in a hole of constant curvature `κ = κ_b h + κ_t r` (build towards the
+//! high side `h`, walk towards the right `r`, at the bit's hole frame), ending at the bit
+//! with its inclination and azimuth, its top clamped on the hole axis (far enough that the
+//! bit does not feel it: [`TendencySettings::pipe_bending_lengths`]), the bit held on the
+//! hole axis with the weight and torque on bit, the hole sections, contact sites, bends and
+//! operation of the case. This is the BHA program's classic set-up (Williamson & Lubinski):
+//! the bit's side force and tilt as functions of the hole's curvature.
+//!
+//! **Equilibrium curvature**: the build curvature at which the bit's side force towards the
+//! high side vanishes (no walk curvature): secant iterations on `F_h(κ_b)`.
+//!
+//! **Bit–rock model** (stated, after Ho 1987 and Lubinski & Woods 1953): the bit drills
+//! along `v = W a + I_b F_s`, `a` the bit's axis, `W` the weight on bit, `F_s` the side
+//! force on the formation (across the hole axis) and `I_b` the bit's **side-cutting index**
+//! (lateral over axial drillability: 0 drills only along the bit's axis, 1 along the
+//! resultant force). A layered formation of anisotropy index `h_f` with bedding normal `n`
+//! turns it to `(1 + h_f)(v·n) n + (1 − h_f)(v − (v·n) n)`: towards the normal of the
+//! bedding (up-dip) for `h_f > 0`. The **steady-state rates** are the hole curvature
+//! `(κ_b, κ_t)` at which that drilling direction is the hole's own direction at the bit —
+//! the curvature the assembly keeps drilling — found by Broyden iterations from zero
+//! curvature on the two angles of the drilling direction from the hole axis. The build rate
+//! is `κ_b`, the turn rate the azimuth's rate `κ_t / sin I`; both in °/30 m.
+//!
+//! A rotary static analysis holds the string in one orientation: a rotating bent housing's
+//! averaging is not modelled (its rates are those of the bend's toolface in the static
+//! state, which the string's twist turns).
+
+use serde::{Deserialize, Serialize};
+
+use crate::bha::{bit_loads_of, BitLoads, HoleFrame};
+use crate::model::{frame_from_axis, transport, Bend, Element, Model, Node, TopBoundary};
+use crate::physics::vec3::{add, dot, scale, sub, Vec3};
+use crate::solve::statics::{solve_static, StaticOptions};
+use crate::well::{SurveyStation, WellPath};
+
+/// Radians per metre to degrees per 30 m.
+pub const RAD_PER_M_TO_DEG_PER_30M: f64 = 30.0 * 180.0 / std::f64::consts::PI;
+
+/// The bit–rock model and the BHA model's extent ([module docs](self)).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct TendencySettings {
+    /// The bit's side-cutting index `I_b` (lateral over axial drillability), 0…1.
+    pub side_cutting_index: f64,
+    /// Formation anisotropy index `h_f` (Lubinski & Woods), −0.5…0.5; 0: isotropic.
+    pub formation_anisotropy: f64,
+    /// Bedding dip (degrees from horizontal).
+    pub dip_deg: f64,
+    /// Azimuth of the dip direction (degrees from north).
+    pub dip_azimuth_deg: f64,
+    /// Pipe above the BHA in the BHA model, in bending lengths of the pipe.
+    pub pipe_bending_lengths: f64,
+}
+
+impl Default for TendencySettings {
+    /// `I_b` = 0.05 (a PDC bit with an active gauge is quoted at 0.01–0.1), isotropic
+    /// formation, 3 bending lengths of pipe.
+    fn default() -> Self {
+        TendencySettings {
+            side_cutting_index: 0.05,
+            formation_anisotropy: 0.0,
+            dip_deg: 0.0,
+            dip_azimuth_deg: 0.0,
+            pipe_bending_lengths: 3.0,
+        }
+    }
+}
+
+/// The tendency of an assembly (`summary.json`'s `tendency`).
+#[derive(Clone, Debug, Default, Serialize, Deserialize, PartialEq)]
+pub struct Tendency {
+    /// Predicted (steady-state) build rate (°/30 m; < 0 drops); null if the iterations did
+    /// not settle or the bit carries no weight.
+    pub build_rate_deg_per_30m: Option<f64>,
+    /// Predicted turn rate: the azimuth's rate (°/30 m, > 0 turns right); null as above or
+    /// in a hole within 1° of vertical (see `walk_curvature_deg_per_30m`).
+    pub turn_rate_deg_per_30m: Option<f64>,
+    /// The predicted curvature towards the right side (°/30 m): the turn without the
+    /// `1/sin I` of the azimuth.
+    pub walk_curvature_deg_per_30m: Option<f64>,
+    /// Build curvature at which the bit's high-side force vanishes (°/30 m); null if none
+    /// within ±30°/30 m.
+    pub equilibrium_curvature_deg_per_30m: Option<f64>,
+    /// The bit's loads in the BHA model in a straight hole (κ = 0).
+    pub bit_straight_hole: Option<BitLoads>,
+    /// Length of the BHA model (m).
+    pub model_length_m: f64,
+    /// The bit–rock model used.
+    pub settings: TendencySettings,
+    /// BHA-model solves it took.
+    pub solves: usize,
+    /// What did not settle, and why.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub notes: Vec<String>,
+}
+
+/// The BHA model of `model` ([module docs](self)): the nodes from `first` to the bit in a
+/// hole of constant curvature `(κ_b, κ_t)` (rad/m), the top clamped, the given weight on
+/// bit; bends keep their toolface from the high side, or take `toolface` (rad from the high
+/// side) when given.
+pub fn bha_model(
+    model: &Model,
+    first: usize,
+    curvature: (f64, f64),
+    weight_on_bit: f64,
+    toolface: Option<f64>,
+) -> Model {
+    let n = model.nodes.len();
+    let bit = n - 1;
+    let frame = HoleFrame::at_node(model, bit);
+    let (kb, kt) = curvature;
+    let kappa = kb.hypot(kt);
+    let c_hat = if kappa > 0.0 {
+        add(
+            &scale(&frame.high, kb / kappa),
+            &scale(&frame.right, kt / kappa),
+        )
+    } else {
+        frame.high
+    };
+    let bit_md = model.nodes[bit].md;
+    let top_md = model.nodes[first].md;
+    let length = bit_md - top_md;
+    // The tangent a distance s above the bit: the hole turns towards ĉ going down.
+    let tangent_above = |s: f64| -> Vec3<f64> {
+        sub(
+            &scale(&frame.axis, (kappa * s).cos()),
+            &scale(&c_hat, (kappa * s).sin()),
+        )
+    };
+    let station = |md: f64, t: Vec3<f64>| SurveyStation {
+        md,
+        inclination_deg: t[2].clamp(-1.0, 1.0).acos().to_degrees(),
+        azimuth_deg: t[1].atan2(t[0]).to_degrees().rem_euclid(360.0),
+    };
+    // One circular arc: a two-station minimum-curvature survey is exactly one.
+    let path = WellPath::from_survey(
+        &[
+            station(top_md, tangent_above(length)),
+            station(bit_md, frame.axis),
+        ],
+        [0.0; 3],
+    )
+    .expect("an arc's survey is valid");
+    let mut nodes: Vec<Node> = model.nodes[first..]
+        .iter()
+        .map(|nd| {
+            let (p, t) = path.at(nd.md);
+            Node {
+                md: nd.md,
+                position: p,
+                hole_axis: t,
+                frame0: frame_from_axis(&t),
+            }
+        })
+        .collect();
+    for i in 1..nodes.len() {
+        nodes[i].frame0 = transport(
+            &nodes[i - 1].frame0,
+            &nodes[i - 1].hole_axis,
+            &nodes[i].hole_axis,
+        );
+    }
+    let elements: Vec<Element> = model.elements[first..]
+        .iter()
+        .enumerate()
+        .map(|(i, e)| {
+            let d = sub(&nodes[i + 1].position, &nodes[i].position);
+            let l0 = dot(&d, &d).sqrt();
+            Element {
+                length0: l0,
+                frame0: frame_from_axis(&scale(&d, 1.0 / l0)),
+                ..e.clone()
+            }
+        })
+        .collect();
+    let sites = model
+        .sites
+        .iter()
+        .filter(|s| s.node > first)
+        .map(|s| crate::model::Site {
+            node: s.node - first,
+            ..s.clone()
+        })
+        .collect();
+    let mut sub_model = Model {
+        nodes,
+        elements,
+        sites,
+        weight_on_bit,
+        top: TopBoundary::Clamped,
+        bit_lateral_fixed: true,
+        point_loads: model
+            .point_loads
+            .iter()
+            .filter(|(k, _)| *k > first)
+            .map(|(k, f)| (k - first, *f))
+            .collect(),
+        unbalance: vec![],
+        bends: vec![],
+        ..model.clone()
+    };
+    sub_model.bends = model
+        .bends
+        .iter()
+        .filter(|b| b.node > first)
+        .map(|b| {
+            let node = b.node - first;
+            let from_high =
+                toolface.unwrap_or_else(|| model.toolface_to_high_side(b.node, b.toolface));
+            Bend {
+                node,
+                angle: b.angle,
+                toolface: sub_model.toolface_from_high_side(node, from_high),
+            }
+        })
+        .collect();
+    sub_model
+}
+
+/// The first node of the BHA model: `bha_length` plus the settings' bending lengths of the
+/// pipe above it (20…90 m), at a node; the surface if the string is shorter.
+pub fn bha_model_top(model: &Model, bha_length: f64, settings: &TendencySettings) -> usize {
+    let n = model.nodes.len();
+    let bit_md = model.nodes[n - 1].md;
+    let bha_top = bit_md - bha_length;
+    // The pipe element just above the BHA.
+    let pipe = model
+        .elements
+        .iter()
+        .enumerate()
+        .rev()
+        .find(|(i, _)| model.nodes[*i + 1].md <= bha_top + 1e-9)
+        .map(|(_, e)| e)
+        .unwrap_or(&model.elements[0]);
+    let frame = HoleFrame::at_node(model, n - 1);
+    let q = pipe.buoyed_weight_per_length * (1.0 - frame.axis[2] * frame.axis[2]).sqrt();
+    let ei = pipe.section.youngs_modulus * pipe.section.second_moment;
+    let lambda = if q > 0.0 {
+        (ei / q).cbrt()
+    } else {
+        f64::INFINITY
+    };
+    let extra = (settings.pipe_bending_lengths * lambda).clamp(20.0, 90.0);
+    let top_md = bha_top - extra;
+    model
+        .nodes
+        .iter()
+        .rposition(|nd| nd.md <= top_md + 1e-9)
+        .unwrap_or(0)
+}
+
+/// The drilling direction's angles from the hole axis (towards the high side, the right;
+/// rad) of the bit–rock model, for the bit's loads `bit` under weight `wob` in the hole
+/// frame `frame`.
+pub fn drilling_angles(
+    bit: &BitLoads,
+    wob: f64,
+    frame: &HoleFrame,
+    settings: &TendencySettings,
+) -> (f64, f64) {
+    let (th, tr) = (
+        bit.tilt_high_side_deg.to_radians(),
+        bit.tilt_right_side_deg.to_radians(),
+    );
+    // The bit's axis from its two tilts.
+    let a = add(
+        &frame.axis,
+        &add(
+            &scale(&frame.high, th.tan()),
+            &scale(&frame.right, tr.tan()),
+        ),
+    );
+    let a = scale(&a, 1.0 / dot(&a, &a).sqrt());
+    let side = add(
+        &scale(&frame.high, bit.high_side_force_n),
+        &scale(&frame.right, bit.right_side_force_n),
+    );
+    let v = add(&scale(&a, wob), &scale(&side, settings.side_cutting_index));
+    let h = settings.formation_anisotropy;
+    let v = if h != 0.0 {
+        // Bedding normal, upwards (z points down): dip from horizontal towards the dip
+        // azimuth.
+        let (dip, az) = (
+            settings.dip_deg.to_radians(),
+            settings.dip_azimuth_deg.to_radians(),
+        );
+        let normal = [-dip.sin() * az.cos(), -dip.sin() * az.sin(), -dip.cos()];
+        let vn = dot(&v, &normal);
+        let along = sub(&v, &scale(&normal, vn));
+        add(&scale(&normal, (1.0 + h) * vn), &scale(&along, 1.0 - h))
+    } else {
+        v
+    };
+    frame.angles(&v)
+}
+
+/// One BHA-model solve: the bit's loads in a hole of curvature `(κ_b, κ_t)`.
+fn bit_at(
+    model: &Model,
+    first: usize,
+    curvature: (f64, f64),
+    wob: f64,
+    toolface: Option<f64>,
+) -> Result<(BitLoads, HoleFrame), String> {
+    let m = bha_model(model, first, curvature, wob, toolface);
+    let sol = solve_static(&m, &StaticOptions::default()).map_err(|e| e.to_string())?;
+    let frame = HoleFrame::at_node(&m, m.nodes.len() - 1);
+    Ok((bit_loads_of(&m, &sol), frame))
+}
+
+/// The tendency of `model`'s assembly at weight on bit `wob` (N; the case's, or the
+/// reaction of a hook-load solve) with `bha_length` the BHA's length (m); `toolface`
+/// overrides every bend's toolface (rad from the high side).
+pub fn tendency(
+    model: &Model,
+    bha_length: f64,
+    wob: f64,
+    toolface: Option<f64>,
+    settings: &TendencySettings,
+) -> Tendency {
+    let first = bha_model_top(model, bha_length, settings);
+    let bit_md = model.nodes[model.nodes.len() - 1].md;
+    let mut out = Tendency {
+        model_length_m: bit_md - model.nodes[first].md,
+        settings: *settings,
+        ..Default::default()
+    };
+    let mut solve = |k: (f64, f64)| {
+        out.solves += 1;
+        bit_at(model, first, k, wob, toolface)
+    };
+    let to_rate = RAD_PER_M_TO_DEG_PER_30M;
+    let limit = 30.0 / to_rate;
+    let straight = match solve((0.0, 0.0)) {
+        Ok(s) => s,
+        Err(e) => {
+            out.notes
+                .push(format!("the BHA model in a straight hole: {e}"));
+            return out;
+        }
+    };
+    out.bit_straight_hole = Some(straight.0);
+    // Equilibrium curvature: secant on the high-side force, from 0 and 1°/30 m.
+    let mut a = (0.0, straight.0.high_side_force_n);
+    let mut b = {
+        let k = 1.0 / to_rate;
+        match solve((k, 0.0)) {
+            Ok(s) => (k, s.0.high_side_force_n),
+            Err(e) => {
+                out.notes.push(format!("equilibrium curvature: {e}"));
+                (f64::NAN, f64::NAN)
+            }
+        }
+    };
+    let mut equilibrium = None;
+    for _ in 0..12 {
+        if !b.1.is_finite() || b.1 == a.1 {
+            break;
+        }
+        let k = (b.0 - b.1 * (b.0 - a.0) / (b.1 - a.1)).clamp(-limit, limit);
+        if (k - b.0).abs() < 1e-4 / to_rate {
+            equilibrium = Some(k);
+            break;
+        }
+        match solve((k, 0.0)) {
+            Ok(s) => {
+                a = b;
+                b = (k, s.0.high_side_force_n);
+            }
+            Err(e) => {
+                out.notes.push(format!(
+                    "equilibrium curvature at {:.2}°/30 m: {e}",
+                    k * to_rate
+                ));
+                break;
+            }
+        }
+        if b.1.abs() < 1e-6 * (1.0 + straight.0.side_force_n) {
+            equilibrium = Some(b.0);
+            break;
+        }
+    }
+    match equilibrium {
+        Some(k) if k.abs() < limit => out.equilibrium_curvature_deg_per_30m = Some(k * to_rate),
+        _ => out
+            .notes
+            .push("no equilibrium curvature within ±30°/30 m".to_string()),
+    }
+    // Steady-state rates: Broyden on the drilling direction's two angles.
+    if wob <= 0.0 {
+        out.notes
+            .push("no weight on bit: the bit does not drill, no build or turn rate".into());
+        return out;
+    }
+    let angles = |s: &(BitLoads, HoleFrame)| drilling_angles(&s.0, wob, &s.1, settings);
+    let mut k = [0.0, 0.0];
+    let mut g = {
+        let (x, y) = angles(&straight);
+        [x, y]
+    };
+    // Jacobian by differences of 1°/30 m.
+    let d = 1.0 / to_rate;
+    let mut jac = [[0.0; 2]; 2];
+    for j in 0..2 {
+        let kk = if j == 0 { (d, 0.0) } else { (0.0, d) };
+        match solve(kk) {
+            Ok(s) => {
+                let (x, y) = angles(&s);
+                jac[0][j] = (x - g[0]) / d;
+                jac[1][j] = (y - g[1]) / d;
+            }
+            Err(e) => {
+                out.notes.push(format!("build/turn rates: {e}"));
+                return out;
+            }
+        }
+    }
+    let mut settled = false;
+    for _ in 0..10 {
+        let det = jac[0][0] * jac[1][1] - jac[0][1] * jac[1][0];
+        if det.abs() < 1e-300 {
+            break;
+        }
+        let dk = [
+            -(jac[1][1] * g[0] - jac[0][1] * g[1]) / det,
+            -(-jac[1][0] * g[0] + jac[0][0] * g[1]) / det,
+        ];
+        let next = [
+            (k[0] + dk[0]).clamp(-limit, limit),
+            (k[1] + dk[1]).clamp(-limit, limit),
+        ];
+        let step = [next[0] - k[0], next[1] - k[1]];
+        let s = match solve((next[0], next[1])) {
+            Ok(s) => s,
+            Err(e) => {
+                out.notes.push(format!("build/turn rates: {e}"));
+                break;
+            }
+        };
+        let (x, y) = angles(&s);
+        let gn = [x, y];
+        // Broyden's update of the Jacobian.
+        let dg = [gn[0] - g[0], gn[1] - g[1]];
+        let ss = step[0] * step[0] + step[1] * step[1];
+        if ss > 0.0 {
+            for r in 0..2 {
+                let jd = jac[r][0] * step[0] + jac[r][1] * step[1];
+                for c in 0..2 {
+                    jac[r][c] += (dg[r] - jd) * step[c] / ss;
+                }
+            }
+        }
+        k = next;
+        g = gn;
+        if step[0].abs().max(step[1].abs()) < 1e-4 / to_rate || g[0].abs().max(g[1].abs()) < 1e-9 {
+            settled = true;
+            break;
+        }
+    }
+    if settled && k[0].abs() < limit && k[1].abs() < limit {
+        out.build_rate_deg_per_30m = Some(k[0] * to_rate);
+        out.walk_curvature_deg_per_30m = Some(k[1] * to_rate);
+        let sin_i = (1.0 - model.nodes[model.nodes.len() - 1].hole_axis[2].powi(2)).sqrt();
+        if sin_i > 1f64.to_radians().sin() {
+            out.turn_rate_deg_per_30m = Some(k[1] * to_rate / sin_i);
+        }
+    } else {
+        out.notes
+            .push("the build/turn iterations did not settle within ±30°/30 m".into());
+    }
+    out
+}
