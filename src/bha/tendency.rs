@@ -38,6 +38,9 @@ use crate::physics::vec3::{add, dot, scale, sub, Vec3};
 use crate::solve::statics::{solve_static, StaticOptions};
 use crate::well::{SurveyStation, WellPath};
 
+/// The curvature of the first secant and difference steps (°/30 m).
+const PROBE: f64 = 0.25;
+
 /// Radians per metre to degrees per 30 m.
 pub const RAD_PER_M_TO_DEG_PER_30M: f64 = 30.0 * 180.0 / std::f64::consts::PI;
 
@@ -192,6 +195,9 @@ pub fn bha_model(
         elements,
         sites,
         weight_on_bit,
+        // The toolface of a bend is the one set (as an MWD reads it at the motor): the
+        // reactive torque's twist of the string above is not the BHA model's.
+        torque_on_bit: 0.0,
         top: TopBoundary::Clamped,
         bit_lateral_fixed: true,
         point_loads: model
@@ -245,7 +251,12 @@ pub fn bha_model_top(model: &Model, bha_length: f64, settings: &TendencySettings
     } else {
         f64::INFINITY
     };
-    let extra = (settings.pipe_bending_lengths * lambda).clamp(20.0, 90.0);
+    // A vertical hole has no lateral load: the longest pipe.
+    let extra = if lambda.is_finite() {
+        (settings.pipe_bending_lengths * lambda).clamp(20.0, 90.0)
+    } else {
+        90.0
+    };
     let top_md = bha_top - extra;
     model
         .nodes
@@ -345,10 +356,10 @@ pub fn tendency(
         }
     };
     out.bit_straight_hole = Some(straight.0);
-    // Equilibrium curvature: secant on the high-side force, from 0 and 1°/30 m.
+    // Equilibrium curvature: secant on the high-side force, from 0 and PROBE.
     let mut a = (0.0, straight.0.high_side_force_n);
     let mut b = {
-        let k = 1.0 / to_rate;
+        let k = PROBE / to_rate;
         match solve((k, 0.0)) {
             Ok(s) => (k, s.0.high_side_force_n),
             Err(e) => {
@@ -403,11 +414,10 @@ pub fn tendency(
         let (x, y) = angles(&straight);
         [x, y]
     };
-    // Jacobian by differences of 1°/30 m.
-    let d = 1.0 / to_rate;
+    // Jacobian by differences of PROBE.
+    let d = PROBE / to_rate;
     let mut jac = [[0.0; 2]; 2];
-    for j in 0..2 {
-        let kk = if j == 0 { (d, 0.0) } else { (0.0, d) };
+    for (j, kk) in [(d, 0.0), (0.0, d)].into_iter().enumerate() {
         match solve(kk) {
             Ok(s) => {
                 let (x, y) = angles(&s);

@@ -22,7 +22,7 @@ mod survey;
 mod tables;
 
 use ctx::Ctx;
-use settings::{dynamics_settings, ensemble_settings};
+use settings::{dynamics_settings, ensemble_settings, tendency_settings};
 pub use spec::*;
 use survey::read_well;
 pub use survey::{survey_from_text, survey_plausibility};
@@ -51,6 +51,8 @@ pub struct Case {
     pub dynamics: Option<DynamicsSettings>,
     /// `[ensemble]`, if given.
     pub ensemble: Option<EnsembleSettings>,
+    /// `[tendency]`, with its defaults when absent.
+    pub tendency: TendencyCase,
     /// What the case holds that is allowed but unusual (a sharp dogleg …): printed by every
     /// command that reads the case and written into its `summary.json`.
     pub warnings: Vec<String>,
@@ -478,8 +480,10 @@ pub fn parse_case(path: &Path, text: &str) -> Result<Case, InputError> {
             }
         }
     }
+    let tendency = tendency_settings(&ctx, spec.tendency.as_ref())?;
     Ok(Case {
         ensemble,
+        tendency,
         title: spec.title.unwrap_or_default(),
         path: path.to_path_buf(),
         model,

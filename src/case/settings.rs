@@ -368,3 +368,101 @@ pub(super) fn dynamics_settings(
         initial_lateral_offset,
     })
 }
+
+/// `[tendency]` checked; `None`: the defaults.
+pub(super) fn tendency_settings(
+    ctx: &Ctx,
+    t: Option<&TendencySpec>,
+) -> Result<TendencyCase, InputError> {
+    let mut out = TendencyCase {
+        settings: crate::bha::tendency::TendencySettings::default(),
+        from_bit: vec![],
+        weight_on_bit: vec![],
+        toolface: vec![],
+    };
+    let Some(t) = t else {
+        return Ok(out);
+    };
+    let s = &mut out.settings;
+    if let Some(x) = &t.side_cutting_index {
+        s.side_cutting_index = ctx.number(
+            x,
+            "tendency.side_cutting_index",
+            |v| (0.0..=1.0).contains(&v),
+            "0 ≤ side_cutting_index ≤ 1",
+        )?;
+    }
+    if let Some(x) = &t.formation_anisotropy {
+        s.formation_anisotropy = ctx.number(
+            x,
+            "tendency.formation_anisotropy",
+            |v| (-0.5..=0.5).contains(&v),
+            "−0.5 ≤ formation_anisotropy ≤ 0.5",
+        )?;
+    }
+    if let Some(q) = &t.dip {
+        s.dip_deg = ctx.angle(q, "tendency.dip", |v| (0.0..=90.0).contains(&v), "0…90°")?;
+    }
+    if let Some(q) = &t.dip_azimuth {
+        s.dip_azimuth_deg = ctx.angle(
+            q,
+            "tendency.dip_azimuth",
+            |v| (0.0..=360.0).contains(&v),
+            "0…360°",
+        )?;
+    }
+    // A list of quantities: each parsed and range-checked, the list's line in errors.
+    let list = |l: &Option<Spanned<Vec<Quantity>>>,
+                key: &str,
+                parse: &dyn Fn(&str) -> Result<f64, crate::units::UnitError>,
+                ok: &dyn Fn(f64) -> bool,
+                range: &str|
+     -> Result<Vec<f64>, InputError> {
+        let Some(l) = l else { return Ok(vec![]) };
+        if l.get_ref().is_empty() || l.get_ref().len() > 200 {
+            return Err(ctx.err(l.span(), key, "give 1 to 200 values"));
+        }
+        l.get_ref()
+            .iter()
+            .map(|q| {
+                let text = match q {
+                    Quantity::Number(x) => x.to_string(),
+                    Quantity::Text(t) => t.clone(),
+                };
+                let v = parse(&text)
+                    .map_err(|e| ctx.err(l.span(), key, format!("{e}; allowed: {range}")))?;
+                if v.is_finite() && ok(v) {
+                    Ok(v)
+                } else {
+                    Err(ctx.err(
+                        l.span(),
+                        key,
+                        format!("{text} is out of range; allowed: {range}"),
+                    ))
+                }
+            })
+            .collect()
+    };
+    out.from_bit = list(
+        &t.from_bit,
+        "tendency.from_bit",
+        &|x| parse_quantity(x, Dimension::Length),
+        &|v| v > 0.0 && v <= 200.0,
+        "0 < from_bit ≤ 200 m",
+    )?;
+    out.weight_on_bit = list(
+        &t.weight_on_bit,
+        "tendency.weight_on_bit",
+        &|x| parse_quantity(x, Dimension::Force),
+        &|v| (0.0..=5e6).contains(&v),
+        "0 ≤ weight_on_bit ≤ 5 MN",
+    )?;
+    out.toolface = list(
+        &t.toolface,
+        "tendency.toolface",
+        &|x| crate::units::parse_angle_deg(x).map(f64::to_radians),
+        &|v| (0.0..=std::f64::consts::TAU).contains(&v),
+        "0…360°",
+    )?;
+    Ok(out)
+}

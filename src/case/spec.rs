@@ -247,6 +247,43 @@ pub struct CaseSpec {
     pub dynamics: Option<DynamicsSpec>,
     /// Variants (`holewall ensemble`).
     pub ensemble: Option<EnsembleSpec>,
+    /// Directional tendency: the bit–rock model and the map of `holewall tendency`.
+    pub tendency: Option<TendencySpec>,
+}
+
+/// `[tendency]`: the bit–rock model of the directional tendency
+/// ([`crate::bha::tendency`]) and the map `holewall tendency` draws (issue 25).
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TendencySpec {
+    /// The bit's side-cutting index: lateral over axial drillability, 0…1 (default 0.05).
+    pub side_cutting_index: Option<Spanned<f64>>,
+    /// Formation anisotropy index (Lubinski & Woods), −0.5…0.5 (default 0: isotropic).
+    pub formation_anisotropy: Option<Spanned<f64>>,
+    /// Bedding dip from horizontal, 0…90° (default 0).
+    pub dip: Option<Q>,
+    /// Azimuth of the dip direction, 0…360° (default 0).
+    pub dip_azimuth: Option<Q>,
+    /// The map's distances of stab1 (nearest the bit) from the bit (rotary assemblies;
+    /// default: 12 from 1 m to the BHA's length, at most 40 m).
+    pub from_bit: Option<Spanned<Vec<Quantity>>>,
+    /// The map's weights on bit (default: 0.25, 0.5, 1, 1.5 and 2 × the case's).
+    pub weight_on_bit: Option<Spanned<Vec<Quantity>>>,
+    /// The map's toolfaces from the high side (assemblies with a bend; default every 30°).
+    pub toolface: Option<Spanned<Vec<Quantity>>>,
+}
+
+/// Checked `[tendency]` settings (defaults where the table or a key is absent).
+#[derive(Clone, Debug, PartialEq)]
+pub struct TendencyCase {
+    /// The bit–rock model.
+    pub settings: crate::bha::tendency::TendencySettings,
+    /// stab1's distances from the bit for the map (m); empty: the default.
+    pub from_bit: Vec<f64>,
+    /// Weights on bit for the map (N); empty: the default.
+    pub weight_on_bit: Vec<f64>,
+    /// Toolfaces from the high side for the map (rad); empty: the default.
+    pub toolface: Vec<f64>,
 }
 
 /// `[ensemble]`: what each variant runs, the grid of variants, the variants whose full

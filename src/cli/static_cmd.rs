@@ -51,6 +51,9 @@ pub struct Summary {
     /// The bit's side force and tilt in the hole's frame (FE; [`crate::bha`] for the
     /// signs): null for the soft string, which has no bending stiffness.
     pub bit: Option<crate::bha::BitLoads>,
+    /// The assembly's directional tendency at the case's weight on bit (FE;
+    /// [`crate::bha::tendency`]): build and turn rates, equilibrium curvature.
+    pub tendency: Option<crate::bha::tendency::Tendency>,
     /// Newton iterations per completed load step (FE).
     pub newton_iterations: Vec<usize>,
     /// Load-step cuts and why (FE).
@@ -84,6 +87,7 @@ pub fn run(
     let mut wob = model.weight_on_bit;
     let mut solver_log = Vec::new();
     let mut bit = None;
+    let mut tendency = None;
     let (rows, hook, torque, its) = match which {
         StaticModel::Fe => {
             let sol = solve_with_progress(
@@ -99,6 +103,13 @@ pub fn run(
             wob = w;
             solver_log = sol.log.clone();
             bit = Some(crate::bha::bit_loads_of(model, &sol));
+            tendency = Some(crate::bha::tendency::tendency(
+                model,
+                case.bha_length,
+                w,
+                None,
+                &case.tendency.settings,
+            ));
             (rows, hook, torque, sol.iterations)
         }
         StaticModel::SoftString => {
@@ -167,6 +178,7 @@ pub fn run(
         sinusoidal_buckling: sinusoidal,
         helical_buckling: helical,
         bit,
+        tendency,
         newton_iterations: its,
         solver_log,
     };
