@@ -72,6 +72,19 @@ enum Command {
         #[arg(long, value_parser = positive_seconds)]
         max_seconds: Option<f64>,
     },
+    /// Directional tendency of the BHA: build/turn rates and equilibrium curvature at the
+    /// case's WOB, and their map over stab1's position (or the bend's toolface) × WOB
+    /// (CSV, plots; the grid from the case's [tendency] table).
+    Tendency {
+        /// Case file (TOML).
+        case: PathBuf,
+        /// Output folder.
+        #[arg(long)]
+        out: PathBuf,
+        /// No progress bar.
+        #[arg(long)]
+        quiet: bool,
+    },
     /// One case, many variants (CSV of overrides or the case's [ensemble] grid): statics
     /// or dynamics per variant, quantities of interest and status in variants.csv.
     Ensemble {
@@ -448,6 +461,9 @@ fn main() -> ExitCode {
                 max_seconds,
             },
         )),
+        Command::Tendency { case, out, quiet } => {
+            print_summary(cli::tendency_cmd::run(&case, &out, !quiet))
+        }
         Command::Run {
             case,
             out,

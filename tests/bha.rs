@@ -174,3 +174,202 @@ fn a_bent_housing_pushes_the_bit_towards_its_toolface() {
         assert!(bit.side_force_n > 5e3);
     }
 }
+
+/// A 1,500 m well holding 30° (8½ in hole, μ 0.25), 6½ in collars with full-gauge
+/// stabilizers (8 15/32 in blades, 1 m long) centred at `stabs` metres from the bit, 120 m
+/// of BHA, then 5 in pipe; rotating at 120 rpm, `wob_kn`.
+fn rotary_case(stabs: &[f64], wob_kn: f64) -> holewall::case::Case {
+    let collar = |len: f64| {
+        format!("[[string]]\nkind = \"collar\"\nlength = \"{len} m\"\nod = \"6.5 in\"\nid = \"2.8125 in\"\n")
+    };
+    let mut string = String::from(
+        "[[string]]\nkind = \"bit\"\nlength = \"0.3 m\"\nod = \"6.5 in\"\nid = \"2.8125 in\"\n",
+    );
+    let mut top = 0.3;
+    for &p in stabs {
+        if p - 0.5 > top + 1e-9 {
+            string += &collar(p - 0.5 - top);
+        }
+        string += "[[string]]\nkind = \"stabilizer\"\nlength = \"1 m\"\nod = \"6.5 in\"\nid = \"2.8125 in\"\nblade_diameter = \"8.46875 in\"\n";
+        top = p + 0.5;
+    }
+    string += &collar(120.0 - top);
+    let text = format!(
+        r#"title = "rotary"
+[well]
+profile = "build_and_hold"
+total_md = "1500 m"
+kickoff_md = "300 m"
+build_rate_deg_per_30m = 3.0
+hold_inclination = 30
+azimuth = 0
+[[hole]]
+bottom_md = "1500 m"
+diameter = "8.5 in"
+friction = 0.25
+[mud]
+density = "1.2 sg"
+{string}[[string]]
+kind = "drill_pipe"
+length = "1380 m"
+od = "5 in"
+id = "4.276 in"
+[operation]
+mode = "rotating"
+weight_on_bit = "{wob_kn} kN"
+rpm = "120 rpm"
+[contact]
+sites = "all_nodes"
+[mesh]
+element_length = "10 m"
+bha_element_length = "0.5 m"
+"#
+    );
+    holewall::case::parse_case(std::path::Path::new("rotary.toml"), &text).unwrap()
+}
+
+#[test]
+fn fulcrum_builds_pendulum_drops_packed_holds() {
+    use holewall::bha::tendency::{assembly_tendency, TendencySettings};
+    // Side-cutting index 1 (the bit drills along the resultant force): the classic
+    // side-force reading of BHA tendency, independent of the tilt's weighting.
+    let settings = TendencySettings {
+        side_cutting_index: 1.0,
+        ..Default::default()
+    };
+    let rate = |stabs: &[f64]| {
+        let case = rotary_case(stabs, 60.0);
+        let t = assembly_tendency(&case.model, case.bha_length, 60e3, &settings);
+        println!("stabilizers at {stabs:?} m: {t:?}");
+        (
+            t.build_rate_deg_per_30m.expect("a build rate"),
+            t.equilibrium_curvature_deg_per_30m
+                .expect("an equilibrium curvature"),
+        )
+    };
+    let fulcrum = rate(&[1.0]);
+    let pendulum = rate(&[18.0]);
+    // The textbook packed assembly: near-bit stabilizer, a short collar, a stabilizer, a
+    // collar, a stabilizer.
+    let packed = rate(&[1.0, 5.0, 14.5]);
+    assert!(fulcrum.0 > 0.5 && fulcrum.1 > 0.5, "fulcrum {fulcrum:?}");
+    assert!(
+        pendulum.0 < -0.5 && pendulum.1 < -0.5,
+        "pendulum {pendulum:?}"
+    );
+    // Packed: within a fifth of the smaller of the other two, for both measures.
+    for (p, f, d) in [
+        (packed.0, fulcrum.0, pendulum.0),
+        (packed.1, fulcrum.1, pendulum.1),
+    ] {
+        assert!(p.abs() < 0.2 * f.abs().min(d.abs()), "packed {packed:?}");
+    }
+}
+
+#[test]
+fn bha_model_in_a_straight_hole_is_the_full_model_and_equilibrium_zeroes_the_force() {
+    use holewall::bha::tendency::{bha_model, bha_model_top, tendency, TendencySettings};
+    let case = rotary_case(&[1.0], 60.0);
+    let m = &case.model;
+    let full = holewall::solve::statics::solve_static(m, &Default::default()).unwrap();
+    let b_full = holewall::bha::bit_loads_of(m, &full);
+    let settings = TendencySettings::default();
+    let t = tendency(m, case.bha_length, 60e3, None, &settings);
+    let b = t.bit_straight_hole.unwrap();
+    println!("full {b_full:?}\nBHA model {b:?}");
+    // The hold section is straight over the BHA model: the same bit (the torque on bit,
+    // dropped in the BHA model, is 0 here).
+    assert!(rel(b.high_side_force_n, b_full.high_side_force_n) < 1e-3);
+    assert!(rel(b.tilt_high_side_deg, b_full.tilt_high_side_deg) < 1e-3);
+    // At the equilibrium curvature the high-side force vanishes (to 0.1 % of a straight
+    // hole's).
+    let k = t.equilibrium_curvature_deg_per_30m.unwrap()
+        / holewall::bha::tendency::RAD_PER_M_TO_DEG_PER_30M;
+    let first = bha_model_top(m, case.bha_length, &settings);
+    let at = bha_model(m, first, (k, 0.0), 60e3, None);
+    let sol = holewall::solve::statics::solve_static(&at, &Default::default()).unwrap();
+    let f = holewall::bha::bit_loads_of(&at, &sol).high_side_force_n;
+    assert!(f.abs() < 1e-3 * b.high_side_force_n.abs(), "{f} at {k}");
+    // Twice the pipe above the BHA: the same tendency (the clamp is far enough).
+    let longer = tendency(
+        m,
+        case.bha_length,
+        60e3,
+        None,
+        &TendencySettings {
+            pipe_bending_lengths: 6.0,
+            ..settings
+        },
+    );
+    let (a, c) = (
+        t.build_rate_deg_per_30m.unwrap(),
+        longer.build_rate_deg_per_30m.unwrap(),
+    );
+    assert!((a - c).abs() < 0.02 * a.abs().max(0.1), "{a} vs {c}");
+}
+
+#[test]
+fn a_bent_housing_at_gauge_tilts_the_bit_geometrically() {
+    // Vertical hole (no lateral weight), no WOB: a 0.5° bend 1.5 m above the bit, a gauge
+    // stabilizer 7 m above it. Bit and stabilizer on the axis, the housing straight either
+    // side of the bend: tilt = θ (L − b)/L towards the toolface, b the bend's and L the
+    // stabilizer's distance from the bit. The pipe above bends the stabilizer a little:
+    // within 1 %.
+    let text = r#"title = "bent"
+[well]
+profile = "vertical"
+total_md = "307.5 m"
+[[hole]]
+bottom_md = "307.5 m"
+diameter = "8.5 in"
+friction = 0.0
+[mud]
+density = "1.0 sg"
+[[string]]
+kind = "bit"
+length = "0.3 m"
+od = "6.75 in"
+id = "2.8125 in"
+[[string]]
+kind = "motor"
+length = "6.2 m"
+od = "6.75 in"
+id = "2.8125 in"
+bend = "0.5 deg"
+bend_from_bottom = "1.2 m"
+bend_toolface = "0 deg"
+[[string]]
+kind = "stabilizer"
+length = "1 m"
+od = "6.75 in"
+id = "2.8125 in"
+blade_diameter = "8.5 in"
+[[string]]
+kind = "drill_pipe"
+length = "300 m"
+od = "5 in"
+id = "4.276 in"
+[operation]
+mode = "sliding"
+weight_on_bit = "0 kN"
+[contact]
+sites = "all_nodes"
+wall_stiffness = "1e10 N/m"
+[mesh]
+element_length = "5 m"
+bha_element_length = "0.1 m"
+"#;
+    let case = holewall::case::parse_case(std::path::Path::new("bent.toml"), text).unwrap();
+    let m = &case.model;
+    let sol = holewall::solve::statics::solve_static(m, &Default::default()).unwrap();
+    let b = holewall::bha::bit_loads_of(m, &sol);
+    let bit_md = m.nodes.last().unwrap().md;
+    let l = bit_md - m.nodes[m.sites[m.stabilizer_sites()[0]].node].md;
+    let bend = bit_md - m.nodes[m.bends[0].node].md;
+    let geometric = 0.5 * (l - bend) / l;
+    let tilt = b.tilt_high_side_deg.hypot(b.tilt_right_side_deg);
+    println!("tilt {tilt:.4}° vs geometric {geometric:.4}° (bend {bend} m, stabilizer {l} m)");
+    assert!(rel(tilt, geometric) < 0.01);
+    // Towards the toolface (0°: the reference axis of a vertical hole, the high side).
+    assert!(b.tilt_high_side_deg > 0.0 && b.tilt_right_side_deg.abs() < 1e-6 * tilt);
+}

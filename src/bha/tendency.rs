@@ -26,9 +26,10 @@
 //! curvature on the two angles of the drilling direction from the hole axis. The build rate
 //! is `κ_b`, the turn rate the azimuth's rate `κ_t / sin I`; both in °/30 m.
 //!
-//! A rotary static analysis holds the string in one orientation: a rotating bent housing's
-//! averaging is not modelled (its rates are those of the bend's toolface in the static
-//! state, which the string's twist turns).
+//! A static analysis holds the string in one orientation. An assembly with a bend that
+//! rotates ([`assembly_tendency`]) drills the mean of its toolfaces: its rates are the
+//! means over 12 toolfaces (every 30°), each a sliding-style BHA model with the rotation's
+//! friction; a bend that slides keeps its toolface.
 
 use serde::{Deserialize, Serialize};
 
@@ -484,4 +485,54 @@ pub fn tendency(
             .push("the build/turn iterations did not settle within ±30°/30 m".into());
     }
     out
+}
+
+/// The tendency of the case's assembly as it is operated: [`tendency`] at the bends'
+/// toolfaces, or — for an assembly with a bend that rotates — the means over 12 toolfaces
+/// (every 30°) of each rate (the bit's straight-hole loads are the first toolface's; the
+/// notes say so and count the toolfaces that settled). The one policy `holewall static` and
+/// `holewall tendency` report.
+pub fn assembly_tendency(
+    model: &Model,
+    bha_length: f64,
+    wob: f64,
+    settings: &TendencySettings,
+) -> Tendency {
+    if model.bends.is_empty() || model.rotation_speed == 0.0 {
+        return tendency(model, bha_length, wob, None, settings);
+    }
+    let all: Vec<Tendency> = (0..12)
+        .map(|k| {
+            tendency(
+                model,
+                bha_length,
+                wob,
+                Some((30.0 * k as f64).to_radians()),
+                settings,
+            )
+        })
+        .collect();
+    let mean = |f: fn(&Tendency) -> Option<f64>| -> Option<f64> {
+        let v: Vec<f64> = all.iter().filter_map(f).collect();
+        (v.len() == all.len()).then(|| v.iter().sum::<f64>() / v.len() as f64)
+    };
+    let settled = all
+        .iter()
+        .filter(|t| t.build_rate_deg_per_30m.is_some())
+        .count();
+    let mut notes = vec![format!(
+        "a rotating bend: the means over 12 toolfaces, {settled} of which settled"
+    )];
+    notes.extend(all.iter().flat_map(|t| t.notes.iter().cloned()).take(4));
+    Tendency {
+        build_rate_deg_per_30m: mean(|t| t.build_rate_deg_per_30m),
+        turn_rate_deg_per_30m: mean(|t| t.turn_rate_deg_per_30m),
+        walk_curvature_deg_per_30m: mean(|t| t.walk_curvature_deg_per_30m),
+        equilibrium_curvature_deg_per_30m: mean(|t| t.equilibrium_curvature_deg_per_30m),
+        bit_straight_hole: all[0].bit_straight_hole,
+        model_length_m: all[0].model_length_m,
+        settings: *settings,
+        solves: all.iter().map(|t| t.solves).sum(),
+        notes,
+    }
 }

@@ -8,6 +8,7 @@ pub mod ensemble_cmd;
 pub mod gpu_info;
 pub mod run_cmd;
 pub mod static_cmd;
+pub mod tendency_cmd;
 
 /// Prints a case's warnings ([`crate::case::Case::warnings`]) on stderr, one a line.
 pub fn print_warnings(case: &crate::case::Case) {

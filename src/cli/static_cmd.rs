@@ -103,11 +103,10 @@ pub fn run(
             wob = w;
             solver_log = sol.log.clone();
             bit = Some(crate::bha::bit_loads_of(model, &sol));
-            tendency = Some(crate::bha::tendency::tendency(
+            tendency = Some(crate::bha::tendency::assembly_tendency(
                 model,
                 case.bha_length,
                 w,
-                None,
                 &case.tendency.settings,
             ));
             (rows, hook, torque, sol.iterations)

@@ -31,6 +31,7 @@ pub mod qoi;
 pub mod report;
 pub mod runner;
 pub mod store;
+pub mod tendency_map;
 
 use std::path::Path;
 
