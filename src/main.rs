@@ -85,6 +85,28 @@ enum Command {
         #[arg(long)]
         quiet: bool,
     },
+    /// Critical rotary speeds: lateral modes of the BHA as it lies in the hole (the static
+    /// state's contacts as supports) and the rpm at which 1×, blade pass and backward whirl
+    /// excite them (CSV, Campbell diagram, mode shapes).
+    CriticalSpeeds {
+        /// Case file (TOML).
+        case: PathBuf,
+        /// Output folder.
+        #[arg(long)]
+        out: PathBuf,
+        /// Highest rotary speed of the map (rpm).
+        #[arg(long, default_value_t = 300.0)]
+        max_rpm: f64,
+        /// Blades of the stabilizers and bit (blade-pass excitation).
+        #[arg(long, default_value_t = 3)]
+        blades: usize,
+        /// Lateral modes reported.
+        #[arg(long, default_value_t = 6)]
+        modes: usize,
+        /// No progress bar.
+        #[arg(long)]
+        quiet: bool,
+    },
     /// One case, many variants (CSV of overrides or the case's [ensemble] grid): statics
     /// or dynamics per variant, quantities of interest and status in variants.csv.
     Ensemble {
@@ -459,6 +481,23 @@ fn main() -> ExitCode {
             cli::static_cmd::StaticCommandOptions {
                 show_progress: !quiet,
                 max_seconds,
+            },
+        )),
+        Command::CriticalSpeeds {
+            case,
+            out,
+            max_rpm,
+            blades,
+            modes,
+            quiet,
+        } => print_summary(cli::critical_cmd::run(
+            &case,
+            &out,
+            cli::critical_cmd::CriticalCommandOptions {
+                max_rpm,
+                blades,
+                modes,
+                show_progress: !quiet,
             },
         )),
         Command::Tendency { case, out, quiet } => {

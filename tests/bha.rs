@@ -373,3 +373,64 @@ bha_element_length = "0.1 m"
     // Towards the toolface (0°: the reference axis of a vertical hole, the high side).
     assert!(b.tilt_high_side_deg > 0.0 && b.tilt_right_side_deg.abs() < 1e-6 * tilt);
 }
+
+#[test]
+fn critical_speed_of_a_pinned_collar_span_is_euler_bernoulli_with_axial_load() {
+    // A weightless 6½ in collar span of 20 m (mud as dense as steel, no added mass in the
+    // modal analysis), pinned at both ends, under a compression P: the first lateral
+    // frequency f = (π/L)² √(EI/ρA) √(1 − P/P_E) / 2π, and the 1× critical speed 60 f.
+    use holewall::bha::critical::{critical_speeds, CriticalOptions};
+    use holewall::model::{mesh_string, Model, TopBoundary, Tubular};
+    let (l, od, id, e, rho) = (20.0, 0.1651, 0.0714, 2.1e11, 7850.0);
+    let t = Tubular {
+        name: "collar".into(),
+        length: l,
+        outer_diameter: od,
+        inner_diameter: id,
+        youngs_modulus: e,
+        poisson_ratio: 0.3,
+        density: rho,
+        element_length: l / 40.0,
+    };
+    let (nodes, elements) = mesh_string(&holewall::well::WellPath::vertical(l), &[t], l, rho);
+    let ei = e * elements[0].section.second_moment;
+    let rho_a = rho * elements[0].section.area;
+    let p_e = std::f64::consts::PI.powi(2) * ei / (l * l);
+    for frac in [0.0, 0.3, 0.6] {
+        let m = Model {
+            weight_on_bit: frac * p_e,
+            top: TopBoundary::Pinned,
+            ..Model::bare(nodes.clone(), elements.clone())
+        };
+        let sol = holewall::solve::statics::solve_static(&m, &Default::default()).unwrap();
+        let options = CriticalOptions {
+            max_rpm: 1e4,
+            blades: 3,
+            modes: 2,
+            mud_density: 0.0,
+        };
+        let cs = critical_speeds(&m, &sol.state, 0, &|_| rho, &options);
+        let k = std::f64::consts::PI / l;
+        let expected = k * k * (ei / rho_a).sqrt() * (1.0 - frac).sqrt() / std::f64::consts::TAU;
+        let f = cs.modes[0].frequency_hz;
+        let one_x = cs
+            .critical
+            .iter()
+            .find(|c| c.excitation == "1x" && c.mode == 1)
+            .unwrap();
+        println!(
+            "P = {frac} P_E: {f:.5} Hz vs {expected:.5} Hz ({:+.3} %), 1× critical {:.1} rpm",
+            100.0 * (f / expected - 1.0),
+            one_x.rpm
+        );
+        assert!((f / expected - 1.0).abs() < 2e-3);
+        assert!((one_x.rpm - 60.0 * f).abs() < 1e-9);
+        // Blade pass at 3×: a third of the rpm.
+        let bp = cs
+            .critical
+            .iter()
+            .find(|c| c.excitation == "blade_pass" && c.mode == 1)
+            .unwrap();
+        assert!((bp.rpm - 20.0 * f).abs() < 1e-9);
+    }
+}

@@ -4,6 +4,7 @@ pub mod bench;
 pub mod bench_corpus;
 pub mod bench_ensemble;
 pub mod contact;
+pub mod critical_cmd;
 pub mod ensemble_cmd;
 pub mod gpu_info;
 pub mod run_cmd;

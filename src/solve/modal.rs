@@ -13,9 +13,20 @@ pub fn mass_matrix(
     kind: MassKind,
     density_of: &dyn Fn(usize) -> f64,
 ) -> BlockTridiagonal {
+    mass_matrix_with_added(model, kind, density_of, &|_| 0.0)
+}
+
+/// [`mass_matrix`] with an added mass per length on the translations of element `i`
+/// (`added_of(i)`, kg/m: the mud inside the pipe and entrained outside).
+pub fn mass_matrix_with_added(
+    model: &Model,
+    kind: MassKind,
+    density_of: &dyn Fn(usize) -> f64,
+    added_of: &dyn Fn(usize) -> f64,
+) -> BlockTridiagonal {
     let mut m = BlockTridiagonal::zeros(model.nodes.len());
     for (i, e) in model.elements.iter().enumerate() {
-        let local = local_mass(&e.section, density_of(i), 0.0, e.length0, kind);
+        let local = local_mass(&e.section, density_of(i), added_of(i), e.length0, kind);
         m.add_element(i, &to_global(&local, &e.frame0));
     }
     m
