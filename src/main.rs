@@ -103,6 +103,9 @@ enum Command {
         /// Lateral modes reported.
         #[arg(long, default_value_t = 6)]
         modes: usize,
+        /// Leave the mud's added mass out of the modes (as the dynamics does).
+        #[arg(long)]
+        no_added_mass: bool,
         /// No progress bar.
         #[arg(long)]
         quiet: bool,
@@ -489,6 +492,7 @@ fn main() -> ExitCode {
             max_rpm,
             blades,
             modes,
+            no_added_mass,
             quiet,
         } => print_summary(cli::critical_cmd::run(
             &case,
@@ -498,6 +502,7 @@ fn main() -> ExitCode {
                 blades,
                 modes,
                 show_progress: !quiet,
+                added_mass: !no_added_mass,
             },
         )),
         Command::Tendency { case, out, quiet } => {

@@ -434,3 +434,83 @@ fn critical_speed_of_a_pinned_collar_span_is_euler_bernoulli_with_axial_load() {
         assert!((bp.rpm - 20.0 * f).abs() < 1e-9);
     }
 }
+
+#[test]
+fn an_imbalance_swept_through_a_predicted_critical_speed_peaks_there() {
+    // cases/critical_speed_sweep.toml: the 1× critical speed of its second lateral mode
+    // pair (no added mass: the dynamics carries none), then the dynamics at 0.85…1.15 of
+    // it; the steady whirl amplitude (last 40 % of 30 s, 2 % damping there) at the mode's
+    // antinode peaks at the predicted speed, at least twice the ends of the sweep.
+    use holewall::bha::critical::{critical_speeds, CriticalOptions};
+    use holewall::solve::dynamics::{DynamicState, Dynamics};
+    use rayon::prelude::*;
+    let case = holewall::case::load_case(
+        &std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("cases/critical_speed_sweep.toml"),
+    )
+    .unwrap();
+    let m0 = &case.model;
+    let st = holewall::solve::statics::solve_static(m0, &Default::default()).unwrap();
+    let first =
+        holewall::bha::tendency::bha_model_top(m0, case.bha_length, &case.tendency.settings);
+    let options = CriticalOptions {
+        max_rpm: 300.0,
+        blades: 3,
+        modes: 6,
+        mud_density: 0.0,
+    };
+    let cs = critical_speeds(m0, &st.state, first, &|i| case.element_density[i], &options);
+    let mode = cs
+        .modes
+        .iter()
+        .find(|m| 60.0 * m.frequency_hz > 20.0)
+        .expect("a mode above 20 rpm");
+    let n_crit = 60.0 * mode.frequency_hz;
+    let probe = first
+        + mode
+            .shape
+            .iter()
+            .enumerate()
+            .max_by(|a, b| a.1 .1.total_cmp(&b.1 .1))
+            .unwrap()
+            .0;
+    let settings = case.dynamics.clone().unwrap();
+    let ratios = [0.85, 0.94, 1.0, 1.06, 1.15];
+    let amplitudes: Vec<f64> = ratios
+        .par_iter()
+        .map(|r| {
+            let mut m = m0.clone();
+            m.rotation_speed = r * n_crit * std::f64::consts::TAU / 60.0;
+            let s0 = holewall::solve::statics::solve_static(&m, &Default::default()).unwrap();
+            let mut d = Dynamics::new(&m, settings.integrator_options(), &|e| {
+                case.element_density[e]
+            });
+            let mut s = d.initial_state_with(s0.state, None).unwrap();
+            let nd = m.nodes[probe].clone();
+            let mut amp: f64 = 0.0;
+            let mut observe = |_: &Dynamics, q: &DynamicState| {
+                if q.t > 0.6 * settings.duration {
+                    let dx: Vec<f64> = (0..3).map(|j| q.q.x[probe][j] - nd.position[j]).collect();
+                    let along: f64 = (0..3).map(|j| dx[j] * nd.hole_axis[j]).sum();
+                    let sq: f64 = dx.iter().map(|v| v * v).sum();
+                    amp = amp.max((sq - along * along).max(0.0).sqrt());
+                }
+            };
+            d.run(&mut s, settings.duration, &mut observe).unwrap();
+            amp
+        })
+        .collect();
+    for (r, a) in ratios.iter().zip(&amplitudes) {
+        println!(
+            "{:.1} rpm ({r} × the predicted {n_crit:.1} rpm): whirl {:.3} mm at MD {:.1} m",
+            r * n_crit,
+            a * 1e3,
+            m0.nodes[probe].md
+        );
+    }
+    let peak = amplitudes[2];
+    assert!(amplitudes.iter().all(|a| *a <= peak), "{amplitudes:?}");
+    assert!(
+        peak > 2.0 * amplitudes[0] && peak > 2.0 * amplitudes[4],
+        "{amplitudes:?}"
+    );
+}

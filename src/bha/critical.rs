@@ -34,7 +34,8 @@ pub struct CriticalOptions {
     pub blades: usize,
     /// Lateral modes reported (the lowest).
     pub modes: usize,
-    /// Mud density (kg/m³) for the added mass.
+    /// Mud density (kg/m³) for the added mass; 0: none (as the dynamics, which carries
+    /// no added mass).
     pub mud_density: f64,
 }
 

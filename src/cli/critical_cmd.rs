@@ -42,6 +42,8 @@ pub struct CriticalCommandOptions {
     pub modes: usize,
     /// Progress bar on stderr (the static solve).
     pub show_progress: bool,
+    /// The mud's added mass in the modes (`false`: like the dynamics, which has none).
+    pub added_mass: bool,
 }
 
 /// Runs the command.
@@ -64,7 +66,11 @@ pub fn run(
         max_rpm: options.max_rpm,
         blades: options.blades,
         modes: options.modes,
-        mud_density: case.mud_density,
+        mud_density: if options.added_mass {
+            case.mud_density
+        } else {
+            0.0
+        },
     };
     let cs = critical_speeds(
         model,
@@ -178,7 +184,7 @@ fn write_plots(
         .iter()
         .map(|c| format!("{:.0} rpm", c.rpm))
         .collect();
-    let mut markers: Vec<Marker> = cs
+    let markers: Vec<Marker> = cs
         .critical
         .iter()
         .zip(&labels)
@@ -188,15 +194,13 @@ fn write_plots(
             y: c.frequency_hz,
         })
         .collect();
-    let operating = format!(
-        "operating {:.0} rpm",
-        rotation_speed * 60.0 / std::f64::consts::TAU
-    );
+    let operating_rpm = rotation_speed * 60.0 / std::f64::consts::TAU;
+    let operating = format!("operating {operating_rpm:.0} rpm");
     if rotation_speed > 0.0 {
-        markers.push(Marker {
-            label: &operating,
-            x: rotation_speed * 60.0 / std::f64::consts::TAU,
-            y: 0.0,
+        series.push(Series {
+            name: &operating,
+            points: vec![(operating_rpm, 0.0), (operating_rpm, top)],
+            wide: true,
         });
     }
     line_plot(
