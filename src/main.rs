@@ -306,6 +306,22 @@ enum BenchCommand {
         #[arg(long)]
         quiet: bool,
     },
+    /// The BHA tendency (build/turn rates, equilibrium curvature) of corpus wells at their
+    /// own WOB: settled / total with the unsettled and why (tendency_corpus.csv).
+    TendencyCorpus {
+        /// Wells (seeds first-seed, first-seed + 1, …).
+        #[arg(long, default_value_t = 500)]
+        wells: usize,
+        /// First seed.
+        #[arg(long, default_value_t = 0)]
+        first_seed: u64,
+        /// Output folder.
+        #[arg(long)]
+        out: PathBuf,
+        /// No progress bar.
+        #[arg(long)]
+        quiet: bool,
+    },
     /// Mesh convergence on corpus wells: hook load, torque, the largest side force and the
     /// stabilizer forces as the pipe elements shrink from 30 m to 0.5 m (mesh.csv, mesh.md).
     Mesh {
@@ -677,6 +693,12 @@ fn main() -> ExitCode {
                 Ok(()) => ExitCode::SUCCESS,
                 Err(e) => fail(&[e]),
             },
+            BenchCommand::TendencyCorpus {
+                wells,
+                first_seed,
+                out,
+                quiet,
+            } => print_summary(cli::bench_corpus::tendency(&out, wells, first_seed, !quiet)),
             BenchCommand::Corpus {
                 wells,
                 first_seed,

@@ -42,6 +42,11 @@ use crate::well::{SurveyStation, WellPath};
 /// The curvature of the first secant and difference steps (°/30 m).
 const PROBE: f64 = 0.25;
 
+/// The iterations have settled when a step changes the curvature by less than this
+/// (°/30 m): the resolution rates are reported to (a vertical hole's near-zero side forces
+/// jitter by more than any finer one).
+const SETTLE: f64 = 0.005;
+
 /// Radians per metre to degrees per 30 m.
 pub const RAD_PER_M_TO_DEG_PER_30M: f64 = 30.0 * 180.0 / std::f64::consts::PI;
 
@@ -375,7 +380,7 @@ pub fn tendency(
             break;
         }
         let k = (b.0 - b.1 * (b.0 - a.0) / (b.1 - a.1)).clamp(-limit, limit);
-        if (k - b.0).abs() < 1e-4 / to_rate {
+        if (k - b.0).abs() < SETTLE / to_rate {
             equilibrium = Some(k);
             break;
         }
@@ -468,7 +473,8 @@ pub fn tendency(
         }
         k = next;
         g = gn;
-        if step[0].abs().max(step[1].abs()) < 1e-4 / to_rate || g[0].abs().max(g[1].abs()) < 1e-9 {
+        if step[0].abs().max(step[1].abs()) < SETTLE / to_rate || g[0].abs().max(g[1].abs()) < 1e-9
+        {
             settled = true;
             break;
         }
@@ -481,8 +487,16 @@ pub fn tendency(
             out.turn_rate_deg_per_30m = Some(k[1] * to_rate / sin_i);
         }
     } else {
-        out.notes
-            .push("the build/turn iterations did not settle within ±30°/30 m".into());
+        let inclination = model.nodes[model.nodes.len() - 1].hole_axis[2]
+            .clamp(-1.0, 1.0)
+            .acos();
+        out.notes.push(if inclination < 1f64.to_radians() {
+            "the build/turn iterations did not settle: a near-vertical hole, whose near-zero side \
+             forces jitter more than the rates' resolution"
+                .into()
+        } else {
+            "the build/turn iterations did not settle within ±30°/30 m".into()
+        });
     }
     out
 }

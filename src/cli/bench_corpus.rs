@@ -398,3 +398,136 @@ pub fn mesh(
     print!("{md}");
     Ok(rows)
 }
+
+/// One corpus well's tendency (a row of `tendency_corpus.csv`).
+#[derive(Clone, Debug, Serialize)]
+pub struct TendencyRow {
+    /// Seed.
+    pub seed: u64,
+    /// Trajectory kind.
+    pub trajectory: String,
+    /// Operation.
+    pub mode: String,
+    /// Inclination at the bit (°).
+    pub bit_inclination_deg: f64,
+    /// Stabilizers.
+    pub stabilizers: usize,
+    /// Bend (°).
+    pub bend_deg: f64,
+    /// Weight on bit (N).
+    pub wob_n: f64,
+    /// Whether the build/turn iterations settled (wells with WOB only).
+    pub settled: bool,
+    /// Build rate (°/30 m).
+    pub build_rate_deg_per_30m: f64,
+    /// Turn rate (°/30 m).
+    pub turn_rate_deg_per_30m: f64,
+    /// Equilibrium curvature (°/30 m).
+    pub equilibrium_curvature_deg_per_30m: f64,
+    /// BHA-model solves.
+    pub solves: usize,
+    /// Wall time (s).
+    pub seconds: f64,
+    /// Why not, when not.
+    pub notes: String,
+}
+
+/// `summary.json` of the tendency benchmark.
+#[derive(Clone, Debug, Serialize)]
+pub struct TendencyCorpusSummary {
+    /// Wells drawn.
+    pub wells: usize,
+    /// Wells with weight on bit (the tendency applies).
+    pub with_wob: usize,
+    /// Of those, settled build/turn rates.
+    pub settled: usize,
+    /// Of those, an equilibrium curvature within ±30°/30 m.
+    pub equilibrium_found: usize,
+    /// The unsettled: seed and why.
+    pub unsettled: Vec<(u64, String)>,
+    /// Time per well (s).
+    pub seconds: Spread,
+    /// Build rates (°/30 m): min, median, max over the settled.
+    pub build_rate: (f64, f64, f64),
+    /// Total wall time (s).
+    pub wall_seconds: f64,
+}
+
+/// The tendency ([`crate::bha::tendency::assembly_tendency`]) of `wells` corpus wells from
+/// `first_seed` at their own weight on bit: `tendency_corpus.csv`, `summary.json` in `out`.
+pub fn tendency(
+    out: &Path,
+    wells: usize,
+    first_seed: u64,
+    show_progress: bool,
+) -> Result<TendencyCorpusSummary, Error> {
+    use rayon::prelude::*;
+    let io = |e: String| Error::Io(std::io::Error::other(e));
+    let clock = std::time::Instant::now();
+    let dir = out.join("wells");
+    std::fs::create_dir_all(&dir)?;
+    let bar = crate::output::progress_bar(
+        show_progress,
+        wells as u64,
+        "{bar:40} {pos}/{len} wells, {elapsed} elapsed",
+    );
+    let rows: Result<Vec<TendencyRow>, Error> = (first_seed..first_seed + wells as u64)
+        .into_par_iter()
+        .map(|seed| {
+            let well = crate::corpus::write_well(seed, &dir).map_err(io)?;
+            let case = crate::case::load_case(&well.case_path)?;
+            let m = &case.model;
+            let t0 = std::time::Instant::now();
+            let t = crate::bha::tendency::assembly_tendency(
+                m,
+                case.bha_length,
+                m.weight_on_bit,
+                &case.tendency.settings,
+            );
+            let axis = m.nodes[m.nodes.len() - 1].hole_axis;
+            bar.inc(1);
+            Ok(TendencyRow {
+                seed,
+                trajectory: well.spec.trajectory.name().to_string(),
+                mode: well.spec.mode.clone(),
+                bit_inclination_deg: axis[2].clamp(-1.0, 1.0).acos().to_degrees(),
+                stabilizers: well.spec.stabilizers,
+                bend_deg: well.spec.bend_deg,
+                wob_n: m.weight_on_bit,
+                settled: t.build_rate_deg_per_30m.is_some(),
+                build_rate_deg_per_30m: t.build_rate_deg_per_30m.unwrap_or(f64::NAN),
+                turn_rate_deg_per_30m: t.turn_rate_deg_per_30m.unwrap_or(f64::NAN),
+                equilibrium_curvature_deg_per_30m: t
+                    .equilibrium_curvature_deg_per_30m
+                    .unwrap_or(f64::NAN),
+                solves: t.solves,
+                seconds: t0.elapsed().as_secs_f64(),
+                notes: t.notes.join("; "),
+            })
+        })
+        .collect();
+    bar.finish_and_clear();
+    let rows = rows?;
+    crate::output::write_csv_rows(&out.join("tendency_corpus.csv"), &rows)?;
+    let with_wob: Vec<&TendencyRow> = rows.iter().filter(|r| r.wob_n > 0.0).collect();
+    let summary = TendencyCorpusSummary {
+        wells: rows.len(),
+        with_wob: with_wob.len(),
+        settled: with_wob.iter().filter(|r| r.settled).count(),
+        equilibrium_found: with_wob
+            .iter()
+            .filter(|r| r.equilibrium_curvature_deg_per_30m.is_finite())
+            .count(),
+        unsettled: with_wob
+            .iter()
+            .filter(|r| !r.settled)
+            .map(|r| (r.seed, r.notes.chars().take(300).collect()))
+            .collect(),
+        seconds: spread(&rows.iter().map(|r| (r.seed, r.seconds)).collect::<Vec<_>>()),
+        build_rate: min_med_max(with_wob.iter().map(|r| r.build_rate_deg_per_30m).collect()),
+        wall_seconds: clock.elapsed().as_secs_f64(),
+    };
+    let json = serde_json::to_vec_pretty(&summary).map_err(std::io::Error::other)?;
+    crate::output::write_atomic(&out.join("summary.json"), &json)?;
+    Ok(summary)
+}
