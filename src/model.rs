@@ -402,6 +402,49 @@ impl Model {
         }
         l.max(1e-9)
     }
+    /// The string from node `first` to the bit: its nodes and elements, and the contact
+    /// sites, bends, point loads and imbalance below `first` renumbered; the top clamped
+    /// there (`first = 0`: the whole string, its own top) and the bit held laterally. The
+    /// BHA models of the tendency and the critical speeds start here.
+    pub fn lower_part(&self, first: usize) -> Model {
+        Model {
+            nodes: self.nodes[first..].to_vec(),
+            elements: self.elements[first..].to_vec(),
+            sites: self
+                .sites
+                .iter()
+                .filter(|s| s.node > first)
+                .map(|s| Site {
+                    node: s.node - first,
+                    ..s.clone()
+                })
+                .collect(),
+            top: if first == 0 {
+                self.top
+            } else {
+                TopBoundary::Clamped
+            },
+            bit_lateral_fixed: true,
+            point_loads: self
+                .point_loads
+                .iter()
+                .filter(|(k, _)| *k > first)
+                .map(|(k, f)| (k - first, *f))
+                .collect(),
+            unbalance: self.unbalance.get(first..).map_or(vec![], |u| u.to_vec()),
+            bends: self
+                .bends
+                .iter()
+                .filter(|b| b.node > first)
+                .map(|b| Bend {
+                    node: b.node - first,
+                    ..*b
+                })
+                .collect(),
+            ..self.clone()
+        }
+    }
+
     /// A model of the mesh with no contact sites or loads: top clamped, bit held laterally,
     /// split friction, no operation.
     pub fn bare(nodes: Vec<Node>, elements: Vec<Element>) -> Model {

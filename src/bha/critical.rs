@@ -20,7 +20,7 @@
 use serde::Serialize;
 
 use crate::bha::HoleFrame;
-use crate::model::{Model, TopBoundary};
+use crate::model::Model;
 use crate::physics::mass::MassKind;
 use crate::solve::modal::{mass_matrix_with_added, modes};
 use crate::solve::statics::StaticState;
@@ -79,46 +79,14 @@ pub struct CriticalSpeeds {
     pub dofs: usize,
 }
 
-/// The part of `model` from node `first` to the bit (its top clamped; `first = 0`: the
-/// whole string with its own top) and its piece of `state`.
+/// The part of `model` from node `first` to the bit ([`Model::lower_part`]) and its
+/// piece of `state`.
 pub fn lower_part(model: &Model, state: &StaticState, first: usize) -> (Model, StaticState) {
-    let sites = model
-        .sites
-        .iter()
-        .filter(|s| s.node > first)
-        .map(|s| crate::model::Site {
-            node: s.node - first,
-            ..s.clone()
-        })
-        .collect();
-    let part = Model {
-        nodes: model.nodes[first..].to_vec(),
-        elements: model.elements[first..].to_vec(),
-        sites,
-        top: if first == 0 {
-            model.top
-        } else {
-            TopBoundary::Clamped
-        },
-        bit_lateral_fixed: true,
-        point_loads: vec![],
-        unbalance: vec![],
-        bends: model
-            .bends
-            .iter()
-            .filter(|b| b.node > first)
-            .map(|b| crate::model::Bend {
-                node: b.node - first,
-                ..*b
-            })
-            .collect(),
-        ..model.clone()
-    };
     let st = StaticState {
         x: state.x[first..].to_vec(),
         rot: state.rot[first..].to_vec(),
     };
-    (part, st)
+    (model.lower_part(first), st)
 }
 
 /// The critical speeds of `model`'s lower part from node `first`, about the static

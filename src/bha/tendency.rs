@@ -34,7 +34,7 @@
 use serde::{Deserialize, Serialize};
 
 use crate::bha::{bit_loads_of, BitLoads, HoleFrame};
-use crate::model::{frame_from_axis, transport, Bend, Element, Model, Node, TopBoundary};
+use crate::model::{frame_from_axis, transport, Bend, Element, Model, Node};
 use crate::physics::vec3::{add, dot, scale, sub, Vec3};
 use crate::solve::statics::{solve_static, StaticOptions};
 use crate::well::{SurveyStation, WellPath};
@@ -187,34 +187,15 @@ pub fn bha_model(
             }
         })
         .collect();
-    let sites = model
-        .sites
-        .iter()
-        .filter(|s| s.node > first)
-        .map(|s| crate::model::Site {
-            node: s.node - first,
-            ..s.clone()
-        })
-        .collect();
     let mut sub_model = Model {
         nodes,
         elements,
-        sites,
         weight_on_bit,
         // The toolface of a bend is the one set (as an MWD reads it at the motor): the
         // reactive torque's twist of the string above is not the BHA model's.
         torque_on_bit: 0.0,
-        top: TopBoundary::Clamped,
-        bit_lateral_fixed: true,
-        point_loads: model
-            .point_loads
-            .iter()
-            .filter(|(k, _)| *k > first)
-            .map(|(k, f)| (k - first, *f))
-            .collect(),
         unbalance: vec![],
-        bends: vec![],
-        ..model.clone()
+        ..model.lower_part(first)
     };
     sub_model.bends = model
         .bends
