@@ -514,3 +514,74 @@ fn an_imbalance_swept_through_a_predicted_critical_speed_peaks_there() {
         "{amplitudes:?}"
     );
 }
+
+#[test]
+fn formation_anisotropy_turns_the_bit_towards_the_bedding_normal() {
+    use holewall::bha::tendency::{drilling_angles, TendencySettings};
+    use holewall::bha::{BitLoads, HoleFrame};
+    // A 30° hole towards north (z down): axis (sin 30°, 0, cos 30°), high side
+    // (cos 30°, 0, −sin 30°), right = axis × high.
+    let (s, c) = (30f64.to_radians().sin(), 30f64.to_radians().cos());
+    let frame = HoleFrame {
+        axis: [s, 0.0, c],
+        high: [c, 0.0, -s],
+        right: [0.0, -1.0, 0.0],
+    };
+    let bit = BitLoads::default();
+    let h = 0.1;
+    // Flat bedding (normal vertical): v' = ((1 − h) sin I, 0, (1 + h) cos I), towards the
+    // vertical — a drop of I − atan((1 − h)/(1 + h) tan I).
+    let flat = TendencySettings {
+        formation_anisotropy: h,
+        ..Default::default()
+    };
+    let (dh, dr) = drilling_angles(&bit, 1e5, &frame, &flat);
+    let expected = ((1.0 - h) / (1.0 + h) * (s / c)).atan() - 30f64.to_radians();
+    assert!((dh - expected).abs() < 1e-12 && dr.abs() < 1e-12, "{dh} {expected}");
+    // Bedding dipping 30° towards north: the hole crosses it at right angles, no turn.
+    let across = TendencySettings {
+        dip_deg: 30.0,
+        dip_azimuth_deg: 0.0,
+        ..flat
+    };
+    let (dh, dr) = drilling_angles(&bit, 1e5, &frame, &across);
+    assert!(dh.abs() < 1e-12 && dr.abs() < 1e-12, "{dh} {dr}");
+    // Isotropic: the bit's tilt and side force alone (I_b F/W towards the force).
+    let loaded = BitLoads {
+        high_side_force_n: 2e3,
+        side_force_n: 2e3,
+        tilt_high_side_deg: 0.1,
+        ..Default::default()
+    };
+    let (dh, _) = drilling_angles(&loaded, 1e5, &frame, &TendencySettings::default());
+    let v_high = 0.1f64.to_radians().tan() / 1.0 + 0.05 * 2e3 / 1e5;
+    assert!((dh - v_high.atan2(1.0)).abs() < 1e-6, "{dh}");
+}
+
+#[test]
+fn tendency_table_errors_name_file_line_and_key() {
+    let base = std::fs::read_to_string(
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("cases/build_and_hold.toml"),
+    )
+    .unwrap();
+    for (table, key) in [
+        ("[tendency]\nside_cutting_index = 2.0\n", "tendency.side_cutting_index"),
+        ("[tendency]\ndip = \"95 deg\"\n", "tendency.dip"),
+        ("[tendency]\nfrom_bit = [\"3 m\", \"-1 m\"]\n", "tendency.from_bit"),
+        ("[tendency]\nweight_on_bit = []\n", "tendency.weight_on_bit"),
+        ("[tendency]\nside_cuting_index = 0.1\n", "side_cuting_index"),
+    ] {
+        let text = format!("{base}\n{table}");
+        let e = holewall::case::parse_case(std::path::Path::new("t.toml"), &text).unwrap_err();
+        let shown = e.to_string();
+        assert!(shown.contains(key) && e.line > 0, "{shown}");
+    }
+    let ok = format!(
+        "{base}\n[tendency]\nside_cutting_index = 0.2\nformation_anisotropy = 0.05\ndip = \"10 deg\"\ndip_azimuth = 45\nfrom_bit = [\"2 m\", \"10 m\"]\nweight_on_bit = [\"50 kN\"]\n"
+    );
+    let case = holewall::case::parse_case(std::path::Path::new("t.toml"), &ok).unwrap();
+    assert_eq!(case.tendency.settings.side_cutting_index, 0.2);
+    assert_eq!(case.tendency.from_bit, vec![2.0, 10.0]);
+    assert!((case.tendency.weight_on_bit[0] - 5e4).abs() < 1e-9);
+    assert!((case.tendency.settings.dip_azimuth_deg - 45.0).abs() < 1e-12);
+}
