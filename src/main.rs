@@ -84,6 +84,9 @@ enum Command {
         /// No progress bar.
         #[arg(long)]
         quiet: bool,
+        /// No BHA-model solve runs past this many seconds (the cells cut say so).
+        #[arg(long, value_parser = positive_seconds)]
+        max_seconds: Option<f64>,
     },
     /// Critical rotary speeds: lateral modes of the BHA as it lies in the hole (the static
     /// state's contacts as supports) and the rpm at which 1×, blade pass and backward whirl
@@ -521,9 +524,12 @@ fn main() -> ExitCode {
                 added_mass: !no_added_mass,
             },
         )),
-        Command::Tendency { case, out, quiet } => {
-            print_summary(cli::tendency_cmd::run(&case, &out, !quiet))
-        }
+        Command::Tendency {
+            case,
+            out,
+            quiet,
+            max_seconds,
+        } => print_summary(cli::tendency_cmd::run(&case, &out, !quiet, max_seconds)),
         Command::Run {
             case,
             out,

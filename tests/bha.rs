@@ -537,7 +537,10 @@ fn formation_anisotropy_turns_the_bit_towards_the_bedding_normal() {
     };
     let (dh, dr) = drilling_angles(&bit, 1e5, &frame, &flat);
     let expected = ((1.0 - h) / (1.0 + h) * (s / c)).atan() - 30f64.to_radians();
-    assert!((dh - expected).abs() < 1e-12 && dr.abs() < 1e-12, "{dh} {expected}");
+    assert!(
+        (dh - expected).abs() < 1e-12 && dr.abs() < 1e-12,
+        "{dh} {expected}"
+    );
     // Bedding dipping 30° towards north: the hole crosses it at right angles, no turn.
     let across = TendencySettings {
         dip_deg: 30.0,
@@ -565,9 +568,15 @@ fn tendency_table_errors_name_file_line_and_key() {
     )
     .unwrap();
     for (table, key) in [
-        ("[tendency]\nside_cutting_index = 2.0\n", "tendency.side_cutting_index"),
+        (
+            "[tendency]\nside_cutting_index = 2.0\n",
+            "tendency.side_cutting_index",
+        ),
         ("[tendency]\ndip = \"95 deg\"\n", "tendency.dip"),
-        ("[tendency]\nfrom_bit = [\"3 m\", \"-1 m\"]\n", "tendency.from_bit"),
+        (
+            "[tendency]\nfrom_bit = [\"3 m\", \"-1 m\"]\n",
+            "tendency.from_bit",
+        ),
         ("[tendency]\nweight_on_bit = []\n", "tendency.weight_on_bit"),
         ("[tendency]\nside_cuting_index = 0.1\n", "side_cuting_index"),
     ] {

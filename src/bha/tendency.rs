@@ -63,6 +63,10 @@ pub struct TendencySettings {
     pub dip_azimuth_deg: f64,
     /// Pipe above the BHA in the BHA model, in bending lengths of the pipe.
     pub pipe_bending_lengths: f64,
+    /// No BHA-model solve starts (or runs on) past this instant: the tendency then says
+    /// which part the budget cut (`holewall static --max-seconds`).
+    #[serde(skip)]
+    pub deadline: Option<std::time::Instant>,
 }
 
 impl Default for TendencySettings {
@@ -75,6 +79,7 @@ impl Default for TendencySettings {
             dip_deg: 0.0,
             dip_azimuth_deg: 0.0,
             pipe_bending_lengths: 3.0,
+            deadline: None,
         }
     }
 }
@@ -304,9 +309,24 @@ fn bit_at(
     curvature: (f64, f64),
     wob: f64,
     toolface: Option<f64>,
+    deadline: Option<std::time::Instant>,
 ) -> Result<(BitLoads, HoleFrame), String> {
+    let max_seconds = match deadline {
+        None => None,
+        Some(d) => {
+            let left = d.saturating_duration_since(std::time::Instant::now());
+            if left.is_zero() {
+                return Err("the time budget ran out before this BHA-model solve".into());
+            }
+            Some(left.as_secs_f64())
+        }
+    };
     let m = bha_model(model, first, curvature, wob, toolface);
-    let sol = solve_static(&m, &StaticOptions::default()).map_err(|e| e.to_string())?;
+    let options = StaticOptions {
+        max_seconds,
+        ..StaticOptions::default()
+    };
+    let sol = solve_static(&m, &options).map_err(|e| e.to_string())?;
     let frame = HoleFrame::at_node(&m, m.nodes.len() - 1);
     Ok((bit_loads_of(&m, &sol), frame))
 }
@@ -330,7 +350,7 @@ pub fn tendency(
     };
     let mut solve = |k: (f64, f64)| {
         out.solves += 1;
-        bit_at(model, first, k, wob, toolface)
+        bit_at(model, first, k, wob, toolface, settings.deadline)
     };
     let to_rate = RAD_PER_M_TO_DEG_PER_30M;
     let limit = 30.0 / to_rate;

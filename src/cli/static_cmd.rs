@@ -79,6 +79,7 @@ pub fn run(
     out: &Path,
     options: StaticCommandOptions,
 ) -> Result<Summary, Error> {
+    let start = std::time::Instant::now();
     let case = load_case(case_path)?;
     super::print_warnings(&case);
     let folder = RunFolder::prepare(out)?;
@@ -103,11 +104,21 @@ pub fn run(
             wob = w;
             solver_log = sol.log.clone();
             bit = Some(crate::bha::bit_loads_of(model, &sol));
+            // The tendency's BHA-model solves share the run's time budget.
+            let settings = crate::bha::tendency::TendencySettings {
+                deadline: options
+                    .max_seconds
+                    .map(|s| start + std::time::Duration::from_secs_f64(s)),
+                ..case.tendency.settings
+            };
+            if options.show_progress {
+                eprintln!("holewall: the BHA's tendency (BHA models in curved holes)…");
+            }
             tendency = Some(crate::bha::tendency::assembly_tendency(
                 model,
                 case.bha_length,
                 w,
-                &case.tendency.settings,
+                &settings,
             ));
             (rows, hook, torque, sol.iterations)
         }

@@ -38,16 +38,27 @@ pub struct TendencySummary {
 }
 
 /// Runs the command.
-pub fn run(case_path: &Path, out: &Path, show_progress: bool) -> Result<TendencySummary, Error> {
+/// `max_seconds`: no BHA-model solve runs past this budget; the cells it cuts say so (and
+/// count as unsolved).
+pub fn run(
+    case_path: &Path,
+    out: &Path,
+    show_progress: bool,
+    max_seconds: Option<f64>,
+) -> Result<TendencySummary, Error> {
     let start = std::time::Instant::now();
     let case = load_case(case_path)?;
     super::print_warnings(&case);
     let folder = RunFolder::prepare(out)?;
+    let settings = crate::bha::tendency::TendencySettings {
+        deadline: max_seconds.map(|s| start + std::time::Duration::from_secs_f64(s)),
+        ..case.tendency.settings
+    };
     let own = assembly_tendency(
         &case.model,
         case.bha_length,
         case.model.weight_on_bit,
-        &case.tendency.settings,
+        &settings,
     );
     let (_, xs, wobs) = crate::ensemble::tendency_map::map_grid(&case);
     let bar = crate::output::progress_bar(
@@ -55,7 +66,7 @@ pub fn run(case_path: &Path, out: &Path, show_progress: bool) -> Result<Tendency
         (xs.len() * wobs.len()) as u64,
         "tendency map {bar:40} {pos}/{len} cells, {elapsed} (eta {eta})",
     );
-    let (axis, cells) = tendency_map(&case, &|| bar.inc(1));
+    let (axis, cells) = tendency_map(&case, &settings, &|| bar.inc(1));
     bar.finish_and_clear();
     let dir = folder.path();
     write_csv(&dir.join("tendency_map.csv"), axis, &cells)?;

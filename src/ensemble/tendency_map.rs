@@ -86,13 +86,18 @@ pub fn map_grid(case: &Case) -> (MapAxis, Vec<f64>, Vec<f64>) {
 /// Computes the map (rayon over cells; `progress` is called once per cell done). A cell
 /// whose model cannot be built (a stabilizer position outside the string) carries the
 /// reason in its notes.
-pub fn tendency_map(case: &Case, progress: &(dyn Fn() + Sync)) -> (MapAxis, Vec<MapCell>) {
+/// `settings` is the case's bit–rock model with the run's deadline, if any.
+pub fn tendency_map(
+    case: &Case,
+    settings: &crate::bha::tendency::TendencySettings,
+    progress: &(dyn Fn() + Sync),
+) -> (MapAxis, Vec<MapCell>) {
     let (axis, xs, wobs) = map_grid(case);
     let cells: Vec<(f64, f64)> = xs
         .iter()
         .flat_map(|&x| wobs.iter().map(move |&w| (x, w)))
         .collect();
-    let settings = case.tendency.settings;
+    let settings = *settings;
     let out = cells
         .par_iter()
         .map(|&(x, w)| {
