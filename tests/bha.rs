@@ -594,3 +594,92 @@ fn tendency_table_errors_name_file_line_and_key() {
     assert!((case.tendency.weight_on_bit[0] - 5e4).abs() < 1e-9);
     assert!((case.tendency.settings.dip_azimuth_deg - 45.0).abs() < 1e-12);
 }
+
+#[test]
+fn the_commands_write_the_bha_outputs() {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let case = root.join("cases/build_and_hold.toml");
+    let case = case.to_str().unwrap();
+    // static: the bit and the tendency in summary.json.
+    let out = common::scratch_dir("bha", "static");
+    let (code, stdout, stderr) =
+        common::holewall(&["static", case, "--out", out.to_str().unwrap(), "--quiet"]);
+    assert_eq!(code, 0, "{stderr}");
+    let s: serde_json::Value = serde_json::from_str(&stdout).unwrap();
+    for k in [
+        "side_force_n",
+        "high_side_force_n",
+        "right_side_force_n",
+        "tilt_high_side_deg",
+        "tilt_right_side_deg",
+    ] {
+        assert!(s["bit"][k].is_f64(), "bit.{k}");
+    }
+    // The near-bit stabilizer builds (a fulcrum).
+    assert!(s["bit"]["high_side_force_n"].as_f64().unwrap() > 0.0);
+    for k in [
+        "build_rate_deg_per_30m",
+        "turn_rate_deg_per_30m",
+        "equilibrium_curvature_deg_per_30m",
+    ] {
+        assert!(s["tendency"][k].is_f64(), "tendency.{k}");
+    }
+    // tendency: the map over stab1's position × WOB, every cell solved.
+    let out = common::scratch_dir("bha", "tendency");
+    let (code, stdout, stderr) =
+        common::holewall(&["tendency", case, "--out", out.to_str().unwrap(), "--quiet"]);
+    assert_eq!(code, 0, "{stderr}");
+    let t: serde_json::Value = serde_json::from_str(&stdout).unwrap();
+    assert_eq!(t["map_axis"], "stab1_from_bit");
+    assert_eq!(t["solved"], t["cells"], "{stdout}");
+    for f in [
+        "tendency_map.csv",
+        "tendency_build.png",
+        "tendency_equilibrium.png",
+        "summary.json",
+    ] {
+        assert!(out.join(f).is_file(), "{f}");
+    }
+    let rows = std::fs::read_to_string(out.join("tendency_map.csv")).unwrap();
+    assert_eq!(
+        rows.lines().count(),
+        1 + t["cells"].as_u64().unwrap() as usize
+    );
+    // critical-speeds: modes, critical speeds, the Campbell diagram.
+    let out = common::scratch_dir("bha", "critical");
+    let (code, stdout, stderr) = common::holewall(&[
+        "critical-speeds",
+        case,
+        "--out",
+        out.to_str().unwrap(),
+        "--quiet",
+    ]);
+    assert_eq!(code, 0, "{stderr}");
+    let c: serde_json::Value = serde_json::from_str(&stdout).unwrap();
+    assert!(!c["lateral_frequencies_hz"].as_array().unwrap().is_empty());
+    for f in [
+        "modes.csv",
+        "critical_speeds.csv",
+        "campbell.png",
+        "mode_shapes.png",
+    ] {
+        assert!(out.join(f).is_file(), "{f}");
+    }
+    // A bad [tendency] value: exit 2, the key named.
+    let bad = common::scratch_dir("bha", "bad").join("bad.toml");
+    let text = std::fs::read_to_string(root.join("cases/build_and_hold.toml")).unwrap();
+    std::fs::write(
+        &bad,
+        format!("{text}\n[tendency]\nformation_anisotropy = 0.9\n"),
+    )
+    .unwrap();
+    let out = common::scratch_dir("bha", "badout");
+    let (code, _, stderr) = common::holewall(&[
+        "tendency",
+        bad.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 2);
+    assert!(stderr.contains("tendency.formation_anisotropy"), "{stderr}");
+}
