@@ -47,7 +47,15 @@ pub enum Param {
 }
 
 /// The operation modes a `mode` key takes, by code (its value is the index).
-pub const MODES: [&str; 4] = ["rotating", "tripping_in", "tripping_out", "sliding"];
+/// (Codes are stable: new modes are appended.)
+pub const MODES: [&str; 6] = [
+    "rotating",
+    "tripping_in",
+    "tripping_out",
+    "sliding",
+    "reaming",
+    "back_reaming",
+];
 
 /// A parsed column key.
 #[derive(Clone, Debug, PartialEq)]

@@ -339,6 +339,26 @@ pub fn parse_case(path: &Path, text: &str) -> Result<Case, InputError> {
         rotation_speed,
     } = read_operation(&ctx, &spec)?;
     let (settings, friction, all_nodes) = read_contact(&ctx, &spec)?;
+    // Reaming and back-reaming move the pipe along and around the hole at once: the
+    // friction is split by the velocity's direction (the coupled model) unless the case
+    // says otherwise — the split model (the paper's) charges full friction both ways.
+    let both_ways = axial_speed != 0.0 && rotation_speed != 0.0;
+    let friction = match friction {
+        Some(f) => {
+            if both_ways && f == FrictionModel::Split {
+                warnings.push(
+                    "contact.friction_model = \"split\" with a mode that moves the pipe along \
+                     and around the hole at once (reaming, back-reaming): each direction takes \
+                     full friction, up to √2 × the coupled model's; \"coupled\" splits it by \
+                     the velocity's direction"
+                        .to_string(),
+                );
+            }
+            f
+        }
+        None if both_ways => FrictionModel::Coupled,
+        None => FrictionModel::Split,
+    };
     let (nodes, elements) = mesh_string(&well, &tubulars, bit_md, mud);
     let n = nodes.len();
     let mut model = Model {

@@ -291,21 +291,28 @@ pub(super) fn read_operation(ctx: &Ctx, spec: &CaseSpec) -> Result<Operation, In
             "give either weight_on_bit (top clamped) or hook_load (bit on bottom), not both",
         ));
     }
-    match (op.mode.get_ref().as_str(), &op.rpm) {
-        ("rotating", None) => {
+    let mode = op.mode.get_ref().as_str();
+    let rotates = matches!(mode, "rotating" | "reaming" | "back_reaming");
+    match (mode, &op.rpm) {
+        (_, None) if rotates => {
             return Err(ctx.err(
                 op.mode.span(),
                 "operation.rpm",
-                "mode = \"rotating\" needs the rotary speed: add rpm = \"90 rpm\" (or the \
-                 value you rotate at) to [operation]",
+                format!(
+                    "mode = {mode:?} needs the rotary speed: add rpm = \"90 rpm\" (or the \
+                     value you rotate at) to [operation]"
+                ),
             ))
         }
-        ("rotating", Some(q)) if rpm == 0.0 => {
+        (_, Some(q)) if rotates && rpm == 0.0 => {
             return Err(ctx.err(
                 q.span(),
                 "operation.rpm",
-                "mode = \"rotating\" at 0 rpm has no rotation, hence no torque: give the \
-                 rotary speed (> 0), or mode = \"sliding\" / \"tripping_in\" / \"tripping_out\"",
+                format!(
+                    "mode = {mode:?} at 0 rpm has no rotation, hence no torque: give the \
+                     rotary speed (> 0), or mode = \"sliding\" / \"tripping_in\" / \
+                     \"tripping_out\""
+                ),
             ))
         }
         ("tripping_in" | "tripping_out" | "sliding", Some(q)) if rpm != 0.0 => {
@@ -321,17 +328,22 @@ pub(super) fn read_operation(ctx: &Ctx, spec: &CaseSpec) -> Result<Operation, In
         }
         _ => {}
     }
-    let (axial_speed, rotation_speed) = match op.mode.get_ref().as_str() {
+    // Reaming (running in while rotating) and back-reaming (pulling out while rotating):
+    // both speeds, the friction split by the velocity's direction at each contact.
+    let (axial_speed, rotation_speed) = match mode {
         "rotating" => (0.0, rpm),
         "tripping_in" => (speed, 0.0),
         "tripping_out" => (-speed, 0.0),
         "sliding" => (speed, 0.0),
+        "reaming" => (speed, rpm),
+        "back_reaming" => (-speed, rpm),
         other => {
             return Err(ctx.err(
                 op.mode.span(),
                 "operation.mode",
                 format!(
-                    "unknown mode {other:?}; allowed: rotating, tripping_in, tripping_out, sliding"
+                    "unknown mode {other:?}; allowed: {}",
+                    crate::keys::MODES.join(", ")
                 ),
             ))
         }
@@ -350,7 +362,7 @@ pub(super) fn read_operation(ctx: &Ctx, spec: &CaseSpec) -> Result<Operation, In
 pub(super) fn read_contact(
     ctx: &Ctx,
     spec: &CaseSpec,
-) -> Result<(ContactSettings, FrictionModel, bool), InputError> {
+) -> Result<(ContactSettings, Option<FrictionModel>, bool), InputError> {
     // Contact.
     let cs = spec.contact.clone();
     let q_or = |q: Option<Q>,
@@ -403,11 +415,12 @@ pub(super) fn read_contact(
             "> 0",
         )?,
     };
+    // `None`: not given (the case chooses by its operation).
     let friction = match cs.as_ref().and_then(|c| c.friction_model.clone()) {
-        None => FrictionModel::Split,
+        None => None,
         Some(s) => match s.get_ref().as_str() {
-            "split" => FrictionModel::Split,
-            "coupled" => FrictionModel::Coupled,
+            "split" => Some(FrictionModel::Split),
+            "coupled" => Some(FrictionModel::Coupled),
             other => {
                 return Err(ctx.err(
                     s.span(),

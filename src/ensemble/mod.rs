@@ -401,9 +401,10 @@ pub fn variant_case(case: &Case, variant: &Variant) -> Result<Option<Case>, Stri
     if let Some(m) = mode {
         let mut op = section(&mut table, "operation")?;
         // The variant chooses the operation: a tripping or sliding variant does not rotate
-        // (the case's rpm belongs to its rotating variants), and a rotating one rotates at
-        // the variant's rpm where it gives one (applied again with the other overrides).
-        if m == "rotating" {
+        // (the case's rpm belongs to its rotating variants), and a rotating, reaming or
+        // back-reaming one rotates at the variant's rpm where it gives one (applied again
+        // with the other overrides).
+        if matches!(m.as_str(), "rotating" | "reaming" | "back_reaming") {
             if let Some((_, rpm)) = variant
                 .overrides
                 .iter()

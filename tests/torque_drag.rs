@@ -1,0 +1,113 @@
+//! Torque and drag as drilling engineers use it (issue 26): reaming and back-reaming
+//! (running in / pulling out while rotating), their loads between tripping and rotating off
+//! bottom, the FE against the soft string.
+
+mod common;
+
+/// `cases/build_and_hold.toml` off bottom (no WOB, no TOB) in `mode`, `extra` added to
+/// `[operation]` (rpm, axial speed).
+fn off_bottom(mode: &str, extra: &str) -> holewall::case::Case {
+    let text = std::fs::read_to_string(
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("cases/build_and_hold.toml"),
+    )
+    .unwrap();
+    let start = text.find("[operation]").unwrap();
+    let end = start + text[start..].find("\n\n").unwrap();
+    let op = format!("[operation]\nmode = \"{mode}\"\n{extra}");
+    let text = format!("{}{}{}", &text[..start], op, &text[end..]);
+    holewall::case::parse_case(std::path::Path::new("off_bottom.toml"), &text).unwrap()
+}
+
+/// (FE hook load, FE surface torque, soft-string hook load, soft-string torque).
+fn loads(case: &holewall::case::Case) -> (f64, f64, f64, f64) {
+    let sol = holewall::solve::statics::solve_static(&case.model, &Default::default())
+        .expect("the FE solve");
+    let (_, hook, torque, _) = holewall::profile::fe_rows(&case.model, &sol);
+    let soft = case.soft_string();
+    (hook, torque, soft.hook_load(), soft.surface_torque())
+}
+
+#[test]
+fn reaming_and_back_reaming_sit_between_tripping_and_rotating() {
+    let speed = "axial_speed = \"0.1 m/s\"\n";
+    let rpm = "rpm = \"60 rpm\"\n";
+    let trip_in = loads(&off_bottom("tripping_in", speed));
+    let trip_out = loads(&off_bottom("tripping_out", speed));
+    let rotating = loads(&off_bottom("rotating", rpm));
+    let reaming = loads(&off_bottom("reaming", &format!("{speed}{rpm}")));
+    let back = loads(&off_bottom("back_reaming", &format!("{speed}{rpm}")));
+    for (name, l) in [
+        ("tripping in", trip_in),
+        ("tripping out", trip_out),
+        ("rotating", rotating),
+        ("reaming", reaming),
+        ("back-reaming", back),
+    ] {
+        println!(
+            "{name}: hook load FE {:.1} kN / soft string {:.1} kN, torque FE {:.2} kN·m / soft string {:.2} kN·m",
+            l.0 / 1e3,
+            l.2 / 1e3,
+            l.1 / 1e3,
+            l.3 / 1e3
+        );
+    }
+    // Hook load: pulling out > back-reaming > rotating > reaming > running in (the friction
+    // along the axis shrinks as the rotation takes the velocity's direction), in both
+    // models.
+    for k in [0, 2] {
+        let h = |l: (f64, f64, f64, f64)| if k == 0 { l.0 } else { l.2 };
+        assert!(h(trip_out) > h(back) && h(back) > h(rotating), "{k}");
+        assert!(h(rotating) > h(reaming) && h(reaming) > h(trip_in), "{k}");
+    }
+    // Torque: below rotating off bottom (part of the friction goes along the axis), above 0.
+    for l in [reaming, back] {
+        assert!(l.1 > 0.0 && l.1 < rotating.1);
+        assert!(l.3 > 0.0 && l.3 < rotating.3);
+        // FE and soft string agree as they do rotating and tripping (docs/validation.md).
+        assert!((l.0 / l.2 - 1.0).abs() < 0.03, "hook {} vs {}", l.0, l.2);
+        assert!((l.1 / l.3 - 1.0).abs() < 0.06, "torque {} vs {}", l.1, l.3);
+    }
+    // The split follows the velocity's direction: with v_axial = 0.1 m/s and the pipe's
+    // surface speed ω r ≈ 0.2 m/s, the axial share is 0.1/√(0.1² + (ωr)²).
+    let r = 0.5 * 0.127;
+    let surface = 60.0 / 60.0 * std::f64::consts::TAU * r;
+    let share = 0.1 / (0.1f64 * 0.1 + surface * surface).sqrt();
+    let drag_reaming = rotating.2 - reaming.2;
+    let drag_in = rotating.2 - trip_in.2;
+    println!("soft string: reaming drag / tripping-in drag {:.3}, axial share of the velocity {share:.3}", drag_reaming / drag_in);
+    assert!((drag_reaming / drag_in - share).abs() < 0.1 * share);
+}
+
+#[test]
+fn reaming_needs_the_rotary_speed() {
+    let text = std::fs::read_to_string(
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("cases/build_and_hold.toml"),
+    )
+    .unwrap();
+    let bad = text.replacen("mode = \"rotating\"", "mode = \"reaming\"", 1);
+    let bad = bad.replacen("rpm = \"120 rpm\"", "", 1);
+    let e = holewall::case::parse_case(std::path::Path::new("r.toml"), &bad).unwrap_err();
+    assert!(e.to_string().contains("operation.rpm"), "{e}");
+    // Reaming takes the coupled friction unless told; told split, it warns.
+    let reaming = text.replacen("mode = \"rotating\"", "mode = \"reaming\"", 1);
+    let case = holewall::case::parse_case(std::path::Path::new("r.toml"), &reaming).unwrap();
+    assert_eq!(
+        case.model.friction,
+        holewall::physics::contact::FrictionModel::Coupled
+    );
+    assert!(case.warnings.is_empty());
+    let split = reaming.replacen("[contact]", "[contact]\nfriction_model = \"split\"", 1);
+    let case = holewall::case::parse_case(std::path::Path::new("r.toml"), &split).unwrap();
+    assert_eq!(
+        case.model.friction,
+        holewall::physics::contact::FrictionModel::Split
+    );
+    assert!(
+        case.warnings.iter().any(|w| w.contains("coupled")),
+        "{:?}",
+        case.warnings
+    );
+    let unknown = text.replacen("mode = \"rotating\"", "mode = \"washing\"", 1);
+    let e = holewall::case::parse_case(std::path::Path::new("r.toml"), &unknown).unwrap_err();
+    assert!(e.to_string().contains("back_reaming"), "{e}");
+}
