@@ -111,3 +111,56 @@ fn reaming_needs_the_rotary_speed() {
     let e = holewall::case::parse_case(std::path::Path::new("r.toml"), &unknown).unwrap_err();
     assert!(e.to_string().contains("back_reaming"), "{e}");
 }
+
+#[test]
+fn an_ensemble_mixing_reaming_and_rotating_runs_each_with_its_friction() {
+    // The engine serves one friction model; a grid of rotating (split) and reaming
+    // (coupled) variants goes to the CPU, saying why, with the results of single runs.
+    let text = std::fs::read_to_string(
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("cases/build_and_hold.toml"),
+    )
+    .unwrap();
+    let text = text.replacen(
+        "rpm = \"120 rpm\"",
+        "rpm = \"120 rpm\"\naxial_speed = \"0.1 m/s\"",
+        1,
+    );
+    let text = format!("{text}\n[ensemble]\n[ensemble.grid]\nmode = [\"rotating\", \"reaming\"]\n");
+    let dir = common::scratch_dir("torque_drag", "mixed");
+    let path = dir.join("mixed.toml");
+    std::fs::write(&path, &text).unwrap();
+    let out = dir.join("out");
+    let (code, _, stderr) = common::holewall(&[
+        "ensemble",
+        path.to_str().unwrap(),
+        "--backend",
+        "gpu",
+        "--out",
+        out.to_str().unwrap(),
+        "--quiet",
+    ]);
+    if code != 0 && stderr.contains("no GPU adapter") {
+        eprintln!("NO GPU ADAPTER: the engine half of this test did not run");
+        return;
+    }
+    assert_eq!(code, 0, "{stderr}");
+    let hooks = common::variants_column(&out, "hook_load_n");
+    let case = holewall::case::load_case(&path).unwrap();
+    for (k, mode) in ["rotating", "reaming"].iter().enumerate() {
+        let single = off_bottom_like(&case, mode);
+        assert!(
+            (hooks[k] / single - 1.0).abs() < 1e-9,
+            "{mode}: {} vs {single}",
+            hooks[k]
+        );
+    }
+}
+
+/// The case's hook load solved alone in `mode` (its own friction model by default).
+fn off_bottom_like(case: &holewall::case::Case, mode: &str) -> f64 {
+    let text = std::fs::read_to_string(&case.path).unwrap();
+    let text = text.replacen("mode = \"rotating\"", &format!("mode = \"{mode}\""), 1);
+    let c = holewall::case::parse_case(&case.path, &text).unwrap();
+    let sol = holewall::solve::statics::solve_static(&c.model, &Default::default()).unwrap();
+    holewall::profile::fe_rows(&c.model, &sol).1
+}

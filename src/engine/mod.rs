@@ -484,7 +484,8 @@ pub struct EngineResult {
     pub log: Vec<String>,
 }
 
-/// An error unless every model shares the first one's mesh and number of sites.
+/// An error unless every model shares the first one's mesh, number of sites and friction
+/// model.
 pub(crate) fn check_same_mesh(models: &[Model]) -> Result<(), String> {
     let base = models.first().ok_or("no variants")?;
     for m in models {
@@ -493,6 +494,14 @@ pub(crate) fn check_same_mesh(models: &[Model]) -> Result<(), String> {
             || m.sites.len() != base.sites.len()
         {
             return Err("variants differ in mesh or number of sites; run them on the CPU".into());
+        }
+        // One contact kernel serves the ensemble: one friction model.
+        if m.friction != base.friction {
+            return Err(
+                "variants differ in friction model (split, coupled: e.g. reaming \
+                        beside rotating); run them on the CPU"
+                    .into(),
+            );
         }
     }
     Ok(())

@@ -36,6 +36,9 @@ pub fn run_static_gpu<T: crate::gpu::contact::GpuReal>(
             "the variants differ in their mesh or number of contact sites".into(),
         ));
     }
+    if let Err(e) = crate::engine::check_same_mesh(&models) {
+        return Ok(Err(e));
+    }
     let results = solve_static_ensemble_with_progress::<T, _>(
         &models,
         &GpuPath(ctx),
@@ -95,6 +98,9 @@ pub fn run_dynamic_gpu<T: crate::gpu::contact::GpuReal>(
         return Ok(Err(
             "the variants differ in their mesh or number of contact sites".into(),
         ));
+    }
+    if let Err(e) = crate::engine::check_same_mesh(&models) {
+        return Ok(Err(e));
     }
     let path = GpuPath(ctx);
     let statics = solve_static_ensemble::<T, _>(&models, &path, &StaticOptions::default())
