@@ -57,6 +57,18 @@ pub const MODES: [&str; 6] = [
     "back_reaming",
 ];
 
+/// The hole sections a contact-law key is limited to (`mu.cased`, `mu.open`, `mu.hole2`):
+/// the sites whose node lies in them (issue 26: friction factors per section).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum HoleSelect {
+    /// Sections marked `cased = true`.
+    Cased,
+    /// The other sections.
+    Open,
+    /// The `[[hole]]` section of this number (1 = the first written, from the surface).
+    Section(usize),
+}
+
 /// A parsed column key.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Key {
@@ -66,10 +78,12 @@ pub struct Key {
     pub param: Param,
     /// Stabilizer (1 = nearest the bit), or every site.
     pub stabilizer: Option<usize>,
+    /// Hole sections (contact-law keys only), or every site.
+    pub hole: Option<HoleSelect>,
 }
 
 /// Every key form, for messages.
-pub const KEY_FORMS: &str = "mu, mu_t, mu_l, k_e, c, m, eps (each optionally .stabK), rpm, wob, tob, stabK.blade, stabK.from_bit, depth, mode, layout, ecc, bend";
+pub const KEY_FORMS: &str = "mu, mu_t, mu_l, k_e, c, m, eps (each optionally .stabK, .cased, .open or .holeN), rpm, wob, tob, stabK.blade, stabK.from_bit, depth, mode, layout, ecc, bend";
 
 impl Key {
     /// Parses a column key.
@@ -83,6 +97,16 @@ impl Key {
         let (head, tail) = match name.split_once('.') {
             Some((h, t)) => (h, Some(t)),
             None => (name, None),
+        };
+        // `.cased`, `.open`, `.holeN` (N ≥ 1).
+        let hole_select = |t: &str| match t {
+            "cased" => Some(HoleSelect::Cased),
+            "open" => Some(HoleSelect::Open),
+            _ => t
+                .strip_prefix("hole")
+                .and_then(|k| k.parse::<usize>().ok())
+                .filter(|&k| k >= 1)
+                .map(HoleSelect::Section),
         };
         let law = |p: &str| match p {
             "mu" => Some(Param::Mu),
@@ -104,6 +128,14 @@ impl Key {
             ("ecc", None) => (Param::Eccentricity, None),
             ("bend", None) => (Param::Bend, None),
             (h, None) if law(h).is_some() => (law(h).unwrap_or(Param::Mu), None),
+            (h, Some(t)) if law(h).is_some() && hole_select(t).is_some() => {
+                return Ok(Key {
+                    name: name.to_string(),
+                    param: law(h).unwrap_or(Param::Mu),
+                    stabilizer: None,
+                    hole: hole_select(t),
+                });
+            }
             (h, Some(t)) if law(h).is_some() => (law(h).unwrap_or(Param::Mu), Some(stab_index(t)?)),
             (h, Some("blade")) => (Param::Blade, Some(stab_index(h)?)),
             (h, Some("from_bit")) => (Param::FromBit, Some(stab_index(h)?)),
@@ -113,6 +145,7 @@ impl Key {
             name: name.to_string(),
             param,
             stabilizer,
+            hole: None,
         })
     }
 

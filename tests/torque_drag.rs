@@ -164,3 +164,60 @@ fn off_bottom_like(case: &holewall::case::Case, mode: &str) -> f64 {
     let sol = holewall::solve::statics::solve_static(&c.model, &Default::default()).unwrap();
     holewall::profile::fe_rows(&c.model, &sol).1
 }
+
+#[test]
+fn friction_per_hole_section_as_variant_keys() {
+    use holewall::ensemble::{apply, Key, Variant};
+    // build_and_hold: 9⅝ in casing to 500 m (μ 0.2), 8½ in open hole below (μ 0.3).
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("cases/build_and_hold.toml");
+    let case = holewall::case::load_case(&path).unwrap();
+    let variant = Variant {
+        name: "v".into(),
+        overrides: vec![
+            (Key::parse("mu.cased").unwrap(), 0.1),
+            (Key::parse("mu.open").unwrap(), 0.45),
+        ],
+    };
+    let m = apply(&case, &variant).unwrap();
+    for s in &m.sites {
+        let md = m.nodes[s.node].md;
+        let want = if md <= 500.0 + 1e-9 { 0.1 } else { 0.45 };
+        assert_eq!((s.params.mu_t, s.params.mu_l), (want, want), "MD {md}");
+    }
+    // The same as the case written with those friction factors.
+    let text = std::fs::read_to_string(&path).unwrap();
+    let edited = text
+        .replacen("friction = 0.2", "friction = 0.1", 1)
+        .replacen("friction = 0.3", "friction = 0.45", 1);
+    let written = holewall::case::parse_case(&path, &edited).unwrap();
+    let hook = |m: &holewall::model::Model| {
+        let sol = holewall::solve::statics::solve_static(m, &Default::default()).unwrap();
+        holewall::profile::fe_rows(m, &sol).1
+    };
+    let (a, b) = (hook(&m), hook(&written.model));
+    assert!((a / b - 1.0).abs() < 1e-12, "{a} vs {b}");
+    // By section number: hole2 is the open hole here; a third section does not exist.
+    let v2 = Variant {
+        name: "v2".into(),
+        overrides: vec![(Key::parse("mu_l.hole2").unwrap(), 0.05)],
+    };
+    let m2 = apply(&case, &v2).unwrap();
+    assert!(m2
+        .sites
+        .iter()
+        .all(|s| (m2.nodes[s.node].md > 500.0) == (s.params.mu_l == 0.05)));
+    let v3 = Variant {
+        name: "v3".into(),
+        overrides: vec![(Key::parse("mu.hole3").unwrap(), 0.2)],
+    };
+    let e = apply(&case, &v3).unwrap_err();
+    assert!(
+        e.contains("mu.hole3") && e.contains("2 [[hole]] sections"),
+        "{e}"
+    );
+    // Malformed section keys are refused with the key forms.
+    for bad in ["mu.hole0", "mu.casing", "wob.cased"] {
+        let e = Key::parse(bad).unwrap_err();
+        assert!(e.contains(".cased"), "{bad}: {e}");
+    }
+}

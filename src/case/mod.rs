@@ -68,17 +68,22 @@ pub struct HoleSection {
     pub diameter: f64,
     /// Friction coefficient against the string.
     pub friction: f64,
+    /// Cased (`[[hole]] cased = true`) or open hole.
+    pub cased: bool,
 }
 
 /// The one lookup of a hole section: the section holding `md` (a section includes its
 /// bottom); below the last section, the last. `hole` is a case's, never empty (the parser
 /// requires a section).
 pub fn hole_section_at(hole: &[HoleSection], md: f64) -> HoleSection {
-    *hole
-        .iter()
-        .find(|h| md <= h.bottom_md + 1e-9)
-        .or(hole.last())
-        .expect("a case has at least one [[hole]] section")
+    hole[hole_section_index(hole, md)]
+}
+
+/// The index in `hole` of the section holding `md` ([`hole_section_at`]).
+pub fn hole_section_index(hole: &[HoleSection], md: f64) -> usize {
+    hole.iter()
+        .position(|h| md <= h.bottom_md + 1e-9)
+        .unwrap_or(hole.len().saturating_sub(1))
 }
 
 impl DynamicsSettings {

@@ -483,6 +483,7 @@ pub(super) fn read_hole(
             bottom_md: bottom,
             diameter: d,
             friction: mu,
+            cased: h.cased,
         });
         previous = bottom;
     }

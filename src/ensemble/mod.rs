@@ -286,9 +286,10 @@ pub fn apply(case: &Case, variant: &Variant) -> Result<Model, String> {
     }
     for (key, value) in &variant.overrides {
         let v = *value;
-        let sites: Vec<usize> = match key.stabilizer {
-            Some(k) => vec![stab(k)?],
-            None => (0..model.sites.len()).collect(),
+        let sites: Vec<usize> = match (key.stabilizer, key.hole) {
+            (Some(k), _) => vec![stab(k)?],
+            (None, Some(select)) => sites_in_sections(case, &model, select, &key.name)?,
+            (None, None) => (0..model.sites.len()).collect(),
         };
         match key.param {
             Param::FromBit | Param::Depth | Param::Mode | Param::Layout => {}
@@ -359,6 +360,41 @@ pub fn apply(case: &Case, variant: &Variant) -> Result<Model, String> {
     }
     model.sites.sort_by_key(|s| s.node);
     Ok(model)
+}
+
+/// The sites of `model` whose node lies in the hole sections `select` names (a section
+/// holds its bottom: [`crate::case::hole_section_index`]); an error when the case has no such
+/// section.
+fn sites_in_sections(
+    case: &Case,
+    model: &Model,
+    select: crate::keys::HoleSelect,
+    key: &str,
+) -> Result<Vec<usize>, String> {
+    use crate::keys::HoleSelect;
+    let in_section = |md: f64| -> bool {
+        let k = crate::case::hole_section_index(&case.hole, md);
+        match select {
+            HoleSelect::Cased => case.hole[k].cased,
+            HoleSelect::Open => !case.hole[k].cased,
+            HoleSelect::Section(n) => k + 1 == n,
+        }
+    };
+    let exists = match select {
+        HoleSelect::Cased => case.hole.iter().any(|h| h.cased),
+        HoleSelect::Open => case.hole.iter().any(|h| !h.cased),
+        HoleSelect::Section(n) => n <= case.hole.len(),
+    };
+    if !exists {
+        return Err(format!(
+            "{key}: the case has no such hole section ({} [[hole]] sections, {} cased)",
+            case.hole.len(),
+            case.hole.iter().filter(|h| h.cased).count()
+        ));
+    }
+    Ok((0..model.sites.len())
+        .filter(|&k| in_section(model.nodes[model.sites[k].node].md))
+        .collect())
 }
 
 fn bit_md_of_model(model: &Model) -> f64 {
