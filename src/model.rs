@@ -240,6 +240,21 @@ pub fn mesh_string(
     bit_md: f64,
     mud_density: f64,
 ) -> (Vec<Node>, Vec<Element>) {
+    mesh_string_two_fluids(well, tubulars_from_bit, bit_md, mud_density, mud_density)
+}
+
+/// [`mesh_string`] with one fluid in the annulus (`outside`, kg/m³) and another inside the
+/// string (`inside`): the buoyed weight per length from the two columns,
+/// `g (ρ_s A_s + ρ_i A_i − ρ_o A_o)` (`A_i`, `A_o` the bore's and the outer diameter's areas;
+/// Lubinski's effective force then carries the two pressures). Equal fluids give
+/// `ρ_s A_s g (1 − ρ/ρ_s)`.
+pub fn mesh_string_two_fluids(
+    well: &WellPath,
+    tubulars_from_bit: &[Tubular],
+    bit_md: f64,
+    outside: f64,
+    inside: f64,
+) -> (Vec<Node>, Vec<Element>) {
     // MD breakpoints from the top down.
     let mut pieces: Vec<(usize, f64, f64)> = Vec::new(); // (component, top md, bottom md)
     let mut bottom = bit_md;
@@ -300,7 +315,12 @@ pub fn mesh_string(
                 section,
                 length0: l0,
                 frame0: frame_from_axis(&scale(&d, 1.0 / l0)),
-                buoyed_weight_per_length: air * (1.0 - mud_density / t.density),
+                buoyed_weight_per_length: {
+                    let quarter_pi = std::f64::consts::FRAC_PI_4;
+                    let bore = quarter_pi * t.inner_diameter * t.inner_diameter;
+                    let outer = quarter_pi * t.outer_diameter * t.outer_diameter;
+                    air + GRAVITY * (inside * bore - outside * outer)
+                },
                 air_weight_per_length: air,
                 outer_diameter: t.outer_diameter,
                 component: k,

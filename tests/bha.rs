@@ -408,6 +408,7 @@ fn critical_speed_of_a_pinned_collar_span_is_euler_bernoulli_with_axial_load() {
             blades: 3,
             modes: 2,
             mud_density: 0.0,
+            mud_inside_density: 0.0,
         };
         let cs = critical_speeds(&m, &sol.state, 0, &|_| rho, &options);
         let k = std::f64::consts::PI / l;
@@ -457,6 +458,7 @@ fn an_imbalance_swept_through_a_predicted_critical_speed_peaks_there() {
         blades: 3,
         modes: 6,
         mud_density: 0.0,
+        mud_inside_density: 0.0,
     };
     let cs = critical_speeds(m0, &st.state, first, &|i| case.element_density[i], &options);
     let mode = cs

@@ -221,3 +221,75 @@ fn friction_per_hole_section_as_variant_keys() {
         assert!(e.contains(".cased"), "{bad}: {e}");
     }
 }
+
+#[test]
+fn two_fluid_columns_buoy_the_string_by_their_own_densities() {
+    // 1,000 m vertical: 900 m of 5 in × 4.276 in pipe on 100 m of 6½ × 2 13/16 in collars,
+    // frictionless, off bottom: the hook load is the string's weight in the two fluids,
+    // g Σ L (ρ_s A_s + ρ_i A_i − ρ_o A_o) — a heavy pill inside (1.8 sg) against 1.2 sg
+    // outside weighs more than 1.2 sg throughout.
+    let case = |inside: &str| {
+        let text = format!(
+            r#"title = "two fluids"
+[well]
+profile = "vertical"
+total_md = "1000 m"
+[[hole]]
+bottom_md = "1000 m"
+diameter = "8.5 in"
+friction = 0.0
+[mud]
+density = "1.2 sg"
+{inside}
+[[string]]
+kind = "collar"
+length = "100 m"
+od = "6.5 in"
+id = "2.8125 in"
+[[string]]
+kind = "drill_pipe"
+length = "900 m"
+od = "5 in"
+id = "4.276 in"
+[operation]
+mode = "tripping_out"
+"#
+        );
+        holewall::case::parse_case(std::path::Path::new("two.toml"), &text).unwrap()
+    };
+    let g = holewall::model::GRAVITY;
+    let area = |od: f64, id: f64| std::f64::consts::FRAC_PI_4 * (od * od - id * id);
+    let weight = |rho_i: f64, rho_o: f64| {
+        let part = |l: f64, od: f64, id: f64| {
+            let (bore, outer) = (
+                std::f64::consts::FRAC_PI_4 * id * id,
+                std::f64::consts::FRAC_PI_4 * od * od,
+            );
+            g * l * (7850.0 * area(od, id) + rho_i * bore - rho_o * outer)
+        };
+        part(100.0, 0.1651, 0.0714375) + part(900.0, 0.127, 0.1086104)
+    };
+    for (inside, rho_i) in [("", 1200.0), ("inside_density = \"1.8 sg\"", 1800.0)] {
+        let c = case(inside);
+        let expected = weight(rho_i, 1200.0);
+        let sol = holewall::solve::statics::solve_static(&c.model, &Default::default()).unwrap();
+        let fe = holewall::profile::fe_rows(&c.model, &sol).1;
+        let soft = c.soft_string().hook_load();
+        println!(
+            "inside {rho_i}: FE {fe:.1} N, soft string {soft:.1} N, closed form {expected:.1} N"
+        );
+        assert!((fe / expected - 1.0).abs() < 1e-6, "FE {fe} vs {expected}");
+        assert!(
+            (soft / expected - 1.0).abs() < 1e-6,
+            "soft {soft} vs {expected}"
+        );
+    }
+    // A bare number in the wrong unit is caught like mud.density.
+    let text = std::fs::read_to_string(
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("cases/build_and_hold.toml"),
+    )
+    .unwrap();
+    let bad = text.replacen("[mud]\n", "[mud]\ninside_density = \"12 sg\"\n", 1);
+    let e = holewall::case::parse_case(std::path::Path::new("b.toml"), &bad).unwrap_err();
+    assert!(e.to_string().contains("mud.inside_density"), "{e}");
+}

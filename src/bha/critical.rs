@@ -34,9 +34,11 @@ pub struct CriticalOptions {
     pub blades: usize,
     /// Lateral modes reported (the lowest).
     pub modes: usize,
-    /// Mud density (kg/m³) for the added mass; 0: none (as the dynamics, which carries
-    /// no added mass).
+    /// Mud density (kg/m³) in the annulus for the added mass; 0: none (as the dynamics,
+    /// which carries no added mass).
     pub mud_density: f64,
+    /// Density of the fluid inside the string (kg/m³) for the added mass.
+    pub mud_inside_density: f64,
 }
 
 /// One lateral mode.
@@ -99,12 +101,11 @@ pub fn critical_speeds(
     options: &CriticalOptions,
 ) -> CriticalSpeeds {
     let (part, st) = lower_part(model, state, first);
-    let rho = options.mud_density;
     let added = |i: usize| {
         let e = &part.elements[i];
         let outer = std::f64::consts::FRAC_PI_4 * e.outer_diameter * e.outer_diameter;
         let inner = (outer - e.section.area).max(0.0);
-        rho * (inner + outer)
+        options.mud_inside_density * inner + options.mud_density * outer
     };
     let mass = mass_matrix_with_added(
         &part,

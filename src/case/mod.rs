@@ -10,7 +10,7 @@ use serde::Deserialize;
 use toml::Spanned;
 
 use crate::error::InputError;
-use crate::model::{add_sites, mesh_string, ContactSettings, Model, TopBoundary, Tubular};
+use crate::model::{add_sites, ContactSettings, Model, TopBoundary, Tubular};
 use crate::physics::contact::FrictionModel;
 use crate::units::{parse_angle_deg, parse_quantity, Dimension};
 use crate::well::{SurveyStation, WellPath};
@@ -43,8 +43,11 @@ pub struct Case {
     pub bit_md: f64,
     /// Length of the BHA (m): the components from the bit up to the first drill pipe.
     pub bha_length: f64,
-    /// Mud density (kg/m³).
+    /// Mud density (kg/m³): the annulus's.
     pub mud_density: f64,
+    /// Density of the fluid inside the string (kg/m³; `mud.inside_density`, else the
+    /// annulus's).
+    pub mud_inside_density: f64,
     /// Steel density per element (kg/m³).
     pub element_density: Vec<f64>,
     /// `[dynamics]`, if given.
@@ -281,6 +284,26 @@ pub fn parse_case(path: &Path, text: &str) -> Result<Case, InputError> {
     if let Some(m) = crate::units::fluid_density_trap(mud, &written) {
         return Err(ctx.err(spec.mud.density.span(), "mud.density", m));
     }
+    let mud_inside = match &spec.mud.inside_density {
+        None => mud,
+        Some(q) => {
+            let v = ctx.quantity(
+                q,
+                "mud.inside_density",
+                Dimension::Density,
+                |x| x >= 0.0,
+                "0 (empty) or 0.5 … 3.0 sg",
+            )?;
+            let written = match q.get_ref() {
+                Quantity::Text(t) => t.clone(),
+                Quantity::Number(x) => crate::units::show(*x),
+            };
+            if let Some(m) = crate::units::fluid_density_trap(v, &written) {
+                return Err(ctx.err(q.span(), "mud.inside_density", m));
+            }
+            v
+        }
+    };
     let mesh = spec.mesh.clone();
     let el_pipe = match mesh.as_ref().and_then(|m| m.element_length.clone()) {
         Some(q) => ctx.quantity(
@@ -364,7 +387,8 @@ pub fn parse_case(path: &Path, text: &str) -> Result<Case, InputError> {
         None if both_ways => FrictionModel::Coupled,
         None => FrictionModel::Split,
     };
-    let (nodes, elements) = mesh_string(&well, &tubulars, bit_md, mud);
+    let (nodes, elements) =
+        crate::model::mesh_string_two_fluids(&well, &tubulars, bit_md, mud, mud_inside);
     let n = nodes.len();
     let mut model = Model {
         nodes,
@@ -516,6 +540,7 @@ pub fn parse_case(path: &Path, text: &str) -> Result<Case, InputError> {
         bit_md,
         bha_length,
         mud_density: mud,
+        mud_inside_density: mud_inside,
         element_density,
         dynamics,
         warnings,

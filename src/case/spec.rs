@@ -58,8 +58,11 @@ pub struct HoleSpec {
 #[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct MudSpec {
-    /// Mud density.
+    /// Mud density (the annulus, and inside the string unless `inside_density` is given).
     pub density: Q,
+    /// Density of the fluid inside the string, when it differs from the annulus's (a heavy
+    /// pill, a displacement; issue 26): buoyancy from the two columns.
+    pub inside_density: Option<Q>,
 }
 
 /// `[[string]]`: one component, listed from the bit up.

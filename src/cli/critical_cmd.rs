@@ -71,6 +71,11 @@ pub fn run(
         } else {
             0.0
         },
+        mud_inside_density: if options.added_mass {
+            case.mud_inside_density
+        } else {
+            0.0
+        },
     };
     let cs = critical_speeds(
         model,
