@@ -54,8 +54,12 @@ pub enum AutoRule {
 
 impl Backend {
     /// Resolves `--backend` for a run at `precision`. `auto` falls back to the CPU, with a
-    /// one-line notice on stderr, when no adapter exists or it cannot run `precision`.
-    pub fn resolve(choice: BackendChoice, precision: Precision) -> Result<Backend, GpuError> {
+    /// one-line notice (returned: the caller shows it), when no adapter exists or it cannot
+    /// run `precision`.
+    pub fn resolve(
+        choice: BackendChoice,
+        precision: Precision,
+    ) -> Result<(Backend, Option<String>), GpuError> {
         Backend::resolve_with(
             choice,
             precision,
@@ -67,16 +71,17 @@ impl Backend {
     /// The one backend policy: `choice` at `precision` for a computation whose CPU path
     /// computes in `cpu_precisions`, `auto` by `rule`. `auto` at a precision only the GPU
     /// computes needs an adapter that has it (an error otherwise); else it falls back to
-    /// the CPU with a one-line notice.
+    /// the CPU with a one-line notice, returned beside the backend (the library prints
+    /// nothing: the command or the run's summary shows it).
     pub fn resolve_with(
         choice: BackendChoice,
         precision: Precision,
         cpu_precisions: &[Precision],
         rule: AutoRule,
-    ) -> Result<Backend, GpuError> {
+    ) -> Result<(Backend, Option<String>), GpuError> {
         let gpu_can = |ctx: &GpuContext| precision == Precision::F32 || ctx.has_f64;
         match choice {
-            BackendChoice::Cpu => Ok(Backend::Cpu),
+            BackendChoice::Cpu => Ok((Backend::Cpu, None)),
             BackendChoice::Gpu => {
                 let ctx = GpuContext::shared()?;
                 if !gpu_can(ctx) {
@@ -85,7 +90,7 @@ impl Backend {
                         ctx.info.name
                     )));
                 }
-                Ok(Backend::Gpu(ctx))
+                Ok((Backend::Gpu(ctx), None))
             }
             BackendChoice::Auto if !cpu_precisions.contains(&precision) => {
                 // Only the GPU computes at this precision, whatever the adapter.
@@ -96,31 +101,31 @@ impl Backend {
                         ctx.info.name
                     )));
                 }
-                Ok(Backend::Gpu(ctx))
+                Ok((Backend::Gpu(ctx), None))
             }
             BackendChoice::Auto => match GpuContext::shared() {
                 Ok(ctx)
                     if rule == AutoRule::FasterPath
                         && ctx.info.device_type == wgpu::DeviceType::Cpu =>
                 {
-                    eprintln!(
-                        "holewall: the only adapter ({}) is a software renderer; using the CPU backend, which is faster there",
+                    Ok((
+                        Backend::Cpu,
+                        Some(format!(
+                            "the only adapter ({}) is a software renderer; using the CPU \
+                             backend, which is faster there",
+                            ctx.info.name
+                        )),
+                    ))
+                }
+                Ok(ctx) if gpu_can(ctx) => Ok((Backend::Gpu(ctx), None)),
+                Ok(ctx) => Ok((
+                    Backend::Cpu,
+                    Some(format!(
+                        "adapter {} has no SHADER_F64; using the CPU backend",
                         ctx.info.name
-                    );
-                    Ok(Backend::Cpu)
-                }
-                Ok(ctx) if gpu_can(ctx) => Ok(Backend::Gpu(ctx)),
-                Ok(ctx) => {
-                    eprintln!(
-                        "holewall: adapter {} has no SHADER_F64; using the CPU backend",
-                        ctx.info.name
-                    );
-                    Ok(Backend::Cpu)
-                }
-                Err(e) => {
-                    eprintln!("holewall: {e}; using the CPU backend");
-                    Ok(Backend::Cpu)
-                }
+                    )),
+                )),
+                Err(e) => Ok((Backend::Cpu, Some(format!("{e}; using the CPU backend")))),
             },
         }
     }

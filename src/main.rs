@@ -480,7 +480,12 @@ fn main() -> ExitCode {
                 );
             }
             let backend = match Backend::resolve(backend, precision) {
-                Ok(b) => b,
+                Ok((b, note)) => {
+                    if let Some(n) = note {
+                        eprintln!("holewall: {n}");
+                    }
+                    b
+                }
                 Err(e) => return fail(&[e.into()]),
             };
             let stdout = std::io::stdout();

@@ -261,7 +261,7 @@ pub fn precision(
         &[Precision::F64],
         crate::backend::AutoRule::AnyAdapter,
     ) {
-        Ok(Backend::Gpu(ctx)) => Some(ctx),
+        Ok((Backend::Gpu(ctx), _)) => Some(ctx),
         _ => None,
     };
     let mut notes = Vec::new();

@@ -68,8 +68,13 @@ pub fn contact(
     let gpu = match backend {
         BackendChoice::Cpu => None,
         other => match Backend::resolve(other, Precision::F32)? {
-            Backend::Gpu(ctx) => Some(ctx),
-            Backend::Cpu => None,
+            (Backend::Gpu(ctx), _) => Some(ctx),
+            (Backend::Cpu, note) => {
+                if let Some(n) = note {
+                    eprintln!("holewall: {n}");
+                }
+                None
+            }
         },
     };
     if let Some(ctx) = gpu {
@@ -679,8 +684,13 @@ pub fn specialisation(pairs: usize, repeats: usize, json: Option<&Path>) -> Resu
         ),
     ];
     let gpu = match Backend::resolve(BackendChoice::Auto, Precision::F32)? {
-        Backend::Gpu(ctx) => Some(ctx),
-        Backend::Cpu => None,
+        (Backend::Gpu(ctx), _) => Some(ctx),
+        (Backend::Cpu, note) => {
+            if let Some(n) = note {
+                eprintln!("holewall: {n}");
+            }
+            None
+        }
     };
     let mut rows = Vec::new();
     for (scene, mode, friction) in scenes {

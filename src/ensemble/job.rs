@@ -121,12 +121,13 @@ pub fn run(
     // The GPU engine, where asked for (or, with auto, where a hardware adapter has f64).
     // The GPU engine where asked for; `auto` takes it on a hardware adapter (the CPU
     // backend computes in f64 only, so f32 always runs on the engine).
-    let gpu = match crate::backend::Backend::resolve_with(
+    let (resolved, resolve_note) = crate::backend::Backend::resolve_with(
         backend,
         precision,
         &[Precision::F64],
         crate::backend::AutoRule::FasterPath,
-    )? {
+    )?;
+    let gpu = match resolved {
         crate::backend::Backend::Gpu(ctx) => Some(ctx),
         crate::backend::Backend::Cpu => None,
     };
@@ -270,7 +271,8 @@ pub fn run(
     // Every chunk, read back (so a resumed or merged run has exactly these bits).
     let mut results = Vec::with_capacity(variants.len());
     let mut backend_name = "cpu";
-    let mut backend_notes: Vec<String> = Vec::new();
+    // Why `auto` chose the CPU, then the chunks' own notes.
+    let mut backend_notes: Vec<String> = resolve_note.into_iter().collect();
     let mut seconds = 0.0;
     for c in 0..nchunks {
         let chunk = read_chunk(&chunk_path(out, c))?;
