@@ -15,7 +15,7 @@ use crate::solve::statics::StaticError;
 /// diameter `hole_diameter`.
 pub fn critical_loads(model: &Model, e: usize, hole_diameter: f64) -> (f64, f64) {
     let el = &model.elements[e];
-    let r = 0.5 * (hole_diameter - el.outer_diameter);
+    let r = 0.5 * (hole_diameter - el.contact_diameter);
     let ei = el.section.bending_stiffness();
     let w = el.buoyed_weight_per_length.max(0.0);
     let t = model.nodes[e].hole_axis;

@@ -42,8 +42,12 @@ pub struct Element {
     pub buoyed_weight_per_length: f64,
     /// Air weight per length (N/m).
     pub air_weight_per_length: f64,
-    /// Outer diameter (m), for stresses and the soft-string torque arm.
+    /// Outer diameter of the body (m), for stresses and buoyancy.
     pub outer_diameter: f64,
+    /// Diameter where the element touches the wall (m): its tool joints' OD (issue 26), or
+    /// the body's — the soft string's torque arm, the buckling clearance, a joint node's
+    /// contact disk.
+    pub contact_diameter: f64,
     /// Index of the string component the element belongs to.
     pub component: usize,
 }
@@ -323,6 +327,7 @@ pub fn mesh_string_two_fluids(
                 },
                 air_weight_per_length: air,
                 outer_diameter: t.outer_diameter,
+                contact_diameter: t.outer_diameter,
                 component: k,
             }
         })
@@ -572,14 +577,15 @@ impl Model {
         self.unbalance.iter().any(|u| u.iter().any(|x| *x != 0.0))
     }
 
-    /// Outer radius of the pipe at node `i` (largest of its elements).
+    /// Outer radius of the pipe at node `i` (largest of its elements' contact diameters:
+    /// a tool joint's where the string has them at its nodes).
     pub fn pipe_radius_at(&self, i: usize) -> f64 {
         let mut r: f64 = 0.0;
         if i > 0 {
-            r = r.max(0.5 * self.elements[i - 1].outer_diameter);
+            r = r.max(0.5 * self.elements[i - 1].contact_diameter);
         }
         if i < self.elements.len() {
-            r = r.max(0.5 * self.elements[i].outer_diameter);
+            r = r.max(0.5 * self.elements[i].contact_diameter);
         }
         r
     }

@@ -293,3 +293,124 @@ mode = "tripping_out"
     let e = holewall::case::parse_case(std::path::Path::new("b.toml"), &bad).unwrap_err();
     assert!(e.to_string().contains("mud.inside_density"), "{e}");
 }
+
+/// A straight 30° hole of 2,000 m from the surface (8½ in, μ 0.25), 5 in × 4.276 in drill pipe to the
+/// surface from the bit, rotating off bottom at 60 rpm; `joints` adds to the pipe.
+fn straight_pipe(joints: &str, element: &str) -> holewall::case::Case {
+    let text = format!(
+        r#"title = "straight pipe"
+[[hole]]
+bottom_md = "2000 m"
+diameter = "8.5 in"
+friction = 0.25
+[well]
+profile = "survey"
+total_md = "2000 m"
+survey = "straight.csv"
+[mud]
+density = "1.2 sg"
+[[string]]
+kind = "drill_pipe"
+length = "2000 m"
+od = "5 in"
+id = "4.276 in"
+{joints}
+[operation]
+mode = "rotating"
+rpm = "60 rpm"
+[contact]
+sites = "all_nodes"
+[mesh]
+element_length = "{element}"
+"#
+    );
+    let dir = common::scratch_dir("torque_drag", "straight");
+    std::fs::write(
+        dir.join("straight.csv"),
+        "md,inclination,azimuth\n0,30,0\n2000,30,0\n",
+    )
+    .unwrap();
+    holewall::case::parse_case(&dir.join("straight.toml"), &text).unwrap()
+}
+
+#[test]
+fn tool_joints_carry_the_contact_and_the_torque_arm() {
+    let joints = "tool_joint_od = \"6.625 in\"\ntool_joint_length = \"0.45 m\"";
+    let body = straight_pipe("", "9.144 m");
+    let tj = straight_pipe(joints, "10 m");
+    // A node at every joint (2000 m in 219 joints of 9.13 m), each a contact site of the
+    // joint's diameter.
+    let m = &tj.model;
+    assert_eq!(m.elements.len(), 219);
+    assert!(m
+        .sites
+        .iter()
+        .all(|s| (2.0 * s.params.disk_radius - 0.168275).abs() < 1e-9));
+    // The joints' steel: π/4 (6⅝² − 5²) in² × 0.45/9.144 of the body's length, buoyed.
+    let e = &m.elements[0];
+    let extra =
+        std::f64::consts::FRAC_PI_4 * (0.168275f64.powi(2) - 0.127f64.powi(2)) * (0.45 / 9.144);
+    let w_body = body.model.elements[0].buoyed_weight_per_length;
+    let expected_w = w_body + holewall::model::GRAVITY * (7850.0 - 1200.0) * extra;
+    assert!((e.buoyed_weight_per_length / expected_w - 1.0).abs() < 1e-12);
+    // Rotating off bottom in a straight hole: torque = μ w sin I L r (the soft string exactly;
+    // the arm is the joint's radius). The FE's rotating pipe climbs the wall until friction
+    // and the normal force balance the weight, N = w sin I / √(1 + μ²): its torque is that
+    // much lower, within 2 % (the lift-off at the clamped top and the held bit).
+    for (case, r) in [(&body, 0.0635), (&tj, 0.5 * 0.168275)] {
+        let w = case.model.elements[0].buoyed_weight_per_length;
+        let closed = 0.25 * w * 0.5 * 2000.0 * r;
+        let soft = case.soft_string().surface_torque();
+        let sol = holewall::solve::statics::solve_static(&case.model, &Default::default()).unwrap();
+        let fe = holewall::profile::fe_rows(&case.model, &sol).2;
+        println!(
+            "arm {r} m: torque closed form {closed:.1}, soft string {soft:.1}, FE {fe:.1} N·m"
+        );
+        assert!(
+            (soft / closed - 1.0).abs() < 1e-3,
+            "soft {soft} vs {closed}"
+        );
+        let climbing = closed / (1.0f64 + 0.25 * 0.25).sqrt();
+        assert!((fe / climbing - 1.0).abs() < 0.02, "FE {fe} vs {climbing}");
+    }
+    // Finer than a joint: body nodes between the joints touch with the body's radius.
+    let fine = straight_pipe(joints, "3 m");
+    let m = &fine.model;
+    assert_eq!(m.elements.len(), 219 * 3);
+    let radii: Vec<f64> = m.sites.iter().map(|s| 2.0 * s.params.disk_radius).collect();
+    let at_joints = radii
+        .iter()
+        .filter(|d| (**d - 0.168275).abs() < 1e-9)
+        .count();
+    assert_eq!(at_joints, 219, "{at_joints}");
+    assert_eq!(
+        radii.iter().filter(|d| (**d - 0.127).abs() < 1e-9).count(),
+        219 * 2
+    );
+}
+
+#[test]
+fn tool_joint_keys_are_checked() {
+    let cases = [
+        ("tool_joint_od = \"4.5 in\"", "string.tool_joint_od"),
+        ("tool_joint_od = \"9 in\"", "string.tool_joint_od"),
+        ("joint_spacing = \"9 m\"", "string.joint_spacing"),
+        (
+            "tool_joint_od = \"6.625 in\"\njoint_spacing = \"40 m\"",
+            "string.joint_spacing",
+        ),
+    ];
+    for (keys, key) in cases {
+        let text = std::fs::read_to_string(
+            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("cases/build_and_hold.toml"),
+        )
+        .unwrap();
+        let text = text.replacen(
+            "kind = \"drill_pipe\"",
+            &format!("kind = \"drill_pipe\"\n{keys}"),
+            1,
+        );
+        let e = holewall::case::parse_case(std::path::Path::new("tj.toml"), &text).unwrap_err();
+        assert!(e.to_string().contains(key) && e.line > 0, "{e}");
+    }
+}

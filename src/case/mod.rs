@@ -329,6 +329,7 @@ pub fn parse_case(path: &Path, text: &str) -> Result<Case, InputError> {
     let StringRead {
         tubulars,
         blades,
+        tool_joints,
         eccentricities,
         bends,
     } = read_string(&ctx, &spec, &hole, bit_md, (el_pipe, el_bha))?;
@@ -387,9 +388,39 @@ pub fn parse_case(path: &Path, text: &str) -> Result<Case, InputError> {
         None if both_ways => FrictionModel::Coupled,
         None => FrictionModel::Split,
     };
-    let (nodes, elements) =
+    let (nodes, mut elements) =
         crate::model::mesh_string_two_fluids(&well, &tubulars, bit_md, mud, mud_inside);
     let n = nodes.len();
+    // Tool joints: the contact diameter, and the joints' steel (beyond the body's OD, over
+    // their share of a joint) in the weight, buoyed by the annulus.
+    for e in elements.iter_mut() {
+        if let Some((tj, tj_length, spacing)) = tool_joints[e.component] {
+            let extra = std::f64::consts::FRAC_PI_4
+                * (tj * tj - e.outer_diameter * e.outer_diameter)
+                * (tj_length / spacing);
+            let rho = tubulars[e.component].density;
+            e.contact_diameter = tj;
+            e.air_weight_per_length += crate::model::GRAVITY * rho * extra;
+            e.buoyed_weight_per_length += crate::model::GRAVITY * (rho - mud) * extra;
+        }
+    }
+    // The joints' nodes (a component with joints meshed finer than a joint has body nodes
+    // between them): MD of every joint from each such component's bottom.
+    let joint_node = |md: f64| -> bool {
+        let mut bottom = bit_md;
+        for (t, j) in tubulars.iter().zip(&tool_joints) {
+            let top = bottom - t.length;
+            if md <= bottom + 1e-9 && md >= top - 1e-9 {
+                if let Some((_, _, spacing)) = j {
+                    let joints = (t.length / spacing).round().max(1.0);
+                    let x = (bottom - md) / (t.length / joints);
+                    return (x - x.round()).abs() < 1e-6;
+                }
+            }
+            bottom = top;
+        }
+        true
+    };
     let mut model = Model {
         nodes,
         elements,
@@ -440,7 +471,17 @@ pub fn parse_case(path: &Path, text: &str) -> Result<Case, InputError> {
         let others: Vec<usize> = (1..n)
             .filter(|i| !stab_nodes.iter().any(|(s, _)| s == i))
             .collect();
-        let radii: Vec<f64> = (0..n).map(|i| model.pipe_radius_at(i)).collect();
+        // A body node between two joints touches with the body's radius.
+        let radii: Vec<f64> = (0..n)
+            .map(|i| {
+                if joint_node(model.nodes[i].md) {
+                    model.pipe_radius_at(i)
+                } else {
+                    let body = |e: usize| 0.5 * model.elements[e].outer_diameter;
+                    body(i.min(model.elements.len() - 1)).max(body(i.saturating_sub(1)))
+                }
+            })
+            .collect();
         add_sites(
             &mut model,
             &others,

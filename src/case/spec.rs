@@ -79,6 +79,14 @@ pub struct ComponentSpec {
     pub id: Q,
     /// Stabilizer blade diameter (makes the component a contact site).
     pub blade_diameter: Option<Q>,
+    /// Tool joints' outer diameter (drill pipe, HWDP; issue 26): the joints are where the
+    /// pipe touches the wall — the component is meshed a node per joint, each a contact site
+    /// of this diameter (with `contact.sites = "all_nodes"`), the soft string's torque arm.
+    pub tool_joint_od: Option<Q>,
+    /// Length of a tool joint (box and pin; default 0.45 m): its steel adds to the weight.
+    pub tool_joint_length: Option<Q>,
+    /// Distance between tool joints (one joint of pipe; default 30 ft = 9.144 m).
+    pub joint_spacing: Option<Q>,
     /// Young's modulus (default 207 GPa).
     pub youngs_modulus: Option<Q>,
     /// Poisson ratio (default 0.3).

@@ -8,6 +8,8 @@ use super::*;
 pub(super) struct StringRead {
     pub(super) tubulars: Vec<Tubular>,
     pub(super) blades: Vec<Option<f64>>,
+    /// Per component: tool joints (OD, length, spacing; m).
+    pub(super) tool_joints: Vec<Option<(f64, f64, f64)>>,
     pub(super) eccentricities: Vec<f64>,
     pub(super) bends: Vec<(f64, f64, f64, std::ops::Range<usize>)>,
 }
@@ -35,6 +37,7 @@ pub(super) fn read_string(
     }
     let mut tubulars = Vec::new();
     let mut blades = Vec::new();
+    let mut tool_joints = Vec::new();
     let mut eccentricities: Vec<f64> = Vec::new();
     let mut bends = Vec::new();
     for c in &spec.string {
@@ -177,6 +180,62 @@ pub(super) fn read_string(
             ));
         }
         let bha = kind != "drill_pipe";
+        let mut element_length = if bha { el_bha } else { el_pipe };
+        let joint = match &c.tool_joint_od {
+            None => {
+                for (k, v) in [
+                    ("string.tool_joint_length", &c.tool_joint_length),
+                    ("string.joint_spacing", &c.joint_spacing),
+                ] {
+                    if let Some(v) = v {
+                        return Err(ctx.err(v.span(), k, "needs string.tool_joint_od"));
+                    }
+                }
+                None
+            }
+            Some(q) => {
+                let md_here = bit_md - tubulars.iter().map(|t: &Tubular| t.length).sum::<f64>();
+                let hole_d = hole_at(md_here).diameter;
+                let tj = ctx.quantity(
+                    q,
+                    "string.tool_joint_od",
+                    Dimension::Length,
+                    |x| x > od && x < hole_d,
+                    &format!(
+                        "od ({} m) < tool_joint_od < hole diameter ({} m)",
+                        crate::units::show(od),
+                        crate::units::show(hole_d)
+                    ),
+                )?;
+                let tj_length = match &c.tool_joint_length {
+                    Some(q) => ctx.quantity(
+                        q,
+                        "string.tool_joint_length",
+                        Dimension::Length,
+                        |x| x > 0.0 && x <= 2.0,
+                        "0 < tool_joint_length ≤ 2 m",
+                    )?,
+                    None => 0.45,
+                };
+                let spacing = match &c.joint_spacing {
+                    Some(q) => ctx.quantity(
+                        q,
+                        "string.joint_spacing",
+                        Dimension::Length,
+                        |x| (3.0..=15.0).contains(&x) && x > tj_length,
+                        "3 … 15 m (one joint of pipe), longer than the tool joint",
+                    )?,
+                    None => 9.144,
+                };
+                // A node at every joint: the component in whole joints, each in as many
+                // elements as the mesh length asks (the last joint takes what is left).
+                let joints = (length / spacing).round().max(1.0);
+                let per_joint = (spacing / element_length).round().max(1.0);
+                element_length = length / (joints * per_joint) * (1.0 + 1e-12);
+                Some((tj, tj_length, spacing))
+            }
+        };
+        tool_joints.push(joint);
         blades.push(blade);
         tubulars.push(Tubular {
             name: kind,
@@ -186,7 +245,7 @@ pub(super) fn read_string(
             youngs_modulus: e,
             poisson_ratio: nu,
             density: rho,
-            element_length: if bha { el_bha } else { el_pipe },
+            element_length,
         });
     }
     let string_length: f64 = tubulars.iter().map(|t| t.length).sum();
@@ -197,6 +256,7 @@ pub(super) fn read_string(
     Ok(StringRead {
         tubulars,
         blades,
+        tool_joints,
         eccentricities,
         bends,
     })

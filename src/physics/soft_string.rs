@@ -84,7 +84,8 @@ pub fn soft_string_with(
         let lateral = add(&scale(&sub(&t2, &t1), f), &scale(&g_perp, weight));
         let normal = dot(&lateral, &lateral).sqrt();
         side_force[i] = normal;
-        let radius = 0.5 * e.outer_diameter;
+        // The torque arm: where the string touches the wall (tool joints where it has them).
+        let radius = 0.5 * e.contact_diameter;
         let (axial_share, torque_share) = {
             let a = -op.axial_speed;
             let c = op.rotation_speed * radius;
