@@ -414,3 +414,60 @@ fn tool_joint_keys_are_checked() {
         assert!(e.to_string().contains(key) && e.line > 0, "{e}");
     }
 }
+
+#[test]
+fn the_tool_joint_broomstick_orders_its_modes() {
+    // cases/broomstick_tool_joints.toml: 6 depths × 5 modes × 3 open-hole friction factors,
+    // every variant converged; at every depth and friction the hook load runs tripping out
+    // > back-reaming > rotating > reaming > tripping in.
+    let case = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/cases/broomstick_tool_joints.toml"
+    );
+    let out = common::scratch_dir("torque_drag", "broomstick");
+    let (code, _, stderr) = common::holewall(&[
+        "ensemble",
+        case,
+        "--backend",
+        "cpu",
+        "--out",
+        out.to_str().unwrap(),
+        "--quiet",
+    ]);
+    assert_eq!(code, 0, "{stderr}");
+    let text = std::fs::read_to_string(out.join("variants.csv")).unwrap();
+    let mut rows = csv::Reader::from_reader(text.as_bytes());
+    let header = rows.headers().unwrap().clone();
+    let col = |name: &str| header.iter().position(|h| h == name).unwrap();
+    let (depth, mode, mu, status, hook) = (
+        col("depth"),
+        col("mode"),
+        col("mu.open"),
+        col("status"),
+        col("hook_load_n"),
+    );
+    let mut loads = std::collections::BTreeMap::new();
+    for r in rows.records() {
+        let r = r.unwrap();
+        assert_eq!(&r[status], "converged");
+        loads.insert(
+            (r[depth].to_string(), r[mu].to_string(), r[mode].to_string()),
+            r[hook].parse::<f64>().unwrap(),
+        );
+    }
+    assert_eq!(loads.len(), 90);
+    let order = [
+        "tripping_out",
+        "back_reaming",
+        "rotating",
+        "reaming",
+        "tripping_in",
+    ];
+    for ((d, m, _), _) in loads.iter().filter(|((_, _, mode), _)| mode == "rotating") {
+        let h: Vec<f64> = order
+            .iter()
+            .map(|o| loads[&(d.clone(), m.clone(), o.to_string())])
+            .collect();
+        assert!(h.windows(2).all(|w| w[0] > w[1]), "depth {d}, μ {m}: {h:?}");
+    }
+}
