@@ -28,6 +28,7 @@ pub mod profile;
 pub mod run;
 pub mod selfcheck;
 pub mod solve;
+pub mod strength;
 pub mod study;
 pub mod units;
 pub mod uq;

@@ -41,6 +41,13 @@ pub struct ProfileRow {
     pub lateral_displacement_m: f64,
     /// In contact with the wall.
     pub in_contact: bool,
+    /// Von Mises stress at the outer fibre (Pa; [`crate::strength`]), on components with a
+    /// grade; empty otherwise.
+    #[serde(with = "crate::output::nan_as_null")]
+    pub von_mises_pa: f64,
+    /// That over the grade's yield strength.
+    #[serde(with = "crate::output::nan_as_null")]
+    pub yield_utilisation: f64,
 }
 
 /// Neutral point: the first MD, going up from the bit, where the axial force turns from
@@ -112,6 +119,8 @@ pub fn fe_rows(
             let t = model.nodes[i].hole_axis;
             let d_t = sub(&d, &scale(&t, dot(&d, &t)));
             ProfileRow {
+                von_mises_pa: f64::NAN,
+                yield_utilisation: f64::NAN,
                 md_m: model.nodes[i].md,
                 x_m: sol.state.x[i][0],
                 y_m: sol.state.x[i][1],

@@ -90,7 +90,7 @@ fn paper_cases_run_end_to_end_with_both_models() {
             hooks.push(summary["hook_load_n"].as_f64().unwrap());
             let csv = std::fs::read_to_string(out.join("profile.csv")).unwrap();
             let header = csv.lines().next().unwrap();
-            assert_eq!(header, "md_m,x_m,y_m,z_m,axial_force_n,axial_stress_pa,torque_nm,bending_moment_nm,side_force_n,side_force_per_length_n_per_m,lateral_displacement_m,in_contact");
+            assert_eq!(header, "md_m,x_m,y_m,z_m,axial_force_n,axial_stress_pa,torque_nm,bending_moment_nm,side_force_n,side_force_per_length_n_per_m,lateral_displacement_m,in_contact,von_mises_pa,yield_utilisation");
             assert!(csv.lines().count() > 100);
         }
         // Vertical well: both models give buoyed weight − WOB.

@@ -471,3 +471,95 @@ fn the_tool_joint_broomstick_orders_its_modes() {
         assert!(h.windows(2).all(|w| w[0] > w[1]), "depth {d}, μ {m}: {h:?}");
     }
 }
+
+#[test]
+fn pipe_strength_matches_api_rp_7g_tables() {
+    use holewall::strength::{PipeStrength, GRADES};
+    // 5 in 19.50 lb/ft drill pipe (ID 4.276 in), G-105: API RP 7G's tables give a tensile
+    // yield of 553,833 lbf new and 436,150 lbf premium (80 % wall), a torsional yield of
+    // 57,633 ft·lbf new (E-75: 41,167).
+    let (lbf, ftlbf, inch) = (4.448_221_615, 1.355_817_948, 0.0254);
+    let grade = |name: &str| GRADES.iter().find(|g| g.0 == name).unwrap().1;
+    let new = PipeStrength::new("G105", grade("G105"), 1.0, 5.0 * inch, 4.276 * inch);
+    let premium = PipeStrength::new("G105", grade("G105"), 0.8, 5.0 * inch, 4.276 * inch);
+    let e75 = PipeStrength::new("E75", grade("E75"), 1.0, 5.0 * inch, 4.276 * inch);
+    let rel = |a: f64, b: f64| (a / b - 1.0).abs();
+    assert!(
+        rel(new.tensile_yield_n() / lbf, 553_833.0) < 1e-3,
+        "{}",
+        new.tensile_yield_n() / lbf
+    );
+    assert!(
+        rel(premium.tensile_yield_n() / lbf, 436_150.0) < 1e-3,
+        "{}",
+        premium.tensile_yield_n() / lbf
+    );
+    assert!(
+        rel(new.torque_limit_nm(0.0) / ftlbf, 57_633.0) < 2e-3,
+        "{}",
+        new.torque_limit_nm(0.0) / ftlbf
+    );
+    assert!(rel(e75.torque_limit_nm(0.0) / ftlbf, 41_167.0) < 2e-3);
+    // The envelope closes at the tensile yield; von Mises of pure tension is F/A.
+    assert_eq!(new.torque_limit_nm(new.tensile_yield_n()), 0.0);
+    let (area, _, _) = new.section();
+    assert!(rel(new.von_mises_pa(1e6, 0.0, 0.0), 1e6 / area) < 1e-12);
+    // At the torque limit under tension P, von Mises equals the yield.
+    let p = 0.5 * new.tensile_yield_n();
+    let q = new.torque_limit_nm(p);
+    assert!(rel(new.von_mises_pa(p, 0.0, q), new.yield_pa) < 1e-12);
+}
+
+#[test]
+fn static_reports_the_strength_of_graded_pipe() {
+    let text = std::fs::read_to_string(
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("cases/build_and_hold.toml"),
+    )
+    .unwrap();
+    let graded = text.replacen(
+        "kind = \"drill_pipe\"",
+        "kind = \"drill_pipe\"\ngrade = \"G105\"\nwear = \"premium\"",
+        1,
+    );
+    let dir = common::scratch_dir("torque_drag", "strength");
+    let path = dir.join("graded.toml");
+    std::fs::write(&path, graded).unwrap();
+    let out = dir.join("out");
+    let (code, stdout, stderr) = common::holewall(&[
+        "static",
+        path.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--quiet",
+    ]);
+    assert_eq!(code, 0, "{stderr}");
+    let s: serde_json::Value = serde_json::from_str(&stdout).unwrap();
+    let st = &s["strength"];
+    let u = st["max_utilisation"].as_f64().unwrap();
+    let hook = s["hook_load_n"].as_f64().unwrap();
+    let yield_n = st["top_tensile_yield_n"].as_f64().unwrap();
+    println!("{st}");
+    // The hook load over the premium pipe's yield bounds the utilisation from below (the
+    // top carries the largest tension; bending and torque add).
+    assert!(
+        u >= hook / yield_n * 0.999 && u < 1.0,
+        "{u} vs {}",
+        hook / yield_n
+    );
+    assert!((st["overpull_margin_n"].as_f64().unwrap() - (0.9 * yield_n - hook)).abs() < 1e-6);
+    assert!(out.join("tension_torque.png").is_file());
+    let profile = std::fs::read_to_string(out.join("profile.csv")).unwrap();
+    assert!(profile
+        .lines()
+        .next()
+        .unwrap()
+        .contains("yield_utilisation"));
+    // An unknown grade names the key.
+    let bad = text.replacen(
+        "kind = \"drill_pipe\"",
+        "kind = \"drill_pipe\"\ngrade = \"P110\"",
+        1,
+    );
+    let e = holewall::case::parse_case(&path, &bad).unwrap_err();
+    assert!(e.to_string().contains("string.grade"), "{e}");
+}

@@ -56,6 +56,9 @@ pub struct Case {
     pub ensemble: Option<EnsembleSettings>,
     /// `[tendency]`, with its defaults when absent.
     pub tendency: TendencyCase,
+    /// Per string component (from the bit up, as `Element::component`): its grade and wear
+    /// class, where the case gives one ([`crate::strength`]).
+    pub strength: Vec<Option<crate::strength::PipeStrength>>,
     /// What the case holds that is allowed but unusual (a sharp dogleg …): printed by every
     /// command that reads the case and written into its `summary.json`.
     pub warnings: Vec<String>,
@@ -330,6 +333,7 @@ pub fn parse_case(path: &Path, text: &str) -> Result<Case, InputError> {
         tubulars,
         blades,
         tool_joints,
+        strength,
         eccentricities,
         bends,
     } = read_string(&ctx, &spec, &hole, bit_md, (el_pipe, el_bha))?;
@@ -574,6 +578,7 @@ pub fn parse_case(path: &Path, text: &str) -> Result<Case, InputError> {
     Ok(Case {
         ensemble,
         tendency,
+        strength,
         title: spec.title.unwrap_or_default(),
         path: path.to_path_buf(),
         model,

@@ -87,6 +87,13 @@ pub struct ComponentSpec {
     pub tool_joint_length: Option<Q>,
     /// Distance between tool joints (one joint of pipe; default 30 ft = 9.144 m).
     pub joint_spacing: Option<Q>,
+    /// Steel grade (`E75`, `X95`, `G105`, `S135`; [`crate::strength`]): the component's
+    /// stresses are then checked against its yield.
+    pub grade: Option<Spanned<String>>,
+    /// Minimum yield strength instead of a grade.
+    pub yield_strength: Option<Q>,
+    /// Wear class: `new` (default), `premium` (80 % wall), `class2` (70 %).
+    pub wear: Option<Spanned<String>>,
     /// Young's modulus (default 207 GPa).
     pub youngs_modulus: Option<Q>,
     /// Poisson ratio (default 0.3).

@@ -10,6 +10,8 @@ pub(super) struct StringRead {
     pub(super) blades: Vec<Option<f64>>,
     /// Per component: tool joints (OD, length, spacing; m).
     pub(super) tool_joints: Vec<Option<(f64, f64, f64)>>,
+    /// Per component: grade and wear, where given.
+    pub(super) strength: Vec<Option<crate::strength::PipeStrength>>,
     pub(super) eccentricities: Vec<f64>,
     pub(super) bends: Vec<(f64, f64, f64, std::ops::Range<usize>)>,
 }
@@ -38,6 +40,7 @@ pub(super) fn read_string(
     let mut tubulars = Vec::new();
     let mut blades = Vec::new();
     let mut tool_joints = Vec::new();
+    let mut strength = Vec::new();
     let mut eccentricities: Vec<f64> = Vec::new();
     let mut bends = Vec::new();
     for c in &spec.string {
@@ -236,6 +239,64 @@ pub(super) fn read_string(
             }
         };
         tool_joints.push(joint);
+        // Grade (or yield strength) and wear class.
+        let wall = match &c.wear {
+            None => 1.0,
+            Some(w) => crate::strength::WEAR
+                .iter()
+                .find(|(n, _)| *n == w.get_ref().as_str())
+                .map(|(_, f)| *f)
+                .ok_or_else(|| {
+                    ctx.err(
+                        w.span(),
+                        "string.wear",
+                        format!(
+                            "unknown wear class {:?}; allowed: new, premium, class2",
+                            w.get_ref()
+                        ),
+                    )
+                })?,
+        };
+        let grade = match (&c.grade, &c.yield_strength) {
+            (Some(_), Some(q)) => {
+                return Err(ctx.err(
+                    q.span(),
+                    "string.yield_strength",
+                    "give grade or yield_strength, not both",
+                ))
+            }
+            (Some(g), None) => Some(
+                crate::strength::GRADES
+                    .iter()
+                    .find(|(n, _)| n.eq_ignore_ascii_case(g.get_ref()))
+                    .copied()
+                    .ok_or_else(|| {
+                        ctx.err(
+                            g.span(),
+                            "string.grade",
+                            format!("unknown grade {:?}; allowed: E75, X95, G105, S135 (or yield_strength)", g.get_ref()),
+                        )
+                    })?,
+            ),
+            (None, Some(q)) => Some((
+                "custom",
+                ctx.quantity(
+                    q,
+                    "string.yield_strength",
+                    Dimension::Pressure,
+                    |x| x > 1e8 && x < 3e9,
+                    "100 MPa … 3 GPa",
+                )?,
+            )),
+            (None, None) => {
+                if let Some(w) = &c.wear {
+                    return Err(ctx.err(w.span(), "string.wear", "needs string.grade (or yield_strength)"));
+                }
+                None
+            }
+        };
+        strength
+            .push(grade.map(|(name, y)| crate::strength::PipeStrength::new(name, y, wall, od, id)));
         blades.push(blade);
         tubulars.push(Tubular {
             name: kind,
@@ -257,6 +318,7 @@ pub(super) fn read_string(
         tubulars,
         blades,
         tool_joints,
+        strength,
         eccentricities,
         bends,
     })

@@ -54,6 +54,10 @@ pub struct Summary {
     /// The assembly's directional tendency at the case's weight on bit (FE;
     /// [`crate::bha::tendency`]): build and turn rates, equilibrium curvature.
     pub tendency: Option<crate::bha::tendency::Tendency>,
+    /// Pipe strength along the graded components: the largest von Mises utilisation and
+    /// where, the overpull margin at the surface, the largest torque against the RP 7G
+    /// limit; null when no component has a grade.
+    pub strength: Option<crate::strength::StrengthSummary>,
     /// Newton iterations per completed load step (FE).
     pub newton_iterations: Vec<usize>,
     /// Load-step cuts and why (FE).
@@ -141,6 +145,8 @@ pub fn run(
                     let area = model.elements[e].section.area;
                     let side = if i < n - 1 { prof.side_force[i] } else { 0.0 };
                     ProfileRow {
+                        von_mises_pa: f64::NAN,
+                        yield_utilisation: f64::NAN,
                         md_m: model.nodes[i].md,
                         x_m: model.nodes[i].position[0],
                         y_m: model.nodes[i].position[1],
@@ -159,6 +165,38 @@ pub fn run(
             (rows, prof.hook_load(), prof.surface_torque(), vec![])
         }
     };
+    let mut rows = rows;
+    // Pipe strength along the graded components (issue 26).
+    let loads: Vec<crate::strength::Loads> = rows
+        .iter()
+        .map(|r| crate::strength::Loads {
+            md: r.md_m,
+            tvd: r.z_m,
+            axial_force: r.axial_force_n,
+            bending_moment: r.bending_moment_nm,
+            torque: r.torque_nm,
+        })
+        .collect();
+    let (stresses, strength) = crate::strength::assess(
+        &loads,
+        &case.strength,
+        &|i| model.elements[i.min(n - 2)].component,
+        &|i| {
+            let e = &model.elements[i.min(n - 2)];
+            (
+                e.outer_diameter,
+                (e.outer_diameter.powi(2) - e.section.area / std::f64::consts::FRAC_PI_4)
+                    .max(0.0)
+                    .sqrt(),
+            )
+        },
+        case.mud_density,
+        hook,
+    );
+    for (r, (vm, u)) in rows.iter_mut().zip(&stresses) {
+        r.von_mises_pa = *vm;
+        r.yield_utilisation = *u;
+    }
     let np = neutral_point(&rows);
     let (k_max, max_side) = rows
         .iter()
@@ -189,12 +227,16 @@ pub fn run(
         helical_buckling: helical,
         bit,
         tendency,
+        strength,
         newton_iterations: its,
         solver_log,
     };
     let dir = folder.path();
     crate::output::write_csv_rows(&dir.join("profile.csv"), &rows)?;
     write_plots(&case, which, &rows, np, summary.bit.as_ref(), dir)?;
+    if summary.strength.is_some() {
+        tension_torque_plot(&case, &rows, dir)?;
+    }
     let json = serde_json::to_vec_pretty(&summary).map_err(std::io::Error::other)?;
     folder.finish(&json)?;
     Ok(summary)
@@ -425,4 +467,69 @@ pub fn stabilizer_labels(model: &Model, rows: &[ProfileRow]) -> Vec<(String, f64
             ))
         })
         .collect()
+}
+
+/// The tension–torque envelope (API RP 7G) of the surface's component, if graded, with the
+/// string's operating points (true axial force, torque) along its graded components.
+fn tension_torque_plot(case: &Case, rows: &[ProfileRow], out: &Path) -> std::io::Result<()> {
+    use crate::plots::{line_plot, Series};
+    let model = &case.model;
+    let n = model.nodes.len();
+    let component = |i: usize| model.elements[i.min(n - 2)].component;
+    let Some(top) = case.strength.get(component(0)).copied().flatten() else {
+        return Ok(());
+    };
+    let yield_n = top.tensile_yield_n();
+    let envelope: Vec<(f64, f64)> = (0..=60)
+        .map(|k| {
+            let p = yield_n * k as f64 / 60.0;
+            (p / 1e3, top.torque_limit_nm(p) / 1e3)
+        })
+        .collect();
+    let points: Vec<(f64, f64)> = rows
+        .iter()
+        .enumerate()
+        .filter(|(i, _)| {
+            case.strength
+                .get(component(*i))
+                .copied()
+                .flatten()
+                .is_some()
+        })
+        .map(|(i, r)| {
+            let e = &model.elements[i.min(n - 2)];
+            let od = e.outer_diameter;
+            let id = (od * od - e.section.area / std::f64::consts::FRAC_PI_4)
+                .max(0.0)
+                .sqrt();
+            let f =
+                crate::strength::true_axial_force(r.axial_force_n, r.z_m, case.mud_density, od, id);
+            (f / 1e3, r.torque_nm.abs() / 1e3)
+        })
+        .collect();
+    let name = format!(
+        "{} {:.3} in envelope ({:.0} % wall)",
+        top.grade,
+        model.elements[0].outer_diameter / 0.0254,
+        100.0 * top.wall_fraction
+    );
+    line_plot(
+        &out.join("tension_torque.png"),
+        &format!("{}: tension–torque envelope (API RP 7G)", case.title),
+        "true axial force, tension + (kN)",
+        "torque (kN·m)",
+        &[
+            Series {
+                name: &name,
+                points: envelope,
+                wide: true,
+            },
+            Series {
+                name: "along the string (graded components)",
+                points,
+                wide: false,
+            },
+        ],
+        &[],
+    )
 }
