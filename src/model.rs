@@ -52,6 +52,16 @@ pub struct Element {
     pub component: usize,
 }
 
+impl Element {
+    /// The bore's diameter (m), from the body's OD and the steel area.
+    pub fn inner_diameter(&self) -> f64 {
+        (self.outer_diameter * self.outer_diameter
+            - self.section.area / std::f64::consts::FRAC_PI_4)
+            .max(0.0)
+            .sqrt()
+    }
+}
+
 /// A contact element at a node (paper §2).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Site {

@@ -183,12 +183,7 @@ pub fn run(
         &|i| model.elements[i.min(n - 2)].component,
         &|i| {
             let e = &model.elements[i.min(n - 2)];
-            (
-                e.outer_diameter,
-                (e.outer_diameter.powi(2) - e.section.area / std::f64::consts::FRAC_PI_4)
-                    .max(0.0)
-                    .sqrt(),
-            )
+            (e.outer_diameter, e.inner_diameter())
         },
         case.mud_density,
         hook,
@@ -498,10 +493,7 @@ fn tension_torque_plot(case: &Case, rows: &[ProfileRow], out: &Path) -> std::io:
         })
         .map(|(i, r)| {
             let e = &model.elements[i.min(n - 2)];
-            let od = e.outer_diameter;
-            let id = (od * od - e.section.area / std::f64::consts::FRAC_PI_4)
-                .max(0.0)
-                .sqrt();
+            let (od, id) = (e.outer_diameter, e.inner_diameter());
             let f =
                 crate::strength::true_axial_force(r.axial_force_n, r.z_m, case.mud_density, od, id);
             (f / 1e3, r.torque_nm.abs() / 1e3)
