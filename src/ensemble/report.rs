@@ -282,8 +282,9 @@ pub(crate) fn uncertainty_report(
 }
 
 /// The classic T&D "broomstick" when the variants vary `depth`: hook load against bit
-/// depth, one line per combination of the other keys (mode, friction, …). `None` without a
-/// `depth` key.
+/// depth, one line per combination of the other keys (mode, friction, …), and the string's
+/// tensile limit (90 % of the surface component's yield) where it has a grade. `None`
+/// without a `depth` key.
 pub(crate) fn broomstick(
     case: &Case,
     variants: &[Variant],
@@ -324,7 +325,7 @@ pub(crate) fn broomstick(
     for (_, pts) in &mut lines {
         pts.sort_by(|a, b| a.0.total_cmp(&b.0));
     }
-    let series: Vec<Series> = lines
+    let mut series: Vec<Series> = lines
         .iter()
         .map(|(l, pts)| Series {
             name: l,
@@ -332,6 +333,34 @@ pub(crate) fn broomstick(
             wide: false,
         })
         .collect();
+    // The string's tensile limit: 90 % of the surface component's yield, where it has a grade.
+    let top = case
+        .model
+        .elements
+        .first()
+        .and_then(|e| case.strength.get(e.component).copied().flatten());
+    let limit_name;
+    if let Some(s) = top {
+        let (lo, hi) = lines
+            .iter()
+            .flat_map(|(_, p)| p.iter().map(|x| x.0))
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), d| {
+                (a.min(d), b.max(d))
+            });
+        limit_name = format!(
+            "90 % of the tensile yield ({}, {:.0} % wall)",
+            s.grade,
+            100.0 * s.wall_fraction
+        );
+        if lo.is_finite() {
+            let y = 0.9 * s.tensile_yield_n() * 1e-3;
+            series.push(Series {
+                name: &limit_name,
+                points: vec![(lo, y), (hi, y)],
+                wide: true,
+            });
+        }
+    }
     line_plot(
         &out.join("broomstick.png"),
         &format!("{}: hook load against bit depth", case.title),
