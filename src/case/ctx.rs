@@ -74,6 +74,27 @@ impl Ctx<'_> {
         }
     }
 
+    /// A fluid's density (kg/m³): ≥ 0, with the unit trap of
+    /// [`crate::units::fluid_density_trap`] ("1.3 ppg … did you mean 1.3 sg?"); `zero` says
+    /// what 0 means there.
+    pub(super) fn fluid_density(&self, q: &Q, key: &str, zero: &str) -> Result<f64, InputError> {
+        let v = self.quantity(
+            q,
+            key,
+            Dimension::Density,
+            |x| x >= 0.0,
+            &format!("{zero} or 0.5 … 3.0 sg"),
+        )?;
+        let written = match q.get_ref() {
+            Quantity::Text(t) => t.clone(),
+            Quantity::Number(x) => crate::units::show(*x),
+        };
+        match crate::units::fluid_density_trap(v, &written) {
+            Some(m) => Err(self.err(q.span(), key, m)),
+            None => Ok(v),
+        }
+    }
+
     pub(super) fn angle(
         &self,
         q: &Q,

@@ -273,39 +273,10 @@ pub fn parse_case(path: &Path, text: &str) -> Result<Case, InputError> {
             limit,
         )?);
     }
-    let mud = ctx.quantity(
-        &spec.mud.density,
-        "mud.density",
-        Dimension::Density,
-        |x| x >= 0.0,
-        "0 (a dry string) or 0.5 … 3.0 sg",
-    )?;
-    let written = match spec.mud.density.get_ref() {
-        Quantity::Text(t) => t.clone(),
-        Quantity::Number(x) => crate::units::show(*x),
-    };
-    if let Some(m) = crate::units::fluid_density_trap(mud, &written) {
-        return Err(ctx.err(spec.mud.density.span(), "mud.density", m));
-    }
+    let mud = ctx.fluid_density(&spec.mud.density, "mud.density", "0 (a dry string)")?;
     let mud_inside = match &spec.mud.inside_density {
         None => mud,
-        Some(q) => {
-            let v = ctx.quantity(
-                q,
-                "mud.inside_density",
-                Dimension::Density,
-                |x| x >= 0.0,
-                "0 (empty) or 0.5 … 3.0 sg",
-            )?;
-            let written = match q.get_ref() {
-                Quantity::Text(t) => t.clone(),
-                Quantity::Number(x) => crate::units::show(*x),
-            };
-            if let Some(m) = crate::units::fluid_density_trap(v, &written) {
-                return Err(ctx.err(q.span(), "mud.inside_density", m));
-            }
-            v
-        }
+        Some(q) => ctx.fluid_density(q, "mud.inside_density", "0 (empty)")?,
     };
     let mesh = spec.mesh.clone();
     let el_pipe = match mesh.as_ref().and_then(|m| m.element_length.clone()) {
