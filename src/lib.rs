@@ -25,6 +25,7 @@ pub mod output;
 pub mod physics;
 pub mod plots;
 pub mod profile;
+pub mod rig;
 pub mod run;
 pub mod selfcheck;
 pub mod solve;

@@ -439,17 +439,44 @@ fn the_tool_joint_broomstick_orders_its_modes() {
     let mut rows = csv::Reader::from_reader(text.as_bytes());
     let header = rows.headers().unwrap().clone();
     let col = |name: &str| header.iter().position(|h| h == name).unwrap();
-    let (depth, mode, mu, status, hook) = (
+    let (depth, mode, mu, status, hook, reading) = (
         col("depth"),
         col("mode"),
         col("mu.open"),
         col("status"),
         col("hook_load_n"),
+        col("weight_indicator_n"),
     );
+    // The case's rig: an 80 klbf block on 10 lines, K = 0.99, a dead-line indicator.
+    let rig = holewall::rig::Rig {
+        block_weight_n: 80e3 * 4.448_221_615_260_5,
+        lines: 10,
+        sheave_efficiency: 0.99,
+        ..Default::default()
+    };
     let mut loads = std::collections::BTreeMap::new();
     for r in rows.records() {
         let r = r.unwrap();
         assert_eq!(&r[status], "converged");
+        let (h, w): (f64, f64) = (r[hook].parse().unwrap(), r[reading].parse().unwrap());
+        let travel = match &r[mode] {
+            "tripping_out" | "back_reaming" => holewall::rig::Travel::Hoisting,
+            "tripping_in" | "reaming" => holewall::rig::Travel::Lowering,
+            _ => holewall::rig::Travel::AtRest,
+        };
+        let want = rig.reading(h, travel).weight_indicator_n;
+        assert!(
+            (w - want).abs() < 1e-6 * want,
+            "{}: {w} vs {want}",
+            &r[mode]
+        );
+        match travel {
+            holewall::rig::Travel::Hoisting => assert!(w < h + rig.block_weight_n),
+            holewall::rig::Travel::Lowering => assert!(w > h + rig.block_weight_n),
+            holewall::rig::Travel::AtRest => {
+                assert!((w - h - rig.block_weight_n).abs() < 1e-6 * w)
+            }
+        }
         loads.insert(
             (r[depth].to_string(), r[mu].to_string(), r[mode].to_string()),
             r[hook].parse::<f64>().unwrap(),
@@ -562,4 +589,59 @@ fn static_reports_the_strength_of_graded_pipe() {
     );
     let e = holewall::case::parse_case(&path, &bad).unwrap_err();
     assert!(e.to_string().contains("string.grade"), "{e}");
+}
+
+#[test]
+fn the_rig_reads_block_weight_and_dead_line_and_checks_its_keys() {
+    // Tripping out of cases/build_and_hold.toml with a 350 kN block on 8 lines: summary.json
+    // carries the line tensions and the dead-line reading of `holewall::rig`.
+    let text = std::fs::read_to_string(
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("cases/build_and_hold.toml"),
+    )
+    .unwrap();
+    let start = text.find("[operation]").unwrap();
+    let end = start + text[start..].find("\n\n").unwrap();
+    let op = "[operation]\nmode = \"tripping_out\"\naxial_speed = \"0.3 m/s\"\n\n[rig]\n\
+              block_weight = \"350 kN\"\nlines = 8\n";
+    let with_rig = format!("{}{}{}", &text[..start], op, &text[end..]);
+    let dir = common::scratch_dir("torque_drag", "rig");
+    let path = dir.join("rig.toml");
+    std::fs::write(&path, &with_rig).unwrap();
+    let (code, stdout, stderr) = common::holewall(&[
+        "static",
+        path.to_str().unwrap(),
+        "--out",
+        dir.join("out").to_str().unwrap(),
+        "--quiet",
+    ]);
+    assert_eq!(code, 0, "{stderr}");
+    let s: serde_json::Value = serde_json::from_str(&stdout).unwrap();
+    let rig = &s["rig"];
+    let hook = s["hook_load_n"].as_f64().unwrap();
+    assert_eq!(rig["travel"], "hoisting");
+    assert!((rig["hook_load_n"].as_f64().unwrap() - (hook + 350e3)).abs() < 1e-6 * hook);
+    // Hoisting on 8 lines at K = 0.9615: the fast line is W/(E n), E = 0.842 (Bourgoyne et
+    // al. Table 1.2); the dead line reads 8 K^7 (1 − K)/(1 − K^8) W.
+    let w = hook + 350e3;
+    let fast = rig["fast_line_n"].as_f64().unwrap();
+    assert!((fast - w / (0.842 * 8.0)).abs() < 1e-3 * fast, "{fast}");
+    let k: f64 = 0.9615;
+    let closed = 8.0 * k.powi(7) * (1.0 - k) / (1.0 - k.powi(8)) * w;
+    let reads = rig["weight_indicator_n"].as_f64().unwrap();
+    assert!((reads - closed).abs() < 1e-9 * w, "{reads} vs {closed}");
+    // Bad keys name the key and the line.
+    for (bad, key) in [
+        ("lines = 7", "rig.lines"),
+        ("sheave_efficiency = 0.5", "rig.sheave_efficiency"),
+        ("weight_indicator = \"drum\"", "rig.weight_indicator"),
+        ("block_weight = \"-1 kN\"", "rig.block_weight"),
+    ] {
+        let text = match bad.split(' ').next().unwrap() {
+            "lines" => with_rig.replace("lines = 8\n", &format!("{bad}\n")),
+            "block_weight" => with_rig.replace("block_weight = \"350 kN\"", bad),
+            _ => with_rig.replace("[rig]\n", &format!("[rig]\n{bad}\n")),
+        };
+        let e = holewall::case::parse_case(&path, &text).unwrap_err();
+        assert!(e.to_string().contains(key) && e.line > 0, "{e}");
+    }
 }

@@ -22,7 +22,7 @@ mod survey;
 mod tables;
 
 use ctx::Ctx;
-use settings::{dynamics_settings, ensemble_settings, tendency_settings};
+use settings::{dynamics_settings, ensemble_settings, rig_settings, tendency_settings};
 pub use spec::*;
 use survey::read_well;
 pub use survey::{survey_from_text, survey_plausibility};
@@ -59,6 +59,8 @@ pub struct Case {
     /// Per string component (from the bit up, as `Element::component`): its grade and wear
     /// class, where the case gives one ([`crate::strength`]).
     pub strength: Vec<Option<crate::strength::PipeStrength>>,
+    /// `[rig]`: block weight and the weight indicator ([`crate::rig`]), if given.
+    pub rig: Option<crate::rig::Rig>,
     /// What the case holds that is allowed but unusual (a sharp dogleg …): printed by every
     /// command that reads the case and written into its `summary.json`.
     pub warnings: Vec<String>,
@@ -546,7 +548,9 @@ pub fn parse_case(path: &Path, text: &str) -> Result<Case, InputError> {
         }
     }
     let tendency = tendency_settings(&ctx, spec.tendency.as_ref())?;
+    let rig = rig_settings(&ctx, spec.rig.as_ref())?;
     Ok(Case {
+        rig,
         ensemble,
         tendency,
         strength,

@@ -466,3 +466,52 @@ pub(super) fn tendency_settings(
     )?;
     Ok(out)
 }
+
+/// `[rig]` ([`crate::rig`]); `None` when absent.
+pub(super) fn rig_settings(
+    ctx: &Ctx,
+    r: Option<&RigSpec>,
+) -> Result<Option<crate::rig::Rig>, InputError> {
+    let Some(r) = r else { return Ok(None) };
+    let mut rig = crate::rig::Rig::default();
+    if let Some(q) = &r.block_weight {
+        rig.block_weight_n = ctx.quantity(
+            q,
+            "rig.block_weight",
+            Dimension::Force,
+            |x| (0.0..=5e6).contains(&x),
+            "0 ≤ block_weight ≤ 5 MN",
+        )?;
+    }
+    if let Some(x) = &r.lines {
+        rig.lines = ctx.number(
+            x,
+            "rig.lines",
+            |v| v.fract() == 0.0 && (2.0..=16.0).contains(&v) && v as u32 % 2 == 0,
+            "an even whole number, 2 … 16",
+        )? as u32;
+    }
+    if let Some(x) = &r.sheave_efficiency {
+        rig.sheave_efficiency = ctx.number(
+            x,
+            "rig.sheave_efficiency",
+            |v| (0.9..=1.0).contains(&v),
+            "0.9 ≤ sheave_efficiency ≤ 1",
+        )?;
+    }
+    if let Some(w) = &r.weight_indicator {
+        rig.indicator = match w.get_ref().as_str() {
+            "dead_line" => crate::rig::Indicator::DeadLine,
+            "hook" => crate::rig::Indicator::Hook,
+            other => {
+                return Err(ctx.err(
+                    w.span(),
+                    "rig.weight_indicator",
+                    format!("unknown weight indicator {other:?}; allowed: dead_line, hook"),
+                ))
+            }
+        };
+    }
+    rig.tared = r.tared.unwrap_or(false);
+    Ok(Some(rig))
+}

@@ -267,6 +267,24 @@ pub struct CaseSpec {
     pub ensemble: Option<EnsembleSpec>,
     /// Directional tendency: the bit–rock model and the map of `holewall tendency`.
     pub tendency: Option<TendencySpec>,
+    /// The rig's hoisting system: block weight and what the weight indicator reads.
+    pub rig: Option<RigSpec>,
+}
+
+/// `[rig]`: block weight, reeving and the weight indicator ([`crate::rig`]).
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RigSpec {
+    /// Travelling block, hook and top drive.
+    pub block_weight: Option<Q>,
+    /// Lines strung between crown and travelling block.
+    pub lines: Option<Spanned<f64>>,
+    /// Sheave efficiency.
+    pub sheave_efficiency: Option<Spanned<f64>>,
+    /// `dead_line` or `hook`.
+    pub weight_indicator: Option<Spanned<String>>,
+    /// Indicator zeroed with the block hanging.
+    pub tared: Option<bool>,
 }
 
 /// `[tendency]`: the bit–rock model of the directional tendency

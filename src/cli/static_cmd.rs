@@ -58,6 +58,10 @@ pub struct Summary {
     /// where, the overpull margin at the surface, the largest torque against the RP 7G
     /// limit; null when no component has a grade.
     pub strength: Option<crate::strength::StrengthSummary>,
+    /// The rig's side of the hook load (`[rig]`): block weight, line tensions and what the
+    /// weight indicator reads while the block moves as the operation does
+    /// ([`crate::rig`]); null without a `[rig]`.
+    pub rig: Option<crate::rig::RigReading>,
     /// Newton iterations per completed load step (FE).
     pub newton_iterations: Vec<usize>,
     /// Load-step cuts and why (FE).
@@ -223,6 +227,12 @@ pub fn run(
         bit,
         tendency,
         strength,
+        rig: case.rig.map(|r| {
+            r.reading(
+                hook,
+                crate::rig::Travel::of_axial_speed(case.model.axial_speed),
+            )
+        }),
         newton_iterations: its,
         solver_log,
     };

@@ -99,6 +99,10 @@ pub struct VariantResult {
     /// Hook load (N): the top's axial reaction of a static solution; for a dynamic run the
     /// top element's axial force in the last state.
     pub hook_load_n: Option<f64>,
+    /// What the rig's weight indicator reads for that load ([`crate::rig`]): static
+    /// variants of a case with a `[rig]`.
+    #[serde(default)]
+    pub weight_indicator_n: Option<f64>,
     /// Largest surface torque (N·m).
     #[serde(with = "crate::output::nan_as_null")]
     pub max_surface_torque_nm: f64,
@@ -150,6 +154,7 @@ pub(crate) fn failed(name: &str, reason: String, stabs: usize) -> VariantResult 
         reason,
         neutral_point_from_bit_m: None,
         hook_load_n: None,
+        weight_indicator_n: None,
         max_surface_torque_nm: f64::NAN,
         string: StringQoi::default(),
         stabilizers: vec![StabilizerQoi::default(); stabs],
@@ -183,6 +188,7 @@ pub(crate) fn finished(
         reason: log.first().cloned().unwrap_or_default(),
         neutral_point_from_bit_m,
         hook_load_n: hook_load_n.is_finite().then_some(hook_load_n),
+        weight_indicator_n: None,
         max_surface_torque_nm,
         string,
         stabilizers,
@@ -240,8 +246,13 @@ pub fn static_result(
         helical_buckling: Some(helical),
         stick_slip_severity: None,
     };
+    let travel = crate::rig::Travel::of_axial_speed(model.axial_speed);
     VariantResult {
         bit: Some(crate::bha::bit_loads_of(model, sol)),
+        weight_indicator_n: case
+            .rig
+            .filter(|_| hook.is_finite())
+            .map(|r| r.reading(hook, travel).weight_indicator_n),
         ..finished(
             name,
             &sol.log,
@@ -497,6 +508,13 @@ pub fn qoi_columns(
             r.neutral_point_from_bit_m
         }),
         col("hook_load_n".into(), Unit::Force, &|r| r.hook_load_n),
+    ];
+    if results.iter().any(|r| r.weight_indicator_n.is_some()) {
+        q.push(col("weight_indicator_n".into(), Unit::Force, &|r| {
+            r.weight_indicator_n
+        }));
+    }
+    q.extend([
         col("max_surface_torque_nm".into(), Unit::Torque, &|r| {
             Some(r.max_surface_torque_nm)
         }),
@@ -505,7 +523,7 @@ pub fn qoi_columns(
             Unit::ForcePerLength,
             &|r| r.string.max_side_force_per_length_n_per_m,
         ),
-    ];
+    ]);
     if !dynamic {
         // The bit's loads and attitude (issue 25).
         for (j, name) in crate::bha::BIT_COLUMNS.iter().enumerate() {

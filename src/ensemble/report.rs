@@ -150,6 +150,12 @@ pub(crate) fn variants_csv(
         ]
         .map(String::from),
     );
+    let rig = case.rig.is_some();
+    if rig {
+        // What the weight indicator reads (`[rig]`), after the string's load.
+        let at = header.iter().position(|h| h == "hook_load_n").unwrap_or(0) + 1;
+        header.insert(at, "weight_indicator_n".into());
+    }
     if dynamic {
         header.push("stick_slip_severity".into());
     } else {
@@ -209,6 +215,9 @@ pub(crate) fn variants_csv(
         row.push(r.reason.clone());
         row.push(r.neutral_point_from_bit_m.map(fmt).unwrap_or_default());
         row.push(r.hook_load_n.map(fmt).unwrap_or_default());
+        if rig {
+            row.push(r.weight_indicator_n.map(fmt).unwrap_or_default());
+        }
         row.push(fmt(r.max_surface_torque_nm));
         let opt = |x: Option<f64>| x.map(fmt).unwrap_or_default();
         let flag = |x: Option<bool>| x.map(|b| b.to_string()).unwrap_or_default();
@@ -314,7 +323,12 @@ pub(crate) fn broomstick(
             })
             .collect::<Vec<_>>()
             .join(", ");
-        let Some(hook) = r.hook_load_n.filter(|h| h.is_finite()) else {
+        // What the rig reads where the case has a `[rig]`, else the string's load.
+        let Some(hook) = r
+            .weight_indicator_n
+            .or(r.hook_load_n)
+            .filter(|h| h.is_finite())
+        else {
             continue;
         };
         match lines.iter_mut().find(|(l, _)| *l == label) {
@@ -353,7 +367,11 @@ pub(crate) fn broomstick(
             100.0 * s.wall_fraction
         );
         if lo.is_finite() {
-            let y = 0.9 * s.tensile_yield_n() * 1e-3;
+            // On the indicator's scale: at rest it adds the block weight unless tared.
+            let block = case
+                .rig
+                .map_or(0.0, |r| if r.tared { 0.0 } else { r.block_weight_n });
+            let y = (0.9 * s.tensile_yield_n() + block) * 1e-3;
             series.push(Series {
                 name: &limit_name,
                 points: vec![(lo, y), (hi, y)],
@@ -361,11 +379,19 @@ pub(crate) fn broomstick(
             });
         }
     }
+    let y_label = match case.rig {
+        Some(r) if r.tared => "weight indicator, block tared (kN)".to_string(),
+        Some(r) => format!(
+            "weight indicator, incl. {:.0} kN block (kN)",
+            r.block_weight_n * 1e-3
+        ),
+        None => "hook load (kN)".to_string(),
+    };
     line_plot(
         &out.join("broomstick.png"),
         &format!("{}: hook load against bit depth", case.title),
         "bit depth, MD (m)",
-        "hook load (kN)",
+        &y_label,
         &series,
         &[],
     )?;
