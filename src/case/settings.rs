@@ -487,7 +487,7 @@ pub(super) fn rig_settings(
         rig.lines = ctx.number(
             x,
             "rig.lines",
-            |v| v.fract() == 0.0 && (2.0..=16.0).contains(&v) && v as u32 % 2 == 0,
+            |v| v.fract() == 0.0 && (2.0..=16.0).contains(&v) && (v as u32).is_multiple_of(2),
             "an even whole number, 2 … 16",
         )? as u32;
     }
