@@ -10,6 +10,7 @@
 
 pub mod backend;
 pub mod bha;
+pub mod calibrate;
 pub mod case;
 pub mod cli;
 pub mod corpus;

@@ -113,6 +113,41 @@ enum Command {
         #[arg(long)]
         quiet: bool,
     },
+    /// Friction factors from measured loads: the cased- and open-hole friction factors that
+    /// best explain a CSV of hook loads and surface torques against bit depth (a Bayesian
+    /// grid over the FE model), their 95 % intervals, the residuals against depth and the
+    /// broomstick with the measurements over it. Exit code 1 when the residuals say the
+    /// string or survey is wrong rather than the friction (every output still written).
+    Calibrate {
+        /// Case file (TOML).
+        case: PathBuf,
+        /// CSV of measurements: bit_md_m (or _ft), mode, hook_load_kn (or _n, _klbf) and/or
+        /// surface_torque_knm (or _nm, _kftlbf); wob_kn for drilling rows; rpm.
+        #[arg(long)]
+        measured: PathBuf,
+        /// Output folder.
+        #[arg(long)]
+        out: PathBuf,
+        /// Grid nodes per friction factor (FE runs at each, for every measured station).
+        #[arg(long, default_value_t = 9)]
+        nodes: usize,
+        /// Range of the friction factors: low,high.
+        #[arg(long, value_parser = mu_range, default_value = "0.05,0.6")]
+        mu_range: (f64, f64),
+        /// Standard deviation of the hook-load noise (kN); unknown (integrated out) if not
+        /// given.
+        #[arg(long)]
+        sigma_hook_kn: Option<f64>,
+        /// Standard deviation of the torque noise (kN·m); unknown if not given.
+        #[arg(long)]
+        sigma_torque_knm: Option<f64>,
+        /// No model run starts past this many seconds (the run then stops, exit code 3).
+        #[arg(long, value_parser = positive_seconds)]
+        max_seconds: Option<f64>,
+        /// No progress bar.
+        #[arg(long)]
+        quiet: bool,
+    },
     /// One case, many variants (CSV of overrides or the case's [ensemble] grid): statics
     /// or dynamics per variant, quantities of interest and status in variants.csv.
     Ensemble {
@@ -529,6 +564,36 @@ fn main() -> ExitCode {
                 added_mass: !no_added_mass,
             },
         )),
+        Command::Calibrate {
+            case,
+            measured,
+            out,
+            nodes,
+            mu_range,
+            sigma_hook_kn,
+            sigma_torque_knm,
+            max_seconds,
+            quiet,
+        } => {
+            let start = std::time::Instant::now();
+            let options = holewall::calibrate::CalibrateOptions {
+                nodes,
+                range: mu_range,
+                sigma_hook: sigma_hook_kn.map(|s| s * 1e3),
+                sigma_torque: sigma_torque_knm.map(|s| s * 1e3),
+                deadline: max_seconds.map(|s| start + std::time::Duration::from_secs_f64(s)),
+            };
+            match cli::calibrate_cmd::run(&case, &measured, &out, options, !quiet) {
+                Ok(s) if !s.calibration.accepted => {
+                    println!("{}", serde_json::to_string_pretty(&s).unwrap_or_default());
+                    for why in &s.calibration.rejected_because {
+                        eprintln!("holewall: calibration rejected: {why}");
+                    }
+                    ExitCode::from(1)
+                }
+                other => print_summary(other),
+            }
+        }
         Command::Tendency {
             case,
             out,
@@ -767,6 +832,20 @@ fn main() -> ExitCode {
 }
 
 /// `--max-seconds`: a finite number of seconds > 0.
+fn mu_range(s: &str) -> Result<(f64, f64), String> {
+    let bad = || format!("{s:?}: allowed: low,high with 0 ≤ low < high ≤ 2");
+    let (a, b) = s.split_once(',').ok_or_else(bad)?;
+    let (a, b): (f64, f64) = (
+        a.trim().parse().map_err(|_| bad())?,
+        b.trim().parse().map_err(|_| bad())?,
+    );
+    if a >= 0.0 && b > a && b <= 2.0 {
+        Ok((a, b))
+    } else {
+        Err(bad())
+    }
+}
+
 fn positive_seconds(s: &str) -> Result<f64, String> {
     match s.parse::<f64>() {
         Ok(x) if x.is_finite() && x > 0.0 => Ok(x),

@@ -26,6 +26,10 @@ pub struct Marker<'a> {
 }
 
 fn bounds(series: &[Series]) -> ((f64, f64), (f64, f64)) {
+    bounds_of(&series.iter().collect::<Vec<_>>())
+}
+
+fn bounds_of(series: &[&Series]) -> ((f64, f64), (f64, f64)) {
     let mut xr = (f64::INFINITY, f64::NEG_INFINITY);
     let mut yr = (f64::INFINITY, f64::NEG_INFINITY);
     for s in series {
@@ -59,7 +63,23 @@ pub fn line_plot(
     markers: &[Marker],
 ) -> std::io::Result<()> {
     atomic_png(path, |tmp| {
-        draw(tmp, title, x_label, y_label, series, markers)
+        draw(tmp, title, x_label, y_label, series, markers, &[])
+    })
+}
+
+/// Lines with measured points over them: point set `k` takes line `k`'s colour (a mode's
+/// measurements over its modelled curve), drawn as filled circles with their own legend
+/// entries.
+pub fn lines_and_points(
+    path: &Path,
+    title: &str,
+    x_label: &str,
+    y_label: &str,
+    series: &[Series],
+    points: &[Series],
+) -> std::io::Result<()> {
+    atomic_png(path, |tmp| {
+        draw(tmp, title, x_label, y_label, series, &[], points)
     })
 }
 
@@ -70,10 +90,12 @@ fn draw(
     y_label: &str,
     series: &[Series],
     markers: &[Marker],
+    points: &[Series],
 ) -> Result<(), Box<dyn std::error::Error>> {
     let root = BitMapBackend::new(path, (1000, 640)).into_drawing_area();
     root.fill(&WHITE)?;
-    let ((x0, x1), (y0, mut y1)) = bounds(series);
+    let all: Vec<&Series> = series.iter().chain(points).collect();
+    let ((x0, x1), (y0, mut y1)) = bounds_of(&all);
     if !markers.is_empty() {
         // Head room for the markers' labels above their points.
         y1 += 0.1 * (y1 - y0);
@@ -111,6 +133,18 @@ fn draw(
             )?
             .label(s.name)
             .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], style));
+    }
+    for (k, p) in points.iter().enumerate() {
+        let c = colour(k);
+        chart
+            .draw_series(
+                p.points
+                    .iter()
+                    .filter(|(x, y)| x.is_finite() && y.is_finite())
+                    .map(move |&q| Circle::new(q, 5, c.filled())),
+            )?
+            .label(p.name)
+            .legend(move |(x, y)| Circle::new((x + 10, y), 5, c.filled()));
     }
     for m in markers {
         // The label beside the point, up and to the left, on a white box: it neither
@@ -777,6 +811,66 @@ pub fn class_scatter(
             .background_style(WHITE.mix(0.8))
             .border_style(BLACK)
             .draw()?;
+        root.present()?;
+        Ok(())
+    })
+}
+
+/// A heat map of `values[i][j]` (≥ 0) over the cells centred on `xs[i]` × `ys[j]` (uniform
+/// grids), white at 0 to dark blue at the largest value, with `marks` drawn as labelled
+/// red points (e.g. a posterior density and its mode).
+pub fn heat_map(
+    path: &Path,
+    title: &str,
+    x_label: &str,
+    y_label: &str,
+    (xs, ys): (&[f64], &[f64]),
+    values: &[Vec<f64>],
+    marks: &[Marker],
+) -> std::io::Result<()> {
+    let top = values
+        .iter()
+        .flatten()
+        .copied()
+        .filter(|v| v.is_finite())
+        .fold(0.0f64, f64::max)
+        .max(f64::MIN_POSITIVE);
+    let half = |g: &[f64]| {
+        if g.len() > 1 {
+            0.5 * (g[1] - g[0])
+        } else {
+            0.5
+        }
+    };
+    let (hx, hy) = (half(xs), half(ys));
+    let xr = (xs[0] - hx, xs[xs.len() - 1] + hx);
+    let yr = (ys[0] - hy, ys[ys.len() - 1] + hy);
+    atomic_png(path, |tmp| {
+        let root = BitMapBackend::new(tmp, (900, 760)).into_drawing_area();
+        root.fill(&WHITE)?;
+        let mut chart = xy_chart(&root, title, 22, 80, x_label, y_label, xr, yr)?;
+        chart.draw_series(xs.iter().enumerate().flat_map(|(i, &x)| {
+            ys.iter().enumerate().map(move |(j, &y)| {
+                let t = (values[i][j] / top).clamp(0.0, 1.0);
+                let c = RGBColor(
+                    (255.0 * (1.0 - 0.9 * t)) as u8,
+                    (255.0 * (1.0 - 0.75 * t)) as u8,
+                    (255.0 * (1.0 - 0.35 * t)) as u8,
+                );
+                Rectangle::new([(x - hx, y - hy), (x + hx, y + hy)], c.filled())
+            })
+        }))?;
+        for m in marks {
+            chart.draw_series(std::iter::once(
+                EmptyElement::at((m.x, m.y))
+                    + Circle::new((0, 0), 6, RED.filled())
+                    + Text::new(
+                        m.label.to_string(),
+                        (10, -8),
+                        ("sans-serif", 16).into_font(),
+                    ),
+            ))?;
+        }
         root.present()?;
         Ok(())
     })
