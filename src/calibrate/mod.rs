@@ -28,10 +28,11 @@
 //! **Checks.** The FE runs again at the MAP at every station: its residuals (measured −
 //! modelled) are the ones written and plotted, and their difference from the spline's is
 //! the surrogate's error (reported). The calibration is **rejected** (exit code 1, every
-//! output still written) when a mode's residuals trend with depth (least-squares slope,
-//! two-sided p < 0.001 by Student's t — friction cannot make a load error that grows with
-//! depth; a wrong string weight or survey can), when the MAP sits on the grid's edge, or,
-//! with a stated noise, when the residuals exceed it (χ², p < 0.001).
+//! output still written) when a mode's residuals, or every mode's together, trend with
+//! depth (least-squares slope, two-sided p < 0.001 by Student's t — friction cannot make a
+//! load error that grows with depth; a wrong string weight or survey can), or, with a
+//! stated noise, when the residuals exceed it (χ², p < 0.001). A MAP on the range's edge,
+//! an interval reaching it or a surrogate error above a quarter of the noise are warnings.
 
 use serde::Serialize;
 
@@ -228,8 +229,8 @@ pub struct Residual {
 /// A mode's residual trend with depth (least squares).
 #[derive(Clone, Debug, Serialize)]
 pub struct Trend {
-    /// Mode.
-    pub mode: MeasuredMode,
+    /// Mode (`pick_up`, …), or `all` for every mode's residuals together.
+    pub mode: &'static str,
     /// `hook_load` or `torque`.
     pub quantity: &'static str,
     /// Rows.
@@ -586,7 +587,23 @@ pub fn calibrate(
     let mut trends = Vec::new();
     let mut rejected = Vec::new();
     let mut warnings = Vec::new();
-    for (m, _) in MeasuredMode::NAMES {
+    // Per mode, then every mode together (a wrong string weight shifts them all alike).
+    let groups: Vec<(&'static str, Option<MeasuredMode>)> = std::iter::once(("all", None))
+        .chain(
+            MeasuredMode::NAMES
+                .iter()
+                .map(|(m, _)| (m.name(), Some(*m))),
+        )
+        .collect();
+    let several_modes = MeasuredMode::NAMES
+        .iter()
+        .filter(|(m, _)| rows.iter().any(|r| r.mode == *m))
+        .count()
+        > 1;
+    for (group, mode) in groups {
+        if mode.is_none() && !several_modes {
+            continue;
+        }
         for (quantity, pick) in [
             (
                 "hook_load",
@@ -596,7 +613,7 @@ pub fn calibrate(
         ] {
             let pts: Vec<(f64, f64)> = residuals
                 .iter()
-                .filter(|r| r.mode == m)
+                .filter(|r| mode.is_none_or(|m| r.mode == m))
                 .filter_map(|r| pick(r).map(|x| (r.bit_md_m, x)))
                 .collect();
             if pts.is_empty() {
@@ -605,17 +622,20 @@ pub fn calibrate(
             let (mean, rms, slope, p) = trend(&pts);
             if let Some(p) = p.filter(|p| *p < 1e-3) {
                 let unit = if quantity == "torque" { "kN·m" } else { "kN" };
+                let whose = match mode {
+                    Some(m) => format!("of {}", m.name()),
+                    None => "of every mode together".into(),
+                };
                 rejected.push(format!(
-                    "the {} residuals of {} trend with depth ({:+.1} {unit} per 1000 m, p = \
+                    "the {} residuals {whose} trend with depth ({:+.1} {unit} per 1000 m, p = \
                      {p:.1e}): friction does not make a load error that grows with depth — \
                      check the string (weights, lengths) and the survey",
                     quantity.replace('_', " "),
-                    m.name(),
                     slope * 1e-3
                 ));
             }
             trends.push(Trend {
-                mode: m,
+                mode: group,
                 quantity,
                 rows: pts.len(),
                 mean,
@@ -628,10 +648,12 @@ pub fn calibrate(
     for e in &estimates {
         let h = fine[1] - fine[0];
         if e.map <= opts.range.0 + 0.5 * h || e.map >= opts.range.1 - 0.5 * h {
-            rejected.push(format!(
+            // A warning, not a rejection: a weakly constrained factor (a ridge of the
+            // posterior) can peak anywhere along it.
+            warnings.push(format!(
                 "{}'s best value {:.3} is on the edge of the range {}–{}: the data ask for a \
-                 friction factor outside it (or the model is wrong); widen --mu-range only \
-                 if such a value is physical",
+                 friction factor there or beyond (or they hardly constrain it: see its 95 % \
+                 interval); widen --mu-range only if such a value is physical",
                 e.key, e.map, opts.range.0, opts.range.1
             ));
         } else if e.interval_95.0 <= opts.range.0 + h || e.interval_95.1 >= opts.range.1 - h {

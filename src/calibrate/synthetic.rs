@@ -26,6 +26,8 @@ pub struct SyntheticPlan {
     pub sigma_torque: f64,
     /// Noise seed.
     pub seed: u64,
+    /// Rotary speed of the rotating rows (rad/s); `None`: the case's.
+    pub rpm: Option<f64>,
 }
 
 /// Measurements of `case` by `plan`: a hook load in every row, a surface torque in the
@@ -43,7 +45,7 @@ pub fn synthetic(case: &Case, plan: &SyntheticPlan) -> Result<Vec<Measurement>, 
                 } else {
                     0.0
                 },
-                rpm: None,
+                rpm: plan.rpm.filter(|_| m.rotates()),
                 hook_load: Some(0.0),
                 surface_torque: m.rotates().then_some(0.0),
             });
@@ -71,14 +73,15 @@ pub fn synthetic(case: &Case, plan: &SyntheticPlan) -> Result<Vec<Measurement>, 
 
 /// Writes measurements as a measured file (SI columns), atomically.
 pub fn write_measured(rows: &[Measurement], path: &Path) -> std::io::Result<()> {
-    let mut text = String::from("bit_md_m,mode,wob_n,hook_load_n,surface_torque_nm\n");
+    let mut text = String::from("bit_md_m,mode,wob_n,rpm,hook_load_n,surface_torque_nm\n");
     let opt = |x: Option<f64>| x.map(|v| format!("{v}")).unwrap_or_default();
     for r in rows {
         text.push_str(&format!(
-            "{},{},{},{},{}\n",
+            "{},{},{},{},{},{}\n",
             r.bit_md,
             r.mode.name(),
             r.wob,
+            opt(r.rpm.map(|w| w * 30.0 / std::f64::consts::PI)),
             opt(r.hook_load),
             opt(r.surface_torque)
         ));
