@@ -344,6 +344,23 @@ enum BenchCommand {
         #[arg(long)]
         quiet: bool,
     },
+    /// Friction calibration on corpus wells: synthetic loads at friction factors drawn
+    /// from each seed, recovered within the 95 % intervals?; the same loads on a 30 %
+    /// heavier drill pipe rejected? (calibrate_corpus.csv, summary.json).
+    CalibrateCorpus {
+        /// Wells (seeds first-seed, first-seed + 1, …).
+        #[arg(long, default_value_t = 20)]
+        wells: usize,
+        /// First seed.
+        #[arg(long, default_value_t = 0)]
+        first_seed: u64,
+        /// Output folder.
+        #[arg(long)]
+        out: PathBuf,
+        /// No progress bar.
+        #[arg(long)]
+        quiet: bool,
+    },
     /// The BHA tendency (build/turn rates, equilibrium curvature) of corpus wells at their
     /// own WOB: settled / total with the unsettled and why (tendency_corpus.csv).
     TendencyCorpus {
@@ -769,6 +786,12 @@ fn main() -> ExitCode {
                 Ok(()) => ExitCode::SUCCESS,
                 Err(e) => fail(&[e]),
             },
+            BenchCommand::CalibrateCorpus {
+                wells,
+                first_seed,
+                out,
+                quiet,
+            } => print_summary(cli::bench_calibrate::run(&out, wells, first_seed, !quiet)),
             BenchCommand::TendencyCorpus {
                 wells,
                 first_seed,
