@@ -6,10 +6,16 @@
 //!   724 MPa, S135 931 MPa; or a `yield_strength` given.
 //! - **Wear class** (API RP 7G, uniform OD wear at the remaining wall): new 100 %, premium
 //!   80 %, class 2 70 %: `OD_worn = ID + 2 · fraction · (OD − ID)/2`.
-//! - **Stresses** at the outer fibre of the worn section: axial `σ = F_true/A + M c/I` with
-//!   the true axial force from the effective one, `F_true = F_eff − p A_o + p A_i` (Lubinski's
-//!   effective force is `F_true + p A_o − p A_i`; `p = ρ g TVD`, one mud), shear `τ = T c/J`, `σ_vm = √(σ² + 3 τ²)`; utilisation
-//!   `σ_vm / Y`.
+//! - **Stresses** of the worn section, triaxial: axial `σ_z = F_true/A ± M r/I` with the true
+//!   axial force from the effective one, `F_true = F_eff − p_o A_o + p_i A_i` (Lubinski's
+//!   effective force is `F_true + p_o A_o − p_i A_i`; `p_o = ρ_o g TVD` outside, `p_i = ρ_i g
+//!   TVD` inside: `mud.density`, `mud.inside_density`), Lamé's radial and hoop stresses of a
+//!   thick-walled tube under `p_i`, `p_o` (`σ_r = a − b/r²`, `σ_θ = a + b/r²`,
+//!   `a = (p_i r_i² − p_o r_o²)/(r_o² − r_i²)`, `b = (p_i − p_o) r_i² r_o²/(r_o² − r_i²)`),
+//!   shear `τ = T r/J`; von Mises `√(½((σ_z−σ_θ)² + (σ_θ−σ_r)² + (σ_r−σ_z)²) + 3τ²)`, the
+//!   largest at the inner and outer fibre on the tension and compression side of the bend;
+//!   utilisation `σ_vm / Y`. Under equal pressures inside and out the stress is the
+//!   effective one's (a hanging string's bottom, `F_eff = 0`, is stress-free).
 //! - **Tension–torque envelope** (API RP 7G's combined loading, von Mises at the outer fibre
 //!   without bending): `Q(P) = (2J/D) √(Y² − (P/A)²) / √3`; at zero tension the torsional
 //!   yield `Q = 0.57735 · 2 J Y / D` (RP 7G's `0.096167 J Y / D` in ft·lbf, in, psi).
@@ -80,24 +86,55 @@ impl PipeStrength {
     }
 
     /// Von Mises stress at the outer fibre (Pa) under the true axial force `f_true` (N,
-    /// tension positive), bending moment `m` (N·m) and torque `t` (N·m).
+    /// tension positive), bending moment `m` (N·m) and torque `t` (N·m), no pressure (API
+    /// RP 7G's form).
     pub fn von_mises_pa(&self, f_true: f64, m: f64, t: f64) -> f64 {
+        self.von_mises_triaxial_pa(f_true, m, t, 0.0, 0.0)
+    }
+
+    /// The largest von Mises stress (Pa) over the inner and outer fibre, on both sides of
+    /// the bend, with the pressures `p_i` inside and `p_o` outside (Pa) as well (Lamé; the
+    /// module's doc).
+    pub fn von_mises_triaxial_pa(&self, f_true: f64, m: f64, t: f64, p_i: f64, p_o: f64) -> f64 {
         let (area, second, polar) = self.section();
-        let c = 0.5 * self.od;
-        let sigma = f_true / area + m.abs() * c / second;
-        let tau = t * c / polar;
-        (sigma * sigma + 3.0 * tau * tau).sqrt()
+        let (ro, ri) = (0.5 * self.od, 0.5 * self.id);
+        let d = ro * ro - ri * ri;
+        let a = (p_i * ri * ri - p_o * ro * ro) / d;
+        let b = (p_i - p_o) * ri * ri * ro * ro / d;
+        let mut worst: f64 = 0.0;
+        for r in [ro, ri] {
+            if r <= 0.0 {
+                continue;
+            }
+            let (s_r, s_t) = (a - b / (r * r), a + b / (r * r));
+            let tau = t * r / polar;
+            for side in [1.0, -1.0] {
+                let s_z = f_true / area + side * m.abs() * r / second;
+                let vm = (0.5 * ((s_z - s_t).powi(2) + (s_t - s_r).powi(2) + (s_r - s_z).powi(2))
+                    + 3.0 * tau * tau)
+                    .sqrt();
+                worst = worst.max(vm);
+            }
+        }
+        worst
     }
 }
 
-/// The true axial force from the effective one at TVD `tvd` (m) in mud of density `rho`
-/// (kg/m³), for a pipe of outer and inner diameter `od`, `id` (Lubinski: the effective force
-/// is the true one plus `p A_o − p A_i`; at the bottom of a hanging string the effective
-/// force is 0 and the true one the end pressure's compression `−p A_s`).
-pub fn true_axial_force(f_eff: f64, tvd: f64, rho: f64, od: f64, id: f64) -> f64 {
-    let p = rho * crate::model::GRAVITY * tvd.max(0.0);
+/// The true axial force from the effective one at TVD `tvd` (m), mud of density `rho_o`
+/// outside and `rho_i` inside (kg/m³), for a pipe of outer and inner diameter `od`, `id`
+/// (Lubinski: the effective force is the true one plus `p_o A_o − p_i A_i`; at the bottom of
+/// a hanging string in one mud the effective force is 0 and the true one the end pressure's
+/// compression `−p A_s`).
+pub fn true_axial_force(f_eff: f64, tvd: f64, (rho_o, rho_i): (f64, f64), od: f64, id: f64) -> f64 {
+    let (p_o, p_i) = pressures(tvd, (rho_o, rho_i));
     let q = std::f64::consts::FRAC_PI_4;
-    f_eff - p * q * (od * od - id * id)
+    f_eff - p_o * q * od * od + p_i * q * id * id
+}
+
+/// Hydrostatic pressures (outside, inside) at TVD `tvd` (Pa) of the two mud columns.
+pub fn pressures(tvd: f64, (rho_o, rho_i): (f64, f64)) -> (f64, f64) {
+    let g = crate::model::GRAVITY * tvd.max(0.0);
+    (rho_o * g, rho_i * g)
 }
 
 /// The strength check of a static profile (`holewall static`).
@@ -133,13 +170,14 @@ pub struct Loads {
 
 /// Von Mises stress and utilisation per node (NaN on ungraded components), and the
 /// summary; `None` when no component is graded. `component_of(i)` is node `i`'s component,
-/// `nominal(i)` its body's OD and ID, `rho` the mud density, `hook_load` the hook load (N).
+/// `nominal(i)` its body's OD and ID, `rho` the mud densities (outside, inside), `hook_load`
+/// the hook load (N).
 pub fn assess(
     rows: &[Loads],
     strength: &[Option<PipeStrength>],
     component_of: &dyn Fn(usize) -> usize,
     nominal: &dyn Fn(usize) -> (f64, f64),
-    rho: f64,
+    rho: (f64, f64),
     hook_load: f64,
 ) -> (Vec<(f64, f64)>, Option<StrengthSummary>) {
     let mut out = Vec::with_capacity(rows.len());
@@ -152,7 +190,8 @@ pub fn assess(
         };
         let (od, id) = nominal(i);
         let f_true = true_axial_force(r.axial_force, r.tvd, rho, od, id);
-        let vm = s.von_mises_pa(f_true, r.bending_moment, r.torque);
+        let (p_o, p_i) = pressures(r.tvd, rho);
+        let vm = s.von_mises_triaxial_pa(f_true, r.bending_moment, r.torque, p_i, p_o);
         let u = vm / s.yield_pa;
         if worst.0.is_nan() || u > worst.0 {
             worst = (u, r.md);

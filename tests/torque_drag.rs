@@ -538,6 +538,36 @@ fn pipe_strength_matches_api_rp_7g_tables() {
 }
 
 #[test]
+fn pressure_enters_the_von_mises_stress_by_lame() {
+    use holewall::strength::{true_axial_force, PipeStrength};
+    let (od, id) = (5.0 * 0.0254, 4.276 * 0.0254);
+    let pipe = PipeStrength::new("G105", 105_000.0 * 6_894.757, 1.0, od, id);
+    let (area, _, _) = pipe.section();
+    // The bottom of a string hanging in one mud (F_eff = 0) at 3,000 m TVD: true force
+    // −p A_s, radial and hoop stresses −p: a hydrostatic state, no von Mises stress.
+    let rho = 1200.0;
+    let p = rho * holewall::model::GRAVITY * 3000.0;
+    let f = true_axial_force(0.0, 3000.0, (rho, rho), od, id);
+    assert!((f + p * area).abs() < 1e-9 * p * area);
+    assert!(pipe.von_mises_triaxial_pa(f, 0.0, 0.0, p, p) < 1e-6 * p);
+    // 30 MPa inside, nothing outside, no axial stress: the inner fibre's hoop stress
+    // p (r_o² + r_i²)/(r_o² − r_i²) and radial −p (Lamé) give
+    // σ_vm = √(½((σ_θ)² + (σ_θ + p)² + p²)).
+    let pi = 30e6;
+    let (ro, ri) = (0.5 * od, 0.5 * id);
+    let hoop = pi * (ro * ro + ri * ri) / (ro * ro - ri * ri);
+    let want = (0.5 * (hoop * hoop + (hoop + pi).powi(2) + pi * pi)).sqrt();
+    let got = pipe.von_mises_triaxial_pa(0.0, 0.0, 0.0, pi, 0.0);
+    assert!((got - want).abs() < 1e-9 * want, "{got} vs {want}");
+    // Two fluid columns: 1.8 sg inside, 1.2 sg outside, F_eff = 0 at 2,000 m: the true force
+    // −p_o A_o + p_i A_i.
+    let (po, pin) = (1200.0 * 9.80665 * 2000.0, 1800.0 * 9.80665 * 2000.0);
+    let q = std::f64::consts::FRAC_PI_4;
+    let f2 = true_axial_force(0.0, 2000.0, (1200.0, 1800.0), od, id);
+    assert!((f2 - (-po * q * od * od + pin * q * id * id)).abs() < 1e-6 * po * area);
+}
+
+#[test]
 fn static_reports_the_strength_of_graded_pipe() {
     let text = std::fs::read_to_string(
         std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("cases/build_and_hold.toml"),

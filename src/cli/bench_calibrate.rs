@@ -123,11 +123,19 @@ fn one_well(seed: u64, dir: &Path) -> Result<CalibrateRow, String> {
     let keys = crate::calibrate::unknowns(&case);
     let mu: Vec<f64> = keys
         .iter()
-        .map(|k| if k.name == "mu.cased" { mu_cased } else { mu_open })
+        .map(|k| {
+            if k.name == "mu.cased" {
+                mu_cased
+            } else {
+                mu_open
+            }
+        })
         .collect();
     let top = (shoe + 0.25 * (total - shoe)).max(0.5 * total);
     let plan = SyntheticPlan {
-        depths: (0..5).map(|i| top + (total - top) * i as f64 / 4.0).collect(),
+        depths: (0..5)
+            .map(|i| top + (total - top) * i as f64 / 4.0)
+            .collect(),
         modes: vec![
             MeasuredMode::PickUp,
             MeasuredMode::SlackOff,

@@ -1,9 +1,9 @@
 //! The commands behind the `holewall` binary (argument parsing stays in `src/main.rs`).
 
 pub mod bench;
+pub mod bench_calibrate;
 pub mod bench_corpus;
 pub mod bench_ensemble;
-pub mod bench_calibrate;
 pub mod calibrate_cmd;
 pub mod contact;
 pub mod critical_cmd;

@@ -189,7 +189,7 @@ pub fn run(
             let e = &model.elements[i.min(n - 2)];
             (e.outer_diameter, e.inner_diameter())
         },
-        case.mud_density,
+        (case.mud_density, case.mud_inside_density),
         hook,
     );
     for (r, (vm, u)) in rows.iter_mut().zip(&stresses) {
@@ -504,8 +504,13 @@ fn tension_torque_plot(case: &Case, rows: &[ProfileRow], out: &Path) -> std::io:
         .map(|(i, r)| {
             let e = &model.elements[i.min(n - 2)];
             let (od, id) = (e.outer_diameter, e.inner_diameter());
-            let f =
-                crate::strength::true_axial_force(r.axial_force_n, r.z_m, case.mud_density, od, id);
+            let f = crate::strength::true_axial_force(
+                r.axial_force_n,
+                r.z_m,
+                (case.mud_density, case.mud_inside_density),
+                od,
+                id,
+            );
             (f / 1e3, r.torque_nm.abs() / 1e3)
         })
         .collect();
