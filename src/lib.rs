@@ -15,6 +15,7 @@ pub mod case;
 pub mod cli;
 pub mod corpus;
 pub mod diagnose;
+pub mod display_units;
 pub mod engine;
 pub mod ensemble;
 pub mod error;

@@ -17,6 +17,10 @@ use holewall::cli;
 struct Args {
     #[command(subcommand)]
     command: Command,
+    /// Units of the outputs (CSV columns, summary.json, plot axes): SI, or oilfield (ft,
+    /// klbf, kft·lbf, lbf/ft, psi, ppg, °/100 ft). Inputs take either, as written.
+    #[arg(long, value_enum, global = true, default_value_t = holewall::display_units::UnitSystem::Si)]
+    units: holewall::display_units::UnitSystem,
 }
 
 #[derive(Subcommand)]
@@ -462,13 +466,25 @@ fn fail(errors: &[holewall::Error]) -> ExitCode {
 }
 
 /// Prints a command's JSON summary on success; reports the error otherwise.
+/// A summary as printed: JSON in the outputs' units (`--units`).
+fn summary_text<T: serde::Serialize>(summary: &T) -> String {
+    match holewall::display_units::get() {
+        holewall::display_units::UnitSystem::Field => {
+            serde_json::to_string_pretty(&holewall::display_units::convert_json(
+                &serde_json::to_value(summary).unwrap_or_default(),
+            ))
+            .unwrap_or_default()
+        }
+        holewall::display_units::UnitSystem::Si => {
+            serde_json::to_string_pretty(summary).unwrap_or_default()
+        }
+    }
+}
+
 fn print_summary<T: serde::Serialize>(result: Result<T, holewall::Error>) -> ExitCode {
     match result {
         Ok(summary) => {
-            println!(
-                "{}",
-                serde_json::to_string_pretty(&summary).unwrap_or_default()
-            );
+            println!("{}", summary_text(&summary));
             ExitCode::SUCCESS
         }
         Err(e) => fail(&[e]),
@@ -499,6 +515,7 @@ fn print_ensemble_summary(
 
 fn main() -> ExitCode {
     let args = Args::parse();
+    holewall::display_units::set(args.units);
     match args.command {
         Command::Contact {
             backend,
@@ -602,7 +619,7 @@ fn main() -> ExitCode {
             };
             match cli::calibrate_cmd::run(&case, &measured, &out, options, !quiet) {
                 Ok(s) if !s.calibration.accepted => {
-                    println!("{}", serde_json::to_string_pretty(&s).unwrap_or_default());
+                    println!("{}", summary_text(&s));
                     for why in &s.calibration.rejected_because {
                         eprintln!("holewall: calibration rejected: {why}");
                     }

@@ -181,6 +181,8 @@ impl RunFolder {
     /// Writes `summary.json` (last), then puts the staging folder in place of `--out`.
     pub fn finish(mut self, summary_json: &[u8]) -> Result<(), crate::error::Error> {
         write_atomic(&self.staging.join("summary.json"), summary_json)?;
+        // `--units field`: the CSVs and summary.json translated, still in staging.
+        crate::display_units::convert_folder(&self.staging)?;
         let out = self.target.clone();
         if out.is_dir() {
             // An empty folder or an earlier run (checked by `prepare`): moved aside, then gone.

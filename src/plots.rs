@@ -15,6 +15,56 @@ pub struct Series<'a> {
     pub wide: bool,
 }
 
+/// Series in the output units ([`crate::display_units`]): names through `text`, points
+/// scaled by the axes' factors.
+struct InUnits {
+    names: Vec<String>,
+    points: Vec<Vec<(f64, f64)>>,
+    wide: Vec<bool>,
+}
+
+impl InUnits {
+    fn new(series: &[Series], kx: f64, ky: f64) -> Self {
+        InUnits {
+            names: series
+                .iter()
+                .map(|s| crate::display_units::text(s.name))
+                .collect(),
+            points: series
+                .iter()
+                .map(|s| s.points.iter().map(|(x, y)| (x * kx, y * ky)).collect())
+                .collect(),
+            wide: series.iter().map(|s| s.wide).collect(),
+        }
+    }
+
+    fn series(&self) -> Vec<Series<'_>> {
+        self.names
+            .iter()
+            .zip(&self.points)
+            .zip(&self.wide)
+            .map(|((name, points), wide)| Series {
+                name,
+                points: points.clone(),
+                wide: *wide,
+            })
+            .collect()
+    }
+}
+
+/// Title and axis labels in the output units, and the axes' factors.
+fn labels_in_units(
+    title: &str,
+    x_label: &str,
+    y_label: &str,
+) -> (String, (String, f64), (String, f64)) {
+    (
+        crate::display_units::text(title),
+        crate::display_units::axis(x_label),
+        crate::display_units::axis(y_label),
+    )
+}
+
 /// A marked point with a label (e.g. the neutral point).
 pub struct Marker<'a> {
     /// Label.
@@ -62,8 +112,23 @@ pub fn line_plot(
     series: &[Series],
     markers: &[Marker],
 ) -> std::io::Result<()> {
+    let (title, (xl, kx), (yl, ky)) = labels_in_units(title, x_label, y_label);
+    let lines = InUnits::new(series, kx, ky);
+    let labels: Vec<String> = markers
+        .iter()
+        .map(|m| crate::display_units::text(m.label))
+        .collect();
+    let markers: Vec<Marker> = markers
+        .iter()
+        .zip(&labels)
+        .map(|(m, label)| Marker {
+            label,
+            x: m.x * kx,
+            y: m.y * ky,
+        })
+        .collect();
     atomic_png(path, |tmp| {
-        draw(tmp, title, x_label, y_label, series, markers, &[])
+        draw(tmp, &title, &xl, &yl, &lines.series(), &markers, &[])
     })
 }
 
@@ -78,8 +143,10 @@ pub fn lines_and_points(
     series: &[Series],
     points: &[Series],
 ) -> std::io::Result<()> {
+    let (title, (xl, kx), (yl, ky)) = labels_in_units(title, x_label, y_label);
+    let (lines, dots) = (InUnits::new(series, kx, ky), InUnits::new(points, kx, ky));
     atomic_png(path, |tmp| {
-        draw(tmp, title, x_label, y_label, series, &[], points)
+        draw(tmp, &title, &xl, &yl, &lines.series(), &[], &dots.series())
     })
 }
 
@@ -182,6 +249,14 @@ pub fn orbit_plot(
     points: &[(f64, f64)],
     clearance_mm: f64,
 ) -> std::io::Result<()> {
+    // In field units the axes are in inches: every length scaled, the labels' "mm" too.
+    let (x_desc, k) = crate::display_units::axis("lateral x (mm)");
+    let (y_desc, _) = crate::display_units::axis("lateral y (mm)");
+    let title = crate::display_units::text(title);
+    let title = title.as_str();
+    let points: Vec<(f64, f64)> = points.iter().map(|(x, y)| (x * k, y * k)).collect();
+    let points = points.as_slice();
+    let clearance_mm = clearance_mm * k;
     let extent = points
         .iter()
         .filter(|(x, y)| x.is_finite() && y.is_finite())
@@ -199,8 +274,8 @@ pub fn orbit_plot(
             .build_cartesian_2d(-r..r, -r..r)?;
         chart
             .configure_mesh()
-            .x_desc("lateral x (mm)")
-            .y_desc("lateral y (mm)")
+            .x_desc(x_desc.as_str())
+            .y_desc(y_desc.as_str())
             .x_label_formatter(&tick)
             .y_label_formatter(&tick)
             .label_style(("sans-serif", 15))
@@ -214,17 +289,22 @@ pub fn orbit_plot(
                 .collect();
             chart
                 .draw_series(LineSeries::new(circle, BLACK.stroke_width(2)))?
-                .label(format!("clearance {} mm", tick(&clearance_mm)))
+                .label(format!(
+                    "clearance {} {}",
+                    tick(&clearance_mm),
+                    if k == 1.0 { "mm" } else { "in" }
+                ))
                 .legend(|(x, y)| {
                     PathElement::new(vec![(x, y), (x + 20, y)], BLACK.stroke_width(2))
                 });
         }
         // Motion below a micrometre (or a millionth of the clearance) is no motion.
-        if extent <= 1e-3f64.max(1e-6 * clearance_mm) {
+        if extent <= (1e-3 * k).max(1e-6 * clearance_mm) {
             chart.draw_series(std::iter::once(Text::new(
                 format!(
-                    "no lateral motion: the string stayed on the hole axis (largest |r| = {} mm)",
-                    tick(&extent)
+                    "no lateral motion: the string stayed on the hole axis (largest |r| = {} {})",
+                    tick(&extent),
+                    if k == 1.0 { "mm" } else { "in" }
                 ),
                 (-0.95 * r, 0.5 * r),
                 ("sans-serif", 17).into_font(),
@@ -372,7 +452,16 @@ pub fn histogram(
     values: &[f64],
     marks: &[(&str, f64)],
 ) -> std::io::Result<()> {
-    let v: Vec<f64> = values.iter().copied().filter(|x| x.is_finite()).collect();
+    let title = crate::display_units::text(title);
+    let (x_label, k) = crate::display_units::axis(x_label);
+    let (title, x_label) = (title.as_str(), x_label.as_str());
+    let marks: Vec<(&str, f64)> = marks.iter().map(|(l, x)| (*l, x * k)).collect();
+    let marks = marks.as_slice();
+    let v: Vec<f64> = values
+        .iter()
+        .map(|x| x * k)
+        .filter(|x| x.is_finite())
+        .collect();
     atomic_png(path, |tmp| {
         let root = BitMapBackend::new(tmp, (1000, 640)).into_drawing_area();
         root.fill(&WHITE)?;
@@ -440,6 +529,10 @@ pub fn scatter(
     y_label: &str,
     points: &[(f64, f64)],
 ) -> std::io::Result<()> {
+    let (title, (x_label, kx), (y_label, ky)) = labels_in_units(title, x_label, y_label);
+    let (title, x_label, y_label) = (title.as_str(), x_label.as_str(), y_label.as_str());
+    let points: Vec<(f64, f64)> = points.iter().map(|(x, y)| (x * kx, y * ky)).collect();
+    let points = points.as_slice();
     let series = [Series {
         name: "",
         points: points.to_vec(),
@@ -780,6 +873,10 @@ pub fn class_scatter(
     points: &[(f64, f64, usize)],
     classes: &[&str],
 ) -> std::io::Result<()> {
+    let (title, (x_label, kx), (y_label, ky)) = labels_in_units(title, x_label, y_label);
+    let (title, x_label, y_label) = (title.as_str(), x_label.as_str(), y_label.as_str());
+    let points: Vec<(f64, f64, usize)> = points.iter().map(|p| (p.0 * kx, p.1 * ky, p.2)).collect();
+    let points = points.as_slice();
     let all: Vec<(f64, f64)> = points.iter().map(|p| (p.0, p.1)).collect();
     let ((x0, x1), (y0, y1)) = bounds(&[Series {
         name: "",
@@ -828,6 +925,26 @@ pub fn heat_map(
     values: &[Vec<f64>],
     marks: &[Marker],
 ) -> std::io::Result<()> {
+    let (title, (x_label, kx), (y_label, ky)) = labels_in_units(title, x_label, y_label);
+    let (title, x_label, y_label) = (title.as_str(), x_label.as_str(), y_label.as_str());
+    let (xs, ys): (Vec<f64>, Vec<f64>) = (
+        xs.iter().map(|x| x * kx).collect(),
+        ys.iter().map(|y| y * ky).collect(),
+    );
+    let (xs, ys) = (xs.as_slice(), ys.as_slice());
+    let labels: Vec<String> = marks
+        .iter()
+        .map(|m| crate::display_units::text(m.label))
+        .collect();
+    let marks: Vec<Marker> = marks
+        .iter()
+        .zip(&labels)
+        .map(|(m, label)| Marker {
+            label,
+            x: m.x * kx,
+            y: m.y * ky,
+        })
+        .collect();
     let top = values
         .iter()
         .flatten()

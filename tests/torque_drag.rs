@@ -675,3 +675,74 @@ fn the_rig_reads_block_weight_and_dead_line_and_checks_its_keys() {
         assert!(e.to_string().contains(key) && e.line > 0, "{e}");
     }
 }
+
+#[test]
+fn field_units_translate_every_output() {
+    // `holewall static --units field` against the SI run: the same numbers in ft, klbf,
+    // kft·lbf; profile.csv's columns renamed and scaled; `--units si` is the default.
+    let case = concat!(env!("CARGO_MANIFEST_DIR"), "/cases/build_and_hold.toml");
+    let dir = common::scratch_dir("torque_drag", "units");
+    let run = |units: &str, out: &str| {
+        let (code, stdout, stderr) = common::holewall(&[
+            "static",
+            case,
+            "--out",
+            dir.join(out).to_str().unwrap(),
+            "--quiet",
+            "--units",
+            units,
+        ]);
+        assert_eq!(code, 0, "{stderr}");
+        serde_json::from_str::<serde_json::Value>(&stdout).unwrap()
+    };
+    let si = run("si", "si");
+    let field = run("field", "field");
+    let lbf = 4.448_221_615_260_5;
+    let ft = 0.3048;
+    let close = |a: f64, b: f64| (a - b).abs() <= 1e-9 * b.abs().max(1.0);
+    assert!(close(
+        field["hook_load_klbf"].as_f64().unwrap() * 1e3 * lbf,
+        si["hook_load_n"].as_f64().unwrap()
+    ));
+    assert!(close(
+        field["surface_torque_kftlbf"].as_f64().unwrap() * 1e3 * lbf * ft,
+        si["surface_torque_nm"].as_f64().unwrap()
+    ));
+    assert!(close(
+        field["neutral_point_from_bit_ft"].as_f64().unwrap() * ft,
+        si["neutral_point_from_bit_m"].as_f64().unwrap()
+    ));
+    // summary.json on disk as printed.
+    let on_disk: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("field/summary.json")).unwrap())
+            .unwrap();
+    assert_eq!(on_disk["hook_load_klbf"], field["hook_load_klbf"]);
+    let read = |out: &str| {
+        let text = std::fs::read_to_string(dir.join(out).join("profile.csv")).unwrap();
+        let mut r = csv::Reader::from_reader(text.as_bytes());
+        let h: Vec<String> = r.headers().unwrap().iter().map(String::from).collect();
+        let last: Vec<String> = r
+            .records()
+            .last()
+            .unwrap()
+            .unwrap()
+            .iter()
+            .map(String::from)
+            .collect();
+        (h, last)
+    };
+    let ((hs, rs), (hf, rf)) = (read("si"), read("field"));
+    assert_eq!(hf[0], "md_ft");
+    assert!(hf.contains(&"axial_force_klbf".to_string()));
+    assert!(hf.contains(&"side_force_per_length_lbf_per_ft".to_string()));
+    let col = |h: &[String], name: &str| h.iter().position(|x| x == name).unwrap();
+    let md_si: f64 = rs[col(&hs, "md_m")].parse().unwrap();
+    let md_f: f64 = rf[col(&hf, "md_ft")].parse().unwrap();
+    assert!(close(md_f * ft, md_si));
+    let t_si: f64 = rs[col(&hs, "torque_nm")].parse().unwrap();
+    let t_f: f64 = rf[col(&hf, "torque_kftlbf")].parse().unwrap();
+    assert!((t_f * 1e3 * lbf * ft - t_si).abs() <= 1e-9 * t_si.abs().max(1.0));
+    // A bad unit system is refused by the argument parser (exit code 2).
+    let (code, _, _) = common::holewall(&["static", case, "--out", "x", "--units", "imperial"]);
+    assert_eq!(code, 2);
+}

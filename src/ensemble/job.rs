@@ -423,6 +423,9 @@ pub fn run(
             .unwrap_or_default()
             .as_bytes(),
     )?;
+    // `--units field`: variants.csv, the statistics' CSVs and summary.json translated (the
+    // chunks and run.json, the run's own state, stay SI).
+    crate::display_units::convert_folder(out)?;
     Ok(summary)
 }
 
