@@ -296,7 +296,7 @@ mod tests {
             .take(3)
             .map(|x| x.parse().unwrap())
             .collect();
-        assert!((row[0] - 3280.839_895).abs() < 1e-5);
+        assert!((row[0] - 3_280.839_895).abs() < 1e-5);
         assert!((row[1] - 1.0).abs() < 1e-12 && (row[2] - 1.0).abs() < 1e-9);
         let j = serde_json::json!({"hook_load_n": 4448.221615260505, "interval": [1, 2],
             "rig": {"dead_line_n": 44482.21615260505, "travel": "hoisting"},
