@@ -27,6 +27,7 @@ pub mod output;
 pub mod physics;
 pub mod plots;
 pub mod profile;
+pub mod report_html;
 pub mod rig;
 pub mod run;
 pub mod selfcheck;

@@ -78,7 +78,7 @@ pub fn out_error(out: &Path, message: String) -> crate::error::Error {
 
 /// Whether `name` is a file a single run (`holewall static`, `holewall run`) writes.
 fn is_single_run_output(name: &str) -> bool {
-    [".png", ".svg", ".csv", ".json"]
+    [".png", ".svg", ".csv", ".json", ".html"]
         .iter()
         .any(|ext| name.ends_with(ext))
 }
@@ -99,6 +99,8 @@ pub struct RunFolder {
     /// An earlier run is replaced at the end.
     pub replaces_earlier_run: bool,
     finished: bool,
+    /// `report.html`'s command and case file ([`RunFolder::with_report`]).
+    report: Option<(String, std::path::PathBuf)>,
 }
 
 impl RunFolder {
@@ -165,7 +167,15 @@ impl RunFolder {
             staging,
             replaces_earlier_run,
             finished: false,
+            report: None,
         })
+    }
+
+    /// The folder gets a `report.html` ([`crate::report_html`]) at [`RunFolder::finish`]:
+    /// `command` made it from the case file `case`.
+    pub fn with_report(mut self, command: &str, case: &Path) -> Self {
+        self.report = Some((command.to_string(), case.to_path_buf()));
+        self
     }
 
     /// Where the run writes its files until [`RunFolder::finish`].
@@ -183,6 +193,9 @@ impl RunFolder {
         write_atomic(&self.staging.join("summary.json"), summary_json)?;
         // `--units field`: the CSVs and summary.json translated, still in staging.
         crate::display_units::convert_folder(&self.staging)?;
+        if let Some((command, case)) = &self.report {
+            crate::report_html::write(&self.staging, command, Some(case))?;
+        }
         let out = self.target.clone();
         if out.is_dir() {
             // An empty folder or an earlier run (checked by `prepare`): moved aside, then gone.

@@ -69,7 +69,7 @@ pub fn run(
         }
         .into());
     }
-    let folder = RunFolder::prepare(out)?;
+    let folder = RunFolder::prepare(out)?.with_report("calibrate", case_path);
     let bar = crate::output::progress_bar(
         show_progress,
         0,

@@ -55,7 +55,7 @@ pub fn run(
     let start = std::time::Instant::now();
     let case = load_case(case_path)?;
     super::print_warnings(&case);
-    let folder = RunFolder::prepare(out)?;
+    let folder = RunFolder::prepare(out)?.with_report("critical-speeds", case_path);
     let model = &case.model;
     let sol =
         crate::profile::solve_with_progress(&case, StaticOptions::default(), options.show_progress)

@@ -12,7 +12,7 @@ pub use crate::run::{RunOptions, RunSummary, SiteWhirl};
 pub fn run(case_path: &Path, out: &Path, options: RunOptions) -> Result<RunSummary, Error> {
     let case = load_case(case_path)?;
     super::print_warnings(&case);
-    let folder = RunFolder::prepare(out)?;
+    let folder = RunFolder::prepare(out)?.with_report("run", case_path);
     let summary = crate::run::run_case(&case, folder.path(), options)?;
     folder.finish(&crate::run::summary_json(&summary)?)?;
     print_notices(&summary);

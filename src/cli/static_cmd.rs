@@ -90,7 +90,7 @@ pub fn run(
     let start = std::time::Instant::now();
     let case = load_case(case_path)?;
     super::print_warnings(&case);
-    let folder = RunFolder::prepare(out)?;
+    let folder = RunFolder::prepare(out)?.with_report("static", case_path);
     let model = &case.model;
     let n = model.nodes.len();
     let mut wob = model.weight_on_bit;

@@ -49,7 +49,7 @@ pub fn run(
     let start = std::time::Instant::now();
     let case = load_case(case_path)?;
     super::print_warnings(&case);
-    let folder = RunFolder::prepare(out)?;
+    let folder = RunFolder::prepare(out)?.with_report("tendency", case_path);
     let settings = crate::bha::tendency::TendencySettings {
         deadline: max_seconds.map(|s| start + std::time::Duration::from_secs_f64(s)),
         ..case.tendency.settings

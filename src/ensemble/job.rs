@@ -426,6 +426,7 @@ pub fn run(
     // `--units field`: variants.csv, the statistics' CSVs and summary.json translated (the
     // chunks and run.json, the run's own state, stay SI).
     crate::display_units::convert_folder(out)?;
+    crate::report_html::write(out, "ensemble", Some(&case.path))?;
     Ok(summary)
 }
 

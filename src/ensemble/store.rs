@@ -144,7 +144,7 @@ pub(crate) fn read_chunk(path: &Path) -> Result<Chunk, Error> {
 pub(crate) fn is_run_output(name: &str) -> bool {
     matches!(
         name,
-        "run.json" | "summary.json" | "variants.csv" | "chunks" | "series"
+        "run.json" | "summary.json" | "variants.csv" | "chunks" | "series" | "report.html"
     ) || name.ends_with(".png")
 }
 
