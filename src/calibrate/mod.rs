@@ -329,6 +329,38 @@ fn spline_weights(nodes: &[f64], x: f64) -> Vec<f64> {
     w
 }
 
+/// Fills the NaN entries of a tensor grid's values (`n` per axis, `d` axes, first axis
+/// slowest) with the mean of their filled neighbours along the axes, sweeping until none is
+/// left (a grid with no finite value stays as it is).
+fn fill_from_neighbours(values: &mut [f64], n: usize, d: usize) {
+    if values.iter().all(|v| !v.is_finite()) {
+        return;
+    }
+    while values.iter().any(|v| !v.is_finite()) {
+        let before = values.to_vec();
+        for k in 0..values.len() {
+            if before[k].is_finite() {
+                continue;
+            }
+            let mut neighbours = Vec::new();
+            let stride = |a: usize| n.pow((d - 1 - a) as u32);
+            for a in 0..d {
+                let i = (k / stride(a)) % n;
+                if i > 0 {
+                    neighbours.push(before[k - stride(a)]);
+                }
+                if i + 1 < n {
+                    neighbours.push(before[k + stride(a)]);
+                }
+            }
+            let ok: Vec<f64> = neighbours.into_iter().filter(|v| v.is_finite()).collect();
+            if !ok.is_empty() {
+                values[k] = ok.iter().sum::<f64>() / ok.len() as f64;
+            }
+        }
+    }
+}
+
 /// Uniform grid of `n` points on `[lo, hi]`.
 fn linspace(lo: f64, hi: f64, n: usize) -> Vec<f64> {
     if n == 1 {
@@ -417,23 +449,42 @@ pub fn calibrate(
         .collect();
     bar.set_length((variants.len() + st.len()) as u64);
     let results = run_until(case, &variants, opts.deadline, bar)?;
-    // Modelled loads per station per node.
+    // Modelled loads per station per node; a node whose FE run failed at some station (a
+    // slack-off that locks up, a solve that does not converge) is filled from its grid
+    // neighbours for the spline, and the posterior is zero around it.
     let mut hook = vec![vec![0.0; node_count]; st.len()];
     let mut torque = vec![vec![0.0; node_count]; st.len()];
+    let mut failed_node = vec![false; node_count];
+    let mut failures: Vec<String> = Vec::new();
     for (k, r) in results.iter().enumerate() {
         let (node, s) = (k / st.len(), k % st.len());
-        let (h, t) = modelled(r).ok_or_else(|| {
-            Error::failed(format!(
-                "the model failed at {} m {} with {:?} = {:?}: {}",
-                st[s].bit_md,
-                st[s].mode.name(),
-                keys.iter().map(|k| k.name.as_str()).collect::<Vec<_>>(),
-                node_mu(node),
-                r.reason
-            ))
-        })?;
-        hook[s][node] = h;
-        torque[s][node] = t;
+        match modelled(r) {
+            Some((h, t)) => {
+                hook[s][node] = h;
+                torque[s][node] = t;
+            }
+            None => {
+                hook[s][node] = f64::NAN;
+                torque[s][node] = f64::NAN;
+                failed_node[node] = true;
+                failures.push(format!(
+                    "{} m {} at {:?}: {}",
+                    st[s].bit_md,
+                    st[s].mode.name(),
+                    node_mu(node),
+                    r.reason.chars().take(160).collect::<String>()
+                ));
+            }
+        }
+    }
+    if failed_node.iter().all(|f| *f) {
+        return Err(Error::failed(format!(
+            "the model failed at every grid node (e.g. {})",
+            failures.first().cloned().unwrap_or_default()
+        )));
+    }
+    for values in hook.iter_mut().chain(torque.iter_mut()) {
+        fill_from_neighbours(values, opts.nodes, d);
     }
     // The fine grid and the spline weights per axis.
     let fine = linspace(opts.range.0, opts.range.1, FINE);
@@ -461,11 +512,26 @@ pub fn calibrate(
     };
     let n_h = rows.iter().filter(|r| r.hook_load.is_some()).count();
     let n_t = rows.iter().filter(|r| r.surface_torque.is_some()).count();
+    // A fine point is left out when the grid node nearest it failed.
+    let h_grid = grid.get(1).map_or(1.0, |g| g - grid[0]);
+    let nearest = |x: f64| -> usize {
+        (((x - grid[0]) / h_grid).round().max(0.0) as usize).min(opts.nodes - 1)
+    };
+    let masked = |f: usize| -> bool {
+        let node = match d {
+            1 => nearest(fine[f]),
+            _ => nearest(fine[f / FINE]) * opts.nodes + nearest(fine[f % FINE]),
+        };
+        failed_node[node]
+    };
     let log_post: Vec<f64> = {
         use rayon::prelude::*;
         (0..fine_count)
             .into_par_iter()
             .map(|f| {
+                if masked(f) {
+                    return f64::NEG_INFINITY;
+                }
                 let pred: Vec<(f64, f64)> = (0..st.len())
                     .map(|s| (surrogate(&hook[s], f), surrogate(&torque[s], f)))
                     .collect();
@@ -709,6 +775,17 @@ pub fn calibrate(
             ));
         }
     }
+    if !failures.is_empty() {
+        warnings.push(format!(
+            "{} of {} model runs failed, at {} of {} grid nodes; the posterior is zero around \
+             those nodes (first: {})",
+            failures.len(),
+            variants.len(),
+            failed_node.iter().filter(|f| **f).count(),
+            node_count,
+            failures[0]
+        ));
+    }
     let fine_axes = vec![fine.clone(); d];
     let posterior = if d == 2 {
         (0..FINE)
@@ -787,6 +864,22 @@ mod tests {
                 .sum();
             assert!((s - f(x)).abs() < 2e-3 * f(x), "{x}: {s} vs {}", f(x));
         }
+    }
+
+    #[test]
+    fn failed_nodes_are_filled_from_their_neighbours() {
+        // A 3 × 3 grid, x + 10 y, the centre and a corner missing.
+        let mut v: Vec<f64> = (0..9)
+            .map(|k| (k / 3) as f64 + 10.0 * (k % 3) as f64)
+            .collect();
+        v[4] = f64::NAN;
+        v[8] = f64::NAN;
+        fill_from_neighbours(&mut v, 3, 2);
+        assert_eq!(v[4], 11.0); // the mean of 1, 21, 10, 12
+        assert_eq!(v[8], 0.5 * (12.0 + 21.0));
+        let mut none = vec![f64::NAN; 4];
+        fill_from_neighbours(&mut none, 2, 2);
+        assert!(none.iter().all(|x| x.is_nan()));
     }
 
     #[test]
