@@ -13,8 +13,7 @@
 
 use std::sync::atomic::{AtomicU8, Ordering};
 
-const LBF: f64 = 4.448_221_615_260_5;
-const FT: f64 = 0.3048;
+use crate::units::{FT, LBF};
 const PSI: f64 = 6_894.757_293_168;
 const PPG: f64 = 119.826_427_316_5;
 

@@ -52,6 +52,32 @@ impl InUnits {
     }
 }
 
+/// Markers' labels in the output units.
+fn marker_labels(markers: &[Marker]) -> Vec<String> {
+    markers
+        .iter()
+        .map(|m| crate::display_units::text(m.label))
+        .collect()
+}
+
+/// Markers at their points scaled by the axes' factors, with `labels` ([`marker_labels`]).
+fn scaled_markers<'a>(
+    markers: &[Marker],
+    labels: &'a [String],
+    kx: f64,
+    ky: f64,
+) -> Vec<Marker<'a>> {
+    markers
+        .iter()
+        .zip(labels)
+        .map(|(m, label)| Marker {
+            label,
+            x: m.x * kx,
+            y: m.y * ky,
+        })
+        .collect()
+}
+
 /// Title and axis labels in the output units, and the axes' factors.
 fn labels_in_units(
     title: &str,
@@ -114,19 +140,8 @@ pub fn line_plot(
 ) -> std::io::Result<()> {
     let (title, (xl, kx), (yl, ky)) = labels_in_units(title, x_label, y_label);
     let lines = InUnits::new(series, kx, ky);
-    let labels: Vec<String> = markers
-        .iter()
-        .map(|m| crate::display_units::text(m.label))
-        .collect();
-    let markers: Vec<Marker> = markers
-        .iter()
-        .zip(&labels)
-        .map(|(m, label)| Marker {
-            label,
-            x: m.x * kx,
-            y: m.y * ky,
-        })
-        .collect();
+    let labels = marker_labels(markers);
+    let markers = scaled_markers(markers, &labels, kx, ky);
     atomic_png(path, |tmp| {
         draw(tmp, &title, &xl, &yl, &lines.series(), &markers, &[])
     })
@@ -932,19 +947,8 @@ pub fn heat_map(
         ys.iter().map(|y| y * ky).collect(),
     );
     let (xs, ys) = (xs.as_slice(), ys.as_slice());
-    let labels: Vec<String> = marks
-        .iter()
-        .map(|m| crate::display_units::text(m.label))
-        .collect();
-    let marks: Vec<Marker> = marks
-        .iter()
-        .zip(&labels)
-        .map(|(m, label)| Marker {
-            label,
-            x: m.x * kx,
-            y: m.y * ky,
-        })
-        .collect();
+    let labels = marker_labels(marks);
+    let marks = scaled_markers(marks, &labels, kx, ky);
     let top = values
         .iter()
         .flatten()

@@ -147,6 +147,19 @@ impl Rig {
     }
 }
 
+/// The y axis of a hook-load plot (kN): the weight indicator's reading where the case has a
+/// `[rig]`, else the string's load.
+pub fn hook_load_axis(rig: Option<Rig>) -> String {
+    match rig {
+        Some(r) if r.tared => "weight indicator, block tared (kN)".to_string(),
+        Some(r) => format!(
+            "weight indicator, incl. {:.0} kN block (kN)",
+            r.block_weight_n * 1e-3
+        ),
+        None => "hook load (kN)".to_string(),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

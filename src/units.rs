@@ -56,8 +56,10 @@ impl Dimension {
     }
 }
 
-const LBF: f64 = 4.448_221_615_260_5;
-const FT: f64 = 0.3048;
+/// One pound-force (N).
+pub const LBF: f64 = 4.448_221_615_260_5;
+/// One foot (m).
+pub const FT: f64 = 0.3048;
 const INCH: f64 = 0.0254;
 
 /// Known units: (name, dimension, factor to SI).

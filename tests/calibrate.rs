@@ -76,56 +76,55 @@ fn check_recovered(s: &serde_json::Value, truth: &[(&str, f64)], widest: f64) {
 
 #[test]
 fn calibration_recovers_the_friction_factors_of_synthetic_measurements() {
-    // 1. The shipped broomstick case (casing to 500 m, nearly vertical: the cased factor is
-    // barely constrained, its interval wide; the open hole's is).
-    let case = manifest("cases/broomstick_tool_joints.toml");
-    let (code, s, stderr, out) = measure_and_calibrate(
-        "broomstick",
-        &case,
-        &case,
-        vec![700.0, 900.0, 1100.0, 1300.0, 1500.0],
-        vec![0.18, 0.32],
-        1,
-    );
-    assert_eq!(code, 0, "{stderr}");
-    check_recovered(&s, &[("mu.cased", 0.18), ("mu.open", 0.32)], 0.6);
-    for f in [
-        "posterior.csv",
-        "posterior.png",
-        "residuals_torque.png",
-        "torque.png",
-    ] {
-        assert!(out.join(f).is_file(), "{f}");
-    }
-    let open = &s["calibration"]["estimates"][1];
-    assert!(open["sd"].as_f64().unwrap() < 0.08, "{open}");
-    // 2. 2,500 m build-and-hold cased to 1,200 m through the build: both factors.
-    let case = manifest("cases/build_and_hold_2500.toml");
-    let (code, s, stderr, _) = measure_and_calibrate(
-        "2500",
-        &case,
-        &case,
-        vec![1300.0, 1600.0, 1900.0, 2200.0, 2500.0],
-        vec![0.22, 0.35],
-        2,
-    );
-    assert_eq!(code, 0, "{stderr}");
-    check_recovered(&s, &[("mu.cased", 0.22), ("mu.open", 0.35)], 0.25);
-    // 3. A generated well (corpus seed 1: build and hold to 54°, 1,281 m, 8¾ in hole).
     let dir = common::scratch_dir("calibrate", "corpus");
-    let well = holewall::corpus::write_well(1, &dir).unwrap();
-    let path = well.case_path.to_str().unwrap().to_string();
-    let total = well.spec.total_md;
-    let (code, s, stderr, _) = measure_and_calibrate(
-        "corpus1",
-        &path,
-        &path,
-        (0..5).map(|i| total - 100.0 * i as f64).collect(),
-        vec![0.15, 0.28],
-        3,
-    );
-    assert_eq!(code, 0, "{stderr}");
-    check_recovered(&s, &[("mu.cased", 0.15), ("mu.open", 0.28)], 0.6);
+    let corpus = holewall::corpus::write_well(1, &dir).unwrap();
+    let corpus_path = corpus.case_path.to_str().unwrap().to_string();
+    let total = corpus.spec.total_md;
+    // (tag, case, bit depths, truth (cased, open), seed, widest interval allowed):
+    // 1. the shipped broomstick case (casing to 500 m, nearly vertical: the cased factor is
+    //    barely constrained, its interval wide; the open hole's is);
+    // 2. 2,500 m build-and-hold cased to 1,200 m through the build: both factors;
+    // 3. a generated well (corpus seed 1: build and hold to 54°, 1,281 m, 8¾ in hole).
+    let wells = [
+        (
+            "broomstick",
+            manifest("cases/broomstick_tool_joints.toml"),
+            vec![700.0, 900.0, 1100.0, 1300.0, 1500.0],
+            (0.18, 0.32),
+            1,
+            0.6,
+        ),
+        (
+            "2500",
+            manifest("cases/build_and_hold_2500.toml"),
+            vec![1300.0, 1600.0, 1900.0, 2200.0, 2500.0],
+            (0.22, 0.35),
+            2,
+            0.25,
+        ),
+        (
+            "corpus1",
+            corpus_path,
+            (0..5).map(|i| total - 100.0 * i as f64).collect(),
+            (0.15, 0.28),
+            3,
+            0.6,
+        ),
+    ];
+    for (tag, case, depths, (cased, open), seed, widest) in wells {
+        let (code, s, stderr, out) =
+            measure_and_calibrate(tag, &case, &case, depths, vec![cased, open], seed);
+        assert_eq!(code, 0, "{tag}: {stderr}");
+        check_recovered(&s, &[("mu.cased", cased), ("mu.open", open)], widest);
+        for f in [
+            "posterior.csv",
+            "posterior.png",
+            "residuals_torque.png",
+            "torque.png",
+        ] {
+            assert!(out.join(f).is_file(), "{tag}: {f}");
+        }
+    }
 }
 
 #[test]

@@ -99,12 +99,8 @@ pub fn parse_measured(source: &str, text: &str) -> Result<Vec<Measurement>, Inpu
         key: key.to_string(),
         message,
     };
-    const LBF: f64 = 4.448_221_615_260_5;
-    const FT: f64 = 0.3048;
-    let mut reader = csv::ReaderBuilder::new()
-        .trim(csv::Trim::All)
-        .comment(Some(b'#'))
-        .from_reader(text.as_bytes());
+    use crate::units::{FT, LBF};
+    let mut reader = crate::ensemble::input_csv(text);
     let header = reader
         .headers()
         .map_err(|e| err(1, "-", format!("not a CSV: {e}")))?

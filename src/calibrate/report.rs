@@ -116,6 +116,30 @@ fn posterior(case: &Case, cal: &Calibration, dir: &Path) -> Result<Vec<String>, 
     Ok(vec!["posterior.csv".into(), "posterior.png".into()])
 }
 
+/// One point series per mode (named `names[k]` for `modes[k]`): the points of `items` of
+/// that mode.
+fn by_mode<'a, T>(
+    modes: &[MeasuredMode],
+    names: &'a [String],
+    items: &[T],
+    mode: impl Fn(&T) -> MeasuredMode,
+    point: impl Fn(&T) -> Option<(f64, f64)>,
+) -> Vec<Series<'a>> {
+    modes
+        .iter()
+        .zip(names)
+        .map(|(m, name)| Series {
+            name,
+            points: items
+                .iter()
+                .filter(|x| mode(x) == *m)
+                .filter_map(&point)
+                .collect(),
+            wide: false,
+        })
+        .collect()
+}
+
 /// The modes in `rows`' order of [`MeasuredMode::NAMES`].
 fn modes_of(modes: impl Iterator<Item = MeasuredMode> + Clone) -> Vec<MeasuredMode> {
     MeasuredMode::NAMES
@@ -140,20 +164,13 @@ fn residual_plots(case: &Case, cal: &Calibration, dir: &Path) -> Result<Vec<Stri
         }),
     ] {
         let names: Vec<String> = modes.iter().map(|m| m.name().replace('_', " ")).collect();
-        let sets: Vec<Series> = modes
-            .iter()
-            .zip(&names)
-            .map(|(m, n)| Series {
-                name: n,
-                points: cal
-                    .residuals
-                    .iter()
-                    .filter(|r| r.mode == *m)
-                    .filter_map(|r| pick(r).map(|x| (r.bit_md_m, x * 1e-3)))
-                    .collect(),
-                wide: false,
-            })
-            .collect();
+        let sets = by_mode(
+            &modes,
+            &names,
+            &cal.residuals,
+            |r| r.mode,
+            |r| pick(r).map(|x| (r.bit_md_m, x * 1e-3)),
+        );
         if sets.iter().all(|s| s.points.is_empty()) {
             continue;
         }
@@ -232,14 +249,7 @@ fn broomsticks(
         .iter()
         .map(|m| format!("{} (measured)", m.name().replace('_', " ")))
         .collect();
-    let hook_label = match case.rig {
-        Some(r) if r.tared => "weight indicator, block tared (kN)".to_string(),
-        Some(r) => format!(
-            "weight indicator, incl. {:.0} kN block (kN)",
-            r.block_weight_n * 1e-3
-        ),
-        None => "hook load (kN)".to_string(),
-    };
+    let hook_label = crate::rig::hook_load_axis(case.rig);
     let mut files = Vec::new();
     for (file, what, y_label, pick_model, pick_measured) in [
         (
@@ -257,19 +267,13 @@ fn broomsticks(
             |r| r.surface_torque,
         ),
     ] {
-        let measured: Vec<Series> = modes
-            .iter()
-            .zip(&measured_names)
-            .map(|(m, n)| Series {
-                name: n,
-                points: rows
-                    .iter()
-                    .filter(|r| r.mode == *m)
-                    .filter_map(|r| pick_measured(r).map(|x| (r.bit_md, x * 1e-3)))
-                    .collect(),
-                wide: false,
-            })
-            .collect();
+        let measured = by_mode(
+            &modes,
+            &measured_names,
+            rows,
+            |r| r.mode,
+            |r| pick_measured(r).map(|x| (r.bit_md, x * 1e-3)),
+        );
         if measured.iter().all(|s| s.points.is_empty()) {
             continue;
         }

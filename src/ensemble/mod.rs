@@ -77,12 +77,17 @@ pub fn variants_from_csv(path: &Path) -> Result<Vec<Variant>, InputError> {
     variants_from_csv_text(&source, &text)
 }
 
-/// As [`variants_from_csv`], from text.
-pub fn variants_from_csv_text(source: &str, text: &str) -> Result<Vec<Variant>, InputError> {
-    let mut reader = csv::ReaderBuilder::new()
+/// The reader of a user's CSV (variants, measurements): cells trimmed, `#` lines comments.
+pub(crate) fn input_csv(text: &str) -> csv::Reader<&[u8]> {
+    csv::ReaderBuilder::new()
         .trim(csv::Trim::All)
         .comment(Some(b'#'))
-        .from_reader(text.as_bytes());
+        .from_reader(text.as_bytes())
+}
+
+/// As [`variants_from_csv`], from text.
+pub fn variants_from_csv_text(source: &str, text: &str) -> Result<Vec<Variant>, InputError> {
+    let mut reader = input_csv(text);
     let header = reader
         .headers()
         .map_err(|e| input_error(source, 1, "-", e.to_string()))?

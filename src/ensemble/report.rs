@@ -379,14 +379,7 @@ pub(crate) fn broomstick(
             });
         }
     }
-    let y_label = match case.rig {
-        Some(r) if r.tared => "weight indicator, block tared (kN)".to_string(),
-        Some(r) => format!(
-            "weight indicator, incl. {:.0} kN block (kN)",
-            r.block_weight_n * 1e-3
-        ),
-        None => "hook load (kN)".to_string(),
-    };
+    let y_label = crate::rig::hook_load_axis(case.rig);
     line_plot(
         &out.join("broomstick.png"),
         &format!("{}: hook load against bit depth", case.title),
