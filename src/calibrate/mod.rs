@@ -30,8 +30,10 @@
 //! the surrogate's error (reported). The calibration is **rejected** (exit code 1, every
 //! output still written) when a mode's residuals, or every mode's together, trend with
 //! depth (least-squares slope, two-sided p < 0.001 by Student's t — friction cannot make a
-//! load error that grows with depth; a wrong string weight or survey can), or, with a
-//! stated noise, when the residuals exceed it (χ², p < 0.001). A MAP on the range's edge,
+//! load error that grows with depth; a wrong string weight or survey can), when per-mode
+//! offsets and depth trends explain the residuals far better than the friction factors
+//! alone (a lack-of-fit F-test, p < 0.001), or, with a stated noise, when the residuals
+//! exceed it (χ², p < 0.001). A MAP on the range's edge,
 //! an interval reaching it or a surrogate error above a quarter of the noise are warnings.
 
 use serde::Serialize;
@@ -264,6 +266,9 @@ pub struct Calibration {
     pub trends: Vec<Trend>,
     /// Residual per row at the MAP.
     pub residuals: Vec<Residual>,
+    /// The lack-of-fit F-tests (hook load, torque): per-mode offsets and depth trends
+    /// against the friction factors alone.
+    pub lack_of_fit: Vec<(&'static str, LackOfFit)>,
     /// FE runs.
     pub model_runs: usize,
     /// Whether the friction factors explain the data.
@@ -369,6 +374,58 @@ fn linspace(lo: f64, hi: f64, n: usize) -> Vec<f64> {
     (0..n)
         .map(|i| lo + (hi - lo) * i as f64 / (n - 1) as f64)
         .collect()
+}
+
+/// A lack-of-fit F-test.
+#[derive(Clone, Copy, Debug, Serialize)]
+pub struct LackOfFit {
+    /// F statistic.
+    pub f: f64,
+    /// Numerator degrees of freedom (the per-mode parameters).
+    pub df1: usize,
+    /// Denominator degrees of freedom.
+    pub df2: usize,
+    /// Its p-value.
+    pub p_value: f64,
+}
+
+/// The F-test of residuals `groups` (per mode: (depth, residual)) at a fit of `fitted`
+/// parameters against per-mode lines in depth (an offset where a mode has one depth):
+/// `F = ((SSR₀ − SSR₁)/q) / (SSR₁/(n − fitted − q))`. `None` with too few rows.
+fn lack_of_fit(groups: &[Vec<(f64, f64)>], fitted: usize) -> Option<LackOfFit> {
+    use statrs::distribution::{ContinuousCDF, FisherSnedecor};
+    let n: usize = groups.iter().map(|g| g.len()).sum();
+    let ssr0: f64 = groups.iter().flatten().map(|p| p.1 * p.1).sum();
+    let (mut ssr1, mut q) = (0.0, 0usize);
+    for g in groups {
+        let m = g.len() as f64;
+        let xm = g.iter().map(|p| p.0).sum::<f64>() / m;
+        let ym = g.iter().map(|p| p.1).sum::<f64>() / m;
+        let sxx: f64 = g.iter().map(|p| (p.0 - xm).powi(2)).sum();
+        if g.len() >= 3 && sxx > 0.0 {
+            let b = g.iter().map(|p| (p.0 - xm) * (p.1 - ym)).sum::<f64>() / sxx;
+            ssr1 += g
+                .iter()
+                .map(|p| (p.1 - ym - b * (p.0 - xm)).powi(2))
+                .sum::<f64>();
+            q += 2;
+        } else {
+            ssr1 += g.iter().map(|p| (p.1 - ym).powi(2)).sum::<f64>();
+            q += 1;
+        }
+    }
+    let df2 = n.checked_sub(fitted + q).filter(|d| *d >= 2)?;
+    if ssr1 <= 0.0 {
+        return None;
+    }
+    let f = ((ssr0 - ssr1).max(0.0) / q as f64) / (ssr1 / df2 as f64);
+    let dist = FisherSnedecor::new(q as f64, df2 as f64).ok()?;
+    Some(LackOfFit {
+        f,
+        df1: q,
+        df2,
+        p_value: 1.0 - dist.cdf(f),
+    })
 }
 
 /// Least-squares trend of `(depth, residual)`: (mean, rms, slope per km, p of zero slope).
@@ -661,6 +718,7 @@ pub fn calibrate(
                 .map(|(m, _)| (m.name(), Some(*m))),
         )
         .collect();
+    let mut lack_of_fit_notes: Vec<(&'static str, LackOfFit)> = Vec::new();
     let several_modes = MeasuredMode::NAMES
         .iter()
         .filter(|(m, _)| rows.iter().any(|r| r.mode == *m))
@@ -709,6 +767,39 @@ pub fn calibrate(
                 slope_per_km: slope,
                 p_value: p,
             });
+        }
+    }
+    // Lack of fit: do per-mode offsets and trends with depth explain the residuals
+    // significantly better than the friction factors alone? (F-test, p < 0.001.)
+    for (quantity, pick) in [
+        (
+            "hook load",
+            (|r: &Residual| r.hook_load_residual_n) as fn(&Residual) -> Option<f64>,
+        ),
+        ("torque", |r: &Residual| r.torque_residual_nm),
+    ] {
+        let groups: Vec<Vec<(f64, f64)>> = MeasuredMode::NAMES
+            .iter()
+            .map(|(m, _)| {
+                residuals
+                    .iter()
+                    .filter(|r| r.mode == *m)
+                    .filter_map(|r| pick(r).map(|x| (r.bit_md_m, x)))
+                    .collect::<Vec<_>>()
+            })
+            .filter(|g| !g.is_empty())
+            .collect();
+        if let Some(f) = lack_of_fit(&groups, d) {
+            lack_of_fit_notes.push((quantity, f));
+            if f.p_value < 1e-3 {
+                rejected.push(format!(
+                    "the {quantity} residuals have a structure friction cannot make: per-mode \
+                     offsets and trends with depth explain them far better (F = {:.1} on {} \
+                     and {} degrees of freedom, p = {:.1e}) — check the string (weights, \
+                     lengths), the survey and the rig's reading",
+                    f.f, f.df1, f.df2, f.p_value
+                ));
+            }
         }
     }
     for e in &estimates {
@@ -806,6 +897,7 @@ pub fn calibrate(
         surrogate_error,
         trends,
         residuals,
+        lack_of_fit: lack_of_fit_notes,
         model_runs: variants.len() + st.len(),
         fine: fine_axes,
         posterior,
@@ -880,6 +972,21 @@ mod tests {
         let mut none = vec![f64::NAN; 4];
         fill_from_neighbours(&mut none, 2, 2);
         assert!(none.iter().all(|x| x.is_nan()));
+    }
+
+    #[test]
+    fn lack_of_fit_sees_per_mode_offsets_not_noise() {
+        let noise = [0.3, -0.2, 0.1, -0.4, 0.2, 0.0, -0.1, 0.3, -0.3, 0.1];
+        let group = |shift: f64, k: usize| -> Vec<(f64, f64)> {
+            (0..5)
+                .map(|i| (500.0 + 100.0 * i as f64, noise[(i + k) % 10] + shift))
+                .collect()
+        };
+        let clean = lack_of_fit(&[group(0.0, 0), group(0.0, 3), group(0.0, 6)], 2).unwrap();
+        assert!(clean.p_value > 0.01, "{clean:?}");
+        let biased = lack_of_fit(&[group(2.0, 0), group(-2.0, 3), group(0.0, 6)], 2).unwrap();
+        assert!(biased.p_value < 1e-3, "{biased:?}");
+        assert_eq!((biased.df1, biased.df2), (6, 7));
     }
 
     #[test]
