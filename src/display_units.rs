@@ -142,14 +142,14 @@ pub fn convert_folder(dir: &std::path::Path) -> std::io::Result<()> {
         if name.ends_with(".csv") {
             let text = std::fs::read_to_string(&path)?;
             let out = convert_csv(&text).map_err(std::io::Error::other)?;
-            crate::output::write_atomic(&path, out.as_bytes())?;
+            crate::atomic_file::write_atomic(&path, out.as_bytes())?;
         } else if name == "summary.json" {
             let text = std::fs::read_to_string(&path)?;
             let v: serde_json::Value =
                 serde_json::from_str(&text).map_err(std::io::Error::other)?;
             let out =
                 serde_json::to_vec_pretty(&convert_json(&v)).map_err(std::io::Error::other)?;
-            crate::output::write_atomic(&path, &out)?;
+            crate::atomic_file::write_atomic(&path, &out)?;
         }
     }
     Ok(())

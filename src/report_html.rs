@@ -274,7 +274,7 @@ pub fn write(dir: &Path, command: &str, case: Option<&Path>) -> std::io::Result<
          document.body.setAttribute('data-check', bad === 0 ? 'ok images=' + imgs.length : \
          'broken images=' + bad);\n});\n</script>\n</body></html>\n",
     );
-    crate::output::write_atomic(&dir.join("report.html"), html.as_bytes())
+    crate::atomic_file::write_atomic(&dir.join("report.html"), html.as_bytes())
 }
 
 #[cfg(test)]
