@@ -164,33 +164,29 @@ fn data_from_a_heavier_string_are_rejected() {
 fn a_bad_measured_file_is_an_input_error() {
     let dir = common::scratch_dir("calibrate", "bad");
     let file = dir.join("bad.csv");
-    std::fs::write(
-        &file,
-        "bit_md_m,mode,hook_load_kn\n900,pick_up,640\n1100,tripping,700\n",
-    )
-    .unwrap();
-    let (code, _, stderr) = common::holewall(&[
-        "calibrate",
-        &manifest("cases/broomstick_tool_joints.toml"),
-        "--measured",
-        file.to_str().unwrap(),
-        "--out",
-        dir.join("out").to_str().unwrap(),
-        "--quiet",
-    ]);
-    assert_eq!(code, 2, "{stderr}");
-    assert!(stderr.contains("bad.csv:3: mode: unknown mode"), "{stderr}");
-    // Deeper than the hole.
-    std::fs::write(&file, "bit_md_m,mode,hook_load_kn\n1900,pick_up,640\n").unwrap();
-    let (code, _, stderr) = common::holewall(&[
-        "calibrate",
-        &manifest("cases/broomstick_tool_joints.toml"),
-        "--measured",
-        file.to_str().unwrap(),
-        "--out",
-        dir.join("out").to_str().unwrap(),
-        "--quiet",
-    ]);
-    assert_eq!(code, 2, "{stderr}");
-    assert!(stderr.contains("below the case's hole"), "{stderr}");
+    // (file text, what stderr must say): an unknown mode names file and line; a row deeper
+    // than the case's hole is refused.
+    for (text, says) in [
+        (
+            "bit_md_m,mode,hook_load_kn\n900,pick_up,640\n1100,tripping,700\n",
+            "bad.csv:3: mode: unknown mode",
+        ),
+        (
+            "bit_md_m,mode,hook_load_kn\n1900,pick_up,640\n",
+            "below the case's hole",
+        ),
+    ] {
+        std::fs::write(&file, text).unwrap();
+        let (code, _, stderr) = common::holewall(&[
+            "calibrate",
+            &manifest("cases/broomstick_tool_joints.toml"),
+            "--measured",
+            file.to_str().unwrap(),
+            "--out",
+            dir.join("out").to_str().unwrap(),
+            "--quiet",
+        ]);
+        assert_eq!(code, 2, "{stderr}");
+        assert!(stderr.contains(says), "{stderr}");
+    }
 }
