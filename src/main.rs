@@ -207,6 +207,10 @@ enum Command {
         /// chunks.
         #[arg(long, value_parser = positive_seconds)]
         max_seconds: Option<f64>,
+        /// Measured hook loads and surface torques against bit depth (the CSV of
+        /// `holewall calibrate`), drawn over the broomstick as points.
+        #[arg(long)]
+        measured: Option<PathBuf>,
     },
     /// Studies of a case: `precision` (error against run time per path and step),
     /// `stability` (where the solver works).
@@ -664,6 +668,7 @@ fn main() -> ExitCode {
             shard,
             force,
             max_seconds,
+            measured,
         } => {
             let mc = match cli::ensemble_cmd::monte_carlo(
                 samples,
@@ -690,6 +695,7 @@ fn main() -> ExitCode {
                 shard,
                 force,
                 max_seconds,
+                measured,
             };
             print_ensemble_summary(
                 holewall::ensemble::job::run(

@@ -25,6 +25,7 @@ pub fn caption(file: &str) -> Option<String> {
         ("bit_displacement", "Axial displacement of the bit over time."),
         ("energy", "Energy balance of the time integration: kinetic, strain, work done, dissipated."),
         ("broomstick", "Broomstick: hook load (as the weight indicator reads it where the case has a [rig]) against bit depth per mode and friction, with the pipe's tensile limit; measured loads as points where given."),
+        ("broomstick_torque", "Surface torque against bit depth per rotating mode and friction; measured torques as points where given."),
         ("torque", "Surface torque against bit depth: measured (points) and modelled at the calibrated friction factors (lines)."),
         ("neutral_point", "Neutral point of each variant."),
         ("posterior", "Posterior of the friction factors given the measurements (darker = more probable), with the MAP and the 95 % intervals on the axes."),

@@ -425,16 +425,53 @@ fn the_tool_joint_broomstick_orders_its_modes() {
         "/cases/broomstick_tool_joints.toml"
     );
     let out = common::scratch_dir("torque_drag", "broomstick");
+    let measured = concat!(env!("CARGO_MANIFEST_DIR"), "/cases/broomstick_measured.csv");
+    // A bad measured file is refused (exit 2, file and line) before anything is written.
+    let bad = common::scratch_dir("torque_drag", "broomstick_bad").with_extension("csv");
+    std::fs::write(
+        &bad,
+        "bit_md_m,mode,hook_load_kn\n700,pick_up,600\n900,spinning,640\n",
+    )
+    .unwrap();
+    std::fs::remove_dir_all(&out).unwrap();
+    let (code, _, stderr) = common::holewall(&[
+        "ensemble",
+        case,
+        "--measured",
+        bad.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--quiet",
+    ]);
+    assert_eq!(code, 2, "{stderr}");
+    assert!(
+        stderr.contains(&format!("{}:3", bad.display())) && stderr.contains("spinning"),
+        "{stderr}"
+    );
+    assert!(!out.exists(), "nothing is written for a refused run");
     let (code, _, stderr) = common::holewall(&[
         "ensemble",
         case,
         "--backend",
         "cpu",
+        "--measured",
+        measured,
         "--out",
         out.to_str().unwrap(),
         "--quiet",
     ]);
     assert_eq!(code, 0, "{stderr}");
+    // The measurements over the hook-load and torque broomsticks.
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    for f in ["broomstick.png", "broomstick_torque.png"] {
+        assert!(summary["outputs"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .any(|o| o == f));
+        assert!(out.join(f).exists(), "{f}");
+    }
     let text = std::fs::read_to_string(out.join("variants.csv")).unwrap();
     let mut rows = csv::Reader::from_reader(text.as_bytes());
     let header = rows.headers().unwrap().clone();

@@ -80,6 +80,39 @@ pub struct Measurement {
     pub surface_torque: Option<f64>,
 }
 
+/// One point series per mode (named `names[k]` for `modes[k]`): the points of `items` of
+/// that mode.
+pub fn by_mode<'a, T>(
+    modes: &[MeasuredMode],
+    names: &'a [String],
+    items: &[T],
+    mode: impl Fn(&T) -> MeasuredMode,
+    point: impl Fn(&T) -> Option<(f64, f64)>,
+) -> Vec<crate::plots::Series<'a>> {
+    modes
+        .iter()
+        .zip(names)
+        .map(|(m, name)| crate::plots::Series {
+            name,
+            points: items
+                .iter()
+                .filter(|x| mode(x) == *m)
+                .filter_map(&point)
+                .collect(),
+            wide: false,
+        })
+        .collect()
+}
+
+/// The modes in `rows`' order of [`MeasuredMode::NAMES`].
+pub fn modes_of(modes: impl Iterator<Item = MeasuredMode> + Clone) -> Vec<MeasuredMode> {
+    MeasuredMode::NAMES
+        .iter()
+        .map(|(m, _)| *m)
+        .filter(|m| modes.clone().any(|x| x == *m))
+        .collect()
+}
+
 /// Reads a measured file ([module docs](self) for its columns).
 pub fn read_measured(path: &Path) -> Result<Vec<Measurement>, InputError> {
     let text = std::fs::read_to_string(path).map_err(|e| InputError {

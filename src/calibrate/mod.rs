@@ -50,7 +50,7 @@ pub mod report;
 pub mod stats;
 pub mod synthetic;
 
-pub use measured::{parse_measured, read_measured, MeasuredMode, Measurement};
+pub use measured::{by_mode, modes_of, parse_measured, read_measured, MeasuredMode, Measurement};
 pub use stats::LackOfFit;
 use stats::{fill_from_neighbours, lack_of_fit, linspace, spline_weights, trend};
 

@@ -4,7 +4,7 @@
 
 use std::path::Path;
 
-use super::{model_at, Calibration, MeasuredMode, Measurement, Station};
+use super::{by_mode, model_at, modes_of, Calibration, Measurement, Station};
 use crate::case::Case;
 use crate::error::Error;
 use crate::plots::{heat_map, line_plot, lines_and_points, Marker, Series};
@@ -114,39 +114,6 @@ fn posterior(case: &Case, cal: &Calibration, dir: &Path) -> Result<Vec<String>, 
         )?;
     }
     Ok(vec!["posterior.csv".into(), "posterior.png".into()])
-}
-
-/// One point series per mode (named `names[k]` for `modes[k]`): the points of `items` of
-/// that mode.
-fn by_mode<'a, T>(
-    modes: &[MeasuredMode],
-    names: &'a [String],
-    items: &[T],
-    mode: impl Fn(&T) -> MeasuredMode,
-    point: impl Fn(&T) -> Option<(f64, f64)>,
-) -> Vec<Series<'a>> {
-    modes
-        .iter()
-        .zip(names)
-        .map(|(m, name)| Series {
-            name,
-            points: items
-                .iter()
-                .filter(|x| mode(x) == *m)
-                .filter_map(&point)
-                .collect(),
-            wide: false,
-        })
-        .collect()
-}
-
-/// The modes in `rows`' order of [`MeasuredMode::NAMES`].
-fn modes_of(modes: impl Iterator<Item = MeasuredMode> + Clone) -> Vec<MeasuredMode> {
-    MeasuredMode::NAMES
-        .iter()
-        .map(|(m, _)| *m)
-        .filter(|m| modes.clone().any(|x| x == *m))
-        .collect()
 }
 
 fn residual_plots(case: &Case, cal: &Calibration, dir: &Path) -> Result<Vec<String>, Error> {

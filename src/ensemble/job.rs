@@ -153,6 +153,12 @@ pub fn run(
             }
         }
     }
+    // The measurements to draw over the broomstick, read before any work (a bad file is
+    // refused with its line and column).
+    let measured = match &options.measured {
+        Some(p) => crate::calibrate::read_measured(p)?,
+        None => Vec::new(),
+    };
     // Check every variant against the case before any work.
     for v in &variants {
         if let Err(e) = apply(&case, v) {
@@ -320,9 +326,7 @@ pub fn run(
             .filter_map(|(i, r)| f(r).filter(|x| x.is_finite()).map(|y| (i as f64, y)))
             .collect()
     };
-    if let Some(file) = broomstick(&case, &variants, &results, out)? {
-        outputs.push(file);
-    }
+    outputs.extend(broomstick(&case, &variants, &results, &measured, out)?);
     if monte_carlo.is_none() {
         line_plot(
             &out.join("neutral_point.png"),
@@ -519,6 +523,7 @@ pub fn merge(
         shard: None,
         force: false,
         max_seconds: None,
+        measured: None,
     };
     run(
         &whole.case,

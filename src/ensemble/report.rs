@@ -292,54 +292,58 @@ pub(crate) fn uncertainty_report(
 
 /// The classic T&D "broomstick" when the variants vary `depth`: hook load against bit
 /// depth, one line per combination of the other keys (mode, friction, …), and the string's
-/// tensile limit (90 % of the surface component's yield) where it has a grade. `None`
-/// without a `depth` key.
+/// tensile limit (90 % of the surface component's yield) where it has a grade
+/// (`broomstick.png`); where a variant rotates, the surface torque the same way
+/// (`broomstick_torque.png`). `measured` (a `--measured` file, [`crate::calibrate::measured`])
+/// is drawn over them as points, a shape per mode. Nothing without a `depth` key.
 pub(crate) fn broomstick(
     case: &Case,
     variants: &[Variant],
     results: &[VariantResult],
+    measured: &[crate::calibrate::Measurement],
     out: &Path,
-) -> Result<Option<String>, Error> {
+) -> Result<Vec<String>, Error> {
     use crate::ensemble::Param;
     let has_depth = |v: &Variant| v.overrides.iter().any(|(k, _)| k.param == Param::Depth);
     if variants.is_empty() || !variants.iter().all(has_depth) {
-        return Ok(None);
+        return Ok(Vec::new());
     }
-    let mut lines: Vec<(String, Vec<(f64, f64)>)> = Vec::new();
-    for (v, r) in variants.iter().zip(results) {
-        let depth = v
-            .overrides
-            .iter()
-            .find(|(k, _)| k.param == Param::Depth)
-            .map(|(_, d)| *d)
-            .unwrap_or(f64::NAN);
-        let label = v
-            .overrides
-            .iter()
-            .filter(|(k, _)| k.param != Param::Depth)
-            .map(|(k, x)| match k.param {
-                Param::Mode => k.format(*x),
-                _ => format!("{} {}", k.name, crate::plots::tick(x)),
-            })
-            .collect::<Vec<_>>()
-            .join(", ");
-        // What the rig reads where the case has a `[rig]`, else the string's load.
-        let Some(hook) = r
-            .weight_indicator_n
-            .or(r.hook_load_n)
-            .filter(|h| h.is_finite())
-        else {
-            continue;
-        };
-        match lines.iter_mut().find(|(l, _)| *l == label) {
-            Some((_, pts)) => pts.push((depth, hook * 1e-3)),
-            None => lines.push((label, vec![(depth, hook * 1e-3)])),
+    // One line per combination of the keys other than depth, of `pick` (kN or kN·m).
+    let lines_of = |pick: &dyn Fn(&VariantResult) -> Option<f64>| {
+        let mut lines: Vec<(String, Vec<(f64, f64)>)> = Vec::new();
+        for (v, r) in variants.iter().zip(results) {
+            let depth = v
+                .overrides
+                .iter()
+                .find(|(k, _)| k.param == Param::Depth)
+                .map(|(_, d)| *d)
+                .unwrap_or(f64::NAN);
+            let label = v
+                .overrides
+                .iter()
+                .filter(|(k, _)| k.param != Param::Depth)
+                .map(|(k, x)| match k.param {
+                    Param::Mode => k.format(*x),
+                    _ => format!("{} {}", k.name, crate::plots::tick(x)),
+                })
+                .collect::<Vec<_>>()
+                .join(", ");
+            let Some(y) = pick(r).filter(|h| h.is_finite()) else {
+                continue;
+            };
+            match lines.iter_mut().find(|(l, _)| *l == label) {
+                Some((_, pts)) => pts.push((depth, y * 1e-3)),
+                None => lines.push((label, vec![(depth, y * 1e-3)])),
+            }
         }
-    }
-    for (_, pts) in &mut lines {
-        pts.sort_by(|a, b| a.0.total_cmp(&b.0));
-    }
-    let mut series: Vec<Series> = lines
+        for (_, pts) in &mut lines {
+            pts.sort_by(|a, b| a.0.total_cmp(&b.0));
+        }
+        lines
+    };
+    // What the rig reads where the case has a `[rig]`, else the string's load.
+    let hook_lines = lines_of(&|r| r.weight_indicator_n.or(r.hook_load_n));
+    let mut series: Vec<Series> = hook_lines
         .iter()
         .map(|(l, pts)| Series {
             name: l,
@@ -355,7 +359,7 @@ pub(crate) fn broomstick(
         .and_then(|e| case.strength.get(e.component).copied().flatten());
     let limit_name;
     if let Some(s) = top {
-        let (lo, hi) = lines
+        let (lo, hi) = hook_lines
             .iter()
             .flat_map(|(_, p)| p.iter().map(|x| x.0))
             .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), d| {
@@ -379,16 +383,90 @@ pub(crate) fn broomstick(
             });
         }
     }
-    let y_label = crate::rig::hook_load_axis(case.rig);
-    line_plot(
-        &out.join("broomstick.png"),
-        &format!("{}: hook load against bit depth", case.title),
-        "bit depth, MD (m)",
-        &y_label,
+    // The measurements, a point set per mode that has the quantity.
+    let modes = crate::calibrate::modes_of(measured.iter().map(|m| m.mode));
+    let names: Vec<String> = modes
+        .iter()
+        .map(|m| format!("{} (measured)", m.name().replace('_', " ")))
+        .collect();
+    let measured_of = |pick: fn(&crate::calibrate::Measurement) -> Option<f64>| {
+        let sets = crate::calibrate::by_mode(
+            &modes,
+            &names,
+            measured,
+            |m| m.mode,
+            |m| pick(m).map(|y| (m.bit_md, y * 1e-3)),
+        );
+        sets.into_iter()
+            .filter(|s| !s.points.is_empty())
+            .collect::<Vec<_>>()
+    };
+    let title = |what: &str| {
+        format!(
+            "{}: {what} against bit depth{}",
+            case.title,
+            if measured.is_empty() {
+                ""
+            } else {
+                ", measured as points"
+            }
+        )
+    };
+    let draw = |file: &str, what: &str, y_label: &str, lines: &[Series], points: &[Series]| {
+        if points.is_empty() {
+            line_plot(
+                &out.join(file),
+                &title(what),
+                "bit depth, MD (m)",
+                y_label,
+                lines,
+                &[],
+            )
+        } else {
+            crate::plots::lines_and_measured(
+                &out.join(file),
+                &title(what),
+                "bit depth, MD (m)",
+                y_label,
+                lines,
+                points,
+            )
+        }
+    };
+    let mut files = Vec::new();
+    draw(
+        "broomstick.png",
+        "hook load",
+        &crate::rig::hook_load_axis(case.rig),
         &series,
-        &[],
+        &measured_of(|m| m.hook_load),
     )?;
-    Ok(Some("broomstick.png".into()))
+    files.push("broomstick.png".to_string());
+    // Surface torque of the lines that rotate (a sliding or tripping line reads 0).
+    let torque_lines: Vec<(String, Vec<(f64, f64)>)> = lines_of(&|r| Some(r.max_surface_torque_nm))
+        .into_iter()
+        .filter(|(_, p)| p.iter().any(|q| q.1.abs() > 1e-3))
+        .collect();
+    let torques = measured_of(|m| m.surface_torque);
+    if !torque_lines.is_empty() || !torques.is_empty() {
+        let series: Vec<Series> = torque_lines
+            .iter()
+            .map(|(l, pts)| Series {
+                name: l,
+                points: pts.clone(),
+                wide: false,
+            })
+            .collect();
+        draw(
+            "broomstick_torque.png",
+            "surface torque",
+            "surface torque (kN·m)",
+            &series,
+            &torques,
+        )?;
+        files.push("broomstick_torque.png".to_string());
+    }
+    Ok(files)
 }
 
 /// The values every variant ran with (not only its overrides), SI: bit depth, rotary speed,

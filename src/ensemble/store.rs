@@ -27,6 +27,10 @@ pub struct EnsembleOptions {
     /// Wall-time budget (s, `--max-seconds`): no chunk is started once it is spent; the
     /// run stops resumable ([`crate::Error::Stopped`]).
     pub max_seconds: Option<f64>,
+    /// Measured hook loads and surface torques (`--measured FILE`, the file of
+    /// `holewall calibrate`): drawn over the broomstick. Only plots change, so a run resumed
+    /// or merged with another file keeps its results.
+    pub measured: Option<std::path::PathBuf>,
 }
 
 impl Default for EnsembleOptions {
@@ -37,6 +41,7 @@ impl Default for EnsembleOptions {
             shard: None,
             force: false,
             max_seconds: None,
+            measured: None,
         }
     }
 }

@@ -148,7 +148,15 @@ pub fn line_plot(
     let labels = marker_labels(markers);
     let markers = scaled_markers(markers, &labels, kx, ky);
     atomic_png(path, |tmp| {
-        draw(tmp, &title, &xl, &yl, &lines.series(), &markers, &[])
+        draw(
+            tmp,
+            &title,
+            &xl,
+            &yl,
+            &lines.series(),
+            &markers,
+            (&[], Dots::LineColours),
+        )
     })
 }
 
@@ -166,8 +174,52 @@ pub fn lines_and_points(
     let (title, (xl, kx), (yl, ky)) = labels_in_units(title, x_label, y_label);
     let (lines, dots) = (InUnits::new(series, kx, ky), InUnits::new(points, kx, ky));
     atomic_png(path, |tmp| {
-        draw(tmp, &title, &xl, &yl, &lines.series(), &[], &dots.series())
+        draw(
+            tmp,
+            &title,
+            &xl,
+            &yl,
+            &lines.series(),
+            &[],
+            (&dots.series(), Dots::LineColours),
+        )
     })
+}
+
+/// Lines with measured points over them where the points do not belong to one line each
+/// (an ensemble's broomstick: many lines per mode, one point set per mode): each point set
+/// gets its own dark colour and shape (filled circle, triangle, square, …) so it reads apart
+/// from the lines.
+pub fn lines_and_measured(
+    path: &Path,
+    title: &str,
+    x_label: &str,
+    y_label: &str,
+    series: &[Series],
+    points: &[Series],
+) -> std::io::Result<()> {
+    let (title, (xl, kx), (yl, ky)) = labels_in_units(title, x_label, y_label);
+    let (lines, dots) = (InUnits::new(series, kx, ky), InUnits::new(points, kx, ky));
+    atomic_png(path, |tmp| {
+        draw(
+            tmp,
+            &title,
+            &xl,
+            &yl,
+            &lines.series(),
+            &[],
+            (&dots.series(), Dots::Own),
+        )
+    })
+}
+
+/// How point sets are coloured.
+#[derive(Clone, Copy, PartialEq)]
+enum Dots {
+    /// Point set `k` in line `k`'s colour, filled circles.
+    LineColours,
+    /// Their own dark colours and shapes.
+    Own,
 }
 
 fn draw(
@@ -177,7 +229,7 @@ fn draw(
     y_label: &str,
     series: &[Series],
     markers: &[Marker],
-    points: &[Series],
+    (points, dots): (&[Series], Dots),
 ) -> Result<(), Box<dyn std::error::Error>> {
     let root = BitMapBackend::new(path, (1000, 640)).into_drawing_area();
     root.fill(&WHITE)?;
@@ -222,16 +274,49 @@ fn draw(
             .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], style));
     }
     for (k, p) in points.iter().enumerate() {
-        let c = colour(k);
-        chart
-            .draw_series(
-                p.points
-                    .iter()
-                    .filter(|(x, y)| x.is_finite() && y.is_finite())
-                    .map(move |&q| Circle::new(q, 5, c.filled())),
-            )?
-            .label(p.name)
-            .legend(move |(x, y)| Circle::new((x + 10, y), 5, c.filled()));
+        let pts = p
+            .points
+            .iter()
+            .filter(|(x, y)| x.is_finite() && y.is_finite())
+            .copied();
+        let shape = if dots == Dots::Own { k % 3 } else { 0 };
+        let c = match dots {
+            Dots::LineColours => colour(k),
+            Dots::Own => [
+                BLACK,
+                RGBColor(140, 70, 0),
+                RGBColor(90, 0, 120),
+                RGBColor(0, 100, 60),
+                RGBColor(110, 110, 110),
+            ][k % 5],
+        };
+        let style = c.filled();
+        let name = p.name;
+        match shape {
+            0 => {
+                chart
+                    .draw_series(pts.map(move |q| Circle::new(q, 5, style)))?
+                    .label(name)
+                    .legend(move |(x, y)| Circle::new((x + 10, y), 5, style));
+            }
+            1 => {
+                chart
+                    .draw_series(pts.map(move |q| TriangleMarker::new(q, 7, style)))?
+                    .label(name)
+                    .legend(move |(x, y)| TriangleMarker::new((x + 10, y), 7, style));
+            }
+            _ => {
+                let square = move |q: (i32, i32)| {
+                    Rectangle::new([(q.0 - 5, q.1 - 5), (q.0 + 5, q.1 + 5)], style)
+                };
+                chart
+                    .draw_series(pts.map(move |q| {
+                        EmptyElement::at(q) + Rectangle::new([(-5, -5), (5, 5)], style)
+                    }))?
+                    .label(name)
+                    .legend(move |(x, y)| square((x + 10, y)));
+            }
+        }
     }
     for m in markers {
         // The label beside the point, up and to the left, on a white box: it neither
