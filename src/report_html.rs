@@ -17,7 +17,7 @@ pub fn caption(file: &str) -> Option<String> {
     let fixed: &[(&str, &str)] = &[
         ("axial_force", "Effective axial force along the string (tension +); the neutral point is where it crosses zero."),
         ("axial_stress", "Axial stress along the string."),
-        ("side_force", "Contact (side) force per site along the string: where the string touches the wall and how hard."),
+        ("side_force", "Contact (side) force per site along the string: where the string touches the wall and how hard (in an ensemble: each stabilizer's largest side force against the varied input it follows most)."),
         ("surface_torque", "Torque along the string, from the bit to the surface."),
         ("bha_deflection", "The BHA's lateral deflection in the hole, with the bit's side force and tilt."),
         ("fe_vs_soft_string", "The FE stiff-string loads against the soft-string (Johancsik) model."),
@@ -27,7 +27,7 @@ pub fn caption(file: &str) -> Option<String> {
         ("broomstick", "Broomstick: hook load (as the weight indicator reads it where the case has a [rig]) against bit depth per mode and friction, with the pipe's tensile limit; measured loads as points where given."),
         ("broomstick_torque", "Surface torque against bit depth per rotating mode and friction; measured torques as points where given."),
         ("torque", "Surface torque against bit depth: measured (points) and modelled at the calibrated friction factors (lines)."),
-        ("neutral_point", "Neutral point of each variant."),
+        ("neutral_point", "Neutral point of the variants against the varied input it follows most (a line per combination of the other inputs; points where the variants are scattered rows)."),
         ("posterior", "Posterior of the friction factors given the measurements (darker = more probable), with the MAP and the 95 % intervals on the axes."),
         ("residuals", "Hook-load residuals (measured − modelled at the calibrated friction) against bit depth, per mode: a trend with depth means a wrong string or survey, not friction."),
         ("residuals_torque", "Torque residuals (measured − modelled) against bit depth."),

@@ -13,7 +13,6 @@ use crate::case::{load_case, Analysis};
 use crate::ensemble::apply;
 use crate::error::{Error, InputError};
 use crate::output::{out_error, write_atomic};
-use crate::plots::{line_plot, Series};
 
 /// Runs the command.
 pub fn run(
@@ -319,59 +318,9 @@ pub fn run(
         }
         None => None,
     };
-    let idx = |f: &dyn Fn(&VariantResult) -> Option<f64>| -> Vec<(f64, f64)> {
-        results
-            .iter()
-            .enumerate()
-            .filter_map(|(i, r)| f(r).filter(|x| x.is_finite()).map(|y| (i as f64, y)))
-            .collect()
-    };
     outputs.extend(broomstick(&case, &variants, &results, &measured, out)?);
     if monte_carlo.is_none() {
-        line_plot(
-            &out.join("neutral_point.png"),
-            &format!("{}: neutral point over the variants", case.title),
-            "variant",
-            "neutral point from the bit (m)",
-            &[Series {
-                name: "neutral point",
-                points: idx(&|r| r.neutral_point_from_bit_m),
-                wide: false,
-            }],
-            &[],
-        )?;
-        outputs.push("neutral_point.png".into());
-        let names: Vec<String> = (1..=stabs).map(crate::model::stabilizer_name).collect();
-        // One line per stabilizer of a per-stabilizer quantity over the variants.
-        let per_stabilizer = |file: &str,
-                              title: &str,
-                              y_label: &str,
-                              f: &dyn Fn(&StabilizerQoi) -> Option<f64>|
-         -> Result<(), Error> {
-            let series: Vec<Series> = (0..stabs)
-                .map(|k| Series {
-                    name: &names[k],
-                    points: idx(&|r| r.stabilizers.get(k).and_then(f)),
-                    wide: false,
-                })
-                .collect();
-            line_plot(
-                &out.join(file),
-                &format!("{}: {title}", case.title),
-                "variant",
-                y_label,
-                &series,
-                &[],
-            )?;
-            Ok(())
-        };
-        per_stabilizer(
-            "side_force.png",
-            "largest side force per stabilizer",
-            "side force (N)",
-            &|q| Some(q.max_side_force_n),
-        )?;
-        outputs.push("side_force.png".into());
+        outputs.extend(over_the_inputs(&case, &variants, &results, stabs, out)?);
         if dynamic {
             outputs.extend(whirl_maps(&case, &variants, &results, stabs, out)?);
         }
