@@ -4,6 +4,7 @@
 
 use std::path::Path;
 
+use super::plots::{broomstick, over_the_inputs};
 use super::qoi::*;
 use super::report::*;
 use super::runner::*;
