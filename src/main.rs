@@ -312,6 +312,26 @@ enum BenchCommand {
         #[arg(long)]
         json: Option<PathBuf>,
     },
+    /// A roofline per kernel (contact, beam, assembly, block solve): achieved GFLOP/s and
+    /// GB/s beside this device's FMA and copy ceilings, measured here, f32 and f64
+    /// (kernels.md, kernels.json, roofline.png).
+    Kernels {
+        /// Variants per run (comma-separated).
+        #[arg(long, value_delimiter = ',', default_values_t = [16usize, 256, 4096])]
+        variants: Vec<usize>,
+        /// Nodes of the string each variant holds (3–2000).
+        #[arg(long, default_value_t = 21)]
+        nodes: usize,
+        /// Timed repeats (the median is reported).
+        #[arg(long, default_value_t = 5)]
+        repeats: usize,
+        /// Output folder.
+        #[arg(long)]
+        out: PathBuf,
+        /// No progress bar.
+        #[arg(long)]
+        quiet: bool,
+    },
     /// Operations and time per beam element: the hyper-dual forms against the closed form
     /// (force only; force and tangent in f64 and f32), one core; their agreement.
     Element {
@@ -799,6 +819,16 @@ fn main() -> ExitCode {
                 json,
             } => match cli::bench::statics(&case, variants.as_deref(), repeats, json.as_deref()) {
                 Ok(()) => ExitCode::SUCCESS,
+                Err(e) => fail(&[e]),
+            },
+            BenchCommand::Kernels {
+                variants,
+                nodes,
+                repeats,
+                out,
+                quiet,
+            } => match cli::bench_kernels::run(&variants, nodes, repeats, &out, !quiet) {
+                Ok(_) => ExitCode::SUCCESS,
                 Err(e) => fail(&[e]),
             },
             BenchCommand::Element {

@@ -426,7 +426,7 @@ struct ElementReport {
 
 /// Cost per transcendental (sin, cos, atan2, powf) in the FLOP figures: a polynomial of
 /// about this many operations (the f64 `atan2` written out for the GPU takes ≈ 40).
-const TRANSCENDENTAL_FLOPS: u64 = 20;
+pub(crate) const TRANSCENDENTAL_FLOPS: u64 = 20;
 
 /// Random element states of a 9 m collar: stretched, bent, twisted, spun rigidly by up to
 /// 300 rad, relative rotations up to 0.5 rad (reproducible).

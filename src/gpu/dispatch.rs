@@ -29,6 +29,41 @@ impl Out<'_> {
     }
 }
 
+/// One kernel's dispatches timed by [`timed`]: the wall time of each repeat (submit to
+/// finished, outputs restored to their initial contents before each, outside the clock) and
+/// the bytes its bindings hold (parameters, inputs, outputs: what one run must at least read
+/// or write).
+#[derive(Clone, Debug)]
+pub struct KernelTiming {
+    /// The kernel's label.
+    pub label: String,
+    /// Seconds per repeat (all of the kernel's passes).
+    pub seconds: Vec<f64>,
+    /// Bytes of its inputs (parameters included).
+    pub bytes_in: u64,
+    /// Bytes of its outputs.
+    pub bytes_out: u64,
+    /// Invocations per pass.
+    pub invocations: usize,
+    /// Passes (dispatches) per run.
+    pub passes: usize,
+}
+
+thread_local! {
+    static TIMING: std::cell::RefCell<Option<(usize, Vec<KernelTiming>)>> =
+        const { std::cell::RefCell::new(None) };
+}
+
+/// Runs `f` with every dispatch of this module timed `repeats` times after its first (the
+/// results `f` gets are the first run's): `holewall bench kernels`' measurement, on this
+/// thread only.
+pub fn timed<R>(repeats: usize, f: impl FnOnce() -> R) -> (R, Vec<KernelTiming>) {
+    let before = TIMING.with(|t| t.replace(Some((repeats.max(1), Vec::new()))));
+    let r = f();
+    let got = TIMING.with(|t| t.replace(before));
+    (r, got.map(|g| g.1).unwrap_or_default())
+}
+
 /// Runs `pipeline` once; returns the bytes of each output, in order.
 pub fn run_once(
     ctx: &GpuContext,
@@ -62,6 +97,15 @@ pub fn run_passes(
     invocations: usize,
 ) -> Result<Vec<Vec<u8>>, GpuError> {
     let output_bytes: Vec<usize> = outputs.iter().map(Out::bytes).collect();
+    let input_bytes: usize = inputs.iter().map(|b| b.len()).sum();
+    // The outputs' initial contents (for a timed run's restore).
+    let initial: Vec<Option<&[u8]>> = outputs
+        .iter()
+        .map(|o| match o {
+            Out::From(b) if !b.is_empty() => Some(*b),
+            _ => None,
+        })
+        .collect();
     let device = &ctx.device;
     let dims: Vec<wgpu::Buffer> = params
         .iter()
@@ -85,7 +129,9 @@ pub fn run_passes(
             })
         })
         .collect();
-    let usage = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC;
+    // COPY_DST: a timed run restores the outputs' first contents before each repeat.
+    let usage =
+        wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST;
     let outputs: Vec<wgpu::Buffer> = outputs
         .iter()
         .map(|out| match out {
@@ -168,5 +214,71 @@ pub fn run_passes(
         }
     }
     staging.unmap();
+    if let Some(repeats) = TIMING.with(|t| t.borrow().as_ref().map(|t| t.0)) {
+        // The outputs' first contents, to restore before each timed run.
+        let pristine: Vec<(usize, wgpu::Buffer)> = initial
+            .iter()
+            .enumerate()
+            .filter_map(|(k, b)| b.map(|b| (k, b)))
+            .map(|(k, b)| {
+                (
+                    k,
+                    device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                        label: Some(label),
+                        contents: b,
+                        usage: wgpu::BufferUsages::COPY_SRC,
+                    }),
+                )
+            })
+            .collect();
+        let wait = || {
+            device
+                .poll(wgpu::PollType::wait_indefinitely())
+                .map(|_| ())
+                .map_err(|e| GpuError::Device(e.to_string()))
+        };
+        let mut seconds = Vec::with_capacity(repeats);
+        for _ in 0..repeats {
+            if !pristine.is_empty() {
+                let mut e = device
+                    .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(label) });
+                for (k, b) in &pristine {
+                    e.copy_buffer_to_buffer(b, 0, &outputs[*k], 0, b.size());
+                }
+                ctx.queue.submit([e.finish()]);
+                wait()?;
+            }
+            let mut e = device
+                .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(label) });
+            {
+                let mut pass = e.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                    label: Some(label),
+                    timestamp_writes: None,
+                });
+                pass.set_pipeline(pipeline);
+                for bg in &bind_groups {
+                    pass.set_bind_group(0, bg, &[]);
+                    pass.dispatch_workgroups(invocations.div_ceil(WORKGROUP) as u32, 1, 1);
+                }
+            }
+            let clock = std::time::Instant::now();
+            ctx.queue.submit([e.finish()]);
+            wait()?;
+            seconds.push(clock.elapsed().as_secs_f64());
+        }
+        let timing = KernelTiming {
+            label: label.to_string(),
+            seconds,
+            bytes_in: (params.iter().map(|p| p.len()).sum::<usize>() + input_bytes) as u64,
+            bytes_out: output_bytes.iter().sum::<usize>() as u64,
+            invocations,
+            passes: params.len(),
+        };
+        TIMING.with(|t| {
+            if let Some(t) = t.borrow_mut().as_mut() {
+                t.1.push(timing)
+            }
+        });
+    }
     Ok(result)
 }

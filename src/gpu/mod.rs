@@ -3,6 +3,7 @@
 pub mod assemble;
 pub mod beam;
 pub mod block_lu;
+pub mod ceilings;
 pub mod compose;
 pub mod contact;
 pub mod context;

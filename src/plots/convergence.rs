@@ -180,3 +180,99 @@ pub fn loglog_plot(
         Ok(())
     })
 }
+
+/// A roofline: on log–log axes of arithmetic intensity (FLOP/byte) and GFLOP/s, each `roofs`
+/// line (name, its points: the bound `min(peak, bandwidth × intensity)`) and each `kernels`
+/// point set (name, (intensity, achieved GFLOP/s)), one colour and shape per set.
+pub fn roofline_plot(
+    path: &Path,
+    title: &str,
+    roofs: &[(String, Vec<(f64, f64)>)],
+    kernels: &[(String, Vec<(f64, f64)>)],
+) -> std::io::Result<()> {
+    let positive = |p: &&(f64, f64)| p.0 > 0.0 && p.1 > 0.0 && p.0.is_finite() && p.1.is_finite();
+    let all: Vec<(f64, f64)> = roofs
+        .iter()
+        .chain(kernels)
+        .flat_map(|(_, p)| p.iter().filter(positive).copied())
+        .collect();
+    let range = |f: &dyn Fn(&(f64, f64)) -> f64| {
+        all.iter()
+            .map(f)
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
+                (a.min(v), b.max(v))
+            })
+    };
+    let ((mut x0, mut x1), (mut y0, mut y1)) = (range(&|p| p.0), range(&|p| p.1));
+    if !x0.is_finite() {
+        (x0, x1, y0, y1) = (0.01, 100.0, 0.01, 100.0);
+    }
+    let (x0, x1, y0, y1) = (x0 / 1.5, x1 * 1.5, y0 / 2.0, y1 * 2.0);
+    atomic_png(path, |tmp| {
+        let root = BitMapBackend::new(tmp, (1000, 680)).into_drawing_area();
+        root.fill(&WHITE)?;
+        let caption = fitted_caption(&root, title, 20);
+        let mut chart = ChartBuilder::on(&root)
+            .caption(&caption.0, ("sans-serif", caption.1))
+            .margin(12)
+            .x_label_area_size(48)
+            .y_label_area_size(90)
+            .build_cartesian_2d(
+                (x0..x1).log_scale().with_key_points(log_ticks(x0, x1)),
+                (y0..y1).log_scale().with_key_points(log_ticks(y0, y1)),
+            )?;
+        chart
+            .configure_mesh()
+            .x_desc("arithmetic intensity (FLOP/byte)")
+            .y_desc("GFLOP/s")
+            .x_label_formatter(&tick)
+            .y_label_formatter(&tick)
+            .label_style(("sans-serif", 15))
+            .draw()?;
+        for (k, (name, p)) in roofs.iter().enumerate() {
+            let c = [BLACK, RGBColor(120, 120, 120)][k % 2];
+            chart
+                .draw_series(LineSeries::new(
+                    p.iter().filter(positive).copied(),
+                    c.stroke_width(3),
+                ))?
+                .label(name.as_str())
+                .legend(move |(x, y)| {
+                    PathElement::new(vec![(x, y), (x + 20, y)], c.stroke_width(3))
+                });
+        }
+        let colours = [
+            BLUE,
+            RED,
+            GREEN,
+            MAGENTA,
+            CYAN,
+            RGBColor(140, 70, 0),
+            RGBColor(90, 0, 120),
+            RGBColor(0, 100, 60),
+        ];
+        for (k, (name, p)) in kernels.iter().enumerate() {
+            let c = colours[k % colours.len()].filled();
+            let pts: Vec<(f64, f64)> = p.iter().filter(positive).copied().collect();
+            if k % 2 == 0 {
+                chart
+                    .draw_series(pts.iter().map(|&q| Circle::new(q, 6, c)))?
+                    .label(name.as_str())
+                    .legend(move |(x, y)| Circle::new((x + 10, y), 6, c));
+            } else {
+                chart
+                    .draw_series(pts.iter().map(|&q| TriangleMarker::new(q, 8, c)))?
+                    .label(name.as_str())
+                    .legend(move |(x, y)| TriangleMarker::new((x + 10, y), 8, c));
+            }
+        }
+        chart
+            .configure_series_labels()
+            .position(SeriesLabelPosition::LowerRight)
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .draw()?;
+        root.present()?;
+        Ok(())
+    })
+}

@@ -6,7 +6,7 @@ use plotters::prelude::*;
 
 mod convergence;
 mod maps;
-pub use convergence::{convergence_plot, log_ticks, loglog_plot};
+pub use convergence::{convergence_plot, log_ticks, loglog_plot, roofline_plot};
 pub use maps::{class_scatter, heat_map, tile_map, Tile};
 
 /// One line of a plot.

@@ -1,0 +1,132 @@
+//! The device's own ceilings, measured on it, for a roofline (`holewall bench kernels`): an
+//! FMA-chain kernel (eight independent chains per invocation in registers, f32 and f64) for
+//! the arithmetic peak, and a copy kernel (`vec4<f32>` read and written once) for the memory
+//! bandwidth. Both run through [`crate::gpu::dispatch`] under its timing, as the kernels do.
+
+use crate::error::GpuError;
+use crate::gpu::dispatch::{run_once, timed, Out};
+use crate::gpu::GpuContext;
+
+/// Chains per invocation of the FMA kernel.
+const CHAINS: usize = 8;
+
+fn fma_wgsl(f64: bool) -> String {
+    let (t, s) = if f64 { ("f64", "lf") } else { ("f32", "f") };
+    let mut body = String::new();
+    for c in 0..CHAINS {
+        body.push_str(&format!(
+            "    var a{c} = {t}(gid.x) * 1.0e-9{s} + {c}.0{s};\n"
+        ));
+    }
+    body.push_str("    for (var k = 0u; k < params[0]; k++) {\n");
+    for c in 0..CHAINS {
+        body.push_str(&format!("        a{c} = fma(a{c}, b, c);\n"));
+    }
+    body.push_str("    }\n    out[gid.x] = ");
+    body.push_str(
+        &(0..CHAINS)
+            .map(|c| format!("a{c}"))
+            .collect::<Vec<_>>()
+            .join(" + "),
+    );
+    body.push_str(";\n");
+    format!(
+        "@group(0) @binding(0) var<storage, read> params: array<u32>;\n\
+         @group(0) @binding(1) var<storage, read_write> out: array<{t}>;\n\
+         @compute @workgroup_size(64)\n\
+         fn main(@builtin(global_invocation_id) gid: vec3<u32>) {{\n\
+         \x20   let b = {t}(params[1]) * 1.0e-9{s} + 0.999999{s};\n\
+         \x20   let c = {t}(params[1]) * 1.0e-9{s} + 1.0e-7{s};\n\
+         {body}}}\n"
+    )
+}
+
+const COPY_WGSL: &str = "@group(0) @binding(0) var<storage, read> params: array<u32>;
+@group(0) @binding(1) var<storage, read> src: array<vec4<f32>>;
+@group(0) @binding(2) var<storage, read_write> dst: array<vec4<f32>>;
+@compute @workgroup_size(64)
+fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
+    if (gid.x < params[0]) {
+        dst[gid.x] = src[gid.x];
+    }
+}
+";
+
+/// The measured ceilings (medians over the repeats).
+#[derive(Clone, Copy, Debug, serde::Serialize)]
+pub struct Ceilings {
+    /// FMA-chain throughput, f32 (GFLOP/s, an FMA counted as two).
+    pub fma_gflops_f32: f64,
+    /// The same in f64, where the adapter has it.
+    pub fma_gflops_f64: Option<f64>,
+    /// Copy bandwidth (GB/s, bytes read plus bytes written).
+    pub copy_gbytes_per_s: f64,
+}
+
+fn median(mut x: Vec<f64>) -> f64 {
+    x.sort_by(f64::total_cmp);
+    x.get(x.len() / 2).copied().unwrap_or(f64::NAN)
+}
+
+/// Measures the ceilings on `ctx`: `repeats` timed runs each.
+pub fn measure(ctx: &GpuContext, repeats: usize) -> Result<Ceilings, GpuError> {
+    let invocations: usize = 1 << 18;
+    let iterations: u32 = 1024;
+    let fma = |f64: bool| -> Result<f64, GpuError> {
+        let pipeline = ctx.pipeline("ceiling_fma", &fma_wgsl(f64))?;
+        let size = if f64 { 8 } else { 4 };
+        let params = [iterations, 1u32];
+        let (r, t) = timed(repeats, || {
+            run_once(
+                ctx,
+                &pipeline,
+                "ceiling_fma",
+                bytemuck::cast_slice(&params),
+                &[],
+                &[Out::Empty(invocations * size)],
+                invocations,
+            )
+        });
+        r?;
+        let seconds = median(t.into_iter().flat_map(|k| k.seconds).collect());
+        let flops = (invocations * iterations as usize * CHAINS * 2) as f64;
+        Ok(flops / seconds / 1e9)
+    };
+    let fma_gflops_f32 = fma(false)?;
+    let fma_gflops_f64 = if ctx.has_f64 { Some(fma(true)?) } else { None };
+    // The copy: as large as one binding allows, up to 32 MiB each way (2^21 invocations: within one dispatch's 65,535 workgroups).
+    let bytes = (ctx.max_binding_bytes() as usize).min(32 << 20) / 16 * 16;
+    let words = bytes / 16;
+    let pipeline = ctx.pipeline("ceiling_copy", COPY_WGSL)?;
+    let src = vec![1u8; bytes];
+    let params = [words as u32];
+    let (r, t) = timed(repeats, || {
+        run_once(
+            ctx,
+            &pipeline,
+            "ceiling_copy",
+            bytemuck::cast_slice(&params),
+            &[&src],
+            &[Out::Empty(bytes)],
+            words,
+        )
+    });
+    r?;
+    let seconds = median(t.into_iter().flat_map(|k| k.seconds).collect());
+    Ok(Ceilings {
+        fma_gflops_f32,
+        fma_gflops_f64,
+        copy_gbytes_per_s: 2.0 * bytes as f64 / seconds / 1e9,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn the_ceiling_kernels_are_valid_wgsl() {
+        for f64 in [false, true] {
+            crate::gpu::compose::validate(&super::fma_wgsl(f64)).unwrap();
+        }
+        crate::gpu::compose::validate(super::COPY_WGSL).unwrap();
+    }
+}

@@ -1,0 +1,61 @@
+//! `holewall bench kernels` (issue 27): the roofline per kernel runs on the adapter at hand
+//! and its figures are consistent — the ceilings measured, every kernel timed, no kernel
+//! above its precision's FMA ceiling (which would mean its FLOPs are over-counted or the
+//! ceiling under-measured), bytes at least the kernel's own outputs, the files written.
+
+mod common;
+
+#[test]
+fn the_roofline_bench_measures_every_kernel_under_its_ceilings() {
+    let Some(ctx) = common::gpu() else { return };
+    let out = common::scratch_dir("bench_kernels", "roofline");
+    let (code, stdout, stderr) = common::holewall(&[
+        "bench",
+        "kernels",
+        "--variants",
+        "16,64",
+        "--nodes",
+        "11",
+        "--repeats",
+        "3",
+        "--out",
+        out.to_str().unwrap(),
+        "--quiet",
+    ]);
+    assert_eq!(code, 0, "{stderr}");
+    assert!(stdout.contains("| block solve |"), "{stdout}");
+    let r: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("kernels.json")).unwrap()).unwrap();
+    let c = &r["ceilings"];
+    let fma32 = c["fma_gflops_f32"].as_f64().unwrap();
+    let copy = c["copy_gbytes_per_s"].as_f64().unwrap();
+    assert!(fma32 > 0.1 && copy > 0.1, "{c}");
+    let rows = r["rows"].as_array().unwrap();
+    let precisions = if ctx.has_f64 { 2 } else { 1 };
+    assert_eq!(
+        rows.len(),
+        4 * 2 * precisions,
+        "4 kernels × 2 sizes × precisions"
+    );
+    for k in rows {
+        let f = |key: &str| k[key].as_f64().unwrap_or(f64::NAN);
+        assert!(
+            f("seconds") > 0.0 && f("flops") > 0.0 && f("bytes") > 0.0,
+            "{k}"
+        );
+        // Above 1.2 × the FMA ceiling would be a counting error (noise allows a little).
+        assert!(f("fraction_of_fma") < 1.2, "{k}");
+        // Bytes are the bindings' sizes: at least the outputs the kernel writes.
+        assert!(f("gbytes_per_s") > 0.0 && f("intensity") > 0.0, "{k}");
+    }
+    // The block solve's counted FLOPs grow linearly in V at fixed n.
+    let lu: Vec<f64> = rows
+        .iter()
+        .filter(|k| k["kernel"] == "block solve" && k["precision"] == "f32")
+        .map(|k| k["flops"].as_f64().unwrap())
+        .collect();
+    assert!((lu[1] / lu[0] - 4.0).abs() < 1e-9, "{lu:?}");
+    for f in ["kernels.md", "roofline.png"] {
+        assert!(out.join(f).exists(), "{f}");
+    }
+}
