@@ -90,85 +90,10 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         }
         return;
     }
-    var aug: array<real, 78>; // 6 rows × 13 columns, row-major
-    var prev_x: array<real, 36>;
-    var prev_z: array<real, 6>;
-    if (dims.begin > 0u) {
-        for (var k = 0u; k < 36u; k = k + 1u) {
-            prev_x[k] = work_x[blk(dims.begin - 1u, k, v)];
-        }
-        for (var k = 0u; k < 6u; k = k + 1u) {
-            prev_z[k] = work_z[vec_at(dims.begin - 1u, k, v)];
-        }
-    }
-    for (var i = dims.begin; i < dims.end; i = i + 1u) {
-        for (var r = 0u; r < 6u; r = r + 1u) {
-            for (var c = 0u; c < 6u; c = c + 1u) {
-                aug[13u * r + c] = diag[blk(i, 6u * r + c, v)];
-                if (i + 1u < n) {
-                    aug[13u * r + 6u + c] = upper[blk(i, 6u * r + c, v)];
-                } else {
-                    aug[13u * r + 6u + c] = real(0.0);
-                }
-            }
-            aug[13u * r + 12u] = rhs[vec_at(i, r, v)];
-            if (i > 0u) {
-                for (var k = 0u; k < 6u; k = k + 1u) {
-                    let l = lower[blk(i - 1u, 6u * r + k, v)];
-                    for (var c = 0u; c < 6u; c = c + 1u) {
-                        aug[13u * r + c] = aug[13u * r + c] - l * prev_x[6u * k + c];
-                    }
-                    aug[13u * r + 12u] = aug[13u * r + 12u] - l * prev_z[k];
-                }
-            }
-        }
-        // Gauss–Jordan with partial pivoting on the 6 × 13 block.
-        for (var col = 0u; col < 6u; col = col + 1u) {
-            var p = col;
-            for (var r = col + 1u; r < 6u; r = r + 1u) {
-                if (abs(aug[13u * r + col]) > abs(aug[13u * p + col])) {
-                    p = r;
-                }
-            }
-            if (p != col) {
-                for (var c = 0u; c < 13u; c = c + 1u) {
-                    let t = aug[13u * col + c];
-                    aug[13u * col + c] = aug[13u * p + c];
-                    aug[13u * p + c] = t;
-                }
-            }
-            let pivot = aug[13u * col + col];
-            if (bad_pivot(pivot)) {
-                status[v] = 1u;
-                for (var k = 0u; k < 6u * n; k = k + 1u) {
-                    x[k * dims.num_variants + v] = real(0.0);
-                }
-                return;
-            }
-            let inv = real(1.0) / pivot;
-            for (var c = col; c < 13u; c = c + 1u) {
-                aug[13u * col + c] = aug[13u * col + c] * inv;
-            }
-            for (var r = 0u; r < 6u; r = r + 1u) {
-                if (r != col) {
-                    let f = aug[13u * r + col];
-                    for (var c = col; c < 13u; c = c + 1u) {
-                        aug[13u * r + c] = aug[13u * r + c] - f * aug[13u * col + c];
-                    }
-                }
-            }
-        }
-        for (var r = 0u; r < 6u; r = r + 1u) {
-            for (var c = 0u; c < 6u; c = c + 1u) {
-                prev_x[6u * r + c] = aug[13u * r + 6u + c];
-                if (i + 1u < n) {
-                    work_x[blk(i, 6u * r + c, v)] = aug[13u * r + 6u + c];
-                }
-            }
-            prev_z[r] = aug[13u * r + 12u];
-            work_z[vec_at(i, r, v)] = aug[13u * r + 12u];
-        }
-    }
+    // The forward walk, written out by src/gpu/block_lu.rs (`serial_forward`): the 6 × 13
+    // block, X_{i−1} and z_{i−1} as scalars with constant names, so no private array is
+    // indexed at run time (they stay in registers).
+    //@FORWARD
 }
 #else
 // Lanes per variant (src/gpu/block_lu.rs LANES) and variants per workgroup.

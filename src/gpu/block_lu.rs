@@ -80,7 +80,149 @@ pub fn block_lu_wgsl(f64: bool, form: LuForm) -> Result<String, GpuError> {
     if form == LuForm::Serial {
         flags.insert("SERIAL");
     }
-    compose("block_lu.wgsl", &flags, f64)
+    let text = compose("block_lu.wgsl", &flags, f64)?;
+    Ok(text.replace("    //@FORWARD\n", &serial_forward()))
+}
+
+/// The serial form's forward walk (see `shaders/block_lu.wgsl`), written out: the augmented
+/// block `[G_i | U_i | y_i]` as 78 scalars `a{r}_{c}`, `X_{i−1}` and `z_{i−1}` as `px{k}`,
+/// `pz{k}`, every loop over rows and columns unrolled, the row swap of partial pivoting a
+/// branch per candidate row — no private array indexed at run time, so a compiler keeps them
+/// in registers (issue 27; an indexed `array<real, 78>` lives in memory). The operations and
+/// their order are the twin's ([`crate::kernels::block_lu::eliminate`]), so the results are.
+fn serial_forward() -> String {
+    use std::fmt::Write;
+    let mut s = String::new();
+    let w = &mut s;
+    for r in 0..6 {
+        for c in 0..13 {
+            let _ = writeln!(w, "    var a{r}_{c}: real;");
+        }
+    }
+    for k in 0..36 {
+        let _ = writeln!(w, "    var px{k}: real;");
+    }
+    for k in 0..6 {
+        let _ = writeln!(w, "    var pz{k}: real;");
+    }
+    let _ = writeln!(w, "    if (dims.begin > 0u) {{");
+    for k in 0..36 {
+        let _ = writeln!(w, "        px{k} = work_x[blk(dims.begin - 1u, {k}u, v)];");
+    }
+    for k in 0..6 {
+        let _ = writeln!(
+            w,
+            "        pz{k} = work_z[vec_at(dims.begin - 1u, {k}u, v)];"
+        );
+    }
+    let _ = writeln!(w, "    }}");
+    let _ = writeln!(
+        w,
+        "    for (var i = dims.begin; i < dims.end; i = i + 1u) {{"
+    );
+    let _ = writeln!(w, "        let has_up = i + 1u < n;");
+    for r in 0..6 {
+        for c in 0..6 {
+            let _ = writeln!(w, "        a{r}_{c} = diag[blk(i, {}u, v)];", 6 * r + c);
+        }
+        let _ = writeln!(w, "        if (has_up) {{");
+        for c in 0..6 {
+            let _ = writeln!(
+                w,
+                "            a{r}_{} = upper[blk(i, {}u, v)];",
+                6 + c,
+                6 * r + c
+            );
+        }
+        let _ = writeln!(w, "        }} else {{");
+        for c in 0..6 {
+            let _ = writeln!(w, "            a{r}_{} = real(0.0);", 6 + c);
+        }
+        let _ = writeln!(w, "        }}");
+        let _ = writeln!(w, "        a{r}_12 = rhs[vec_at(i, {r}u, v)];");
+        let _ = writeln!(w, "        if (i > 0u) {{");
+        for k in 0..6 {
+            let _ = writeln!(w, "            {{");
+            let _ = writeln!(
+                w,
+                "                let l = lower[blk(i - 1u, {}u, v)];",
+                6 * r + k
+            );
+            for c in 0..6 {
+                let _ = writeln!(
+                    w,
+                    "                a{r}_{c} = a{r}_{c} - l * px{};",
+                    6 * k + c
+                );
+            }
+            let _ = writeln!(w, "                a{r}_12 = a{r}_12 - l * pz{k};");
+            let _ = writeln!(w, "            }}");
+        }
+        let _ = writeln!(w, "        }}");
+    }
+    // Gauss–Jordan with partial pivoting on the 6 × 13 block.
+    for col in 0..6 {
+        let _ = writeln!(w, "        {{");
+        let _ = writeln!(w, "            var p = {col}u;");
+        let _ = writeln!(w, "            var best = abs(a{col}_{col});");
+        for r in col + 1..6 {
+            let _ = writeln!(
+                w,
+                "            if (abs(a{r}_{col}) > best) {{ p = {r}u; best = abs(a{r}_{col}); }}"
+            );
+        }
+        for r in col + 1..6 {
+            let _ = writeln!(w, "            if (p == {r}u) {{");
+            for c in 0..13 {
+                let _ = writeln!(
+                    w,
+                    "                {{ let t = a{col}_{c}; a{col}_{c} = a{r}_{c}; a{r}_{c} = t; }}"
+                );
+            }
+            let _ = writeln!(w, "            }}");
+        }
+        let _ = writeln!(w, "            let pivot = a{col}_{col};");
+        let _ = writeln!(w, "            if (bad_pivot(pivot)) {{");
+        let _ = writeln!(w, "                status[v] = 1u;");
+        let _ = writeln!(
+            w,
+            "                for (var k = 0u; k < 6u * n; k = k + 1u) {{ x[k * dims.num_variants + v] = real(0.0); }}"
+        );
+        let _ = writeln!(w, "                return;");
+        let _ = writeln!(w, "            }}");
+        let _ = writeln!(w, "            let inv = real(1.0) / pivot;");
+        for c in col..13 {
+            let _ = writeln!(w, "            a{col}_{c} = a{col}_{c} * inv;");
+        }
+        for r in (0..6).filter(|&r| r != col) {
+            let _ = writeln!(w, "            {{");
+            let _ = writeln!(w, "                let f = a{r}_{col};");
+            for c in col..13 {
+                let _ = writeln!(w, "                a{r}_{c} = a{r}_{c} - f * a{col}_{c};");
+            }
+            let _ = writeln!(w, "            }}");
+        }
+        let _ = writeln!(w, "        }}");
+    }
+    for r in 0..6 {
+        for c in 0..6 {
+            let _ = writeln!(w, "        px{} = a{r}_{};", 6 * r + c, 6 + c);
+        }
+        let _ = writeln!(w, "        if (has_up) {{");
+        for c in 0..6 {
+            let _ = writeln!(
+                w,
+                "            work_x[blk(i, {}u, v)] = a{r}_{};",
+                6 * r + c,
+                6 + c
+            );
+        }
+        let _ = writeln!(w, "        }}");
+        let _ = writeln!(w, "        pz{r} = a{r}_12;");
+        let _ = writeln!(w, "        work_z[vec_at(i, {r}u, v)] = a{r}_12;");
+    }
+    let _ = writeln!(w, "    }}");
+    s
 }
 
 /// Bytes per variant on the GPU for a chain of `n` nodes at `size`-byte floats: the
