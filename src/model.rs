@@ -246,6 +246,26 @@ pub struct Tubular {
     pub element_length: f64,
 }
 
+/// A vertical string of 6.5 in × 0.071 m collar, `length` m in `elements` equal elements, in
+/// mud of `mud_density` (kg/m³): top clamped, bit held laterally ([`Model::bare`]). The
+/// mesh of kernel benchmarks, and (in mud as dense as steel: weightless) of closed-form
+/// tests.
+pub fn vertical_collar(length: f64, elements: usize, mud_density: f64) -> Model {
+    let well = WellPath::vertical(length);
+    let t = Tubular {
+        name: "collar".into(),
+        length,
+        outer_diameter: 0.165,
+        inner_diameter: 0.071,
+        youngs_modulus: 2.1e11,
+        poisson_ratio: 0.3,
+        density: 7850.0,
+        element_length: length / elements as f64,
+    };
+    let (nodes, elements) = mesh_string(&well, &[t], length, mud_density);
+    Model::bare(nodes, elements)
+}
+
 /// Meshes tubulars listed **from the bit up** along `well`, the bit at `bit_md`. Returns
 /// nodes (surface first) and elements, with buoyancy factor `1 − ρ_mud/ρ_steel`.
 pub fn mesh_string(

@@ -77,20 +77,7 @@ fn counted<R: Send>(f: impl FnOnce() -> R + Send) -> f64 {
 
 /// A vertical collar string of `n` nodes: the mesh the kernels run over.
 fn string_model(n: usize) -> crate::model::Model {
-    let l = 9.0 * (n - 1) as f64;
-    let well = crate::well::WellPath::vertical(l);
-    let t = crate::model::Tubular {
-        name: "collar".into(),
-        length: l,
-        outer_diameter: 0.165,
-        inner_diameter: 0.071,
-        youngs_modulus: 2.1e11,
-        poisson_ratio: 0.3,
-        density: 7850.0,
-        element_length: 9.0,
-    };
-    let (nodes, elements) = crate::model::mesh_string(&well, &[t], l, 1200.0);
-    crate::model::Model::bare(nodes, elements)
+    crate::model::vertical_collar(9.0 * (n - 1) as f64, n - 1, 1200.0)
 }
 
 /// A well-conditioned block-tridiagonal batch (diagonally dominant blocks).

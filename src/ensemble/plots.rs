@@ -206,14 +206,7 @@ pub(crate) fn over_the_inputs(
                 })
                 .collect();
             if groups.len() <= MAX_LINES && groups.iter().all(|(_, p)| p.len() > 1) {
-                let series: Vec<Series> = groups
-                    .iter()
-                    .map(|(l, p)| Series {
-                        name: l,
-                        points: p.clone(),
-                        wide: false,
-                    })
-                    .collect();
+                let series: Vec<Series> = crate::plots::named_series(&groups);
                 line_plot(&out.join(file), &title, &x_label, y_label, &series, &[])?;
             } else {
                 // Scattered rows or too many lines: the points of each pick against the key.
@@ -234,14 +227,7 @@ pub(crate) fn over_the_inputs(
                         )
                     })
                     .collect();
-                let series: Vec<Series> = sets
-                    .iter()
-                    .map(|(l, p)| Series {
-                        name: l,
-                        points: p.clone(),
-                        wide: false,
-                    })
-                    .collect();
+                let series: Vec<Series> = crate::plots::named_series(&sets);
                 crate::plots::lines_and_points(
                     &out.join(file),
                     &title,
@@ -321,14 +307,7 @@ pub(crate) fn broomstick(
         |pick: &dyn Fn(&VariantResult) -> Option<f64>| lines_over(variants, results, x, 1e-3, pick);
     // What the rig reads where the case has a `[rig]`, else the string's load.
     let hook_lines = lines_of(&|r| r.weight_indicator_n.or(r.hook_load_n));
-    let mut series: Vec<Series> = hook_lines
-        .iter()
-        .map(|(l, pts)| Series {
-            name: l,
-            points: pts.clone(),
-            wide: false,
-        })
-        .collect();
+    let mut series: Vec<Series> = crate::plots::named_series(&hook_lines);
     // The string's tensile limit: 90 % of the surface component's yield, where it has a grade.
     let top = case
         .model
@@ -427,14 +406,7 @@ pub(crate) fn broomstick(
         .collect();
     let torques = measured_of(|m| m.surface_torque);
     if !torque_lines.is_empty() || !torques.is_empty() {
-        let series: Vec<Series> = torque_lines
-            .iter()
-            .map(|(l, pts)| Series {
-                name: l,
-                points: pts.clone(),
-                wide: false,
-            })
-            .collect();
+        let series: Vec<Series> = crate::plots::named_series(&torque_lines);
         draw(
             "broomstick_torque.png",
             "surface torque",

@@ -177,19 +177,24 @@ pub fn run_passes(
             })
         })
         .collect();
-    let mut encoder =
-        device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(label) });
-    {
-        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-            label: Some(label),
-            timestamp_writes: None,
-        });
-        pass.set_pipeline(pipeline);
-        for bg in &bind_groups {
-            pass.set_bind_group(0, bg, &[]);
-            pass.dispatch_workgroups(invocations.div_ceil(WORKGROUP) as u32, 1, 1);
+    // An encoder holding every pass of the kernel (the first run, and each timed repeat).
+    let passes = || {
+        let mut encoder =
+            device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(label) });
+        {
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some(label),
+                timestamp_writes: None,
+            });
+            pass.set_pipeline(pipeline);
+            for bg in &bind_groups {
+                pass.set_bind_group(0, bg, &[]);
+                pass.dispatch_workgroups(invocations.div_ceil(WORKGROUP) as u32, 1, 1);
+            }
         }
-    }
+        encoder
+    };
+    let mut encoder = passes();
     let mut offset = 0u64;
     for (b, &bytes) in outputs.iter().zip(&output_bytes) {
         let size = bytes.max(4) as u64;
@@ -248,19 +253,7 @@ pub fn run_passes(
                 ctx.queue.submit([e.finish()]);
                 wait()?;
             }
-            let mut e = device
-                .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(label) });
-            {
-                let mut pass = e.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                    label: Some(label),
-                    timestamp_writes: None,
-                });
-                pass.set_pipeline(pipeline);
-                for bg in &bind_groups {
-                    pass.set_bind_group(0, bg, &[]);
-                    pass.dispatch_workgroups(invocations.div_ceil(WORKGROUP) as u32, 1, 1);
-                }
-            }
+            let e = passes();
             let clock = std::time::Instant::now();
             ctx.queue.submit([e.finish()]);
             wait()?;

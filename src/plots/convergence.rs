@@ -123,25 +123,9 @@ pub fn loglog_plot(
     let (y0, y1) = (y0 / 3.0, y1 * 3.0);
     atomic_png(path, |tmp| {
         let root = BitMapBackend::new(tmp, (1000, 680)).into_drawing_area();
-        root.fill(&WHITE)?;
-        let caption = fitted_caption(&root, title, 20);
-        let mut chart = ChartBuilder::on(&root)
-            .caption(&caption.0, ("sans-serif", caption.1))
-            .margin(12)
-            .x_label_area_size(48)
-            .y_label_area_size(90)
-            .build_cartesian_2d(
-                (x0..x1).log_scale().with_key_points(log_ticks(x0, x1)),
-                (y0..y1).log_scale().with_key_points(log_ticks(y0, y1)),
-            )?;
-        chart
-            .configure_mesh()
-            .x_desc(x_label)
-            .y_desc(y_label)
-            .x_label_formatter(&tick)
-            .y_label_formatter(&|y| format!("{y:.0e}"))
-            .label_style(("sans-serif", 15))
-            .draw()?;
+        let mut chart = loglog_chart(&root, title, (x0, x1, x_label), (y0, y1, y_label), &|y| {
+            format!("{y:.0e}")
+        })?;
         let colours = [BLUE, RED, GREEN, MAGENTA];
         for (k, (name, p)) in series.iter().enumerate() {
             let c = colours[k % colours.len()];
@@ -210,25 +194,13 @@ pub fn roofline_plot(
     let (x0, x1, y0, y1) = (x0 / 1.5, x1 * 1.5, y0 / 2.0, y1 * 2.0);
     atomic_png(path, |tmp| {
         let root = BitMapBackend::new(tmp, (1000, 680)).into_drawing_area();
-        root.fill(&WHITE)?;
-        let caption = fitted_caption(&root, title, 20);
-        let mut chart = ChartBuilder::on(&root)
-            .caption(&caption.0, ("sans-serif", caption.1))
-            .margin(12)
-            .x_label_area_size(48)
-            .y_label_area_size(90)
-            .build_cartesian_2d(
-                (x0..x1).log_scale().with_key_points(log_ticks(x0, x1)),
-                (y0..y1).log_scale().with_key_points(log_ticks(y0, y1)),
-            )?;
-        chart
-            .configure_mesh()
-            .x_desc("arithmetic intensity (FLOP/byte)")
-            .y_desc("GFLOP/s")
-            .x_label_formatter(&tick)
-            .y_label_formatter(&tick)
-            .label_style(("sans-serif", 15))
-            .draw()?;
+        let mut chart = loglog_chart(
+            &root,
+            title,
+            (x0, x1, "arithmetic intensity (FLOP/byte)"),
+            (y0, y1, "GFLOP/s"),
+            &tick,
+        )?;
         for (k, (name, p)) in roofs.iter().enumerate() {
             let c = [BLACK, RGBColor(120, 120, 120)][k % 2];
             chart
@@ -275,4 +247,50 @@ pub fn roofline_plot(
         root.present()?;
         Ok(())
     })
+}
+
+/// Log–log axes with key points at the decades (and their 2, 5 where few), the title fitted
+/// to the width, the mesh drawn: the chart of [`loglog_plot`] and [`roofline_plot`].
+#[allow(clippy::type_complexity)]
+fn loglog_chart<'a, 'b>(
+    root: &'a DrawingArea<BitMapBackend<'b>, plotters::coord::Shift>,
+    title: &str,
+    (x0, x1, x_label): (f64, f64, &str),
+    (y0, y1, y_label): (f64, f64, &str),
+    y_format: &dyn Fn(&f64) -> String,
+) -> Result<
+    ChartContext<
+        'a,
+        BitMapBackend<'b>,
+        Cartesian2d<
+            plotters::coord::combinators::WithKeyPoints<
+                plotters::coord::combinators::LogCoord<f64>,
+            >,
+            plotters::coord::combinators::WithKeyPoints<
+                plotters::coord::combinators::LogCoord<f64>,
+            >,
+        >,
+    >,
+    Box<dyn std::error::Error>,
+> {
+    root.fill(&WHITE)?;
+    let caption = fitted_caption(root, title, 20);
+    let mut chart = ChartBuilder::on(root)
+        .caption(&caption.0, ("sans-serif", caption.1))
+        .margin(12)
+        .x_label_area_size(48)
+        .y_label_area_size(90)
+        .build_cartesian_2d(
+            (x0..x1).log_scale().with_key_points(log_ticks(x0, x1)),
+            (y0..y1).log_scale().with_key_points(log_ticks(y0, y1)),
+        )?;
+    chart
+        .configure_mesh()
+        .x_desc(x_label)
+        .y_desc(y_label)
+        .x_label_formatter(&tick)
+        .y_label_formatter(y_format)
+        .label_style(("sans-serif", 15))
+        .draw()?;
+    Ok(chart)
 }

@@ -134,6 +134,17 @@ fn bounds_of(series: &[&Series]) -> ((f64, f64), (f64, f64)) {
     (pad(xr), pad(yr))
 }
 
+/// Thin lines (or point sets) from named point lists.
+pub fn named_series(sets: &[(String, Vec<(f64, f64)>)]) -> Vec<Series<'_>> {
+    sets.iter()
+        .map(|(name, points)| Series {
+            name,
+            points: points.clone(),
+            wide: false,
+        })
+        .collect()
+}
+
 /// Draws `series` (and `markers`) into a PNG at `path`.
 pub fn line_plot(
     path: &Path,
@@ -171,8 +182,25 @@ pub fn lines_and_points(
     series: &[Series],
     points: &[Series],
 ) -> std::io::Result<()> {
+    lines_with_dots(
+        path,
+        (title, x_label, y_label),
+        series,
+        points,
+        Dots::LineColours,
+    )
+}
+
+/// [`lines_and_points`] and [`lines_and_measured`]: lines, then point sets coloured by `dots`.
+fn lines_with_dots(
+    path: &Path,
+    (title, x_label, y_label): (&str, &str, &str),
+    series: &[Series],
+    points: &[Series],
+    dots: Dots,
+) -> std::io::Result<()> {
     let (title, (xl, kx), (yl, ky)) = labels_in_units(title, x_label, y_label);
-    let (lines, dots) = (InUnits::new(series, kx, ky), InUnits::new(points, kx, ky));
+    let (lines, pts) = (InUnits::new(series, kx, ky), InUnits::new(points, kx, ky));
     atomic_png(path, |tmp| {
         draw(
             tmp,
@@ -181,7 +209,7 @@ pub fn lines_and_points(
             &yl,
             &lines.series(),
             &[],
-            (&dots.series(), Dots::LineColours),
+            (&pts.series(), dots),
         )
     })
 }
@@ -198,19 +226,7 @@ pub fn lines_and_measured(
     series: &[Series],
     points: &[Series],
 ) -> std::io::Result<()> {
-    let (title, (xl, kx), (yl, ky)) = labels_in_units(title, x_label, y_label);
-    let (lines, dots) = (InUnits::new(series, kx, ky), InUnits::new(points, kx, ky));
-    atomic_png(path, |tmp| {
-        draw(
-            tmp,
-            &title,
-            &xl,
-            &yl,
-            &lines.series(),
-            &[],
-            (&dots.series(), Dots::Own),
-        )
-    })
+    lines_with_dots(path, (title, x_label, y_label), series, points, Dots::Own)
 }
 
 /// How point sets are coloured.

@@ -112,19 +112,7 @@ pub const STEEL: f64 = 7850.0;
 /// A vertical 6.5 in × 0.071 m collar of length `l` in `elements` elements, in mud as dense
 /// as steel (weightless): top clamped, bit held laterally (`Model::bare`).
 pub fn weightless_collar(l: f64, elements: usize) -> holewall::model::Model {
-    let well = holewall::well::WellPath::vertical(l);
-    let t = holewall::model::Tubular {
-        name: "collar".into(),
-        length: l,
-        outer_diameter: 0.165,
-        inner_diameter: 0.071,
-        youngs_modulus: 2.1e11,
-        poisson_ratio: 0.3,
-        density: STEEL,
-        element_length: l / elements as f64,
-    };
-    let (nodes, elements) = holewall::model::mesh_string(&well, &[t], l, STEEL);
-    holewall::model::Model::bare(nodes, elements)
+    holewall::model::vertical_collar(l, elements, STEEL)
 }
 
 /// A column of an ensemble's `variants.csv` in `out`, as numbers.
