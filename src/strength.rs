@@ -35,6 +35,10 @@ pub struct PipeStrength {
     pub od: f64,
     /// Inner diameter (m).
     pub id: f64,
+    /// The tool joint's make-up torque (N·m, `tool_joint_makeup_torque`), where the case
+    /// gives it: the connection's torque limit in service (a joint made up to it must not be
+    /// turned harder, or it makes up further downhole and the pin or box yields).
+    pub makeup_torque_nm: Option<f64>,
 }
 
 /// The grades by name: (name, minimum yield strength in Pa).
@@ -57,7 +61,14 @@ impl PipeStrength {
             wall_fraction,
             od: id + wall_fraction * (od - id),
             id,
+            makeup_torque_nm: None,
         }
+    }
+
+    /// The same pipe with its tool joint's make-up torque (N·m).
+    pub fn with_makeup_torque(mut self, makeup_torque_nm: Option<f64>) -> Self {
+        self.makeup_torque_nm = makeup_torque_nm;
+        self
     }
 
     /// Steel area, second moment and polar moment of the worn section (m², m⁴, m⁴).
@@ -151,6 +162,10 @@ pub struct StrengthSummary {
     /// Largest torque over the RP 7G limit at the local tension, along the graded
     /// components.
     pub max_torque_utilisation: f64,
+    /// Largest torque over the tool joint's make-up torque, along the components that give
+    /// one (the connection's limit; above 1 the joints make up further downhole).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub max_makeup_torque_utilisation: Option<f64>,
 }
 
 /// One node of a profile as the strength check reads it.
@@ -183,6 +198,7 @@ pub fn assess(
     let mut out = Vec::with_capacity(rows.len());
     let mut worst = (f64::NAN, f64::NAN);
     let mut worst_torque: f64 = 0.0;
+    let mut worst_makeup: Option<f64> = None;
     for (i, r) in rows.iter().enumerate() {
         let Some(s) = strength.get(component_of(i)).copied().flatten() else {
             out.push((f64::NAN, f64::NAN));
@@ -203,6 +219,10 @@ pub fn assess(
             f64::INFINITY
         };
         worst_torque = worst_torque.max(tu);
+        if let Some(m) = s.makeup_torque_nm {
+            let mu = r.torque.abs() / m;
+            worst_makeup = Some(worst_makeup.map_or(mu, |w| w.max(mu)));
+        }
         out.push((vm, u));
     }
     if worst.0.is_nan() {
@@ -215,6 +235,7 @@ pub fn assess(
         top_tensile_yield_n: top.map(|s| s.tensile_yield_n()),
         overpull_margin_n: top.map(|s| 0.9 * s.tensile_yield_n() - hook_load),
         max_torque_utilisation: worst_torque,
+        max_makeup_torque_utilisation: worst_makeup,
     };
     (out, Some(summary))
 }

@@ -783,3 +783,64 @@ fn field_units_translate_every_output() {
     let (code, _, _) = common::holewall(&["static", case, "--out", "x", "--units", "imperial"]);
     assert_eq!(code, 2);
 }
+
+#[test]
+fn the_tool_joint_make_up_torque_is_checked_along_the_string() {
+    // The shipped broomstick case's pipe has NC50 joints made up to 36,000 ft·lbf: the
+    // summary's utilisation is the largest |torque| along the pipe over that torque (the
+    // profile's torque column; the collars below carry no make-up torque), and bad keys are
+    // refused with their line.
+    let case = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/cases/broomstick_tool_joints.toml"
+    );
+    let out = common::scratch_dir("torque_drag", "makeup");
+    let (code, _, stderr) =
+        common::holewall(&["static", case, "--out", out.to_str().unwrap(), "--quiet"]);
+    assert_eq!(code, 0, "{stderr}");
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    let u = summary["strength"]["max_makeup_torque_utilisation"]
+        .as_f64()
+        .unwrap();
+    let makeup = 36_000.0 * 4.448_221_615_260_5 * 0.3048;
+    let text = std::fs::read_to_string(out.join("profile.csv")).unwrap();
+    let mut rows = csv::Reader::from_reader(text.as_bytes());
+    let header = rows.headers().unwrap().clone();
+    let col = |name: &str| header.iter().position(|h| h == name).unwrap();
+    let (md, torque) = (col("md_m"), col("torque_nm"));
+    // The pipe is the top 1,410 m of the 1,500 m string.
+    let worst = rows
+        .records()
+        .map(|r| r.unwrap())
+        .filter(|r| r[md].parse::<f64>().unwrap() <= 1410.0 - 1e-6)
+        .map(|r| r[torque].parse::<f64>().unwrap().abs())
+        .fold(0.0f64, f64::max);
+    assert!(worst > 0.0);
+    assert!(
+        (u - worst / makeup).abs() < 1e-9 * u.max(1e-12),
+        "{u} vs {}",
+        worst / makeup
+    );
+    // Refused: without a grade, without tool joints, out of range.
+    let base = std::fs::read_to_string(case).unwrap();
+    for (edit, key) in [
+        (
+            base.replace("grade = \"G105\"\nwear = \"premium\"\n", ""),
+            "string.tool_joint_makeup_torque",
+        ),
+        (
+            base.replace("tool_joint_od = \"6.625 in\"     # NC50\n", "")
+                .replace("tool_joint_length = \"0.45 m\"\n", "")
+                .replace("joint_spacing = \"30 ft\"\n", ""),
+            "string.tool_joint_makeup_torque",
+        ),
+        (
+            base.replace("\"36000 ft.lbf\"", "\"10 N.m\""),
+            "string.tool_joint_makeup_torque",
+        ),
+    ] {
+        let e = holewall::case::parse_case(std::path::Path::new("tj.toml"), &edit).unwrap_err();
+        assert!(e.key == key && e.line > 0, "{e}");
+    }
+}

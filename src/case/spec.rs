@@ -87,6 +87,11 @@ pub struct ComponentSpec {
     pub tool_joint_length: Option<Q>,
     /// Distance between tool joints (one joint of pipe; default 30 ft = 9.144 m).
     pub joint_spacing: Option<Q>,
+    /// The tool joints' make-up torque (the connection's datasheet, e.g. NC50 6⅝ in × 3¼ in:
+    /// ≈ 38,000 ft·lbf): the connection's torque limit, checked along the string and drawn
+    /// on the tension–torque envelope and the torque broomstick. Needs `tool_joint_od` and a
+    /// grade.
+    pub tool_joint_makeup_torque: Option<Q>,
     /// Steel grade (`E75`, `X95`, `G105`, `S135`; [`crate::strength`]): the component's
     /// stresses are then checked against its yield.
     pub grade: Option<Spanned<String>>,

@@ -189,6 +189,10 @@ pub(super) fn read_string(
                 for (k, v) in [
                     ("string.tool_joint_length", &c.tool_joint_length),
                     ("string.joint_spacing", &c.joint_spacing),
+                    (
+                        "string.tool_joint_makeup_torque",
+                        &c.tool_joint_makeup_torque,
+                    ),
                 ] {
                     if let Some(v) = v {
                         return Err(ctx.err(v.span(), k, "needs string.tool_joint_od"));
@@ -295,8 +299,26 @@ pub(super) fn read_string(
                 None
             }
         };
-        strength
-            .push(grade.map(|(name, y)| crate::strength::PipeStrength::new(name, y, wall, od, id)));
+        let makeup = match (&c.tool_joint_makeup_torque, &grade) {
+            (None, _) => None,
+            (Some(q), None) => {
+                return Err(ctx.err(
+                    q.span(),
+                    "string.tool_joint_makeup_torque",
+                    "needs string.grade (or yield_strength): the limit is drawn on the pipe's tension–torque envelope",
+                ))
+            }
+            (Some(q), Some(_)) => Some(ctx.quantity(
+                q,
+                "string.tool_joint_makeup_torque",
+                Dimension::Torque,
+                |x| (1e3..=3e5).contains(&x),
+                "1 … 300 kN·m (≈ 740 … 221,000 ft·lbf)",
+            )?),
+        };
+        strength.push(grade.map(|(name, y)| {
+            crate::strength::PipeStrength::new(name, y, wall, od, id).with_makeup_torque(makeup)
+        }));
         blades.push(blade);
         tubulars.push(Tubular {
             name: kind,

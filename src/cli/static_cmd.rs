@@ -520,23 +520,36 @@ fn tension_torque_plot(case: &Case, rows: &[ProfileRow], out: &Path) -> std::io:
         model.elements[0].outer_diameter / 0.0254,
         100.0 * top.wall_fraction
     );
+    let mut series = vec![
+        Series {
+            name: &name,
+            points: envelope,
+            wide: true,
+        },
+        Series {
+            name: "along the string (graded components)",
+            points,
+            wide: false,
+        },
+    ];
+    let makeup_name;
+    if let Some(m) = top.makeup_torque_nm {
+        makeup_name = format!(
+            "tool-joint make-up torque {:.1} kN·m (the connection's limit)",
+            m / 1e3
+        );
+        series.push(Series {
+            name: &makeup_name,
+            points: vec![(0.0, m / 1e3), (yield_n / 1e3, m / 1e3)],
+            wide: false,
+        });
+    }
     line_plot(
         &out.join("tension_torque.png"),
         &format!("{}: tension–torque envelope (API RP 7G)", case.title),
         "true axial force, tension + (kN)",
         "torque (kN·m)",
-        &[
-            Series {
-                name: &name,
-                points: envelope,
-                wide: true,
-            },
-            Series {
-                name: "along the string (graded components)",
-                points,
-                wide: false,
-            },
-        ],
+        &series,
         &[],
     )
 }

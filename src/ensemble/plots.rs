@@ -271,6 +271,10 @@ pub(crate) fn over_the_inputs(
     Ok(vec!["neutral_point.png".into(), "side_force.png".into()])
 }
 
+/// A limit line further above the loads than this (× the largest) is named in the legend
+/// with its distance, not drawn: the loads stay readable.
+const OFF_SCALE: f64 = 3.0;
+
 /// A quantity of a variant's result.
 type Pick = dyn Fn(&VariantResult) -> Option<f64>;
 
@@ -406,7 +410,44 @@ pub(crate) fn broomstick(
         .collect();
     let torques = measured_of(|m| m.surface_torque);
     if !torque_lines.is_empty() || !torques.is_empty() {
-        let series: Vec<Series> = crate::plots::named_series(&torque_lines);
+        let mut series: Vec<Series> = crate::plots::named_series(&torque_lines);
+        // The surface connection's make-up torque, where the case gives it.
+        // Drawn where it is within OFF_SCALE of the largest torque; named (in the legend)
+        // with how far off the scale it is otherwise, so the loads stay readable.
+        let makeup = top.and_then(|s| s.makeup_torque_nm).map(|m| m / 1e3);
+        let largest = torque_lines
+            .iter()
+            .flat_map(|(_, p)| p.iter().map(|x| x.1))
+            .fold(0.0f64, f64::max);
+        let makeup_name = makeup.map(|m| {
+            let off = m > OFF_SCALE * largest && largest > 0.0;
+            format!(
+                "tool-joint make-up torque {m:.1} kN·m (the connection's limit){}",
+                if off {
+                    format!(": off the scale, {:.1}× the largest torque", m / largest)
+                } else {
+                    String::new()
+                }
+            )
+        });
+        if let (Some(m), Some(name)) = (makeup, &makeup_name) {
+            let (lo, hi) = torque_lines
+                .iter()
+                .flat_map(|(_, p)| p.iter().map(|x| x.0))
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), d| {
+                    (a.min(d), b.max(d))
+                });
+            let drawn = lo.is_finite() && m <= OFF_SCALE * largest;
+            series.push(Series {
+                name,
+                points: if drawn {
+                    vec![(lo, m), (hi, m)]
+                } else {
+                    vec![]
+                },
+                wide: true,
+            });
+        }
         draw(
             "broomstick_torque.png",
             "surface torque",
