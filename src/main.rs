@@ -312,6 +312,23 @@ enum BenchCommand {
         #[arg(long)]
         json: Option<PathBuf>,
     },
+    /// The whole performance table of this machine in one command: contact, element,
+    /// roofline per kernel, static and dynamic ensembles, each against the CPU path
+    /// (device.md, device.json) — run it on a GPU and send the folder back.
+    Device {
+        /// Output folder.
+        #[arg(long)]
+        out: PathBuf,
+        /// Folder of the shipped cases (the static ensembles).
+        #[arg(long, default_value = "cases")]
+        cases: PathBuf,
+        /// Smaller sizes and fewer repeats (a first look).
+        #[arg(long)]
+        quick: bool,
+        /// No progress bar.
+        #[arg(long)]
+        quiet: bool,
+    },
     /// A roofline per kernel (contact, beam, assembly, block solve): achieved GFLOP/s and
     /// GB/s beside this device's FMA and copy ceilings, measured here, f32 and f64
     /// (kernels.md, kernels.json, roofline.png).
@@ -818,6 +835,22 @@ fn main() -> ExitCode {
                 repeats,
                 json,
             } => match cli::bench::statics(&case, variants.as_deref(), repeats, json.as_deref()) {
+                Ok(()) => ExitCode::SUCCESS,
+                Err(e) => fail(&[e]),
+            },
+            BenchCommand::Device {
+                out,
+                cases,
+                quick,
+                quiet,
+            } => match cli::bench_device::run(
+                &out,
+                &cases,
+                cli::bench_device::DeviceOptions {
+                    quick,
+                    show_progress: !quiet,
+                },
+            ) {
                 Ok(()) => ExitCode::SUCCESS,
                 Err(e) => fail(&[e]),
             },

@@ -3,6 +3,7 @@
 pub mod bench;
 pub mod bench_calibrate;
 pub mod bench_corpus;
+pub mod bench_device;
 pub mod bench_ensemble;
 pub mod bench_kernels;
 pub mod calibrate_cmd;
