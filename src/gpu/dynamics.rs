@@ -1,5 +1,5 @@
 //! Runs `shaders/dynamics.wgsl` (twin: `src/kernels/dynamics.rs`) one-shot, for tests; the
-//! engine binds the same kernels to resident buffers (`src/gpu/ensemble.rs`).
+//! engine binds the same kernels to resident buffers (`src/gpu/ensemble/`).
 
 use std::collections::BTreeSet;
 

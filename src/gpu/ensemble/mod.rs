@@ -1,0 +1,696 @@
+//! A chunk of variants resident on the GPU for the ensemble Newton iteration
+//! ([`crate::engine`]): every buffer and bind group is made once, when the chunk is opened;
+//! an iteration records the kernels (beam → sites → contact → assembly → block LU → norms,
+//! then update → … for a trial) into command buffers, and the host reads back only the
+//! four norms and the solve status per variant ([`Norms`]), and writes one α per variant.
+//!
+//! Two configuration slots (current and trial) each with their assembled system: a trial
+//! the line search accepts becomes the current one by swapping slots, without evaluating
+//! again.
+
+use std::marker::PhantomData;
+use std::sync::Arc;
+
+use wgpu::util::DeviceExt;
+
+use crate::engine::Stage;
+use crate::engine::{Ensemble, EnsembleTables};
+use crate::error::GpuError;
+use crate::gpu::block_lu::LuForm;
+use crate::gpu::contact::{contact_wgsl, require_precision, GpuReal};
+use crate::gpu::dispatch::WORKGROUP;
+use crate::gpu::layout::{AssembleDims, BeamDims, ChainDims, ContactDims};
+use crate::gpu::GpuContext;
+use crate::kernels::contact::{OUTPUT_LEN, STATE_LEN};
+use crate::kernels::update::{ConfigBatch, Norms};
+use crate::model::Model;
+use crate::physics::contact::PARAMS_LEN;
+
+mod dynamic;
+mod iteration;
+pub use dynamic::{gather_sites_dynamic_gpu, GpuDynamic};
+pub use iteration::{gather_sites_gpu, sites_wgsl, sites_wgsl_for};
+
+/// Status the block solve starts with; still there afterwards means it did not finish.
+const RUNNING: u32 = 2;
+
+/// Bytes per variant of every buffer of a chunk, for a chain of `n` nodes with `s` sites
+/// at `size`-byte floats: two configurations and two assembled systems, the base and its
+/// chords, element forces and tangents, contact inputs and outputs (all
+/// [`OUTPUT_LEN`] fields: the dynamic engine's; a static chunk holds
+/// [`crate::kernels::contact::output_fields`]), loads, the factorisation workspace, the
+/// step, and the per-variant scalars. (The shared tables — translation bases, sections,
+/// frames — are per chunk.)
+pub fn bytes_per_variant(n: usize, s: usize, size: usize) -> usize {
+    let m = n.saturating_sub(1);
+    let reals = 2 * 12 * n            // x, rot: two slots
+        + 4 * m                       // base chords and stretches
+        + 12 * m + 144 * m            // element force, tangent
+        + (OUTPUT_LEN + STATE_LEN + PARAMS_LEN + 6) * s // contact out, state, params, normals, base
+        + 6 * n                       // loads
+        + 2 * (36 * n + 72 * m + 6 * n) // two systems
+        + 36 * m + 6 * n + 6 * n      // LU workspace, y, Δ
+        + 4 + 1; // norms, α
+    size * reals + 4 * (n + 2 * s + 1) // node_site, pair_node, contact flags, status
+}
+
+/// The largest per-variant array of one binding, in bytes: the element tangents.
+fn largest_binding_per_variant(n: usize, s: usize, size: usize) -> usize {
+    let m = n.saturating_sub(1);
+    size * (144 * m).max(36 * n).max(OUTPUT_LEN * s)
+}
+
+/// The most variants of `model` one chunk may hold on `ctx`: every binding within the
+/// adapter's limit, every dispatch within its workgroup count.
+pub fn max_variants(ctx: &GpuContext, model: &Model, size: usize) -> usize {
+    let n = model.nodes.len();
+    let s = model.sites.len();
+    let by_binding = ctx.max_binding_bytes() as usize / largest_binding_per_variant(n, s, size);
+    let widest = n.max(s).max(LuForm::for_adapter(ctx).lanes());
+    let by_groups = ctx.limits.max_compute_workgroups_per_dimension as usize * WORKGROUP / widest;
+    by_binding.min(by_groups).max(1)
+}
+
+struct Slot {
+    x: wgpu::Buffer,
+    rot: wgpu::Buffer,
+    beam: wgpu::BindGroup,
+    /// The force-only beam kernel's group (trials).
+    beam_force: wgpu::BindGroup,
+    sites: wgpu::BindGroup,
+    assemble: wgpu::BindGroup,
+    lu: Vec<wgpu::BindGroup>,
+    norms_solve: wgpu::BindGroup,
+    norms_trial: wgpu::BindGroup,
+    update: wgpu::BindGroup,
+    _keep: Vec<wgpu::Buffer>,
+}
+
+struct Pipelines {
+    beam: Arc<wgpu::ComputePipeline>,
+    /// The beam kernel built `FORCE_ONLY` (line-search trials).
+    beam_force: Arc<wgpu::ComputePipeline>,
+    sites: Arc<wgpu::ComputePipeline>,
+    contact: Arc<wgpu::ComputePipeline>,
+    assemble: Arc<wgpu::ComputePipeline>,
+    block_lu: Arc<wgpu::ComputePipeline>,
+    norms: Arc<wgpu::ComputePipeline>,
+    update: Arc<wgpu::ComputePipeline>,
+}
+
+/// A chunk of variants on the GPU (see the module docs).
+pub struct GpuEnsemble<T: GpuReal> {
+    ctx: &'static GpuContext,
+    p: Pipelines,
+    slots: [Slot; 2],
+    /// Whether each slot's assembled system has its tangent (a trial's has its residual only).
+    formed: [bool; 2],
+    /// Invocations per variant of the block solve ([`LuForm`]).
+    lu_lanes: usize,
+    current: usize,
+    contact: wgpu::BindGroup,
+    c: Common,
+    num_variants: usize,
+    num_nodes: usize,
+    num_pairs: usize,
+    _real: PhantomData<T>,
+}
+
+fn storage<T: bytemuck::Pod>(ctx: &GpuContext, label: &str, data: &[T]) -> wgpu::Buffer {
+    let bytes: &[u8] = bytemuck::cast_slice(data);
+    // Bindings may not be empty: pad to one 16-byte word.
+    let padded: Vec<u8>;
+    let contents = if bytes.len() < 16 {
+        padded = bytes
+            .iter()
+            .copied()
+            .chain(std::iter::repeat(0))
+            .take(16)
+            .collect();
+        &padded[..]
+    } else {
+        bytes
+    };
+    ctx.device
+        .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some(label),
+            contents,
+            usage: wgpu::BufferUsages::STORAGE
+                | wgpu::BufferUsages::COPY_DST
+                | wgpu::BufferUsages::COPY_SRC,
+        })
+}
+
+fn empty(ctx: &GpuContext, label: &str, bytes: usize) -> wgpu::Buffer {
+    ctx.device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some(label),
+        size: bytes.max(16) as u64,
+        usage: wgpu::BufferUsages::STORAGE
+            | wgpu::BufferUsages::COPY_DST
+            | wgpu::BufferUsages::COPY_SRC,
+        mapped_at_creation: false,
+    })
+}
+
+/// A kernel's parameter block (binding 0): read-only storage, not a uniform, which lavapipe
+/// would inline and recompile the kernel for at every dispatch (see `tests/shaders.rs`).
+fn param_block<U: bytemuck::Pod>(ctx: &GpuContext, label: &str, u: &U) -> wgpu::Buffer {
+    ctx.device
+        .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some(label),
+            contents: bytemuck::bytes_of(u),
+            usage: wgpu::BufferUsages::STORAGE,
+        })
+}
+
+/// A bind group with `buffers` at bindings 0, 1, … in order.
+fn bind(
+    ctx: &GpuContext,
+    pipeline: &wgpu::ComputePipeline,
+    label: &str,
+    buffers: &[&wgpu::Buffer],
+) -> wgpu::BindGroup {
+    let entries: Vec<wgpu::BindGroupEntry> = buffers
+        .iter()
+        .enumerate()
+        .map(|(k, b)| wgpu::BindGroupEntry {
+            binding: k as u32,
+            resource: b.as_entire_binding(),
+        })
+        .collect();
+    ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some(label),
+        layout: &pipeline.get_bind_group_layout(0),
+        entries: &entries,
+    })
+}
+
+fn dispatch(
+    pass: &mut wgpu::ComputePass,
+    pipeline: &wgpu::ComputePipeline,
+    group: &wgpu::BindGroup,
+    invocations: usize,
+) {
+    if invocations == 0 {
+        return;
+    }
+    pass.set_pipeline(pipeline);
+    pass.set_bind_group(0, group, &[]);
+    pass.dispatch_workgroups(invocations.div_ceil(WORKGROUP) as u32, 1, 1);
+}
+
+/// The buffers every chunk has, static or dynamic: shared tables, contact and element
+/// work, the block solve's workspace and step, the per-variant scalars, and the parameter blocks.
+struct Common {
+    sections: wgpu::Buffer,
+    frames: wgpu::Buffer,
+    chords: wgpu::Buffer,
+    /// Unstrained rotations per element and variant (a scene with a kink only).
+    rest: Option<wgpu::Buffer>,
+    /// The base at every pair across its hole axis, `3 P` (the sites kernel's `b`).
+    pair_base: wgpu::Buffer,
+    basis: wgpu::Buffer,
+    fixed: wgpu::Buffer,
+    node_site: wgpu::Buffer,
+    pair_node: wgpu::Buffer,
+    normals: wgpu::Buffer,
+    pair_state: wgpu::Buffer,
+    params: wgpu::Buffer,
+    f_ext: wgpu::Buffer,
+    elem_force: wgpu::Buffer,
+    elem_tangent: wgpu::Buffer,
+    values: wgpu::Buffer,
+    flags: wgpu::Buffer,
+    work_x: wgpu::Buffer,
+    work_z: wgpu::Buffer,
+    delta: wgpu::Buffer,
+    status: wgpu::Buffer,
+    /// [`RUNNING`] per variant: copied into `status` before every block solve.
+    running: wgpu::Buffer,
+    ones: wgpu::Buffer,
+    alpha: wgpu::Buffer,
+    norms: wgpu::Buffer,
+    chain_dims: wgpu::Buffer,
+    beam_dims: wgpu::Buffer,
+    sites_dims: wgpu::Buffer,
+    contact_dims: wgpu::Buffer,
+    assemble_dims: wgpu::Buffer,
+    lu_dims: Vec<wgpu::Buffer>,
+}
+
+impl Common {
+    /// The beam kernel's bind group on configuration (`x`, `rot`); `force_only`: for the
+    /// kernel built `FORCE_ONLY`, which has no tangent binding.
+    fn beam_group(
+        &self,
+        ctx: &GpuContext,
+        pipeline: &wgpu::ComputePipeline,
+        x: &wgpu::Buffer,
+        rot: &wgpu::Buffer,
+        force_only: bool,
+    ) -> wgpu::BindGroup {
+        let mut all = vec![
+            &self.beam_dims,
+            x,
+            rot,
+            &self.frames,
+            &self.sections,
+            &self.chords,
+        ];
+        all.extend(&self.rest);
+        all.push(&self.elem_force);
+        if !force_only {
+            all.push(&self.elem_tangent);
+        }
+        bind(ctx, pipeline, "beam", &all)
+    }
+
+    /// The contact kernel's bind group.
+    fn contact_group(&self, ctx: &GpuContext, pipeline: &wgpu::ComputePipeline) -> wgpu::BindGroup {
+        bind(
+            ctx,
+            pipeline,
+            "contact",
+            &[
+                &self.contact_dims,
+                &self.normals,
+                &self.params,
+                &self.pair_state,
+                &self.values,
+                &self.flags,
+            ],
+        )
+    }
+
+    /// The assembly's inputs before the constraints (bindings 1–8).
+    fn assembly_inputs(&self) -> [&wgpu::Buffer; 9] {
+        [
+            &self.assemble_dims,
+            &self.elem_force,
+            &self.elem_tangent,
+            &self.values,
+            &self.flags,
+            &self.node_site,
+            &self.f_ext,
+            &self.basis,
+            &self.fixed,
+        ]
+    }
+
+    /// One bind group per pass of the block solve of `system` (diag, upper, lower, rhs).
+    fn lu_groups(
+        &self,
+        ctx: &GpuContext,
+        pipeline: &wgpu::ComputePipeline,
+        system: [&wgpu::Buffer; 4],
+    ) -> Vec<wgpu::BindGroup> {
+        self.lu_dims
+            .iter()
+            .map(|d| {
+                let [diag, upper, lower, rhs] = system;
+                bind(
+                    ctx,
+                    pipeline,
+                    "block_lu",
+                    &[
+                        d,
+                        diag,
+                        upper,
+                        lower,
+                        rhs,
+                        &self.work_x,
+                        &self.work_z,
+                        &self.delta,
+                        &self.status,
+                    ],
+                )
+            })
+            .collect()
+    }
+
+    /// Sets every variant's block-solve status to [`RUNNING`] (recorded on `encoder`).
+    fn reset_status(&self, encoder: &mut wgpu::CommandEncoder, v: usize) {
+        encoder.copy_buffer_to_buffer(&self.running, 0, &self.status, 0, 4 * v as u64);
+    }
+
+    /// The norms of `rhs` and the step with `alpha` (or ones).
+    fn norms_group(
+        &self,
+        ctx: &GpuContext,
+        pipeline: &wgpu::ComputePipeline,
+        alpha: &wgpu::Buffer,
+        rhs: &wgpu::Buffer,
+    ) -> wgpu::BindGroup {
+        bind(
+            ctx,
+            pipeline,
+            "norms",
+            &[&self.chain_dims, &self.delta, alpha, rhs, &self.norms],
+        )
+    }
+
+    /// Checks the chunk against the adapter's limits and makes its common buffers; the
+    /// pair parameters and loads start as given (or empty, written per load step).
+    fn new<T: GpuReal>(
+        ctx: &'static GpuContext,
+        model: &Model,
+        tables: &EnsembleTables<T>,
+        params: Option<&[T]>,
+        f_ext: Option<&[T]>,
+    ) -> Result<Self, GpuError> {
+        require_precision::<T>(ctx)?;
+        let (v, n, s) = (tables.num_variants, tables.num_nodes, tables.num_sites);
+        let (m, p) = (n.saturating_sub(1), tables.pair_node.len());
+        let size = std::mem::size_of::<T>();
+        if largest_binding_per_variant(n, s, size) * v > ctx.max_binding_bytes() as usize {
+            return Err(GpuError::Unsupported(format!(
+                "{v} variants of {n} nodes exceed one binding of {} bytes; split the variants",
+                ctx.max_binding_bytes()
+            )));
+        }
+        // The norms loop over 6n entries per invocation: llvmpipe's loop budget.
+        if 6 * n > 60_000 {
+            return Err(GpuError::Unsupported(format!(
+                "norms of {n} nodes exceed one invocation's loop budget"
+            )));
+        }
+        let cast = |x: Vec<f64>| -> Vec<T> { x.into_iter().map(T::from_f64_lossy).collect() };
+        let table = |label: &str, x: Vec<f64>| storage(ctx, label, &cast(x));
+        let given = |label: &str, x: Option<&[T]>, len: usize| match x {
+            Some(x) => storage(ctx, label, x),
+            None => empty(ctx, label, len * size),
+        };
+        Ok(Common {
+            sections: table("sections", crate::kernels::beam::section_table(model)),
+            frames: table("frames", crate::kernels::beam::frame_table(model)),
+            chords: storage(ctx, "chords", &tables.chords),
+            rest: (!tables.rest.is_empty()).then(|| storage(ctx, "rest", &tables.rest)),
+            pair_base: storage(ctx, "pair_base", &tables.pair_base),
+            basis: storage(ctx, "basis", &tables.basis),
+            fixed: storage(ctx, "fixed", &tables.fixed),
+            node_site: storage(ctx, "node_site", &tables.node_site),
+            pair_node: storage(ctx, "pair_node", &tables.pair_node),
+            normals: storage(ctx, "pair_normals", &tables.pair_normals),
+            pair_state: storage(ctx, "pair_state", &tables.pair_state),
+            params: given("pair_params", params, PARAMS_LEN * p),
+            f_ext: given("f_ext", f_ext, 6 * n * v),
+            elem_force: empty(ctx, "elem_force", 12 * m * v * size),
+            elem_tangent: empty(ctx, "elem_tangent", 144 * m * v * size),
+            values: empty(
+                ctx,
+                "contact_values",
+                crate::kernels::contact::output_fields(&tables.terms) * p * size,
+            ),
+            flags: empty(ctx, "contact_flags", 4 * p),
+            work_x: empty(ctx, "lu_work", 36 * m.max(1) * v * size),
+            work_z: empty(ctx, "lu_work_z", 6 * n * v * size),
+            delta: empty(ctx, "delta", 6 * n * v * size),
+            status: empty(ctx, "status", 4 * v),
+            running: storage(ctx, "status_running", &vec![RUNNING; v]),
+            ones: storage(ctx, "ones", &vec![T::one(); v]),
+            alpha: empty(ctx, "alpha", v * size),
+            norms: empty(ctx, "norms", 4 * v * size),
+            chain_dims: param_block(
+                ctx,
+                "chain_dims",
+                &ChainDims {
+                    num_variants: v as u32,
+                    num_nodes: n as u32,
+                    _pad0: 0,
+                    _pad1: 0,
+                },
+            ),
+            beam_dims: param_block(
+                ctx,
+                "beam_dims",
+                &BeamDims {
+                    num_variants: v as u32,
+                    num_elements: m as u32,
+                    _pad0: 0,
+                    _pad1: 0,
+                },
+            ),
+            sites_dims: param_block(
+                ctx,
+                "sites_dims",
+                &ContactDims {
+                    num_pairs: p as u32,
+                    num_variants: v as u32,
+                    pair_offset: 0,
+                    _pad: 0,
+                },
+            ),
+            // The contact kernel sees one "variant" per site: every pair has its own axis.
+            contact_dims: param_block(
+                ctx,
+                "contact_dims",
+                &ContactDims {
+                    num_pairs: p as u32,
+                    num_variants: 1,
+                    pair_offset: 0,
+                    _pad: 0,
+                },
+            ),
+            assemble_dims: param_block(
+                ctx,
+                "assemble_dims",
+                &AssembleDims {
+                    num_variants: v as u32,
+                    num_nodes: n as u32,
+                    num_sites: s as u32,
+                    _pad: 0,
+                },
+            ),
+            lu_dims: crate::gpu::block_lu::pass_dims(n, v)
+                .iter()
+                .map(|d| param_block(ctx, "lu_dims", d))
+                .collect(),
+        })
+    }
+}
+
+impl<T: GpuReal> GpuEnsemble<T> {
+    /// Compiles (or fetches) the kernels for the chunk's terms and precision and uploads
+    /// its tables and start configuration.
+    pub fn new(
+        ctx: &'static GpuContext,
+        model: &Model,
+        tables: &EnsembleTables<T>,
+    ) -> Result<Self, GpuError> {
+        let f64 = T::IS_F64;
+        let kink = !tables.rest.is_empty();
+        let (v, n) = (tables.num_variants, tables.num_nodes);
+        let (m, p) = (n.saturating_sub(1), tables.pair_node.len());
+        let size = std::mem::size_of::<T>();
+        let c = Common::new(ctx, model, tables, None, None)?;
+        let pipelines = Pipelines {
+            beam: ctx.pipeline("beam", &crate::gpu::beam::beam_wgsl(f64, false, kink)?)?,
+            beam_force: ctx
+                .pipeline("beam_force", &crate::gpu::beam::beam_wgsl(f64, true, kink)?)?,
+            sites: ctx.pipeline("sites", &sites_wgsl(f64)?)?,
+            contact: ctx.pipeline("contact", &contact_wgsl(&tables.terms, f64)?)?,
+            assemble: ctx.pipeline("assemble", &crate::gpu::assemble::assemble_wgsl(f64)?)?,
+            block_lu: ctx.pipeline(
+                "block_lu",
+                &crate::gpu::block_lu::block_lu_wgsl(f64, LuForm::for_adapter(ctx))?,
+            )?,
+            norms: ctx.pipeline("norms", &crate::gpu::update::update_wgsl(true, f64)?)?,
+            update: ctx.pipeline("update", &crate::gpu::update::update_wgsl(false, f64)?)?,
+        };
+        let contact = c.contact_group(ctx, &pipelines.contact);
+        let make_slot = |label: &str| -> Slot {
+            let x = storage(ctx, label, &tables.start.x);
+            let rot = storage(ctx, label, &tables.start.rot);
+            let diag = empty(ctx, "diag", 36 * n * v * size);
+            let upper = empty(ctx, "upper", 36 * m.max(1) * v * size);
+            let lower = empty(ctx, "lower", 36 * m.max(1) * v * size);
+            let rhs = empty(ctx, "rhs", 6 * n * v * size);
+            let beam = c.beam_group(ctx, &pipelines.beam, &x, &rot, false);
+            let beam_force = c.beam_group(ctx, &pipelines.beam_force, &x, &rot, true);
+            let sites = bind(
+                ctx,
+                &pipelines.sites,
+                "sites",
+                &[&c.sites_dims, &c.pair_node, &x, &c.pair_base, &c.pair_state],
+            );
+            let inputs = c.assembly_inputs();
+            let assemble = bind(
+                ctx,
+                &pipelines.assemble,
+                "assemble",
+                &[&inputs[..], &[&diag, &upper, &lower, &rhs]].concat(),
+            );
+            let lu = c.lu_groups(ctx, &pipelines.block_lu, [&diag, &upper, &lower, &rhs]);
+            let norms_solve = c.norms_group(ctx, &pipelines.norms, &c.ones, &rhs);
+            let norms_trial = c.norms_group(ctx, &pipelines.norms, &c.alpha, &rhs);
+            let update = bind(
+                ctx,
+                &pipelines.update,
+                "update",
+                &[
+                    &c.chain_dims,
+                    &c.delta,
+                    &c.alpha,
+                    &c.basis,
+                    &c.node_site,
+                    &c.pair_base,
+                    &c.normals,
+                    &c.params,
+                    &x,
+                    &rot,
+                ],
+            );
+            Slot {
+                x,
+                rot,
+                beam,
+                beam_force,
+                sites,
+                assemble,
+                lu,
+                norms_solve,
+                norms_trial,
+                update,
+                _keep: vec![diag, upper, lower, rhs],
+            }
+        };
+        let slots = [make_slot("config_a"), make_slot("config_b")];
+        Ok(GpuEnsemble {
+            ctx,
+            p: pipelines,
+            slots,
+            formed: [false; 2],
+            lu_lanes: LuForm::for_adapter(ctx).lanes(),
+            current: 0,
+            contact,
+            c,
+            num_variants: v,
+            num_nodes: n,
+            num_pairs: p,
+            _real: PhantomData,
+        })
+    }
+
+    /// Records the evaluation of `slot`: beam, sites, contact, assembly — the residual
+    /// alone (the force-only beam kernel) where `tangent` is false.
+    fn record_evaluate(&self, pass: &mut wgpu::ComputePass, slot: usize, tangent: bool) {
+        let s = &self.slots[slot];
+        let p = &self.p;
+        record_chain(
+            pass,
+            false,
+            self.num_nodes,
+            self.num_variants,
+            self.num_pairs,
+            |stage| match stage {
+                Stage::Predict => None,
+                Stage::Beam if tangent => Some((&*p.beam, &s.beam)),
+                Stage::Beam => Some((&*p.beam_force, &s.beam_force)),
+                Stage::Sites => Some((&*p.sites, &s.sites)),
+                Stage::Contact => Some((&*p.contact, &self.contact)),
+                Stage::Assemble => Some((&*p.assemble, &s.assemble)),
+            },
+        );
+    }
+
+    fn encoder(&self, label: &str) -> wgpu::CommandEncoder {
+        encoder(self.ctx, label)
+    }
+
+    /// Submits `encoder` after copying the norms and statuses out; reads them back.
+    fn finish_with_norms(
+        &self,
+        encoder: wgpu::CommandEncoder,
+    ) -> Result<(Norms<T>, Vec<u32>), GpuError> {
+        let v = self.num_variants;
+        let norm_bytes = (4 * v * std::mem::size_of::<T>()) as u64;
+        let out = submit_and_read(
+            self.ctx,
+            encoder,
+            &[(&self.c.norms, norm_bytes), (&self.c.status, 4 * v as u64)],
+        )?;
+        Ok((
+            norms_from_bytes(&out[0]),
+            bytemuck::cast_slice(&out[1]).to_vec(),
+        ))
+    }
+}
+
+/// Records the evaluation chain ([`crate::engine::evaluation`]) into `pass`, each stage
+/// with the pipeline and bind group `bind` gives it (`None`: not on this path).
+fn record_chain<'b>(
+    pass: &mut wgpu::ComputePass,
+    dynamic: bool,
+    n: usize,
+    v: usize,
+    p: usize,
+    bind: impl Fn(Stage) -> Option<(&'b wgpu::ComputePipeline, &'b wgpu::BindGroup)>,
+) {
+    for &stage in crate::engine::evaluation(dynamic) {
+        if let Some((pipeline, group)) = bind(stage) {
+            dispatch(
+                pass,
+                pipeline,
+                group,
+                crate::engine::invocations(stage, n, v, p),
+            );
+        }
+    }
+}
+
+fn encoder(ctx: &GpuContext, label: &str) -> wgpu::CommandEncoder {
+    ctx.device
+        .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(label) })
+}
+
+/// `[max r, max αΔ, Δ·r, r·r]` rows per variant, from the norms kernel's output bytes.
+fn norms_from_bytes<T: GpuReal>(bytes: &[u8]) -> Norms<T> {
+    let values: &[T] = bytemuck::cast_slice(bytes);
+    let rows: Vec<[T; 4]> = values
+        .chunks_exact(4)
+        .map(|c| [c[0], c[1], c[2], c[3]])
+        .collect();
+    Norms::from_rows(&rows)
+}
+
+/// Submits `encoder` with copies of the first `bytes` of each buffer into one staging
+/// buffer appended, waits, and returns the bytes of each.
+fn submit_and_read(
+    ctx: &GpuContext,
+    mut encoder: wgpu::CommandEncoder,
+    reads: &[(&wgpu::Buffer, u64)],
+) -> Result<Vec<Vec<u8>>, GpuError> {
+    let total: u64 = reads.iter().map(|(_, b)| b.max(&4)).sum();
+    let staging = ctx.device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("read"),
+        size: total.max(4),
+        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    });
+    let mut offset = 0;
+    for (buffer, bytes) in reads {
+        if *bytes > 0 {
+            encoder.copy_buffer_to_buffer(buffer, 0, &staging, offset, *bytes);
+        }
+        offset += bytes.max(&4);
+    }
+    ctx.queue.submit([encoder.finish()]);
+    staging.slice(..).map_async(wgpu::MapMode::Read, |_| {});
+    ctx.device
+        .poll(wgpu::PollType::wait_indefinitely())
+        .map_err(|e| GpuError::Device(e.to_string()))?;
+    let mut out = Vec::with_capacity(reads.len());
+    {
+        let view = staging
+            .slice(..)
+            .get_mapped_range()
+            .map_err(|e| GpuError::Device(format!("map: {e}")))?;
+        let mut offset = 0usize;
+        for (_, bytes) in reads {
+            out.push(view[offset..offset + *bytes as usize].to_vec());
+            offset += (*bytes).max(4) as usize;
+        }
+    }
+    staging.unmap();
+    Ok(out)
+}
