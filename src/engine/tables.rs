@@ -1,0 +1,126 @@
+//! The tables of a chunk of variants (mesh, sections, frames, sites, constraints, loads), built
+//! once from the variants' models, all on the first one's mesh. Split from `engine/mod.rs`
+//! (issue 24: no file over 800 lines), behaviour unchanged.
+
+use super::*;
+
+/// An error unless every model shares the first one's mesh, number of sites and friction
+/// model.
+pub(crate) fn check_same_mesh(models: &[Model]) -> Result<(), String> {
+    let base = models.first().ok_or("no variants")?;
+    for m in models {
+        if m.nodes.len() != base.nodes.len()
+            || m.elements.len() != base.elements.len()
+            || m.sites.len() != base.sites.len()
+        {
+            return Err("variants differ in mesh or number of sites; run them on the CPU".into());
+        }
+        // One contact kernel serves the ensemble: one friction model.
+        if m.friction != base.friction {
+            return Err(
+                "variants differ in friction model (split, coupled: e.g. reaming \
+                        beside rotating); run them on the CPU"
+                    .into(),
+            );
+        }
+    }
+    Ok(())
+}
+
+/// The tables of a chunk of variants (all on the first one's mesh).
+pub fn ensemble_tables<T: Real>(models: &[Model]) -> Result<EnsembleTables<T>, String> {
+    ensemble_tables_from(models, None)
+}
+
+/// As [`ensemble_tables`], the chunk starting from `start` (displacements from the
+/// reference `3 n V`, rotations `9 n V`; none: each variant laid on the low side) — a
+/// compacted or re-tried chunk starts where its variants stand, and does not lay them out
+/// again.
+pub fn ensemble_tables_from<T: Real>(
+    models: &[Model],
+    start: Option<(Vec<T>, Vec<T>)>,
+) -> Result<EnsembleTables<T>, String> {
+    check_same_mesh(models)?;
+    let t = |x: f64| T::from_f64_lossy(x);
+    let base = &models[0];
+    let (v, n, s_count) = (models.len(), base.nodes.len(), base.sites.len());
+    let (basis, fixed) = constraint_tables(base);
+    let given = start.is_some();
+    let (x, rot) =
+        start.unwrap_or_else(|| (vec![T::zero(); 3 * n * v], vec![T::zero(); 9 * n * v]));
+    let mut start = ConfigBatch {
+        num_variants: v,
+        num_nodes: n,
+        x,
+        rot,
+        basis: basis.iter().map(|&b| t(b)).collect(),
+    };
+    for (j, m) in models.iter().enumerate().filter(|_| !given) {
+        let s = if m.sites.is_empty() {
+            StaticState::initial(m)
+        } else {
+            StaticState::on_low_side(m)
+        };
+        for i in 0..n {
+            for k in 0..3 {
+                start.x[(3 * i + k) * v + j] = t(s.x[i][k] - base.nodes[i].position[k]);
+            }
+            for r in 0..3 {
+                for c in 0..3 {
+                    start.rot[(9 * i + 3 * r + c) * v + j] = t(s.rot[i][r][c]);
+                }
+            }
+        }
+    }
+    let p = s_count * v;
+    let mut node_site = vec![NO_SITE; n * v];
+    let mut pair_node = vec![0u32; p];
+    let mut pair_normals = vec![T::zero(); 3 * p];
+    let mut pair_state = vec![T::zero(); STATE_LEN * p];
+    let mut params = vec![T::zero(); PARAMS_LEN * p];
+    for (j, m) in models.iter().enumerate() {
+        for (k, site) in m.sites.iter().enumerate() {
+            let i = k * v + j;
+            node_site[site.node * v + j] = k as u32;
+            pair_node[i] = site.node as u32;
+            let axis = m.nodes[site.node].hole_axis;
+            let len = (axis[0] * axis[0] + axis[1] * axis[1] + axis[2] * axis[2]).sqrt();
+            for a in 0..3 {
+                pair_normals[3 * i + a] = t(axis[a] / len);
+                pair_state[(3 + a) * p + i] = t(axis[a] * m.axial_speed);
+            }
+            pair_state[6 * p + i] = t(m.rotation_speed);
+            for (f, x) in site.params.to_array().into_iter().enumerate() {
+                params[f * p + i] = t(x);
+            }
+        }
+    }
+    let mut batch = ContactBatch::<T>::new(1, p);
+    batch.pair_params = params;
+    let terms = batch.required_terms(base.friction, ContactMode::Static);
+    let node_ref: Vec<f64> = base.nodes.iter().flat_map(|nd| nd.position).collect();
+    let mut tables = EnsembleTables {
+        num_variants: v,
+        num_nodes: n,
+        num_sites: s_count,
+        basis: start.basis.clone(),
+        fixed,
+        node_site,
+        pair_node,
+        node_ref,
+        pair_normals,
+        pair_state,
+        start,
+        base: Vec::new(),
+        pair_base: Vec::new(),
+        chords: Vec::new(),
+        rest: crate::kernels::beam::rest_table(models, &|_| 1.0)
+            .into_iter()
+            .map(|x| T::from_f64_lossy(x))
+            .collect(),
+        terms,
+    };
+    // The static solve starts from the reference as base.
+    tables.set_base(base, vec![0.0; 3 * n * v]);
+    Ok(tables)
+}

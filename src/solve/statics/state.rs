@@ -1,0 +1,173 @@
+//! The static configuration ([`StaticState`]) and its first guesses: the string laid in the
+//! hole, prestressed by the soft string's stretch and lifted off near held points (the load
+//! path's start). Split from `solve/statics.rs` (issue 24: no file over 800 lines),
+//! behaviour unchanged.
+
+use super::*;
+
+/// Nodal configuration.
+#[derive(Clone, Debug)]
+pub struct StaticState {
+    /// Node positions.
+    pub x: Vec<Vec3<f64>>,
+    /// Nodal rotations (from the initial configuration).
+    pub rot: Vec<Mat3<f64>>,
+}
+
+impl StaticState {
+    /// A first guess near the equilibrium under gravity (the load path's first stage), from
+    /// the frictionless soft-string solution without bit loads (issue 22):
+    /// - **prestressed**: each node moved along its hole axis by the stretch `∫ F/EA` of
+    ///   the string above it (below it where the top is free axially), so the first
+    ///   tangent carries the tension's geometric stiffness — without it a vertical section
+    ///   under kilometres of pipe has only its bending stiffness laterally, and the first
+    ///   Newton step throws it metres through the wall;
+    /// - **laid on the wall** where a cable would lie: every contact node along the
+    ///   lateral load `q = F·dt/ds + w·g_⊥` (tension `F` pulls the string to the inside of a
+    ///   bend, weight to the low side), at the depth where the wall carries its share;
+    /// - **lifting off near held points**: within the bending length of the top, the bit
+    ///   and each stabilizer, the offset grows as a pinned beam's deflection (a collar
+    ///   node 0.3 m above a bit held on the axis, laid on the wall, bends the collar with
+    ///   hundreds of MN).
+    pub fn on_low_side(model: &Model) -> StaticState {
+        use crate::physics::soft_string::{soft_string, Operation};
+        let mut s = StaticState::initial(model);
+        let n = model.nodes.len();
+        let cable = soft_string(
+            model,
+            &Operation {
+                axial_speed: 0.0,
+                rotation_speed: 0.0,
+                weight_on_bit: 0.0,
+                torque_on_bit: 0.0,
+                friction: 0.0,
+            },
+        );
+        // Axial prestress: each node moved along its hole axis by the stretch of the
+        // string above it (below it where the top is free axially).
+        let stretch: Vec<f64> = (0..n - 1)
+            .map(|e| {
+                let el = &model.elements[e];
+                0.5 * (cable.tension[e] + cable.tension[e + 1]) * el.length0
+                    / (el.section.youngs_modulus * el.section.area)
+            })
+            .collect();
+        let mut u = vec![0.0; n];
+        if matches!(model.top, TopBoundary::Clamped | TopBoundary::Pinned) {
+            for e in 0..n - 1 {
+                u[e + 1] = u[e] + stretch[e];
+            }
+        } else {
+            for e in (0..n - 1).rev() {
+                u[e] = u[e + 1] - stretch[e];
+            }
+        }
+        for ((x, ui), node) in s.x.iter_mut().zip(&u).zip(&model.nodes) {
+            for (xk, tk) in x.iter_mut().zip(node.hole_axis) {
+                *xk += ui * tk;
+            }
+        }
+        // Lateral: each contact node towards its lateral load, at the depth where the wall
+        // carries the node's share of it.
+        let mut offset: Vec<Option<(Vec3<f64>, f64)>> = vec![None; n];
+        let mut load = vec![0.0; n];
+        for site in &model.sites {
+            let i = site.node;
+            let held = i == 0 || (model.bit_lateral_fixed && i + 1 == n);
+            if held {
+                continue;
+            }
+            let (a, b) = (i.saturating_sub(1), (i + 1).min(n - 1));
+            let ds = model.nodes[b].md - model.nodes[a].md;
+            let dt = scale(
+                &sub(&model.nodes[b].hole_axis, &model.nodes[a].hole_axis),
+                1.0 / ds,
+            );
+            let t = model.nodes[i].hole_axis;
+            let g = [0.0, 0.0, 1.0];
+            let g_perp = sub(&g, &scale(&t, dot(&g, &t)));
+            let w = model.elements[i.min(n - 2)].buoyed_weight_per_length;
+            let q = [
+                cable.tension[i] * dt[0] + w * g_perp[0],
+                cable.tension[i] * dt[1] + w * g_perp[1],
+                cable.tension[i] * dt[2] + w * g_perp[2],
+            ];
+            // Lateral part only.
+            let q = sub(&q, &scale(&t, dot(&q, &t)));
+            let len = dot(&q, &q).sqrt();
+            if len > 1e-3 * w.abs().max(1e-12) {
+                // Penetration at which the wall carries the node's share of the lateral
+                // load (bisection on the spring law): a fixed guess would be far too deep for
+                // a stiff wall (k_e = 1e11 with a soft spring) and far too shallow for a soft one.
+                let share = len * 0.5 * ds;
+                let depth = site.params.clearance + penetration_for(share, &site.params);
+                offset[i] = Some((scale(&q, 1.0 / len), depth));
+                load[i] = len;
+            }
+        }
+        // Bending: next to a point held on or close to the axis (the top, the bit, a
+        // stabilizer) the string cannot reach the wall at once; it lifts off over its
+        // bending length, the tangency length of a pinned beam under its lateral load q,
+        // `L = (24 EI c / q)^¼` (c the clearance), shortened by tension T to `4 √(EI/T)`.
+        let bending_length = |site: &crate::model::Site| {
+            let i = site.node;
+            let ei = model.elements[i.min(n - 2)].section.bending_stiffness();
+            let c = site.params.clearance.max(1e-6);
+            let mut l = (24.0 * ei * c / load[i].max(1e-12)).powf(0.25);
+            if cable.tension[i] > 0.0 {
+                l = l.min(4.0 * (ei / cable.tension[i]).sqrt());
+            }
+            l
+        };
+        // Offset `m_a + (m − m_a) g(s/L)` within L of an anchor (offset m_a), with
+        // `g(x) = 2x − 2x³ + x⁴` the pinned beam's deflection (g(1) = 1, g'(1) = 0).
+        let ramp = |x: f64| 2.0 * x - 2.0 * x.powi(3) + x.powi(4);
+        let mut magnitude: Vec<f64> = offset.iter().map(|o| o.map_or(0.0, |o| o.1)).collect();
+        let mut anchors: Vec<(usize, f64)> = vec![(0, 0.0)];
+        if model.bit_lateral_fixed {
+            anchors.push((n - 1, 0.0));
+        }
+        // First the stabilizers against the top and the bit, then every other node against
+        // those and the stabilizers.
+        for stabilizers in [true, false] {
+            for site in model.sites.iter().filter(|s| s.stabilizer == stabilizers) {
+                let i = site.node;
+                let Some((_, m)) = offset[i] else { continue };
+                if anchors.iter().any(|a| a.0 == i) {
+                    continue;
+                }
+                let l = bending_length(site);
+                let below = anchors.iter().filter(|a| a.0 > i).min_by_key(|a| a.0);
+                let above = anchors.iter().filter(|a| a.0 < i).max_by_key(|a| a.0);
+                for &(k, m_a) in below.into_iter().chain(above) {
+                    let d = (model.nodes[i].md - model.nodes[k].md).abs();
+                    if d < l && m_a < m {
+                        magnitude[i] = magnitude[i].min(m_a + (m - m_a) * ramp(d / l));
+                    }
+                }
+            }
+            if stabilizers {
+                for site in model.sites.iter().filter(|s| s.stabilizer) {
+                    anchors.push((site.node, magnitude[site.node]));
+                }
+            }
+        }
+        for i in 0..n {
+            if let Some((dir, _)) = offset[i] {
+                for (x, d) in s.x[i].iter_mut().zip(dir) {
+                    *x += magnitude[i] * d;
+                }
+            }
+        }
+        s
+    }
+
+    /// The undeformed configuration (every node on the hole axis, no rotation).
+    pub fn initial(model: &Model) -> StaticState {
+        let eye = rotation_exp(&[0.0; 3]);
+        StaticState {
+            x: model.nodes.iter().map(|n| n.position).collect(),
+            rot: vec![eye; model.nodes.len()],
+        }
+    }
+}
