@@ -1,0 +1,158 @@
+//! The dynamic engine's CPU path: [`TwinDynamic`], the kernels' twins run in the engine's
+//! order on a dynamic chunk (the oracle of the GPU's dynamic chunk). Split from
+//! `engine/dynamic.rs` (issue 24: no file over 800 lines), behaviour unchanged.
+
+use super::*;
+
+/// The twins' dynamic chunk (f64).
+pub struct TwinDynamic<'a> {
+    model: &'a Model,
+    tables: EnsembleTables<f64>,
+    dynamic: DynamicTables<f64>,
+    contact: ContactBatch<f64>,
+    coefficients: Option<StepCoefficients<f64>>,
+    top: Vec<f64>,
+    state: DynamicBatch<f64>,
+    unknown: Vec<f64>,
+    trial: DynamicBatch<f64>,
+    delta: Vec<f64>,
+}
+
+impl<'a> TwinDynamic<'a> {
+    /// Holds a chunk on the CPU twins.
+    pub fn new(
+        model: &'a Model,
+        tables: &EnsembleTables<f64>,
+        dynamic: &DynamicTables<f64>,
+    ) -> Self {
+        let p = tables.pair_node.len();
+        let mut contact = ContactBatch::new(1, p);
+        contact.site_normals = tables.pair_normals.clone();
+        contact.pair_state = tables.pair_state.clone();
+        contact.pair_params = dynamic.pair_params.clone();
+        TwinDynamic {
+            model,
+            tables: tables.clone(),
+            dynamic: dynamic.clone(),
+            contact,
+            coefficients: None,
+            top: Vec::new(),
+            state: dynamic.start.clone(),
+            unknown: dynamic.start.vdot.clone(),
+            trial: dynamic.start.clone(),
+            delta: vec![0.0; 6 * tables.num_nodes * tables.num_variants],
+        }
+    }
+
+    /// Predicts the trial at `vdot` and assembles its system (`tangent`) or its residual.
+    fn evaluate_at(
+        &mut self,
+        mut vdot: Vec<f64>,
+        tangent: bool,
+    ) -> Result<ChainBatch<f64>, String> {
+        let c = self.coefficients.ok_or("no step begun")?;
+        predict(&c, &self.top, &self.state, &mut vdot, &mut self.trial);
+        let p = options_coefficients(&c);
+        let tr = &self.trial;
+        Ok(crate::engine::twin_evaluate(
+            self.model,
+            &self.tables,
+            &mut self.contact,
+            &tr.u,
+            &tr.rot,
+            &self.dynamic.f_ext,
+            tangent,
+            Some((
+                tr,
+                crate::engine::AssemblyDynamic {
+                    coefficients: [p.0, p.1, self.dynamic.a0],
+                    mass: &self.dynamic.mass,
+                    inertia0: &self.dynamic.inertia0,
+                    unbalance: &self.dynamic.unbalance,
+                },
+            )),
+        ))
+    }
+}
+
+/// `(hγ', h²β')` of a step.
+pub fn options_coefficients<T: Real>(c: &StepCoefficients<T>) -> (T, T) {
+    let one = T::one();
+    let ratio = (one - c.alpha_f) / (one - c.alpha_m);
+    (c.h * c.gamma * ratio, c.h * c.h * c.beta * ratio)
+}
+
+impl DynamicEnsemble<f64> for TwinDynamic<'_> {
+    fn begin_step(&mut self, c: &StepCoefficients<f64>, top: &[f64]) -> Result<(), String> {
+        self.coefficients = Some(*c);
+        self.top = top.to_vec();
+        self.unknown = self.state.vdot.clone();
+        Ok(())
+    }
+    fn iterate(&mut self) -> Result<Iteration<f64>, String> {
+        let sys = self.evaluate_at(self.unknown.clone(), true)?;
+        // The top's prescribed accelerations, as the predictor wrote them.
+        self.unknown = self.trial.vdot.clone();
+        let (delta, status) = block_lu(&sys);
+        self.delta = delta;
+        let (v, n) = (self.tables.num_variants, self.tables.num_nodes);
+        let norms = norms(&sys.rhs, &self.delta, &vec![1.0; v], n, v);
+        let inertial = inertial_scale(&self.dynamic.mass, &self.unknown, n, v);
+        Ok(Iteration {
+            norms,
+            status,
+            inertial,
+        })
+    }
+    fn trial(&mut self, alpha: &[f64]) -> Result<Norms<f64>, String> {
+        let (v, n) = (self.tables.num_variants, self.tables.num_nodes);
+        let cand = accelerate(&self.tables.basis, &self.unknown, &self.delta, alpha, n, v);
+        let sys = self.evaluate_at(cand, false)?;
+        Ok(norms(&sys.rhs, &self.delta, alpha, n, v))
+    }
+    fn correct(&mut self, alpha: &[f64]) -> Result<(), String> {
+        let (v, n) = (self.tables.num_variants, self.tables.num_nodes);
+        self.unknown = accelerate(&self.tables.basis, &self.unknown, &self.delta, alpha, n, v);
+        Ok(())
+    }
+    fn accept_trial(&mut self) -> Result<(), String> {
+        // The candidate with the top's prescribed accelerations, as the predictor wrote it
+        // (the trial formed its residual only: the next iteration evaluates its system).
+        self.unknown = self.trial.vdot.clone();
+        Ok(())
+    }
+    fn end_step(&mut self) -> Result<(), String> {
+        let c = self.coefficients.ok_or("no step begun")?;
+        let mut vdot = self.unknown.clone();
+        let mut next = self.state.clone();
+        predict(&c, &self.top, &self.state, &mut vdot, &mut next);
+        self.state = next;
+        Ok(())
+    }
+    fn state(&mut self) -> Result<DynamicBatch<f64>, String> {
+        Ok(self.state.clone())
+    }
+    fn set_state(&mut self, state: &DynamicBatch<f64>) -> Result<(), String> {
+        self.state = state.clone();
+        Ok(())
+    }
+    fn unknown(&mut self) -> Result<Vec<f64>, String> {
+        Ok(self.unknown.clone())
+    }
+    fn set_unknown(&mut self, vdot: &[f64]) -> Result<(), String> {
+        self.unknown = vdot.to_vec();
+        Ok(())
+    }
+}
+
+impl TwinPath {
+    /// The twins' dynamic chunk.
+    pub fn dynamic<'a>(
+        &self,
+        model: &'a Model,
+        tables: &EnsembleTables<f64>,
+        dynamic: &DynamicTables<f64>,
+    ) -> TwinDynamic<'a> {
+        TwinDynamic::new(model, tables, dynamic)
+    }
+}
