@@ -7,6 +7,7 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand};
 use holewall::backend::{Backend, BackendChoice, Precision};
 use holewall::cli;
+use holewall::cli::bench_cmd::{positive_seconds, BenchCommand};
 
 #[derive(Parser)]
 #[command(
@@ -234,221 +235,6 @@ enum Command {
     Bench {
         #[command(subcommand)]
         what: BenchCommand,
-    },
-}
-
-#[derive(Subcommand)]
-enum BenchCommand {
-    /// Scene-specialised contact kernels against the all-terms kernel on the same scenes
-    /// (frictionless / split friction, static / dynamic): CPU twin f64, GPU f32 and f64
-    /// resident; the gain (all-terms time / specialised time) and the outputs' difference.
-    Specialisation {
-        /// (variant, site) pairs per evaluation.
-        #[arg(long, default_value_t = 200_000)]
-        pairs: usize,
-        /// Timed repeats per kernel (the median is reported).
-        #[arg(long, default_value_t = 7)]
-        repeats: usize,
-        /// Also write the results as JSON here.
-        #[arg(long)]
-        json: Option<PathBuf>,
-    },
-    /// Contact evaluations per second: CPU f64 (all cores), GPU f32 and f64.
-    Contact {
-        /// (variant, site) pairs per evaluation.
-        #[arg(long, default_value_t = 1_000_000)]
-        pairs: usize,
-        /// Timed repeats per path (the median is reported).
-        #[arg(long, default_value_t = 7)]
-        repeats: usize,
-        /// Where to compute the GPU paths (`cpu` benchmarks the CPU only).
-        #[arg(long, value_enum, default_value_t = BackendChoice::Auto)]
-        backend: BackendChoice,
-        /// Also write the results as JSON here.
-        #[arg(long)]
-        json: Option<PathBuf>,
-    },
-    /// Variant-steps per second of dynamic ensembles (V variants × n nodes): CPU f64
-    /// integrator, GPU engine f64 and f32; bytes and FLOPs per Newton iteration; a
-    /// work-precision table.
-    Ensemble {
-        /// Nodes of the benchmark string (comma-separated).
-        #[arg(long, value_delimiter = ',', default_value = "100,400,1000")]
-        nodes: Vec<usize>,
-        /// Variants per ensemble (comma-separated).
-        #[arg(long, value_delimiter = ',', default_value = "1,16,256,4096")]
-        variants: Vec<usize>,
-        /// Time steps per run (2 ms each, from the static equilibrium).
-        #[arg(long, default_value_t = 5)]
-        steps: usize,
-        /// Timed repeats per cell (the median is reported).
-        #[arg(long, default_value_t = 3)]
-        repeats: usize,
-        /// Skip a cell whose time, estimated from smaller cells, exceeds this (s).
-        #[arg(long, default_value_t = 120.0)]
-        budget: f64,
-        /// CPU only (no GPU rows).
-        #[arg(long)]
-        cpu_only: bool,
-        /// Nodes of the work-precision runs (0: none).
-        #[arg(long, default_value_t = 100)]
-        precision_nodes: usize,
-        /// Also write the results as JSON here.
-        #[arg(long)]
-        json: Option<PathBuf>,
-    },
-    /// Wall time of a static ensemble on every path in one run: CPU backend, engine on the
-    /// CPU twins, engine on the GPU (f64, f32); iterations per load step and cuts of each.
-    Statics {
-        /// Case file.
-        case: PathBuf,
-        /// CSV of variants (default: the case's `[ensemble.grid]`, else the case alone).
-        #[arg(long)]
-        variants: Option<PathBuf>,
-        /// Timed repeats per path (the median is reported).
-        #[arg(long, default_value_t = 3)]
-        repeats: usize,
-        /// Also write the results as JSON here.
-        #[arg(long)]
-        json: Option<PathBuf>,
-    },
-    /// The whole performance table of this machine in one command: contact, element,
-    /// roofline per kernel, static and dynamic ensembles, each against the CPU path
-    /// (device.md, device.json) — run it on a GPU and send the folder back.
-    Device {
-        /// Output folder.
-        #[arg(long)]
-        out: PathBuf,
-        /// Folder of the shipped cases (the static ensembles).
-        #[arg(long, default_value = "cases")]
-        cases: PathBuf,
-        /// Smaller sizes and fewer repeats (a first look).
-        #[arg(long)]
-        quick: bool,
-        /// No progress bar.
-        #[arg(long)]
-        quiet: bool,
-    },
-    /// A roofline per kernel (contact, beam, assembly, block solve): achieved GFLOP/s and
-    /// GB/s beside this device's FMA and copy ceilings, measured here, f32 and f64
-    /// (kernels.md, kernels.json, roofline.png).
-    Kernels {
-        /// Variants per run (comma-separated).
-        #[arg(long, value_delimiter = ',', default_values_t = [16usize, 256, 4096])]
-        variants: Vec<usize>,
-        /// Nodes of the string each variant holds (3–2000).
-        #[arg(long, default_value_t = 21)]
-        nodes: usize,
-        /// Timed repeats (the median is reported).
-        #[arg(long, default_value_t = 5)]
-        repeats: usize,
-        /// Output folder.
-        #[arg(long)]
-        out: PathBuf,
-        /// No progress bar.
-        #[arg(long)]
-        quiet: bool,
-    },
-    /// Operations and time per beam element: the hyper-dual forms against the closed form
-    /// (force only; force and tangent in f64 and f32), one core; their agreement.
-    Element {
-        /// Random element states timed per repeat.
-        #[arg(long, default_value_t = 2000)]
-        states: usize,
-        /// Timed repeats (the median is reported).
-        #[arg(long, default_value_t = 7)]
-        repeats: usize,
-        /// Also write the results as JSON here.
-        #[arg(long)]
-        json: Option<PathBuf>,
-    },
-    /// The FE static solve on a corpus of ordinary wells drawn from seeds (issue 22):
-    /// solved / total, load steps, cuts, iterations and time per well, FE/soft-string
-    /// hook-load and torque ratios (corpus.csv, summary.json, plots); the first
-    /// `--engine-sample` wells also through the ensemble engine (twin f64, GPU f64, f32).
-    Corpus {
-        /// Wells (seeds first-seed, first-seed + 1, …).
-        #[arg(long, default_value_t = 500)]
-        wells: usize,
-        /// First seed.
-        #[arg(long, default_value_t = 0)]
-        first_seed: u64,
-        /// Wells also run through the engine (the first ones of at most --engine-max-nodes).
-        #[arg(long, default_value_t = 0)]
-        engine_sample: usize,
-        /// Largest mesh (nodes) of the engine sample.
-        #[arg(long, default_value_t = 1000)]
-        engine_max_nodes: usize,
-        /// Start no new well after this many seconds (the rest are reported as not run).
-        #[arg(long, value_parser = positive_seconds)]
-        max_seconds: Option<f64>,
-        /// Output folder (created; wells/ holds each well's case and survey).
-        #[arg(long)]
-        out: PathBuf,
-        /// No progress bar.
-        #[arg(long)]
-        quiet: bool,
-    },
-    /// Friction calibration on corpus wells: synthetic loads at friction factors drawn
-    /// from each seed, recovered within the 95 % intervals?; the same loads on a 30 %
-    /// heavier drill pipe rejected? (calibrate_corpus.csv, summary.json).
-    CalibrateCorpus {
-        /// Wells (seeds first-seed, first-seed + 1, …).
-        #[arg(long, default_value_t = 20)]
-        wells: usize,
-        /// First seed.
-        #[arg(long, default_value_t = 0)]
-        first_seed: u64,
-        /// Output folder.
-        #[arg(long)]
-        out: PathBuf,
-        /// No progress bar.
-        #[arg(long)]
-        quiet: bool,
-    },
-    /// The BHA tendency (build/turn rates, equilibrium curvature) of corpus wells at their
-    /// own WOB: settled / total with the unsettled and why (tendency_corpus.csv).
-    TendencyCorpus {
-        /// Wells (seeds first-seed, first-seed + 1, …).
-        #[arg(long, default_value_t = 500)]
-        wells: usize,
-        /// First seed.
-        #[arg(long, default_value_t = 0)]
-        first_seed: u64,
-        /// Output folder.
-        #[arg(long)]
-        out: PathBuf,
-        /// No progress bar.
-        #[arg(long)]
-        quiet: bool,
-    },
-    /// Mesh convergence on corpus wells: hook load, torque, the largest side force and the
-    /// stabilizer forces as the pipe elements shrink from 30 m to 0.5 m (mesh.csv, mesh.md).
-    Mesh {
-        /// Corpus seeds (default: the first build-and-hold, S-shaped and horizontal well
-        /// drilling or rotating with a stabilizer).
-        #[arg(long, value_delimiter = ',')]
-        seeds: Option<Vec<u64>>,
-        /// Output folder.
-        #[arg(long)]
-        out: PathBuf,
-        /// No progress bar.
-        #[arg(long)]
-        quiet: bool,
-    },
-    /// Time steps per second and Newton iterations per step of `holewall run` (CPU f64).
-    Dynamics {
-        /// Case file with a `[dynamics]` table.
-        case: PathBuf,
-        /// Steps per repeat (at the case's time step, from the static equilibrium).
-        #[arg(long, default_value_t = 200)]
-        steps: usize,
-        /// Timed repeats (the median is reported).
-        #[arg(long, default_value_t = 5)]
-        repeats: usize,
-        /// Also write the results as JSON here.
-        #[arg(long)]
-        json: Option<PathBuf>,
     },
 }
 
@@ -940,7 +726,7 @@ fn main() -> ExitCode {
     }
 }
 
-/// `--max-seconds`: a finite number of seconds > 0.
+/// `--mu-range`: low,high with 0 ≤ low < high ≤ 2.
 fn mu_range(s: &str) -> Result<(f64, f64), String> {
     let bad = || format!("{s:?}: allowed: low,high with 0 ≤ low < high ≤ 2");
     let (a, b) = s.split_once(',').ok_or_else(bad)?;
@@ -952,12 +738,5 @@ fn mu_range(s: &str) -> Result<(f64, f64), String> {
         Ok((a, b))
     } else {
         Err(bad())
-    }
-}
-
-fn positive_seconds(s: &str) -> Result<f64, String> {
-    match s.parse::<f64>() {
-        Ok(x) if x.is_finite() && x > 0.0 => Ok(x),
-        _ => Err(format!("{s:?}: allowed: a number of seconds > 0")),
     }
 }
