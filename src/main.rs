@@ -580,7 +580,7 @@ fn main() -> ExitCode {
                 pairs,
                 repeats,
                 json,
-            } => match cli::bench::specialisation(pairs, repeats, json.as_deref()) {
+            } => match cli::bench_specialisation::specialisation(pairs, repeats, json.as_deref()) {
                 Ok(()) => ExitCode::SUCCESS,
                 Err(e) => fail(&[e]),
             },
