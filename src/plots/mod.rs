@@ -354,11 +354,40 @@ fn draw(
     }
     chart
         .configure_series_labels()
+        .position(legend_corner(&all, (x0, x1), (y0, y1)))
         .background_style(WHITE.mix(0.8))
         .border_style(BLACK)
         .draw()?;
     root.present()?;
     Ok(())
+}
+
+/// The corner of the plot whose quarter (the outer 45 % of each axis) holds the fewest
+/// points of `series` (lines sampled at their points): where the legend covers least.
+/// Upper right wins ties, then upper left.
+fn legend_corner(
+    series: &[&Series],
+    (x0, x1): (f64, f64),
+    (y0, y1): (f64, f64),
+) -> SeriesLabelPosition {
+    let (wx, wy) = (0.45 * (x1 - x0), 0.45 * (y1 - y0));
+    let corners = [
+        (SeriesLabelPosition::UpperRight, x1 - wx..=x1, y1 - wy..=y1),
+        (SeriesLabelPosition::UpperLeft, x0..=x0 + wx, y1 - wy..=y1),
+        (SeriesLabelPosition::LowerRight, x1 - wx..=x1, y0..=y0 + wy),
+        (SeriesLabelPosition::LowerLeft, x0..=x0 + wx, y0..=y0 + wy),
+    ];
+    let count = |xr: &std::ops::RangeInclusive<f64>, yr: &std::ops::RangeInclusive<f64>| {
+        series
+            .iter()
+            .flat_map(|s| s.points.iter())
+            .filter(|(x, y)| xr.contains(x) && yr.contains(y))
+            .count()
+    };
+    corners
+        .into_iter()
+        .min_by_key(|(_, xr, yr)| count(xr, yr))
+        .map_or(SeriesLabelPosition::UpperRight, |c| c.0)
 }
 
 /// An orbit: the lateral displacement `points` (x, y, in mm) inside the clearance circle of
@@ -738,6 +767,31 @@ pub type BandPoint = (f64, f64, f64, f64);
 
 #[cfg(test)]
 mod tests {
+    #[test]
+    fn the_legend_goes_where_the_data_are_not() {
+        use plotters::prelude::SeriesLabelPosition as P;
+        let at = |pts: Vec<(f64, f64)>| {
+            let s = super::Series {
+                name: "s",
+                points: pts,
+                wide: false,
+            };
+            super::legend_corner(&[&s], (0.0, 10.0), (0.0, 10.0))
+        };
+        // A broomstick low across the plot: upper right is free.
+        assert!(matches!(at(vec![(1.0, 1.0), (9.0, 2.0)]), P::UpperRight));
+        // Data in the upper right and along the bottom: upper left.
+        assert!(matches!(
+            at(vec![(9.0, 9.0), (8.0, 8.0), (1.0, 1.0), (9.0, 1.0)]),
+            P::UpperLeft
+        ));
+        // Everything in the upper half: the lower right.
+        assert!(matches!(
+            at(vec![(1.0, 9.0), (9.0, 9.0), (2.0, 8.0)]),
+            P::LowerRight
+        ));
+    }
+
     #[test]
     fn equal_marks_share_a_label_and_log_axes_tick_each_decade() {
         let l = super::mark_labels(&[("P10", 12.0), ("P50", 12.0), ("P90", 15.0)]);
