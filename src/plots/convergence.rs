@@ -17,11 +17,7 @@ pub fn convergence_plot(
         .iter()
         .flat_map(|(_, p)| p.iter().flat_map(|&(n, v, a, b)| [(n, v), (n, a), (n, b)]))
         .collect();
-    let ((x0, x1), (y0, y1)) = bounds(&[Series {
-        name: "",
-        points: all,
-        wide: false,
-    }]);
+    let ((x0, x1), (y0, y1)) = point_bounds(all);
     atomic_png(path, |tmp| {
         let root = BitMapBackend::new(tmp, (1000, 640)).into_drawing_area();
         root.fill(&WHITE)?;

@@ -5,7 +5,7 @@ use std::path::Path;
 use plotters::prelude::*;
 
 use super::{
-    atomic_png, bounds, labels_in_units, marker_labels, scaled_markers, xy_chart, Marker, Series,
+    atomic_png, labels_in_units, marker_labels, point_bounds, scaled_markers, xy_chart, Marker,
 };
 
 /// One tile of a [`tile_map`].
@@ -96,11 +96,7 @@ pub fn class_scatter(
     let points: Vec<(f64, f64, usize)> = points.iter().map(|p| (p.0 * kx, p.1 * ky, p.2)).collect();
     let points = points.as_slice();
     let all: Vec<(f64, f64)> = points.iter().map(|p| (p.0, p.1)).collect();
-    let ((x0, x1), (y0, y1)) = bounds(&[Series {
-        name: "",
-        points: all,
-        wide: false,
-    }]);
+    let ((x0, x1), (y0, y1)) = point_bounds(all);
     atomic_png(path, |tmp| {
         let root = BitMapBackend::new(tmp, (900, 660)).into_drawing_area();
         root.fill(&WHITE)?;

@@ -110,6 +110,15 @@ fn bounds(series: &[Series]) -> ((f64, f64), (f64, f64)) {
     bounds_of(&series.iter().collect::<Vec<_>>())
 }
 
+/// [`bounds`] of bare points.
+fn point_bounds(points: Vec<(f64, f64)>) -> ((f64, f64), (f64, f64)) {
+    bounds(&[Series {
+        name: "",
+        points,
+        wide: false,
+    }])
+}
+
 fn bounds_of(series: &[&Series]) -> ((f64, f64), (f64, f64)) {
     let mut xr = (f64::INFINITY, f64::NEG_INFINITY);
     let mut yr = (f64::INFINITY, f64::NEG_INFINITY);
@@ -415,21 +424,7 @@ pub fn orbit_plot(
     atomic_png(path, |tmp| {
         let root = BitMapBackend::new(tmp, (760, 760)).into_drawing_area();
         root.fill(&WHITE)?;
-        let caption = fitted_caption(&root, title, 20);
-        let mut chart = ChartBuilder::on(&root)
-            .caption(&caption.0, ("sans-serif", caption.1))
-            .margin(12)
-            .x_label_area_size(48)
-            .y_label_area_size(70)
-            .build_cartesian_2d(-r..r, -r..r)?;
-        chart
-            .configure_mesh()
-            .x_desc(x_desc.as_str())
-            .y_desc(y_desc.as_str())
-            .x_label_formatter(&tick)
-            .y_label_formatter(&tick)
-            .label_style(("sans-serif", 15))
-            .draw()?;
+        let mut chart = xy_chart(&root, title, 20, 70, &x_desc, &y_desc, (-r, r), (-r, r))?;
         if clearance_mm > 0.0 {
             let circle: Vec<(f64, f64)> = (0..=360)
                 .map(|k| {
