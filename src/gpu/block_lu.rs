@@ -81,7 +81,9 @@ pub fn block_lu_wgsl(f64: bool, form: LuForm) -> Result<String, GpuError> {
         flags.insert("SERIAL");
     }
     let text = compose("block_lu.wgsl", &flags, f64)?;
-    Ok(text.replace("    //@FORWARD\n", &serial_forward()))
+    // The written-out walk is the same text every time: made once per process.
+    static FORWARD: std::sync::OnceLock<String> = std::sync::OnceLock::new();
+    Ok(text.replace("    //@FORWARD\n", FORWARD.get_or_init(serial_forward)))
 }
 
 /// The serial form's forward walk (see `shaders/block_lu.wgsl`), written out: the augmented
