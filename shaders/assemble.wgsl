@@ -12,6 +12,16 @@
 
 @group(0) @binding(0) var<storage, read> dims: AssembleDims;
 @group(0) @binding(1) var<storage, read> elem_force: array<real>;
+#if FORCE_ONLY
+// The static residual alone (line-search trials): no tangent read, no blocks written.
+@group(0) @binding(2) var<storage, read> contact: array<real>;
+@group(0) @binding(3) var<storage, read> contact_flag: array<u32>;
+@group(0) @binding(4) var<storage, read> node_site: array<u32>;
+@group(0) @binding(5) var<storage, read> f_ext: array<real>;
+@group(0) @binding(6) var<storage, read> basis: array<real>;
+@group(0) @binding(7) var<storage, read> fixed: array<u32>;
+@group(0) @binding(8) var<storage, read_write> out_rhs: array<real>;
+#else
 @group(0) @binding(2) var<storage, read> elem_tangent: array<real>;
 @group(0) @binding(3) var<storage, read> contact: array<real>;
 @group(0) @binding(4) var<storage, read> contact_flag: array<u32>;
@@ -52,6 +62,7 @@ const OUT_C_OMEGA: u32 = 42u;
 @group(0) @binding(11) var<storage, read_write> out_lower: array<real>;
 @group(0) @binding(12) var<storage, read_write> out_rhs: array<real>;
 #endif
+#endif
 
 // Field offsets of the contact kernel's outputs (src/kernels/contact.rs OUT_G, OUT_K).
 const OUT_G: u32 = 0u;
@@ -78,6 +89,7 @@ fn mul3(a: array<vec3<real>, 3>, b: array<vec3<real>, 3>) -> array<vec3<real>, 3
 }
 #endif
 
+#if !FORCE_ONLY
 // block ← diag(B_a, I)ᵀ · block · diag(B_b, I): rows of node a, then columns of node b.
 fn transform(blk: ptr<function, array<real, 36>>, a: u32, b: u32) {
     var rows: array<real, 18>;
@@ -118,6 +130,8 @@ fn clear_fixed(blk: ptr<function, array<real, 36>>, row_mask: u32, col_mask: u32
     }
 }
 
+#endif
+
 @compute @workgroup_size(64)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let nv = dims.num_variants;
@@ -129,33 +143,41 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let v = gid.x % nv;
     let pairs = dims.num_sites * nv;
     var r: array<real, 6>;
+#if !FORCE_ONLY
     var d: array<real, 36>;
     var u: array<real, 36>;
     var l: array<real, 36>;
+#endif
     for (var k = 0u; k < 6u; k = k + 1u) {
         r[k] = -f_ext[(6u * i + k) * nv + v];
     }
+#if !FORCE_ONLY
     for (var k = 0u; k < 36u; k = k + 1u) {
         d[k] = real(0.0);
     }
+#endif
     if (i > 0u) {
         let e = i - 1u;
         for (var k = 0u; k < 6u; k = k + 1u) {
             r[k] = r[k] + elem_force[(12u * e + 6u + k) * nv + v];
+#if !FORCE_ONLY
             for (var c = 0u; c < 6u; c = c + 1u) {
                 d[6u * k + c] = d[6u * k + c] + elem_tangent[(144u * e + 12u * (6u + k) + 6u + c) * nv + v];
             }
+#endif
         }
     }
     if (i + 1u < n) {
         let e = i;
         for (var k = 0u; k < 6u; k = k + 1u) {
             r[k] = r[k] + elem_force[(12u * e + k) * nv + v];
+#if !FORCE_ONLY
             for (var c = 0u; c < 6u; c = c + 1u) {
                 d[6u * k + c] = d[6u * k + c] + elem_tangent[(144u * e + 12u * k + c) * nv + v];
                 u[6u * k + c] = elem_tangent[(144u * e + 12u * k + 6u + c) * nv + v];
                 l[6u * k + c] = elem_tangent[(144u * e + 12u * (6u + k) + c) * nv + v];
             }
+#endif
         }
     }
     let s = node_site[i * nv + v];
@@ -164,9 +186,11 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         if (contact_flag[p] != 0u) {
             for (var k = 0u; k < 6u; k = k + 1u) {
                 r[k] = r[k] + contact[(OUT_G + k) * pairs + p];
+#if !FORCE_ONLY
                 for (var c = 0u; c < 3u; c = c + 1u) {
                     d[6u * k + c] = d[6u * k + c] + contact[(OUT_K + 3u * k + c) * pairs + p];
                 }
+#endif
             }
         }
     }
@@ -291,7 +315,9 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
 #endif
 #endif
     // Constraints (as statics::constrain): bases, then fixed DOFs.
+#if !FORCE_ONLY
     transform(&d, i, i);
+#endif
     let rv = vec3<real>(r[0], r[1], r[2]);
     for (var row = 0u; row < 3u; row = row + 1u) {
         var s = real(0.0);
@@ -301,16 +327,21 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         r[row] = s;
     }
     let f_i = fixed[i];
+#if !FORCE_ONLY
     clear_fixed(&d, f_i, f_i);
+#endif
     for (var k = 0u; k < 6u; k = k + 1u) {
         if ((f_i & (1u << k)) != 0u) {
             r[k] = real(0.0);
+#if !FORCE_ONLY
             d[6u * k + k] = real(1.0);
+#endif
         }
     }
     for (var k = 0u; k < 6u; k = k + 1u) {
         out_rhs[(6u * i + k) * nv + v] = r[k];
     }
+#if !FORCE_ONLY
     for (var k = 0u; k < 36u; k = k + 1u) {
         out_diag[(36u * i + k) * nv + v] = d[k];
     }
@@ -325,4 +356,5 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
             out_lower[(36u * i + k) * nv + v] = l[k];
         }
     }
+#endif
 }

@@ -4,8 +4,8 @@
 
 mod common;
 
-use holewall::gpu::assemble::assemble_gpu;
-use holewall::kernels::assemble::{assemble, AssemblyInputs, NO_SITE};
+use holewall::gpu::assemble::{assemble_gpu, assemble_residual_gpu};
+use holewall::kernels::assemble::{assemble, assemble_residual, AssemblyInputs, NO_SITE};
 use holewall::kernels::contact::{response_fields, OUTPUT_LEN};
 use holewall::physics::beam::{force_and_tangent, ElementState};
 use holewall::solve::statics::{
@@ -202,4 +202,54 @@ fn twin_gathers_what_the_solver_scatters_and_the_gpu_agrees() {
     let e_rhs = rel(&up(&gpu32.rhs), &twin.rhs);
     eprintln!("f32 vs f64 twin: diag {e_diag:.2e}, rhs {e_rhs:.2e} (u32 = 6.0e-8)");
     assert!(e_diag <= 4.0 * f32::EPSILON as f64);
+}
+
+/// The line-search trials' assembly (the kernel built `FORCE_ONLY`, twin
+/// `assemble_residual`) gives the full assembly's residual, constraints included, without
+/// reading the element tangents: the twin to the bit, the GPU to the bit of the GPU's full
+/// assembly (the same sums in the same order), f64 and f32.
+#[test]
+fn the_residual_only_assembly_gives_the_full_residual() {
+    let v = 5;
+    let (_, _, a) = inputs(v, true);
+    assert!(a.fixed.iter().any(|&f| f != 0), "the bed must fix DOFs");
+    let full = assemble(&a);
+    let mut bare = a.clone();
+    bare.elem_tangent = Vec::new();
+    let twin = assemble_residual(&bare);
+    assert_eq!(twin, full.rhs);
+    assert!(twin.iter().filter(|r| **r != 0.0).count() > twin.len() / 2);
+    let Some(ctx) = common::gpu() else { return };
+    if ctx.has_f64 {
+        let gpu_full = assemble_gpu(ctx, &a).unwrap();
+        let gpu = assemble_residual_gpu(ctx, &bare).unwrap();
+        assert_eq!(
+            gpu, gpu_full.rhs,
+            "f64: residual-only = full assembly's residual"
+        );
+    }
+    let down = |x: &[f64]| x.iter().map(|&y| y as f32).collect::<Vec<f32>>();
+    let a32 = AssemblyInputs::<f32> {
+        num_variants: a.num_variants,
+        num_nodes: a.num_nodes,
+        num_sites: a.num_sites,
+        elem_force: down(&a.elem_force),
+        elem_tangent: down(&a.elem_tangent),
+        contact: down(&a.contact),
+        contact_flag: a.contact_flag.clone(),
+        node_site: a.node_site.clone(),
+        f_ext: down(&a.f_ext),
+        basis: down(&a.basis),
+        fixed: a.fixed.clone(),
+        dynamic: None,
+    };
+    let gpu_full = assemble_gpu(ctx, &a32).unwrap();
+    let mut bare32 = a32.clone();
+    bare32.elem_tangent = Vec::new();
+    assert_eq!(
+        assemble_residual_gpu(ctx, &bare32).unwrap(),
+        gpu_full.rhs,
+        "f32: residual-only = full assembly's residual"
+    );
+    assert_eq!(assemble_residual(&bare32), assemble(&a32).rhs);
 }

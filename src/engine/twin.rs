@@ -7,7 +7,8 @@ use super::*;
 
 /// The twins' run of [`evaluation`] on a configuration (`x` displacements from the base,
 /// `rot`): the constrained system — its residual alone where `tangent` is false (the
-/// beam stage forms forces only; the tangent blocks are then meaningless). `dynamic`: the predicted trial state and the dynamic
+/// beam stage forms forces only; in statics the blocks are then left empty, as the
+/// assembly built `FORCE_ONLY` leaves them; in dynamics they are meaningless). `dynamic`: the predicted trial state and the dynamic
 /// assembly's inputs (the predictor itself is run by the caller, which owns the step's
 /// state).
 #[allow(clippy::too_many_arguments)]
@@ -55,7 +56,7 @@ pub(crate) fn twin_evaluate(
             Stage::Contact => contact(&t.terms, contact_batch, &mut out),
             Stage::Assemble => {
                 let (elem_force, elem_tangent) = elements.take().unwrap_or_default();
-                system = Some(assemble(&AssemblyInputs {
+                let inputs = AssemblyInputs {
                     num_variants: v,
                     num_nodes: n,
                     num_sites: t.num_sites,
@@ -79,7 +80,20 @@ pub(crate) fn twin_evaluate(
                             unbalance: d.unbalance.to_vec(),
                         }
                     }),
-                }));
+                };
+                system = Some(if tangent || inputs.dynamic.is_some() {
+                    assemble(&inputs)
+                } else {
+                    // A static trial: the residual alone (the kernel built `FORCE_ONLY`).
+                    ChainBatch {
+                        num_variants: v,
+                        num_nodes: n,
+                        diag: Vec::new(),
+                        upper: Vec::new(),
+                        lower: Vec::new(),
+                        rhs: crate::kernels::assemble::assemble_residual(&inputs),
+                    }
+                });
             }
         }
     }

@@ -37,6 +37,57 @@ pub fn assemble_wgsl_with(dynamic: bool, unbalance: bool, f64: bool) -> Result<S
     compose("assemble.wgsl", &flags, f64)
 }
 
+/// The WGSL text of the static assembly built `FORCE_ONLY` (the residual alone, for the
+/// line-search trials; twin: [`crate::kernels::assemble::assemble_residual`]).
+pub fn assemble_force_wgsl(f64: bool) -> Result<String, GpuError> {
+    let mut flags = BTreeSet::from(["FORCE_ONLY"]);
+    if f64 {
+        flags.insert("F64");
+    }
+    compose("assemble.wgsl", &flags, f64)
+}
+
+/// The static residual of every variant on the GPU (the kernel built `FORCE_ONLY`), laid
+/// out as the twin's `rhs`.
+pub fn assemble_residual_gpu<T: GpuReal>(
+    ctx: &'static GpuContext,
+    a: &AssemblyInputs<T>,
+) -> Result<Vec<T>, GpuError> {
+    crate::gpu::contact::require_precision::<T>(ctx)?;
+    if a.dynamic.is_some() {
+        return Err(GpuError::Unsupported(
+            "the residual-only assembly is static".into(),
+        ));
+    }
+    let (n, nv) = (a.num_nodes, a.num_variants);
+    let size = std::mem::size_of::<T>();
+    let pipeline = ctx.pipeline("assemble_force", &assemble_force_wgsl(T::IS_F64)?)?;
+    let dims = AssembleDims {
+        num_variants: nv as u32,
+        num_nodes: n as u32,
+        num_sites: a.num_sites as u32,
+        _pad: 0,
+    };
+    let out = run_once(
+        ctx,
+        &pipeline,
+        "assemble_force",
+        bytemuck::bytes_of(&dims),
+        &[
+            bytemuck::cast_slice(&a.elem_force),
+            bytemuck::cast_slice(&a.contact),
+            bytemuck::cast_slice(&a.contact_flag),
+            bytemuck::cast_slice(&a.node_site),
+            bytemuck::cast_slice(&a.f_ext),
+            bytemuck::cast_slice(&a.basis),
+            bytemuck::cast_slice(&a.fixed),
+        ],
+        &[Out::Empty(6 * n * nv * size)],
+        n * nv,
+    )?;
+    Ok(bytemuck::cast_slice(&out[0]).to_vec())
+}
+
 /// Assembles every variant on the GPU; the result is laid out as the twin's.
 pub fn assemble_gpu<T: GpuReal>(
     ctx: &'static GpuContext,

@@ -124,11 +124,13 @@ fn clear_fixed<T: Real>(blk: &mut [T; 36], row_mask: u32, col_mask: u32) {
 }
 
 /// One (node, variant) invocation: residual (6), diagonal (36), and, below the last node,
-/// upper and lower (36 each).
+/// upper and lower (36 each). With `tangent` false (the kernel built `FORCE_ONLY`, static
+/// only) the residual alone: the element tangents are not read and the blocks stay zero.
 fn node_blocks<T: Real>(
     a: &AssemblyInputs<T>,
     i: usize,
     v: usize,
+    tangent: bool,
 ) -> ([T; 6], [T; 36], [T; 36], [T; 36]) {
     let nv = a.num_variants;
     let n = a.num_nodes;
@@ -144,6 +146,9 @@ fn node_blocks<T: Real>(
         let e = i - 1;
         for k in 0..6 {
             r[k] = r[k] + a.elem_force[(12 * e + 6 + k) * nv + v];
+            if !tangent {
+                continue;
+            }
             for c in 0..6 {
                 d[6 * k + c] =
                     d[6 * k + c] + a.elem_tangent[(144 * e + 12 * (6 + k) + 6 + c) * nv + v];
@@ -154,6 +159,9 @@ fn node_blocks<T: Real>(
         let e = i;
         for k in 0..6 {
             r[k] = r[k] + a.elem_force[(12 * e + k) * nv + v];
+            if !tangent {
+                continue;
+            }
             for c in 0..6 {
                 d[6 * k + c] = d[6 * k + c] + a.elem_tangent[(144 * e + 12 * k + c) * nv + v];
                 u[6 * k + c] = a.elem_tangent[(144 * e + 12 * k + 6 + c) * nv + v];
@@ -167,13 +175,16 @@ fn node_blocks<T: Real>(
         if a.contact_flag[p] != 0 {
             for k in 0..6 {
                 r[k] = r[k] + a.contact[(OUT_G + k) * pairs + p];
+                if !tangent {
+                    continue;
+                }
                 for c in 0..3 {
                     d[6 * k + c] = d[6 * k + c] + a.contact[(OUT_K + 3 * k + c) * pairs + p];
                 }
             }
         }
     }
-    if let Some(dy) = &a.dynamic {
+    if let Some(dy) = a.dynamic.as_ref().filter(|_| tangent) {
         let [hg, hhb, a0] = dy.coefficients;
         for k in 0..36 {
             d[k] = hhb * d[k];
@@ -277,7 +288,9 @@ fn node_blocks<T: Real>(
     }
     // Constraints (as statics::constrain): bases, then fixed DOFs.
     let b_i = &a.basis[9 * i..9 * i + 9];
-    transform(&mut d, b_i, b_i);
+    if tangent {
+        transform(&mut d, b_i, b_i);
+    }
     let rv = r;
     for row in 0..3 {
         let mut s = T::zero();
@@ -287,6 +300,14 @@ fn node_blocks<T: Real>(
         r[row] = s;
     }
     let f_i = a.fixed[i];
+    if !tangent {
+        for k in 0..6 {
+            if f_i & (1 << k) != 0 {
+                r[k] = T::zero();
+            }
+        }
+        return (r, d, u, l);
+    }
     clear_fixed(&mut d, f_i, f_i);
     for k in 0..6 {
         if f_i & (1 << k) != 0 {
@@ -311,7 +332,7 @@ pub fn assemble<T: Real + Send + Sync>(a: &AssemblyInputs<T>) -> ChainBatch<T> {
     let (n, nv) = (a.num_nodes, a.num_variants);
     let per: Vec<_> = (0..n * nv)
         .into_par_iter()
-        .map(|idx| node_blocks(a, idx / nv, idx % nv))
+        .map(|idx| node_blocks(a, idx / nv, idx % nv, true))
         .collect();
     let m = n.saturating_sub(1);
     let mut out = ChainBatch {
@@ -336,4 +357,25 @@ pub fn assemble<T: Real + Send + Sync>(a: &AssemblyInputs<T>) -> ChainBatch<T> {
         }
     }
     out
+}
+
+/// The static residual alone of every variant (twin of the kernel built `FORCE_ONLY`, the
+/// line-search trials'): `rhs` as [`assemble`] gives it, without reading the element
+/// tangents (`a.elem_tangent` may be empty). Panics on dynamic inputs (the dynamic
+/// residual is not split from its matrix).
+pub fn assemble_residual<T: Real + Send + Sync>(a: &AssemblyInputs<T>) -> Vec<T> {
+    assert!(a.dynamic.is_none(), "the residual-only assembly is static");
+    let (n, nv) = (a.num_nodes, a.num_variants);
+    let per: Vec<[T; 6]> = (0..n * nv)
+        .into_par_iter()
+        .map(|idx| node_blocks(a, idx / nv, idx % nv, false).0)
+        .collect();
+    let mut rhs = vec![T::zero(); 6 * n * nv];
+    for (idx, r) in per.into_iter().enumerate() {
+        let (i, v) = (idx / nv, idx % nv);
+        for k in 0..6 {
+            rhs[(6 * i + k) * nv + v] = r[k];
+        }
+    }
+    rhs
 }

@@ -79,6 +79,8 @@ struct Slot {
     beam_force: wgpu::BindGroup,
     sites: wgpu::BindGroup,
     assemble: wgpu::BindGroup,
+    /// The residual-only assembly's group (trials).
+    assemble_force: wgpu::BindGroup,
     lu: Vec<wgpu::BindGroup>,
     norms_solve: wgpu::BindGroup,
     norms_trial: wgpu::BindGroup,
@@ -93,6 +95,8 @@ struct Pipelines {
     sites: Arc<wgpu::ComputePipeline>,
     contact: Arc<wgpu::ComputePipeline>,
     assemble: Arc<wgpu::ComputePipeline>,
+    /// The assembly built `FORCE_ONLY` (line-search trials: the residual alone).
+    assemble_force: Arc<wgpu::ComputePipeline>,
     block_lu: Arc<wgpu::ComputePipeline>,
     norms: Arc<wgpu::ComputePipeline>,
     update: Arc<wgpu::ComputePipeline>,
@@ -490,6 +494,10 @@ impl<T: GpuReal> GpuEnsemble<T> {
             sites: ctx.pipeline("sites", &sites_wgsl(f64)?)?,
             contact: ctx.pipeline("contact", &contact_wgsl(&tables.terms, f64)?)?,
             assemble: ctx.pipeline("assemble", &crate::gpu::assemble::assemble_wgsl(f64)?)?,
+            assemble_force: ctx.pipeline(
+                "assemble_force",
+                &crate::gpu::assemble::assemble_force_wgsl(f64)?,
+            )?,
             block_lu: ctx.pipeline(
                 "block_lu",
                 &crate::gpu::block_lu::block_lu_wgsl(f64, LuForm::for_adapter(ctx))?,
@@ -520,6 +528,22 @@ impl<T: GpuReal> GpuEnsemble<T> {
                 "assemble",
                 &[&inputs[..], &[&diag, &upper, &lower, &rhs]].concat(),
             );
+            let assemble_force = bind(
+                ctx,
+                &pipelines.assemble_force,
+                "assemble_force",
+                &[
+                    &c.assemble_dims,
+                    &c.elem_force,
+                    &c.values,
+                    &c.flags,
+                    &c.node_site,
+                    &c.f_ext,
+                    &c.basis,
+                    &c.fixed,
+                    &rhs,
+                ],
+            );
             let lu = c.lu_groups(ctx, &pipelines.block_lu, [&diag, &upper, &lower, &rhs]);
             let norms_solve = c.norms_group(ctx, &pipelines.norms, &c.ones, &rhs);
             let norms_trial = c.norms_group(ctx, &pipelines.norms, &c.alpha, &rhs);
@@ -547,6 +571,7 @@ impl<T: GpuReal> GpuEnsemble<T> {
                 beam_force,
                 sites,
                 assemble,
+                assemble_force,
                 lu,
                 norms_solve,
                 norms_trial,
@@ -572,7 +597,7 @@ impl<T: GpuReal> GpuEnsemble<T> {
     }
 
     /// Records the evaluation of `slot`: beam, sites, contact, assembly — the residual
-    /// alone (the force-only beam kernel) where `tangent` is false.
+    /// alone (the beam kernel and the assembly built `FORCE_ONLY`) where `tangent` is false.
     fn record_evaluate(&self, pass: &mut wgpu::ComputePass, slot: usize, tangent: bool) {
         let s = &self.slots[slot];
         let p = &self.p;
@@ -588,7 +613,8 @@ impl<T: GpuReal> GpuEnsemble<T> {
                 Stage::Beam => Some((&*p.beam_force, &s.beam_force)),
                 Stage::Sites => Some((&*p.sites, &s.sites)),
                 Stage::Contact => Some((&*p.contact, &self.contact)),
-                Stage::Assemble => Some((&*p.assemble, &s.assemble)),
+                Stage::Assemble if tangent => Some((&*p.assemble, &s.assemble)),
+                Stage::Assemble => Some((&*p.assemble_force, &s.assemble_force)),
             },
         );
     }
