@@ -51,10 +51,15 @@ fn put3(field: u32, i: u32, x: vec3<real>) {
 
 // Output fields of the scene: g (6), K (18) and, in dynamics, C (18), c_omega (6). A
 // static scene's buffer holds only the first 24 (src/kernels/contact.rs `output_fields`).
+// Built FORCE_ONLY (static line-search trials): g alone; the K fields are not written.
 #if DYNAMIC
 const OUT_FIELDS: u32 = 48u;
 #else
+#if FORCE_ONLY
+const OUT_FIELDS: u32 = 6u;
+#else
 const OUT_FIELDS: u32 = 24u;
+#endif
 #endif
 
 // Zero outputs (no contact, or no force). Every output is written exactly once per pair.
@@ -238,6 +243,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     // Rows written as vectors (no dynamic indexing): K row r = dir[r]·∂N/∂x + kf_t[r]·tᵀ.
     put3(0u, i, dir_f * normal);
     put3(3u, i, dir_m * normal);
+#if !FORCE_ONLY
     let dn_dx = u * dn_dx_u + t * dn_dx_t;
     put3(6u, i, dn_dx * dir_f.x + t * kf_t.x);
     put3(9u, i, dn_dx * dir_f.y + t * kf_t.y);
@@ -245,6 +251,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     put3(15u, i, dn_dx * dir_m.x + t * km_t.x);
     put3(18u, i, dn_dx * dir_m.y + t * km_t.y);
     put3(21u, i, dn_dx * dir_m.z + t * km_t.z);
+#endif
 #if DYNAMIC
     let dn_dv = u * dn_dv_u;
     put3(24u, i, dn_dv * dir_f.x + (t * cf_t.x + n * cf_n.x) * normal);

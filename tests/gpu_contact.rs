@@ -388,3 +388,57 @@ fn static_scenes_allocate_no_damping_outputs() {
         }
     }
 }
+
+/// The static line-search trials' contact kernel (built `FORCE_ONLY`) gives the full
+/// kernel's force and moment `g` and contact flags to the bit, on every static law and
+/// friction model, f64 and f32, and writes no stiffness fields; a dynamic scene has none.
+#[test]
+fn force_only_kernel_gives_the_full_kernels_forces() {
+    use holewall::gpu::contact::{contact_force_wgsl, GpuContactRun};
+    let Some(ctx) = common::gpu() else { return };
+    let dynamic = ContactTerms::all(FrictionModel::Split, ContactMode::Dynamic);
+    assert!(contact_force_wgsl(&dynamic, false).is_err());
+    let mut checked = 0;
+    for friction in [FrictionModel::Split, FrictionModel::Coupled] {
+        let b64 = random_batch(11, 40, 60, friction);
+        let b32 = b64.cast::<f32>();
+        for spring in [SpringLaw::Linear, SpringLaw::PowerBlend] {
+            for frictionless in [false, true] {
+                let mut terms = ContactTerms::all(friction, ContactMode::Static);
+                terms.spring = spring;
+                terms.damping = false;
+                if frictionless {
+                    terms.friction = None;
+                }
+                if ctx.has_f64 {
+                    let full = contact_gpu(ctx, &terms, &b64).unwrap();
+                    let run = GpuContactRun::force_only(ctx, &terms, &b64).unwrap();
+                    run.dispatch().unwrap();
+                    let lean = run.read().unwrap();
+                    assert_eq!(lean.contact, full.contact);
+                    for i in 0..b64.num_pairs() {
+                        let (a, b) = (lean.fields(i), full.fields(i));
+                        assert_eq!(a[..6], b[..6], "f64 {terms:?} pair {i}");
+                        assert!(a[6..].iter().all(|x| *x == 0.0), "no K written");
+                    }
+                }
+                let full = contact_gpu(ctx, &terms, &b32).unwrap();
+                let run = GpuContactRun::force_only(ctx, &terms, &b32).unwrap();
+                run.dispatch().unwrap();
+                let lean = run.read().unwrap();
+                assert_eq!(lean.contact, full.contact);
+                let touching = lean.contact.iter().filter(|c| **c != 0).count();
+                assert!(touching > b32.num_pairs() / 10, "{touching} in contact");
+                for i in 0..b32.num_pairs() {
+                    assert_eq!(
+                        lean.fields(i)[..6],
+                        full.fields(i)[..6],
+                        "f32 {terms:?} pair {i}"
+                    );
+                }
+                checked += 1;
+            }
+        }
+    }
+    assert_eq!(checked, 8);
+}

@@ -79,6 +79,23 @@ pub fn contact_wgsl(terms: &ContactTerms, f64: bool) -> Result<String, GpuError>
     compose("contact.wgsl", &flags, f64)
 }
 
+/// The WGSL text of the static contact kernel built `FORCE_ONLY` (line-search trials):
+/// the force and moment `g` (fields 0–5) and the contact flag alone; the stiffness fields
+/// are not written. Dynamic scenes have none (their trials need the whole response).
+pub fn contact_force_wgsl(terms: &ContactTerms, f64: bool) -> Result<String, GpuError> {
+    if terms.mode == ContactMode::Dynamic {
+        return Err(GpuError::Unsupported(
+            "the force-only contact kernel is static".into(),
+        ));
+    }
+    let mut flags = contact_flags(terms);
+    flags.insert("FORCE_ONLY");
+    if f64 {
+        flags.insert("F64");
+    }
+    compose("contact.wgsl", &flags, f64)
+}
+
 /// Invocations per workgroup in `shaders/contact.wgsl`.
 const WORKGROUP: usize = 64;
 
@@ -120,6 +137,16 @@ impl<T: GpuReal> GpuContactRun<T> {
         Self::with_chunk_limit(ctx, terms, batch, usize::MAX)
     }
 
+    /// As [`Self::new`] with the static kernel built `FORCE_ONLY` ([`contact_force_wgsl`]):
+    /// the outputs' `g` fields and flags as the full kernel's; the others zero.
+    pub fn force_only(
+        ctx: &'static GpuContext,
+        terms: &ContactTerms,
+        batch: &ContactBatch<T>,
+    ) -> Result<Self, GpuError> {
+        Self::build(ctx, terms, batch, usize::MAX, true)
+    }
+
     /// As [`Self::new`], with at most `max_chunk_pairs` pairs per chunk (tests use it to put
     /// chunk boundaries inside a site).
     pub fn with_chunk_limit(
@@ -128,9 +155,23 @@ impl<T: GpuReal> GpuContactRun<T> {
         batch: &ContactBatch<T>,
         max_chunk_pairs: usize,
     ) -> Result<Self, GpuError> {
+        Self::build(ctx, terms, batch, max_chunk_pairs, false)
+    }
+
+    fn build(
+        ctx: &'static GpuContext,
+        terms: &ContactTerms,
+        batch: &ContactBatch<T>,
+        max_chunk_pairs: usize,
+        force_only: bool,
+    ) -> Result<Self, GpuError> {
         require_precision::<T>(ctx)?;
-        let wgsl = contact_wgsl(terms, T::IS_F64)?;
-        let pipeline = ctx.pipeline("contact", &wgsl)?;
+        let (label, wgsl) = if force_only {
+            ("contact_force", contact_force_wgsl(terms, T::IS_F64)?)
+        } else {
+            ("contact", contact_wgsl(terms, T::IS_F64)?)
+        };
+        let pipeline = ctx.pipeline(label, &wgsl)?;
         let device = &ctx.device;
         let size = std::mem::size_of::<T>();
         let max_binding = ctx.max_binding_bytes() as usize;

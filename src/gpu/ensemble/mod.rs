@@ -94,6 +94,8 @@ struct Pipelines {
     beam_force: Arc<wgpu::ComputePipeline>,
     sites: Arc<wgpu::ComputePipeline>,
     contact: Arc<wgpu::ComputePipeline>,
+    /// The contact kernel built `FORCE_ONLY` (line-search trials: `g` alone).
+    contact_force: Arc<wgpu::ComputePipeline>,
     assemble: Arc<wgpu::ComputePipeline>,
     /// The assembly built `FORCE_ONLY` (line-search trials: the residual alone).
     assemble_force: Arc<wgpu::ComputePipeline>,
@@ -113,6 +115,7 @@ pub struct GpuEnsemble<T: GpuReal> {
     lu_lanes: usize,
     current: usize,
     contact: wgpu::BindGroup,
+    contact_force: wgpu::BindGroup,
     c: Common,
     num_variants: usize,
     num_nodes: usize,
@@ -493,6 +496,10 @@ impl<T: GpuReal> GpuEnsemble<T> {
                 .pipeline("beam_force", &crate::gpu::beam::beam_wgsl(f64, true, kink)?)?,
             sites: ctx.pipeline("sites", &sites_wgsl(f64)?)?,
             contact: ctx.pipeline("contact", &contact_wgsl(&tables.terms, f64)?)?,
+            contact_force: ctx.pipeline(
+                "contact_force",
+                &crate::gpu::contact::contact_force_wgsl(&tables.terms, f64)?,
+            )?,
             assemble: ctx.pipeline("assemble", &crate::gpu::assemble::assemble_wgsl(f64)?)?,
             assemble_force: ctx.pipeline(
                 "assemble_force",
@@ -506,6 +513,7 @@ impl<T: GpuReal> GpuEnsemble<T> {
             update: ctx.pipeline("update", &crate::gpu::update::update_wgsl(false, f64)?)?,
         };
         let contact = c.contact_group(ctx, &pipelines.contact);
+        let contact_force = c.contact_group(ctx, &pipelines.contact_force);
         let make_slot = |label: &str| -> Slot {
             let x = storage(ctx, label, &tables.start.x);
             let rot = storage(ctx, label, &tables.start.rot);
@@ -588,6 +596,7 @@ impl<T: GpuReal> GpuEnsemble<T> {
             lu_lanes: LuForm::for_adapter(ctx).lanes(),
             current: 0,
             contact,
+            contact_force,
             c,
             num_variants: v,
             num_nodes: n,
@@ -597,7 +606,8 @@ impl<T: GpuReal> GpuEnsemble<T> {
     }
 
     /// Records the evaluation of `slot`: beam, sites, contact, assembly — the residual
-    /// alone (the beam kernel and the assembly built `FORCE_ONLY`) where `tangent` is false.
+    /// alone (the beam, contact and assembly kernels built `FORCE_ONLY`) where `tangent` is
+    /// false.
     fn record_evaluate(&self, pass: &mut wgpu::ComputePass, slot: usize, tangent: bool) {
         let s = &self.slots[slot];
         let p = &self.p;
@@ -612,7 +622,8 @@ impl<T: GpuReal> GpuEnsemble<T> {
                 Stage::Beam if tangent => Some((&*p.beam, &s.beam)),
                 Stage::Beam => Some((&*p.beam_force, &s.beam_force)),
                 Stage::Sites => Some((&*p.sites, &s.sites)),
-                Stage::Contact => Some((&*p.contact, &self.contact)),
+                Stage::Contact if tangent => Some((&*p.contact, &self.contact)),
+                Stage::Contact => Some((&*p.contact_force, &self.contact_force)),
                 Stage::Assemble if tangent => Some((&*p.assemble, &s.assemble)),
                 Stage::Assemble => Some((&*p.assemble_force, &s.assemble_force)),
             },
