@@ -21,6 +21,10 @@
 @group(0) @binding(6) var<storage, read> basis: array<real>;
 @group(0) @binding(7) var<storage, read> fixed: array<u32>;
 @group(0) @binding(8) var<storage, read_write> out_rhs: array<real>;
+#if MASKED
+// Built MASKED (the engine's trials): a variant whose mask entry is 0 is skipped.
+@group(0) @binding(9) var<storage, read> searching: array<u32>;
+#endif
 #else
 @group(0) @binding(2) var<storage, read> elem_tangent: array<real>;
 @group(0) @binding(3) var<storage, read> contact: array<real>;
@@ -141,6 +145,11 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
     let i = gid.x / nv;
     let v = gid.x % nv;
+#if MASKED
+    if (searching[v] == 0u) {
+        return;
+    }
+#endif
     let pairs = dims.num_sites * nv;
     var r: array<real, 6>;
 #if !FORCE_ONLY

@@ -47,11 +47,19 @@
 @group(0) @binding(7) var<storage, read_write> elem_force: array<real>;
 #if !FORCE_ONLY
 @group(0) @binding(8) var<storage, read_write> elem_tangent: array<real>;
+#else
+#if MASKED
+@group(0) @binding(8) var<storage, read> searching: array<u32>;
+#endif
 #endif
 #else
 @group(0) @binding(6) var<storage, read_write> elem_force: array<real>;
 #if !FORCE_ONLY
 @group(0) @binding(7) var<storage, read_write> elem_tangent: array<real>;
+#else
+#if MASKED
+@group(0) @binding(7) var<storage, read> searching: array<u32>;
+#endif
 #endif
 #endif
 
@@ -290,6 +298,13 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
     let e = gid.x / nv;
     let v = gid.x % nv;
+#if MASKED
+    // Built MASKED with FORCE_ONLY (the engine's line-search trials): a variant whose mask
+    // entry is 0 is skipped, its forces left as they were.
+    if (searching[v] == 0u) {
+        return;
+    }
+#endif
     let base = vec3<real>(chord[(4u * e) * nv + v], chord[(4u * e + 1u) * nv + v], chord[(4u * e + 2u) * nv + v]);
     let stretch = chord[(4u * e + 3u) * nv + v];
     let k = vec3<real>(section[4u * e], section[4u * e + 1u], section[4u * e + 2u]);

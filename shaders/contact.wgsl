@@ -30,6 +30,11 @@ fn pow_pos(x: f32, m: f32) -> f32 {
 @group(0) @binding(4) var<storage, read_write> out_values: array<real>;
 // 1 where delta > 0.
 @group(0) @binding(5) var<storage, read_write> out_contact: array<u32>;
+#if MASKED
+// Built MASKED (with FORCE_ONLY: the engine's line-search trials): pairs whose mask entry is
+// 0 are skipped, their outputs left as they were.
+@group(0) @binding(6) var<storage, read> searching: array<u32>;
+#endif
 
 fn param(field: u32, i: u32) -> real {
     return pair_params[field * dims.num_pairs + i];
@@ -129,6 +134,11 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     if (i >= dims.num_pairs) {
         return;
     }
+#if MASKED
+    if (searching[(dims.pair_offset + i) % dims.mask_variants] == 0u) {
+        return;
+    }
+#endif
     out_contact[i] = 0u;
 
     let site = (dims.pair_offset + i) / dims.num_variants;

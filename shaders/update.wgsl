@@ -13,6 +13,10 @@
 @group(0) @binding(3) var<storage, read> residual: array<real>;
 // Per variant: largest |r|, largest |α Δ|, Δ · r, r · r.
 @group(0) @binding(4) var<storage, read_write> norm_out: array<real>;
+#if MASKED
+// Built MASKED (the engine's trials): a variant whose mask entry is 0 is skipped.
+@group(0) @binding(5) var<storage, read> searching: array<u32>;
+#endif
 #else
 @group(0) @binding(3) var<storage, read> basis: array<real>;
 // Site at each (node, variant), NO_SITE where none; per pair (site · V + variant) the base
@@ -22,8 +26,37 @@
 @group(0) @binding(5) var<storage, read> pair_base: array<real>;
 @group(0) @binding(6) var<storage, read> pair_normals: array<real>;
 @group(0) @binding(7) var<storage, read> pair_params: array<real>;
+#if OUT_OF_PLACE
+// Built OUT_OF_PLACE (the engine's trials): the configuration moved from is read here and
+// the result written to x, rot (the trial's slot); without, x and rot are updated in place.
+@group(0) @binding(8) var<storage, read> x_from: array<real>;
+@group(0) @binding(9) var<storage, read> rot_from: array<real>;
+@group(0) @binding(10) var<storage, read_write> x: array<real>;
+@group(0) @binding(11) var<storage, read_write> rot: array<real>;
+#if MASKED
+// Built MASKED: a variant whose mask entry is 0 is skipped (its trial slot left as it was).
+@group(0) @binding(12) var<storage, read> searching: array<u32>;
+#endif
+
+fn x_at(k: u32) -> real {
+    return x_from[k];
+}
+
+fn rot_at(k: u32) -> real {
+    return rot_from[k];
+}
+#else
 @group(0) @binding(8) var<storage, read_write> x: array<real>;
 @group(0) @binding(9) var<storage, read_write> rot: array<real>;
+
+fn x_at(k: u32) -> real {
+    return x[k];
+}
+
+fn rot_at(k: u32) -> real {
+    return rot[k];
+}
+#endif
 #endif
 
 #if !NORMS
@@ -60,6 +93,11 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
     let i = gid.x / nv;
     let v = gid.x % nv;
+#if MASKED
+    if (searching[v] == 0u) {
+        return;
+    }
+#endif
     let al = alpha[v];
     let du = vec3<real>(
         al * delta[(6u * i) * nv + v],
@@ -71,7 +109,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         let brow = vec3<real>(basis[9u * i + 3u * r], basis[9u * i + 3u * r + 1u], basis[9u * i + 3u * r + 2u]);
         step[r] = dot(brow, du);
     }
-    let x_old = vec3<real>(x[(3u * i) * nv + v], x[(3u * i + 1u) * nv + v], x[(3u * i + 2u) * nv + v]);
+    let x_old = vec3<real>(x_at((3u * i) * nv + v), x_at((3u * i + 1u) * nv + v), x_at((3u * i + 2u) * nv + v));
     let site = node_site[i * nv + v];
     if (site != NO_SITE) {
         let pair = site * nv + v;
@@ -90,7 +128,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     ));
     var old: array<real, 9>;
     for (var k = 0u; k < 9u; k = k + 1u) {
-        old[k] = rot[(9u * i + k) * nv + v];
+        old[k] = rot_at((9u * i + k) * nv + v);
     }
     for (var r = 0u; r < 3u; r = r + 1u) {
         for (var c = 0u; c < 3u; c = c + 1u) {
@@ -115,6 +153,11 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     if (v >= nv) {
         return;
     }
+#if MASKED
+    if (searching[v] == 0u) {
+        return;
+    }
+#endif
     var r = real(0.0);
     var d = real(0.0);
     var dot_dr = real(0.0);

@@ -397,7 +397,7 @@ fn force_only_kernel_gives_the_full_kernels_forces() {
     use holewall::gpu::contact::{contact_force_wgsl, GpuContactRun};
     let Some(ctx) = common::gpu() else { return };
     let dynamic = ContactTerms::all(FrictionModel::Split, ContactMode::Dynamic);
-    assert!(contact_force_wgsl(&dynamic, false).is_err());
+    assert!(contact_force_wgsl(&dynamic, false, false).is_err());
     let mut checked = 0;
     for friction in [FrictionModel::Split, FrictionModel::Coupled] {
         let b64 = random_batch(11, 40, 60, friction);

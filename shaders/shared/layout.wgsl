@@ -6,7 +6,9 @@ struct ContactDims {
     num_variants: u32,
     // Index of this dispatch's first pair in the whole batch.
     pair_offset: u32,
-    _pad: u32,
+    // Built MASKED: entries of the activity mask; pair i belongs to mask entry
+    // (pair_offset + i) % mask_variants (the engine's pairs are site · V + variant).
+    mask_variants: u32,
 }
 
 // Keep in sync with src/gpu/layout.rs (ChainDims).

@@ -118,8 +118,10 @@ pub trait Ensemble<T> {
     fn solve(&mut self) -> Result<(Norms<T>, Vec<u32>), String>;
     /// Trial = current + `α Δ`, its residual evaluated (not its tangent: a rejected
     /// trial's tangent would be wasted, and the tangent is most of an evaluation); the norms of the
-    /// trial's residual with `Δ`, `α`.
-    fn trial(&mut self, alpha: &[T]) -> Result<Norms<T>, String>;
+    /// trial's residual with `Δ`, `α`. Masked as [`NewtonSystem::trial`]: the variants in
+    /// `search` are moved and evaluated (their norms are read); on the `first` trial of a
+    /// search every variant's trial is set, later ones keep the others' trials as they are.
+    fn trial(&mut self, alpha: &[T], search: &[bool], first: bool) -> Result<Norms<T>, String>;
     /// Makes the last trial (configuration and residual) the current one; its tangent is
     /// formed by the next [`Ensemble::evaluate`].
     fn accept_trial(&mut self);
@@ -582,9 +584,9 @@ impl<T: Real> NewtonSystem for EngineStatic<'_, T> {
             solved: status.iter().map(|&s| s == SOLVED).collect(),
         })
     }
-    fn trial(&mut self, alpha: &[f64]) -> Result<TrialProbe, String> {
+    fn trial(&mut self, alpha: &[f64], search: &[bool], first: bool) -> Result<TrialProbe, String> {
         self.flush()?;
-        let r = self.ensemble.trial(&negated::<T>(alpha))?;
+        let r = self.ensemble.trial(&negated::<T>(alpha), search, first)?;
         Ok(trial_probe(&r))
     }
     fn accept(&mut self, alpha: &[f64], trial_matches: bool) -> Result<(), String> {

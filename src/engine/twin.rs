@@ -201,10 +201,28 @@ impl Ensemble<f64> for TwinEnsemble<'_> {
         );
         Ok((n, status))
     }
-    fn trial(&mut self, alpha: &[f64]) -> Result<Norms<f64>, String> {
+    fn trial(&mut self, alpha: &[f64], search: &[bool], first: bool) -> Result<Norms<f64>, String> {
         let other = 1 - self.current;
-        self.config[other] = self.config[self.current].clone();
-        update(&mut self.config[other], &self.walls, &self.delta, alpha);
+        let mut moved = self.config[self.current].clone();
+        update(&mut moved, &self.walls, &self.delta, alpha);
+        if first {
+            self.config[other] = moved;
+        } else {
+            // The searching variants' trials; the others keep theirs (as the GPU's masked
+            // update leaves them).
+            let v = self.tables.num_variants;
+            let to = &mut self.config[other];
+            for (k, x) in moved.x.iter().enumerate() {
+                if search[k % v] {
+                    to.x[k] = *x;
+                }
+            }
+            for (k, r) in moved.rot.iter().enumerate() {
+                if search[k % v] {
+                    to.rot[k] = *r;
+                }
+            }
+        }
         self.evaluate_slot(other, false);
         Ok(norms(
             self.rhs(other)?,

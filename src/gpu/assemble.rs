@@ -39,8 +39,12 @@ pub fn assemble_wgsl_with(dynamic: bool, unbalance: bool, f64: bool) -> Result<S
 
 /// The WGSL text of the static assembly built `FORCE_ONLY` (the residual alone, for the
 /// line-search trials; twin: [`crate::kernels::assemble::assemble_residual`]).
-pub fn assemble_force_wgsl(f64: bool) -> Result<String, GpuError> {
+/// `masked`: variants whose entry of the activity mask (binding 9) is 0 are skipped.
+pub fn assemble_force_wgsl(f64: bool, masked: bool) -> Result<String, GpuError> {
     let mut flags = BTreeSet::from(["FORCE_ONLY"]);
+    if masked {
+        flags.insert("MASKED");
+    }
     if f64 {
         flags.insert("F64");
     }
@@ -61,7 +65,7 @@ pub fn assemble_residual_gpu<T: GpuReal>(
     }
     let (n, nv) = (a.num_nodes, a.num_variants);
     let size = std::mem::size_of::<T>();
-    let pipeline = ctx.pipeline("assemble_force", &assemble_force_wgsl(T::IS_F64)?)?;
+    let pipeline = ctx.pipeline("assemble_force", &assemble_force_wgsl(T::IS_F64, false)?)?;
     let dims = AssembleDims {
         num_variants: nv as u32,
         num_nodes: n as u32,

@@ -28,6 +28,19 @@ pub fn beam_wgsl(f64: bool, force_only: bool, kink: bool) -> Result<String, GpuE
     compose("beam.wgsl", &flags, f64)
 }
 
+/// The force-only beam kernel built `MASKED` (the engine's line-search trials): elements
+/// of variants whose entry of the activity mask (the last binding) is 0 are skipped.
+pub fn beam_trial_wgsl(f64: bool, kink: bool) -> Result<String, GpuError> {
+    let mut flags = BTreeSet::from(["FORCE_ONLY", "MASKED"]);
+    if kink {
+        flags.insert("KINK");
+    }
+    if f64 {
+        flags.insert("F64");
+    }
+    compose("beam.wgsl", &flags, f64)
+}
+
 /// Element forces and tangents of V variants on the GPU at displacements `u` from the base
 /// whose chords are `chords` ([`crate::kernels::beam::base_chords`]) and unstrained rotations
 /// `rest` ([`crate::kernels::beam::rest_table`], empty: none), laid out as the twin's; with

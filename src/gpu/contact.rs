@@ -82,7 +82,13 @@ pub fn contact_wgsl(terms: &ContactTerms, f64: bool) -> Result<String, GpuError>
 /// The WGSL text of the static contact kernel built `FORCE_ONLY` (line-search trials):
 /// the force and moment `g` (fields 0–5) and the contact flag alone; the stiffness fields
 /// are not written. Dynamic scenes have none (their trials need the whole response).
-pub fn contact_force_wgsl(terms: &ContactTerms, f64: bool) -> Result<String, GpuError> {
+/// `masked`: pairs whose entry of the activity mask (binding 6, entry
+/// `(pair_offset + i) % mask_variants`) is 0 are skipped.
+pub fn contact_force_wgsl(
+    terms: &ContactTerms,
+    f64: bool,
+    masked: bool,
+) -> Result<String, GpuError> {
     if terms.mode == ContactMode::Dynamic {
         return Err(GpuError::Unsupported(
             "the force-only contact kernel is static".into(),
@@ -90,6 +96,9 @@ pub fn contact_force_wgsl(terms: &ContactTerms, f64: bool) -> Result<String, Gpu
     }
     let mut flags = contact_flags(terms);
     flags.insert("FORCE_ONLY");
+    if masked {
+        flags.insert("MASKED");
+    }
     if f64 {
         flags.insert("F64");
     }
@@ -167,7 +176,10 @@ impl<T: GpuReal> GpuContactRun<T> {
     ) -> Result<Self, GpuError> {
         require_precision::<T>(ctx)?;
         let (label, wgsl) = if force_only {
-            ("contact_force", contact_force_wgsl(terms, T::IS_F64)?)
+            (
+                "contact_force",
+                contact_force_wgsl(terms, T::IS_F64, false)?,
+            )
         } else {
             ("contact", contact_wgsl(terms, T::IS_F64)?)
         };
@@ -243,7 +255,7 @@ impl<T: GpuReal> GpuContactRun<T> {
                 num_pairs: len as u32,
                 num_variants: batch.num_variants as u32,
                 pair_offset: offset as u32,
-                _pad: 0,
+                mask_variants: 0,
             };
             let dims = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some("contact_dims"),

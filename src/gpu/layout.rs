@@ -12,8 +12,10 @@ pub struct ContactDims {
     pub num_variants: u32,
     /// Index of this dispatch's first pair in the whole batch.
     pub pair_offset: u32,
-    /// Padding to 16 bytes.
-    pub _pad: u32,
+    /// The kernel built `MASKED`: entries of the activity mask; pair `i` belongs to entry
+    /// `(pair_offset + i) % mask_variants` (the engine's pairs are `site · V + variant`).
+    /// Unused otherwise.
+    pub mask_variants: u32,
 }
 
 /// Dispatch dimensions of the block-tridiagonal solve (parameter binding 0 of

@@ -12,7 +12,25 @@ use crate::kernels::update::{ConfigBatch, Norms};
 
 /// The WGSL text of the update (`norms = false`) or of the norms, at a precision.
 pub fn update_wgsl(norms: bool, f64: bool) -> Result<String, GpuError> {
+    update_wgsl_with(norms, f64, false, false)
+}
+
+/// [`update_wgsl`] for the engine's line-search trials: `out_of_place`, the update reads
+/// the configuration it moves from (bindings 8, 9) and writes the trial's (10, 11);
+/// `masked`, variants whose entry of the activity mask (the last binding) is 0 are skipped.
+pub fn update_wgsl_with(
+    norms: bool,
+    f64: bool,
+    out_of_place: bool,
+    masked: bool,
+) -> Result<String, GpuError> {
     let mut flags = BTreeSet::new();
+    if out_of_place && !norms {
+        flags.insert("OUT_OF_PLACE");
+    }
+    if masked {
+        flags.insert("MASKED");
+    }
     if f64 {
         flags.insert("F64");
     }

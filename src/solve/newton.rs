@@ -193,8 +193,14 @@ pub trait NewtonSystem {
     /// Evaluates (where its system is stale) and solves at the current point of every
     /// variant.
     fn solve(&mut self) -> Result<Probe, String>;
-    /// Evaluates the trial point `current + α Δ` of every variant (α = 0: the current).
-    fn trial(&mut self, alpha: &[f64]) -> Result<TrialProbe, String>;
+    /// Evaluates trial points `current + α Δ` for the variants in `search` (their
+    /// [`TrialProbe`] entries are read; the others' may be anything). `first`: the first
+    /// trial of a line search — every variant's trial point is set (α = 0: the current);
+    /// later trials move only the variants in `search`, every other keeps the trial point
+    /// it has (a variant whose step was accepted at an earlier trial of the search), so
+    /// that [`NewtonSystem::accept`] may take the trial points as they stand. A system may
+    /// evaluate more than `search` (one variant's systems do).
+    fn trial(&mut self, alpha: &[f64], search: &[bool], first: bool) -> Result<TrialProbe, String>;
     /// Current `+= α Δ`. `trial_matches`: the last trial was at exactly these α (its
     /// evaluation may be kept).
     fn accept(&mut self, alpha: &[f64], trial_matches: bool) -> Result<(), String>;
@@ -430,7 +436,8 @@ impl Newton {
             if !pending.iter().any(|&p| p) {
                 break;
             }
-            let r = sys.trial(&alpha)?;
+            // Only the variants still searching pay for a trial (issue 27).
+            let r = sys.trial(&alpha, &pending, trial == 0)?;
             self.trials += 1;
             trial_matches = true;
             let last = trial == s.line_search.max_halvings;
@@ -535,7 +542,7 @@ mod tests {
             }
             Ok(p)
         }
-        fn trial(&mut self, alpha: &[f64]) -> Result<TrialProbe, String> {
+        fn trial(&mut self, alpha: &[f64], _: &[bool], _: bool) -> Result<TrialProbe, String> {
             let mut t = TrialProbe::default();
             for j in 0..self.x.len() {
                 let x = self.x[j] + alpha[j] * self.delta[j];

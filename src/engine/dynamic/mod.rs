@@ -730,7 +730,7 @@ impl<T: Real> NewtonSystem for DynamicStep<'_, T> {
             solved: status.iter().map(|&s| s == SOLVED).collect(),
         })
     }
-    fn trial(&mut self, alpha: &[f64]) -> Result<TrialProbe, String> {
+    fn trial(&mut self, alpha: &[f64], _: &[bool], _: bool) -> Result<TrialProbe, String> {
         let r = self.ensemble.trial(&negated::<T>(alpha))?;
         Ok(trial_probe(&r))
     }

@@ -215,8 +215,8 @@ impl<T: GpuReal> GpuDynamic<T> {
                 "scale",
                 &[&c.chain_dims, &mass, &b.vdot_k, &b.scale],
             ),
-            beam: c.beam_group(ctx, &pl.beam, &b.u_1, &b.rot_1, false),
-            beam_force: c.beam_group(ctx, &pl.beam_force, &b.u_1, &b.rot_1, true),
+            beam: c.beam_group(ctx, &pl.beam, &b.u_1, &b.rot_1, false, false),
+            beam_force: c.beam_group(ctx, &pl.beam_force, &b.u_1, &b.rot_1, true, false),
             sites: bind(
                 ctx,
                 &pl.sites,
@@ -231,12 +231,12 @@ impl<T: GpuReal> GpuDynamic<T> {
                     &c.normals,
                 ],
             ),
-            contact: c.contact_group(ctx, &pl.contact),
+            contact: c.contact_group(ctx, &pl.contact, false),
             assemble_unknown: assemble(&b.vdot_k),
             assemble_candidate: assemble(&b.vdot_c),
             lu: c.lu_groups(ctx, &pl.block_lu, [&diag, &upper, &lower, &rhs]),
-            norms_iterate: c.norms_group(ctx, &pl.norms, &c.ones, &rhs),
-            norms_trial: c.norms_group(ctx, &pl.norms, &c.alpha, &rhs),
+            norms_iterate: c.norms_group(ctx, &pl.norms, &c.ones, &rhs, false),
+            norms_trial: c.norms_group(ctx, &pl.norms, &c.alpha, &rhs, false),
         };
         Ok(GpuDynamic {
             ctx,
@@ -506,7 +506,7 @@ pub fn gather_sites_dynamic_gpu<T: GpuReal>(
         num_pairs: pair_node.len() as u32,
         num_variants: num_variants as u32,
         pair_offset: 0,
-        _pad: 0,
+        mask_variants: 0,
     };
     // Bindings: dims, pair_node, u, pair_base, pair_state (read-write), vel, pair_normals — the
     // read-write one sits between inputs, so bind by hand.

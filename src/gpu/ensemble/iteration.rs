@@ -68,21 +68,28 @@ impl<T: GpuReal> Ensemble<T> for GpuEnsemble<T> {
         Ok((norms, status))
     }
 
-    fn trial(&mut self, alpha: &[T]) -> Result<Norms<T>, String> {
+    fn trial(&mut self, alpha: &[T], search: &[bool], first: bool) -> Result<Norms<T>, String> {
         let v = self.num_variants;
-        let (cur, other) = (self.current, 1 - self.current);
-        self.ctx
-            .queue
-            .write_buffer(&self.c.alpha, 0, bytemuck::cast_slice(alpha));
+        let other = 1 - self.current;
+        let q = &self.ctx.queue;
+        q.write_buffer(&self.c.alpha, 0, bytemuck::cast_slice(alpha));
+        let active: Vec<u32> = search.iter().map(|&s| u32::from(s)).collect();
+        q.write_buffer(&self.c.active, 0, bytemuck::cast_slice(&active));
         let mut encoder = self.encoder("trial");
-        let (a, b) = (&self.slots[cur], &self.slots[other]);
-        encoder.copy_buffer_to_buffer(&a.x, 0, &b.x, 0, a.x.size());
-        encoder.copy_buffer_to_buffer(&a.rot, 0, &b.rot, 0, a.rot.size());
+        let b = &self.slots[other];
         {
+            // The update moves from the current slot into the trial's (every variant on a
+            // search's first trial, the searching ones after); the kernels built `MASKED`
+            // evaluate the searching variants alone.
             let mut pass = encoder.begin_compute_pass(&Default::default());
-            dispatch(&mut pass, &self.p.update, &b.update, self.num_nodes * v);
+            let update = if first {
+                &b.update_trial_all
+            } else {
+                &b.update_trial
+            };
+            dispatch(&mut pass, &self.p.update_trial, update, self.num_nodes * v);
             self.record_evaluate(&mut pass, other, false);
-            dispatch(&mut pass, &self.p.norms, &b.norms_trial, v);
+            dispatch(&mut pass, &self.p.norms_trial, &b.norms_trial, v);
         }
         self.formed[other] = false;
         self.finish_with_norms(encoder)
@@ -178,7 +185,7 @@ pub fn gather_sites_gpu<T: GpuReal>(
         num_pairs: pair_node.len() as u32,
         num_variants: num_variants as u32,
         pair_offset: 0,
-        _pad: 0,
+        mask_variants: 0,
     };
     let out = crate::gpu::dispatch::run_once(
         ctx,

@@ -75,7 +75,7 @@ struct Slot {
     x: wgpu::Buffer,
     rot: wgpu::Buffer,
     beam: wgpu::BindGroup,
-    /// The force-only beam kernel's group (trials).
+    /// The trials' beam kernel (force only, masked).
     beam_force: wgpu::BindGroup,
     sites: wgpu::BindGroup,
     assemble: wgpu::BindGroup,
@@ -85,23 +85,31 @@ struct Slot {
     norms_solve: wgpu::BindGroup,
     norms_trial: wgpu::BindGroup,
     update: wgpu::BindGroup,
+    /// A trial into this slot from the other: every variant moved (the search's first).
+    update_trial_all: wgpu::BindGroup,
+    /// A trial into this slot from the other: the searching variants alone.
+    update_trial: wgpu::BindGroup,
     _keep: Vec<wgpu::Buffer>,
 }
 
 struct Pipelines {
     beam: Arc<wgpu::ComputePipeline>,
-    /// The beam kernel built `FORCE_ONLY` (line-search trials).
+    /// The beam kernel built `FORCE_ONLY` and `MASKED` (line-search trials).
     beam_force: Arc<wgpu::ComputePipeline>,
     sites: Arc<wgpu::ComputePipeline>,
     contact: Arc<wgpu::ComputePipeline>,
-    /// The contact kernel built `FORCE_ONLY` (line-search trials: `g` alone).
+    /// The contact kernel built `FORCE_ONLY` and `MASKED` (line-search trials: `g` alone).
     contact_force: Arc<wgpu::ComputePipeline>,
     assemble: Arc<wgpu::ComputePipeline>,
-    /// The assembly built `FORCE_ONLY` (line-search trials: the residual alone).
+    /// The assembly built `FORCE_ONLY` and `MASKED` (line-search trials: the residual alone).
     assemble_force: Arc<wgpu::ComputePipeline>,
     block_lu: Arc<wgpu::ComputePipeline>,
     norms: Arc<wgpu::ComputePipeline>,
+    /// The norms built `MASKED` (trials).
+    norms_trial: Arc<wgpu::ComputePipeline>,
     update: Arc<wgpu::ComputePipeline>,
+    /// The update built `OUT_OF_PLACE` and `MASKED` (trials: from one slot into the other).
+    update_trial: Arc<wgpu::ComputePipeline>,
 }
 
 /// A chunk of variants on the GPU (see the module docs).
@@ -235,19 +243,26 @@ struct Common {
     /// [`RUNNING`] per variant: copied into `status` before every block solve.
     running: wgpu::Buffer,
     ones: wgpu::Buffer,
+    /// Per variant, 1 where a trial evaluates it (the variants still searching), else 0.
+    active: wgpu::Buffer,
+    /// Per variant, 1: every variant (the first trial's update).
+    all_active: wgpu::Buffer,
     alpha: wgpu::Buffer,
     norms: wgpu::Buffer,
     chain_dims: wgpu::Buffer,
     beam_dims: wgpu::Buffer,
     sites_dims: wgpu::Buffer,
     contact_dims: wgpu::Buffer,
+    /// As `contact_dims`, with the activity mask's V (the masked trials' kernel).
+    contact_trial_dims: wgpu::Buffer,
     assemble_dims: wgpu::Buffer,
     lu_dims: Vec<wgpu::Buffer>,
 }
 
 impl Common {
     /// The beam kernel's bind group on configuration (`x`, `rot`); `force_only`: for the
-    /// kernel built `FORCE_ONLY`, which has no tangent binding.
+    /// kernel built `FORCE_ONLY`, which has no tangent binding; `masked`: built `MASKED`
+    /// too (the activity mask last).
     fn beam_group(
         &self,
         ctx: &GpuContext,
@@ -255,6 +270,7 @@ impl Common {
         x: &wgpu::Buffer,
         rot: &wgpu::Buffer,
         force_only: bool,
+        masked: bool,
     ) -> wgpu::BindGroup {
         let mut all = vec![
             &self.beam_dims,
@@ -268,25 +284,37 @@ impl Common {
         all.push(&self.elem_force);
         if !force_only {
             all.push(&self.elem_tangent);
+        } else if masked {
+            all.push(&self.active);
         }
         bind(ctx, pipeline, "beam", &all)
     }
 
-    /// The contact kernel's bind group.
-    fn contact_group(&self, ctx: &GpuContext, pipeline: &wgpu::ComputePipeline) -> wgpu::BindGroup {
-        bind(
-            ctx,
-            pipeline,
-            "contact",
-            &[
-                &self.contact_dims,
-                &self.normals,
-                &self.params,
-                &self.pair_state,
-                &self.values,
-                &self.flags,
-            ],
-        )
+    /// The contact kernel's bind group; `masked`: for the kernel built `MASKED` (the
+    /// activity mask last).
+    fn contact_group(
+        &self,
+        ctx: &GpuContext,
+        pipeline: &wgpu::ComputePipeline,
+        masked: bool,
+    ) -> wgpu::BindGroup {
+        let dims = if masked {
+            &self.contact_trial_dims
+        } else {
+            &self.contact_dims
+        };
+        let mut all = vec![
+            dims,
+            &self.normals,
+            &self.params,
+            &self.pair_state,
+            &self.values,
+            &self.flags,
+        ];
+        if masked {
+            all.push(&self.active);
+        }
+        bind(ctx, pipeline, "contact", &all)
     }
 
     /// The assembly's inputs before the constraints (bindings 1–8).
@@ -340,20 +368,21 @@ impl Common {
         encoder.copy_buffer_to_buffer(&self.running, 0, &self.status, 0, 4 * v as u64);
     }
 
-    /// The norms of `rhs` and the step with `alpha` (or ones).
+    /// The norms of `rhs` and the step with `alpha` (or ones); `masked`: for the kernel
+    /// built `MASKED` (the activity mask last).
     fn norms_group(
         &self,
         ctx: &GpuContext,
         pipeline: &wgpu::ComputePipeline,
         alpha: &wgpu::Buffer,
         rhs: &wgpu::Buffer,
+        masked: bool,
     ) -> wgpu::BindGroup {
-        bind(
-            ctx,
-            pipeline,
-            "norms",
-            &[&self.chain_dims, &self.delta, alpha, rhs, &self.norms],
-        )
+        let mut all = vec![&self.chain_dims, &self.delta, alpha, rhs, &self.norms];
+        if masked {
+            all.push(&self.active);
+        }
+        bind(ctx, pipeline, "norms", &all)
     }
 
     /// Checks the chunk against the adapter's limits and makes its common buffers; the
@@ -415,6 +444,8 @@ impl Common {
             status: empty(ctx, "status", 4 * v),
             running: storage(ctx, "status_running", &vec![RUNNING; v]),
             ones: storage(ctx, "ones", &vec![T::one(); v]),
+            active: storage(ctx, "active", &vec![1u32; v]),
+            all_active: storage(ctx, "all_active", &vec![1u32; v]),
             alpha: empty(ctx, "alpha", v * size),
             norms: empty(ctx, "norms", 4 * v * size),
             chain_dims: param_block(
@@ -444,7 +475,7 @@ impl Common {
                     num_pairs: p as u32,
                     num_variants: v as u32,
                     pair_offset: 0,
-                    _pad: 0,
+                    mask_variants: 0,
                 },
             ),
             // The contact kernel sees one "variant" per site: every pair has its own axis.
@@ -455,7 +486,17 @@ impl Common {
                     num_pairs: p as u32,
                     num_variants: 1,
                     pair_offset: 0,
-                    _pad: 0,
+                    mask_variants: 0,
+                },
+            ),
+            contact_trial_dims: param_block(
+                ctx,
+                "contact_trial_dims",
+                &ContactDims {
+                    num_pairs: p as u32,
+                    num_variants: 1,
+                    pair_offset: 0,
+                    mask_variants: v as u32,
                 },
             ),
             assemble_dims: param_block(
@@ -493,36 +534,50 @@ impl<T: GpuReal> GpuEnsemble<T> {
         let pipelines = Pipelines {
             beam: ctx.pipeline("beam", &crate::gpu::beam::beam_wgsl(f64, false, kink)?)?,
             beam_force: ctx
-                .pipeline("beam_force", &crate::gpu::beam::beam_wgsl(f64, true, kink)?)?,
+                .pipeline("beam_trial", &crate::gpu::beam::beam_trial_wgsl(f64, kink)?)?,
             sites: ctx.pipeline("sites", &sites_wgsl(f64)?)?,
             contact: ctx.pipeline("contact", &contact_wgsl(&tables.terms, f64)?)?,
             contact_force: ctx.pipeline(
-                "contact_force",
-                &crate::gpu::contact::contact_force_wgsl(&tables.terms, f64)?,
+                "contact_trial",
+                &crate::gpu::contact::contact_force_wgsl(&tables.terms, f64, true)?,
             )?,
             assemble: ctx.pipeline("assemble", &crate::gpu::assemble::assemble_wgsl(f64)?)?,
             assemble_force: ctx.pipeline(
-                "assemble_force",
-                &crate::gpu::assemble::assemble_force_wgsl(f64)?,
+                "assemble_trial",
+                &crate::gpu::assemble::assemble_force_wgsl(f64, true)?,
             )?,
             block_lu: ctx.pipeline(
                 "block_lu",
                 &crate::gpu::block_lu::block_lu_wgsl(f64, LuForm::for_adapter(ctx))?,
             )?,
             norms: ctx.pipeline("norms", &crate::gpu::update::update_wgsl(true, f64)?)?,
+            norms_trial: ctx.pipeline(
+                "norms_trial",
+                &crate::gpu::update::update_wgsl_with(true, f64, false, true)?,
+            )?,
             update: ctx.pipeline("update", &crate::gpu::update::update_wgsl(false, f64)?)?,
+            update_trial: ctx.pipeline(
+                "update_trial",
+                &crate::gpu::update::update_wgsl_with(false, f64, true, true)?,
+            )?,
         };
-        let contact = c.contact_group(ctx, &pipelines.contact);
-        let contact_force = c.contact_group(ctx, &pipelines.contact_force);
-        let make_slot = |label: &str| -> Slot {
-            let x = storage(ctx, label, &tables.start.x);
-            let rot = storage(ctx, label, &tables.start.rot);
+        let contact = c.contact_group(ctx, &pipelines.contact, false);
+        let contact_force = c.contact_group(ctx, &pipelines.contact_force, true);
+        let configs = ["config_a", "config_b"].map(|label| {
+            (
+                storage(ctx, label, &tables.start.x),
+                storage(ctx, label, &tables.start.rot),
+            )
+        });
+        let make_slot = |k: usize| -> Slot {
+            let (x, rot) = configs[k].clone();
+            let (x_from, rot_from) = &configs[1 - k];
             let diag = empty(ctx, "diag", 36 * n * v * size);
             let upper = empty(ctx, "upper", 36 * m.max(1) * v * size);
             let lower = empty(ctx, "lower", 36 * m.max(1) * v * size);
             let rhs = empty(ctx, "rhs", 6 * n * v * size);
-            let beam = c.beam_group(ctx, &pipelines.beam, &x, &rot, false);
-            let beam_force = c.beam_group(ctx, &pipelines.beam_force, &x, &rot, true);
+            let beam = c.beam_group(ctx, &pipelines.beam, &x, &rot, false, false);
+            let beam_force = c.beam_group(ctx, &pipelines.beam_force, &x, &rot, true, true);
             let sites = bind(
                 ctx,
                 &pipelines.sites,
@@ -550,28 +605,38 @@ impl<T: GpuReal> GpuEnsemble<T> {
                     &c.basis,
                     &c.fixed,
                     &rhs,
+                    &c.active,
                 ],
             );
             let lu = c.lu_groups(ctx, &pipelines.block_lu, [&diag, &upper, &lower, &rhs]);
-            let norms_solve = c.norms_group(ctx, &pipelines.norms, &c.ones, &rhs);
-            let norms_trial = c.norms_group(ctx, &pipelines.norms, &c.alpha, &rhs);
+            let norms_solve = c.norms_group(ctx, &pipelines.norms, &c.ones, &rhs, false);
+            let norms_trial = c.norms_group(ctx, &pipelines.norms_trial, &c.alpha, &rhs, true);
+            let walls = [
+                &c.chain_dims,
+                &c.delta,
+                &c.alpha,
+                &c.basis,
+                &c.node_site,
+                &c.pair_base,
+                &c.normals,
+                &c.params,
+            ];
             let update = bind(
                 ctx,
                 &pipelines.update,
                 "update",
-                &[
-                    &c.chain_dims,
-                    &c.delta,
-                    &c.alpha,
-                    &c.basis,
-                    &c.node_site,
-                    &c.pair_base,
-                    &c.normals,
-                    &c.params,
-                    &x,
-                    &rot,
-                ],
+                &[&walls[..], &[&x, &rot]].concat(),
             );
+            let trial_update = |mask: &wgpu::Buffer| {
+                bind(
+                    ctx,
+                    &pipelines.update_trial,
+                    "update_trial",
+                    &[&walls[..], &[x_from, rot_from, &x, &rot, mask]].concat(),
+                )
+            };
+            let update_trial_all = trial_update(&c.all_active);
+            let update_trial = trial_update(&c.active);
             Slot {
                 x,
                 rot,
@@ -584,10 +649,12 @@ impl<T: GpuReal> GpuEnsemble<T> {
                 norms_solve,
                 norms_trial,
                 update,
+                update_trial_all,
+                update_trial,
                 _keep: vec![diag, upper, lower, rhs],
             }
         };
-        let slots = [make_slot("config_a"), make_slot("config_b")];
+        let slots = [make_slot(0), make_slot(1)];
         Ok(GpuEnsemble {
             ctx,
             p: pipelines,

@@ -161,7 +161,12 @@ impl crate::solve::newton::NewtonSystem for CpuStep<'_, '_> {
             solved: vec![solved],
         })
     }
-    fn trial(&mut self, alpha: &[f64]) -> Result<crate::solve::newton::TrialProbe, String> {
+    fn trial(
+        &mut self,
+        alpha: &[f64],
+        _: &[bool],
+        _: bool,
+    ) -> Result<crate::solve::newton::TrialProbe, String> {
         let cand = self.moved(alpha[0]);
         let mut probe = self.trial.clone();
         self.predict(&mut probe, &cand);

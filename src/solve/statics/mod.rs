@@ -667,7 +667,12 @@ impl crate::solve::newton::NewtonSystem for CpuStatic<'_> {
             solved: vec![solved],
         })
     }
-    fn trial(&mut self, alpha: &[f64]) -> Result<crate::solve::newton::TrialProbe, String> {
+    fn trial(
+        &mut self,
+        alpha: &[f64],
+        _: &[bool],
+        _: bool,
+    ) -> Result<crate::solve::newton::TrialProbe, String> {
         let s = update(&self.c, &self.walls, &self.state, &self.delta, alpha[0]);
         assemble(&self.loaded, &s, 1.0, &self.f_step, &mut self.trial, None);
         constrain_residual(&self.c, &mut self.trial);
