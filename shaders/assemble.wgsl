@@ -22,7 +22,8 @@
 @group(0) @binding(7) var<storage, read> fixed: array<u32>;
 @group(0) @binding(8) var<storage, read_write> out_rhs: array<real>;
 #if MASKED
-// Built MASKED (the engine's trials): a variant whose mask entry is 0 is skipped.
+// Built MASKED (the engine's trials): the variants still searching, compacted:
+// [A, v_0, …, v_{A−1}]; the others are skipped.
 @group(0) @binding(9) var<storage, read> searching: array<u32>;
 #endif
 #else
@@ -140,15 +141,20 @@ fn clear_fixed(blk: ptr<function, array<real, 36>>, row_mask: u32, col_mask: u32
 fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let nv = dims.num_variants;
     let n = dims.num_nodes;
+#if MASKED
+    // One invocation per (node, searching variant).
+    let count = searching[0];
+    if (gid.x >= n * count) {
+        return;
+    }
+    let i = gid.x / count;
+    let v = searching[1u + gid.x % count];
+#else
     if (gid.x >= n * nv) {
         return;
     }
     let i = gid.x / nv;
     let v = gid.x % nv;
-#if MASKED
-    if (searching[v] == 0u) {
-        return;
-    }
 #endif
     let pairs = dims.num_sites * nv;
     var r: array<real, 6>;

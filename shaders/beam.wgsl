@@ -49,6 +49,7 @@
 @group(0) @binding(8) var<storage, read_write> elem_tangent: array<real>;
 #else
 #if MASKED
+// The variants still searching, compacted: [A, v_0, …, v_{A−1}].
 @group(0) @binding(8) var<storage, read> searching: array<u32>;
 #endif
 #endif
@@ -58,6 +59,7 @@
 @group(0) @binding(7) var<storage, read_write> elem_tangent: array<real>;
 #else
 #if MASKED
+// The variants still searching, compacted: [A, v_0, …, v_{A−1}].
 @group(0) @binding(7) var<storage, read> searching: array<u32>;
 #endif
 #endif
@@ -293,17 +295,21 @@ fn spun(t: Triad, axis: vec3<real>) -> Triad {
 @compute @workgroup_size(64)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let nv = dims.num_variants;
+#if MASKED
+    // Built MASKED with FORCE_ONLY (the engine's line-search trials): one invocation per
+    // (element, searching variant); the other variants' forces are left as they were.
+    let count = searching[0];
+    if (gid.x >= dims.num_elements * count) {
+        return;
+    }
+    let e = gid.x / count;
+    let v = searching[1u + gid.x % count];
+#else
     if (gid.x >= dims.num_elements * nv) {
         return;
     }
     let e = gid.x / nv;
     let v = gid.x % nv;
-#if MASKED
-    // Built MASKED with FORCE_ONLY (the engine's line-search trials): a variant whose mask
-    // entry is 0 is skipped, its forces left as they were.
-    if (searching[v] == 0u) {
-        return;
-    }
 #endif
     let base = vec3<real>(chord[(4u * e) * nv + v], chord[(4u * e + 1u) * nv + v], chord[(4u * e + 2u) * nv + v]);
     let stretch = chord[(4u * e + 3u) * nv + v];

@@ -31,8 +31,8 @@ fn pow_pos(x: f32, m: f32) -> f32 {
 // 1 where delta > 0.
 @group(0) @binding(5) var<storage, read_write> out_contact: array<u32>;
 #if MASKED
-// Built MASKED (with FORCE_ONLY: the engine's line-search trials): pairs whose mask entry is
-// 0 are skipped, their outputs left as they were.
+// Built MASKED (with FORCE_ONLY: the engine's line-search trials): the variants still
+// searching, compacted: [A, v_0, …, v_{A−1}]; the other pairs' outputs are left as they were.
 @group(0) @binding(6) var<storage, read> searching: array<u32>;
 #endif
 
@@ -130,12 +130,17 @@ fn friction_factors(s_t: real, s_l: real, eps: real) -> Friction {
 
 @compute @workgroup_size(64)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
-    let i = gid.x;
-    if (i >= dims.num_pairs) {
+#if MASKED
+    // One invocation per (site, searching variant): pair site · V + v (the engine's pairs,
+    // pair_offset 0).
+    let count = searching[0];
+    if (gid.x >= (dims.num_pairs / dims.mask_variants) * count) {
         return;
     }
-#if MASKED
-    if (searching[(dims.pair_offset + i) % dims.mask_variants] == 0u) {
+    let i = (gid.x / count) * dims.mask_variants + searching[1u + gid.x % count];
+#else
+    let i = gid.x;
+    if (i >= dims.num_pairs) {
         return;
     }
 #endif

@@ -16,6 +16,11 @@
 @group(0) @binding(2) var<storage, read> u: array<real>;
 @group(0) @binding(3) var<storage, read> pair_base: array<real>;
 @group(0) @binding(4) var<storage, read_write> pair_state: array<real>;
+#if MASKED
+// Built MASKED (static; the engine's line-search trials): the variants still searching,
+// compacted: [A, v_0, …, v_{A−1}]; one invocation per (site, searching variant).
+@group(0) @binding(5) var<storage, read> searching: array<u32>;
+#endif
 #if DYNAMIC
 // Node velocities [(6 · node + k) · V + variant] (ẋ, ω) and the pairs' hole axes.
 @group(0) @binding(5) var<storage, read> vel: array<real>;
@@ -24,13 +29,22 @@
 
 @compute @workgroup_size(64)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
-    let i = gid.x;
     let p = dims.num_pairs;
+    let nv = dims.num_variants;
+#if MASKED
+    let count = searching[0];
+    if (gid.x >= (p / nv) * count) {
+        return;
+    }
+    let v = searching[1u + gid.x % count];
+    let i = (gid.x / count) * nv + v;
+#else
+    let i = gid.x;
     if (i >= p) {
         return;
     }
-    let nv = dims.num_variants;
     let v = i % nv;
+#endif
     let node = pair_node[i];
     for (var k = 0u; k < 3u; k = k + 1u) {
         pair_state[k * p + i] = pair_base[3u * i + k] + u[(3u * node + k) * nv + v];

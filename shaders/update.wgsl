@@ -14,7 +14,8 @@
 // Per variant: largest |r|, largest |α Δ|, Δ · r, r · r.
 @group(0) @binding(4) var<storage, read_write> norm_out: array<real>;
 #if MASKED
-// Built MASKED (the engine's trials): a variant whose mask entry is 0 is skipped.
+// Built MASKED (the engine's trials): the variants still searching, compacted:
+// [A, v_0, …, v_{A−1}]; the others are skipped.
 @group(0) @binding(5) var<storage, read> searching: array<u32>;
 #endif
 #else
@@ -34,7 +35,8 @@
 @group(0) @binding(10) var<storage, read_write> x: array<real>;
 @group(0) @binding(11) var<storage, read_write> rot: array<real>;
 #if MASKED
-// Built MASKED: a variant whose mask entry is 0 is skipped (its trial slot left as it was).
+// Built MASKED: the variants to move, compacted: [A, v_0, …, v_{A−1}]; the others' trial
+// configurations are left as they were.
 @group(0) @binding(12) var<storage, read> searching: array<u32>;
 #endif
 
@@ -88,15 +90,20 @@ fn wall_following_step(d: vec3<real>, t: vec3<real>, du: vec3<real>, min_radius:
 fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let nv = dims.num_variants;
     let n = dims.num_nodes;
+#if MASKED
+    // One invocation per (node, listed variant).
+    let count = searching[0];
+    if (gid.x >= n * count) {
+        return;
+    }
+    let i = gid.x / count;
+    let v = searching[1u + gid.x % count];
+#else
     if (gid.x >= n * nv) {
         return;
     }
     let i = gid.x / nv;
     let v = gid.x % nv;
-#if MASKED
-    if (searching[v] == 0u) {
-        return;
-    }
 #endif
     let al = alpha[v];
     let du = vec3<real>(
@@ -149,12 +156,14 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
 @compute @workgroup_size(64)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let nv = dims.num_variants;
-    let v = gid.x;
-    if (v >= nv) {
+#if MASKED
+    if (gid.x >= searching[0]) {
         return;
     }
-#if MASKED
-    if (searching[v] == 0u) {
+    let v = searching[1u + gid.x];
+#else
+    let v = gid.x;
+    if (v >= nv) {
         return;
     }
 #endif

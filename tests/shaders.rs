@@ -87,6 +87,18 @@ fn every_contact_specialisation_validates() {
                         };
                         let wgsl = contact_wgsl(&terms, f64).unwrap();
                         validate(&wgsl).unwrap_or_else(|e| panic!("{terms:?} f64={f64}: {e}"));
+                        if mode == ContactMode::Static {
+                            // The trials' kernels: force only, with and without the list.
+                            for masked in [false, true] {
+                                let lean =
+                                    holewall::gpu::contact::contact_force_wgsl(&terms, f64, masked)
+                                        .unwrap();
+                                validate(&lean).unwrap_or_else(|e| {
+                                    panic!("{terms:?} force only, masked {masked}: {e}")
+                                });
+                                assert_eq!(lean.contains("f64"), f64);
+                            }
+                        }
                         assert_no_uniform(&wgsl);
                         assert_eq!(
                             wgsl.contains("f64"),
@@ -146,6 +158,7 @@ fn engine_kernels_validate_in_both_precisions() {
             holewall::gpu::update::update_wgsl_with(false, f64, true, true).unwrap(),
             holewall::gpu::update::update_wgsl_with(true, f64, false, true).unwrap(),
             holewall::gpu::ensemble::sites_wgsl(f64).unwrap(),
+            holewall::gpu::ensemble::sites_trial_wgsl(f64).unwrap(),
             holewall::gpu::ensemble::sites_wgsl_for(true, f64).unwrap(),
             holewall::gpu::assemble::assemble_wgsl_for(true, f64).unwrap(),
             holewall::gpu::dynamics::dynamics_wgsl(DynamicsKernel::Predict, f64).unwrap(),

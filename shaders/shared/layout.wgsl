@@ -6,8 +6,8 @@ struct ContactDims {
     num_variants: u32,
     // Index of this dispatch's first pair in the whole batch.
     pair_offset: u32,
-    // Built MASKED: entries of the activity mask; pair i belongs to mask entry
-    // (pair_offset + i) % mask_variants (the engine's pairs are site · V + variant).
+    // Built MASKED: V, the variants per site of the engine's pairs (site · V + variant)
+    // from which the compacted list of searching variants picks.
     mask_variants: u32,
 }
 

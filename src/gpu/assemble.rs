@@ -39,7 +39,8 @@ pub fn assemble_wgsl_with(dynamic: bool, unbalance: bool, f64: bool) -> Result<S
 
 /// The WGSL text of the static assembly built `FORCE_ONLY` (the residual alone, for the
 /// line-search trials; twin: [`crate::kernels::assemble::assemble_residual`]).
-/// `masked`: variants whose entry of the activity mask (binding 9) is 0 are skipped.
+/// `masked`: one invocation per (node, listed variant) of the compacted list of searching
+/// variants `[A, v_0, …]` (binding 9); the others are skipped.
 pub fn assemble_force_wgsl(f64: bool, masked: bool) -> Result<String, GpuError> {
     let mut flags = BTreeSet::from(["FORCE_ONLY"]);
     if masked {

@@ -28,8 +28,9 @@ pub fn beam_wgsl(f64: bool, force_only: bool, kink: bool) -> Result<String, GpuE
     compose("beam.wgsl", &flags, f64)
 }
 
-/// The force-only beam kernel built `MASKED` (the engine's line-search trials): elements
-/// of variants whose entry of the activity mask (the last binding) is 0 are skipped.
+/// The force-only beam kernel built `MASKED` (the engine's line-search trials): one
+/// invocation per (element, listed variant) of the compacted list of searching variants
+/// `[A, v_0, …]` (the last binding); the other variants are skipped.
 pub fn beam_trial_wgsl(f64: bool, kink: bool) -> Result<String, GpuError> {
     let mut flags = BTreeSet::from(["FORCE_ONLY", "MASKED"]);
     if kink {

@@ -82,8 +82,9 @@ pub fn contact_wgsl(terms: &ContactTerms, f64: bool) -> Result<String, GpuError>
 /// The WGSL text of the static contact kernel built `FORCE_ONLY` (line-search trials):
 /// the force and moment `g` (fields 0–5) and the contact flag alone; the stiffness fields
 /// are not written. Dynamic scenes have none (their trials need the whole response).
-/// `masked`: pairs whose entry of the activity mask (binding 6, entry
-/// `(pair_offset + i) % mask_variants`) is 0 are skipped.
+/// `masked`: one invocation per (site, listed variant) of the compacted list of searching
+/// variants `[A, v_0, …]` (binding 6; pairs `site · V + v`, V = `mask_variants`); the
+/// other pairs are skipped.
 pub fn contact_force_wgsl(
     terms: &ContactTerms,
     f64: bool,

@@ -12,8 +12,8 @@ pub struct ContactDims {
     pub num_variants: u32,
     /// Index of this dispatch's first pair in the whole batch.
     pub pair_offset: u32,
-    /// The kernel built `MASKED`: entries of the activity mask; pair `i` belongs to entry
-    /// `(pair_offset + i) % mask_variants` (the engine's pairs are `site · V + variant`).
+    /// The kernel built `MASKED`: V, the variants per site of the engine's pairs
+    /// (`site · V + variant`) from which the compacted list of searching variants picks.
     /// Unused otherwise.
     pub mask_variants: u32,
 }

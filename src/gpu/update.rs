@@ -17,7 +17,8 @@ pub fn update_wgsl(norms: bool, f64: bool) -> Result<String, GpuError> {
 
 /// [`update_wgsl`] for the engine's line-search trials: `out_of_place`, the update reads
 /// the configuration it moves from (bindings 8, 9) and writes the trial's (10, 11);
-/// `masked`, variants whose entry of the activity mask (the last binding) is 0 are skipped.
+/// `masked`, one invocation per (node, listed variant) — per listed variant for the norms —
+/// of a compacted list `[A, v_0, …]` (the last binding); the others are skipped.
 pub fn update_wgsl_with(
     norms: bool,
     f64: bool,

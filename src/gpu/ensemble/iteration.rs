@@ -10,6 +10,16 @@ pub fn sites_wgsl(f64: bool) -> Result<String, GpuError> {
     sites_wgsl_for(false, f64)
 }
 
+/// The WGSL text of the static sites gather built `MASKED` (the engine's line-search
+/// trials: one invocation per (site, listed variant) of the compacted list `[A, v_0, …]`).
+pub fn sites_trial_wgsl(f64: bool) -> Result<String, GpuError> {
+    let mut flags = std::collections::BTreeSet::from(["MASKED"]);
+    if f64 {
+        flags.insert("F64");
+    }
+    crate::gpu::compose::compose("sites.wgsl", &flags, f64)
+}
+
 /// The WGSL text of the static or dynamic sites gather at a precision.
 pub fn sites_wgsl_for(dynamic: bool, f64: bool) -> Result<String, GpuError> {
     let mut flags = std::collections::BTreeSet::new();
@@ -39,7 +49,7 @@ impl<T: GpuReal> Ensemble<T> for GpuEnsemble<T> {
         let mut encoder = self.encoder("evaluate");
         {
             let mut pass = encoder.begin_compute_pass(&Default::default());
-            self.record_evaluate(&mut pass, self.current, true);
+            self.record_evaluate(&mut pass, self.current, None);
         }
         self.ctx.queue.submit([encoder.finish()]);
         self.formed[self.current] = true;
@@ -73,23 +83,33 @@ impl<T: GpuReal> Ensemble<T> for GpuEnsemble<T> {
         let other = 1 - self.current;
         let q = &self.ctx.queue;
         q.write_buffer(&self.c.alpha, 0, bytemuck::cast_slice(alpha));
-        let active: Vec<u32> = search.iter().map(|&s| u32::from(s)).collect();
-        q.write_buffer(&self.c.active, 0, bytemuck::cast_slice(&active));
+        // The variants still searching, compacted: [A, v_0, …, v_{A−1}].
+        let mut list: Vec<u32> = vec![0];
+        list.extend((0..v as u32).filter(|&j| search[j as usize]));
+        let count = list.len() - 1;
+        list[0] = count as u32;
+        q.write_buffer(&self.c.active, 0, bytemuck::cast_slice(&list));
         let mut encoder = self.encoder("trial");
         let b = &self.slots[other];
         {
             // The update moves from the current slot into the trial's (every variant on a
             // search's first trial, the searching ones after); the kernels built `MASKED`
-            // evaluate the searching variants alone.
+            // run one invocation per item and searching variant (issue 27: only the
+            // variants still searching pay for a trial).
             let mut pass = encoder.begin_compute_pass(&Default::default());
-            let update = if first {
-                &b.update_trial_all
+            let (update, moved) = if first {
+                (&b.update_trial_all, v)
             } else {
-                &b.update_trial
+                (&b.update_trial, count)
             };
-            dispatch(&mut pass, &self.p.update_trial, update, self.num_nodes * v);
-            self.record_evaluate(&mut pass, other, false);
-            dispatch(&mut pass, &self.p.norms_trial, &b.norms_trial, v);
+            dispatch(
+                &mut pass,
+                &self.p.update_trial,
+                update,
+                self.num_nodes * moved,
+            );
+            self.record_evaluate(&mut pass, other, Some(count));
+            dispatch(&mut pass, &self.p.norms_trial, &b.norms_trial, count);
         }
         self.formed[other] = false;
         self.finish_with_norms(encoder)

@@ -29,7 +29,7 @@ use crate::physics::contact::PARAMS_LEN;
 mod dynamic;
 mod iteration;
 pub use dynamic::{gather_sites_dynamic_gpu, GpuDynamic};
-pub use iteration::{gather_sites_gpu, sites_wgsl, sites_wgsl_for};
+pub use iteration::{gather_sites_gpu, sites_trial_wgsl, sites_wgsl, sites_wgsl_for};
 
 /// Status the block solve starts with; still there afterwards means it did not finish.
 const RUNNING: u32 = 2;
@@ -78,6 +78,8 @@ struct Slot {
     /// The trials' beam kernel (force only, masked).
     beam_force: wgpu::BindGroup,
     sites: wgpu::BindGroup,
+    /// The trials' sites gather (masked).
+    sites_trial: wgpu::BindGroup,
     assemble: wgpu::BindGroup,
     /// The residual-only assembly's group (trials).
     assemble_force: wgpu::BindGroup,
@@ -97,6 +99,8 @@ struct Pipelines {
     /// The beam kernel built `FORCE_ONLY` and `MASKED` (line-search trials).
     beam_force: Arc<wgpu::ComputePipeline>,
     sites: Arc<wgpu::ComputePipeline>,
+    /// The sites gather built `MASKED` (trials).
+    sites_trial: Arc<wgpu::ComputePipeline>,
     contact: Arc<wgpu::ComputePipeline>,
     /// The contact kernel built `FORCE_ONLY` and `MASKED` (line-search trials: `g` alone).
     contact_force: Arc<wgpu::ComputePipeline>,
@@ -243,9 +247,10 @@ struct Common {
     /// [`RUNNING`] per variant: copied into `status` before every block solve.
     running: wgpu::Buffer,
     ones: wgpu::Buffer,
-    /// Per variant, 1 where a trial evaluates it (the variants still searching), else 0.
+    /// The variants a trial evaluates (those still searching), compacted:
+    /// `[A, v_0, …, v_{A−1}]`, room for V.
     active: wgpu::Buffer,
-    /// Per variant, 1: every variant (the first trial's update).
+    /// Every variant, `[V, 0, 1, …, V−1]` (a search's first trial moves them all).
     all_active: wgpu::Buffer,
     alpha: wgpu::Buffer,
     norms: wgpu::Buffer,
@@ -444,8 +449,14 @@ impl Common {
             status: empty(ctx, "status", 4 * v),
             running: storage(ctx, "status_running", &vec![RUNNING; v]),
             ones: storage(ctx, "ones", &vec![T::one(); v]),
-            active: storage(ctx, "active", &vec![1u32; v]),
-            all_active: storage(ctx, "all_active", &vec![1u32; v]),
+            active: storage(ctx, "active", &vec![0u32; v + 1]),
+            all_active: storage(
+                ctx,
+                "all_active",
+                &std::iter::once(v as u32)
+                    .chain(0..v as u32)
+                    .collect::<Vec<u32>>(),
+            ),
             alpha: empty(ctx, "alpha", v * size),
             norms: empty(ctx, "norms", 4 * v * size),
             chain_dims: param_block(
@@ -536,6 +547,7 @@ impl<T: GpuReal> GpuEnsemble<T> {
             beam_force: ctx
                 .pipeline("beam_trial", &crate::gpu::beam::beam_trial_wgsl(f64, kink)?)?,
             sites: ctx.pipeline("sites", &sites_wgsl(f64)?)?,
+            sites_trial: ctx.pipeline("sites_trial", &iteration::sites_trial_wgsl(f64)?)?,
             contact: ctx.pipeline("contact", &contact_wgsl(&tables.terms, f64)?)?,
             contact_force: ctx.pipeline(
                 "contact_trial",
@@ -583,6 +595,19 @@ impl<T: GpuReal> GpuEnsemble<T> {
                 &pipelines.sites,
                 "sites",
                 &[&c.sites_dims, &c.pair_node, &x, &c.pair_base, &c.pair_state],
+            );
+            let sites_trial = bind(
+                ctx,
+                &pipelines.sites_trial,
+                "sites_trial",
+                &[
+                    &c.sites_dims,
+                    &c.pair_node,
+                    &x,
+                    &c.pair_base,
+                    &c.pair_state,
+                    &c.active,
+                ],
             );
             let inputs = c.assembly_inputs();
             let assemble = bind(
@@ -643,6 +668,7 @@ impl<T: GpuReal> GpuEnsemble<T> {
                 beam,
                 beam_force,
                 sites,
+                sites_trial,
                 assemble,
                 assemble_force,
                 lu,
@@ -672,29 +698,27 @@ impl<T: GpuReal> GpuEnsemble<T> {
         })
     }
 
-    /// Records the evaluation of `slot`: beam, sites, contact, assembly — the residual
-    /// alone (the beam, contact and assembly kernels built `FORCE_ONLY`) where `tangent` is
-    /// false.
-    fn record_evaluate(&self, pass: &mut wgpu::ComputePass, slot: usize, tangent: bool) {
+    /// Records the evaluation of `slot`: beam, sites, contact, assembly, with the tangent
+    /// for every variant (`trial` None), or, for a trial of the `Some(A)` variants listed
+    /// in `c.active`, the residual alone of those (the kernels built `FORCE_ONLY` and
+    /// `MASKED`, one invocation per item and listed variant).
+    fn record_evaluate(&self, pass: &mut wgpu::ComputePass, slot: usize, trial: Option<usize>) {
         let s = &self.slots[slot];
         let p = &self.p;
-        record_chain(
-            pass,
-            false,
-            self.num_nodes,
-            self.num_variants,
-            self.num_pairs,
-            |stage| match stage {
-                Stage::Predict => None,
-                Stage::Beam if tangent => Some((&*p.beam, &s.beam)),
-                Stage::Beam => Some((&*p.beam_force, &s.beam_force)),
-                Stage::Sites => Some((&*p.sites, &s.sites)),
-                Stage::Contact if tangent => Some((&*p.contact, &self.contact)),
-                Stage::Contact => Some((&*p.contact_force, &self.contact_force)),
-                Stage::Assemble if tangent => Some((&*p.assemble, &s.assemble)),
-                Stage::Assemble => Some((&*p.assemble_force, &s.assemble_force)),
-            },
-        );
+        let tangent = trial.is_none();
+        let v = trial.unwrap_or(self.num_variants);
+        let pairs = self.num_pairs / self.num_variants.max(1) * v;
+        record_chain(pass, false, self.num_nodes, v, pairs, |stage| match stage {
+            Stage::Predict => None,
+            Stage::Beam if tangent => Some((&*p.beam, &s.beam)),
+            Stage::Beam => Some((&*p.beam_force, &s.beam_force)),
+            Stage::Sites if tangent => Some((&*p.sites, &s.sites)),
+            Stage::Sites => Some((&*p.sites_trial, &s.sites_trial)),
+            Stage::Contact if tangent => Some((&*p.contact, &self.contact)),
+            Stage::Contact => Some((&*p.contact_force, &self.contact_force)),
+            Stage::Assemble if tangent => Some((&*p.assemble, &s.assemble)),
+            Stage::Assemble => Some((&*p.assemble_force, &s.assemble_force)),
+        });
     }
 
     fn encoder(&self, label: &str) -> wgpu::CommandEncoder {
