@@ -177,20 +177,7 @@ fn twin_gathers_what_the_solver_scatters_and_the_gpu_agrees() {
         assert!(worst.iter().all(|w| *w <= 1e-15));
     }
     // f32: the inputs rounded to f32, summed in f32; against the f64 twin.
-    let a32 = AssemblyInputs::<f32> {
-        num_variants: a.num_variants,
-        num_nodes: a.num_nodes,
-        num_sites: a.num_sites,
-        elem_force: a.elem_force.iter().map(|&x| x as f32).collect(),
-        elem_tangent: a.elem_tangent.iter().map(|&x| x as f32).collect(),
-        contact: a.contact.iter().map(|&x| x as f32).collect(),
-        contact_flag: a.contact_flag.clone(),
-        node_site: a.node_site.clone(),
-        f_ext: a.f_ext.iter().map(|&x| x as f32).collect(),
-        basis: a.basis.iter().map(|&x| x as f32).collect(),
-        fixed: a.fixed.clone(),
-        dynamic: None,
-    };
+    let a32 = a.map_static(|x| x as f32);
     let gpu32 = assemble_gpu(ctx, &a32).unwrap();
     let twin32 = assemble(&a32);
     let up = |x: &[f32]| x.iter().map(|&y| y as f64).collect::<Vec<f64>>();
@@ -228,21 +215,7 @@ fn the_residual_only_assembly_gives_the_full_residual() {
             "f64: residual-only = full assembly's residual"
         );
     }
-    let down = |x: &[f64]| x.iter().map(|&y| y as f32).collect::<Vec<f32>>();
-    let a32 = AssemblyInputs::<f32> {
-        num_variants: a.num_variants,
-        num_nodes: a.num_nodes,
-        num_sites: a.num_sites,
-        elem_force: down(&a.elem_force),
-        elem_tangent: down(&a.elem_tangent),
-        contact: down(&a.contact),
-        contact_flag: a.contact_flag.clone(),
-        node_site: a.node_site.clone(),
-        f_ext: down(&a.f_ext),
-        basis: down(&a.basis),
-        fixed: a.fixed.clone(),
-        dynamic: None,
-    };
+    let a32 = a.map_static(|x| x as f32);
     let gpu_full = assemble_gpu(ctx, &a32).unwrap();
     let mut bare32 = a32.clone();
     bare32.elem_tangent = Vec::new();

@@ -129,24 +129,6 @@ fn assembly_inputs(n: usize, v: usize) -> AssemblyInputs<f64> {
     }
 }
 
-fn cast_assembly<U>(a: &AssemblyInputs<f64>, f: impl Fn(f64) -> U) -> AssemblyInputs<U> {
-    let c = |x: &[f64]| x.iter().map(|&y| f(y)).collect::<Vec<U>>();
-    AssemblyInputs {
-        num_variants: a.num_variants,
-        num_nodes: a.num_nodes,
-        num_sites: a.num_sites,
-        elem_force: c(&a.elem_force),
-        elem_tangent: c(&a.elem_tangent),
-        contact: c(&a.contact),
-        contact_flag: a.contact_flag.clone(),
-        node_site: a.node_site.clone(),
-        f_ext: c(&a.f_ext),
-        basis: c(&a.basis),
-        fixed: a.fixed.clone(),
-        dynamic: None,
-    }
-}
-
 fn cast_chain<U>(b: &ChainBatch<f64>, f: impl Fn(f64) -> U) -> ChainBatch<U> {
     let c = |x: &[f64]| x.iter().map(|&y| f(y)).collect::<Vec<U>>();
     ChainBatch {
@@ -178,7 +160,7 @@ fn counts(n: usize) -> Counts {
         let mut out = ContactOutputs::new(pairs);
         crate::kernels::contact::contact(&terms, &batch, &mut out);
     }) / pairs as f64;
-    let a = cast_assembly(&assembly_inputs(n, 1), Counted);
+    let a = assembly_inputs(n, 1).map_static(Counted);
     let assemble = counted(|| crate::kernels::assemble::assemble(&a));
     let b = cast_chain(&chain_batch(n, 1), Counted);
     let block_lu = counted(|| crate::kernels::block_lu::block_lu(&b));
@@ -273,7 +255,7 @@ fn run_size<T: GpuReal>(
         r.map_err(|e| e.to_string()).and_then(|_| of(t)),
     ));
     // The assembly.
-    let a = cast_assembly(&assembly_inputs(n, v), to_t);
+    let a = assembly_inputs(n, v).map_static(to_t);
     let (r, t) =
         crate::gpu::dispatch::timed(repeats, || crate::gpu::assemble::assemble_gpu::<T>(ctx, &a));
     rows.push((

@@ -1,9 +1,7 @@
 //! Runs `shaders/assemble.wgsl` (twin: `src/kernels/assemble.rs`).
 
-use std::collections::BTreeSet;
-
 use crate::error::GpuError;
-use crate::gpu::compose::compose;
+use crate::gpu::compose::compose_if;
 use crate::gpu::contact::GpuReal;
 use crate::gpu::dispatch::{run_once, Out};
 use crate::gpu::layout::AssembleDims;
@@ -24,17 +22,11 @@ pub fn assemble_wgsl_for(dynamic: bool, f64: bool) -> Result<String, GpuError> {
 /// The WGSL text of the assembly: static or dynamic, with (`unbalance`, dynamic only) the
 /// mass-imbalance binding and terms, at a precision.
 pub fn assemble_wgsl_with(dynamic: bool, unbalance: bool, f64: bool) -> Result<String, GpuError> {
-    let mut flags = BTreeSet::new();
-    if dynamic && unbalance {
-        flags.insert("UNBALANCE");
-    }
-    if f64 {
-        flags.insert("F64");
-    }
-    if dynamic {
-        flags.insert("DYNAMIC");
-    }
-    compose("assemble.wgsl", &flags, f64)
+    compose_if(
+        "assemble.wgsl",
+        &[("UNBALANCE", dynamic && unbalance), ("DYNAMIC", dynamic)],
+        f64,
+    )
 }
 
 /// The WGSL text of the static assembly built `FORCE_ONLY` (the residual alone, for the
@@ -42,14 +34,11 @@ pub fn assemble_wgsl_with(dynamic: bool, unbalance: bool, f64: bool) -> Result<S
 /// `masked`: one invocation per (node, listed variant) of the compacted list of searching
 /// variants `[A, v_0, …]` (binding 9); the others are skipped.
 pub fn assemble_force_wgsl(f64: bool, masked: bool) -> Result<String, GpuError> {
-    let mut flags = BTreeSet::from(["FORCE_ONLY"]);
-    if masked {
-        flags.insert("MASKED");
-    }
-    if f64 {
-        flags.insert("F64");
-    }
-    compose("assemble.wgsl", &flags, f64)
+    compose_if(
+        "assemble.wgsl",
+        &[("FORCE_ONLY", true), ("MASKED", masked)],
+        f64,
+    )
 }
 
 /// The static residual of every variant on the GPU (the kernel built `FORCE_ONLY`), laid
@@ -67,30 +56,41 @@ pub fn assemble_residual_gpu<T: GpuReal>(
     let (n, nv) = (a.num_nodes, a.num_variants);
     let size = std::mem::size_of::<T>();
     let pipeline = ctx.pipeline("assemble_force", &assemble_force_wgsl(T::IS_F64, false)?)?;
-    let dims = AssembleDims {
-        num_variants: nv as u32,
-        num_nodes: n as u32,
-        num_sites: a.num_sites as u32,
-        _pad: 0,
-    };
+    let (dims, inputs) = static_bindings(a, false);
     let out = run_once(
         ctx,
         &pipeline,
         "assemble_force",
         bytemuck::bytes_of(&dims),
-        &[
-            bytemuck::cast_slice(&a.elem_force),
-            bytemuck::cast_slice(&a.contact),
-            bytemuck::cast_slice(&a.contact_flag),
-            bytemuck::cast_slice(&a.node_site),
-            bytemuck::cast_slice(&a.f_ext),
-            bytemuck::cast_slice(&a.basis),
-            bytemuck::cast_slice(&a.fixed),
-        ],
+        &inputs,
         &[Out::Empty(6 * n * nv * size)],
         n * nv,
     )?;
     Ok(bytemuck::cast_slice(&out[0]).to_vec())
+}
+
+/// The dimensions and the static inputs (bindings 1–8, or 1–7 without the tangents) of
+/// the assembly of `a`.
+fn static_bindings<T: GpuReal>(a: &AssemblyInputs<T>, tangent: bool) -> (AssembleDims, Vec<&[u8]>) {
+    let dims = AssembleDims {
+        num_variants: a.num_variants as u32,
+        num_nodes: a.num_nodes as u32,
+        num_sites: a.num_sites as u32,
+        _pad: 0,
+    };
+    let mut inputs: Vec<&[u8]> = vec![bytemuck::cast_slice(&a.elem_force)];
+    if tangent {
+        inputs.push(bytemuck::cast_slice(&a.elem_tangent));
+    }
+    inputs.extend([
+        bytemuck::cast_slice(&a.contact),
+        bytemuck::cast_slice(&a.contact_flag),
+        bytemuck::cast_slice(&a.node_site),
+        bytemuck::cast_slice(&a.f_ext),
+        bytemuck::cast_slice(&a.basis),
+        bytemuck::cast_slice(&a.fixed),
+    ]);
+    (dims, inputs)
 }
 
 /// Assembles every variant on the GPU; the result is laid out as the twin's.
@@ -117,22 +117,7 @@ pub fn assemble_gpu<T: GpuReal>(
         "assemble",
         &assemble_wgsl_with(a.dynamic.is_some(), unbalance, T::IS_F64)?,
     )?;
-    let dims = AssembleDims {
-        num_variants: nv as u32,
-        num_nodes: n as u32,
-        num_sites: a.num_sites as u32,
-        _pad: 0,
-    };
-    let mut inputs: Vec<&[u8]> = vec![
-        bytemuck::cast_slice(&a.elem_force),
-        bytemuck::cast_slice(&a.elem_tangent),
-        bytemuck::cast_slice(&a.contact),
-        bytemuck::cast_slice(&a.contact_flag),
-        bytemuck::cast_slice(&a.node_site),
-        bytemuck::cast_slice(&a.f_ext),
-        bytemuck::cast_slice(&a.basis),
-        bytemuck::cast_slice(&a.fixed),
-    ];
+    let (dims, mut inputs) = static_bindings(a, true);
     if let Some(dy) = &a.dynamic {
         inputs.extend([
             bytemuck::cast_slice(&dy.coefficients[..]),

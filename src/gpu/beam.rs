@@ -1,9 +1,7 @@
 //! Runs `shaders/beam.wgsl` (twin: `src/kernels/beam.rs`).
 
-use std::collections::BTreeSet;
-
 use crate::error::GpuError;
-use crate::gpu::compose::compose;
+use crate::gpu::compose::compose_if;
 use crate::gpu::contact::GpuReal;
 use crate::gpu::dispatch::{run_once, Out};
 use crate::gpu::layout::BeamDims;
@@ -15,31 +13,22 @@ use crate::model::Model;
 /// the force alone, without the tangent binding; with `kink` the unstrained-rotation
 /// binding (6) before the outputs (a scene with a bent sub; none otherwise).
 pub fn beam_wgsl(f64: bool, force_only: bool, kink: bool) -> Result<String, GpuError> {
-    let mut flags = BTreeSet::new();
-    if kink {
-        flags.insert("KINK");
-    }
-    if f64 {
-        flags.insert("F64");
-    }
-    if force_only {
-        flags.insert("FORCE_ONLY");
-    }
-    compose("beam.wgsl", &flags, f64)
+    compose_if(
+        "beam.wgsl",
+        &[("KINK", kink), ("FORCE_ONLY", force_only)],
+        f64,
+    )
 }
 
 /// The force-only beam kernel built `MASKED` (the engine's line-search trials): one
 /// invocation per (element, listed variant) of the compacted list of searching variants
 /// `[A, v_0, …]` (the last binding); the other variants are skipped.
 pub fn beam_trial_wgsl(f64: bool, kink: bool) -> Result<String, GpuError> {
-    let mut flags = BTreeSet::from(["FORCE_ONLY", "MASKED"]);
-    if kink {
-        flags.insert("KINK");
-    }
-    if f64 {
-        flags.insert("F64");
-    }
-    compose("beam.wgsl", &flags, f64)
+    compose_if(
+        "beam.wgsl",
+        &[("FORCE_ONLY", true), ("MASKED", true), ("KINK", kink)],
+        f64,
+    )
 }
 
 /// Element forces and tangents of V variants on the GPU at displacements `u` from the base

@@ -49,7 +49,22 @@ pub fn source(name: &str) -> Result<&'static str, GpuError> {
         .ok_or_else(|| GpuError::Shader(format!("no shader named {name}")))
 }
 
-/// Composes `name` with the given flags set; `f64` selects the float type.
+/// Composes `name` with each flag of `flags` whose condition holds, and `F64` where `f64`
+/// (which also selects the float type).
+pub fn compose_if(
+    name: &str,
+    flags: &[(&'static str, bool)],
+    f64: bool,
+) -> Result<String, GpuError> {
+    let mut set: BTreeSet<&str> = flags.iter().filter(|f| f.1).map(|f| f.0).collect();
+    if f64 {
+        set.insert("F64");
+    }
+    compose(name, &set, f64)
+}
+
+/// Composes `name` with the `#if` flags in `flags` (the caller adds `F64` for f64; see
+/// [`compose_if`], which does).
 pub fn compose(name: &str, flags: &BTreeSet<&str>, f64: bool) -> Result<String, GpuError> {
     let mut out = String::new();
     out.push_str(if f64 {

@@ -1,9 +1,7 @@
 //! Runs `shaders/update.wgsl` (twin: `src/kernels/update.rs`): the update and the norms.
 
-use std::collections::BTreeSet;
-
 use crate::error::GpuError;
-use crate::gpu::compose::compose;
+use crate::gpu::compose::compose_if;
 use crate::gpu::contact::GpuReal;
 use crate::gpu::dispatch::{run_once, Out};
 use crate::gpu::layout::ChainDims;
@@ -25,20 +23,15 @@ pub fn update_wgsl_with(
     out_of_place: bool,
     masked: bool,
 ) -> Result<String, GpuError> {
-    let mut flags = BTreeSet::new();
-    if out_of_place && !norms {
-        flags.insert("OUT_OF_PLACE");
-    }
-    if masked {
-        flags.insert("MASKED");
-    }
-    if f64 {
-        flags.insert("F64");
-    }
-    if norms {
-        flags.insert("NORMS");
-    }
-    compose("update.wgsl", &flags, f64)
+    compose_if(
+        "update.wgsl",
+        &[
+            ("OUT_OF_PLACE", out_of_place && !norms),
+            ("MASKED", masked),
+            ("NORMS", norms),
+        ],
+        f64,
+    )
 }
 
 fn dims(b_nodes: usize, nv: usize) -> ChainDims {

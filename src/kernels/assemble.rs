@@ -59,6 +59,28 @@ pub struct AssemblyInputs<T> {
     pub dynamic: Option<DynamicInputs<T>>,
 }
 
+impl AssemblyInputs<f64> {
+    /// The static inputs with every real mapped by `f` (to f32, or to a counting type);
+    /// the dynamic terms are left out.
+    pub fn map_static<U>(&self, f: impl Fn(f64) -> U) -> AssemblyInputs<U> {
+        let c = |x: &[f64]| x.iter().map(|&y| f(y)).collect::<Vec<U>>();
+        AssemblyInputs {
+            num_variants: self.num_variants,
+            num_nodes: self.num_nodes,
+            num_sites: self.num_sites,
+            elem_force: c(&self.elem_force),
+            elem_tangent: c(&self.elem_tangent),
+            contact: c(&self.contact),
+            contact_flag: self.contact_flag.clone(),
+            node_site: self.node_site.clone(),
+            f_ext: c(&self.f_ext),
+            basis: c(&self.basis),
+            fixed: self.fixed.clone(),
+            dynamic: None,
+        }
+    }
+}
+
 /// What the dynamic assembly adds (generalised-α iteration matrix
 /// `S = M + hγ' C_t + h²β' K_t` and the inertial residual; lumped mass, as
 /// `solve::dynamics` with `mass = "lumped"` and mass-proportional Rayleigh damping on the

@@ -13,23 +13,12 @@ pub fn sites_wgsl(f64: bool) -> Result<String, GpuError> {
 /// The WGSL text of the static sites gather built `MASKED` (the engine's line-search
 /// trials: one invocation per (site, listed variant) of the compacted list `[A, v_0, …]`).
 pub fn sites_trial_wgsl(f64: bool) -> Result<String, GpuError> {
-    let mut flags = std::collections::BTreeSet::from(["MASKED"]);
-    if f64 {
-        flags.insert("F64");
-    }
-    crate::gpu::compose::compose("sites.wgsl", &flags, f64)
+    crate::gpu::compose::compose_if("sites.wgsl", &[("MASKED", true)], f64)
 }
 
 /// The WGSL text of the static or dynamic sites gather at a precision.
 pub fn sites_wgsl_for(dynamic: bool, f64: bool) -> Result<String, GpuError> {
-    let mut flags = std::collections::BTreeSet::new();
-    if f64 {
-        flags.insert("F64");
-    }
-    if dynamic {
-        flags.insert("DYNAMIC");
-    }
-    crate::gpu::compose::compose("sites.wgsl", &flags, f64)
+    crate::gpu::compose::compose_if("sites.wgsl", &[("DYNAMIC", dynamic)], f64)
 }
 
 impl<T: GpuReal> Ensemble<T> for GpuEnsemble<T> {
