@@ -603,6 +603,35 @@ struct CpuStatic<'a> {
     delta: Vec<f64>,
     trial_state: Option<(f64, StaticState)>,
     evaluated: bool,
+    /// Proximal shift (N/m) and its anchor ([`crate::solve::continuation`]'s relaxation).
+    shift: f64,
+    anchor: Vec<Vec3<f64>>,
+}
+
+/// Adds a proximal shift `s (x − a)` to the translations' residual and `s I` to their
+/// tangent blocks (before the constraints: `s I` is the same in any node basis).
+fn add_shift(
+    s: f64,
+    x: &[Vec3<f64>],
+    anchor: &[Vec3<f64>],
+    residual: &mut [f64],
+    tangent: Option<&mut BlockTridiagonal>,
+) {
+    if s == 0.0 {
+        return;
+    }
+    for (i, (x, a)) in x.iter().zip(anchor).enumerate() {
+        for k in 0..3 {
+            residual[6 * i + k] += s * (x[k] - a[k]);
+        }
+    }
+    if let Some(t) = tangent {
+        for d in t.diag.iter_mut() {
+            for (k, row) in d.iter_mut().take(3).enumerate() {
+                row[k] += s;
+            }
+        }
+    }
 }
 
 impl<'a> CpuStatic<'a> {
@@ -627,6 +656,8 @@ impl<'a> CpuStatic<'a> {
             delta: vec![0.0; 6 * n],
             trial_state: None,
             evaluated: false,
+            shift: 0.0,
+            anchor: Vec::new(),
         }
     }
 }
@@ -642,6 +673,13 @@ impl crate::solve::newton::NewtonSystem for CpuStatic<'_> {
                 &self.state,
                 1.0,
                 &self.f_step,
+                &mut self.residual,
+                Some(&mut self.tangent),
+            );
+            add_shift(
+                self.shift,
+                &self.state.x,
+                &self.anchor,
                 &mut self.residual,
                 Some(&mut self.tangent),
             );
@@ -675,6 +713,7 @@ impl crate::solve::newton::NewtonSystem for CpuStatic<'_> {
     ) -> Result<crate::solve::newton::TrialProbe, String> {
         let s = update(&self.c, &self.walls, &self.state, &self.delta, alpha[0]);
         assemble(&self.loaded, &s, 1.0, &self.f_step, &mut self.trial, None);
+        add_shift(self.shift, &s.x, &self.anchor, &mut self.trial, None);
         constrain_residual(&self.c, &mut self.trial);
         self.trial_state = Some((alpha[0], s));
         Ok(crate::solve::newton::TrialProbe {
@@ -726,6 +765,25 @@ impl crate::solve::continuation::StaticSystem for CpuStatic<'_> {
             .filter(|k| k % 6 < 3)
             .max_by(|&a, &b| self.residual[a].abs().total_cmp(&self.residual[b].abs()))?;
         Some(self.model.nodes[k / 6].md)
+    }
+    fn relax_scale(&mut self, _j: usize) -> Option<f64> {
+        let shortest = self
+            .model
+            .elements
+            .iter()
+            .map(|e| e.length0)
+            .fold(f64::INFINITY, f64::min);
+        Some(self.f_ref / shortest.max(1e-3))
+    }
+    fn set_shift(&mut self, _j: usize, s: f64) -> Result<(), String> {
+        self.shift = s;
+        self.anchor = if s == 0.0 {
+            Vec::new()
+        } else {
+            self.state.x.clone()
+        };
+        self.evaluated = false;
+        Ok(())
     }
     fn step_floor(&mut self, _j: usize) -> Result<f64, String> {
         let largest = self
