@@ -77,6 +77,8 @@ pub struct CorpusSummary {
     pub by_mode: BTreeMap<String, (usize, usize)>,
     /// Solved wells whose load path cut a step or changed stage (reported, not a pass).
     pub solved_with_cuts: usize,
+    /// Solved wells whose load path relaxed past a fold (of `solved_with_cuts`).
+    pub solved_by_relaxation: usize,
     /// Time per well (s), every well.
     pub seconds: Spread,
     /// Time per well (s), wells meshed with 10 m pipe elements.
@@ -225,6 +227,7 @@ pub fn run(out: &Path, options: &CorpusOptions) -> Result<CorpusSummary, Error> 
         by_element_length: count(&|r| format!("{:>4} m", r.spec.element_m)),
         by_mode: count(&|r| r.spec.mode.clone()),
         solved_with_cuts: solved.iter().filter(|r| r.step_cuts > 0).count(),
+        solved_by_relaxation: solved.iter().filter(|r| r.relaxed).count(),
         seconds: spread(
             &results
                 .iter()
@@ -255,8 +258,12 @@ pub fn run(out: &Path, options: &CorpusOptions) -> Result<CorpusSummary, Error> 
     if !engine_rows.is_empty() {
         crate::output::write_csv_rows(&out.join("engine.csv"), &engine_rows)?;
     }
-    let classes = ["solved", "failed"];
-    let class = |r: &WellResult| usize::from(!r.solved);
+    let classes = ["solved", "solved by relaxation", "failed"];
+    let class = |r: &WellResult| match (r.solved, r.relaxed) {
+        (true, false) => 0,
+        (true, true) => 1,
+        (false, _) => 2,
+    };
     crate::plots::class_scatter(
         &out.join("corpus_time.png"),
         &format!(

@@ -531,6 +531,9 @@ pub struct WellResult {
     pub load_steps: usize,
     /// Load-step cuts and stage changes (each a result to report, not a pass).
     pub step_cuts: usize,
+    /// Whether the load path relaxed past a fold ([`crate::solve::continuation`]): solved,
+    /// reported apart.
+    pub relaxed: bool,
     /// Newton iterations over all steps.
     pub iterations: usize,
     /// Wall time of the FE solve (s).
@@ -575,6 +578,7 @@ pub fn run_well(
         solved: false,
         load_steps: 0,
         step_cuts: 0,
+        relaxed: false,
         iterations: 0,
         seconds,
         fe_hook_load_n: f64::NAN,
@@ -594,6 +598,10 @@ pub fn run_well(
             r.solved = true;
             r.load_steps = sol.iterations.len();
             r.step_cuts = sol.log.len();
+            r.relaxed = sol
+                .log
+                .iter()
+                .any(|l| l.contains(crate::solve::continuation::RELAXED));
             r.iterations = sol.iterations.iter().sum();
             r.fe_hook_load_n = hook;
             r.hook_load_ratio = hook / r.soft_hook_load_n;
@@ -644,6 +652,7 @@ pub struct WellRow {
     solved: bool,
     load_steps: usize,
     step_cuts: usize,
+    relaxed: bool,
     iterations: usize,
     seconds: f64,
     fe_hook_load_n: f64,
@@ -679,6 +688,7 @@ impl WellResult {
             solved: self.solved,
             load_steps: self.load_steps,
             step_cuts: self.step_cuts,
+            relaxed: self.relaxed,
             iterations: self.iterations,
             seconds: self.seconds,
             fe_hook_load_n: self.fe_hook_load_n,

@@ -94,8 +94,15 @@ struct Relax {
     step: f64,
 }
 
+/// The words a relaxation's log line carries (the corpus counts the wells it solved).
+pub const RELAXED: &str = "relaxed by proximal points";
+
 /// Sub-solves a relaxation may take before the variant fails.
 const RELAX_MAX_SUBS: usize = 400;
+/// Newton iterations a relaxation may take before the variant fails, in units of a step's
+/// `max_iterations` (a failed sub-solve counted in full): a fold the corpus crosses takes
+/// 1–3 of them (well 17: 566 iterations of 200).
+const RELAX_MAX_BUDGET: usize = 15;
 /// A shift below `s0 ×` this is followed by the closing plain solve.
 const RELAX_FLOOR: f64 = 1e-3;
 /// A shift above `s0 ×` this ends a relaxation that cannot make progress.
@@ -116,6 +123,7 @@ pub struct LoadPath {
     g_step: f64,
     target: LoadTarget,
     min_step: f64,
+    max_iterations: usize,
     gravity_reason: String,
     relax: Option<Relax>,
     /// Newton iterations of every completed step.
@@ -154,6 +162,7 @@ impl LoadPath {
                 exponent: 1.0,
             },
             min_step: options.min_step,
+            max_iterations: options.max_iterations,
             gravity_reason: String::new(),
             relax: None,
             iterations: Vec::new(),
@@ -315,7 +324,7 @@ impl LoadPath {
                 if r.s == 0.0 {
                     // The closing plain solve converged: an equilibrium at the target.
                     self.log.push(format!(
-                        "{}; relaxed by proximal points to an equilibrium past it ({} sub-solves, {} Newton iterations)",
+                        "{}; {RELAXED} to an equilibrium past it ({} sub-solves, {} Newton iterations)",
                         r.reason, r.subs, r.iterations
                     ));
                     let target = r.target;
@@ -334,6 +343,11 @@ impl LoadPath {
                         // From the gravity stage: the load steps start afresh.
                         self.step = self.step.max(self.min_step);
                     }
+                } else if r.iterations >= RELAX_MAX_BUDGET * self.max_iterations {
+                    return self.failed(format!(
+                        "the relaxation's budget of {} Newton iterations ran out",
+                        RELAX_MAX_BUDGET * self.max_iterations
+                    ));
                 } else {
                     r.last = r.s;
                     if iterations <= 5 {
@@ -516,9 +530,13 @@ impl LoadPath {
             Stage::Relax => {
                 let r = self.relax.as_mut().expect("a relaxation");
                 r.subs += 1;
+                r.iterations += self.max_iterations;
                 r.s = if r.s == 0.0 { 4.0 * r.last } else { 4.0 * r.s };
                 r.last = r.s;
-                if r.s > RELAX_CEILING * r.s0 || r.subs >= RELAX_MAX_SUBS {
+                if r.s > RELAX_CEILING * r.s0
+                    || r.subs >= RELAX_MAX_SUBS
+                    || r.iterations >= RELAX_MAX_BUDGET * self.max_iterations
+                {
                     let r = self.relax.take().expect("a relaxation");
                     self.log.push(format!(
                         "relaxation after \"{}\" stopped after {} sub-solves ({} Newton iterations): {reason}",
@@ -742,6 +760,25 @@ mod tests {
         let e = p.error.unwrap().to_string();
         assert!(e.contains("found no equilibrium past it either"), "{e}");
         assert!(e.contains("applying the bit loads"), "{e}");
+    }
+
+    #[test]
+    fn a_relaxation_stops_when_its_iteration_budget_is_spent() {
+        let (mut p, _) = stuck(Some(1e6));
+        let mut next = Next::Step;
+        let mut subs = 0;
+        while next == Next::Step {
+            // Hard sub-solves: the shift stays, the iterations add up.
+            next = p.converged(150);
+            subs += 1;
+        }
+        assert_eq!(next, Next::Failed);
+        assert_eq!(subs, (RELAX_MAX_BUDGET * 200).div_ceil(150));
+        let e = p.error.unwrap().to_string();
+        assert!(
+            e.contains("budget of 3000 Newton iterations ran out"),
+            "{e}"
+        );
     }
 
     #[test]
