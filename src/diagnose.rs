@@ -69,6 +69,31 @@ fn worst_helical(case: &Case, axial: &[f64]) -> Option<(f64, f64, f64, f64, f64,
     worst
 }
 
+/// The drag a helically buckled string adds to a soft-string profile, by Mitchell's wall
+/// force of a helix `N = r F² / (4 EI)` per length (the contact a helix of compression `F`
+/// presses on a wall of radial clearance `r`, beyond the weight's): `Σ μ N L` over the
+/// elements whose compression passes their helical load (N). First order: `F` is the soft
+/// string's, without the compression this drag adds itself (where that feedback runs away
+/// the string locks up). The axial force a stiff string loses against a soft one where it
+/// buckles helically is of this size.
+pub fn helical_drag(case: &Case, axial: &[f64]) -> f64 {
+    let model = &case.model;
+    (0..model.elements.len())
+        .map(|e| {
+            let f = -0.5 * (axial[e] + axial[e + 1]);
+            let md = 0.5 * (model.nodes[e].md + model.nodes[e + 1].md);
+            let hole = case.hole_at(md);
+            let (_, h) = critical_loads(model, e, hole.diameter);
+            if f <= h {
+                return 0.0;
+            }
+            let el = &model.elements[e];
+            let r = 0.5 * (hole.diameter - el.contact_diameter);
+            hole.friction * r * f * f / (4.0 * el.section.bending_stiffness()) * el.length0
+        })
+        .sum()
+}
+
 /// The largest WOB that keeps every element below its helical buckling load, if the
 /// compression of each element falls one for one with the WOB (soft string, top clamped).
 fn helical_free_wob(case: &Case, axial: &[f64]) -> f64 {
@@ -82,6 +107,27 @@ fn helical_free_wob(case: &Case, axial: &[f64]) -> f64 {
         })
         .fold(f64::INFINITY, f64::min)
         .max(0.0)
+}
+
+/// A warning for a solved FE profile (nodal axial forces, tension +) whose compression
+/// passes the helical buckling load where the elements are too long for the helix (fewer
+/// than 4 per pitch): the answer is an equilibrium of the mesh, which carries less of the
+/// helix's wall force and drag than the string does. `None` where no such element.
+pub fn unresolved_helix(case: &Case, axial: &[f64]) -> Option<String> {
+    let (ratio, md, f, h, pitch, length) = worst_helical(case, axial)?;
+    (ratio > 1.0 && pitch < 4.0 * length).then(|| {
+        format!(
+            "the compression reaches {:.1} kN at MD {md:.0} m, {ratio:.1}× the helical buckling \
+             load there ({:.1} kN): the string winds into a helix of pitch ≈ {pitch:.1} m, which \
+             elements of {length:.1} m cannot follow (≥ 4 per pitch: mesh.element_length ≤ \
+             {:.1} m); this answer carries less of the helix's drag than the string does \
+             (Mitchell's estimate of that drag: {:.1} kN)",
+            f / 1e3,
+            h / 1e3,
+            pitch / 4.0,
+            helical_drag(case, axial) / 1e3
+        )
+    })
 }
 
 /// A failed static solve's message with the likely reason, from the case's soft-string

@@ -87,14 +87,29 @@ fn corpus_sample_solves_and_agrees_with_the_soft_string() {
             continue;
         }
         solved += 1;
-        // A stiff string carries the hook load a cable does, to a few per cent (side forces
-        // differ where the pipe spans a bend; the wells agreed within 2.2 %).
-        assert!(
-            (0.93..=1.07).contains(&r.hook_load_ratio),
-            "seed {}: FE/soft-string hook load {}",
-            s.seed,
-            r.hook_load_ratio
-        );
+        let (fe, soft, drag) = (r.fe_hook_load_n, r.soft_hook_load_n, r.helical_drag_n);
+        if drag > 0.07 * soft.abs() {
+            // Compressed past its helical load, the string winds into a helix whose wall
+            // force (Mitchell's `r F²/4EI`) adds drag a soft string leaves out: a stiff
+            // string's hook load lies below the soft string's, by at most a few times that
+            // drag's first-order estimate (the FE's coarser helix carries less of it), never
+            // above it beyond the 7 % of a straight string.
+            assert!(
+                fe <= soft + 0.07 * soft.abs() && fe >= soft - 3.0 * drag,
+                "seed {}: helically buckled, FE hook load {fe} N against the soft string's {soft} N less up to 3 × {drag} N of helix drag",
+                s.seed
+            );
+        } else {
+            // A stiff string carries the hook load a cable does, to a few per cent (side
+            // forces differ where the pipe spans a bend; the wells agreed within
+            // 2.2 %).
+            assert!(
+                (0.93..=1.07).contains(&r.hook_load_ratio),
+                "seed {}: FE/soft-string hook load {}",
+                s.seed,
+                r.hook_load_ratio
+            );
+        }
         // Torque: in a deviated hole (the pipe on the wall along most of its length) within
         // 40 %; near-vertical holes touch the wall only at survey noise, which a soft string
         // counts in full and a stiff string spans.

@@ -48,6 +48,11 @@ pub struct Summary {
     pub sinusoidal_buckling: bool,
     /// Compression beyond √2 × that (helical buckling).
     pub helical_buckling: bool,
+    /// The drag a helically buckled string adds to this profile, by Mitchell's wall force
+    /// `r F²/4EI` at the full friction factor (N; 0 without helical buckling;
+    /// [`crate::diagnose::helical_drag`]): missing from a soft string's hook load; where
+    /// it is a sizeable part of the hook load, the soft string's answer is not to be trusted.
+    pub helical_buckling_drag_n: f64,
     /// The bit's side force and tilt in the hole's frame (FE; [`crate::bha`] for the
     /// signs): null for the soft string, which has no bending stiffness.
     pub bit: Option<crate::bha::BitLoads>,
@@ -208,8 +213,16 @@ pub fn run(
             }
         });
     let (sinusoidal, helical) = buckling(&case, model, &rows);
+    let mut warnings = case.warnings.clone();
+    if let StaticModel::Fe = which {
+        let axial: Vec<f64> = rows.iter().map(|r| r.axial_force_n).collect();
+        if let Some(w) = crate::diagnose::unresolved_helix(&case, &axial) {
+            eprintln!("holewall: warning: {w}");
+            warnings.push(w);
+        }
+    }
     let summary = Summary {
-        warnings: case.warnings.clone(),
+        warnings,
         title: case.title.clone(),
         model: match which {
             StaticModel::Fe => "fe".into(),
@@ -224,6 +237,10 @@ pub fn run(
         max_side_force_md_m: rows[k_max].md_m,
         sinusoidal_buckling: sinusoidal,
         helical_buckling: helical,
+        helical_buckling_drag_n: crate::diagnose::helical_drag(
+            &case,
+            &rows.iter().map(|r| r.axial_force_n).collect::<Vec<_>>(),
+        ),
         bit,
         tendency,
         strength,

@@ -542,6 +542,9 @@ pub struct WellResult {
     pub fe_hook_load_n: f64,
     /// Soft-string hook load (N).
     pub soft_hook_load_n: f64,
+    /// The drag a helically buckled string adds to the soft string's profile (N; 0 where
+    /// no element passes its helical load: [`crate::diagnose::helical_drag`]).
+    pub helical_drag_n: f64,
     /// FE / soft-string hook load.
     pub hook_load_ratio: f64,
     /// FE surface torque (N·m).
@@ -583,6 +586,7 @@ pub fn run_well(
         seconds,
         fe_hook_load_n: f64::NAN,
         soft_hook_load_n: soft.hook_load(),
+        helical_drag_n: crate::diagnose::helical_drag(&case, &soft.tension),
         hook_load_ratio: f64::NAN,
         fe_torque_nm: f64::NAN,
         soft_torque_nm: soft.surface_torque(),
@@ -657,6 +661,7 @@ pub struct WellRow {
     seconds: f64,
     fe_hook_load_n: f64,
     soft_hook_load_n: f64,
+    helical_drag_n: f64,
     hook_load_ratio: f64,
     fe_torque_nm: f64,
     soft_torque_nm: f64,
@@ -693,6 +698,7 @@ impl WellResult {
             seconds: self.seconds,
             fe_hook_load_n: self.fe_hook_load_n,
             soft_hook_load_n: self.soft_hook_load_n,
+            helical_drag_n: self.helical_drag_n,
             hook_load_ratio: self.hook_load_ratio,
             fe_torque_nm: self.fe_torque_nm,
             soft_torque_nm: self.soft_torque_nm,

@@ -223,6 +223,8 @@ struct Track {
     updates: usize,
     last_step: f64,
     floor: f64,
+    /// Updates before this solve fails (`max_iterations` unless started with a limit).
+    limit: usize,
 }
 
 /// One variant's Newton state ([`Newton::state`]).
@@ -270,6 +272,12 @@ impl Newton {
     /// floor ([`NewtonSettings::step_floor`]); `polish`: after converging, take one more
     /// step (to rounding level), then stop.
     pub fn start(&mut self, j: usize, floor: f64, polish: bool) {
+        self.start_limited(j, floor, polish, None);
+    }
+
+    /// As [`Newton::start`], failing after `limit` updates where given (fewer than the
+    /// settings' `max_iterations`: a relaxation's sub-solve).
+    pub fn start_limited(&mut self, j: usize, floor: f64, polish: bool, limit: Option<usize>) {
         self.tracks[j] = Track {
             running: true,
             polish,
@@ -277,6 +285,9 @@ impl Newton {
             updates: 0,
             last_step: f64::INFINITY,
             floor,
+            limit: limit.map_or(self.settings.max_iterations, |l| {
+                l.min(self.settings.max_iterations)
+            }),
         };
         if let Some(a) = self.round.alpha.get_mut(j) {
             *a = 0.0;
@@ -394,13 +405,13 @@ impl Newton {
                 }
                 continue;
             }
-            if track.updates >= s.max_iterations {
+            if track.updates >= track.limit {
                 track.running = false;
                 events.push((
                     j,
                     Event::Failed(format!(
                         "Newton did not converge in {} iterations (residual {measure:.3e} of the force scale)",
-                        s.max_iterations
+                        track.limit
                     )),
                 ));
                 continue;

@@ -775,6 +775,12 @@ impl crate::solve::continuation::StaticSystem for CpuStatic<'_> {
             .fold(f64::INFINITY, f64::min);
         Some(self.f_ref / shortest.max(1e-3))
     }
+    fn unshifted_measure(&mut self, _j: usize) -> f64 {
+        let mut r = vec![0.0; self.residual.len()];
+        assemble(&self.loaded, &self.state, 1.0, &self.f_step, &mut r, None);
+        constrain_residual(&self.c, &mut r);
+        residual_measure(&r, self.f_ref)
+    }
     fn set_shift(&mut self, _j: usize, s: f64) -> Result<(), String> {
         self.shift = s;
         self.anchor = if s == 0.0 {
