@@ -366,9 +366,11 @@ impl LoadPath {
                         // From the gravity stage: the load steps start afresh.
                         self.step = self.step.max(self.min_step);
                     }
-                } else if r.iterations >= RELAX_MAX_BUDGET * self.max_iterations {
+                } else if r.iterations >= RELAX_MAX_BUDGET * self.max_iterations
+                    || r.subs >= RELAX_MAX_SUBS
+                {
                     return self.failed(format!(
-                        "the relaxation's budget of {} Newton iterations ran out",
+                        "the relaxation's budget of {} Newton iterations or {RELAX_MAX_SUBS} sub-solves ran out",
                         RELAX_MAX_BUDGET * self.max_iterations
                     ));
                 } else {
@@ -817,9 +819,17 @@ mod tests {
         assert_eq!(subs, (RELAX_MAX_BUDGET * 200).div_ceil(150));
         let e = p.error.unwrap().to_string();
         assert!(
-            e.contains("budget of 3000 Newton iterations ran out"),
+            e.contains("budget of 3000 Newton iterations or 400 sub-solves ran out"),
             "{e}"
         );
+        // Easy sub-solves at the smallest shift that never settle: the sub-solve count.
+        let (mut p, _) = stuck(Some(1e6));
+        let mut subs = 0;
+        while p.converged(2) == Next::Step {
+            subs += 1;
+        }
+        assert_eq!(subs + 1, RELAX_MAX_SUBS);
+        assert!(p.error.is_some());
     }
 
     #[test]
