@@ -47,6 +47,14 @@ pub struct LoadTarget {
     pub exponent: f64,
 }
 
+/// Gravity in full, no bit loads, no friction, linear laws: the first stage's loads.
+const GRAVITY_ONLY: LoadTarget = LoadTarget {
+    gravity: 1.0,
+    lambda: 0.0,
+    friction: 0.0,
+    exponent: 1.0,
+};
+
 /// What follows the end of a step's solve.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Next {
@@ -198,12 +206,7 @@ impl LoadPath {
 
     fn set_target(&mut self) {
         self.target = match self.stage {
-            Stage::Gravity => LoadTarget {
-                gravity: 1.0,
-                lambda: 0.0,
-                friction: 0.0,
-                exponent: 1.0,
-            },
+            Stage::Gravity => GRAVITY_ONLY,
             Stage::GravityRamp => LoadTarget {
                 gravity: (self.g + self.g_step).min(1.0),
                 lambda: 0.0,
@@ -476,14 +479,8 @@ impl LoadPath {
                     ));
                     let why = std::mem::take(&mut self.gravity_reason);
                     if let Some(s0) = relax {
-                        let target = LoadTarget {
-                            gravity: 1.0,
-                            lambda: 0.0,
-                            friction: 0.0,
-                            exponent: 1.0,
-                        };
                         let why = format!("the gravity stage failed ({why})");
-                        return self.relax_after(target, s0, why, true);
+                        return self.relax_after(GRAVITY_ONLY, s0, why, true);
                     }
                     return fail(self, self.step, why);
                 }
@@ -502,14 +499,8 @@ impl LoadPath {
                     ));
                     let why = std::mem::take(&mut self.gravity_reason);
                     if let Some(s0) = relax {
-                        let target = LoadTarget {
-                            gravity: 1.0,
-                            lambda: 0.0,
-                            friction: 0.0,
-                            exponent: 1.0,
-                        };
                         let why = format!("the gravity stage failed ({why})");
-                        return self.relax_after(target, s0, why, true);
+                        return self.relax_after(GRAVITY_ONLY, s0, why, true);
                     }
                     return fail(self, self.step, why);
                 }
