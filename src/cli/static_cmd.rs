@@ -213,9 +213,9 @@ pub fn run(
             }
         });
     let (sinusoidal, helical) = buckling(&case, model, &rows);
+    let axial: Vec<f64> = rows.iter().map(|r| r.axial_force_n).collect();
     let mut warnings = case.warnings.clone();
     if let StaticModel::Fe = which {
-        let axial: Vec<f64> = rows.iter().map(|r| r.axial_force_n).collect();
         if let Some(w) = crate::diagnose::unresolved_helix(&case, &axial) {
             eprintln!("holewall: warning: {w}");
             warnings.push(w);
@@ -237,10 +237,7 @@ pub fn run(
         max_side_force_md_m: rows[k_max].md_m,
         sinusoidal_buckling: sinusoidal,
         helical_buckling: helical,
-        helical_buckling_drag_n: crate::diagnose::helical_drag(
-            &case,
-            &rows.iter().map(|r| r.axial_force_n).collect::<Vec<_>>(),
-        ),
+        helical_buckling_drag_n: crate::diagnose::helical_drag(&case, &axial),
         bit,
         tendency,
         strength,
