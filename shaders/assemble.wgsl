@@ -3,7 +3,8 @@
 // With DYNAMIC: the generalised-α iteration matrix M + hγ' C_t + h²β' K_t and the inertial
 // residual (lumped mass, gyroscopic moments, mass-proportional Rayleigh damping); with
 // UNBALANCE also each node's mass imbalance as a rigid eccentric mass
-// (physics::mass::unbalance_terms).
+// (physics::mass::unbalance_terms). With SHIFT (static only) a relaxation's proximal shift
+// (solve::continuation's Stage::Relax), its three bindings last.
 //
 // One invocation per (node, variant), index = node · V + variant; each gathers the halves of
 // its two elements and its contact site, so no two invocations write the same entry, then
@@ -25,6 +26,17 @@
 // Built MASKED (the engine's trials): the variants still searching, compacted:
 // [A, v_0, …, v_{A−1}]; the others are skipped.
 @group(0) @binding(9) var<storage, read> searching: array<u32>;
+#if SHIFT
+@group(0) @binding(10) var<storage, read> shift: array<real>;
+@group(0) @binding(11) var<storage, read> anchor: array<real>;
+@group(0) @binding(12) var<storage, read> x_now: array<real>;
+#endif
+#else
+#if SHIFT
+@group(0) @binding(9) var<storage, read> shift: array<real>;
+@group(0) @binding(10) var<storage, read> anchor: array<real>;
+@group(0) @binding(11) var<storage, read> x_now: array<real>;
+#endif
 #endif
 #else
 @group(0) @binding(2) var<storage, read> elem_tangent: array<real>;
@@ -66,6 +78,11 @@ const OUT_C_OMEGA: u32 = 42u;
 @group(0) @binding(10) var<storage, read_write> out_upper: array<real>;
 @group(0) @binding(11) var<storage, read_write> out_lower: array<real>;
 @group(0) @binding(12) var<storage, read_write> out_rhs: array<real>;
+#if SHIFT
+@group(0) @binding(13) var<storage, read> shift: array<real>;
+@group(0) @binding(14) var<storage, read> anchor: array<real>;
+@group(0) @binding(15) var<storage, read> x_now: array<real>;
+#endif
 #endif
 #endif
 
@@ -328,6 +345,21 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         }
     }
 #endif
+#endif
+#if SHIFT
+    // A relaxation's proximal shift (static only; twin: kernels::assemble's ShiftInputs):
+    // s_v (u − a) on the translations' residual, s_v I on their diagonal block, before the
+    // constraints. Laid out [(3 i + k) V + v], as the configuration.
+    let s_v = shift[v];
+    if (s_v != real(0.0)) {
+        for (var k = 0u; k < 3u; k = k + 1u) {
+            let at = (3u * i + k) * nv + v;
+            r[k] = r[k] + s_v * (x_now[at] - anchor[at]);
+#if !FORCE_ONLY
+            d[7u * k] = d[7u * k] + s_v;
+#endif
+        }
+    }
 #endif
     // Constraints (as statics::constrain): bases, then fixed DOFs.
 #if !FORCE_ONLY

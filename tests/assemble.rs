@@ -59,6 +59,7 @@ fn inputs(
             .collect(),
         fixed: vec![0; n],
         dynamic: None,
+        shift: None,
     };
     if constrained {
         let (basis, fixed) = constraint_tables(&model);
@@ -225,4 +226,108 @@ fn the_residual_only_assembly_gives_the_full_residual() {
         "f32: residual-only = full assembly's residual"
     );
     assert_eq!(assemble_residual(&bare32), assemble(&a32).rhs);
+}
+
+/// A relaxation's proximal shift (the kernel built `SHIFT`, twin `ShiftInputs`): the twin
+/// adds `s_v (u − a)` to each node's translations' residual and `s_v` to their diagonal,
+/// before the constraints (without constraints: exactly that difference from the plain
+/// assembly; a variant with `s_v = 0` unchanged to the bit); the GPU, full and
+/// residual-only, f64 and f32, agrees with the twin.
+#[test]
+fn the_proximal_shift_adds_its_spring_before_the_constraints_and_the_gpu_agrees() {
+    use holewall::kernels::assemble::ShiftInputs;
+    use rand::{Rng, SeedableRng};
+    let v = 5;
+    let mut rng = rand::rngs::StdRng::seed_from_u64(11);
+    let with_shift = |a: &AssemblyInputs<f64>, rng: &mut rand::rngs::StdRng| {
+        let n = a.num_nodes;
+        let mut b = a.clone();
+        b.shift = Some(ShiftInputs {
+            // Variant 2 without a shift.
+            shift: (0..v)
+                .map(|j| {
+                    if j == 2 {
+                        0.0
+                    } else {
+                        rng.random_range(1e3..1e7)
+                    }
+                })
+                .collect(),
+            anchor: (0..3 * n * v)
+                .map(|_| rng.random_range(-0.1..0.1))
+                .collect(),
+            x: (0..3 * n * v)
+                .map(|_| rng.random_range(-0.1..0.1))
+                .collect(),
+        });
+        b
+    };
+    let (_, _, a0) = inputs(v, false);
+    let s0 = with_shift(&a0, &mut rng);
+    let (plain, shifted) = (assemble(&a0), assemble(&s0));
+    let sh = s0.shift.as_ref().unwrap();
+    let n = a0.num_nodes;
+    for i in 0..n {
+        for j in 0..v {
+            for k in 0..6 {
+                let at = (6 * i + k) * v + j;
+                let want = if k < 3 {
+                    let x = (3 * i + k) * v + j;
+                    plain.rhs[at] + sh.shift[j] * (sh.x[x] - sh.anchor[x])
+                } else {
+                    plain.rhs[at]
+                };
+                assert_eq!(shifted.rhs[at], want, "rhs node {i} variant {j} dof {k}");
+                for c in 0..6 {
+                    let d = (36 * i + 6 * k + c) * v + j;
+                    let add = if k == c && k < 3 { sh.shift[j] } else { 0.0 };
+                    assert_eq!(shifted.diag[d], plain.diag[d] + add);
+                }
+            }
+        }
+    }
+    assert_eq!(shifted.upper, plain.upper);
+    // With the constraints: the GPU against the twin.
+    let (_, _, a) = inputs(v, true);
+    let s = with_shift(&a, &mut rng);
+    let twin = assemble(&s);
+    let mut bare = s.clone();
+    bare.elem_tangent = Vec::new();
+    assert_eq!(assemble_residual(&bare), twin.rhs);
+    let plain = assemble(&a);
+    for i in 0..n {
+        for k in 0..6 {
+            let at = (6 * i + k) * v + 2;
+            assert_eq!(
+                twin.rhs[at], plain.rhs[at],
+                "an unshifted variant is unchanged"
+            );
+        }
+    }
+    let Some(ctx) = common::gpu() else { return };
+    if ctx.has_f64 {
+        let gpu = assemble_gpu(ctx, &s).unwrap();
+        assert_eq!(gpu.rhs, twin.rhs, "f64 GPU rhs = twin");
+        assert_eq!(gpu.diag, twin.diag, "f64 GPU diag = twin");
+        assert_eq!(assemble_residual_gpu(ctx, &bare).unwrap(), twin.rhs);
+    }
+    let s32 = s.map_static(|x| x as f32);
+    let gpu32 = assemble_gpu(ctx, &s32).unwrap();
+    let twin32 = assemble(&s32);
+    assert_eq!(gpu32.diag, twin32.diag, "f32 GPU diag = f32 twin");
+    let mut bare32 = s32.clone();
+    bare32.elem_tangent = Vec::new();
+    assert_eq!(
+        assemble_residual_gpu(ctx, &bare32).unwrap(),
+        gpu32.rhs,
+        "f32: residual-only = full"
+    );
+    let worst = gpu32
+        .rhs
+        .iter()
+        .zip(&twin32.rhs)
+        .map(|(g, t)| (g - t).abs() / t.abs().max(1.0))
+        .fold(0.0f32, f32::max);
+    eprintln!("f32 GPU vs f32 twin, shifted rhs: {worst:.2e}");
+    assert!(worst <= 8.0 * f32::EPSILON, "f32 rhs {worst:e}");
 }

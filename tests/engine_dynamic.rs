@@ -342,6 +342,7 @@ fn dynamic_kernels_equal_their_twins() {
             pair_normals: pair_normals.clone(),
             unbalance: Vec::new(),
         }),
+        shift: None,
     };
     let asm_twin = assemble(&a);
     // With a mass imbalance at every other node (the kernel built UNBALANCE): the twin

@@ -126,6 +126,7 @@ fn assembly_inputs(n: usize, v: usize) -> AssemblyInputs<f64> {
             .collect(),
         fixed,
         dynamic: None,
+        shift: None,
     }
 }
 

@@ -132,11 +132,26 @@ pub trait Ensemble<T> {
     /// Replaces the current configuration (displacements from the base and rotations;
     /// its system must be evaluated again).
     fn set_config(&mut self, config: &ConfigBatch<T>) -> Result<(), String>;
+    /// Sets a relaxation's proximal shift (`None`: none; [`Shift`]): every evaluation from
+    /// now on adds `s_v (u − a_v)` to each node's translations' residual and `s_v I` to their
+    /// diagonal block (the systems must be evaluated again).
+    fn set_shift(&mut self, shift: Option<&Shift<T>>) -> Result<(), String>;
     /// Moves the base to the current configuration, given as `tables` after
     /// [`EnsembleTables::set_base`] with the host's sum of the old base and the current
     /// displacements: the displacements from it are set to zero, the rotations kept (the
     /// system must be evaluated again).
     fn rebase(&mut self, tables: &EnsembleTables<T>) -> Result<(), String>;
+}
+
+/// A relaxation's proximal shift on a chunk ([`crate::solve::continuation`]'s
+/// `Stage::Relax`, as the CPU solve's): the shift per variant and its anchor.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Shift<T> {
+    /// The shift per variant (N/m on the translations; 0: none), `V`.
+    pub shift: Vec<T>,
+    /// Each variant's anchor as displacements from the current base, `3 n V`
+    /// (`[(3 i + k) V + v]`; zero where the variant has no shift).
+    pub anchor: Vec<T>,
 }
 
 /// A kernel path: makes the [`Ensemble`] of a chunk of variants.
@@ -265,7 +280,7 @@ fn solve_chunk<T: Real + Send + Sync, P: KernelPath<T>>(
     let mesh = &models[0];
     let size = std::mem::size_of::<T>();
     let ensemble = path.open(mesh, &tables)?;
-    let mut sys = EngineStatic::new(models.iter().collect(), ensemble, tables, None);
+    let mut sys = EngineStatic::new(models.iter().collect(), ensemble, tables, None, None);
     // f32 solves full load a second time from its own converged state as base: the
     // answer's last digits are then f32's rounding of millimetres, not of the string's
     // whole sag (`docs/validation.md`).
@@ -315,9 +330,10 @@ fn solve_chunk<T: Real + Send + Sync, P: KernelPath<T>>(
         let mut tables = ensemble_tables_from::<T>(&sub_models, Some(start))?;
         tables.set_base(mesh, columns(&sys.tables.base, m, &keep));
         let saved = keep.iter().map(|&i| sys.saved[i].clone()).collect();
+        let shifts = keep.iter().map(|&i| sys.shifts[i].clone()).collect();
         let kept_models = keep.iter().map(|&i| sys.models[i]).collect();
         let ensemble = path.open(mesh, &tables)?;
-        sys = EngineStatic::new(kept_models, ensemble, tables, Some(saved));
+        sys = EngineStatic::new(kept_models, ensemble, tables, Some(saved), Some(shifts));
         resume = Some(keep.iter().map(|&i| states[i].clone()).collect::<Vec<_>>());
         members = keep.iter().map(|&i| members[i]).collect();
     }
@@ -441,15 +457,28 @@ struct EngineStatic<'a, T> {
     to_save: Vec<usize>,
     to_restore: Vec<usize>,
     to_rebase: bool,
+    /// Per variant: a relaxation's shift (0: none) and its anchor (displacements from the
+    /// reference, `3 n`; empty without a shift).
+    shifts: Vec<(f64, Vec<f64>)>,
+    /// Variants whose shift was set since the last flush (anchored at their restart point,
+    /// where the load path leaves them before it sets a shift).
+    to_anchor: Vec<usize>,
+    /// The shifts differ from what the ensemble holds.
+    shift_changed: bool,
+    /// Each variant's residual measure without its shift at the current states (kept
+    /// until a state changes).
+    unshifted: Option<Vec<f64>>,
 }
 
 impl<'a, T: Real> EngineStatic<'a, T> {
-    /// `saved`: the variants' restart points (none: their start states).
+    /// `saved`: the variants' restart points (none: their start states); `shifts`: their
+    /// relaxations' shifts and anchors (none: no shift).
     fn new(
         models: Vec<&'a Model>,
         ensemble: Box<dyn Ensemble<T> + 'a>,
         tables: EnsembleTables<T>,
         saved: Option<Vec<(Vec<f64>, Vec<f64>)>>,
+        shifts: Option<Vec<(f64, Vec<f64>)>>,
     ) -> Self {
         let (v, n, p) = (
             tables.num_variants,
@@ -469,7 +498,12 @@ impl<'a, T: Real> EngineStatic<'a, T> {
                 })
                 .collect()
         });
+        let shifts = shifts.unwrap_or_else(|| vec![(0.0, Vec::new()); v]);
         EngineStatic {
+            shift_changed: shifts.iter().any(|s| s.0 != 0.0),
+            shifts,
+            to_anchor: Vec::new(),
+            unshifted: None,
             loads: models.iter().map(|m| split_loads(m)).collect(),
             f_ref: models.iter().map(|m| reference_force(m)).collect(),
             models,
@@ -516,6 +550,7 @@ impl<'a, T: Real> EngineStatic<'a, T> {
             if !restores.is_empty() {
                 self.ensemble.set_config(&config)?;
                 self.evaluated = false;
+                self.unshifted = None;
             }
             if std::mem::take(&mut self.to_rebase) {
                 // f32: the states become the motion from here (host sums in f64).
@@ -526,7 +561,22 @@ impl<'a, T: Real> EngineStatic<'a, T> {
                 self.tables.set_base(self.models[0], moved);
                 self.ensemble.rebase(&self.tables)?;
                 self.evaluated = false;
+                self.unshifted = None;
+                // The anchors are held as displacements from the base.
+                self.shift_changed |= self.shifts.iter().any(|s| s.0 != 0.0);
             }
+        }
+        for j in std::mem::take(&mut self.to_anchor) {
+            let (s, anchor) = &mut self.shifts[j];
+            *anchor = if *s == 0.0 {
+                Vec::new()
+            } else {
+                self.saved[j].0.clone()
+            };
+            self.shift_changed = true;
+        }
+        if std::mem::take(&mut self.shift_changed) {
+            self.upload_shift()?;
         }
         if self.loads_changed {
             self.ensemble
@@ -535,6 +585,52 @@ impl<'a, T: Real> EngineStatic<'a, T> {
             self.evaluated = false;
         }
         Ok(())
+    }
+}
+
+impl<T: Real> EngineStatic<'_, T> {
+    /// Gives the ensemble the shifts and anchors (none where no variant has a shift).
+    fn upload_shift(&mut self) -> Result<(), String> {
+        let (v, n) = (self.tables.num_variants, self.tables.num_nodes);
+        self.evaluated = false;
+        if self.shifts.iter().all(|s| s.0 == 0.0) {
+            return self.ensemble.set_shift(None);
+        }
+        let mut anchor = vec![T::zero(); 3 * n * v];
+        for (j, (s, a)) in self.shifts.iter().enumerate() {
+            if *s != 0.0 {
+                for (k, a) in a.iter().enumerate() {
+                    anchor[k * v + j] = T::from_f64_lossy(a - self.tables.base[k * v + j]);
+                }
+            }
+        }
+        let shift = Shift {
+            shift: self.shifts.iter().map(|s| T::from_f64_lossy(s.0)).collect(),
+            anchor,
+        };
+        self.ensemble.set_shift(Some(&shift))
+    }
+
+    /// Every variant's residual measure at its current state without its shift: the
+    /// residual of a trial at α = 0 with the shift taken off (the shift is given back at
+    /// the next flush). A variant whose last step `Δ` is not finite gets NaN (its
+    /// relaxation then goes on: no false equilibrium).
+    fn unshifted_measures(&mut self) -> Result<Vec<f64>, String> {
+        self.flush()?;
+        let v = self.tables.num_variants;
+        if self.shifts.iter().any(|s| s.0 != 0.0) {
+            self.ensemble.set_shift(None)?;
+            self.shift_changed = true;
+            self.evaluated = false;
+        }
+        let r = self
+            .ensemble
+            .trial(&vec![T::zero(); v], &vec![true; v], true)?;
+        Ok(r.residual_max
+            .iter()
+            .zip(&self.f_ref)
+            .map(|(r, f_ref)| r.to_f64_lossy() / f_ref)
+            .collect())
     }
 }
 
@@ -591,6 +687,7 @@ impl<T: Real> NewtonSystem for EngineStatic<'_, T> {
     }
     fn accept(&mut self, alpha: &[f64], trial_matches: bool) -> Result<(), String> {
         self.flush()?;
+        self.unshifted = None;
         if trial_matches {
             // The trial's residual only: its tangent is formed when the next solve needs it.
             self.ensemble.accept_trial();
@@ -653,6 +750,27 @@ impl<T: Real> StaticSystem for EngineStatic<'_, T> {
             })
         };
         Ok(NewtonSettings::step_floor(size, largest))
+    }
+    fn relax_scale(&mut self, j: usize) -> Option<f64> {
+        Some(crate::solve::statics::relax_scale(
+            self.models[j],
+            self.f_ref[j],
+        ))
+    }
+    fn unshifted_measure(&mut self, j: usize) -> f64 {
+        if self.unshifted.is_none() {
+            // A failed read leaves the relaxation going (no false equilibrium).
+            self.unshifted = self.unshifted_measures().ok();
+        }
+        self.unshifted.as_ref().map_or(f64::INFINITY, |m| m[j])
+    }
+    fn set_shift(&mut self, j: usize, s: f64) -> Result<(), String> {
+        if s == 0.0 && self.shifts[j].0 == 0.0 {
+            return Ok(());
+        }
+        self.shifts[j].0 = s;
+        self.to_anchor.push(j);
+        Ok(())
     }
 }
 

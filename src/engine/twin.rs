@@ -10,7 +10,7 @@ use super::*;
 /// beam stage forms forces only; in statics the blocks are then left empty, as the
 /// assembly built `FORCE_ONLY` leaves them; in dynamics they are meaningless). `dynamic`: the predicted trial state and the dynamic
 /// assembly's inputs (the predictor itself is run by the caller, which owns the step's
-/// state).
+/// state). `shift`: a relaxation's shift per variant and anchor (static only).
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn twin_evaluate(
     model: &Model,
@@ -24,6 +24,7 @@ pub(crate) fn twin_evaluate(
         &crate::kernels::dynamics::DynamicBatch<f64>,
         AssemblyDynamic,
     )>,
+    shift: Option<&Shift<f64>>,
 ) -> ChainBatch<f64> {
     let (v, n) = (t.num_variants, t.num_nodes);
     let mut elements = None;
@@ -80,6 +81,11 @@ pub(crate) fn twin_evaluate(
                             unbalance: d.unbalance.to_vec(),
                         }
                     }),
+                    shift: shift.map(|sh| crate::kernels::assemble::ShiftInputs {
+                        shift: sh.shift.clone(),
+                        anchor: sh.anchor.clone(),
+                        x: x.to_vec(),
+                    }),
                 };
                 system = Some(if tangent || inputs.dynamic.is_some() {
                     assemble(&inputs)
@@ -128,6 +134,8 @@ struct TwinEnsemble<'a> {
     /// What the update needs to make contact nodes follow their wall (kept in step with
     /// the loads and the base).
     walls: crate::kernels::update::UpdateWalls<f64>,
+    /// A relaxation's shift (none: the assembly runs without it).
+    shift: Option<Shift<f64>>,
 }
 
 impl TwinEnsemble<'_> {
@@ -142,6 +150,7 @@ impl TwinEnsemble<'_> {
             &self.f_ext,
             tangent,
             None,
+            self.shift.as_ref(),
         );
         self.system[slot] = Some((system, tangent));
     }
@@ -255,6 +264,11 @@ impl Ensemble<f64> for TwinEnsemble<'_> {
         self.system[self.current] = None;
         Ok(())
     }
+    fn set_shift(&mut self, shift: Option<&Shift<f64>>) -> Result<(), String> {
+        self.shift = shift.cloned();
+        self.system = [None, None];
+        Ok(())
+    }
     fn rebase(&mut self, tables: &EnsembleTables<f64>) -> Result<(), String> {
         self.tables = tables.clone();
         self.refresh_walls();
@@ -287,6 +301,7 @@ impl KernelPath<f64> for TwinPath {
             current: 0,
             delta: vec![0.0; 6 * tables.num_nodes * tables.num_variants],
             walls: Default::default(),
+            shift: None,
         };
         twin.refresh_walls();
         Ok(Box::new(twin))

@@ -41,6 +41,21 @@ pub fn assemble_force_wgsl(f64: bool, masked: bool) -> Result<String, GpuError> 
     )
 }
 
+/// The WGSL text of the static assembly built `SHIFT` (a relaxation's proximal shift,
+/// [`crate::kernels::assemble::ShiftInputs`]; its bindings `shift`, `anchor`, `x` last):
+/// `force_only` the residual alone, `masked` as [`assemble_force_wgsl`].
+pub fn assemble_shift_wgsl(f64: bool, force_only: bool, masked: bool) -> Result<String, GpuError> {
+    compose_if(
+        "assemble.wgsl",
+        &[
+            ("FORCE_ONLY", force_only),
+            ("MASKED", force_only && masked),
+            ("SHIFT", true),
+        ],
+        f64,
+    )
+}
+
 /// The static residual of every variant on the GPU (the kernel built `FORCE_ONLY`), laid
 /// out as the twin's `rhs`.
 pub fn assemble_residual_gpu<T: GpuReal>(
@@ -55,18 +70,41 @@ pub fn assemble_residual_gpu<T: GpuReal>(
     }
     let (n, nv) = (a.num_nodes, a.num_variants);
     let size = std::mem::size_of::<T>();
-    let pipeline = ctx.pipeline("assemble_force", &assemble_force_wgsl(T::IS_F64, false)?)?;
+    let wgsl = match a.shift {
+        Some(_) => assemble_shift_wgsl(T::IS_F64, true, false)?,
+        None => assemble_force_wgsl(T::IS_F64, false)?,
+    };
+    let pipeline = ctx.pipeline("assemble_force", &wgsl)?;
     let (dims, inputs) = static_bindings(a, false);
+    // The shift's bindings follow the output in the kernel: passed after it (read only).
+    let mut outputs = vec![Out::Empty(6 * n * nv * size)];
+    outputs.extend(shift_bindings(a));
     let out = run_once(
         ctx,
         &pipeline,
         "assemble_force",
         bytemuck::bytes_of(&dims),
         &inputs,
-        &[Out::Empty(6 * n * nv * size)],
+        &outputs,
         n * nv,
     )?;
     Ok(bytemuck::cast_slice(&out[0]).to_vec())
+}
+
+/// The shift's inputs of `a` (`shift`, `anchor`, `x`), empty without one: bound after
+/// the kernel's outputs, so passed as outputs that start with them (the kernel only reads
+/// them).
+fn shift_bindings<T: GpuReal>(a: &AssemblyInputs<T>) -> Vec<Out<'_>> {
+    a.shift
+        .iter()
+        .flat_map(|sh| {
+            [
+                Out::From(bytemuck::cast_slice(&sh.shift)),
+                Out::From(bytemuck::cast_slice(&sh.anchor)),
+                Out::From(bytemuck::cast_slice(&sh.x)),
+            ]
+        })
+        .collect()
 }
 
 /// The dimensions and the static inputs (bindings 1–8, or 1–7 without the tangents) of
@@ -113,10 +151,16 @@ pub fn assemble_gpu<T: GpuReal>(
         )));
     }
     let unbalance = a.dynamic.as_ref().is_some_and(|d| !d.unbalance.is_empty());
-    let pipeline = ctx.pipeline(
-        "assemble",
-        &assemble_wgsl_with(a.dynamic.is_some(), unbalance, T::IS_F64)?,
-    )?;
+    let wgsl = match (&a.dynamic, &a.shift) {
+        (Some(_), Some(_)) => {
+            return Err(GpuError::Unsupported(
+                "the proximal shift is static only".into(),
+            ))
+        }
+        (None, Some(_)) => assemble_shift_wgsl(T::IS_F64, false, false)?,
+        _ => assemble_wgsl_with(a.dynamic.is_some(), unbalance, T::IS_F64)?,
+    };
+    let pipeline = ctx.pipeline("assemble", &wgsl)?;
     let (dims, mut inputs) = static_bindings(a, true);
     if let Some(dy) = &a.dynamic {
         inputs.extend([
@@ -132,18 +176,20 @@ pub fn assemble_gpu<T: GpuReal>(
             inputs.push(bytemuck::cast_slice(&dy.unbalance));
         }
     }
+    let mut outputs = vec![
+        Out::Empty(36 * n * nv * size),
+        Out::Empty(36 * m * nv * size),
+        Out::Empty(36 * m * nv * size),
+        Out::Empty(6 * n * nv * size),
+    ];
+    outputs.extend(shift_bindings(a));
     let out = run_once(
         ctx,
         &pipeline,
         "assemble",
         bytemuck::bytes_of(&dims),
         &inputs,
-        &[
-            Out::Empty(36 * n * nv * size),
-            Out::Empty(36 * m * nv * size),
-            Out::Empty(36 * m * nv * size),
-            Out::Empty(6 * n * nv * size),
-        ],
+        &outputs,
         n * nv,
     )?;
     let cast = |b: &Vec<u8>| -> Vec<T> { bytemuck::cast_slice(b).to_vec() };

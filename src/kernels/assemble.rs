@@ -57,6 +57,23 @@ pub struct AssemblyInputs<T> {
     pub fixed: Vec<u32>,
     /// The dynamic terms (`None`: the static residual and tangent).
     pub dynamic: Option<DynamicInputs<T>>,
+    /// A relaxation's proximal shift (static only; `None`: none, the kernel is then built
+    /// without it).
+    pub shift: Option<ShiftInputs<T>>,
+}
+
+/// What a relaxation's proximal shift adds to the static assembly
+/// ([`crate::solve::continuation`]'s `Stage::Relax`): `s_v (u − a)` on each node's
+/// translations' residual and `s_v I` on their diagonal block, before the constraints (as
+/// the CPU solve's `add_shift`: `s I` is the same in any node basis).
+#[derive(Clone, Debug, PartialEq)]
+pub struct ShiftInputs<T> {
+    /// The shift per variant (N/m; 0: none), `V`.
+    pub shift: Vec<T>,
+    /// The anchor's displacements from the base, `3 n V` (`[(3 i + k) V + v]`).
+    pub anchor: Vec<T>,
+    /// The configuration's displacements from the base, `3 n V`.
+    pub x: Vec<T>,
 }
 
 impl AssemblyInputs<f64> {
@@ -77,6 +94,11 @@ impl AssemblyInputs<f64> {
             basis: c(&self.basis),
             fixed: self.fixed.clone(),
             dynamic: None,
+            shift: self.shift.as_ref().map(|sh| ShiftInputs {
+                shift: c(&sh.shift),
+                anchor: c(&sh.anchor),
+                x: c(&sh.x),
+            }),
         }
     }
 }
@@ -304,6 +326,18 @@ fn node_blocks<T: Real>(
                     for b in 0..6 {
                         d[6 * a + b] = d[6 * a + b] + ju[a][b];
                     }
+                }
+            }
+        }
+    }
+    if let Some(sh) = &a.shift {
+        let s_v = sh.shift[v];
+        if s_v != T::zero() {
+            for k in 0..3 {
+                let at = (3 * i + k) * nv + v;
+                r[k] = r[k] + s_v * (sh.x[at] - sh.anchor[at]);
+                if tangent {
+                    d[7 * k] = d[7 * k] + s_v;
                 }
             }
         }

@@ -71,6 +71,7 @@ impl<'a> TwinDynamic<'a> {
                     unbalance: &self.dynamic.unbalance,
                 },
             )),
+            None,
         ))
     }
 }

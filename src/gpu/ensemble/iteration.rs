@@ -159,6 +159,24 @@ impl<T: GpuReal> Ensemble<T> for GpuEnsemble<T> {
         Ok(())
     }
 
+    fn set_shift(&mut self, shift: Option<&Shift<T>>) -> Result<(), String> {
+        match shift {
+            None => self.shifted = false,
+            Some(sh) => {
+                if self.shift.is_none() {
+                    self.shift = Some(self.shift_parts().map_err(|e| e.to_string())?);
+                }
+                let parts = self.shift.as_ref().expect("made above");
+                let q = &self.ctx.queue;
+                q.write_buffer(&parts.shift, 0, bytemuck::cast_slice(&sh.shift));
+                q.write_buffer(&parts.anchor, 0, bytemuck::cast_slice(&sh.anchor));
+                self.shifted = true;
+            }
+        }
+        self.formed = [false; 2];
+        Ok(())
+    }
+
     fn rebase(&mut self, tables: &EnsembleTables<T>) -> Result<(), String> {
         let q = &self.ctx.queue;
         if !tables.pair_base.is_empty() {

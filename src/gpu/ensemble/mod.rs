@@ -14,7 +14,7 @@ use std::sync::Arc;
 use wgpu::util::DeviceExt;
 
 use crate::engine::Stage;
-use crate::engine::{Ensemble, EnsembleTables};
+use crate::engine::{Ensemble, EnsembleTables, Shift};
 use crate::error::GpuError;
 use crate::gpu::block_lu::LuForm;
 use crate::gpu::contact::{contact_wgsl, require_precision, GpuReal};
@@ -91,7 +91,20 @@ struct Slot {
     update_trial_all: wgpu::BindGroup,
     /// A trial into this slot from the other: the searching variants alone.
     update_trial: wgpu::BindGroup,
-    _keep: Vec<wgpu::Buffer>,
+    /// The assembled system: diag, upper, lower, rhs.
+    system: [wgpu::Buffer; 4],
+}
+
+/// A relaxation's proximal shift on the GPU, made when a chunk first relaxes: the
+/// assembly built `SHIFT` (full and trial forms), the shift per variant and the anchors,
+/// and each slot's bind groups of those kernels.
+struct ShiftParts {
+    assemble: Arc<wgpu::ComputePipeline>,
+    assemble_force: Arc<wgpu::ComputePipeline>,
+    shift: wgpu::Buffer,
+    anchor: wgpu::Buffer,
+    /// Per slot: the full assembly's group and the trials'.
+    groups: [(wgpu::BindGroup, wgpu::BindGroup); 2],
 }
 
 struct Pipelines {
@@ -132,6 +145,9 @@ pub struct GpuEnsemble<T: GpuReal> {
     num_variants: usize,
     num_nodes: usize,
     num_pairs: usize,
+    /// A relaxation's shift (made at the first); `shifted`: the assembly runs with it.
+    shift: Option<ShiftParts>,
+    shifted: bool,
     _real: PhantomData<T>,
 }
 
@@ -328,6 +344,20 @@ impl Common {
             &self.assemble_dims,
             &self.elem_force,
             &self.elem_tangent,
+            &self.values,
+            &self.flags,
+            &self.node_site,
+            &self.f_ext,
+            &self.basis,
+            &self.fixed,
+        ]
+    }
+
+    /// The residual-only assembly's inputs (bindings 0–7: no tangents).
+    fn assembly_force_inputs(&self) -> [&wgpu::Buffer; 8] {
+        [
+            &self.assemble_dims,
+            &self.elem_force,
             &self.values,
             &self.flags,
             &self.node_site,
@@ -620,18 +650,7 @@ impl<T: GpuReal> GpuEnsemble<T> {
                 ctx,
                 &pipelines.assemble_force,
                 "assemble_force",
-                &[
-                    &c.assemble_dims,
-                    &c.elem_force,
-                    &c.values,
-                    &c.flags,
-                    &c.node_site,
-                    &c.f_ext,
-                    &c.basis,
-                    &c.fixed,
-                    &rhs,
-                    &c.active,
-                ],
+                &[&c.assembly_force_inputs()[..], &[&rhs, &c.active]].concat(),
             );
             let lu = c.lu_groups(ctx, &pipelines.block_lu, [&diag, &upper, &lower, &rhs]);
             let norms_solve = c.norms_group(ctx, &pipelines.norms, &c.ones, &rhs, false);
@@ -677,7 +696,7 @@ impl<T: GpuReal> GpuEnsemble<T> {
                 update,
                 update_trial_all,
                 update_trial,
-                _keep: vec![diag, upper, lower, rhs],
+                system: [diag, upper, lower, rhs],
             }
         };
         let slots = [make_slot(0), make_slot(1)];
@@ -694,7 +713,54 @@ impl<T: GpuReal> GpuEnsemble<T> {
             num_variants: v,
             num_nodes: n,
             num_pairs: p,
+            shift: None,
+            shifted: false,
             _real: PhantomData,
+        })
+    }
+
+    /// The shift's kernels, buffers and bind groups (made once, at a chunk's first
+    /// relaxation).
+    fn shift_parts(&self) -> Result<ShiftParts, GpuError> {
+        let ctx = self.ctx;
+        let f64 = T::IS_F64;
+        let size = std::mem::size_of::<T>();
+        let (v, n) = (self.num_variants, self.num_nodes);
+        let assemble = ctx.pipeline(
+            "assemble_shift",
+            &crate::gpu::assemble::assemble_shift_wgsl(f64, false, false)?,
+        )?;
+        let assemble_force = ctx.pipeline(
+            "assemble_trial_shift",
+            &crate::gpu::assemble::assemble_shift_wgsl(f64, true, true)?,
+        )?;
+        let shift = empty(ctx, "shift", v * size);
+        let anchor = empty(ctx, "anchor", 3 * n * v * size);
+        let c = &self.c;
+        let groups = [0, 1].map(|k| {
+            let slot = &self.slots[k];
+            let [diag, upper, lower, rhs] = &slot.system;
+            let tail = [&shift, &anchor, &slot.x];
+            let full = bind(
+                ctx,
+                &assemble,
+                "assemble_shift",
+                &[&c.assembly_inputs()[..], &[diag, upper, lower, rhs], &tail].concat(),
+            );
+            let force = bind(
+                ctx,
+                &assemble_force,
+                "assemble_trial_shift",
+                &[&c.assembly_force_inputs()[..], &[rhs, &c.active], &tail].concat(),
+            );
+            (full, force)
+        });
+        Ok(ShiftParts {
+            assemble,
+            assemble_force,
+            shift,
+            anchor,
+            groups,
         })
     }
 
@@ -716,8 +782,12 @@ impl<T: GpuReal> GpuEnsemble<T> {
             Stage::Sites => Some((&*p.sites_trial, &s.sites_trial)),
             Stage::Contact if tangent => Some((&*p.contact, &self.contact)),
             Stage::Contact => Some((&*p.contact_force, &self.contact_force)),
-            Stage::Assemble if tangent => Some((&*p.assemble, &s.assemble)),
-            Stage::Assemble => Some((&*p.assemble_force, &s.assemble_force)),
+            Stage::Assemble => match (&self.shift, self.shifted, tangent) {
+                (Some(sh), true, true) => Some((&*sh.assemble, &sh.groups[slot].0)),
+                (Some(sh), true, false) => Some((&*sh.assemble_force, &sh.groups[slot].1)),
+                (_, _, true) => Some((&*p.assemble, &s.assemble)),
+                (_, _, false) => Some((&*p.assemble_force, &s.assemble_force)),
+            },
         });
     }
 

@@ -608,6 +608,19 @@ struct CpuStatic<'a> {
     anchor: Vec<Vec3<f64>>,
 }
 
+/// The first proximal shift of a relaxation of `model` (N/m; [`StaticSystem::relax_scale`]
+/// of the CPU solve and the engine): the force scale `f_ref` over the shortest element.
+///
+/// [`StaticSystem::relax_scale`]: crate::solve::continuation::StaticSystem::relax_scale
+pub fn relax_scale(model: &Model, f_ref: f64) -> f64 {
+    let shortest = model
+        .elements
+        .iter()
+        .map(|e| e.length0)
+        .fold(f64::INFINITY, f64::min);
+    f_ref / shortest.max(1e-3)
+}
+
 /// Adds a proximal shift `s (x − a)` to the translations' residual and `s I` to their
 /// tangent blocks (before the constraints: `s I` is the same in any node basis).
 fn add_shift(
@@ -767,13 +780,7 @@ impl crate::solve::continuation::StaticSystem for CpuStatic<'_> {
         Some(self.model.nodes[k / 6].md)
     }
     fn relax_scale(&mut self, _j: usize) -> Option<f64> {
-        let shortest = self
-            .model
-            .elements
-            .iter()
-            .map(|e| e.length0)
-            .fold(f64::INFINITY, f64::min);
-        Some(self.f_ref / shortest.max(1e-3))
+        Some(relax_scale(self.model, self.f_ref))
     }
     fn unshifted_measure(&mut self, _j: usize) -> f64 {
         let mut r = vec![0.0; self.residual.len()];
