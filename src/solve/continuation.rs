@@ -146,6 +146,10 @@ pub struct LoadPath {
     pub log: Vec<String>,
     /// Why the variant failed, once it has.
     pub error: Option<StaticError>,
+    /// The answer came by relaxation past a fold, or f32's second solve at full load
+    /// failed from it: a small residual says less there (near a fold the tangent is nearly
+    /// singular), so the f32 engine confirms such an answer in f64 (`engine::verify_f32`).
+    pub doubtful: bool,
 }
 
 /// The residual measure below which a relaxation's answer is an equilibrium: in f64 (the
@@ -199,6 +203,7 @@ impl LoadPath {
             iterations: Vec::new(),
             log: Vec::new(),
             error: None,
+            doubtful: false,
         };
         p.set_target();
         p
@@ -371,6 +376,7 @@ impl LoadPath {
                     ));
                     let target = r.target;
                     self.relax = None;
+                    self.doubtful = true;
                     self.lambda = target.lambda;
                     self.stage = if self.lambda >= 1.0 {
                         if self.refine {
@@ -531,6 +537,7 @@ impl LoadPath {
                 self.log.push(format!(
                     "full load solved again from its own state as base failed ({reason}); the first solution kept"
                 ));
+                self.doubtful = true;
                 self.stage = Stage::Done;
                 return Next::Finished;
             }
