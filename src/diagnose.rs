@@ -94,6 +94,71 @@ pub fn helical_drag(case: &Case, axial: &[f64]) -> f64 {
         .sum()
 }
 
+/// Compression beyond this many helical buckling loads ends [`lock_up`]'s profile: the
+/// buckled string's wall force (quadratic in the compression) has run away there.
+pub const LOCK_UP_RATIO: f64 = 100.0;
+
+/// Where a string locks up: the soft string's compression runs away.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LockUp {
+    /// MD where the compression passes [`LOCK_UP_RATIO`] helical loads (or runs out of
+    /// numbers), m.
+    pub md: f64,
+    /// The compression at the bit end of the element where it ran away, N.
+    pub compression_n: f64,
+    /// That element's helical buckling load, N.
+    pub helical_n: f64,
+}
+
+/// Lock-up, as a drilling engineer checks it: the soft string of the case's operation
+/// carrying, beyond the weight's side force, the wall force of its own buckled shape —
+/// Mitchell's `r F² / (8 EI)` per length past the sinusoidal load and `r F² / (4 EI)` past
+/// the helical load (`F` the compression, `r` the radial clearance) — with the drag that
+/// force adds feeding back into `F` (sub-steps of
+/// [`crate::physics::soft_string::SUB_STEP`]). Pushed in or slid against friction, the
+/// compression then grows like `tan`: it runs away within a finite length, and above that
+/// point no push from the surface moves the string. `None` where it does not run away
+/// before the surface. An FE static solve of such a load finds no equilibrium (its load
+/// steps fold before the full load).
+pub fn lock_up(case: &Case) -> Option<LockUp> {
+    let model = &case.model;
+    let mid = |e: usize| 0.5 * (model.nodes[e].md + model.nodes[e + 1].md);
+    let friction_at = |md: f64| case.hole_at(md).friction;
+    let extra = |e: usize, tension: f64| -> f64 {
+        let f = -tension;
+        if f <= 0.0 || !f.is_finite() {
+            return if f.is_finite() { 0.0 } else { f64::INFINITY };
+        }
+        let hole = case.hole_at(mid(e)).diameter;
+        let (s, h) = critical_loads(model, e, hole);
+        let el = &model.elements[e];
+        let r = 0.5 * (hole - el.contact_diameter);
+        let ei = el.section.bending_stiffness();
+        if r <= 0.0 || f <= s {
+            0.0
+        } else if f <= h {
+            r * f * f / (8.0 * ei)
+        } else {
+            r * f * f / (4.0 * ei)
+        }
+    };
+    let profile = crate::physics::soft_string::soft_string_loaded(
+        model,
+        &case.operation(),
+        &friction_at,
+        &extra,
+    );
+    (0..model.elements.len()).rev().find_map(|e| {
+        let f = -profile.tension[e];
+        let (_, h) = critical_loads(model, e, case.hole_at(mid(e)).diameter);
+        (!f.is_finite() || f > LOCK_UP_RATIO * h).then(|| LockUp {
+            md: model.nodes[e].md,
+            compression_n: -profile.tension[e + 1],
+            helical_n: h,
+        })
+    })
+}
+
 /// The largest WOB that keeps every element below its helical buckling load, if the
 /// compression of each element falls one for one with the WOB (soft string, top clamped).
 fn helical_free_wob(case: &Case, axial: &[f64]) -> f64 {

@@ -171,20 +171,25 @@ impl Case {
 
     /// The soft-string profile of the case's operation, with each hole section's friction.
     pub fn soft_string(&self) -> crate::physics::soft_string::SoftStringProfile {
-        use crate::physics::soft_string::{soft_string_with, Operation};
-        let model = &self.model;
         let friction_at = |md: f64| self.hole_at(md).friction;
-        soft_string_with(
-            model,
-            &Operation {
-                axial_speed: model.axial_speed,
-                rotation_speed: model.rotation_speed,
-                weight_on_bit: model.weight_on_bit,
-                torque_on_bit: model.torque_on_bit,
-                friction: friction_at(0.0),
-            },
+        crate::physics::soft_string::soft_string_with(
+            &self.model,
+            &self.operation(),
             &friction_at,
         )
+    }
+
+    /// The case's operation for the soft string (speeds and bit loads; the friction of the
+    /// hole at the surface, each section's where it has one).
+    pub fn operation(&self) -> crate::physics::soft_string::Operation {
+        let model = &self.model;
+        crate::physics::soft_string::Operation {
+            axial_speed: model.axial_speed,
+            rotation_speed: model.rotation_speed,
+            weight_on_bit: model.weight_on_bit,
+            torque_on_bit: model.torque_on_bit,
+            friction: self.hole_at(0.0).friction,
+        }
     }
 }
 

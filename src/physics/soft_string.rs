@@ -14,6 +14,9 @@
 use crate::model::Model;
 use crate::physics::vec3::{add, dot, scale, sub};
 
+/// The longest sub-step (m) of [`soft_string_loaded`]'s added wall force.
+pub const SUB_STEP: f64 = 0.25;
+
 /// The operation: what moves, which sets the friction direction.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Operation {
@@ -64,6 +67,20 @@ pub fn soft_string_with(
     op: &Operation,
     friction_at: &dyn Fn(f64) -> f64,
 ) -> SoftStringProfile {
+    soft_string_loaded(model, op, friction_at, &|_, _| 0.0)
+}
+
+/// As [`soft_string_with`], with a normal force per length added to each element's
+/// (`extra(e, F)`, N/m, for element `e` at effective tension `F`: a buckled string's wall
+/// force), integrated from the element's lower end up in sub-steps of at most
+/// [`SUB_STEP`] m (the added force may grow fast with the compression). Where the tension
+/// turns non-finite the profile keeps it so from there up (the caller's lock-up).
+pub fn soft_string_loaded(
+    model: &Model,
+    op: &Operation,
+    friction_at: &dyn Fn(f64) -> f64,
+    extra: &dyn Fn(usize, f64) -> f64,
+) -> SoftStringProfile {
     let n = model.nodes.len();
     let mut tension = vec![0.0; n];
     let mut torque = vec![0.0; n];
@@ -83,7 +100,6 @@ pub fn soft_string_with(
         let g_perp = sub(&g, &scale(&mean, dot(&g, &mean)));
         let lateral = add(&scale(&sub(&t2, &t1), f), &scale(&g_perp, weight));
         let normal = dot(&lateral, &lateral).sqrt();
-        side_force[i] = normal;
         // The torque arm: where the string touches the wall (tool joints where it has them).
         let radius = 0.5 * e.contact_diameter;
         let (axial_share, torque_share) = {
@@ -97,8 +113,21 @@ pub fn soft_string_with(
             }
         };
         let mu = friction_at(0.5 * (model.nodes[i].md + model.nodes[i + 1].md));
-        tension[i] = f + weight * dot(&g, &mean) + mu * normal * axial_share;
-        torque[i] = torque[i + 1] + mu * normal * radius * torque_share;
+        let length = model.nodes[i + 1].md - model.nodes[i].md;
+        // The added wall force, stepped up the element with the tension it changes.
+        let subs = (length / SUB_STEP).ceil().max(1.0);
+        let h = length / subs;
+        let mut added = 0.0;
+        let mut t = f;
+        for _ in 0..subs as usize {
+            let q = extra(i, t) * h;
+            added += q;
+            t += (weight * dot(&g, &mean) + mu * normal * axial_share) * h / length.max(1e-12)
+                + mu * q * axial_share;
+        }
+        side_force[i] = normal + added;
+        tension[i] = f + weight * dot(&g, &mean) + mu * (normal + added) * axial_share;
+        torque[i] = torque[i + 1] + mu * (normal + added) * radius * torque_share;
     }
     SoftStringProfile {
         tension,
