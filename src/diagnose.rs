@@ -297,6 +297,110 @@ pub fn static_failure(case: &Case, error: &StaticError) -> String {
                 ));
             }
         }
+        if let Some(lu) = lock_up(case) {
+            msg.push_str(&format!(
+                "\n  lock-up: a soft string carrying its buckled shape's wall force (Mitchell) \
+                 runs away at MD {:.0} m (compression past {LOCK_UP_RATIO}× the helical load \
+                 of {:.1} kN): above it no push from the surface moves the string, and this \
+                 load may have no equilibrium",
+                lu.md,
+                lu.helical_n / 1e3
+            ));
+        } else if model.axial_speed > 0.0 && profile.hook_load() < 0.0 {
+            msg.push_str(&format!(
+                "\n  the soft string's hook load is {:.1} kN: running in, the string must be \
+                 pushed from the surface (the weight indicator's lock-up)",
+                profile.hook_load() / 1e3
+            ));
+        }
     }
     msg
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A straight horizontal 8.5 in hole, 5 in drill pipe slid in with `wob` at the bit.
+    fn horizontal(friction: f64, wob_kn: f64) -> Case {
+        let dir = std::env::temp_dir().join(format!("holewall_lockup_{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        std::fs::write(
+            dir.join("h.csv"),
+            "md, inclination, azimuth\n0, 90, 0\n3000, 90, 0\n",
+        )
+        .unwrap();
+        let text = format!(
+            "[well]\nprofile = \"survey\"\nsurvey = \"h.csv\"\ntotal_md = \"2500 m\"\n\
+             [[hole]]\nbottom_md = \"2500 m\"\ndiameter = \"8.5 in\"\nfriction = {friction}\n\
+             [mud]\ndensity = \"1.2 sg\"\n\
+             [[string]]\nkind = \"drill_pipe\"\nlength = \"2500 m\"\nod = \"5 in\"\nid = \"4.276 in\"\n\
+             [operation]\nmode = \"sliding\"\nweight_on_bit = \"{wob_kn} kN\"\n\
+             [mesh]\nelement_length = \"2 m\"\n"
+        );
+        let case = crate::case::parse_case(&dir.join("h.toml"), &text).unwrap();
+        let _ = std::fs::remove_dir_all(&dir);
+        case
+    }
+
+    /// Past the helical load in a horizontal hole the compression obeys
+    /// `dF/ds = μ w + μ r F² / (4 EI)` up from the bit (slid in: friction against the push),
+    /// so `F(s) = √(a/b) tan(√(ab) s + atan(F₀ √(b/a)))`, `a = μ w`, `b = μ r / (4 EI)`:
+    /// it reaches `LOCK_UP_RATIO` helical loads at a distance from the bit in closed form.
+    #[test]
+    fn lock_up_runs_away_where_the_helix_riccati_does() {
+        let case = horizontal(0.3, 250.0);
+        let model = &case.model;
+        let e = model.elements.len() - 1;
+        let el = &model.elements[e];
+        let hole = case.hole_at(model.nodes[e].md).diameter;
+        let (_, h) = critical_loads(model, e, hole);
+        assert!(
+            250e3 > h,
+            "the WOB must start past the helical load ({h} N)"
+        );
+        let (mu, w) = (0.3, el.buoyed_weight_per_length);
+        let r = 0.5 * (hole - el.contact_diameter);
+        let (a, b) = (mu * w, mu * r / (4.0 * el.section.bending_stiffness()));
+        let (k, scale) = ((a * b).sqrt(), (a / b).sqrt());
+        let closed = ((LOCK_UP_RATIO * h / scale).atan() - (250e3 / scale).atan()) / k;
+        let lu = lock_up(&case).expect("slid in past its helical load, the string locks up");
+        let bit = model.nodes.last().unwrap().md;
+        let from_bit = bit - lu.md;
+        eprintln!("lock-up {from_bit:.1} m from the bit, closed form {closed:.1} m");
+        assert!(
+            (from_bit - closed).abs() <= 2.0 + 0.01 * closed,
+            "lock-up {from_bit:.1} m from the bit; closed form {closed:.1} m"
+        );
+        assert!(lu.helical_n == h && lu.compression_n > h);
+        // Without friction nothing resists the push: no lock-up; nor with the WOB below
+        // the sinusoidal load and little friction over this length.
+        assert_eq!(lock_up(&horizontal(0.0, 250.0)), None);
+        assert_eq!(lock_up(&horizontal(0.05, 20.0)), None);
+    }
+
+    /// A failed solve of a load that locks up says so, with where.
+    #[test]
+    fn a_failure_that_locks_up_says_so() {
+        let error = StaticError::LoadStep {
+            stage: "applying the bit loads and friction (stage 2)".into(),
+            from: 0.5,
+            step: 1e-4,
+            min: 1e-4,
+            reason: "Newton did not converge".into(),
+            at_md: Some(1200.0),
+        };
+        let case = horizontal(0.3, 250.0);
+        let lu = lock_up(&case).unwrap();
+        let msg = static_failure(&case, &error);
+        assert!(
+            msg.contains("lock-up: a soft string") && msg.contains(&format!("MD {:.0} m", lu.md)),
+            "{msg}"
+        );
+        // Below the runaway: no lock-up line (a hole horizontal from the surface has no
+        // weight to push with, which the weight indicator's line says).
+        let weak = static_failure(&horizontal(0.05, 20.0), &error);
+        assert!(!weak.contains("lock-up: a soft string"), "{weak}");
+        assert!(weak.contains("must be pushed from the surface"), "{weak}");
+    }
 }

@@ -172,11 +172,7 @@ impl Case {
     /// The soft-string profile of the case's operation, with each hole section's friction.
     pub fn soft_string(&self) -> crate::physics::soft_string::SoftStringProfile {
         let friction_at = |md: f64| self.hole_at(md).friction;
-        crate::physics::soft_string::soft_string_with(
-            &self.model,
-            &self.operation(),
-            &friction_at,
-        )
+        crate::physics::soft_string::soft_string_with(&self.model, &self.operation(), &friction_at)
     }
 
     /// The case's operation for the soft string (speeds and bit loads; the friction of the

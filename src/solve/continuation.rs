@@ -836,7 +836,9 @@ mod tests {
         assert_eq!(subs, (RELAX_MAX_BUDGET * 200).div_ceil(150));
         let e = p.error.unwrap().to_string();
         assert!(
-            e.contains("budget of 3000 Newton iterations or 400 sub-solves ran out"),
+            e.contains(&format!(
+                "budget of 3000 Newton iterations or {RELAX_MAX_SUBS} sub-solves ran out"
+            )),
             "{e}"
         );
         // Easy sub-solves at the smallest shift that never settle: the sub-solve count.
