@@ -79,6 +79,13 @@ pub struct CorpusSummary {
     pub solved_with_cuts: usize,
     /// Solved wells whose load path relaxed past a fold (of `solved_with_cuts`).
     pub solved_by_relaxation: usize,
+    /// Failed wells whose load locks up by the soft string carrying its buckled wall
+    /// force ([`crate::diagnose::lock_up`]): a failure the physics predicts, still a
+    /// failure.
+    pub failed_locking_up: usize,
+    /// Solved wells whose load locks up by that soft string (the FE answer, on a mesh that
+    /// may not resolve the helix, disagrees with it: read its warning).
+    pub solved_locking_up: usize,
     /// Time per well (s), every well.
     pub seconds: Spread,
     /// Time per well (s), wells meshed with 10 m pipe elements.
@@ -228,6 +235,11 @@ pub fn run(out: &Path, options: &CorpusOptions) -> Result<CorpusSummary, Error> 
         by_mode: count(&|r| r.spec.mode.clone()),
         solved_with_cuts: solved.iter().filter(|r| r.step_cuts > 0).count(),
         solved_by_relaxation: solved.iter().filter(|r| r.relaxed).count(),
+        failed_locking_up: results
+            .iter()
+            .filter(|r| !r.solved && r.lock_up_md_m.is_finite())
+            .count(),
+        solved_locking_up: solved.iter().filter(|r| r.lock_up_md_m.is_finite()).count(),
         seconds: spread(
             &results
                 .iter()

@@ -545,6 +545,9 @@ pub struct WellResult {
     /// The drag a helically buckled string adds to the soft string's profile (N; 0 where
     /// no element passes its helical load: [`crate::diagnose::helical_drag`]).
     pub helical_drag_n: f64,
+    /// Where a soft string carrying its buckled shape's wall force locks up (MD, m; NaN
+    /// where it does not: [`crate::diagnose::lock_up`]).
+    pub lock_up_md_m: f64,
     /// FE / soft-string hook load.
     pub hook_load_ratio: f64,
     /// FE surface torque (N·m).
@@ -587,6 +590,7 @@ pub fn run_well(
         fe_hook_load_n: f64::NAN,
         soft_hook_load_n: soft.hook_load(),
         helical_drag_n: crate::diagnose::helical_drag(&case, &soft.tension),
+        lock_up_md_m: crate::diagnose::lock_up(&case).map_or(f64::NAN, |l| l.md),
         hook_load_ratio: f64::NAN,
         fe_torque_nm: f64::NAN,
         soft_torque_nm: soft.surface_torque(),
@@ -662,6 +666,7 @@ pub struct WellRow {
     fe_hook_load_n: f64,
     soft_hook_load_n: f64,
     helical_drag_n: f64,
+    lock_up_md_m: f64,
     hook_load_ratio: f64,
     fe_torque_nm: f64,
     soft_torque_nm: f64,
@@ -699,6 +704,7 @@ impl WellResult {
             fe_hook_load_n: self.fe_hook_load_n,
             soft_hook_load_n: self.soft_hook_load_n,
             helical_drag_n: self.helical_drag_n,
+            lock_up_md_m: self.lock_up_md_m,
             hook_load_ratio: self.hook_load_ratio,
             fe_torque_nm: self.fe_torque_nm,
             soft_torque_nm: self.soft_torque_nm,
