@@ -323,7 +323,11 @@ mod tests {
 
     /// A straight horizontal 8.5 in hole, 5 in drill pipe slid in with `wob` at the bit.
     fn horizontal(friction: f64, wob_kn: f64) -> Case {
-        let dir = std::env::temp_dir().join(format!("holewall_lockup_{}", std::process::id()));
+        // One folder per call: the tests run in parallel and each removes its own.
+        static CALLS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+        let call = CALLS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        let dir =
+            std::env::temp_dir().join(format!("holewall_lockup_{}_{call}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();
         std::fs::write(
             dir.join("h.csv"),
