@@ -146,7 +146,7 @@ pub fn lock_up(case: &Case) -> Option<LockUp> {
         model,
         &case.operation(),
         &friction_at,
-        &extra,
+        Some(&extra),
     );
     (0..model.elements.len()).rev().find_map(|e| {
         let f = -profile.tension[e];

@@ -67,19 +67,19 @@ pub fn soft_string_with(
     op: &Operation,
     friction_at: &dyn Fn(f64) -> f64,
 ) -> SoftStringProfile {
-    soft_string_loaded(model, op, friction_at, &|_, _| 0.0)
+    soft_string_loaded(model, op, friction_at, None)
 }
 
-/// As [`soft_string_with`], with a normal force per length added to each element's
-/// (`extra(e, F)`, N/m, for element `e` at effective tension `F`: a buckled string's wall
-/// force), integrated from the element's lower end up in sub-steps of at most
+/// As [`soft_string_with`], with (`extra`, where given) a normal force per length added to
+/// each element's (`extra(e, F)`, N/m, for element `e` at effective tension `F`: a buckled
+/// string's wall force), integrated from the element's lower end up in sub-steps of at most
 /// [`SUB_STEP`] m (the added force may grow fast with the compression). Where the tension
 /// turns non-finite the profile keeps it so from there up (the caller's lock-up).
 pub fn soft_string_loaded(
     model: &Model,
     op: &Operation,
     friction_at: &dyn Fn(f64) -> f64,
-    extra: &dyn Fn(usize, f64) -> f64,
+    extra: Option<&dyn Fn(usize, f64) -> f64>,
 ) -> SoftStringProfile {
     let n = model.nodes.len();
     let mut tension = vec![0.0; n];
@@ -115,15 +115,17 @@ pub fn soft_string_loaded(
         let mu = friction_at(0.5 * (model.nodes[i].md + model.nodes[i + 1].md));
         let length = model.nodes[i + 1].md - model.nodes[i].md;
         // The added wall force, stepped up the element with the tension it changes.
-        let subs = (length / SUB_STEP).ceil().max(1.0);
-        let h = length / subs;
         let mut added = 0.0;
-        let mut t = f;
-        for _ in 0..subs as usize {
-            let q = extra(i, t) * h;
-            added += q;
-            t += (weight * dot(&g, &mean) + mu * normal * axial_share) * h / length.max(1e-12)
-                + mu * q * axial_share;
+        if let Some(extra) = extra {
+            let subs = (length / SUB_STEP).ceil().max(1.0);
+            let h = length / subs;
+            let mut t = f;
+            for _ in 0..subs as usize {
+                let q = extra(i, t) * h;
+                added += q;
+                t += (weight * dot(&g, &mean) + mu * normal * axial_share) * h / length.max(1e-12)
+                    + mu * q * axial_share;
+            }
         }
         side_force[i] = normal + added;
         tension[i] = f + weight * dot(&g, &mean) + mu * (normal + added) * axial_share;

@@ -173,7 +173,7 @@ impl<T: GpuReal> GpuDynamic<T> {
                 ],
             )
         };
-        let inputs = c.assembly_inputs();
+        let inputs = c.assembly_inputs(true);
         let assemble = |vdot: &wgpu::Buffer| {
             let mut dynamic_inputs = vec![
                 &b.dyn_coef,

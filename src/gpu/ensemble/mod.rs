@@ -338,33 +338,22 @@ impl Common {
         bind(ctx, pipeline, "contact", &all)
     }
 
-    /// The assembly's inputs before the constraints (bindings 1–8).
-    fn assembly_inputs(&self) -> [&wgpu::Buffer; 9] {
-        [
-            &self.assemble_dims,
-            &self.elem_force,
-            &self.elem_tangent,
+    /// The assembly's inputs before the constraints (bindings 0–8; `tangent` false: the
+    /// residual-only kernel's 0–7, without the element tangents).
+    fn assembly_inputs(&self, tangent: bool) -> Vec<&wgpu::Buffer> {
+        let mut all = vec![&self.assemble_dims, &self.elem_force];
+        if tangent {
+            all.push(&self.elem_tangent);
+        }
+        all.extend([
             &self.values,
             &self.flags,
             &self.node_site,
             &self.f_ext,
             &self.basis,
             &self.fixed,
-        ]
-    }
-
-    /// The residual-only assembly's inputs (bindings 0–7: no tangents).
-    fn assembly_force_inputs(&self) -> [&wgpu::Buffer; 8] {
-        [
-            &self.assemble_dims,
-            &self.elem_force,
-            &self.values,
-            &self.flags,
-            &self.node_site,
-            &self.f_ext,
-            &self.basis,
-            &self.fixed,
-        ]
+        ]);
+        all
     }
 
     /// One bind group per pass of the block solve of `system` (diag, upper, lower, rhs).
@@ -639,7 +628,7 @@ impl<T: GpuReal> GpuEnsemble<T> {
                     &c.active,
                 ],
             );
-            let inputs = c.assembly_inputs();
+            let inputs = c.assembly_inputs(true);
             let assemble = bind(
                 ctx,
                 &pipelines.assemble,
@@ -650,7 +639,7 @@ impl<T: GpuReal> GpuEnsemble<T> {
                 ctx,
                 &pipelines.assemble_force,
                 "assemble_force",
-                &[&c.assembly_force_inputs()[..], &[&rhs, &c.active]].concat(),
+                &[&c.assembly_inputs(false)[..], &[&rhs, &c.active]].concat(),
             );
             let lu = c.lu_groups(ctx, &pipelines.block_lu, [&diag, &upper, &lower, &rhs]);
             let norms_solve = c.norms_group(ctx, &pipelines.norms, &c.ones, &rhs, false);
@@ -745,13 +734,18 @@ impl<T: GpuReal> GpuEnsemble<T> {
                 ctx,
                 &assemble,
                 "assemble_shift",
-                &[&c.assembly_inputs()[..], &[diag, upper, lower, rhs], &tail].concat(),
+                &[
+                    &c.assembly_inputs(true)[..],
+                    &[diag, upper, lower, rhs],
+                    &tail,
+                ]
+                .concat(),
             );
             let force = bind(
                 ctx,
                 &assemble_force,
                 "assemble_trial_shift",
-                &[&c.assembly_force_inputs()[..], &[rhs, &c.active], &tail].concat(),
+                &[&c.assembly_inputs(false)[..], &[rhs, &c.active], &tail].concat(),
             );
             (full, force)
         });
