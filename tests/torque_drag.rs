@@ -844,3 +844,58 @@ fn the_tool_joint_make_up_torque_is_checked_along_the_string() {
         assert!(e.key == key && e.line > 0, "{e}");
     }
 }
+
+/// A depth and mode variant's case is built from the case's tables edited in place (no file
+/// read again): the same model, to the bit, as the case file with `total_md` and `mode`
+/// rewritten by hand; a depth past the hole is refused with the key.
+#[test]
+fn a_depth_and_mode_variant_is_the_case_file_edited() {
+    use holewall::ensemble::{variant_case, Variant};
+    use holewall::keys::Key;
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("cases/broomstick.toml");
+    let case = holewall::case::load_case(&path).unwrap();
+    let key = |name: &str, text: &str| {
+        let k = Key::parse(name).unwrap();
+        let v = k.value(text).unwrap();
+        (k, v)
+    };
+    let variant = Variant {
+        name: "v".into(),
+        overrides: vec![key("depth", "1200 m"), key("mode", "tripping_in")],
+    };
+    let rebuilt = variant_case(&case, &variant)
+        .unwrap()
+        .expect("a rebuilt case");
+    let text = std::fs::read_to_string(&path).unwrap();
+    let edited = text
+        .replace("total_md = \"1500 m\"", "total_md = \"1200 m\"")
+        .replace("mode = \"rotating\"", "mode = \"tripping_in\"")
+        .replace("rpm = \"120 rpm\"\n", "");
+    assert_ne!(edited, text);
+    let by_hand = holewall::case::parse_case(&path, &edited).unwrap();
+    let (a, b) = (&rebuilt.model, &by_hand.model);
+    assert_eq!(a.nodes.len(), b.nodes.len());
+    assert_eq!(a.sites.len(), b.sites.len());
+    for (p, q) in a.nodes.iter().zip(&b.nodes) {
+        assert_eq!(p.md, q.md);
+        assert_eq!(p.position, q.position);
+    }
+    assert_eq!(rebuilt.bit_md, 1200.0);
+    assert_eq!(
+        (a.axial_speed, a.rotation_speed, a.weight_on_bit),
+        (b.axial_speed, b.rotation_speed, b.weight_on_bit)
+    );
+    assert!(
+        a.axial_speed < 0.0 || a.axial_speed > 0.0,
+        "tripping moves the pipe"
+    );
+    assert_eq!(a.rotation_speed, 0.0, "a tripping variant does not rotate");
+    // Deeper than the survey/hole allows: the variant is refused, naming the key.
+    let deep = Variant {
+        name: "deep".into(),
+        overrides: vec![key("depth", "1600 m")],
+    };
+    let e = variant_case(&case, &deep).unwrap_err();
+    assert!(e.contains("above the bit at 1600 m"), "{e}");
+    println!("{e}");
+}

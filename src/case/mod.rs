@@ -64,6 +64,21 @@ pub struct Case {
     /// What the case holds that is allowed but unusual (a sharp dogleg …): printed by every
     /// command that reads the case and written into its `summary.json`.
     pub warnings: Vec<String>,
+    /// What it was built from: a variant's case is built again from an edited copy
+    /// ([`Case::rebuilt`]).
+    pub source: std::sync::Arc<CaseSource>,
+}
+
+/// What a case is built from: its text (for the lines of messages), its tables as read and
+/// its survey's stations with their lines (read once from the survey file).
+#[derive(Clone, Debug)]
+pub struct CaseSource {
+    /// The case file's text.
+    pub text: String,
+    /// Its tables as read.
+    pub spec: CaseSpec,
+    /// The survey's path and stations (with their lines), where the well is a survey.
+    pub survey: Option<(PathBuf, Vec<(SurveyStation, usize)>)>,
 }
 
 /// A hole section (`[[hole]]`): from the previous section's bottom (or the surface) down to
@@ -205,8 +220,32 @@ pub fn load_case(path: &Path) -> Result<Case, InputError> {
 
 /// Parses a case from its text (`path` names it in messages and anchors relative paths).
 pub fn parse_case(path: &Path, text: &str) -> Result<Case, InputError> {
+    let spec = read_spec(path, text)?;
+    build_case(
+        path,
+        CaseSource {
+            text: text.to_string(),
+            spec,
+            survey: None,
+        },
+    )
+}
+
+impl Case {
+    /// This case built again from its tables edited by `edit` (a variant's depth or mode):
+    /// every input checked as written, the survey's stations as read before (the files are
+    /// not read again).
+    pub fn rebuilt(&self, edit: impl FnOnce(&mut CaseSpec)) -> Result<Case, InputError> {
+        let mut source = (*self.source).clone();
+        edit(&mut source.spec);
+        build_case(&self.path, source)
+    }
+}
+
+/// The case file's tables (serde), an error naming the line and key where they do not read.
+fn read_spec(path: &Path, text: &str) -> Result<CaseSpec, InputError> {
     let ctx = Ctx { path, text };
-    let spec: CaseSpec = toml::from_str(text).map_err(|e| {
+    toml::from_str(text).map_err(|e| {
         let line = e.span().map(|s| ctx.line(s.start)).unwrap_or(0);
         // The key the error sits on: the text before `=` on its line, qualified by the
         // table header above it (`operation.rpm`), where there is one.
@@ -243,7 +282,15 @@ pub fn parse_case(path: &Path, text: &str) -> Result<Case, InputError> {
                 }
             },
         }
-    })?;
+    })
+}
+
+/// The case from its tables ([`CaseSource`]): values checked, the well, hole and string
+/// read, the mesh and the contact sites built.
+fn build_case(path: &Path, mut source: CaseSource) -> Result<Case, InputError> {
+    let text = std::mem::take(&mut source.text);
+    let ctx = Ctx { path, text: &text };
+    let spec = &source.spec;
     let bit_md = ctx.quantity(
         &spec.well.total_md,
         "well.total_md",
@@ -252,7 +299,7 @@ pub fn parse_case(path: &Path, text: &str) -> Result<Case, InputError> {
         "0 < total_md ≤ 20 km",
     )?;
     let mut warnings: Vec<String> = Vec::new();
-    let (well, survey_read) = read_well(&ctx, &spec, path, bit_md)?;
+    let (well, survey_read) = read_well(&ctx, spec, path, bit_md, source.survey.take())?;
     // Below a survey's last station the path goes on along its last tangent.
 
     let hole = read_hole(&ctx, &spec, path, bit_md)?;
@@ -550,12 +597,16 @@ pub fn parse_case(path: &Path, text: &str) -> Result<Case, InputError> {
     }
     let tendency = tendency_settings(&ctx, spec.tendency.as_ref())?;
     let rig = rig_settings(&ctx, spec.rig.as_ref())?;
+    let title = spec.title.clone().unwrap_or_default();
+    source.survey = survey_read;
+    source.text = text;
     Ok(Case {
         rig,
         ensemble,
         tendency,
         strength,
-        title: spec.title.unwrap_or_default(),
+        title,
+        source: std::sync::Arc::new(source),
         path: path.to_path_buf(),
         model,
         hole,

@@ -85,6 +85,7 @@ pub(super) fn read_well(
     spec: &CaseSpec,
     path: &Path,
     bit_md: f64,
+    read_before: Option<(PathBuf, Vec<(SurveyStation, usize)>)>,
 ) -> Result<(WellPath, Option<(PathBuf, Vec<(SurveyStation, usize)>)>), InputError> {
     let mut survey_read: Option<(PathBuf, Vec<(SurveyStation, usize)>)> = None;
     let well = match spec.well.profile.get_ref().as_str() {
@@ -143,7 +144,10 @@ pub(super) fn read_well(
                 )
             })?;
             let survey_path = path.parent().unwrap_or(Path::new(".")).join(file.get_ref());
-            let read = read_survey(&survey_path, ctx, file.span())?;
+            let read = match read_before {
+                Some((before, read)) if before == survey_path => read,
+                _ => read_survey(&survey_path, ctx, file.span())?,
+            };
             let survey_err = |line: usize, message: String| InputError {
                 source_name: survey_path.display().to_string(),
                 line,

@@ -407,10 +407,12 @@ fn bit_md_of_model(model: &Model) -> f64 {
     model.nodes.last().map_or(0.0, |n| n.md)
 }
 
-/// The case rebuilt for a variant's `depth` and `mode`, if it has either: the case file
-/// read again with `well.total_md` and `operation.mode` replaced (every other input and
-/// check as written).
+/// The case rebuilt for a variant's `depth` and `mode`, if it has either: its tables with
+/// `well.total_md` and `operation.mode` replaced (every other input and check as written;
+/// the files are not read again: [`Case::rebuilt`]).
 pub fn variant_case(case: &Case, variant: &Variant) -> Result<Option<Case>, String> {
+    use crate::case::Quantity;
+    use toml::Spanned;
     let depth = variant
         .overrides
         .iter()
@@ -424,46 +426,36 @@ pub fn variant_case(case: &Case, variant: &Variant) -> Result<Option<Case>, Stri
     if depth.is_none() && mode.is_none() {
         return Ok(None);
     }
-    let text =
-        std::fs::read_to_string(&case.path).map_err(|e| format!("{}: {e}", case.path.display()))?;
-    let mut table: toml::Table = text
-        .parse()
-        .map_err(|e| format!("{}: {e}", case.path.display()))?;
-    let section = |t: &mut toml::Table, name: &str| -> Result<toml::Table, String> {
-        match t.get(name) {
-            Some(toml::Value::Table(s)) => Ok(s.clone()),
-            _ => Err(format!("the case has no [{name}] table")),
+    let rpm = variant
+        .overrides
+        .iter()
+        .find(|(k, _)| k.param == Param::Rpm)
+        .map(|(_, v)| *v);
+    case.rebuilt(|spec| {
+        if let Some(d) = depth {
+            let span = spec.well.total_md.span();
+            spec.well.total_md = Spanned::new(span, Quantity::Number(d));
         }
-    };
-    if let Some(d) = depth {
-        let mut well = section(&mut table, "well")?;
-        well.insert("total_md".into(), toml::Value::Float(d));
-        table.insert("well".into(), toml::Value::Table(well));
-    }
-    if let Some(m) = mode {
-        let mut op = section(&mut table, "operation")?;
-        // The variant chooses the operation: a tripping or sliding variant does not rotate
-        // (the case's rpm belongs to its rotating variants), and a rotating, reaming or
-        // back-reaming one rotates at the variant's rpm where it gives one (applied again
-        // with the other overrides).
-        if matches!(m.as_str(), "rotating" | "reaming" | "back_reaming") {
-            if let Some((_, rpm)) = variant
-                .overrides
-                .iter()
-                .find(|(k, _)| k.param == Param::Rpm)
-            {
-                op.insert("rpm".into(), toml::Value::String(format!("{rpm} rad/s")));
+        if let Some(m) = mode {
+            let op = &mut spec.operation;
+            // The variant chooses the operation: a tripping or sliding variant does not
+            // rotate (the case's rpm belongs to its rotating variants), and a rotating,
+            // reaming or back-reaming one rotates at the variant's rpm where it gives one
+            // (applied again with the other overrides).
+            if matches!(m.as_str(), "rotating" | "reaming" | "back_reaming") {
+                if let Some(rpm) = rpm {
+                    let span = op.rpm.as_ref().map_or(op.mode.span(), |q| q.span());
+                    op.rpm = Some(Spanned::new(span, Quantity::Text(format!("{rpm} rad/s"))));
+                }
+            } else {
+                op.rpm = None;
             }
-        } else {
-            op.remove("rpm");
+            let span = op.mode.span();
+            op.mode = Spanned::new(span, m);
         }
-        op.insert("mode".into(), toml::Value::String(m));
-        table.insert("operation".into(), toml::Value::Table(op));
-    }
-    let edited = toml::to_string(&table).map_err(|e| e.to_string())?;
-    crate::case::parse_case(&case.path, &edited)
-        .map(Some)
-        .map_err(|e| format!("depth/mode: {}", e.message))
+    })
+    .map(Some)
+    .map_err(|e| format!("depth/mode: {}: {}", e.key, e.message))
 }
 
 /// `n` samples of the uncertain inputs as variants named `s00001`, … (each overriding every

@@ -1,0 +1,146 @@
+//! The driver of the load paths ([`super`]): every variant of a [`StaticSystem`] stepped
+//! through its loads by one [`Newton`], each path's policy ([`LoadPath`]) deciding what
+//! follows a step's end.
+
+use super::{LoadPath, LoadTarget, Next};
+use crate::solve::newton::{Event, Newton, NewtonSettings, NewtonState, NewtonSystem};
+
+/// A static problem of V variants that [`solve_loads`] can step through its loads.
+pub trait StaticSystem: NewtonSystem {
+    /// Sets variant `j`'s loads (effective from the next solve).
+    fn set_target(&mut self, j: usize, target: &LoadTarget) -> Result<(), String>;
+    /// Keeps variant `j`'s current state as its restart point (a step completed).
+    fn save(&mut self, j: usize) -> Result<(), String>;
+    /// Returns variant `j` to its restart point.
+    fn restore(&mut self, j: usize) -> Result<(), String>;
+    /// The rounding floor of a step of variant `j` ([`NewtonSettings::step_floor`]).
+    fn step_floor(&mut self, j: usize) -> Result<f64, String>;
+    /// Where variant `j`'s residual force is largest now (MD, m), for a failure's
+    /// message; `None` where the system does not keep it at hand.
+    fn worst_residual_md(&mut self, _j: usize) -> Option<f64> {
+        None
+    }
+    /// The first proximal shift of a relaxation of variant `j` (N/m on the translations;
+    /// [`Stage::Relax`]); `None` where the system cannot relax (its variants fail where a
+    /// step fails at the smallest size).
+    fn relax_scale(&mut self, _j: usize) -> Option<f64> {
+        None
+    }
+    /// Variant `j`'s residual measure at its current state without the shift (a
+    /// relaxation has settled where it is below the tolerance).
+    fn unshifted_measure(&mut self, _j: usize) -> f64 {
+        f64::INFINITY
+    }
+    /// Sets variant `j`'s proximal shift `s` (0: none), anchored at its current state:
+    /// the residual gains `s (x − a)` on the translations, the tangent `s I`.
+    fn set_shift(&mut self, _j: usize, s: f64) -> Result<(), String> {
+        if s == 0.0 {
+            Ok(())
+        } else {
+            Err("this system cannot relax".into())
+        }
+    }
+}
+
+/// Runs every variant's load path to its end through one [`Newton`]; `progress` gets the
+/// mean load factor reached after each iteration. Returns the Newton's solve count.
+pub fn solve_loads(
+    sys: &mut dyn StaticSystem,
+    paths: &mut [LoadPath],
+    settings: NewtonSettings,
+    progress: &mut dyn FnMut(f64),
+) -> Result<usize, String> {
+    let mut solves = 0;
+    solve_loads_from(
+        sys,
+        paths,
+        settings,
+        None,
+        &|_, _| false,
+        &mut solves,
+        progress,
+    )?;
+    Ok(solves)
+}
+
+/// As [`solve_loads`], resuming (`resume`: each variant's Newton state, the system built
+/// on their current states and restart points) or from the start (every variant's state
+/// saved as its first restart point), until every path is finished or, between
+/// iterations, `stop(running, variants)` says so. Returns each variant's Newton state then
+/// (for [`solve_loads_from`] on a compacted system); adds the solves to `solves`.
+#[allow(clippy::too_many_arguments)]
+pub fn solve_loads_from(
+    sys: &mut dyn StaticSystem,
+    paths: &mut [LoadPath],
+    settings: NewtonSettings,
+    resume: Option<&[NewtonState]>,
+    stop: &dyn Fn(usize, usize) -> bool,
+    solves: &mut usize,
+    progress: &mut dyn FnMut(f64),
+) -> Result<Vec<NewtonState>, String> {
+    let v = sys.variants();
+    let mut newton = Newton::new(settings, v);
+    for (j, path) in paths.iter().enumerate() {
+        if path.finished() {
+            continue;
+        }
+        sys.set_target(j, &path.target())?;
+        match resume {
+            Some(states) => newton.resume(j, states[j].clone()),
+            None => {
+                sys.save(j)?;
+                let floor = sys.step_floor(j)?;
+                newton.start(j, floor, path.polish());
+            }
+        }
+    }
+    while newton.any_running() {
+        let events = newton.test(sys)?;
+        next_steps(sys, paths, &mut newton, events)?;
+        let events = newton.advance(sys)?;
+        next_steps(sys, paths, &mut newton, events)?;
+        progress(paths.iter().map(LoadPath::progress).sum::<f64>() / v.max(1) as f64);
+        if stop(newton.running_count(), v) {
+            break;
+        }
+    }
+    *solves += newton.solves;
+    Ok((0..v).map(|j| newton.state(j)).collect())
+}
+
+/// Variants whose solve ended: the next step of their path from the state it needs.
+fn next_steps(
+    sys: &mut dyn StaticSystem,
+    paths: &mut [LoadPath],
+    newton: &mut Newton,
+    events: Vec<(usize, Event)>,
+) -> Result<(), String> {
+    for (j, event) in events {
+        let path = &mut paths[j];
+        let (next, converged) = match event {
+            Event::Converged(its) => {
+                if path.shift() > 0.0 {
+                    path.shift_settled(sys.unshifted_measure(j));
+                }
+                (path.converged(its), true)
+            }
+            Event::Failed(reason) => {
+                let at = sys.worst_residual_md(j);
+                let relax = sys.relax_scale(j);
+                (path.failed_at(reason, at, relax), false)
+            }
+        };
+        match (next, converged) {
+            (Next::Step, true) => sys.save(j)?,
+            (Next::Step | Next::Finished, false) => sys.restore(j)?,
+            _ => {}
+        }
+        if next == Next::Step {
+            sys.set_target(j, &path.target())?;
+            sys.set_shift(j, path.shift())?;
+            let floor = sys.step_floor(j)?;
+            newton.start_limited(j, floor, path.polish(), path.iteration_limit());
+        }
+    }
+    Ok(())
+}

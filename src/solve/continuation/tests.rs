@@ -1,0 +1,151 @@
+//! Tests of the load path's policy and its driver.
+
+use super::*;
+
+/// A path past its gravity stage, its load step failing until it is below `min_step`.
+fn stuck(relax: Option<f64>) -> (LoadPath, Next) {
+    let mut p = LoadPath::new(&StaticOptions::default(), true, true, false);
+    assert_eq!(p.converged(10), Next::Step);
+    let mut next = Next::Step;
+    while p.stage == Stage::Load {
+        next = p.failed_at("no".into(), Some(100.0), relax);
+    }
+    (p, next)
+}
+
+#[test]
+fn without_a_shift_scale_a_step_below_the_smallest_fails() {
+    let (p, next) = stuck(None);
+    assert_eq!(next, Next::Failed);
+    assert!(matches!(p.error, Some(StaticError::LoadStep { .. })));
+}
+
+#[test]
+fn a_relaxation_whose_residual_stalls_just_above_the_tolerance_settles_saying_so() {
+    // Stalled at 2e-9 (f64 tolerance 1e-9, stall bound 1e-7): settles once
+    // RELAX_STALL_SUBS sub-solves have not improved it by 1 %.
+    let (mut p, _) = stuck(Some(1e6));
+    let mut subs = 0;
+    loop {
+        p.shift_settled(if subs < 10 {
+            1e-6 / (subs + 1) as f64
+        } else {
+            2e-9
+        });
+        subs += 1;
+        if p.converged(2) != Next::Step {
+            break;
+        }
+        assert!(subs < 200, "never settled");
+    }
+    assert_eq!(subs, 10 + RELAX_STALL_SUBS + 1);
+    assert!(p.error.is_none());
+    let log = p.log.last().unwrap();
+    assert!(
+        log.contains(RELAXED) && log.contains("stalled at 2.0e-9"),
+        "{log}"
+    );
+    // Stalled at 1e-6 (a thousand tolerances): not an equilibrium, it goes on.
+    let (mut p, _) = stuck(Some(1e6));
+    for _ in 0..3 * RELAX_STALL_SUBS {
+        p.shift_settled(1e-6);
+        assert_eq!(p.converged(2), Next::Step);
+    }
+}
+
+#[test]
+fn a_relaxation_lowers_its_shift_until_its_answer_is_an_equilibrium() {
+    let (mut p, next) = stuck(Some(1e6));
+    assert_eq!(next, Next::Step);
+    assert_eq!(p.shift(), 1e6);
+    assert_eq!(p.iteration_limit(), Some(RELAX_SUB_ITERATIONS));
+    let t = p.target();
+    assert_eq!((t.gravity, t.lambda, t.friction), (1.0, 1.0, 1.0));
+    // Easy sub-solves quarter the shift, harder ones halve it, hard ones keep it.
+    p.converged(3);
+    assert_eq!(p.shift(), 2.5e5);
+    p.converged(10);
+    assert_eq!(p.shift(), 1.25e5);
+    p.converged(25);
+    assert_eq!(p.shift(), 1.25e5);
+    // A failed sub-solve raises it fourfold.
+    assert_eq!(p.failed("no".into()), Next::Step);
+    assert_eq!(p.shift(), 5e5);
+    // It stays above 1e-3 s0 while the answers are not equilibria…
+    for _ in 0..20 {
+        p.shift_settled(1e-6);
+        assert_eq!(p.converged(2), Next::Step);
+    }
+    assert_eq!(p.shift(), RELAX_FLOOR * 1e6);
+    // …and ends at the first that is.
+    p.shift_settled(1e-10);
+    assert_eq!(p.converged(2), Next::Finished);
+    assert!(p.error.is_none());
+    assert!(p.log.last().unwrap().contains(RELAXED));
+    assert_eq!(p.progress(), 1.0);
+    assert_eq!(p.iteration_limit(), None);
+}
+
+#[test]
+fn a_relaxation_that_cannot_settle_fails_saying_so() {
+    let (mut p, _) = stuck(Some(1.0));
+    let mut next = Next::Step;
+    for _ in 0..RELAX_MAX_SUBS {
+        next = p.failed("no".into());
+        if next == Next::Failed {
+            break;
+        }
+    }
+    assert_eq!(next, Next::Failed);
+    let e = p.error.unwrap().to_string();
+    assert!(e.contains("found no equilibrium past it either"), "{e}");
+    assert!(e.contains("applying the bit loads"), "{e}");
+}
+
+#[test]
+fn a_relaxation_stops_when_its_iteration_budget_is_spent() {
+    let (mut p, _) = stuck(Some(1e6));
+    let mut next = Next::Step;
+    let mut subs = 0;
+    while next == Next::Step {
+        // Hard sub-solves: the shift stays, the iterations add up.
+        next = p.converged(150);
+        subs += 1;
+    }
+    assert_eq!(next, Next::Failed);
+    assert_eq!(subs, (RELAX_MAX_BUDGET * 200).div_ceil(150));
+    let e = p.error.unwrap().to_string();
+    assert!(
+        e.contains(&format!(
+            "budget of 3000 Newton iterations or {RELAX_MAX_SUBS} sub-solves ran out"
+        )),
+        "{e}"
+    );
+    // Easy sub-solves at the smallest shift that never settle: the sub-solve count.
+    let (mut p, _) = stuck(Some(1e6));
+    let mut subs = 0;
+    while p.converged(2) == Next::Step {
+        subs += 1;
+    }
+    assert_eq!(subs + 1, RELAX_MAX_SUBS);
+    assert!(p.error.is_some());
+}
+
+#[test]
+fn a_gravity_stage_that_fails_relaxes_under_gravity_alone() {
+    let mut p = LoadPath::new(&StaticOptions::default(), true, true, false);
+    let mut next = Next::Step;
+    while p.shift() == 0.0 && next == Next::Step {
+        next = p.failed_at("no".into(), None, Some(1e4));
+    }
+    assert_eq!(next, Next::Step);
+    let t = p.target();
+    assert_eq!((t.gravity, t.lambda, t.friction), (1.0, 0.0, 0.0));
+    p.converged(2);
+    // An equilibrium under gravity: the load steps follow from λ = 0.
+    p.shift_settled(0.0);
+    assert_eq!(p.converged(4), Next::Step);
+    assert_eq!(p.shift(), 0.0);
+    assert_eq!(p.stage, Stage::Load);
+    assert!(p.target().lambda > 0.0 && p.target().lambda < 1.0);
+}
