@@ -302,7 +302,7 @@ fn build_case(path: &Path, mut source: CaseSource) -> Result<Case, InputError> {
     let (well, survey_read) = read_well(&ctx, spec, path, bit_md, source.survey.take())?;
     // Below a survey's last station the path goes on along its last tangent.
 
-    let hole = read_hole(&ctx, &spec, path, bit_md)?;
+    let hole = read_hole(&ctx, spec, path, bit_md)?;
     let hole_at = |md: f64| hole_section_at(&hole, md);
 
     if let Some((survey_path, read)) = &survey_read {
@@ -357,7 +357,7 @@ fn build_case(path: &Path, mut source: CaseSource) -> Result<Case, InputError> {
         strength,
         eccentricities,
         bends,
-    } = read_string(&ctx, &spec, &hole, bit_md, (el_pipe, el_bha))?;
+    } = read_string(&ctx, spec, &hole, bit_md, (el_pipe, el_bha))?;
 
     // The mesh's size, before it is built: memory and time grow with the nodes.
     {
