@@ -391,8 +391,8 @@ fn build_case(path: &Path, mut source: CaseSource) -> Result<Case, InputError> {
         hook,
         axial_speed,
         rotation_speed,
-    } = read_operation(&ctx, &spec)?;
-    let (settings, friction, all_nodes) = read_contact(&ctx, &spec)?;
+    } = read_operation(&ctx, spec)?;
+    let (settings, friction, all_nodes) = read_contact(&ctx, spec)?;
     // Reaming and back-reaming move the pipe along and around the hole at once: the
     // friction is split by the velocity's direction (the coupled model) unless the case
     // says otherwise — the split model (the paper's) charges full friction both ways.
