@@ -547,6 +547,16 @@ impl LoadPath {
             p.stage = Stage::Failed;
             Next::Failed
         };
+        // The gravity stage's continuation gave up: relax to gravity in full, or fail.
+        let give_up_gravity = |p: &mut LoadPath| -> Next {
+            let why = std::mem::take(&mut p.gravity_reason);
+            if let Some(s0) = relax {
+                let why = format!("the gravity stage failed ({why})");
+                return p.relax_after(GRAVITY_ONLY, s0, why, true);
+            }
+            let step = p.step;
+            fail(p, step, why)
+        };
         match self.stage {
             Stage::Gravity => {
                 if self.linear_law {
@@ -567,12 +577,7 @@ impl LoadPath {
                         "exponent continuation failed at s = {:.4}: {reason}",
                         self.s
                     ));
-                    let why = std::mem::take(&mut self.gravity_reason);
-                    if let Some(s0) = relax {
-                        let why = format!("the gravity stage failed ({why})");
-                        return self.relax_after(GRAVITY_ONLY, s0, why, true);
-                    }
-                    return fail(self, self.step, why);
+                    return give_up_gravity(self);
                 }
                 self.s_step /= 2.0;
                 self.log.push(format!(
@@ -587,12 +592,7 @@ impl LoadPath {
                         "continuation in gravity failed at γ = {:.4}: {reason}",
                         self.g
                     ));
-                    let why = std::mem::take(&mut self.gravity_reason);
-                    if let Some(s0) = relax {
-                        let why = format!("the gravity stage failed ({why})");
-                        return self.relax_after(GRAVITY_ONLY, s0, why, true);
-                    }
-                    return fail(self, self.step, why);
+                    return give_up_gravity(self);
                 }
                 self.g_step /= 2.0;
                 self.log.push(format!(
