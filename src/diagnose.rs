@@ -195,6 +195,37 @@ pub fn unresolved_helix(case: &Case, axial: &[f64]) -> Option<String> {
     })
 }
 
+/// Lubinski's first-order buckling coefficient: a vertical column standing on its lower end
+/// under its own weight `w` per length buckles once the load there passes `1.94 m w`, with
+/// `m = (EI / w)^⅓` (Lubinski 1950, "A study of the buckling of rotary drilling strings").
+pub const LUBINSKI_FIRST_ORDER: f64 = 1.94;
+
+/// With contact at the stabilizers only (`contact.sites = "stabilizers"`), the string just
+/// above the top stabilizer has nothing to hold it laterally: where the compression there
+/// (`tension`, a soft-string profile, tension positive) passes its first-order buckling load
+/// as a column under its own weight, `1.94 (EI w²)^⅓` ([`LUBINSKI_FIRST_ORDER`]; `w` the
+/// axial part of the buoyed weight of the element above the stabilizer), the model lets it
+/// bow out through the wall. Returns (MD of the stabilizer (m), compression (N), that load
+/// (N)); `None` where it does not apply or is not passed.
+pub fn unsupported_buckling(case: &Case, tension: &[f64]) -> Option<(f64, f64, f64)> {
+    let model = &case.model;
+    if model.sites.is_empty() || !model.sites.iter().all(|s| s.stabilizer) {
+        return None;
+    }
+    let top = model.sites.iter().map(|s| s.node).min()?;
+    if top == 0 || top >= tension.len() {
+        return None;
+    }
+    let compression = -tension[top];
+    let el = &model.elements[top - 1];
+    let w = el.buoyed_weight_per_length * model.nodes[top].hole_axis[2].abs();
+    if compression <= 0.0 || w <= 0.0 {
+        return None;
+    }
+    let critical = LUBINSKI_FIRST_ORDER * (el.section.bending_stiffness() * w * w).cbrt();
+    (compression > critical).then_some((model.nodes[top].md, compression, critical))
+}
+
 /// A failed static solve's message with the likely reason, from the case's soft-string
 /// profile at full load: compression beyond the helical buckling load (the string winds
 /// into a helix the mesh may not resolve), or the load factor it stopped at.
@@ -269,6 +300,17 @@ pub fn static_failure(case: &Case, error: &StaticError) -> String {
             } else {
                 String::new()
             }
+        ));
+    }
+    if let Some((md, f, critical)) = unsupported_buckling(case, &case.soft_string().tension) {
+        msg.push_str(&format!(
+            "\n  likely reason: with contact.sites = \"stabilizers\" nothing holds the string \
+             above the top stabilizer (MD {md:.0} m) laterally, and its compression there at \
+             full load, {:.1} kN, passes its first-order buckling load as a column under its \
+             own weight ({:.1} kN, Lubinski: 1.94 (EI w²)^⅓): it bows out through the wall; \
+             use contact.sites = \"all_nodes\"",
+            f / 1e3,
+            critical / 1e3
         ));
     }
     if let crate::model::TopBoundary::Clamped = model.top {
@@ -406,5 +448,65 @@ mod tests {
         let weak = static_failure(&horizontal(0.05, 20.0), &error);
         assert!(!weak.contains("lock-up: a soft string"), "{weak}");
         assert!(weak.contains("must be pushed from the surface"), "{weak}");
+    }
+
+    /// A vertical 6⅛ in hole drilled at `wob_kn` on a near-bit stabilizer and 5 × 2¼ in
+    /// collars (corpus well 439's BHA), contact at `sites`.
+    fn vertical_bha(wob_kn: f64, sites: &str) -> Case {
+        let text = format!(
+            "[well]\nprofile = \"vertical\"\ntotal_md = \"1000 m\"\n\
+             [[hole]]\nbottom_md = \"1000 m\"\ndiameter = \"6.125 in\"\nfriction = 0.25\n\
+             [mud]\ndensity = \"1.278 sg\"\n\
+             [[string]]\nkind = \"bit\"\nlength = \"0.3 m\"\nod = \"5 in\"\nid = \"2.25 in\"\n\
+             [[string]]\nkind = \"stabilizer\"\nlength = \"1.5 m\"\nod = \"5 in\"\nid = \"2.25 in\"\nblade_diameter = \"6 in\"\n\
+             [[string]]\nkind = \"collar\"\nlength = \"126.2 m\"\nod = \"5 in\"\nid = \"2.25 in\"\n\
+             [[string]]\nkind = \"drill_pipe\"\nlength = \"872 m\"\nod = \"4 in\"\nid = \"3.34 in\"\n\
+             [operation]\nmode = \"rotating\"\nrpm = \"120 rpm\"\nweight_on_bit = \"{wob_kn} kN\"\n\
+             [contact]\nsites = \"{sites}\"\n[mesh]\nelement_length = \"10 m\"\nbha_element_length = \"0.5 m\"\n"
+        );
+        crate::case::parse_case(std::path::Path::new("v.toml"), &text).unwrap()
+    }
+
+    /// Lubinski's first-order load of the collars, from their sizes alone (E 207 GPa, steel
+    /// 7850 kg/m³ — the case defaults — in 1.278 sg mud): `1.94 (EI w²)^⅓` ≈ 19.9 kN. The
+    /// check fires at 28.8 kN (well 439) with contact at the stabilizers only, not at 15 kN,
+    /// and not with contact at every node.
+    #[test]
+    fn unsupported_collars_past_lubinskis_load_are_named() {
+        let (od, id): (f64, f64) = (5.0 * 0.0254, 2.25 * 0.0254);
+        let ei = 207e9 * std::f64::consts::PI / 64.0 * (od.powi(4) - id.powi(4));
+        let w = std::f64::consts::PI / 4.0 * (od * od - id * id) * 9.80665 * (7850.0 - 1278.0);
+        let hand = 1.94 * (ei * w * w).cbrt();
+        let case = vertical_bha(28.8, "stabilizers");
+        let (md, f, critical) = unsupported_buckling(&case, &case.soft_string().tension)
+            .expect("28.8 kN on unsupported collars passes Lubinski's load");
+        eprintln!(
+            "stabilizer at MD {md:.1} m: {f:.0} N against {critical:.0} N (hand {hand:.0} N)"
+        );
+        assert!(
+            (critical - hand).abs() <= 1e-3 * hand,
+            "{critical} vs {hand}"
+        );
+        assert!((19e3..21e3).contains(&critical), "{critical}");
+        // The compression at the stabilizer: the WOB less the bit's and stabilizer's weight.
+        assert!(f < 28.8e3 && f > 28.8e3 - 1.9 * w * 1.1, "{f}");
+        let error = StaticError::LoadStep {
+            stage: "applying the bit loads and friction (stage 2)".into(),
+            from: 0.5,
+            step: 1e-4,
+            min: 1e-4,
+            reason: "r".into(),
+            at_md: None,
+        };
+        let msg = static_failure(&case, &error);
+        assert!(
+            msg.contains("Lubinski") && msg.contains("all_nodes"),
+            "{msg}"
+        );
+        let light = vertical_bha(15.0, "stabilizers");
+        assert!(unsupported_buckling(&light, &light.soft_string().tension).is_none());
+        let walled = vertical_bha(28.8, "all_nodes");
+        assert!(unsupported_buckling(&walled, &walled.soft_string().tension).is_none());
+        assert!(!static_failure(&walled, &error).contains("Lubinski"));
     }
 }
