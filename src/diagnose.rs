@@ -302,7 +302,8 @@ pub fn static_failure(case: &Case, error: &StaticError) -> String {
             }
         ));
     }
-    if let Some((md, f, critical)) = unsupported_buckling(case, &case.soft_string().tension) {
+    let profile = case.soft_string();
+    if let Some((md, f, critical)) = unsupported_buckling(case, &profile.tension) {
         msg.push_str(&format!(
             "\n  likely reason: with contact.sites = \"stabilizers\" nothing holds the string \
              above the top stabilizer (MD {md:.0} m) laterally, and its compression there at \
@@ -314,7 +315,6 @@ pub fn static_failure(case: &Case, error: &StaticError) -> String {
         ));
     }
     if let crate::model::TopBoundary::Clamped = model.top {
-        let profile = case.soft_string();
         if let Some((ratio, md, f, h, pitch, length)) = worst_helical(case, &profile.tension) {
             if ratio > 1.0 {
                 msg.push_str(&format!(

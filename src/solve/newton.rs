@@ -79,9 +79,8 @@ pub struct NewtonSettings {
 /// updates fails (and its step is cut) instead of running on to `max_iterations`. Near a
 /// fold a solve two-cycles at a contact onset for its whole budget (corpus well 28: a
 /// residual of 4.1e-7 ↔ 1.1e-5 of the force scale, 200 iterations a try, 12 tries down to
-/// the smallest step). Measured on the corpus with [`crate::solve::continuation`]'s jumps
-/// (first 50 wells): 80 solves 49, 30 and 50 fewer; contacts that move along many short
-/// elements converge slowly but halve their residual well within 80.
+/// the smallest step). Measured with [`crate::solve::continuation`]'s jumps: 80 solves 49
+/// of the first 50 corpus wells; 30 and 50, tried on wells 17 and 28 only, lose well 28.
 pub const STATIC_STALL_ITERATIONS: usize = 80;
 
 /// The unit roundoff of a float type of `size` bytes.
