@@ -375,14 +375,19 @@ pub fn element_force<T: Trig>(
 }
 
 /// Internal force (12) and consistent tangent (12×12) from the closed form: the force
-/// [`element_force`] evaluated once in 12-direction dual numbers ([`DualN`]), direction `k`
-/// seeded with DOF `k` as a translation or a left spin `(I + [ε e]×)·t` — `K_jk = ∂f_j/∂Δ_k`,
-/// the derivative under the multiplicative update, with the geometric stiffness (`N/l` on
-/// the lateral translations) and the non-symmetric part of spatial spins. ≈ 1.5e4
-/// operations counted as 12 single-direction passes (the GPU kernel's form: each direction
-/// gives the same numbers); one pass shares the value part and the transcendentals. The
-/// hyper-dual form ([`force_and_tangent_hyperdual`]) is the oracle. The force is the value
-/// part, bit for bit [`element_force`]'s.
+/// [`element_force`] evaluated once in dual numbers ([`DualN`]), direction `k` seeded with
+/// DOF `k` as a translation or a left spin `(I + [ε e]×)·t` — `K_jk = ∂f_j/∂Δ_k`, the
+/// derivative under the multiplicative update, with the geometric stiffness (`N/l` on the
+/// lateral translations) and the non-symmetric part of spatial spins. ≈ 1.5e4 operations
+/// counted as 12 single-direction passes (the GPU kernel's form: each direction gives the
+/// same numbers); one pass shares the value part and the transcendentals. The hyper-dual
+/// form ([`force_and_tangent_hyperdual`]) is the oracle. The force is the value part, bit
+/// for bit [`element_force`]'s.
+///
+/// Nine directions are carried, not twelve: both chord forms see the nodes' translations
+/// only through `x₂ − x₁` ([`Chord::resolve`]), so node 1's translation columns are node 2's
+/// negated — exactly, since a seed of −1 instead of +1 negates every derivative the dual
+/// arithmetic forms without changing a rounding.
 #[allow(clippy::needless_range_loop)]
 pub fn force_and_tangent_closed<T: Trig>(
     x: &[[T; 3]; 2],
@@ -390,25 +395,32 @@ pub fn force_and_tangent_closed<T: Trig>(
     chord: &Chord<T>,
     k: &ElementStiffness<T>,
 ) -> ([T; 12], [[T; 12]; 12]) {
-    type D<T> = DualN<T, 12>;
+    // Directions: 0..3 node 2's translations, 3..6 node 1's spins, 6..9 node 2's spins.
+    type D<T> = DualN<T, 9>;
     let mut xs: [[D<T>; 3]; 2] = x.map(|p| p.map(D::constant));
     let mut ts: [Mat3<D<T>>; 2] = triad.map(|m| m.map(|r| r.map(D::constant)));
+    for axis in 0..3 {
+        xs[1][axis].d[axis] = T::one();
+    }
     for node in 0..2 {
         for axis in 0..3 {
-            // Translation: d x = e.
-            xs[node][axis].d[6 * node + axis] = T::one();
             // Spin about e_axis: d t = [e]× t, rows a and b of the triad mix.
-            let col = 6 * node + 3 + axis;
+            let dir = 3 + 3 * node + axis;
             let (a, b) = ((axis + 1) % 3, (axis + 2) % 3);
             for c in 0..3 {
-                ts[node][b][c].d[col] = triad[node][a][c];
-                ts[node][a][c].d[col] = T::zero() - triad[node][b][c];
+                ts[node][b][c].d[dir] = triad[node][a][c];
+                ts[node][a][c].d[dir] = T::zero() - triad[node][b][c];
             }
         }
     }
     let f = element_force(&xs, &ts, &chord.map(D::constant), &k.map(D::constant));
     let force = f.map(|v| v.re);
-    let tangent = f.map(|v| v.d);
+    let tangent = f.map(|v| {
+        let d = v.d;
+        [
+            -d[0], -d[1], -d[2], d[3], d[4], d[5], d[0], d[1], d[2], d[6], d[7], d[8],
+        ]
+    });
     (force, tangent)
 }
 

@@ -169,6 +169,7 @@ impl<T: Real, const N: usize> Default for DualN<T, N> {
 
 impl<T: Real, const N: usize> DualN<T, N> {
     /// A constant.
+    #[inline(always)]
     pub fn constant(re: T) -> Self {
         DualN {
             re,
@@ -177,62 +178,79 @@ impl<T: Real, const N: usize> DualN<T, N> {
     }
 
     /// g(self) with value `g` and derivative `g1` at `self.re`.
-    fn chain(self, g: T, g1: T) -> Self {
-        DualN {
-            re: g,
-            d: self.d.map(|x| g1 * x),
+    #[inline(always)]
+    fn chain(mut self, g: T, g1: T) -> Self {
+        self.re = g;
+        for x in self.d.iter_mut() {
+            *x = g1 * *x;
         }
+        self
     }
 }
 
+// The operations update the left operand's derivative array in place (loops, not
+// `array::from_fn`): the same arithmetic in the same order, without the temporaries that
+// cost the element tangent a third of its time in copies.
+
 impl<T: Real, const N: usize> Add for DualN<T, N> {
     type Output = Self;
-    fn add(self, o: Self) -> Self {
-        DualN {
-            re: self.re + o.re,
-            d: std::array::from_fn(|k| self.d[k] + o.d[k]),
+    #[inline(always)]
+    fn add(mut self, o: Self) -> Self {
+        self.re = self.re + o.re;
+        for (a, b) in self.d.iter_mut().zip(&o.d) {
+            *a = *a + *b;
         }
+        self
     }
 }
 
 impl<T: Real, const N: usize> Sub for DualN<T, N> {
     type Output = Self;
-    fn sub(self, o: Self) -> Self {
-        DualN {
-            re: self.re - o.re,
-            d: std::array::from_fn(|k| self.d[k] - o.d[k]),
+    #[inline(always)]
+    fn sub(mut self, o: Self) -> Self {
+        self.re = self.re - o.re;
+        for (a, b) in self.d.iter_mut().zip(&o.d) {
+            *a = *a - *b;
         }
+        self
     }
 }
 
 impl<T: Real, const N: usize> Neg for DualN<T, N> {
     type Output = Self;
-    fn neg(self) -> Self {
-        DualN {
-            re: -self.re,
-            d: self.d.map(|x| -x),
+    #[inline(always)]
+    fn neg(mut self) -> Self {
+        self.re = -self.re;
+        for a in self.d.iter_mut() {
+            *a = -*a;
         }
+        self
     }
 }
 
 impl<T: Real, const N: usize> Mul for DualN<T, N> {
     type Output = Self;
-    fn mul(self, o: Self) -> Self {
-        DualN {
-            re: self.re * o.re,
-            d: std::array::from_fn(|k| self.re * o.d[k] + self.d[k] * o.re),
+    #[inline(always)]
+    fn mul(mut self, o: Self) -> Self {
+        let (a, b) = (self.re, o.re);
+        self.re = a * b;
+        for (x, y) in self.d.iter_mut().zip(&o.d) {
+            *x = a * *y + *x * b;
         }
+        self
     }
 }
 
 impl<T: Real, const N: usize> Div for DualN<T, N> {
     type Output = Self;
-    fn div(self, o: Self) -> Self {
+    #[inline(always)]
+    fn div(mut self, o: Self) -> Self {
         let q = self.re / o.re;
-        DualN {
-            re: q,
-            d: std::array::from_fn(|k| (self.d[k] - q * o.d[k]) / o.re),
+        self.re = q;
+        for (x, y) in self.d.iter_mut().zip(&o.d) {
+            *x = (*x - q * *y) / o.re;
         }
+        self
     }
 }
 
