@@ -90,8 +90,11 @@ pub struct CorpusSummary {
     pub seconds: Spread,
     /// Time per well (s), wells meshed with 10 m pipe elements.
     pub seconds_10m: Spread,
-    /// Newton iterations per solved well.
+    /// Newton iterations per solved well (its completed load steps).
     pub iterations: Spread,
+    /// Every Newton iteration per well, failed tries, cut steps and relaxations included,
+    /// every well (what the time goes on).
+    pub newton_iterations: Spread,
     /// FE / soft-string hook load, solved wells (median; worst = largest |ratio − 1|).
     pub hook_load_ratio: (f64, f64, f64),
     /// FE / soft-string surface torque, solved rotating wells (min, median, max).
@@ -257,6 +260,12 @@ pub fn run(out: &Path, options: &CorpusOptions) -> Result<CorpusSummary, Error> 
             &solved
                 .iter()
                 .map(|r| (r.spec.seed, r.iterations as f64))
+                .collect::<Vec<_>>(),
+        ),
+        newton_iterations: spread(
+            &results
+                .iter()
+                .map(|r| (r.spec.seed, r.newton_iterations as f64))
                 .collect::<Vec<_>>(),
         ),
         hook_load_ratio: min_med_max(hook),

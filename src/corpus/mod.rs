@@ -534,8 +534,11 @@ pub struct WellResult {
     /// Whether the load path relaxed past a fold ([`crate::solve::continuation`]): solved,
     /// reported apart.
     pub relaxed: bool,
-    /// Newton iterations over all steps.
+    /// Newton iterations of the completed load steps.
     pub iterations: usize,
+    /// Every Newton iteration the solve ran, failed tries, cut steps and relaxation
+    /// sub-solves included (what the time was spent on; for failed wells too).
+    pub newton_iterations: usize,
     /// Wall time of the FE solve (s).
     pub seconds: f64,
     /// FE hook load (N).
@@ -575,7 +578,15 @@ pub fn run_well(
     let model = &case.model;
     let soft = case.soft_string();
     let clock = std::time::Instant::now();
-    let solved = crate::solve::statics::solve_static(model, options);
+    // Every Newton iteration the load path runs, those of failed tries and relaxation
+    // sub-solves included (the progress callback is called once per iteration).
+    let mut newton_iterations = 0usize;
+    let solved = crate::solve::statics::solve_static_monitored(
+        model,
+        crate::solve::statics::static_start(model),
+        options,
+        &mut |_| newton_iterations += 1,
+    );
     let seconds = clock.elapsed().as_secs_f64();
     let rotating = model.rotation_speed != 0.0;
     let mut r = WellResult {
@@ -586,6 +597,7 @@ pub fn run_well(
         step_cuts: 0,
         relaxed: false,
         iterations: 0,
+        newton_iterations,
         seconds,
         fe_hook_load_n: f64::NAN,
         soft_hook_load_n: soft.hook_load(),
@@ -662,6 +674,7 @@ pub struct WellRow {
     step_cuts: usize,
     relaxed: bool,
     iterations: usize,
+    newton_iterations: usize,
     seconds: f64,
     fe_hook_load_n: f64,
     soft_hook_load_n: f64,
@@ -700,6 +713,7 @@ impl WellResult {
             step_cuts: self.step_cuts,
             relaxed: self.relaxed,
             iterations: self.iterations,
+            newton_iterations: self.newton_iterations,
             seconds: self.seconds,
             fe_hook_load_n: self.fe_hook_load_n,
             soft_hook_load_n: self.soft_hook_load_n,

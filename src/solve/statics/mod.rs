@@ -417,12 +417,17 @@ pub fn reference_force(model: &Model) -> f64 {
 /// Solves for static equilibrium at full load, from the undeformed configuration, or with
 /// contact sites from [`StaticState::on_low_side`].
 pub fn solve_static(model: &Model, options: &StaticOptions) -> Result<StaticSolution, StaticError> {
-    let start = if model.sites.is_empty() {
+    solve_static_from(model, static_start(model), options)
+}
+
+/// Where [`solve_static`] starts: the string laid on the low side of the hole where it has
+/// contact sites, on the hole's axis where it has none.
+pub fn static_start(model: &Model) -> StaticState {
+    if model.sites.is_empty() {
         StaticState::initial(model)
     } else {
         StaticState::on_low_side(model)
-    };
-    solve_static_from(model, start, options)
+    }
 }
 
 /// The constrained tangent at a configuration and load factor (for stability checks:
