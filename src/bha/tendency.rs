@@ -516,7 +516,11 @@ pub fn assembly_tendency(
     if model.bends.is_empty() || model.rotation_speed == 0.0 {
         return tendency(model, bha_length, wob, None, settings);
     }
+    // The 12 toolfaces are independent solves: in parallel (rayon keeps their order, so
+    // the means are summed as before).
+    use rayon::prelude::*;
     let all: Vec<Tendency> = (0..12)
+        .into_par_iter()
         .map(|k| {
             tendency(
                 model,
