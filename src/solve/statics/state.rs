@@ -230,12 +230,13 @@ fn turn_around_side_flips(
             continue;
         };
         let phi = dot(&t, &cross(&pa, &pb)).atan2(dot(&pa, &pb));
+        // Rodrigues about the hole axis, `pa` being across it: `pa cos α + (t × pa) sin α`.
+        let quarter = cross(&t, &pa);
         for (k, slot) in offset.iter_mut().enumerate().take(b).skip(a + 1) {
             let tk = model.nodes[k].hole_axis;
             let angle = phi * (md(k) - md(a)) / (md(b) - md(a));
             let (sn, cs) = angle.sin_cos();
-            // Rodrigues: pa turned by `angle` about the hole axis, kept across it.
-            let turned: Vec3<f64> = std::array::from_fn(|r| pa[r] * cs + cross(&t, &pa)[r] * sn);
+            let turned: Vec3<f64> = std::array::from_fn(|r| pa[r] * cs + quarter[r] * sn);
             if let (Some(dir), Some(o)) = (lateral(&turned, &tk), slot.as_mut()) {
                 o.0 = dir;
             }
