@@ -180,11 +180,7 @@ pub fn solve_with_progress(
     show_progress: bool,
 ) -> Result<crate::solve::statics::StaticSolution, String> {
     let model = &case.model;
-    let start = if model.sites.is_empty() {
-        crate::solve::statics::StaticState::initial(model)
-    } else {
-        crate::solve::statics::StaticState::on_low_side(model)
-    };
+    let start = crate::solve::statics::static_start(model);
     let bar = crate::output::progress_bar(
         show_progress,
         1000,

@@ -56,11 +56,7 @@ pub fn ensemble_tables_from<T: Real>(
         basis: basis.iter().map(|&b| t(b)).collect(),
     };
     for (j, m) in models.iter().enumerate().filter(|_| !given) {
-        let s = if m.sites.is_empty() {
-            StaticState::initial(m)
-        } else {
-            StaticState::on_low_side(m)
-        };
+        let s = crate::solve::statics::static_start(m);
         for i in 0..n {
             for k in 0..3 {
                 start.x[(3 * i + k) * v + j] = t(s.x[i][k] - base.nodes[i].position[k]);

@@ -420,8 +420,9 @@ pub fn solve_static(model: &Model, options: &StaticOptions) -> Result<StaticSolu
     solve_static_from(model, static_start(model), options)
 }
 
-/// Where [`solve_static`] starts: the string laid on the low side of the hole where it has
-/// contact sites, on the hole's axis where it has none.
+/// Where every static solve starts ([`solve_static`], the static command, the engine): the
+/// string laid on the low side of the hole where it has contact sites, on the hole's axis
+/// where it has none.
 pub fn static_start(model: &Model) -> StaticState {
     if model.sites.is_empty() {
         StaticState::initial(model)
