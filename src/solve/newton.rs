@@ -73,6 +73,9 @@ pub struct NewtonSettings {
     /// A solve fails once its residual measure has not halved in this many updates
     /// (`usize::MAX`: never; it then runs to `max_iterations`).
     pub stall_iterations: usize,
+    /// A solve started with [`SolveLimits::fold_stall`] stalls after that many updates once
+    /// its residual measure is below this level (0: never; f32, whose floor lies near it).
+    pub fold_level: f64,
 }
 
 /// Statics: a load step's Newton solve that has not halved its residual in this many
@@ -82,6 +85,24 @@ pub struct NewtonSettings {
 /// the smallest step). Measured with [`crate::solve::continuation`]'s jumps: 80 solves 49
 /// of the first 50 corpus wells; 30 and 50, tried on wells 17 and 28 only, lose well 28.
 pub const STATIC_STALL_ITERATIONS: usize = 80;
+
+/// A load step's solve on a path that has met a fold ([`SolveLimits::fold_stall`]) stalls
+/// after [`FOLD_STALL_ITERATIONS`] updates without halving once its residual measure is
+/// below this level (f64; f32's floor, `1e4 u₃₂` ≈ 1.2e-3, lies above it). Past a fold a
+/// step's equations have no root near the last equilibrium: Newton falls to 1e-5–1e-7 of
+/// the force scale in a few iterations and then cycles between the sides of a contact
+/// onset (corpus well 312 at 10 m elements: 52 failed tries, every one a stall, 20 of
+/// them ending below this level), each try spending [`STATIC_STALL_ITERATIONS`].
+pub const FOLD_LEVEL: f64 = 1e-4;
+
+/// See [`FOLD_LEVEL`]. Measured (`holewall bench corpus`): on seeds 0–49, 49 / 50 solved
+/// as with 80, Newton iterations 28,314 → 19,398 and solve time 139 → 113 s; on the 12
+/// slowest wells at 10 m elements 64,762 → 39,744 iterations (well 226 solved, 134 lost:
+/// its relaxation no longer settles). Applied to every load step from the start instead
+/// (not only after a failed one) it cost corpus well 187, whose one slow step converges
+/// after 20 flat iterations, 179 → 2,193 iterations; 10 instead of 20 lost nothing on
+/// seeds 0–49 but slowed well 28 (1,966 → 3,086).
+pub const FOLD_STALL_ITERATIONS: usize = 20;
 
 /// The unit roundoff of a float type of `size` bytes.
 pub fn unit_roundoff(size: usize) -> f64 {
@@ -111,6 +132,7 @@ impl NewtonSettings {
             },
             noise_band_at_floor: size == 4,
             stall_iterations: STATIC_STALL_ITERATIONS,
+            fold_level: if size == 8 { FOLD_LEVEL } else { 0.0 },
         }
     }
 
@@ -162,6 +184,7 @@ impl NewtonSettings {
             },
             noise_band_at_floor: size == 4,
             stall_iterations: usize::MAX,
+            fold_level: 0.0,
         }
     }
 
@@ -242,6 +265,21 @@ struct Track {
     /// The smallest residual measure so far (halved at least) and the update it came at.
     best: f64,
     best_at: usize,
+    /// Updates without the residual halving after which a solve already below
+    /// [`NewtonSettings::fold_level`] stalls (a load step's solve at a fold), where shorter
+    /// than the settings' `stall_iterations`.
+    fold_stall: Option<usize>,
+}
+
+/// What limits one solve beside the settings ([`Newton::start_limited`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct SolveLimits {
+    /// Updates before the solve fails, where fewer than the settings' `max_iterations` (a
+    /// relaxation's sub-solve).
+    pub iterations: Option<usize>,
+    /// Updates without the residual halving after which a solve whose residual is already
+    /// below [`NewtonSettings::fold_level`] stalls (a load step: [`FOLD_STALL_ITERATIONS`]).
+    pub fold_stall: Option<usize>,
 }
 
 /// One variant's Newton state ([`Newton::state`]).
@@ -289,12 +327,12 @@ impl Newton {
     /// floor ([`NewtonSettings::step_floor`]); `polish`: after converging, take one more
     /// step (to rounding level), then stop.
     pub fn start(&mut self, j: usize, floor: f64, polish: bool) {
-        self.start_limited(j, floor, polish, None);
+        self.start_limited(j, floor, polish, SolveLimits::default());
     }
 
     /// As [`Newton::start`], failing after `limit` updates where given (fewer than the
     /// settings' `max_iterations`: a relaxation's sub-solve).
-    pub fn start_limited(&mut self, j: usize, floor: f64, polish: bool, limit: Option<usize>) {
+    pub fn start_limited(&mut self, j: usize, floor: f64, polish: bool, limits: SolveLimits) {
         self.tracks[j] = Track {
             running: true,
             polish,
@@ -302,11 +340,12 @@ impl Newton {
             updates: 0,
             last_step: f64::INFINITY,
             floor,
-            limit: limit.map_or(self.settings.max_iterations, |l| {
+            limit: limits.iterations.map_or(self.settings.max_iterations, |l| {
                 l.min(self.settings.max_iterations)
             }),
             best: f64::INFINITY,
             best_at: 0,
+            fold_stall: limits.fold_stall,
         };
         if let Some(a) = self.round.alpha.get_mut(j) {
             *a = 0.0;
@@ -428,7 +467,10 @@ impl Newton {
                 track.best = measure;
                 track.best_at = track.updates;
             }
-            let stall = s.stall_iterations;
+            let stall = match track.fold_stall {
+                Some(f) if track.best < s.fold_level => s.stall_iterations.min(f),
+                _ => s.stall_iterations,
+            };
             if track.updates >= track.best_at.saturating_add(stall) {
                 track.running = false;
                 events.push((
@@ -626,6 +668,91 @@ mod tests {
         assert!((root * root * root + root - 1e3).abs() < 1e-9);
         assert_eq!(ended.len(), 2);
         assert!(ended.iter().all(|(_, e)| matches!(e, Event::Converged(_))));
+    }
+
+    /// `r(x) = c + |x|`: a V with its least residual `c` at the kink and no root (the
+    /// residual of a load step past a fold, in one unknown). Newton crosses the kink each
+    /// step; its line search settles near `x = 0` at a residual of `c`.
+    struct Kink {
+        x: f64,
+        c: f64,
+        delta: f64,
+    }
+
+    impl NewtonSystem for Kink {
+        fn variants(&self) -> usize {
+            1
+        }
+        fn solve(&mut self) -> Result<Probe, String> {
+            let r = self.c + self.x.abs();
+            let slope = if self.x < 0.0 { -1.0 } else { 1.0 };
+            self.delta = -r / slope;
+            Ok(Probe {
+                measure: vec![r],
+                step: vec![self.delta.abs()],
+                slope: vec![self.delta * r],
+                norm: vec![r],
+                solved: vec![true],
+            })
+        }
+        fn trial(&mut self, alpha: &[f64], _: &[bool], _: bool) -> Result<TrialProbe, String> {
+            let r = self.c + (self.x + alpha[0] * self.delta).abs();
+            Ok(TrialProbe {
+                slope: vec![self.delta * r],
+                norm: vec![r],
+            })
+        }
+        fn accept(&mut self, alpha: &[f64], _: bool) -> Result<(), String> {
+            self.x += alpha[0] * self.delta;
+            Ok(())
+        }
+    }
+
+    /// How a solve of [`Kink`] from `x = 1` ends, and after how many updates.
+    fn kink(c: f64, size: usize, limits: SolveLimits) -> (String, usize) {
+        let mut sys = Kink {
+            x: 1.0,
+            c,
+            delta: 0.0,
+        };
+        let mut newton = Newton::new(NewtonSettings::statics(200, 1e-9, size), 1);
+        newton.start_limited(0, 1e-12, false, limits);
+        let mut ended = Vec::new();
+        while newton.any_running() {
+            ended.extend(newton.iterate(&mut sys).unwrap());
+        }
+        match &ended[..] {
+            [(0, Event::Failed(why))] => (why.clone(), newton.state(0).0.updates),
+            other => panic!("{other:?}"),
+        }
+    }
+
+    #[test]
+    fn a_solve_stalled_near_a_kink_ends_sooner_where_its_path_has_met_a_fold() {
+        let fold = SolveLimits {
+            iterations: None,
+            fold_stall: Some(FOLD_STALL_ITERATIONS),
+        };
+        // Below FOLD_LEVEL: the fold's stall.
+        let (why, updates) = kink(1e-6, 8, fold);
+        assert!(
+            why.contains(&format!("did not halve in {FOLD_STALL_ITERATIONS} ")),
+            "{why}"
+        );
+        assert!(updates < 2 * FOLD_STALL_ITERATIONS, "{updates}");
+        // Without the limit, or above the level, or in f32: the plain stall.
+        for (c, size, limits) in [
+            (1e-6, 8, SolveLimits::default()),
+            (1e-2, 8, fold),
+            (1e-6, 4, fold),
+        ] {
+            let (why, updates) = kink(c, size, limits);
+            assert!(
+                why.contains(&format!("did not halve in {STATIC_STALL_ITERATIONS} ")),
+                "{c} {size}: {why}"
+            );
+            assert!(updates >= STATIC_STALL_ITERATIONS, "{updates}");
+        }
     }
 
     #[test]

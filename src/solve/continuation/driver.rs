@@ -90,7 +90,7 @@ pub fn solve_loads_from(
             None => {
                 sys.save(j)?;
                 let floor = sys.step_floor(j)?;
-                newton.start(j, floor, path.polish());
+                newton.start_limited(j, floor, path.polish(), path.limits());
             }
         }
     }
@@ -139,7 +139,7 @@ fn next_steps(
             sys.set_target(j, &path.target())?;
             sys.set_shift(j, path.shift())?;
             let floor = sys.step_floor(j)?;
-            newton.start_limited(j, floor, path.polish(), path.iteration_limit());
+            newton.start_limited(j, floor, path.polish(), path.limits());
         }
     }
     Ok(())

@@ -37,7 +37,7 @@ mod driver;
 
 pub use driver::{solve_loads, solve_loads_from, StaticSystem};
 
-use super::newton::NewtonSettings;
+use super::newton::{NewtonSettings, SolveLimits, FOLD_STALL_ITERATIONS};
 use super::static_options::{StaticError, StaticOptions};
 
 /// The loads a variant is solved for: each a factor of the full value.
@@ -186,6 +186,8 @@ pub struct LoadPath {
     /// Jumps taken (a load step failed at the smallest size, the rest of the load tried
     /// at once from the last converged state).
     jumps: usize,
+    /// Load steps that failed so far (a load path that has met a fold).
+    load_failures: usize,
     /// The answer came by relaxation past a fold, or f32's second solve at full load
     /// failed from it: a small residual says less there (near a fold the tangent is nearly
     /// singular), so the f32 engine confirms such an answer in f64 (`engine::verify_f32`).
@@ -250,6 +252,7 @@ impl LoadPath {
             error: None,
             doubtful: false,
             jumps: 0,
+            load_failures: 0,
         };
         p.set_target();
         p
@@ -351,6 +354,17 @@ impl LoadPath {
     /// (a relaxation's shifted sub-solve: [`RELAX_SUB_ITERATIONS`]).
     pub fn iteration_limit(&self) -> Option<usize> {
         (self.shift() > 0.0).then_some(RELAX_SUB_ITERATIONS)
+    }
+
+    /// The limits of the solve being run: [`LoadPath::iteration_limit`], and in a load step
+    /// of a path on which one has failed already (it has met a fold) the fold's shorter
+    /// stall ([`crate::solve::newton::FOLD_LEVEL`]).
+    pub fn limits(&self) -> SolveLimits {
+        SolveLimits {
+            iterations: self.iteration_limit(),
+            fold_stall: (self.stage == Stage::Load && self.load_failures > 0)
+                .then_some(FOLD_STALL_ITERATIONS),
+        }
     }
 
     /// Whether the step being solved ends the path with a polishing step.
@@ -610,6 +624,7 @@ impl LoadPath {
                 return Next::Finished;
             }
             Stage::Load => {
+                self.load_failures += 1;
                 if self.step / 2.0 < self.min_step
                     && self.jumps < MAX_JUMPS
                     && 1.0 - self.lambda > 2.0 * self.step

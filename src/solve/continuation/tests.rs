@@ -14,6 +14,32 @@ fn stuck(relax: Option<f64>) -> (LoadPath, Next) {
 }
 
 #[test]
+fn a_load_path_that_has_met_a_fold_stalls_sooner_in_its_load_steps() {
+    let mut p = LoadPath::new(&StaticOptions::default(), true, true, false);
+    // Gravity, and the load steps before one has failed: the plain stall.
+    assert_eq!(p.limits(), SolveLimits::default());
+    assert_eq!(p.converged(10), Next::Step);
+    assert_eq!(p.stage, Stage::Load);
+    assert_eq!(p.limits().fold_stall, None);
+    assert_eq!(p.converged(10), Next::Step);
+    assert_eq!(p.limits().fold_stall, None);
+    // A failed load step: every later one stalls sooner, the relaxation's sub-solves not.
+    assert_eq!(p.failed_at("no".into(), None, Some(1e6)), Next::Step);
+    assert_eq!(p.limits().fold_stall, Some(FOLD_STALL_ITERATIONS));
+    assert_eq!(p.converged(3), Next::Step);
+    assert_eq!(p.limits().fold_stall, Some(FOLD_STALL_ITERATIONS));
+    let (p, _) = stuck(Some(1e6));
+    assert_eq!(p.stage, Stage::Relax);
+    assert_eq!(
+        p.limits(),
+        SolveLimits {
+            iterations: Some(RELAX_SUB_ITERATIONS),
+            fold_stall: None
+        }
+    );
+}
+
+#[test]
 fn without_a_shift_scale_a_step_below_the_smallest_fails() {
     let (p, next) = stuck(None);
     assert_eq!(next, Next::Failed);
