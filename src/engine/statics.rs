@@ -1,0 +1,320 @@
+//! A chunk's static Newton system on a kernel path ([`EngineStatic`]): the
+//! [`StaticSystem`] that [`super::solve_static_ensemble`] steps through the load path.
+
+use super::*;
+
+/// A chunk's static Newton system on a kernel path, for [`solve_loads`]: per variant its
+/// loads, its restart point (kept on the host in f64, as displacements from the reference
+/// and rotations) and its step floor. Saves, restores and load changes are gathered and
+/// carried out together before the next kernel work (one read and one write of the
+/// configuration); in f32 every save also moves the base to the current configuration.
+pub(super) struct EngineStatic<'a, T> {
+    pub(super) models: Vec<&'a Model>,
+    pub(super) ensemble: Box<dyn Ensemble<T> + 'a>,
+    pub(super) tables: EnsembleTables<T>,
+    pub(super) loads: Vec<(Vec<f64>, Vec<f64>)>,
+    pub(super) f_ref: Vec<f64>,
+    f_ext: Vec<T>,
+    params: Vec<T>,
+    loads_changed: bool,
+    evaluated: bool,
+    /// Per variant: displacements from the reference (`3 n`) and rotations (`9 n`).
+    pub(super) saved: Vec<(Vec<f64>, Vec<f64>)>,
+    to_save: Vec<usize>,
+    to_restore: Vec<usize>,
+    to_rebase: bool,
+    /// Per variant: a relaxation's shift (0: none) and its anchor (displacements from the
+    /// reference, `3 n`; empty without a shift).
+    pub(super) shifts: Vec<(f64, Vec<f64>)>,
+    /// Variants whose shift was set since the last flush (anchored at their restart point,
+    /// where the load path leaves them before it sets a shift).
+    to_anchor: Vec<usize>,
+    /// The shifts differ from what the ensemble holds.
+    shift_changed: bool,
+    /// Each variant's residual measure without its shift at the current states (kept
+    /// until a state changes).
+    unshifted: Option<Vec<f64>>,
+}
+
+impl<'a, T: Real> EngineStatic<'a, T> {
+    /// `saved`: the variants' restart points (none: their start states); `shifts`: their
+    /// relaxations' shifts and anchors (none: no shift).
+    pub(super) fn new(
+        models: Vec<&'a Model>,
+        ensemble: Box<dyn Ensemble<T> + 'a>,
+        tables: EnsembleTables<T>,
+        saved: Option<Vec<(Vec<f64>, Vec<f64>)>>,
+        shifts: Option<Vec<(f64, Vec<f64>)>>,
+    ) -> Self {
+        let (v, n, p) = (
+            tables.num_variants,
+            tables.num_nodes,
+            tables.pair_node.len(),
+        );
+        let saved = saved.unwrap_or_else(|| {
+            (0..v)
+                .map(|j| {
+                    let x = (0..3 * n)
+                        .map(|k| tables.base[k * v + j] + tables.start.x[k * v + j].to_f64_lossy())
+                        .collect();
+                    let rot = (0..9 * n)
+                        .map(|k| tables.start.rot[k * v + j].to_f64_lossy())
+                        .collect();
+                    (x, rot)
+                })
+                .collect()
+        });
+        let shifts = shifts.unwrap_or_else(|| vec![(0.0, Vec::new()); v]);
+        EngineStatic {
+            shift_changed: shifts.iter().any(|s| s.0 != 0.0),
+            shifts,
+            to_anchor: Vec::new(),
+            unshifted: None,
+            loads: models.iter().map(|m| split_loads(m)).collect(),
+            f_ref: models.iter().map(|m| reference_force(m)).collect(),
+            models,
+            ensemble,
+            f_ext: vec![T::zero(); 6 * n * v],
+            params: vec![T::zero(); PARAMS_LEN * p],
+            tables,
+            loads_changed: true,
+            evaluated: false,
+            saved,
+            to_save: Vec::new(),
+            to_restore: Vec::new(),
+            to_rebase: false,
+        }
+    }
+
+    /// Carries out the gathered saves, restores (and f32 rebase) and load changes.
+    pub(super) fn flush(&mut self) -> Result<(), String> {
+        let v = self.tables.num_variants;
+        if !self.to_save.is_empty() || !self.to_restore.is_empty() {
+            let mut config = self.ensemble.config()?;
+            for j in std::mem::take(&mut self.to_save) {
+                let (x, rot) = &mut self.saved[j];
+                for (k, x) in x.iter_mut().enumerate() {
+                    *x = self.tables.base[k * v + j] + config.x[k * v + j].to_f64_lossy();
+                }
+                for (k, r) in rot.iter_mut().enumerate() {
+                    *r = config.rot[k * v + j].to_f64_lossy();
+                }
+                if std::mem::size_of::<T>() == 4 {
+                    self.to_rebase = true;
+                }
+            }
+            let restores = std::mem::take(&mut self.to_restore);
+            for &j in &restores {
+                let (x, rot) = &self.saved[j];
+                for (k, x) in x.iter().enumerate() {
+                    config.x[k * v + j] = T::from_f64_lossy(x - self.tables.base[k * v + j]);
+                }
+                for (k, r) in rot.iter().enumerate() {
+                    config.rot[k * v + j] = T::from_f64_lossy(*r);
+                }
+            }
+            if !restores.is_empty() {
+                self.ensemble.set_config(&config)?;
+                self.evaluated = false;
+                self.unshifted = None;
+            }
+            if std::mem::take(&mut self.to_rebase) {
+                // f32: the states become the motion from here (host sums in f64).
+                let mut moved = self.tables.base.clone();
+                for (b, w) in moved.iter_mut().zip(&config.x) {
+                    *b += w.to_f64_lossy();
+                }
+                self.tables.set_base(self.models[0], moved);
+                self.ensemble.rebase(&self.tables)?;
+                self.evaluated = false;
+                self.unshifted = None;
+                // The anchors are held as displacements from the base.
+                self.shift_changed |= self.shifts.iter().any(|s| s.0 != 0.0);
+            }
+        }
+        for j in std::mem::take(&mut self.to_anchor) {
+            let (s, anchor) = &mut self.shifts[j];
+            *anchor = if *s == 0.0 {
+                Vec::new()
+            } else {
+                self.saved[j].0.clone()
+            };
+            self.shift_changed = true;
+        }
+        if std::mem::take(&mut self.shift_changed) {
+            self.upload_shift()?;
+        }
+        if self.loads_changed {
+            self.ensemble
+                .set_loads(&self.f_ext, &self.params, &self.tables.rest)?;
+            self.loads_changed = false;
+            self.evaluated = false;
+        }
+        Ok(())
+    }
+}
+
+impl<T: Real> EngineStatic<'_, T> {
+    /// Gives the ensemble the shifts and anchors (none where no variant has a shift).
+    fn upload_shift(&mut self) -> Result<(), String> {
+        let (v, n) = (self.tables.num_variants, self.tables.num_nodes);
+        self.evaluated = false;
+        if self.shifts.iter().all(|s| s.0 == 0.0) {
+            return self.ensemble.set_shift(None);
+        }
+        let mut anchor = vec![T::zero(); 3 * n * v];
+        for (j, (s, a)) in self.shifts.iter().enumerate() {
+            if *s != 0.0 {
+                for (k, a) in a.iter().enumerate() {
+                    anchor[k * v + j] = T::from_f64_lossy(a - self.tables.base[k * v + j]);
+                }
+            }
+        }
+        let shift = Shift {
+            shift: self.shifts.iter().map(|s| T::from_f64_lossy(s.0)).collect(),
+            anchor,
+        };
+        self.ensemble.set_shift(Some(&shift))
+    }
+
+    /// Every variant's residual measure at its current state without its shift: the
+    /// residual of a trial at α = 0 with the shift taken off (the shift is given back at
+    /// the next flush). A variant whose last step `Δ` is not finite gets NaN (its
+    /// relaxation then goes on: no false equilibrium).
+    fn unshifted_measures(&mut self) -> Result<Vec<f64>, String> {
+        self.flush()?;
+        let v = self.tables.num_variants;
+        if self.shifts.iter().any(|s| s.0 != 0.0) {
+            self.ensemble.set_shift(None)?;
+            self.shift_changed = true;
+            self.evaluated = false;
+        }
+        let r = self
+            .ensemble
+            .trial(&vec![T::zero(); v], &vec![true; v], true)?;
+        Ok(r.residual_max
+            .iter()
+            .zip(&self.f_ref)
+            .map(|(r, f_ref)| r.to_f64_lossy() / f_ref)
+            .collect())
+    }
+}
+
+impl<T: Real> NewtonSystem for EngineStatic<'_, T> {
+    fn variants(&self) -> usize {
+        self.tables.num_variants
+    }
+    fn solve(&mut self) -> Result<Probe, String> {
+        self.flush()?;
+        if !self.evaluated {
+            self.ensemble.evaluate()?;
+            self.evaluated = true;
+        }
+        let (now, status) = self.ensemble.solve()?;
+        let f = |x: &T| x.to_f64_lossy();
+        Ok(Probe {
+            measure: now
+                .residual_max
+                .iter()
+                .zip(&self.f_ref)
+                .map(|(r, f_ref)| f(r) / f_ref)
+                .collect(),
+            step: now.step_max.iter().map(f).collect(),
+            slope: now.step_dot_residual.iter().map(f).collect(),
+            norm: now.residual_square.iter().map(|x| f(x).sqrt()).collect(),
+            solved: status.iter().map(|&s| s == SOLVED).collect(),
+        })
+    }
+    fn trial(&mut self, alpha: &[f64], search: &[bool], first: bool) -> Result<TrialProbe, String> {
+        self.flush()?;
+        let r = self.ensemble.trial(&negated::<T>(alpha), search, first)?;
+        Ok(trial_probe(&r))
+    }
+    fn accept(&mut self, alpha: &[f64], trial_matches: bool) -> Result<(), String> {
+        self.flush()?;
+        self.unshifted = None;
+        if trial_matches {
+            // The trial's residual only: its tangent is formed when the next solve needs it.
+            self.ensemble.accept_trial();
+            self.evaluated = false;
+        } else if alpha.iter().any(|&a| a != 0.0) {
+            self.ensemble.commit(&negated::<T>(alpha))?;
+            self.evaluated = false;
+        }
+        Ok(())
+    }
+}
+
+impl<T: Real> StaticSystem for EngineStatic<'_, T> {
+    fn set_target(&mut self, j: usize, target: &LoadTarget) -> Result<(), String> {
+        let v = self.tables.num_variants;
+        let p = self.tables.pair_node.len();
+        let (gravity, other) = &self.loads[j];
+        for (d, (g, o)) in gravity.iter().zip(other).enumerate() {
+            self.f_ext[d * v + j] = T::from_f64_lossy(target.gravity * g + target.lambda * o);
+        }
+        for (k, site) in self.models[j].sites.iter().enumerate() {
+            let q = loaded_params(&site.params, target);
+            for (f, x) in q.to_array().into_iter().enumerate() {
+                self.params[f * p + k * v + j] = T::from_f64_lossy(x);
+            }
+        }
+        // Kinks grow with the bit loads, as in `loaded_model` (the CPU solve's).
+        if !self.tables.rest.is_empty() {
+            crate::kernels::beam::set_rest_column(
+                &mut self.tables.rest,
+                v,
+                j,
+                self.models[j],
+                target.lambda,
+            );
+        }
+        self.loads_changed = true;
+        Ok(())
+    }
+    fn save(&mut self, j: usize) -> Result<(), String> {
+        self.to_save.push(j);
+        Ok(())
+    }
+    fn restore(&mut self, j: usize) -> Result<(), String> {
+        self.to_restore.push(j);
+        Ok(())
+    }
+    fn step_floor(&mut self, j: usize) -> Result<f64, String> {
+        // From the last saved state (a save pending now is at most one step away).
+        let v = self.tables.num_variants;
+        let x = &self.saved[j].0;
+        let size = std::mem::size_of::<T>();
+        let largest = if size == 4 {
+            x.iter().enumerate().fold(0.0f64, |m, (k, x)| {
+                m.max((x - self.tables.base[k * v + j]).abs())
+            })
+        } else {
+            x.iter().enumerate().fold(0.0f64, |m, (k, x)| {
+                m.max((self.tables.node_ref[k] + x).abs())
+            })
+        };
+        Ok(NewtonSettings::step_floor(size, largest))
+    }
+    fn relax_scale(&mut self, j: usize) -> Option<f64> {
+        Some(crate::solve::statics::relax_scale(
+            self.models[j],
+            self.f_ref[j],
+        ))
+    }
+    fn unshifted_measure(&mut self, j: usize) -> f64 {
+        if self.unshifted.is_none() {
+            // A failed read leaves the relaxation going (no false equilibrium).
+            self.unshifted = self.unshifted_measures().ok();
+        }
+        self.unshifted.as_ref().map_or(f64::INFINITY, |m| m[j])
+    }
+    fn set_shift(&mut self, j: usize, s: f64) -> Result<(), String> {
+        if s == 0.0 && self.shifts[j].0 == 0.0 {
+            return Ok(());
+        }
+        self.shifts[j].0 = s;
+        self.to_anchor.push(j);
+        Ok(())
+    }
+}

@@ -1,0 +1,236 @@
+//! One model's static Newton system on the CPU ([`CpuStatic`]: f64, faer's block solve),
+//! the [`crate::solve::continuation::StaticSystem`] that [`super::solve_static_from`] and
+//! [`super::polish_static`] step through the load path.
+
+use super::*;
+
+/// One model's static Newton system on the CPU (faer), for [`solve_static_from`].
+pub(super) struct CpuStatic<'a> {
+    model: &'a Model,
+    c: Constraints,
+    walls: Vec<Option<Wall>>,
+    f_gravity: Vec<f64>,
+    f_other: Vec<f64>,
+    f_ref: f64,
+    /// The model with the target's friction and spring exponents.
+    loaded: Model,
+    /// External loads of the target.
+    f_step: Vec<f64>,
+    pub(super) state: StaticState,
+    saved: StaticState,
+    solver: ChainSolver,
+    residual: Vec<f64>,
+    tangent: BlockTridiagonal,
+    trial: Vec<f64>,
+    delta: Vec<f64>,
+    trial_state: Option<(f64, StaticState)>,
+    evaluated: bool,
+    /// Proximal shift (N/m) and its anchor ([`crate::solve::continuation`]'s relaxation).
+    shift: f64,
+    anchor: Vec<Vec3<f64>>,
+}
+
+/// The first proximal shift of a relaxation of `model` (N/m; [`StaticSystem::relax_scale`]
+/// of the CPU solve and the engine): the force scale `f_ref` over the shortest element.
+///
+/// [`StaticSystem::relax_scale`]: crate::solve::continuation::StaticSystem::relax_scale
+pub fn relax_scale(model: &Model, f_ref: f64) -> f64 {
+    let shortest = model
+        .elements
+        .iter()
+        .map(|e| e.length0)
+        .fold(f64::INFINITY, f64::min);
+    f_ref / shortest.max(1e-3)
+}
+
+/// Adds a proximal shift `s (x − a)` to the translations' residual and `s I` to their
+/// tangent blocks (before the constraints: `s I` is the same in any node basis).
+fn add_shift(
+    s: f64,
+    x: &[Vec3<f64>],
+    anchor: &[Vec3<f64>],
+    residual: &mut [f64],
+    tangent: Option<&mut BlockTridiagonal>,
+) {
+    if s == 0.0 {
+        return;
+    }
+    for (i, (x, a)) in x.iter().zip(anchor).enumerate() {
+        for k in 0..3 {
+            residual[6 * i + k] += s * (x[k] - a[k]);
+        }
+    }
+    if let Some(t) = tangent {
+        for d in t.diag.iter_mut() {
+            for (k, row) in d.iter_mut().take(3).enumerate() {
+                row[k] += s;
+            }
+        }
+    }
+}
+
+impl<'a> CpuStatic<'a> {
+    pub(super) fn new(model: &'a Model, start: StaticState) -> Self {
+        let (f_gravity, f_other) = split_loads(model);
+        let n = model.nodes.len();
+        CpuStatic {
+            model,
+            c: constraints(model),
+            walls: walls(model),
+            f_ref: reference_force(model),
+            f_step: vec![0.0; 6 * n],
+            f_gravity,
+            f_other,
+            loaded: model.clone(),
+            saved: start.clone(),
+            state: start,
+            solver: ChainSolver::new(),
+            residual: vec![0.0; 6 * n],
+            tangent: BlockTridiagonal::zeros(n),
+            trial: vec![0.0; 6 * n],
+            delta: vec![0.0; 6 * n],
+            trial_state: None,
+            evaluated: false,
+            shift: 0.0,
+            anchor: Vec::new(),
+        }
+    }
+}
+
+impl crate::solve::newton::NewtonSystem for CpuStatic<'_> {
+    fn variants(&self) -> usize {
+        1
+    }
+    fn solve(&mut self) -> Result<crate::solve::newton::Probe, String> {
+        if !self.evaluated {
+            assemble(
+                &self.loaded,
+                &self.state,
+                1.0,
+                &self.f_step,
+                &mut self.residual,
+                Some(&mut self.tangent),
+            );
+            add_shift(
+                self.shift,
+                &self.state.x,
+                &self.anchor,
+                &mut self.residual,
+                Some(&mut self.tangent),
+            );
+            constrain(&self.c, &mut self.residual, &mut self.tangent);
+            self.evaluated = true;
+        }
+        let rhs: Vec<f64> = self.residual.iter().map(|x| -x).collect();
+        let solved = match self.solver.solve(&self.tangent, &rhs) {
+            Ok(d) => {
+                self.delta = d;
+                true
+            }
+            Err(_) => {
+                self.delta.fill(0.0);
+                false
+            }
+        };
+        Ok(crate::solve::newton::Probe {
+            measure: vec![residual_measure(&self.residual, self.f_ref)],
+            step: vec![self.delta.iter().fold(0.0f64, |m, x| m.max(x.abs()))],
+            slope: vec![dot_n(&self.delta, &self.residual)],
+            norm: vec![dot_n(&self.residual, &self.residual).sqrt()],
+            solved: vec![solved],
+        })
+    }
+    fn trial(
+        &mut self,
+        alpha: &[f64],
+        _: &[bool],
+        _: bool,
+    ) -> Result<crate::solve::newton::TrialProbe, String> {
+        let s = update(&self.c, &self.walls, &self.state, &self.delta, alpha[0]);
+        assemble(&self.loaded, &s, 1.0, &self.f_step, &mut self.trial, None);
+        add_shift(self.shift, &s.x, &self.anchor, &mut self.trial, None);
+        constrain_residual(&self.c, &mut self.trial);
+        self.trial_state = Some((alpha[0], s));
+        Ok(crate::solve::newton::TrialProbe {
+            slope: vec![dot_n(&self.delta, &self.trial)],
+            norm: vec![dot_n(&self.trial, &self.trial).sqrt()],
+        })
+    }
+    fn accept(&mut self, alpha: &[f64], trial_matches: bool) -> Result<(), String> {
+        if alpha[0] == 0.0 {
+            return Ok(());
+        }
+        self.state = match self.trial_state.take() {
+            Some((a, s)) if trial_matches && a == alpha[0] => s,
+            _ => update(&self.c, &self.walls, &self.state, &self.delta, alpha[0]),
+        };
+        self.evaluated = false;
+        Ok(())
+    }
+}
+
+impl crate::solve::continuation::StaticSystem for CpuStatic<'_> {
+    fn set_target(
+        &mut self,
+        _j: usize,
+        target: &crate::solve::continuation::LoadTarget,
+    ) -> Result<(), String> {
+        self.loaded = loaded_model(self.model, target);
+        for (f, (g, o)) in self
+            .f_step
+            .iter_mut()
+            .zip(self.f_gravity.iter().zip(&self.f_other))
+        {
+            *f = target.gravity * g + target.lambda * o;
+        }
+        self.evaluated = false;
+        Ok(())
+    }
+    fn save(&mut self, _j: usize) -> Result<(), String> {
+        self.saved = self.state.clone();
+        Ok(())
+    }
+    fn restore(&mut self, _j: usize) -> Result<(), String> {
+        self.state = self.saved.clone();
+        self.evaluated = false;
+        Ok(())
+    }
+    fn worst_residual_md(&mut self, _j: usize) -> Option<f64> {
+        let k = (0..self.residual.len())
+            .filter(|k| k % 6 < 3)
+            .max_by(|&a, &b| self.residual[a].abs().total_cmp(&self.residual[b].abs()))?;
+        Some(self.model.nodes[k / 6].md)
+    }
+    fn relax_scale(&mut self, _j: usize) -> Option<f64> {
+        Some(relax_scale(self.model, self.f_ref))
+    }
+    fn unshifted_measure(&mut self, _j: usize) -> f64 {
+        let mut r = vec![0.0; self.residual.len()];
+        assemble(&self.loaded, &self.state, 1.0, &self.f_step, &mut r, None);
+        constrain_residual(&self.c, &mut r);
+        residual_measure(&r, self.f_ref)
+    }
+    fn set_shift(&mut self, _j: usize, s: f64) -> Result<(), String> {
+        self.shift = s;
+        self.anchor = if s == 0.0 {
+            Vec::new()
+        } else {
+            self.state.x.clone()
+        };
+        self.evaluated = false;
+        Ok(())
+    }
+    fn step_floor(&mut self, _j: usize) -> Result<f64, String> {
+        let largest = self
+            .state
+            .x
+            .iter()
+            .flatten()
+            .fold(0.0f64, |m, x| m.max(x.abs()));
+        Ok(crate::solve::newton::NewtonSettings::step_floor(8, largest))
+    }
+}
+
+fn dot_n(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| x * y).sum()
+}
