@@ -19,6 +19,30 @@ pub enum GpuError {
     Unsupported(String),
 }
 
+/// Why the machinery under a solve failed — a kernel path, a linear solve, a call out of
+/// order — as opposed to a solve that ran and did not converge (a Newton event, a
+/// [`crate::solve::statics::StaticError`]). The error of [`crate::solve::newton::NewtonSystem`],
+/// [`crate::solve::continuation::StaticSystem`] and the engine's kernel paths.
+#[derive(Clone, Debug, Error)]
+pub enum SystemError {
+    /// The GPU path failed (device, shader, read-back).
+    #[error(transparent)]
+    Gpu(#[from] GpuError),
+    /// The block solve did not finish (a GPU dispatch left a status at running) or met a
+    /// non-finite entry.
+    #[error("block solve: {0}")]
+    BlockSolve(String),
+    /// A CPU linear solve failed (faer).
+    #[error("linear solve: {0}")]
+    Linear(String),
+    /// The variants, scene or options cannot run on this path.
+    #[error("{0}")]
+    Unsupported(String),
+    /// A call out of the order the system needs (a defect of the caller).
+    #[error("called out of order: {0}")]
+    Order(&'static str),
+}
+
 /// An input error: names the source, line, key and the allowed range. Exit code 2.
 /// Shown as `source:line: key: message`, or `source: key: message` where no line applies
 /// (`line` 0: a command-line option, a whole file).
@@ -54,6 +78,9 @@ pub enum Error {
     /// GPU failure.
     #[error(transparent)]
     Gpu(#[from] GpuError),
+    /// The machinery under a solve failed (exit code 1).
+    #[error(transparent)]
+    System(#[from] SystemError),
     /// I/O failure.
     #[error("{0}")]
     Io(#[from] std::io::Error),

@@ -329,7 +329,7 @@ pub fn statics(
         )
     };
     let t = median_seconds::<Error>(repeats, || {
-        let r = solve_static_ensemble(&models, &TwinPath, &options).map_err(io)?;
+        let r = solve_static_ensemble(&models, &TwinPath, &options)?;
         figures = Some(engine_figures(&r));
         Ok(())
     })?;
@@ -343,8 +343,7 @@ pub fn statics(
         adapter = ctx.describe();
         if ctx.has_f64 {
             let t = median_seconds::<Error>(repeats, || {
-                let r = solve_static_ensemble::<f64, _>(&models, &GpuPath(ctx), &options)
-                    .map_err(io)?;
+                let r = solve_static_ensemble::<f64, _>(&models, &GpuPath(ctx), &options)?;
                 figures = Some(engine_figures(&r));
                 Ok(())
             })?;
@@ -355,8 +354,7 @@ pub fn statics(
             ));
         }
         let t = median_seconds::<Error>(repeats, || {
-            let r =
-                solve_static_ensemble::<f32, _>(&models, &GpuPath(ctx), &options).map_err(io)?;
+            let r = solve_static_ensemble::<f32, _>(&models, &GpuPath(ctx), &options)?;
             figures = Some(engine_figures(&r));
             Ok(())
         })?;

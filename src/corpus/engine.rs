@@ -48,16 +48,20 @@ pub fn run_well_engine(well: &CorpusWell, path: EnginePath) -> Result<EngineOutc
     let options = crate::solve::statics::StaticOptions::default();
     let clock = std::time::Instant::now();
     let results = match path {
-        EnginePath::Twin => solve_static_ensemble(&models, &TwinPath, &options)?,
+        EnginePath::Twin => {
+            solve_static_ensemble(&models, &TwinPath, &options).map_err(|e| e.to_string())?
+        }
         EnginePath::GpuF64 | EnginePath::GpuF32 => {
             let ctx = crate::gpu::context::GpuContext::shared().map_err(|e| e.to_string())?;
             if path == EnginePath::GpuF64 {
                 if !ctx.has_f64 {
                     return Err(format!("{} has no f64 in shaders", ctx.describe()));
                 }
-                solve_static_ensemble::<f64, _>(&models, &GpuPath(ctx), &options)?
+                solve_static_ensemble::<f64, _>(&models, &GpuPath(ctx), &options)
+                    .map_err(|e| e.to_string())?
             } else {
-                solve_static_ensemble::<f32, _>(&models, &GpuPath(ctx), &options)?
+                solve_static_ensemble::<f32, _>(&models, &GpuPath(ctx), &options)
+                    .map_err(|e| e.to_string())?
             }
         }
     };

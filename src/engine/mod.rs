@@ -110,37 +110,47 @@ pub trait Ensemble<T> {
     /// Sets the external loads (`6 n V`), the pairs' law parameters (`PARAMS_LEN · P`,
     /// field-major) and the elements' unstrained rotations (`6 (n − 1) V`, empty without a
     /// kink) of a load step.
-    fn set_loads(&mut self, f_ext: &[T], pair_params: &[T], rest: &[T]) -> Result<(), String>;
+    fn set_loads(
+        &mut self,
+        f_ext: &[T],
+        pair_params: &[T],
+        rest: &[T],
+    ) -> Result<(), crate::error::SystemError>;
     /// Residual and constrained tangent at the current configuration.
-    fn evaluate(&mut self) -> Result<(), String>;
+    fn evaluate(&mut self) -> Result<(), crate::error::SystemError>;
     /// Solves the current system for `Δ`; the norms of its residual and `Δ` (α = 1) and
     /// the solve's status per variant.
-    fn solve(&mut self) -> Result<(Norms<T>, Vec<u32>), String>;
+    fn solve(&mut self) -> Result<(Norms<T>, Vec<u32>), crate::error::SystemError>;
     /// Trial = current + `α Δ`, its residual evaluated (not its tangent: a rejected
     /// trial's tangent would be wasted, and the tangent is most of an evaluation); the norms of the
     /// trial's residual with `Δ`, `α`. Masked as [`NewtonSystem::trial`]: the variants in
     /// `search` are moved and evaluated (their norms are read); on the `first` trial of a
     /// search every variant's trial is set, later ones keep the others' trials as they are.
-    fn trial(&mut self, alpha: &[T], search: &[bool], first: bool) -> Result<Norms<T>, String>;
+    fn trial(
+        &mut self,
+        alpha: &[T],
+        search: &[bool],
+        first: bool,
+    ) -> Result<Norms<T>, crate::error::SystemError>;
     /// Makes the last trial (configuration and residual) the current one; its tangent is
     /// formed by the next [`Ensemble::evaluate`].
     fn accept_trial(&mut self);
     /// Current += `α Δ` (its system must be evaluated again).
-    fn commit(&mut self, alpha: &[T]) -> Result<(), String>;
+    fn commit(&mut self, alpha: &[T]) -> Result<(), crate::error::SystemError>;
     /// The current configuration, read back.
-    fn config(&mut self) -> Result<ConfigBatch<T>, String>;
+    fn config(&mut self) -> Result<ConfigBatch<T>, crate::error::SystemError>;
     /// Replaces the current configuration (displacements from the base and rotations;
     /// its system must be evaluated again).
-    fn set_config(&mut self, config: &ConfigBatch<T>) -> Result<(), String>;
+    fn set_config(&mut self, config: &ConfigBatch<T>) -> Result<(), crate::error::SystemError>;
     /// Sets a relaxation's proximal shift (`None`: none; [`Shift`]): every evaluation from
     /// now on adds `s_v (u − a_v)` to each node's translations' residual and `s_v I` to their
     /// diagonal block (the systems must be evaluated again).
-    fn set_shift(&mut self, shift: Option<&Shift<T>>) -> Result<(), String>;
+    fn set_shift(&mut self, shift: Option<&Shift<T>>) -> Result<(), crate::error::SystemError>;
     /// Moves the base to the current configuration, given as `tables` after
     /// [`EnsembleTables::set_base`] with the host's sum of the old base and the current
     /// displacements: the displacements from it are set to zero, the rotations kept (the
     /// system must be evaluated again).
-    fn rebase(&mut self, tables: &EnsembleTables<T>) -> Result<(), String>;
+    fn rebase(&mut self, tables: &EnsembleTables<T>) -> Result<(), crate::error::SystemError>;
 }
 
 /// A relaxation's proximal shift on a chunk ([`crate::solve::continuation`]'s
@@ -163,14 +173,14 @@ pub trait KernelPath<T> {
         &'a self,
         model: &'a Model,
         tables: &EnsembleTables<T>,
-    ) -> Result<Box<dyn Ensemble<T> + 'a>, String>;
+    ) -> Result<Box<dyn Ensemble<T> + 'a>, crate::error::SystemError>;
     /// Uploads a chunk for a dynamic run.
     fn open_dynamic<'a>(
         &'a self,
         model: &'a Model,
         tables: &EnsembleTables<T>,
         dynamic: &dynamic::DynamicTables<T>,
-    ) -> Result<Box<dyn dynamic::DynamicEnsemble<T> + 'a>, String>;
+    ) -> Result<Box<dyn dynamic::DynamicEnsemble<T> + 'a>, crate::error::SystemError>;
 }
 
 /// One kernel of the evaluation chain.
@@ -246,7 +256,7 @@ pub fn solve_static_ensemble<T: Real + Send + Sync, P: KernelPath<T>>(
     models: &[Model],
     path: &P,
     options: &StaticOptions,
-) -> Result<Vec<EngineResult>, String> {
+) -> Result<Vec<EngineResult>, crate::error::SystemError> {
     solve_static_ensemble_with_progress(models, path, options, &mut |_| {})
 }
 
@@ -257,7 +267,7 @@ pub fn solve_static_ensemble_with_progress<T: Real + Send + Sync, P: KernelPath<
     path: &P,
     options: &StaticOptions,
     progress: &mut dyn FnMut(f64),
-) -> Result<Vec<EngineResult>, String> {
+) -> Result<Vec<EngineResult>, crate::error::SystemError> {
     check_same_mesh(models)?;
     let chunk = path.max_chunk(&models[0]).max(1);
     let total = models.len();
@@ -276,7 +286,7 @@ fn solve_chunk<T: Real + Send + Sync, P: KernelPath<T>>(
     path: &P,
     options: &StaticOptions,
     progress: &mut dyn FnMut(f64),
-) -> Result<Vec<EngineResult>, String> {
+) -> Result<Vec<EngineResult>, crate::error::SystemError> {
     let tables = ensemble_tables::<T>(models)?;
     let v = tables.num_variants;
     // The mesh every variant shares (the kernels read sections and frames from it).
@@ -491,7 +501,7 @@ impl<T, P: KernelPath<T>> KernelPath<T> for Chunked<P> {
         &'a self,
         model: &'a Model,
         tables: &EnsembleTables<T>,
-    ) -> Result<Box<dyn Ensemble<T> + 'a>, String> {
+    ) -> Result<Box<dyn Ensemble<T> + 'a>, crate::error::SystemError> {
         self.inner.open(model, tables)
     }
     fn open_dynamic<'a>(
@@ -499,7 +509,7 @@ impl<T, P: KernelPath<T>> KernelPath<T> for Chunked<P> {
         model: &'a Model,
         tables: &EnsembleTables<T>,
         dynamic: &dynamic::DynamicTables<T>,
-    ) -> Result<Box<dyn dynamic::DynamicEnsemble<T> + 'a>, String> {
+    ) -> Result<Box<dyn dynamic::DynamicEnsemble<T> + 'a>, crate::error::SystemError> {
         self.inner.open_dynamic(model, tables, dynamic)
     }
 }

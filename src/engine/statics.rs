@@ -87,7 +87,7 @@ impl<'a, T: Real> EngineStatic<'a, T> {
     }
 
     /// Carries out the gathered saves, restores (and f32 rebase) and load changes.
-    pub(super) fn flush(&mut self) -> Result<(), String> {
+    pub(super) fn flush(&mut self) -> Result<(), crate::error::SystemError> {
         let v = self.tables.num_variants;
         if !self.to_save.is_empty() || !self.to_restore.is_empty() {
             let mut config = self.ensemble.config()?;
@@ -156,7 +156,7 @@ impl<'a, T: Real> EngineStatic<'a, T> {
 
 impl<T: Real> EngineStatic<'_, T> {
     /// Gives the ensemble the shifts and anchors (none where no variant has a shift).
-    fn upload_shift(&mut self) -> Result<(), String> {
+    fn upload_shift(&mut self) -> Result<(), crate::error::SystemError> {
         let (v, n) = (self.tables.num_variants, self.tables.num_nodes);
         self.evaluated = false;
         if self.shifts.iter().all(|s| s.0 == 0.0) {
@@ -181,7 +181,7 @@ impl<T: Real> EngineStatic<'_, T> {
     /// residual of a trial at α = 0 with the shift taken off (the shift is given back at
     /// the next flush). A variant whose last step `Δ` is not finite gets NaN (its
     /// relaxation then goes on: no false equilibrium).
-    fn unshifted_measures(&mut self) -> Result<Vec<f64>, String> {
+    fn unshifted_measures(&mut self) -> Result<Vec<f64>, crate::error::SystemError> {
         self.flush()?;
         let v = self.tables.num_variants;
         if self.shifts.iter().any(|s| s.0 != 0.0) {
@@ -204,7 +204,7 @@ impl<T: Real> NewtonSystem for EngineStatic<'_, T> {
     fn variants(&self) -> usize {
         self.tables.num_variants
     }
-    fn solve(&mut self) -> Result<Probe, String> {
+    fn solve(&mut self) -> Result<Probe, crate::error::SystemError> {
         self.flush()?;
         if !self.evaluated {
             self.ensemble.evaluate()?;
@@ -225,12 +225,21 @@ impl<T: Real> NewtonSystem for EngineStatic<'_, T> {
             solved: status.iter().map(|&s| s == SOLVED).collect(),
         })
     }
-    fn trial(&mut self, alpha: &[f64], search: &[bool], first: bool) -> Result<TrialProbe, String> {
+    fn trial(
+        &mut self,
+        alpha: &[f64],
+        search: &[bool],
+        first: bool,
+    ) -> Result<TrialProbe, crate::error::SystemError> {
         self.flush()?;
         let r = self.ensemble.trial(&negated::<T>(alpha), search, first)?;
         Ok(trial_probe(&r))
     }
-    fn accept(&mut self, alpha: &[f64], trial_matches: bool) -> Result<(), String> {
+    fn accept(
+        &mut self,
+        alpha: &[f64],
+        trial_matches: bool,
+    ) -> Result<(), crate::error::SystemError> {
         self.flush()?;
         self.unshifted = None;
         if trial_matches {
@@ -246,7 +255,11 @@ impl<T: Real> NewtonSystem for EngineStatic<'_, T> {
 }
 
 impl<T: Real> StaticSystem for EngineStatic<'_, T> {
-    fn set_target(&mut self, j: usize, target: &LoadTarget) -> Result<(), String> {
+    fn set_target(
+        &mut self,
+        j: usize,
+        target: &LoadTarget,
+    ) -> Result<(), crate::error::SystemError> {
         let v = self.tables.num_variants;
         let p = self.tables.pair_node.len();
         let (gravity, other) = &self.loads[j];
@@ -272,15 +285,15 @@ impl<T: Real> StaticSystem for EngineStatic<'_, T> {
         self.loads_changed = true;
         Ok(())
     }
-    fn save(&mut self, j: usize) -> Result<(), String> {
+    fn save(&mut self, j: usize) -> Result<(), crate::error::SystemError> {
         self.to_save.push(j);
         Ok(())
     }
-    fn restore(&mut self, j: usize) -> Result<(), String> {
+    fn restore(&mut self, j: usize) -> Result<(), crate::error::SystemError> {
         self.to_restore.push(j);
         Ok(())
     }
-    fn step_floor(&mut self, j: usize) -> Result<f64, String> {
+    fn step_floor(&mut self, j: usize) -> Result<f64, crate::error::SystemError> {
         // From the last saved state (a save pending now is at most one step away).
         let v = self.tables.num_variants;
         let x = &self.saved[j].0;
@@ -309,7 +322,7 @@ impl<T: Real> StaticSystem for EngineStatic<'_, T> {
         }
         self.unshifted.as_ref().map_or(f64::INFINITY, |m| m[j])
     }
-    fn set_shift(&mut self, j: usize, s: f64) -> Result<(), String> {
+    fn set_shift(&mut self, j: usize, s: f64) -> Result<(), crate::error::SystemError> {
         if s == 0.0 && self.shifts[j].0 == 0.0 {
             return Ok(());
         }

@@ -6,29 +6,35 @@ use super::*;
 
 /// An error unless every model shares the first one's mesh, number of sites and friction
 /// model.
-pub(crate) fn check_same_mesh(models: &[Model]) -> Result<(), String> {
-    let base = models.first().ok_or("no variants")?;
+pub(crate) fn check_same_mesh(models: &[Model]) -> Result<(), crate::error::SystemError> {
+    let base = models
+        .first()
+        .ok_or(crate::error::SystemError::Unsupported("no variants".into()))?;
     for m in models {
         if m.nodes.len() != base.nodes.len()
             || m.elements.len() != base.elements.len()
             || m.sites.len() != base.sites.len()
         {
-            return Err("variants differ in mesh or number of sites; run them on the CPU".into());
+            return Err(crate::error::SystemError::Unsupported(
+                "variants differ in mesh or number of sites; run them on the CPU".into(),
+            ));
         }
         // One contact kernel serves the ensemble: one friction model.
         if m.friction != base.friction {
-            return Err(
+            return Err(crate::error::SystemError::Unsupported(
                 "variants differ in friction model (split, coupled: e.g. reaming \
                         beside rotating); run them on the CPU"
                     .into(),
-            );
+            ));
         }
     }
     Ok(())
 }
 
 /// The tables of a chunk of variants (all on the first one's mesh).
-pub fn ensemble_tables<T: Real>(models: &[Model]) -> Result<EnsembleTables<T>, String> {
+pub fn ensemble_tables<T: Real>(
+    models: &[Model],
+) -> Result<EnsembleTables<T>, crate::error::SystemError> {
     ensemble_tables_from(models, None)
 }
 
@@ -39,7 +45,7 @@ pub fn ensemble_tables<T: Real>(models: &[Model]) -> Result<EnsembleTables<T>, S
 pub fn ensemble_tables_from<T: Real>(
     models: &[Model],
     start: Option<(Vec<T>, Vec<T>)>,
-) -> Result<EnsembleTables<T>, String> {
+) -> Result<EnsembleTables<T>, crate::error::SystemError> {
     check_same_mesh(models)?;
     let t = |x: f64| T::from_f64_lossy(x);
     let base = &models[0];

@@ -166,11 +166,11 @@ impl TwinEnsemble<'_> {
         };
     }
 
-    fn rhs(&self, slot: usize) -> Result<&[f64], String> {
+    fn rhs(&self, slot: usize) -> Result<&[f64], crate::error::SystemError> {
         self.system[slot]
             .as_ref()
             .map(|s| s.0.rhs.as_slice())
-            .ok_or_else(|| "system not evaluated".to_string())
+            .ok_or(crate::error::SystemError::Order("system not evaluated"))
     }
 }
 
@@ -180,7 +180,7 @@ impl Ensemble<f64> for TwinEnsemble<'_> {
         f_ext: &[f64],
         pair_params: &[f64],
         rest: &[f64],
-    ) -> Result<(), String> {
+    ) -> Result<(), crate::error::SystemError> {
         self.f_ext = f_ext.to_vec();
         self.tables.rest = rest.to_vec();
         self.contact.pair_params = pair_params.to_vec();
@@ -188,15 +188,19 @@ impl Ensemble<f64> for TwinEnsemble<'_> {
         self.refresh_walls();
         Ok(())
     }
-    fn evaluate(&mut self) -> Result<(), String> {
+    fn evaluate(&mut self) -> Result<(), crate::error::SystemError> {
         self.evaluate_slot(self.current, true);
         Ok(())
     }
-    fn solve(&mut self) -> Result<(Norms<f64>, Vec<u32>), String> {
+    fn solve(&mut self) -> Result<(Norms<f64>, Vec<u32>), crate::error::SystemError> {
         let sys = match &self.system[self.current] {
             Some((sys, true)) => sys,
-            Some((_, false)) => return Err("tangent not formed (a trial's residual only)".into()),
-            None => return Err("system not evaluated".into()),
+            Some((_, false)) => {
+                return Err(crate::error::SystemError::Order(
+                    "tangent not formed (a trial's residual only)",
+                ))
+            }
+            None => return Err(crate::error::SystemError::Order("system not evaluated")),
         };
         let (delta, status) = block_lu(sys);
         self.delta = delta;
@@ -210,7 +214,12 @@ impl Ensemble<f64> for TwinEnsemble<'_> {
         );
         Ok((n, status))
     }
-    fn trial(&mut self, alpha: &[f64], search: &[bool], first: bool) -> Result<Norms<f64>, String> {
+    fn trial(
+        &mut self,
+        alpha: &[f64],
+        search: &[bool],
+        first: bool,
+    ) -> Result<Norms<f64>, crate::error::SystemError> {
         let other = 1 - self.current;
         let mut moved = self.config[self.current].clone();
         update(&mut moved, &self.walls, &self.delta, alpha);
@@ -244,7 +253,7 @@ impl Ensemble<f64> for TwinEnsemble<'_> {
     fn accept_trial(&mut self) {
         self.current = 1 - self.current;
     }
-    fn commit(&mut self, alpha: &[f64]) -> Result<(), String> {
+    fn commit(&mut self, alpha: &[f64]) -> Result<(), crate::error::SystemError> {
         update(
             &mut self.config[self.current],
             &self.walls,
@@ -254,22 +263,22 @@ impl Ensemble<f64> for TwinEnsemble<'_> {
         self.system[self.current] = None;
         Ok(())
     }
-    fn config(&mut self) -> Result<ConfigBatch<f64>, String> {
+    fn config(&mut self) -> Result<ConfigBatch<f64>, crate::error::SystemError> {
         Ok(self.config[self.current].clone())
     }
-    fn set_config(&mut self, config: &ConfigBatch<f64>) -> Result<(), String> {
+    fn set_config(&mut self, config: &ConfigBatch<f64>) -> Result<(), crate::error::SystemError> {
         let c = &mut self.config[self.current];
         c.x.copy_from_slice(&config.x);
         c.rot.copy_from_slice(&config.rot);
         self.system[self.current] = None;
         Ok(())
     }
-    fn set_shift(&mut self, shift: Option<&Shift<f64>>) -> Result<(), String> {
+    fn set_shift(&mut self, shift: Option<&Shift<f64>>) -> Result<(), crate::error::SystemError> {
         self.shift = shift.cloned();
         self.system = [None, None];
         Ok(())
     }
-    fn rebase(&mut self, tables: &EnsembleTables<f64>) -> Result<(), String> {
+    fn rebase(&mut self, tables: &EnsembleTables<f64>) -> Result<(), crate::error::SystemError> {
         self.tables = tables.clone();
         self.refresh_walls();
         self.config[self.current].x.fill(0.0);
@@ -286,7 +295,7 @@ impl KernelPath<f64> for TwinPath {
         &'a self,
         model: &'a Model,
         tables: &EnsembleTables<f64>,
-    ) -> Result<Box<dyn Ensemble<f64> + 'a>, String> {
+    ) -> Result<Box<dyn Ensemble<f64> + 'a>, crate::error::SystemError> {
         let p = tables.pair_node.len();
         let mut contact = ContactBatch::new(1, p);
         contact.site_normals = tables.pair_normals.clone();
@@ -311,7 +320,7 @@ impl KernelPath<f64> for TwinPath {
         model: &'a Model,
         tables: &EnsembleTables<f64>,
         dynamic: &dynamic::DynamicTables<f64>,
-    ) -> Result<Box<dyn dynamic::DynamicEnsemble<f64> + 'a>, String> {
+    ) -> Result<Box<dyn dynamic::DynamicEnsemble<f64> + 'a>, crate::error::SystemError> {
         Ok(Box::new(self.dynamic(model, tables, dynamic)))
     }
 }

@@ -37,7 +37,7 @@ pub fn run_static_gpu<T: crate::gpu::contact::GpuReal>(
         ));
     }
     if let Err(e) = crate::engine::check_same_mesh(&models) {
-        return Ok(Err(e));
+        return Ok(Err(e.to_string()));
     }
     let results = solve_static_ensemble_with_progress::<T, _>(
         &models,
@@ -100,7 +100,7 @@ pub fn run_dynamic_gpu<T: crate::gpu::contact::GpuReal>(
         ));
     }
     if let Err(e) = crate::engine::check_same_mesh(&models) {
-        return Ok(Err(e));
+        return Ok(Err(e.to_string()));
     }
     let path = GpuPath(ctx);
     let statics = solve_static_ensemble::<T, _>(&models, &path, &StaticOptions::default())

@@ -16,19 +16,19 @@ impl<T: super::contact::GpuReal> KernelPath<T> for GpuPath {
         &'a self,
         model: &'a Model,
         tables: &EnsembleTables<T>,
-    ) -> Result<Box<dyn Ensemble<T> + 'a>, String> {
+    ) -> Result<Box<dyn Ensemble<T> + 'a>, crate::error::SystemError> {
         super::ensemble::GpuEnsemble::new(self.0, model, tables)
             .map(|e| Box::new(e) as Box<dyn Ensemble<T> + 'a>)
-            .map_err(|e| e.to_string())
+            .map_err(crate::error::SystemError::from)
     }
     fn open_dynamic<'a>(
         &'a self,
         model: &'a Model,
         tables: &EnsembleTables<T>,
         dynamic: &dynamic::DynamicTables<T>,
-    ) -> Result<Box<dyn dynamic::DynamicEnsemble<T> + 'a>, String> {
+    ) -> Result<Box<dyn dynamic::DynamicEnsemble<T> + 'a>, crate::error::SystemError> {
         super::ensemble::GpuDynamic::new(self.0, model, tables, dynamic)
             .map(|e| Box::new(e) as Box<dyn dynamic::DynamicEnsemble<T> + 'a>)
-            .map_err(|e| e.to_string())
+            .map_err(crate::error::SystemError::from)
     }
 }

@@ -229,7 +229,7 @@ pub trait NewtonSystem {
     fn variants(&self) -> usize;
     /// Evaluates (where its system is stale) and solves at the current point of every
     /// variant.
-    fn solve(&mut self) -> Result<Probe, String>;
+    fn solve(&mut self) -> Result<Probe, crate::error::SystemError>;
     /// Evaluates trial points `current + α Δ` for the variants in `search` (their
     /// [`TrialProbe`] entries are read; the others' may be anything). `first`: the first
     /// trial of a line search — every variant's trial point is set (α = 0: the current);
@@ -237,10 +237,19 @@ pub trait NewtonSystem {
     /// it has (a variant whose step was accepted at an earlier trial of the search), so
     /// that [`NewtonSystem::accept`] may take the trial points as they stand. A system may
     /// evaluate more than `search` (one variant's systems do).
-    fn trial(&mut self, alpha: &[f64], search: &[bool], first: bool) -> Result<TrialProbe, String>;
+    fn trial(
+        &mut self,
+        alpha: &[f64],
+        search: &[bool],
+        first: bool,
+    ) -> Result<TrialProbe, crate::error::SystemError>;
     /// Current `+= α Δ`. `trial_matches`: the last trial was at exactly these α (its
     /// evaluation may be kept).
-    fn accept(&mut self, alpha: &[f64], trial_matches: bool) -> Result<(), String>;
+    fn accept(
+        &mut self,
+        alpha: &[f64],
+        trial_matches: bool,
+    ) -> Result<(), crate::error::SystemError>;
 }
 
 /// How a variant's Newton solve ended.
@@ -393,7 +402,10 @@ impl Newton {
 
     /// One iteration of every running variant: [`Newton::test`], then
     /// [`Newton::advance`]. Returns the variants whose solve ended in it, with how.
-    pub fn iterate(&mut self, sys: &mut dyn NewtonSystem) -> Result<Vec<(usize, Event)>, String> {
+    pub fn iterate(
+        &mut self,
+        sys: &mut dyn NewtonSystem,
+    ) -> Result<Vec<(usize, Event)>, crate::error::SystemError> {
         let mut events = self.test(sys)?;
         events.extend(self.advance(sys)?);
         Ok(events)
@@ -403,7 +415,10 @@ impl Newton {
     /// the running ones. Returns the variants whose solve ended (converged with the step
     /// just taken, or failed); the caller may [`Newton::start`] them again (new load,
     /// restored state) before [`Newton::advance`], which then leaves them in place.
-    pub fn test(&mut self, sys: &mut dyn NewtonSystem) -> Result<Vec<(usize, Event)>, String> {
+    pub fn test(
+        &mut self,
+        sys: &mut dyn NewtonSystem,
+    ) -> Result<Vec<(usize, Event)>, crate::error::SystemError> {
         let v = self.tracks.len();
         let s = self.settings;
         let probe = sys.solve()?;
@@ -502,7 +517,10 @@ impl Newton {
     /// Second half of an iteration: the line search of every running variant (all in the
     /// same trials) and the update. Variants (re)started since [`Newton::test`] stay
     /// where they are. Returns the variants whose solve ended in it.
-    pub fn advance(&mut self, sys: &mut dyn NewtonSystem) -> Result<Vec<(usize, Event)>, String> {
+    pub fn advance(
+        &mut self,
+        sys: &mut dyn NewtonSystem,
+    ) -> Result<Vec<(usize, Event)>, crate::error::SystemError> {
         let v = self.tracks.len();
         let s = self.settings;
         let Round {
@@ -513,7 +531,9 @@ impl Newton {
             probe,
         } = std::mem::take(&mut self.round);
         if alpha.len() != v {
-            return Err("Newton::advance without Newton::test".into());
+            return Err(crate::error::SystemError::Order(
+                "Newton::advance without Newton::test",
+            ));
         }
         let mut events = Vec::new();
         let mut trial_matches = false;
@@ -614,7 +634,7 @@ mod tests {
         fn variants(&self) -> usize {
             self.x.len()
         }
-        fn solve(&mut self) -> Result<Probe, String> {
+        fn solve(&mut self) -> Result<Probe, crate::error::SystemError> {
             let mut p = Probe::default();
             self.delta.clear();
             for (x, b) in self.x.iter().zip(&self.b) {
@@ -629,7 +649,12 @@ mod tests {
             }
             Ok(p)
         }
-        fn trial(&mut self, alpha: &[f64], _: &[bool], _: bool) -> Result<TrialProbe, String> {
+        fn trial(
+            &mut self,
+            alpha: &[f64],
+            _: &[bool],
+            _: bool,
+        ) -> Result<TrialProbe, crate::error::SystemError> {
             let mut t = TrialProbe::default();
             for j in 0..self.x.len() {
                 let x = self.x[j] + alpha[j] * self.delta[j];
@@ -639,7 +664,7 @@ mod tests {
             }
             Ok(t)
         }
-        fn accept(&mut self, alpha: &[f64], _: bool) -> Result<(), String> {
+        fn accept(&mut self, alpha: &[f64], _: bool) -> Result<(), crate::error::SystemError> {
             for j in 0..self.x.len() {
                 self.x[j] += alpha[j] * self.delta[j];
             }
@@ -683,7 +708,7 @@ mod tests {
         fn variants(&self) -> usize {
             1
         }
-        fn solve(&mut self) -> Result<Probe, String> {
+        fn solve(&mut self) -> Result<Probe, crate::error::SystemError> {
             let r = self.c + self.x.abs();
             let slope = if self.x < 0.0 { -1.0 } else { 1.0 };
             self.delta = -r / slope;
@@ -695,14 +720,19 @@ mod tests {
                 solved: vec![true],
             })
         }
-        fn trial(&mut self, alpha: &[f64], _: &[bool], _: bool) -> Result<TrialProbe, String> {
+        fn trial(
+            &mut self,
+            alpha: &[f64],
+            _: &[bool],
+            _: bool,
+        ) -> Result<TrialProbe, crate::error::SystemError> {
             let r = self.c + (self.x + alpha[0] * self.delta).abs();
             Ok(TrialProbe {
                 slope: vec![self.delta * r],
                 norm: vec![r],
             })
         }
-        fn accept(&mut self, alpha: &[f64], _: bool) -> Result<(), String> {
+        fn accept(&mut self, alpha: &[f64], _: bool) -> Result<(), crate::error::SystemError> {
             self.x += alpha[0] * self.delta;
             Ok(())
         }

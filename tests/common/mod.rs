@@ -91,7 +91,7 @@ impl holewall::engine::KernelPath<f64> for Counting<'_> {
         &'a self,
         model: &'a holewall::model::Model,
         tables: &holewall::engine::EnsembleTables<f64>,
-    ) -> Result<Box<dyn holewall::engine::Ensemble<f64> + 'a>, String> {
+    ) -> Result<Box<dyn holewall::engine::Ensemble<f64> + 'a>, holewall::error::SystemError> {
         self.opens.set(self.opens.get() + 1);
         self.inner.open(model, tables)
     }
@@ -100,7 +100,10 @@ impl holewall::engine::KernelPath<f64> for Counting<'_> {
         model: &'a holewall::model::Model,
         tables: &holewall::engine::EnsembleTables<f64>,
         dynamic: &holewall::engine::dynamic::DynamicTables<f64>,
-    ) -> Result<Box<dyn holewall::engine::dynamic::DynamicEnsemble<f64> + 'a>, String> {
+    ) -> Result<
+        Box<dyn holewall::engine::dynamic::DynamicEnsemble<f64> + 'a>,
+        holewall::error::SystemError,
+    > {
         self.dynamic_opens.set(self.dynamic_opens.get() + 1);
         self.inner.open_dynamic(model, tables, dynamic)
     }

@@ -76,28 +76,32 @@ pub struct Iteration<T> {
 pub trait DynamicEnsemble<T> {
     /// Starts a step: its coefficients and the top's kinematics per variant
     /// (`TOP_LEN · V`); the unknown starts at `v̇_n`.
-    fn begin_step(&mut self, c: &StepCoefficients<T>, top: &[T]) -> Result<(), String>;
+    fn begin_step(
+        &mut self,
+        c: &StepCoefficients<T>,
+        top: &[T],
+    ) -> Result<(), crate::error::SystemError>;
     /// Predicts at the unknown, evaluates and solves: the norms of the residual and the
     /// correction `Δ` (α = 1), the solve's status and the inertial force scale per variant.
-    fn iterate(&mut self) -> Result<Iteration<T>, String>;
+    fn iterate(&mut self) -> Result<Iteration<T>, crate::error::SystemError>;
     /// The residual at `v̇ + α Δ` (line search; the force-only beam kernel): its norms
     /// with `Δ`, `α`.
-    fn trial(&mut self, alpha: &[T]) -> Result<Norms<T>, String>;
+    fn trial(&mut self, alpha: &[T]) -> Result<Norms<T>, crate::error::SystemError>;
     /// The unknown `+= α Δ`.
-    fn correct(&mut self, alpha: &[T]) -> Result<(), String>;
+    fn correct(&mut self, alpha: &[T]) -> Result<(), crate::error::SystemError>;
     /// The unknown becomes the last trial's candidate (a trial forms its residual only:
     /// the next [`DynamicEnsemble::iterate`] evaluates the candidate's system).
-    fn accept_trial(&mut self) -> Result<(), String>;
+    fn accept_trial(&mut self) -> Result<(), crate::error::SystemError>;
     /// Ends the step: the state at `t_{n+1}` from the unknown.
-    fn end_step(&mut self) -> Result<(), String>;
+    fn end_step(&mut self) -> Result<(), crate::error::SystemError>;
     /// The state, read back.
-    fn state(&mut self) -> Result<DynamicBatch<T>, String>;
+    fn state(&mut self) -> Result<DynamicBatch<T>, crate::error::SystemError>;
     /// Replaces the state at `t_n` (between steps).
-    fn set_state(&mut self, state: &DynamicBatch<T>) -> Result<(), String>;
+    fn set_state(&mut self, state: &DynamicBatch<T>) -> Result<(), crate::error::SystemError>;
     /// The Newton unknown `v̇_{n+1}`, `6 n V`, read back (mid-step).
-    fn unknown(&mut self) -> Result<Vec<T>, String>;
+    fn unknown(&mut self) -> Result<Vec<T>, crate::error::SystemError>;
     /// Replaces the Newton unknown (after [`DynamicEnsemble::begin_step`]).
-    fn set_unknown(&mut self, vdot: &[T]) -> Result<(), String>;
+    fn set_unknown(&mut self, vdot: &[T]) -> Result<(), crate::error::SystemError>;
 }
 
 /// How a variant's dynamic run ended.
@@ -145,7 +149,7 @@ fn dynamic_tables<T: Real>(
     starts: &[DynamicStart],
     density: &[f64],
     options: &DynamicOptions,
-) -> Result<Start<T>, String> {
+) -> Result<Start<T>, crate::error::SystemError> {
     let t = |x: f64| T::from_f64_lossy(x);
     let (v, n) = (models.len(), models[0].nodes.len());
     let p = models[0].sites.len() * v;
@@ -167,7 +171,9 @@ fn dynamic_tables<T: Real>(
     let mut top = (false, false);
     for (j, (m, (q, vel))) in models.iter().zip(starts).enumerate() {
         let mut d = Dynamics::new(m, *options, &|e| density[e]);
-        let s = d.initial_state_with(q.clone(), vel.clone())?;
+        let s = d
+            .initial_state_with(q.clone(), vel.clone())
+            .map_err(|e| crate::error::SystemError::Linear(format!("the initial state: {e}")))?;
         f_ref.push(d.reference_force());
         if j == 0 {
             let (ms, js) = d.lumped();
@@ -267,9 +273,9 @@ pub fn run_dynamic_ensemble<T: Real + Send + Sync, P: KernelPath<T>>(
     t_end: f64,
     every: usize,
     observe: &mut dyn FnMut(usize, f64, &DynamicBatch<T>),
-) -> Result<Vec<DynamicResult>, String> {
+) -> Result<Vec<DynamicResult>, crate::error::SystemError> {
     if let Some(why) = unsupported(options) {
-        return Err(why);
+        return Err(crate::error::SystemError::Unsupported(why));
     }
     super::check_same_mesh(models)?;
     let chunk = path.max_chunk(&models[0]).max(1);
@@ -352,7 +358,7 @@ fn run_chunk<T: Real + Send + Sync, P: KernelPath<T>>(
     t_end: f64,
     every: usize,
     observe: &mut dyn FnMut(f64, &DynamicBatch<T>),
-) -> Result<Vec<DynamicResult>, String> {
+) -> Result<Vec<DynamicResult>, crate::error::SystemError> {
     super::check_same_mesh(models)?;
     let Start {
         tables: dynamic,
@@ -441,7 +447,7 @@ fn run_span<T: Real + Send + Sync, P: KernelPath<T>>(
     t_end: f64,
     h: f64,
     mut observe: Option<(usize, &mut dyn FnMut(f64, &DynamicBatch<T>))>,
-) -> Result<(), String> {
+) -> Result<(), crate::error::SystemError> {
     let t = |x: f64| T::from_f64_lossy(x);
     let m = members.len();
     let size = std::mem::size_of::<T>();
@@ -531,7 +537,9 @@ fn run_span<T: Real + Send + Sync, P: KernelPath<T>>(
             }
         }
         if !retry.is_empty() {
-            let at_n = before.or(at_n).ok_or("no state at the step's start")?;
+            let at_n = before.or(at_n).ok_or(crate::error::SystemError::Order(
+                "no state at the step's start",
+            ))?;
             let mut now = ensemble.state()?;
             let mut steps: Vec<f64> = retry.iter().map(|r| r.1).collect();
             steps.sort_by(|a, b| b.total_cmp(a));
@@ -586,7 +594,7 @@ fn solve_step<T: Real + Send + Sync, P: KernelPath<T>>(
     top: &[T],
     mut newton: Newton,
     hhb: f64,
-) -> Result<(Vec<(usize, String)>, Option<DynamicBatch<T>>), String> {
+) -> Result<(Vec<(usize, String)>, Option<DynamicBatch<T>>), crate::error::SystemError> {
     let m = members.len();
     let mut failed = Vec::new();
     let mut compact = false;
@@ -664,7 +672,7 @@ fn open_subset<'c, T: Real + Send + Sync, P: KernelPath<T>>(
     chunk: &Chunk<'c, T, P>,
     members: &[usize],
     start: &DynamicBatch<T>,
-) -> Result<Box<dyn DynamicEnsemble<T> + 'c>, String> {
+) -> Result<Box<dyn DynamicEnsemble<T> + 'c>, crate::error::SystemError> {
     let v = chunk.tables.num_variants;
     let models: Vec<Model> = members.iter().map(|&j| chunk.models[j].clone()).collect();
     // The static start is not used by a dynamic chunk: the state is `start`.
@@ -695,7 +703,7 @@ fn retry_alone<T: Real + Send + Sync, P: KernelPath<T>>(
     t0: f64,
     t1: f64,
     h: f64,
-) -> Result<DynamicBatch<T>, String> {
+) -> Result<DynamicBatch<T>, crate::error::SystemError> {
     let mut sub = open_subset(chunk, again, start)?;
     run_span(chunk, sub.as_mut(), again, t0, t1, h, None)?;
     sub.state()
@@ -712,7 +720,7 @@ impl<T: Real> NewtonSystem for DynamicStep<'_, T> {
     fn variants(&self) -> usize {
         self.f_ref.len()
     }
-    fn solve(&mut self) -> Result<Probe, String> {
+    fn solve(&mut self) -> Result<Probe, crate::error::SystemError> {
         let Iteration {
             norms,
             status,
@@ -730,11 +738,20 @@ impl<T: Real> NewtonSystem for DynamicStep<'_, T> {
             solved: status.iter().map(|&s| s == SOLVED).collect(),
         })
     }
-    fn trial(&mut self, alpha: &[f64], _: &[bool], _: bool) -> Result<TrialProbe, String> {
+    fn trial(
+        &mut self,
+        alpha: &[f64],
+        _: &[bool],
+        _: bool,
+    ) -> Result<TrialProbe, crate::error::SystemError> {
         let r = self.ensemble.trial(&negated::<T>(alpha))?;
         Ok(trial_probe(&r))
     }
-    fn accept(&mut self, alpha: &[f64], trial_matches: bool) -> Result<(), String> {
+    fn accept(
+        &mut self,
+        alpha: &[f64],
+        trial_matches: bool,
+    ) -> Result<(), crate::error::SystemError> {
         if trial_matches {
             // The trial at these α is the new unknown.
             self.ensemble.accept_trial()?;

@@ -49,8 +49,10 @@ impl<'a> TwinDynamic<'a> {
         &mut self,
         mut vdot: Vec<f64>,
         tangent: bool,
-    ) -> Result<ChainBatch<f64>, String> {
-        let c = self.coefficients.ok_or("no step begun")?;
+    ) -> Result<ChainBatch<f64>, crate::error::SystemError> {
+        let c = self
+            .coefficients
+            .ok_or(crate::error::SystemError::Order("no step begun"))?;
         predict(&c, &self.top, &self.state, &mut vdot, &mut self.trial);
         let p = options_coefficients(&c);
         let tr = &self.trial;
@@ -84,13 +86,17 @@ pub fn options_coefficients<T: Real>(c: &StepCoefficients<T>) -> (T, T) {
 }
 
 impl DynamicEnsemble<f64> for TwinDynamic<'_> {
-    fn begin_step(&mut self, c: &StepCoefficients<f64>, top: &[f64]) -> Result<(), String> {
+    fn begin_step(
+        &mut self,
+        c: &StepCoefficients<f64>,
+        top: &[f64],
+    ) -> Result<(), crate::error::SystemError> {
         self.coefficients = Some(*c);
         self.top = top.to_vec();
         self.unknown = self.state.vdot.clone();
         Ok(())
     }
-    fn iterate(&mut self) -> Result<Iteration<f64>, String> {
+    fn iterate(&mut self) -> Result<Iteration<f64>, crate::error::SystemError> {
         let sys = self.evaluate_at(self.unknown.clone(), true)?;
         // The top's prescribed accelerations, as the predictor wrote them.
         self.unknown = self.trial.vdot.clone();
@@ -105,42 +111,44 @@ impl DynamicEnsemble<f64> for TwinDynamic<'_> {
             inertial,
         })
     }
-    fn trial(&mut self, alpha: &[f64]) -> Result<Norms<f64>, String> {
+    fn trial(&mut self, alpha: &[f64]) -> Result<Norms<f64>, crate::error::SystemError> {
         let (v, n) = (self.tables.num_variants, self.tables.num_nodes);
         let cand = accelerate(&self.tables.basis, &self.unknown, &self.delta, alpha, n, v);
         let sys = self.evaluate_at(cand, false)?;
         Ok(norms(&sys.rhs, &self.delta, alpha, n, v))
     }
-    fn correct(&mut self, alpha: &[f64]) -> Result<(), String> {
+    fn correct(&mut self, alpha: &[f64]) -> Result<(), crate::error::SystemError> {
         let (v, n) = (self.tables.num_variants, self.tables.num_nodes);
         self.unknown = accelerate(&self.tables.basis, &self.unknown, &self.delta, alpha, n, v);
         Ok(())
     }
-    fn accept_trial(&mut self) -> Result<(), String> {
+    fn accept_trial(&mut self) -> Result<(), crate::error::SystemError> {
         // The candidate with the top's prescribed accelerations, as the predictor wrote it
         // (the trial formed its residual only: the next iteration evaluates its system).
         self.unknown = self.trial.vdot.clone();
         Ok(())
     }
-    fn end_step(&mut self) -> Result<(), String> {
-        let c = self.coefficients.ok_or("no step begun")?;
+    fn end_step(&mut self) -> Result<(), crate::error::SystemError> {
+        let c = self
+            .coefficients
+            .ok_or(crate::error::SystemError::Order("no step begun"))?;
         let mut vdot = self.unknown.clone();
         let mut next = self.state.clone();
         predict(&c, &self.top, &self.state, &mut vdot, &mut next);
         self.state = next;
         Ok(())
     }
-    fn state(&mut self) -> Result<DynamicBatch<f64>, String> {
+    fn state(&mut self) -> Result<DynamicBatch<f64>, crate::error::SystemError> {
         Ok(self.state.clone())
     }
-    fn set_state(&mut self, state: &DynamicBatch<f64>) -> Result<(), String> {
+    fn set_state(&mut self, state: &DynamicBatch<f64>) -> Result<(), crate::error::SystemError> {
         self.state = state.clone();
         Ok(())
     }
-    fn unknown(&mut self) -> Result<Vec<f64>, String> {
+    fn unknown(&mut self) -> Result<Vec<f64>, crate::error::SystemError> {
         Ok(self.unknown.clone())
     }
-    fn set_unknown(&mut self, vdot: &[f64]) -> Result<(), String> {
+    fn set_unknown(&mut self, vdot: &[f64]) -> Result<(), crate::error::SystemError> {
         self.unknown = vdot.to_vec();
         Ok(())
     }

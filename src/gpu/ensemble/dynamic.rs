@@ -295,7 +295,7 @@ impl<T: GpuReal> crate::engine::dynamic::DynamicEnsemble<T> for GpuDynamic<T> {
         &mut self,
         c: &crate::kernels::dynamics::StepCoefficients<T>,
         top: &[T],
-    ) -> Result<(), String> {
+    ) -> Result<(), crate::error::SystemError> {
         let q = &self.ctx.queue;
         let (hg, hhb) = crate::engine::dynamic::options_coefficients(c);
         q.write_buffer(&self.b.coef, 0, bytemuck::cast_slice(&c.reals()[..]));
@@ -312,7 +312,9 @@ impl<T: GpuReal> crate::engine::dynamic::DynamicEnsemble<T> for GpuDynamic<T> {
         Ok(())
     }
 
-    fn iterate(&mut self) -> Result<crate::engine::dynamic::Iteration<T>, String> {
+    fn iterate(
+        &mut self,
+    ) -> Result<crate::engine::dynamic::Iteration<T>, crate::error::SystemError> {
         let v = self.num_variants;
         let mut e = encoder(self.ctx, "iterate");
         self.c.reset_status(&mut e, v);
@@ -335,10 +337,12 @@ impl<T: GpuReal> crate::engine::dynamic::DynamicEnsemble<T> for GpuDynamic<T> {
                 (&self.b.scale, v as u64 * size),
             ],
         )
-        .map_err(|e| e.to_string())?;
+        .map_err(crate::error::SystemError::from)?;
         let status: Vec<u32> = bytemuck::cast_slice(&out[1]).to_vec();
         if status.contains(&RUNNING) {
-            return Err("block solve: a dispatch did not complete (status left at running)".into());
+            return Err(crate::error::SystemError::BlockSolve(
+                "a dispatch did not complete (status left at running)".into(),
+            ));
         }
         Ok(crate::engine::dynamic::Iteration {
             norms: norms_from_bytes(&out[0]),
@@ -347,7 +351,7 @@ impl<T: GpuReal> crate::engine::dynamic::DynamicEnsemble<T> for GpuDynamic<T> {
         })
     }
 
-    fn trial(&mut self, alpha: &[T]) -> Result<Norms<T>, String> {
+    fn trial(&mut self, alpha: &[T]) -> Result<Norms<T>, crate::error::SystemError> {
         let v = self.num_variants;
         self.ctx
             .queue
@@ -366,11 +370,11 @@ impl<T: GpuReal> crate::engine::dynamic::DynamicEnsemble<T> for GpuDynamic<T> {
         }
         let size = std::mem::size_of::<T>() as u64;
         let out = submit_and_read(self.ctx, e, &[(&self.c.norms, 4 * v as u64 * size)])
-            .map_err(|e| e.to_string())?;
+            .map_err(crate::error::SystemError::from)?;
         Ok(norms_from_bytes(&out[0]))
     }
 
-    fn correct(&mut self, alpha: &[T]) -> Result<(), String> {
+    fn correct(&mut self, alpha: &[T]) -> Result<(), crate::error::SystemError> {
         self.ctx
             .queue
             .write_buffer(&self.c.alpha, 0, bytemuck::cast_slice(alpha));
@@ -389,7 +393,7 @@ impl<T: GpuReal> crate::engine::dynamic::DynamicEnsemble<T> for GpuDynamic<T> {
         Ok(())
     }
 
-    fn accept_trial(&mut self) -> Result<(), String> {
+    fn accept_trial(&mut self) -> Result<(), crate::error::SystemError> {
         // The candidate (with the top's prescribed accelerations the predictor wrote into
         // it) becomes the unknown; the trial formed its residual only, so the next
         // iteration evaluates its system.
@@ -399,7 +403,7 @@ impl<T: GpuReal> crate::engine::dynamic::DynamicEnsemble<T> for GpuDynamic<T> {
         Ok(())
     }
 
-    fn end_step(&mut self) -> Result<(), String> {
+    fn end_step(&mut self) -> Result<(), crate::error::SystemError> {
         let mut e = encoder(self.ctx, "end_step");
         {
             let mut pass = e.begin_compute_pass(&Default::default());
@@ -425,7 +429,10 @@ impl<T: GpuReal> crate::engine::dynamic::DynamicEnsemble<T> for GpuDynamic<T> {
         Ok(())
     }
 
-    fn set_state(&mut self, s: &crate::kernels::dynamics::DynamicBatch<T>) -> Result<(), String> {
+    fn set_state(
+        &mut self,
+        s: &crate::kernels::dynamics::DynamicBatch<T>,
+    ) -> Result<(), crate::error::SystemError> {
         let b = &self.b;
         let q = &self.ctx.queue;
         for (buffer, data) in [
@@ -440,7 +447,7 @@ impl<T: GpuReal> crate::engine::dynamic::DynamicEnsemble<T> for GpuDynamic<T> {
         Ok(())
     }
 
-    fn unknown(&mut self) -> Result<Vec<T>, String> {
+    fn unknown(&mut self) -> Result<Vec<T>, crate::error::SystemError> {
         let size = std::mem::size_of::<T>() as u64;
         let bytes = 6 * (self.num_nodes * self.num_variants) as u64 * size;
         let out = submit_and_read(
@@ -448,18 +455,20 @@ impl<T: GpuReal> crate::engine::dynamic::DynamicEnsemble<T> for GpuDynamic<T> {
             encoder(self.ctx, "unknown"),
             &[(&self.b.vdot_k, bytes)],
         )
-        .map_err(|e| e.to_string())?;
+        .map_err(crate::error::SystemError::from)?;
         Ok(bytemuck::cast_slice(&out[0]).to_vec())
     }
 
-    fn set_unknown(&mut self, vdot: &[T]) -> Result<(), String> {
+    fn set_unknown(&mut self, vdot: &[T]) -> Result<(), crate::error::SystemError> {
         self.ctx
             .queue
             .write_buffer(&self.b.vdot_k, 0, bytemuck::cast_slice(vdot));
         Ok(())
     }
 
-    fn state(&mut self) -> Result<crate::kernels::dynamics::DynamicBatch<T>, String> {
+    fn state(
+        &mut self,
+    ) -> Result<crate::kernels::dynamics::DynamicBatch<T>, crate::error::SystemError> {
         let (v, n) = (self.num_variants, self.num_nodes);
         let size = std::mem::size_of::<T>() as u64;
         let nv = (n * v) as u64 * size;
@@ -475,7 +484,7 @@ impl<T: GpuReal> crate::engine::dynamic::DynamicEnsemble<T> for GpuDynamic<T> {
                 (&b.vdot_n, 6 * nv),
             ],
         )
-        .map_err(|e| e.to_string())?;
+        .map_err(crate::error::SystemError::from)?;
         let cast = |bytes: &Vec<u8>| -> Vec<T> { bytemuck::cast_slice(bytes).to_vec() };
         Ok(crate::kernels::dynamics::DynamicBatch {
             num_variants: v,

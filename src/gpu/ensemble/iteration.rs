@@ -22,7 +22,12 @@ pub fn sites_wgsl_for(dynamic: bool, f64: bool) -> Result<String, GpuError> {
 }
 
 impl<T: GpuReal> Ensemble<T> for GpuEnsemble<T> {
-    fn set_loads(&mut self, f_ext: &[T], pair_params: &[T], rest: &[T]) -> Result<(), String> {
+    fn set_loads(
+        &mut self,
+        f_ext: &[T],
+        pair_params: &[T],
+        rest: &[T],
+    ) -> Result<(), crate::error::SystemError> {
         let q = &self.ctx.queue;
         q.write_buffer(&self.c.f_ext, 0, bytemuck::cast_slice(f_ext));
         if let Some(b) = &self.c.rest {
@@ -34,7 +39,7 @@ impl<T: GpuReal> Ensemble<T> for GpuEnsemble<T> {
         Ok(())
     }
 
-    fn evaluate(&mut self) -> Result<(), String> {
+    fn evaluate(&mut self) -> Result<(), crate::error::SystemError> {
         let mut encoder = self.encoder("evaluate");
         {
             let mut pass = encoder.begin_compute_pass(&Default::default());
@@ -45,9 +50,11 @@ impl<T: GpuReal> Ensemble<T> for GpuEnsemble<T> {
         Ok(())
     }
 
-    fn solve(&mut self) -> Result<(Norms<T>, Vec<u32>), String> {
+    fn solve(&mut self) -> Result<(Norms<T>, Vec<u32>), crate::error::SystemError> {
         if !self.formed[self.current] {
-            return Err("tangent not formed (a trial's residual only)".into());
+            return Err(crate::error::SystemError::Order(
+                "tangent not formed (a trial's residual only)",
+            ));
         }
         let v = self.num_variants;
         let s = &self.slots[self.current];
@@ -60,14 +67,23 @@ impl<T: GpuReal> Ensemble<T> for GpuEnsemble<T> {
             }
             dispatch(&mut pass, &self.p.norms, &s.norms_solve, v);
         }
-        let (norms, status) = self.finish_with_norms(encoder).map_err(|e| e.to_string())?;
+        let (norms, status) = self
+            .finish_with_norms(encoder)
+            .map_err(crate::error::SystemError::from)?;
         if status.contains(&RUNNING) {
-            return Err("block solve: a dispatch did not complete (status left at running)".into());
+            return Err(crate::error::SystemError::BlockSolve(
+                "a dispatch did not complete (status left at running)".into(),
+            ));
         }
         Ok((norms, status))
     }
 
-    fn trial(&mut self, alpha: &[T], search: &[bool], first: bool) -> Result<Norms<T>, String> {
+    fn trial(
+        &mut self,
+        alpha: &[T],
+        search: &[bool],
+        first: bool,
+    ) -> Result<Norms<T>, crate::error::SystemError> {
         let v = self.num_variants;
         let other = 1 - self.current;
         let q = &self.ctx.queue;
@@ -103,14 +119,14 @@ impl<T: GpuReal> Ensemble<T> for GpuEnsemble<T> {
         self.formed[other] = false;
         self.finish_with_norms(encoder)
             .map(|(n, _)| n)
-            .map_err(|e| e.to_string())
+            .map_err(crate::error::SystemError::from)
     }
 
     fn accept_trial(&mut self) {
         self.current = 1 - self.current;
     }
 
-    fn commit(&mut self, alpha: &[T]) -> Result<(), String> {
+    fn commit(&mut self, alpha: &[T]) -> Result<(), crate::error::SystemError> {
         self.ctx
             .queue
             .write_buffer(&self.c.alpha, 0, bytemuck::cast_slice(alpha));
@@ -128,7 +144,7 @@ impl<T: GpuReal> Ensemble<T> for GpuEnsemble<T> {
         Ok(())
     }
 
-    fn config(&mut self) -> Result<ConfigBatch<T>, String> {
+    fn config(&mut self) -> Result<ConfigBatch<T>, crate::error::SystemError> {
         let (v, n) = (self.num_variants, self.num_nodes);
         let s = &self.slots[self.current];
         let size = std::mem::size_of::<T>() as u64;
@@ -140,7 +156,7 @@ impl<T: GpuReal> Ensemble<T> for GpuEnsemble<T> {
                 (&s.rot, 9 * (n * v) as u64 * size),
             ],
         )
-        .map_err(|e| e.to_string())?;
+        .map_err(crate::error::SystemError::from)?;
         Ok(ConfigBatch {
             num_variants: v,
             num_nodes: n,
@@ -150,7 +166,7 @@ impl<T: GpuReal> Ensemble<T> for GpuEnsemble<T> {
         })
     }
 
-    fn set_config(&mut self, config: &ConfigBatch<T>) -> Result<(), String> {
+    fn set_config(&mut self, config: &ConfigBatch<T>) -> Result<(), crate::error::SystemError> {
         let s = &self.slots[self.current];
         let q = &self.ctx.queue;
         q.write_buffer(&s.x, 0, bytemuck::cast_slice(&config.x));
@@ -159,12 +175,15 @@ impl<T: GpuReal> Ensemble<T> for GpuEnsemble<T> {
         Ok(())
     }
 
-    fn set_shift(&mut self, shift: Option<&Shift<T>>) -> Result<(), String> {
+    fn set_shift(&mut self, shift: Option<&Shift<T>>) -> Result<(), crate::error::SystemError> {
         match shift {
             None => self.shifted = false,
             Some(sh) => {
                 if self.shift.is_none() {
-                    self.shift = Some(self.shift_parts().map_err(|e| e.to_string())?);
+                    self.shift = Some(
+                        self.shift_parts()
+                            .map_err(crate::error::SystemError::from)?,
+                    );
                 }
                 let parts = self.shift.as_ref().expect("made above");
                 let q = &self.ctx.queue;
@@ -177,7 +196,7 @@ impl<T: GpuReal> Ensemble<T> for GpuEnsemble<T> {
         Ok(())
     }
 
-    fn rebase(&mut self, tables: &EnsembleTables<T>) -> Result<(), String> {
+    fn rebase(&mut self, tables: &EnsembleTables<T>) -> Result<(), crate::error::SystemError> {
         let q = &self.ctx.queue;
         if !tables.pair_base.is_empty() {
             q.write_buffer(

@@ -8,13 +8,17 @@ use crate::solve::newton::{Event, Newton, NewtonSettings, NewtonState, NewtonSys
 /// A static problem of V variants that [`solve_loads`] can step through its loads.
 pub trait StaticSystem: NewtonSystem {
     /// Sets variant `j`'s loads (effective from the next solve).
-    fn set_target(&mut self, j: usize, target: &LoadTarget) -> Result<(), String>;
+    fn set_target(
+        &mut self,
+        j: usize,
+        target: &LoadTarget,
+    ) -> Result<(), crate::error::SystemError>;
     /// Keeps variant `j`'s current state as its restart point (a step completed).
-    fn save(&mut self, j: usize) -> Result<(), String>;
+    fn save(&mut self, j: usize) -> Result<(), crate::error::SystemError>;
     /// Returns variant `j` to its restart point.
-    fn restore(&mut self, j: usize) -> Result<(), String>;
+    fn restore(&mut self, j: usize) -> Result<(), crate::error::SystemError>;
     /// The rounding floor of a step of variant `j` ([`NewtonSettings::step_floor`]).
-    fn step_floor(&mut self, j: usize) -> Result<f64, String>;
+    fn step_floor(&mut self, j: usize) -> Result<f64, crate::error::SystemError>;
     /// Where variant `j`'s residual force is largest now (MD, m), for a failure's
     /// message; `None` where the system does not keep it at hand.
     fn worst_residual_md(&mut self, _j: usize) -> Option<f64> {
@@ -33,11 +37,13 @@ pub trait StaticSystem: NewtonSystem {
     }
     /// Sets variant `j`'s proximal shift `s` (0: none), anchored at its current state:
     /// the residual gains `s (x − a)` on the translations, the tangent `s I`.
-    fn set_shift(&mut self, _j: usize, s: f64) -> Result<(), String> {
+    fn set_shift(&mut self, _j: usize, s: f64) -> Result<(), crate::error::SystemError> {
         if s == 0.0 {
             Ok(())
         } else {
-            Err("this system cannot relax".into())
+            Err(crate::error::SystemError::Unsupported(
+                "this system cannot relax".into(),
+            ))
         }
     }
 }
@@ -49,7 +55,7 @@ pub fn solve_loads(
     paths: &mut [LoadPath],
     settings: NewtonSettings,
     progress: &mut dyn FnMut(f64),
-) -> Result<usize, String> {
+) -> Result<usize, crate::error::SystemError> {
     let mut solves = 0;
     solve_loads_from(
         sys,
@@ -77,7 +83,7 @@ pub fn solve_loads_from(
     stop: &dyn Fn(usize, usize) -> bool,
     solves: &mut usize,
     progress: &mut dyn FnMut(f64),
-) -> Result<Vec<NewtonState>, String> {
+) -> Result<Vec<NewtonState>, crate::error::SystemError> {
     let v = sys.variants();
     let mut newton = Newton::new(settings, v);
     for (j, path) in paths.iter().enumerate() {
@@ -114,7 +120,7 @@ fn next_steps(
     paths: &mut [LoadPath],
     newton: &mut Newton,
     events: Vec<(usize, Event)>,
-) -> Result<(), String> {
+) -> Result<(), crate::error::SystemError> {
     for (j, event) in events {
         let path = &mut paths[j];
         let (next, converged) = match event {

@@ -635,7 +635,12 @@ impl<'a> Dynamics<'a> {
         newton.start(0, floor, false);
         loop {
             // One variant: its first event ends the step.
-            if let Some((_, event)) = newton.iterate(&mut sys)?.into_iter().next() {
+            if let Some((_, event)) = newton
+                .iterate(&mut sys)
+                .map_err(|e| e.to_string())?
+                .into_iter()
+                .next()
+            {
                 return match event {
                     Event::Converged(its) => {
                         let vdot = sys.vdot.clone();

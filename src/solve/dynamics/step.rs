@@ -126,7 +126,7 @@ impl crate::solve::newton::NewtonSystem for CpuStep<'_, '_> {
     fn variants(&self) -> usize {
         1
     }
-    fn solve(&mut self) -> Result<crate::solve::newton::Probe, String> {
+    fn solve(&mut self) -> Result<crate::solve::newton::Probe, crate::error::SystemError> {
         let mut trial = std::mem::replace(&mut self.trial, self.s.clone());
         self.predict(&mut trial, &self.vdot);
         let (mut r, mut mat) = self.d.residual_and_matrix(&trial, self.hg, self.hhb, true);
@@ -166,7 +166,7 @@ impl crate::solve::newton::NewtonSystem for CpuStep<'_, '_> {
         alpha: &[f64],
         _: &[bool],
         _: bool,
-    ) -> Result<crate::solve::newton::TrialProbe, String> {
+    ) -> Result<crate::solve::newton::TrialProbe, crate::error::SystemError> {
         let cand = self.moved(alpha[0]);
         let mut probe = self.trial.clone();
         self.predict(&mut probe, &cand);
@@ -177,7 +177,11 @@ impl crate::solve::newton::NewtonSystem for CpuStep<'_, '_> {
             norm: vec![dot_n(&rc, &rc).sqrt()],
         })
     }
-    fn accept(&mut self, alpha: &[f64], _trial_matches: bool) -> Result<(), String> {
+    fn accept(
+        &mut self,
+        alpha: &[f64],
+        _trial_matches: bool,
+    ) -> Result<(), crate::error::SystemError> {
         if alpha[0] != 0.0 {
             self.vdot = self.moved(alpha[0]);
         }

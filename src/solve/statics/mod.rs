@@ -537,7 +537,7 @@ pub fn solve_static_monitored(
             from: 0.0,
             step: 0.0,
             min: options.min_step,
-            reason,
+            reason: reason.to_string(),
             at_md: None,
         });
     }
@@ -580,7 +580,7 @@ pub fn polish_static(
             from: 0.0,
             step: 0.0,
             min: options.min_step,
-            reason,
+            reason: reason.to_string(),
             at_md: None,
         }
     })?;

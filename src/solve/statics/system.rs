@@ -101,7 +101,7 @@ impl crate::solve::newton::NewtonSystem for CpuStatic<'_> {
     fn variants(&self) -> usize {
         1
     }
-    fn solve(&mut self) -> Result<crate::solve::newton::Probe, String> {
+    fn solve(&mut self) -> Result<crate::solve::newton::Probe, crate::error::SystemError> {
         if !self.evaluated {
             assemble(
                 &self.loaded,
@@ -145,7 +145,7 @@ impl crate::solve::newton::NewtonSystem for CpuStatic<'_> {
         alpha: &[f64],
         _: &[bool],
         _: bool,
-    ) -> Result<crate::solve::newton::TrialProbe, String> {
+    ) -> Result<crate::solve::newton::TrialProbe, crate::error::SystemError> {
         let s = update(&self.c, &self.walls, &self.state, &self.delta, alpha[0]);
         assemble(&self.loaded, &s, 1.0, &self.f_step, &mut self.trial, None);
         add_shift(self.shift, &s.x, &self.anchor, &mut self.trial, None);
@@ -156,7 +156,11 @@ impl crate::solve::newton::NewtonSystem for CpuStatic<'_> {
             norm: vec![dot_n(&self.trial, &self.trial).sqrt()],
         })
     }
-    fn accept(&mut self, alpha: &[f64], trial_matches: bool) -> Result<(), String> {
+    fn accept(
+        &mut self,
+        alpha: &[f64],
+        trial_matches: bool,
+    ) -> Result<(), crate::error::SystemError> {
         if alpha[0] == 0.0 {
             return Ok(());
         }
@@ -174,7 +178,7 @@ impl crate::solve::continuation::StaticSystem for CpuStatic<'_> {
         &mut self,
         _j: usize,
         target: &crate::solve::continuation::LoadTarget,
-    ) -> Result<(), String> {
+    ) -> Result<(), crate::error::SystemError> {
         self.loaded = loaded_model(self.model, target);
         for (f, (g, o)) in self
             .f_step
@@ -186,11 +190,11 @@ impl crate::solve::continuation::StaticSystem for CpuStatic<'_> {
         self.evaluated = false;
         Ok(())
     }
-    fn save(&mut self, _j: usize) -> Result<(), String> {
+    fn save(&mut self, _j: usize) -> Result<(), crate::error::SystemError> {
         self.saved = self.state.clone();
         Ok(())
     }
-    fn restore(&mut self, _j: usize) -> Result<(), String> {
+    fn restore(&mut self, _j: usize) -> Result<(), crate::error::SystemError> {
         self.state = self.saved.clone();
         self.evaluated = false;
         Ok(())
@@ -210,7 +214,7 @@ impl crate::solve::continuation::StaticSystem for CpuStatic<'_> {
         constrain_residual(&self.c, &mut r);
         residual_measure(&r, self.f_ref)
     }
-    fn set_shift(&mut self, _j: usize, s: f64) -> Result<(), String> {
+    fn set_shift(&mut self, _j: usize, s: f64) -> Result<(), crate::error::SystemError> {
         self.shift = s;
         self.anchor = if s == 0.0 {
             Vec::new()
@@ -220,7 +224,7 @@ impl crate::solve::continuation::StaticSystem for CpuStatic<'_> {
         self.evaluated = false;
         Ok(())
     }
-    fn step_floor(&mut self, _j: usize) -> Result<f64, String> {
+    fn step_floor(&mut self, _j: usize) -> Result<f64, crate::error::SystemError> {
         let largest = self
             .state
             .x
