@@ -180,16 +180,14 @@ pub fn solve_with_progress(
     show_progress: bool,
 ) -> Result<crate::solve::statics::StaticSolution, String> {
     let model = &case.model;
-    let start = crate::solve::statics::static_start(model);
     let bar = crate::output::progress_bar(
         show_progress,
         1000,
         "{bar:40} {percent:>3}% of the loads (static), {elapsed} elapsed",
     );
-    let solved =
-        crate::solve::statics::solve_static_monitored(model, start, &options, &mut |lambda| {
-            bar.set_position((1000.0 * lambda) as u64)
-        });
+    let solved = crate::solve::statics::solve_static_started(model, &options, &mut |lambda| {
+        bar.set_position((1000.0 * lambda) as u64)
+    });
     bar.finish_and_clear();
     solved.map_err(|e| crate::diagnose::static_failure(case, &e))
 }

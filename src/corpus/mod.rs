@@ -581,12 +581,9 @@ pub fn run_well(
     // Every Newton iteration the load path runs, those of failed tries and relaxation
     // sub-solves included (the progress callback is called once per iteration).
     let mut newton_iterations = 0usize;
-    let solved = crate::solve::statics::solve_static_monitored(
-        model,
-        crate::solve::statics::static_start(model),
-        options,
-        &mut |_| newton_iterations += 1,
-    );
+    let solved = crate::solve::statics::solve_static_started(model, options, &mut |_| {
+        newton_iterations += 1
+    });
     let seconds = clock.elapsed().as_secs_f64();
     let rotating = model.rotation_speed != 0.0;
     let mut r = WellResult {

@@ -89,7 +89,17 @@ pub enum StaticError {
     },
 }
 
+/// How a failure in the load path's first stage names it ([`StaticError::LoadStep`]'s
+/// `stage`).
+pub const GRAVITY_STAGE: &str = "laying the string in the hole under its own weight";
+
 impl StaticError {
+    /// Whether the solve failed laying the string in the hole under gravity (the load
+    /// path's first stage), before any bit load.
+    pub fn in_gravity_stage(&self) -> bool {
+        matches!(self, StaticError::LoadStep { stage, .. } if stage.starts_with(GRAVITY_STAGE))
+    }
+
     /// The load factor reached before the failure.
     pub fn reached(&self) -> f64 {
         match self {

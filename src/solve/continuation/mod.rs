@@ -38,7 +38,7 @@ mod driver;
 pub use driver::{solve_loads, solve_loads_from, StaticSystem};
 
 use super::newton::{NewtonSettings, SolveLimits, FOLD_STALL_ITERATIONS};
-use super::static_options::{StaticError, StaticOptions};
+use super::static_options::{StaticError, StaticOptions, GRAVITY_STAGE};
 
 /// The loads a variant is solved for: each a factor of the full value.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -540,9 +540,10 @@ impl LoadPath {
                 Stage::Gravity | Stage::GravityRamp | Stage::Exponent { .. }
             );
             let stage = if gravity {
-                "laying the string in the hole under its own weight (stage 1 of the load \
-                 path: gravity in full, no bit loads, no friction)"
-                    .to_string()
+                format!(
+                    "{GRAVITY_STAGE} (stage 1 of the load path: gravity in full, no bit \
+                     loads, no friction)"
+                )
             } else {
                 format!(
                     "applying the bit loads and friction (stage 2), the step λ {:.4} → {:.4}",

@@ -29,7 +29,29 @@ impl StaticState {
     ///   and each stabilizer, the offset grows as a pinned beam's deflection (a collar
     ///   node 0.3 m above a bit held on the axis, laid on the wall, bends the collar with
     ///   hundreds of MN).
+    ///
+    /// - **turning around the wall** where the lateral load flips side between
+    ///   neighbouring nodes ([`turn_around_side_flips`]).
+    ///
+    /// This is the first start ([`super::static_start`]);
+    /// [`StaticState::on_low_side_without_turns`] is the second.
     pub fn on_low_side(model: &Model) -> StaticState {
+        Self::laid(model, true).0
+    }
+
+    /// As [`StaticState::on_low_side`], each node towards its own lateral load without the
+    /// turns at side flips; `None` where there is no flip (the start would be the first
+    /// one). The second start of a solve whose gravity stage failed from the first
+    /// ([`super::second_start`]).
+    pub fn on_low_side_without_turns(model: &Model) -> Option<StaticState> {
+        Self::laid(model, true)
+            .1
+            .then(|| Self::laid(model, false).0)
+    }
+
+    /// The laid start; `turn_flips`: turn around the wall at side flips. Returns whether
+    /// there was a flip to turn (with `turn_flips`; false without).
+    fn laid(model: &Model, turn_flips: bool) -> (StaticState, bool) {
         use crate::physics::soft_string::{soft_string, Operation};
         let mut s = StaticState::initial(model);
         let n = model.nodes.len();
@@ -119,13 +141,14 @@ impl StaticState {
             }
             l
         };
-        turn_around_side_flips(model, &mut offset, |i| {
-            model
-                .sites
-                .iter()
-                .find(|s| s.node == i)
-                .map_or(0.0, bending_length)
-        });
+        let turned = turn_flips
+            && turn_around_side_flips(model, &mut offset, |i| {
+                model
+                    .sites
+                    .iter()
+                    .find(|s| s.node == i)
+                    .map_or(0.0, bending_length)
+            });
         // Offset `m_a + (m − m_a) g(s/L)` within L of an anchor (offset m_a), with
         // `g(x) = 2x − 2x³ + x⁴` the pinned beam's deflection (g(1) = 1, g'(1) = 0).
         let ramp = |x: f64| 2.0 * x - 2.0 * x.powi(3) + x.powi(4);
@@ -166,7 +189,7 @@ impl StaticState {
                 }
             }
         }
-        s
+        (s, turned)
     }
 
     /// The undeformed configuration (every node on the hole axis, no rotation).
@@ -188,11 +211,13 @@ impl StaticState {
 /// at least the neighbours) the direction rotates about the hole axis at a constant rate
 /// per metre from the one before the window to the one after it. The magnitudes (the
 /// depth on the wall) are the nodes' own; a node without an offset ends a window.
+/// Returns whether any window was turned.
 fn turn_around_side_flips(
     model: &Model,
     offset: &mut [Option<(Vec3<f64>, f64)>],
     bending_length: impl Fn(usize) -> f64,
-) {
+) -> bool {
+    let mut turned = false;
     let n = offset.len();
     let md = |i: usize| model.nodes[i].md;
     let lateral = |v: &Vec3<f64>, t: &Vec3<f64>| {
@@ -241,8 +266,10 @@ fn turn_around_side_flips(
                 o.0 = dir;
             }
         }
+        turned = true;
         i = b;
     }
+    turned
 }
 
 #[cfg(test)]
@@ -262,7 +289,7 @@ mod tests {
             (0..n).map(|i| Some((flipped(i), 0.05))).collect();
         offset[0] = None;
         let before = offset.clone();
-        turn_around_side_flips(&model, &mut offset, |_| 8.0);
+        assert!(turn_around_side_flips(&model, &mut offset, |_| 8.0));
         let dirs: Vec<Vec3<f64>> = offset[1..].iter().map(|o| o.unwrap().0).collect();
         for d in &dirs {
             assert!((dot(d, d).sqrt() - 1.0).abs() < 1e-12);
@@ -289,7 +316,7 @@ mod tests {
         // No flip, no change.
         let mut same: Vec<Option<(Vec3<f64>, f64)>> = (0..n).map(|_| Some((x, 0.05))).collect();
         let copy = same.clone();
-        turn_around_side_flips(&model, &mut same, |_| 8.0);
+        assert!(!turn_around_side_flips(&model, &mut same, |_| 8.0));
         assert_eq!(same, copy);
     }
 }
