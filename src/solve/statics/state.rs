@@ -44,13 +44,12 @@ impl StaticState {
     /// one). The second start of a solve whose gravity stage failed from the first
     /// ([`super::second_start`]).
     pub fn on_low_side_without_turns(model: &Model) -> Option<StaticState> {
-        Self::laid(model, true)
-            .1
-            .then(|| Self::laid(model, false).0)
+        let (s, has_flip) = Self::laid(model, false);
+        has_flip.then_some(s)
     }
 
     /// The laid start; `turn_flips`: turn around the wall at side flips. Returns whether
-    /// there was a flip to turn (with `turn_flips`; false without).
+    /// the string has a side flip (turned or not).
     fn laid(model: &Model, turn_flips: bool) -> (StaticState, bool) {
         use crate::physics::soft_string::{soft_string, Operation};
         let mut s = StaticState::initial(model);
@@ -141,14 +140,19 @@ impl StaticState {
             }
             l
         };
-        let turned = turn_flips
-            && turn_around_side_flips(model, &mut offset, |i| {
-                model
-                    .sites
-                    .iter()
-                    .find(|s| s.node == i)
-                    .map_or(0.0, bending_length)
-            });
+        // Whether there is a flip to turn: without the turns, found on a copy.
+        let site_length = |i: usize| {
+            model
+                .sites
+                .iter()
+                .find(|s| s.node == i)
+                .map_or(0.0, bending_length)
+        };
+        let has_flip = if turn_flips {
+            turn_around_side_flips(model, &mut offset, site_length)
+        } else {
+            turn_around_side_flips(model, &mut offset.clone(), site_length)
+        };
         // Offset `m_a + (m − m_a) g(s/L)` within L of an anchor (offset m_a), with
         // `g(x) = 2x − 2x³ + x⁴` the pinned beam's deflection (g(1) = 1, g'(1) = 0).
         let ramp = |x: f64| 2.0 * x - 2.0 * x.powi(3) + x.powi(4);
@@ -189,7 +193,7 @@ impl StaticState {
                 }
             }
         }
-        (s, turned)
+        (s, has_flip)
     }
 
     /// The undeformed configuration (every node on the hole axis, no rotation).
