@@ -115,7 +115,7 @@ fn a_relaxation_lowers_its_shift_until_its_answer_is_an_equilibrium() {
     // A failed sub-solve raises it fourfold.
     assert_eq!(p.failed("no".into()), Next::Step);
     assert_eq!(p.shift(), 5e5);
-    // It stays above 1e-3 s0 while the answers are not equilibria…
+    // It stays at or above RELAX_FLOOR s0 while the answers are not equilibria…
     for _ in 0..20 {
         p.shift_settled(1e-6);
         assert_eq!(p.converged(2), Next::Step);
