@@ -14,7 +14,6 @@ use crate::output::write_atomic;
 use crate::physics::vec3::{dot, scale, sub};
 use crate::plots::{line_plot, Series};
 use crate::solve::dynamics::{strain_energy, DynamicState, Dynamics};
-use crate::solve::statics::StaticOptions;
 
 /// `summary.json` of a run.
 #[derive(Clone, Debug, Serialize)]
@@ -186,14 +185,13 @@ pub fn run_case(case: &Case, out: &Path, run_options: RunOptions) -> Result<RunS
     let model = &case.model;
     let start = crate::profile::solve_with_progress(
         case,
-        StaticOptions {
-            max_seconds: run_options.max_seconds,
-            ..StaticOptions::default()
-        },
+        case.settings()
+            .with_max_seconds(run_options.max_seconds)
+            .statics(),
         show_progress,
     )
     .map_err(|e| Error::failed(format!("static start: {e}")))?;
-    let options = settings.integrator_options();
+    let options = case.settings().dynamics();
     let density = case.element_density.clone();
     let mut dynamics = Dynamics::new(model, options, &|e| density[e]);
     let (q0, v0) = case.dynamic_start(model, start.state);

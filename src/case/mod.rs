@@ -110,23 +110,41 @@ pub fn hole_section_index(hole: &[HoleSection], md: f64) -> usize {
 }
 
 impl DynamicsSettings {
-    /// The integrator's options for these settings (time step, generalised-α from
-    /// `rho_inf`, Rayleigh damping, ramp, mass, rate of penetration): one mapping for the
-    /// `run` command, the ensemble and the studies.
-    pub fn integrator_options(&self) -> crate::solve::dynamics::DynamicOptions {
-        crate::solve::dynamics::DynamicOptions {
-            dt: self.time_step,
-            alpha: crate::solve::dynamics::AlphaParams::chung_hulbert(self.rho_inf),
+    /// `base` with these `[dynamics]` settings (time step, ρ∞, Rayleigh damping, ramp, mass,
+    /// rate of penetration): one mapping for the `run` command, the ensemble and the
+    /// studies.
+    pub fn apply_to(
+        &self,
+        base: crate::solve::settings::Settings,
+    ) -> crate::solve::settings::Settings {
+        crate::solve::settings::Settings {
+            time_step: self.time_step,
+            rho_inf: self.rho_inf,
             rayleigh: self.rayleigh,
             ramp_time: self.ramp_time,
             mass: self.mass,
             rop: self.rop,
-            ..Default::default()
+            ..base
         }
+    }
+
+    /// The integrator's options for these settings over the defaults
+    /// ([`DynamicsSettings::apply_to`]).
+    pub fn integrator_options(&self) -> crate::solve::dynamics::DynamicOptions {
+        self.apply_to(crate::solve::settings::Settings::default())
+            .dynamics()
     }
 }
 
 impl Case {
+    /// The solver settings of this case: the defaults ([`crate::solve::settings::Settings`])
+    /// with its `[dynamics]` table where it has one. Every run of the case (the commands, the
+    /// ensemble on the CPU and the GPU) takes its static and dynamic options from here.
+    pub fn settings(&self) -> crate::solve::settings::Settings {
+        let base = crate::solve::settings::Settings::default();
+        self.dynamics.as_ref().map_or(base, |d| d.apply_to(base))
+    }
+
     /// The hole section at `md` ([`hole_section_at`]).
     pub fn hole_at(&self, md: f64) -> HoleSection {
         hole_section_at(&self.hole, md)

@@ -10,7 +10,6 @@ use crate::bha::critical::{critical_speeds, CriticalOptions, CriticalSpeed};
 use crate::case::load_case;
 use crate::error::Error;
 use crate::output::RunFolder;
-use crate::solve::statics::StaticOptions;
 
 /// `summary.json` of `holewall critical-speeds`.
 #[derive(Clone, Debug, Serialize)]
@@ -57,9 +56,12 @@ pub fn run(
     super::print_warnings(&case);
     let folder = RunFolder::prepare(out)?.with_report("critical-speeds", case_path);
     let model = &case.model;
-    let sol =
-        crate::profile::solve_with_progress(&case, StaticOptions::default(), options.show_progress)
-            .map_err(Error::failed)?;
+    let sol = crate::profile::solve_with_progress(
+        &case,
+        case.settings().statics(),
+        options.show_progress,
+    )
+    .map_err(Error::failed)?;
     let first =
         crate::bha::tendency::bha_model_top(model, case.bha_length, &case.tendency.settings);
     let opts = CriticalOptions {

@@ -9,7 +9,6 @@ use crate::case::{load_case, Case};
 use crate::error::Error;
 use crate::model::Model;
 use crate::output::RunFolder;
-use crate::solve::statics::StaticOptions;
 
 use crate::profile::{buckling, fe_rows, neutral_point, solve_with_progress, ProfileRow};
 
@@ -106,10 +105,9 @@ pub fn run(
         StaticModel::Fe => {
             let sol = solve_with_progress(
                 &case,
-                StaticOptions {
-                    max_seconds: options.max_seconds,
-                    ..StaticOptions::default()
-                },
+                case.settings()
+                    .with_max_seconds(options.max_seconds)
+                    .statics(),
                 options.show_progress,
             )
             .map_err(Error::failed)?;

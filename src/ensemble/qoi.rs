@@ -10,7 +10,7 @@ use crate::model::Model;
 use crate::physics::vec3::{dot, scale, sub};
 use crate::profile::{fe_rows, neutral_point, neutral_point_of, nodal_axial_forces};
 use crate::solve::dynamics::{DynamicState, Dynamics};
-use crate::solve::statics::{solve_static, StaticOptions};
+use crate::solve::statics::solve_static;
 
 /// Per-stabilizer quantities of interest.
 #[derive(Clone, Debug, Default, Serialize, Deserialize, PartialEq)]
@@ -201,7 +201,7 @@ pub(crate) fn finished(
 
 /// Static equilibrium of one variant's model.
 pub fn static_variant(case: &Case, name: &str, model: &Model) -> VariantResult {
-    match solve_static(model, &StaticOptions::default()) {
+    match solve_static(model, &case.settings().statics()) {
         Ok(sol) => static_result(case, name, model, &sol),
         Err(e) => failed(name, e.to_string(), model.stabilizer_sites().len()),
     }
@@ -291,7 +291,7 @@ pub fn dynamic_variant_tracked(
             None,
         );
     };
-    let start = match solve_static(model, &StaticOptions::default()) {
+    let start = match solve_static(model, &case.settings().statics()) {
         Ok(s) => s,
         Err(e) => {
             return (
@@ -302,7 +302,7 @@ pub fn dynamic_variant_tracked(
     };
     let mass = track_energy
         .then(|| crate::solve::dynamics::lumped_mass(model, &|e| case.element_density[e]).0);
-    let options = settings.integrator_options();
+    let options = case.settings().dynamics();
     let density = &case.element_density;
     let mut dynamics = Dynamics::new(model, options, &|e| density[e]);
     let (q0, v0) = case.dynamic_start(model, start.state);

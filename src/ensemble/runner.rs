@@ -11,7 +11,6 @@ use crate::ensemble::{apply, Variant};
 use crate::error::{Error, InputError};
 use crate::model::Model;
 use crate::solve::dynamics::{DynamicState, Dynamics};
-use crate::solve::statics::StaticOptions;
 
 /// Static equilibria of every variant through the GPU kernels (in `T`), the variants that
 /// fail there re-run on the CPU with step control (their reason says so). Stabilizer
@@ -42,7 +41,7 @@ pub fn run_static_gpu<T: crate::gpu::contact::GpuReal>(
     let results = solve_static_ensemble_with_progress::<T, _>(
         &models,
         &GpuPath(ctx),
-        &StaticOptions::default(),
+        &case.settings().statics(),
         &mut |f| bar.set_position((f * variants.len() as f64) as u64),
     )
     .map_err(|e| Error::failed(format!("GPU engine: {e}")))?;
@@ -85,7 +84,7 @@ pub fn run_dynamic_gpu<T: crate::gpu::contact::GpuReal>(
     let Some(settings) = case.dynamics.clone() else {
         return Ok(Err("no [dynamics] table".into()));
     };
-    let options = settings.integrator_options();
+    let options = case.settings().dynamics();
     if let Some(why) = unsupported(&options) {
         return Ok(Err(why));
     }
@@ -103,7 +102,7 @@ pub fn run_dynamic_gpu<T: crate::gpu::contact::GpuReal>(
         return Ok(Err(e.to_string()));
     }
     let path = GpuPath(ctx);
-    let statics = solve_static_ensemble::<T, _>(&models, &path, &StaticOptions::default())
+    let statics = solve_static_ensemble::<T, _>(&models, &path, &case.settings().statics())
         .map_err(|e| Error::failed(format!("GPU engine: {e}")))?;
     // Variants whose static start failed on the GPU run wholly on the CPU.
     let on_gpu: Vec<usize> = (0..models.len())

@@ -5,5 +5,6 @@ pub mod continuation;
 pub mod dynamics;
 pub mod modal;
 pub mod newton;
+pub mod settings;
 pub mod static_options;
 pub mod statics;

@@ -25,17 +25,9 @@ pub struct StaticOptions {
 }
 
 impl Default for StaticOptions {
+    /// [`crate::solve::settings::Settings`]' defaults (each documented there).
     fn default() -> Self {
-        StaticOptions {
-            initial_steps: 4,
-            // Contact statics converge slowly where many nodes leave or reach the wall in one
-            // step (one node per iteration along a string): 200 solves 137 of the first 150
-            // corpus wells, 100 solves 127 and 40 solved 109 (`holewall bench corpus`).
-            max_iterations: 200,
-            tolerance: 1e-9,
-            min_step: 1e-4,
-            max_seconds: None,
-        }
+        crate::solve::settings::Settings::default().statics()
     }
 }
 

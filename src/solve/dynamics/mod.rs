@@ -106,19 +106,9 @@ pub struct DynamicOptions {
 }
 
 impl Default for DynamicOptions {
+    /// [`crate::solve::settings::Settings`]' defaults (each documented there).
     fn default() -> Self {
-        DynamicOptions {
-            dt: 1e-3,
-            min_dt: 1e-7,
-            alpha: AlphaParams::chung_hulbert(0.8),
-            max_iterations: 30,
-            tolerance: 1e-8,
-            rayleigh: (0.0, 0.0),
-            ramp_time: 0.0,
-            load_factor: None,
-            mass: MassKind::Lumped,
-            rop: 0.0,
-        }
+        crate::solve::settings::Settings::default().dynamics()
     }
 }
 
