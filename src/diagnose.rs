@@ -115,7 +115,7 @@ pub struct LockUp {
 /// Mitchell's `r F² / (8 EI)` per length past the sinusoidal load and `r F² / (4 EI)` past
 /// the helical load (`F` the compression, `r` the radial clearance) — with the drag that
 /// force adds feeding back into `F` (sub-steps of
-/// [`crate::physics::soft_string::SUB_STEP`]). Pushed in or slid against friction, the
+/// [`crate::solve::soft_string::SUB_STEP`]). Pushed in or slid against friction, the
 /// compression then grows like `tan`: it runs away within a finite length, and above that
 /// point no push from the surface moves the string. `None` where it does not run away
 /// before the surface. An FE static solve of such a load finds no equilibrium (its load
@@ -142,7 +142,7 @@ pub fn lock_up(case: &Case) -> Option<LockUp> {
             r * f * f / (4.0 * ei)
         }
     };
-    let profile = crate::physics::soft_string::soft_string_loaded(
+    let profile = crate::solve::soft_string::soft_string_loaded(
         model,
         &case.operation(),
         &friction_at,

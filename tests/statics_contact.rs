@@ -2,8 +2,8 @@
 //! against soft-string torque & drag.
 
 use holewall::model::{add_sites, mesh_string, ContactSettings, Model, Tubular};
-use holewall::physics::soft_string::{soft_string, Operation};
 use holewall::solve::chain::BlockTridiagonal;
+use holewall::solve::soft_string::{soft_string, Operation};
 use holewall::solve::statics::{
     constrained_tangent, solve_static, solve_static_from, StaticOptions, StaticState,
 };

@@ -45,12 +45,13 @@ use crate::error::{Error, InputError};
 /// Fine-grid points per unknown for the posterior.
 pub const FINE: usize = 161;
 
-pub mod measured;
 pub mod report;
 pub mod stats;
 pub mod synthetic;
 
-pub use measured::{by_mode, modes_of, parse_measured, read_measured, MeasuredMode, Measurement};
+pub use crate::ensemble::measured::{
+    by_mode, modes_of, parse_measured, read_measured, MeasuredMode, Measurement,
+};
 pub use stats::LackOfFit;
 use stats::{fill_from_neighbours, lack_of_fit, linspace, spline_weights, trend};
 

@@ -203,16 +203,16 @@ impl Case {
     }
 
     /// The soft-string profile of the case's operation, with each hole section's friction.
-    pub fn soft_string(&self) -> crate::physics::soft_string::SoftStringProfile {
+    pub fn soft_string(&self) -> crate::solve::soft_string::SoftStringProfile {
         let friction_at = |md: f64| self.hole_at(md).friction;
-        crate::physics::soft_string::soft_string_with(&self.model, &self.operation(), &friction_at)
+        crate::solve::soft_string::soft_string_with(&self.model, &self.operation(), &friction_at)
     }
 
     /// The case's operation for the soft string (speeds and bit loads; the friction of the
     /// hole at the surface, each section's where it has one).
-    pub fn operation(&self) -> crate::physics::soft_string::Operation {
+    pub fn operation(&self) -> crate::solve::soft_string::Operation {
         let model = &self.model;
-        crate::physics::soft_string::Operation {
+        crate::solve::soft_string::Operation {
             axial_speed: model.axial_speed,
             rotation_speed: model.rotation_speed,
             weight_on_bit: model.weight_on_bit,

@@ -485,7 +485,7 @@ pub fn write_well(seed: u64, dir: &Path) -> Result<CorpusWell, String> {
 /// The largest weight on bit (N) at which the soft-string compression stays below the
 /// sinusoidal-buckling load of every element (bisection; friction of the operation).
 pub fn buckling_limited_wob(case: &crate::case::Case, sliding: bool) -> f64 {
-    use crate::physics::soft_string::{soft_string_with, Operation};
+    use crate::solve::soft_string::{soft_string_with, Operation};
     let model = &case.model;
     let ok = |wob: f64| {
         let op = Operation {

@@ -156,7 +156,7 @@ pub fn run(
     // The measurements to draw over the broomstick, read before any work (a bad file is
     // refused with its line and column).
     let measured = match &options.measured {
-        Some(p) => crate::calibrate::read_measured(p)?,
+        Some(p) => crate::ensemble::measured::read_measured(p)?,
         None => Vec::new(),
     };
     // Check every variant against the case before any work.

@@ -27,6 +27,7 @@
 //! `.stabK` applies to every contact site.
 
 pub mod job;
+pub mod measured;
 pub mod plots;
 pub mod qoi;
 pub mod report;

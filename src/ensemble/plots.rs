@@ -285,13 +285,13 @@ const MAX_LINES: usize = 24;
 /// depth, one line per combination of the other keys (mode, friction, …), and the string's
 /// tensile limit (90 % of the surface component's yield) where it has a grade
 /// (`broomstick.png`); where a variant rotates, the surface torque the same way
-/// (`broomstick_torque.png`). `measured` (a `--measured` file, [`crate::calibrate::measured`])
+/// (`broomstick_torque.png`). `measured` (a `--measured` file, [`crate::ensemble::measured`])
 /// is drawn over them as points, a shape per mode. Nothing without a `depth` key.
 pub(crate) fn broomstick(
     case: &Case,
     variants: &[Variant],
     results: &[VariantResult],
-    measured: &[crate::calibrate::Measurement],
+    measured: &[crate::ensemble::measured::Measurement],
     out: &Path,
 ) -> Result<Vec<String>, Error> {
     use crate::ensemble::Param;
@@ -345,13 +345,13 @@ pub(crate) fn broomstick(
         }
     }
     // The measurements, a point set per mode that has the quantity.
-    let modes = crate::calibrate::modes_of(measured.iter().map(|m| m.mode));
+    let modes = crate::ensemble::measured::modes_of(measured.iter().map(|m| m.mode));
     let names: Vec<String> = modes
         .iter()
         .map(|m| format!("{} (measured)", m.name().replace('_', " ")))
         .collect();
-    let measured_of = |pick: fn(&crate::calibrate::Measurement) -> Option<f64>| {
-        let sets = crate::calibrate::by_mode(
+    let measured_of = |pick: fn(&crate::ensemble::measured::Measurement) -> Option<f64>| {
+        let sets = crate::ensemble::measured::by_mode(
             &modes,
             &names,
             measured,

@@ -9,7 +9,6 @@ pub mod count;
 pub mod dual;
 pub mod mass;
 pub mod rotation;
-pub mod soft_string;
 pub mod vec3;
 
 /// Float type the physics is generic over: `f32` (what a GPU f32 run computes) or `f64`

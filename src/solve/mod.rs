@@ -1,4 +1,5 @@
-//! Solvers: the chain linear algebra and the static equilibrium.
+//! Solvers: the chain linear algebra, the static equilibrium (FE and soft string), the
+//! dynamics.
 
 pub mod chain;
 pub mod continuation;
@@ -6,5 +7,6 @@ pub mod dynamics;
 pub mod modal;
 pub mod newton;
 pub mod settings;
+pub mod soft_string;
 pub mod static_options;
 pub mod statics;

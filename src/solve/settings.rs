@@ -1,13 +1,13 @@
 //! Every solver setting of a run in one struct, each field documented with its default (in
 //! the manner of rapier's `IntegrationParameters`): the static solve's options
-//! ([`StaticOptions`], and through them its Newton settings, [`StaticOptions::newton`]) and
-//! the integrator's ([`DynamicOptions`]) are derived from it, so a default lives in one
+//! ([`Settings::statics`] → [`crate::solve::static_options::StaticOptions`], and through
+//! them its Newton settings) and the integrator's ([`Settings::dynamics`] →
+//! [`crate::solve::dynamics::DynamicOptions`]) are derived from it (those two methods live
+//! beside the structs they build, so this module imports neither), a default lives in one
 //! place and every path (the commands, the ensemble on the CPU and the GPU, the studies)
 //! takes the same ones from a case ([`crate::case::Case::settings`]).
 
 use crate::physics::mass::MassKind;
-use crate::solve::dynamics::{AlphaParams, DynamicOptions};
-use crate::solve::static_options::StaticOptions;
 
 /// The solver settings of a run (module docs).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -81,38 +81,12 @@ impl Settings {
             ..self
         }
     }
-
-    /// The static solve's options.
-    pub fn statics(&self) -> StaticOptions {
-        StaticOptions {
-            initial_steps: self.static_initial_steps,
-            max_iterations: self.static_max_iterations,
-            tolerance: self.static_tolerance,
-            min_step: self.static_min_step,
-            max_seconds: self.max_seconds,
-        }
-    }
-
-    /// The integrator's options (no load factor over time: a study sets its own).
-    pub fn dynamics(&self) -> DynamicOptions {
-        DynamicOptions {
-            dt: self.time_step,
-            min_dt: self.min_time_step,
-            alpha: AlphaParams::chung_hulbert(self.rho_inf),
-            max_iterations: self.dynamic_max_iterations,
-            tolerance: self.dynamic_tolerance,
-            rayleigh: self.rayleigh,
-            ramp_time: self.ramp_time,
-            load_factor: None,
-            mass: self.mass,
-            rop: self.rop,
-        }
-    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::solve::dynamics::AlphaParams;
 
     #[test]
     fn the_options_derived_from_the_settings_carry_every_field() {

@@ -31,6 +31,19 @@ impl Default for StaticOptions {
     }
 }
 
+impl crate::solve::settings::Settings {
+    /// The static solve's options.
+    pub fn statics(&self) -> StaticOptions {
+        StaticOptions {
+            initial_steps: self.static_initial_steps,
+            max_iterations: self.static_max_iterations,
+            tolerance: self.static_tolerance,
+            min_step: self.static_min_step,
+            max_seconds: self.max_seconds,
+        }
+    }
+}
+
 impl StaticOptions {
     /// The Newton settings of a static solve in a precision of `size` bytes for `models`
     /// (the deep line search where any has a soft law): the one place `solve_static`, the

@@ -112,6 +112,24 @@ impl Default for DynamicOptions {
     }
 }
 
+impl crate::solve::settings::Settings {
+    /// The integrator's options (no load factor over time: a study sets its own).
+    pub fn dynamics(&self) -> DynamicOptions {
+        DynamicOptions {
+            dt: self.time_step,
+            min_dt: self.min_time_step,
+            alpha: AlphaParams::chung_hulbert(self.rho_inf),
+            max_iterations: self.dynamic_max_iterations,
+            tolerance: self.dynamic_tolerance,
+            rayleigh: self.rayleigh,
+            ramp_time: self.ramp_time,
+            load_factor: None,
+            mass: self.mass,
+            rop: self.rop,
+        }
+    }
+}
+
 /// Dynamic state.
 #[derive(Clone, Debug)]
 pub struct DynamicState {

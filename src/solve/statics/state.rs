@@ -51,7 +51,7 @@ impl StaticState {
     /// The laid start; `turn_flips`: turn around the wall at side flips. Returns whether
     /// the string has a side flip (turned or not).
     fn laid(model: &Model, turn_flips: bool) -> (StaticState, bool) {
-        use crate::physics::soft_string::{soft_string, Operation};
+        use crate::solve::soft_string::{soft_string, Operation};
         let mut s = StaticState::initial(model);
         let n = model.nodes.len();
         let cable = soft_string(
