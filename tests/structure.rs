@@ -132,3 +132,28 @@ fn no_import_cycles_and_the_library_below_the_cli() {
     assert!(up.is_empty(), "library modules importing the CLI: {up:?}");
     assert!(mods.len() > 50, "{} modules read", mods.len());
 }
+
+/// Issue 24: no source file in `src/` over 800 lines (tests included: a long test module
+/// moves to a `tests.rs` of its own).
+#[test]
+fn no_source_file_over_800_lines() {
+    fn walk(dir: &Path, out: &mut Vec<(String, usize)>) {
+        for e in std::fs::read_dir(dir).unwrap() {
+            let p = e.unwrap().path();
+            if p.is_dir() {
+                walk(&p, out);
+            } else if p.extension().is_some_and(|x| x == "rs") {
+                let n = std::fs::read_to_string(&p).unwrap().lines().count();
+                out.push((p.display().to_string(), n));
+            }
+        }
+    }
+    let mut files = Vec::new();
+    walk(
+        &Path::new(env!("CARGO_MANIFEST_DIR")).join("src"),
+        &mut files,
+    );
+    let long: Vec<_> = files.iter().filter(|(_, n)| *n > 800).collect();
+    assert!(long.is_empty(), "files over 800 lines: {long:?}");
+    assert!(files.len() > 50, "{} files read", files.len());
+}
