@@ -189,6 +189,38 @@ fn corpus_wells_through_the_engine_match_the_cpu() {
     assert_eq!(checked, 3);
 }
 
+/// Two folds beyond the first 50 seeds that a relaxation whose shift stops at 1e-3 of its
+/// start could not pass (each failed with it: the relaxation spent its budget), and that the
+/// floor of 1e-5 (`continuation::RELAX_FLOOR`) solves: seed 206 (horizontal, tripping in,
+/// 10 m elements) relaxes past a fold of the load steps, seed 372 (near-vertical, sliding,
+/// stabilizer-only contact) in the gravity stage. Both must end relaxed, with the hook load
+/// within 7 % of the soft string's.
+#[test]
+fn folds_beyond_the_sample_solve_by_relaxation() {
+    let dir = tempdir::Dir::new("corpus_folds");
+    for seed in [206, 372] {
+        let well = write_well(seed, dir.path()).unwrap();
+        let r = run_well(&well, &Default::default()).unwrap();
+        eprintln!(
+            "seed {seed}: solved {} in {:.2} s, {} Newton iterations, relaxed {}, hook FE {:.1} kN / soft {:.1} kN {}",
+            r.solved,
+            r.seconds,
+            r.newton_iterations,
+            r.relaxed,
+            r.fe_hook_load_n / 1e3,
+            r.soft_hook_load_n / 1e3,
+            r.error
+        );
+        assert!(r.solved, "seed {seed}: {}", r.error);
+        assert!(r.relaxed, "seed {seed}: solved without relaxing");
+        assert!(
+            (r.hook_load_ratio - 1.0).abs() <= 0.07,
+            "seed {seed}: FE/soft-string hook load {}",
+            r.hook_load_ratio
+        );
+    }
+}
+
 /// `cases/build_and_hold_2500.toml` with its operation and mesh replaced.
 fn reproducer(mode: &str, element: f64) -> holewall::case::Case {
     let text = std::fs::read_to_string(concat!(
