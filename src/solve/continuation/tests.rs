@@ -193,3 +193,17 @@ fn a_gravity_stage_that_fails_relaxes_under_gravity_alone() {
     assert_eq!(p.stage, Stage::Load);
     assert!(p.target().lambda > 0.0 && p.target().lambda < 1.0);
 }
+
+#[test]
+fn a_failed_gravity_step_relaxes_at_once_where_the_system_can_and_ramps_where_it_cannot() {
+    let mut p = LoadPath::new(&StaticOptions::default(), true, true, false);
+    assert_eq!(p.failed_at("no".into(), None, Some(1e4)), Next::Step);
+    assert_eq!(p.stage, Stage::Relax);
+    assert_eq!(p.shift(), 1e4);
+    let t = p.target();
+    assert_eq!((t.gravity, t.lambda), (1.0, 0.0));
+    let mut p = LoadPath::new(&StaticOptions::default(), true, true, false);
+    assert_eq!(p.failed_at("no".into(), None, None), Next::Step);
+    assert_eq!(p.stage, Stage::GravityRamp);
+    assert!(p.target().gravity < 1.0);
+}
