@@ -90,10 +90,8 @@ enum Stage {
 struct Relax {
     /// The loads relaxed to (the failed step's).
     target: LoadTarget,
-    /// Shift now (N/m; 0: the closing plain solve).
+    /// Shift now (N/m; never below [`RELAX_FLOOR`] × `s0`).
     s: f64,
-    /// The last nonzero shift (where a closing solve fails, relaxation resumes above it).
-    last: f64,
     /// The starting shift (the system's scale).
     s0: f64,
     /// Sub-solves so far.
@@ -314,7 +312,7 @@ impl LoadPath {
     }
 
     /// The proximal shift of the sub-solve being run (N/m on the translations; 0 outside a
-    /// relaxation and in its closing plain solve).
+    /// relaxation).
     pub fn shift(&self) -> f64 {
         match (&self.stage, &self.relax) {
             (Stage::Relax, Some(r)) => r.s,
@@ -327,13 +325,12 @@ impl LoadPath {
     /// an equilibrium and the relaxation ends there.
     pub fn shift_settled(&mut self, measure: f64) {
         if let (Stage::Relax, Some(r)) = (&self.stage, self.relax.as_mut()) {
-            r.settled = r.s > 0.0 && measure < self.tolerance;
+            r.settled = measure < self.tolerance;
             if measure < 0.99 * r.best {
                 r.best = measure;
                 r.best_at = r.subs;
             }
             if !r.settled
-                && r.s > 0.0
                 && measure <= self.stall_tolerance
                 && r.subs >= r.best_at + RELAX_STALL_SUBS
             {
@@ -432,9 +429,9 @@ impl LoadPath {
                 let r = self.relax.as_mut().expect("a relaxation");
                 r.subs += 1;
                 r.iterations += iterations;
-                if r.s == 0.0 || r.settled {
-                    // The closing plain solve converged, or a sub-solve whose shift force is
-                    // below the tolerance: an equilibrium at the target.
+                if r.settled {
+                    // A sub-solve whose answer is an equilibrium without the shift (or
+                    // stalled just above the tolerance): an equilibrium at the target.
                     let stall = r.stalled.map_or(String::new(), |m| {
                         format!(
                             "; its residual stalled at {m:.1e} of the force scale, above the \
@@ -471,7 +468,6 @@ impl LoadPath {
                         RELAX_MAX_BUDGET * self.max_iterations
                     ));
                 } else {
-                    r.last = r.s;
                     if iterations <= 5 {
                         r.s /= 4.0;
                     } else if iterations <= 15 {
@@ -507,7 +503,6 @@ impl LoadPath {
         self.relax = Some(Relax {
             target,
             s: s0,
-            last: s0,
             s0,
             subs: 0,
             iterations: 0,
@@ -659,13 +654,8 @@ impl LoadPath {
             Stage::Relax => {
                 let r = self.relax.as_mut().expect("a relaxation");
                 r.subs += 1;
-                r.iterations += if r.s > 0.0 {
-                    RELAX_SUB_ITERATIONS.min(self.max_iterations)
-                } else {
-                    self.max_iterations
-                };
-                r.s = if r.s == 0.0 { 4.0 * r.last } else { 4.0 * r.s };
-                r.last = r.s;
+                r.iterations += RELAX_SUB_ITERATIONS.min(self.max_iterations);
+                r.s *= 4.0;
                 if r.s > RELAX_CEILING * r.s0
                     || r.subs >= RELAX_MAX_SUBS
                     || r.iterations >= RELAX_MAX_BUDGET * self.max_iterations
