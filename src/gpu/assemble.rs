@@ -88,7 +88,7 @@ pub fn assemble_residual_gpu<T: GpuReal>(
         &outputs,
         n * nv,
     )?;
-    Ok(bytemuck::cast_slice(&out[0]).to_vec())
+    Ok(crate::gpu::readback::values(&out[0]))
 }
 
 /// The shift's inputs of `a` (`shift`, `anchor`, `x`), empty without one: bound after

@@ -89,7 +89,7 @@ pub fn beam_gpu<T: GpuReal>(
         ne * num_variants,
     )?;
     Ok((
-        bytemuck::cast_slice(&out[0]).to_vec(),
+        crate::gpu::readback::values(&out[0]),
         out.get(1)
             .map(|t| bytemuck::cast_slice(t).to_vec())
             .unwrap_or_default(),

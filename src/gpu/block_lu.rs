@@ -353,8 +353,8 @@ pub fn block_lu_gpu_form<T: GpuReal>(
             ],
             lanes * len,
         )?;
-        let xs: &[T] = bytemuck::cast_slice(&out[2]);
-        let st: &[u32] = bytemuck::cast_slice(&out[3]);
+        let xs: Vec<T> = crate::gpu::readback::values(&out[2]);
+        let st: Vec<u32> = crate::gpu::readback::values(&out[3]);
         for k in 0..6 * n {
             x[k * v + offset..k * v + offset + len].copy_from_slice(&xs[k * len..(k + 1) * len]);
         }

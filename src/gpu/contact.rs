@@ -10,6 +10,7 @@ use wgpu::util::DeviceExt;
 use crate::error::GpuError;
 use crate::gpu::compose::compose;
 use crate::gpu::layout::ContactDims;
+use crate::gpu::readback;
 use crate::gpu::GpuContext;
 use crate::kernels::contact::{output_fields, ContactBatch, ContactOutputs, STATE_LEN};
 use crate::physics::contact::{ContactMode, ContactTerms, FrictionModel, SpringLaw, PARAMS_LEN};
@@ -116,7 +117,6 @@ struct Chunk {
     state: wgpu::Buffer,
     values: wgpu::Buffer,
     contact: wgpu::Buffer,
-    staging: wgpu::Buffer,
     bind_group: wgpu::BindGroup,
 }
 
@@ -129,6 +129,8 @@ pub struct GpuContactRun<T: GpuReal> {
     num_pairs: usize,
     /// Output fields the kernel writes ([`output_fields`]).
     fields: usize,
+    /// Where [`Self::read`] copies every chunk's outputs (made once).
+    staging: wgpu::Buffer,
     _real: PhantomData<T>,
 }
 
@@ -246,12 +248,6 @@ impl<T: GpuReal> GpuContactRun<T> {
                 usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
                 mapped_at_creation: false,
             });
-            let staging = device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some("contact_staging"),
-                size: values_bytes + contact_bytes,
-                usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-                mapped_at_creation: false,
-            });
             let dims = ContactDims {
                 num_pairs: len as u32,
                 num_variants: batch.num_variants as u32,
@@ -300,17 +296,27 @@ impl<T: GpuReal> GpuContactRun<T> {
                 state,
                 values,
                 contact,
-                staging,
                 bind_group,
             });
             offset += len;
         }
+        let reads: Vec<u64> = chunks
+            .iter()
+            .flat_map(|c| {
+                [
+                    bytes_of_len::<T>(fields * c.len),
+                    bytes_of_len::<u32>(c.len),
+                ]
+            })
+            .collect();
+        let staging = readback::staging_buffer(ctx, "contact_staging", &reads);
         Ok(GpuContactRun {
             ctx,
             pipeline,
             chunks,
             num_pairs,
             fields,
+            staging,
             _real: PhantomData,
         })
     }
@@ -381,50 +387,33 @@ impl<T: GpuReal> GpuContactRun<T> {
     pub fn read(&self) -> Result<ContactOutputs<T>, GpuError> {
         let p = self.num_pairs;
         let mut out = ContactOutputs::new(p);
-        let mut encoder = self
+        let encoder = self
             .ctx
             .device
             .create_command_encoder(&wgpu::CommandEncoderDescriptor {
                 label: Some("contact_read"),
             });
-        for chunk in &self.chunks {
-            let values_bytes = bytes_of_len::<T>(self.fields * chunk.len);
-            encoder.copy_buffer_to_buffer(&chunk.values, 0, &chunk.staging, 0, values_bytes);
-            encoder.copy_buffer_to_buffer(
-                &chunk.contact,
-                0,
-                &chunk.staging,
-                values_bytes,
-                bytes_of_len::<u32>(chunk.len),
-            );
-        }
-        self.ctx.queue.submit([encoder.finish()]);
-        for chunk in &self.chunks {
-            chunk
-                .staging
-                .slice(..)
-                .map_async(wgpu::MapMode::Read, |_| {});
-        }
-        self.wait()?;
-        for chunk in &self.chunks {
-            let values_bytes = bytes_of_len::<T>(self.fields * chunk.len) as usize;
-            {
-                let view = chunk
-                    .staging
-                    .slice(..)
-                    .get_mapped_range()
-                    .map_err(|e| GpuError::Device(format!("map: {e}")))?;
-                let values: &[T] = bytemuck::cast_slice(&view[..values_bytes]);
-                let flags: &[u32] = bytemuck::cast_slice(&view[values_bytes..]);
-                // Fields a static scene leaves out stay zero, as the twin's.
-                for k in 0..self.fields {
-                    out.values[k * p + chunk.offset..k * p + chunk.offset + chunk.len]
-                        .copy_from_slice(&values[k * chunk.len..(k + 1) * chunk.len]);
-                }
-                out.contact[chunk.offset..chunk.offset + chunk.len]
-                    .copy_from_slice(&flags[..chunk.len]);
+        let reads: Vec<(&wgpu::Buffer, u64)> = self
+            .chunks
+            .iter()
+            .flat_map(|c| {
+                [
+                    (&c.values, bytes_of_len::<T>(self.fields * c.len)),
+                    (&c.contact, bytes_of_len::<u32>(c.len)),
+                ]
+            })
+            .collect();
+        let bytes = readback::submit_and_read_into(self.ctx, encoder, &self.staging, &reads)?;
+        for (chunk, pair) in self.chunks.iter().zip(bytes.chunks_exact(2)) {
+            let values: Vec<T> = readback::values(&pair[0]);
+            let flags: Vec<u32> = readback::values(&pair[1]);
+            // Fields a static scene leaves out stay zero, as the twin's.
+            for k in 0..self.fields {
+                out.values[k * p + chunk.offset..k * p + chunk.offset + chunk.len]
+                    .copy_from_slice(&values[k * chunk.len..(k + 1) * chunk.len]);
             }
-            chunk.staging.unmap();
+            out.contact[chunk.offset..chunk.offset + chunk.len]
+                .copy_from_slice(&flags[..chunk.len]);
         }
         Ok(out)
     }

@@ -150,13 +150,6 @@ pub fn run_passes(
             }),
         })
         .collect();
-    let total: usize = output_bytes.iter().map(|b| b.max(&4)).sum();
-    let staging = device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some(label),
-        size: total as u64,
-        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-        mapped_at_creation: false,
-    });
     let layout = pipeline.get_bind_group_layout(0);
     let bind_groups: Vec<wgpu::BindGroup> = dims
         .iter()
@@ -194,31 +187,12 @@ pub fn run_passes(
         }
         encoder
     };
-    let mut encoder = passes();
-    let mut offset = 0u64;
-    for (b, &bytes) in outputs.iter().zip(&output_bytes) {
-        let size = bytes.max(4) as u64;
-        encoder.copy_buffer_to_buffer(b, 0, &staging, offset, size);
-        offset += size;
-    }
-    ctx.queue.submit([encoder.finish()]);
-    staging.slice(..).map_async(wgpu::MapMode::Read, |_| {});
-    device
-        .poll(wgpu::PollType::wait_indefinitely())
-        .map_err(|e| GpuError::Device(e.to_string()))?;
-    let mut result = Vec::new();
-    {
-        let view = staging
-            .slice(..)
-            .get_mapped_range()
-            .map_err(|e| GpuError::Device(format!("map: {e}")))?;
-        let mut offset = 0usize;
-        for &bytes in &output_bytes {
-            result.push(view[offset..offset + bytes].to_vec());
-            offset += bytes.max(4);
-        }
-    }
-    staging.unmap();
+    let reads: Vec<(&wgpu::Buffer, u64)> = outputs
+        .iter()
+        .zip(&output_bytes)
+        .map(|(b, &bytes)| (b, bytes as u64))
+        .collect();
+    let result = crate::gpu::readback::submit_and_read(ctx, passes(), &reads)?;
     if let Some(repeats) = TIMING.with(|t| t.borrow().as_ref().map(|t| t.0)) {
         // The outputs' first contents, to restore before each timed run.
         let pristine: Vec<(usize, wgpu::Buffer)> = initial

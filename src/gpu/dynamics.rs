@@ -128,7 +128,7 @@ pub fn accelerate_gpu<T: GpuReal>(
         &[Out::Empty(std::mem::size_of_val(vdot))],
         num_nodes * num_variants,
     )?;
-    Ok(bytemuck::cast_slice(&out[0]).to_vec())
+    Ok(crate::gpu::readback::values(&out[0]))
 }
 
 /// [`crate::kernels::dynamics::inertial_scale`] on the GPU.
@@ -150,5 +150,5 @@ pub fn inertial_scale_gpu<T: GpuReal>(
         &[Out::Empty(num_variants * std::mem::size_of::<T>())],
         num_variants,
     )?;
-    Ok(bytemuck::cast_slice(&out[0]).to_vec())
+    Ok(crate::gpu::readback::values(&out[0]))
 }

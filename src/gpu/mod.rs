@@ -12,6 +12,7 @@ pub mod dynamics;
 pub mod ensemble;
 pub mod layout;
 pub mod path;
+pub mod readback;
 pub mod update;
 
 pub use context::{list_adapters, AdapterSummary, GpuContext};

@@ -87,8 +87,8 @@ pub fn update_gpu<T: GpuReal>(
         ],
         b.num_nodes * b.num_variants,
     )?;
-    b.x = bytemuck::cast_slice(&out[0]).to_vec();
-    b.rot = bytemuck::cast_slice(&out[1]).to_vec();
+    b.x = crate::gpu::readback::values(&out[0]);
+    b.rot = crate::gpu::readback::values(&out[1]);
     Ok(())
 }
 
@@ -126,7 +126,7 @@ pub fn norms_gpu<T: GpuReal>(
         &[Out::Empty(4 * num_variants * size)],
         num_variants,
     )?;
-    let rows: &[T] = bytemuck::cast_slice(&out[0]);
+    let rows: Vec<T> = crate::gpu::readback::values(&out[0]);
     let rows: Vec<[T; 4]> = rows
         .chunks_exact(4)
         .map(|c| [c[0], c[1], c[2], c[3]])

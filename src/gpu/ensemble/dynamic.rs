@@ -338,7 +338,7 @@ impl<T: GpuReal> crate::engine::dynamic::DynamicEnsemble<T> for GpuDynamic<T> {
             ],
         )
         .map_err(crate::error::SystemError::from)?;
-        let status: Vec<u32> = bytemuck::cast_slice(&out[1]).to_vec();
+        let status: Vec<u32> = values(&out[1]);
         if status.contains(&RUNNING) {
             return Err(crate::error::SystemError::BlockSolve(
                 "a dispatch did not complete (status left at running)".into(),
@@ -347,7 +347,7 @@ impl<T: GpuReal> crate::engine::dynamic::DynamicEnsemble<T> for GpuDynamic<T> {
         Ok(crate::engine::dynamic::Iteration {
             norms: norms_from_bytes(&out[0]),
             status,
-            inertial: bytemuck::cast_slice(&out[2]).to_vec(),
+            inertial: values(&out[2]),
         })
     }
 
@@ -456,7 +456,7 @@ impl<T: GpuReal> crate::engine::dynamic::DynamicEnsemble<T> for GpuDynamic<T> {
             &[(&self.b.vdot_k, bytes)],
         )
         .map_err(crate::error::SystemError::from)?;
-        Ok(bytemuck::cast_slice(&out[0]).to_vec())
+        Ok(values(&out[0]))
     }
 
     fn set_unknown(&mut self, vdot: &[T]) -> Result<(), crate::error::SystemError> {
@@ -557,5 +557,5 @@ pub fn gather_sites_dynamic_gpu<T: GpuReal>(
         e,
         &[(&state_b, std::mem::size_of_val(pair_state) as u64)],
     )?;
-    Ok(bytemuck::cast_slice(&out[0]).to_vec())
+    Ok(values(&out[0]))
 }

@@ -160,8 +160,8 @@ impl<T: GpuReal> Ensemble<T> for GpuEnsemble<T> {
         Ok(ConfigBatch {
             num_variants: v,
             num_nodes: n,
-            x: bytemuck::cast_slice(&out[0]).to_vec(),
-            rot: bytemuck::cast_slice(&out[1]).to_vec(),
+            x: values(&out[0]),
+            rot: values(&out[1]),
             basis: Vec::new(),
         })
     }
@@ -248,5 +248,5 @@ pub fn gather_sites_gpu<T: GpuReal>(
         ))],
         pair_node.len(),
     )?;
-    Ok(bytemuck::cast_slice(&out[0]).to_vec())
+    Ok(values(&out[0]))
 }

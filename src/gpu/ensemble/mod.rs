@@ -20,6 +20,7 @@ use crate::gpu::block_lu::LuForm;
 use crate::gpu::contact::{contact_wgsl, require_precision, GpuReal};
 use crate::gpu::dispatch::WORKGROUP;
 use crate::gpu::layout::{AssembleDims, BeamDims, ChainDims, ContactDims};
+use crate::gpu::readback::{submit_and_read, values};
 use crate::gpu::GpuContext;
 use crate::kernels::contact::{OUTPUT_LEN, STATE_LEN};
 use crate::kernels::update::{ConfigBatch, Norms};
@@ -490,10 +491,7 @@ impl<T: GpuReal> GpuEnsemble<T> {
             encoder,
             &[(&self.c.norms, norm_bytes), (&self.c.status, 4 * v as u64)],
         )?;
-        Ok((
-            norms_from_bytes(&out[0]),
-            bytemuck::cast_slice(&out[1]).to_vec(),
-        ))
+        Ok((norms_from_bytes(&out[0]), values(&out[1])))
     }
 }
 
@@ -532,46 +530,4 @@ fn norms_from_bytes<T: GpuReal>(bytes: &[u8]) -> Norms<T> {
         .map(|c| [c[0], c[1], c[2], c[3]])
         .collect();
     Norms::from_rows(&rows)
-}
-
-/// Submits `encoder` with copies of the first `bytes` of each buffer into one staging
-/// buffer appended, waits, and returns the bytes of each.
-fn submit_and_read(
-    ctx: &GpuContext,
-    mut encoder: wgpu::CommandEncoder,
-    reads: &[(&wgpu::Buffer, u64)],
-) -> Result<Vec<Vec<u8>>, GpuError> {
-    let total: u64 = reads.iter().map(|(_, b)| b.max(&4)).sum();
-    let staging = ctx.device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("read"),
-        size: total.max(4),
-        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-        mapped_at_creation: false,
-    });
-    let mut offset = 0;
-    for (buffer, bytes) in reads {
-        if *bytes > 0 {
-            encoder.copy_buffer_to_buffer(buffer, 0, &staging, offset, *bytes);
-        }
-        offset += bytes.max(&4);
-    }
-    ctx.queue.submit([encoder.finish()]);
-    staging.slice(..).map_async(wgpu::MapMode::Read, |_| {});
-    ctx.device
-        .poll(wgpu::PollType::wait_indefinitely())
-        .map_err(|e| GpuError::Device(e.to_string()))?;
-    let mut out = Vec::with_capacity(reads.len());
-    {
-        let view = staging
-            .slice(..)
-            .get_mapped_range()
-            .map_err(|e| GpuError::Device(format!("map: {e}")))?;
-        let mut offset = 0usize;
-        for (_, bytes) in reads {
-            out.push(view[offset..offset + *bytes as usize].to_vec());
-            offset += (*bytes).max(4) as usize;
-        }
-    }
-    staging.unmap();
-    Ok(out)
 }
