@@ -81,9 +81,12 @@ pub enum Error {
     /// The machinery under a solve failed (exit code 1).
     #[error(transparent)]
     System(#[from] SystemError),
-    /// I/O failure.
+    /// I/O failure (reading or writing a file).
     #[error("{0}")]
     Io(#[from] std::io::Error),
+    /// A result that could not be encoded or decoded (CSV, JSON, a plot): exit code 1.
+    #[error("{0}")]
+    Encode(String),
     /// A solve, a run or an engine that failed on valid input (a static solve that did not
     /// converge, a time step that failed, the GPU engine's error): exit code 1.
     #[error("{0}")]
@@ -93,7 +96,24 @@ pub enum Error {
     Stopped(String),
 }
 
+impl From<csv::Error> for Error {
+    fn from(e: csv::Error) -> Self {
+        Error::Encode(format!("CSV: {e}"))
+    }
+}
+
+impl From<serde_json::Error> for Error {
+    fn from(e: serde_json::Error) -> Self {
+        Error::Encode(format!("JSON: {e}"))
+    }
+}
+
 impl Error {
+    /// [`Error::Encode`] from any message (a CSV writer's, a plot's).
+    pub fn encode(message: impl std::fmt::Display) -> Self {
+        Error::Encode(message.to_string())
+    }
+
     /// [`Error::Failed`] from any message.
     pub fn failed(message: impl std::fmt::Display) -> Self {
         Error::Failed(message.to_string())

@@ -178,7 +178,7 @@ pub fn solve_with_progress(
     case: &Case,
     options: crate::solve::statics::StaticOptions,
     show_progress: bool,
-) -> Result<crate::solve::statics::StaticSolution, String> {
+) -> Result<crate::solve::statics::StaticSolution, crate::error::Error> {
     let model = &case.model;
     let bar = crate::output::progress_bar(
         show_progress,
@@ -189,5 +189,5 @@ pub fn solve_with_progress(
         bar.set_position((1000.0 * lambda) as u64)
     });
     bar.finish_and_clear();
-    solved.map_err(|e| crate::diagnose::static_failure(case, &e))
+    solved.map_err(|e| crate::error::Error::Failed(crate::diagnose::static_failure(case, &e)))
 }

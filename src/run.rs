@@ -142,19 +142,17 @@ fn record(
 
 fn csv_bytes(header: &[&str], rows: impl Iterator<Item = Vec<f64>>) -> Result<Vec<u8>, Error> {
     let mut w = csv::Writer::from_writer(Vec::new());
-    w.write_record(header)
-        .map_err(|e| Error::Io(std::io::Error::other(e)))?;
+    w.write_record(header).map_err(Error::from)?;
     for r in rows {
         w.write_record(r.iter().map(|x| x.to_string()))
-            .map_err(|e| Error::Io(std::io::Error::other(e)))?;
+            .map_err(Error::from)?;
     }
-    w.into_inner()
-        .map_err(|e| Error::Io(std::io::Error::other(e.to_string())))
+    w.into_inner().map_err(Error::encode)
 }
 
 /// `summary.json` of a run, as bytes.
 pub fn summary_json(summary: &RunSummary) -> Result<Vec<u8>, Error> {
-    Ok(serde_json::to_vec_pretty(summary).map_err(std::io::Error::other)?)
+    Ok(serde_json::to_vec_pretty(summary)?)
 }
 
 /// Runs a loaded case (its model may carry an ensemble variant's overrides), writing its

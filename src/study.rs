@@ -204,7 +204,7 @@ fn run_on(
     case: &Case,
     path: &str,
     gpu: Option<&'static crate::gpu::GpuContext>,
-) -> Result<(VariantResult, f64), String> {
+) -> Result<(VariantResult, f64), Error> {
     let variant = Variant {
         name: "study".into(),
         overrides: vec![],
@@ -213,24 +213,28 @@ fn run_on(
     let clock = std::time::Instant::now();
     let result = match (path, gpu) {
         ("cpu-f64", _) => crate::ensemble::qoi::dynamic_variant(case, "study", &case.model),
-        ("gpu-f64", Some(ctx)) if !ctx.has_f64 => return Err("the adapter has no f64".into()),
+        ("gpu-f64", Some(ctx)) if !ctx.has_f64 => {
+            return Err(Error::failed("the adapter has no f64"))
+        }
         ("gpu-f64", Some(ctx)) => {
             crate::ensemble::runner::run_dynamic_gpu::<f64>(case, &[variant], ctx, &bar)
-                .map_err(|e| e.to_string())??
+                .map_err(Error::failed)?
+                .map_err(Error::failed)?
                 .remove(0)
         }
         ("gpu-f32", Some(ctx)) => {
             crate::ensemble::runner::run_dynamic_gpu::<f32>(case, &[variant], ctx, &bar)
-                .map_err(|e| e.to_string())??
+                .map_err(Error::failed)?
+                .map_err(Error::failed)?
                 .remove(0)
         }
-        _ => return Err("no GPU adapter".into()),
+        _ => return Err(Error::failed("no GPU adapter")),
     };
     if result.solved_by == crate::ensemble::qoi::SolvedBy::Cpu && path != "cpu-f64" {
-        return Err(format!(
+        return Err(Error::failed(format!(
             "the engine failed the run ({}); not a {path} result",
             result.reason
-        ));
+        )));
     }
     Ok((result, clock.elapsed().as_secs_f64()))
 }
@@ -390,7 +394,7 @@ pub fn precision(
         recommendation,
         notes,
     };
-    folder.finish(&serde_json::to_vec_pretty(&summary).map_err(std::io::Error::other)?)?;
+    folder.finish(&serde_json::to_vec_pretty(&summary)?)?;
     Ok(summary)
 }
 
@@ -637,7 +641,7 @@ pub fn stability(
         failed: map.len() - count("converged") - count("step_cut"),
         map,
     };
-    folder.finish(&serde_json::to_vec_pretty(&summary).map_err(std::io::Error::other)?)?;
+    folder.finish(&serde_json::to_vec_pretty(&summary)?)?;
     Ok(summary)
 }
 

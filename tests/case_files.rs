@@ -664,7 +664,8 @@ fn runs_can_be_bounded_in_wall_time() {
         },
         false,
     )
-    .unwrap_err();
+    .unwrap_err()
+    .to_string();
     assert!(
         e.contains("--max-seconds budget") && e.contains("% of the loads"),
         "{e}"

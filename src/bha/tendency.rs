@@ -302,6 +302,17 @@ pub fn drilling_angles(
     frame.angles(&v)
 }
 
+/// Why one BHA-model solve gave no bit loads.
+#[derive(Debug, thiserror::Error)]
+enum BitSolveError {
+    /// The tendency's wall-clock budget was spent before the solve began.
+    #[error("the time budget ran out before this BHA-model solve")]
+    Budget,
+    /// The static solve failed.
+    #[error(transparent)]
+    Static(#[from] crate::solve::statics::StaticError),
+}
+
 /// One BHA-model solve: the bit's loads in a hole of curvature `(κ_b, κ_t)`.
 fn bit_at(
     model: &Model,
@@ -310,13 +321,13 @@ fn bit_at(
     wob: f64,
     toolface: Option<f64>,
     deadline: Option<std::time::Instant>,
-) -> Result<(BitLoads, HoleFrame), String> {
+) -> Result<(BitLoads, HoleFrame), BitSolveError> {
     let max_seconds = match deadline {
         None => None,
         Some(d) => {
             let left = d.saturating_duration_since(std::time::Instant::now());
             if left.is_zero() {
-                return Err("the time budget ran out before this BHA-model solve".into());
+                return Err(BitSolveError::Budget);
             }
             Some(left.as_secs_f64())
         }
@@ -326,7 +337,7 @@ fn bit_at(
         max_seconds,
         ..StaticOptions::default()
     };
-    let sol = solve_static(&m, &options).map_err(|e| e.to_string())?;
+    let sol = solve_static(&m, &options)?;
     let frame = HoleFrame::at_node(&m, m.nodes.len() - 1);
     Ok((bit_loads_of(&m, &sol), frame))
 }

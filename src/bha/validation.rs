@@ -263,10 +263,10 @@ impl PendulumScene {
     /// centroid of the contact forces in excess of the distributed load `q` over the 2 m
     /// from the first node in contact — the closed form's point force `q L / 2 − …` at `L`,
     /// which a stiff wall spreads over the few nodes around it.
-    pub fn solve(&self) -> Result<(BitLoads, f64), String> {
+    pub fn solve(&self) -> Result<(BitLoads, f64), crate::solve::statics::StaticError> {
         let m = self.model();
         let (_, q, _, _) = self.constants(&m);
-        let sol = solve_static(&m, &StaticOptions::default()).map_err(|e| e.to_string())?;
+        let sol = solve_static(&m, &StaticOptions::default())?;
         let bit_md = m.nodes.last().map_or(0.0, |n| n.md);
         let contacts: Vec<(f64, f64)> = m
             .sites

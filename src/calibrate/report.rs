@@ -38,7 +38,7 @@ fn label(key: &str) -> String {
 }
 
 fn posterior(case: &Case, cal: &Calibration, dir: &Path) -> Result<Vec<String>, Error> {
-    let io = |e: csv::Error| Error::Io(std::io::Error::other(e));
+    let io = Error::from;
     let mut w = csv::Writer::from_writer(Vec::new());
     let mut header: Vec<String> = cal.keys.iter().map(|k| k.name.clone()).collect();
     header.push("density".into());
@@ -57,7 +57,7 @@ fn posterior(case: &Case, cal: &Calibration, dir: &Path) -> Result<Vec<String>, 
                 .map_err(io)?;
         }
     }
-    let bytes = w.into_inner().map_err(|e| Error::Io(e.into_error()))?;
+    let bytes = w.into_inner().map_err(Error::encode)?;
     crate::output::write_atomic(&dir.join("posterior.csv"), &bytes)?;
     let title = format!("{}: friction factors from the measured loads", case.title);
     let map_label = |e: &super::Estimate| {

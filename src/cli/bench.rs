@@ -118,7 +118,7 @@ pub fn contact(
             adapter,
             rows,
         };
-        let text = serde_json::to_string_pretty(&report).map_err(std::io::Error::other)?;
+        let text = serde_json::to_string_pretty(&report)?;
         write_atomic(path, text.as_bytes())?;
     }
     Ok(())
@@ -178,10 +178,12 @@ pub fn dynamics(
     use crate::solve::statics::{solve_static, StaticOptions};
     let case = crate::case::load_case(case_path)?;
     let settings = case.dynamics.clone().ok_or_else(|| {
-        Error::Io(std::io::Error::other(format!(
-            "{}: bench dynamics needs a [dynamics] table",
-            case_path.display()
-        )))
+        Error::Input(crate::error::InputError {
+            source_name: case_path.display().to_string(),
+            line: 0,
+            key: "dynamics".into(),
+            message: "bench dynamics needs a [dynamics] table".into(),
+        })
     })?;
     let model = &case.model;
     let start = solve_static(model, &StaticOptions::default())
@@ -272,12 +274,11 @@ pub fn statics(
             overrides: Vec::new(),
         }]
     });
-    let io = |e: String| Error::Io(std::io::Error::other(e));
     let models: Vec<crate::model::Model> = list
         .iter()
         .map(|v| crate::ensemble::apply(&case, v))
         .collect::<Result<_, _>>()
-        .map_err(io)?;
+        .map_err(Error::failed)?;
     let options = StaticOptions::default();
     let summary = |its: Vec<Vec<usize>>, cuts: usize, solved: usize| {
         let mut all: Vec<usize> = its.into_iter().flatten().collect();

@@ -108,8 +108,8 @@ fn heavier(text: &str) -> Result<String, String> {
 
 fn one_well(seed: u64, dir: &Path) -> Result<CalibrateRow, String> {
     let start = std::time::Instant::now();
-    let well = crate::corpus::write_well(seed, dir)?;
-    let well = crate::corpus::remesh(&well, 10.0, 1.0)?;
+    let well = crate::corpus::write_well(seed, dir).map_err(|e| e.to_string())?;
+    let well = crate::corpus::remesh(&well, 10.0, 1.0).map_err(|e| e.to_string())?;
     let case = crate::case::load_case(&well.case_path).map_err(|e| e.to_string())?;
     let shoe = case
         .hole
@@ -271,7 +271,7 @@ pub fn run(
         worst,
         wall_seconds: clock.elapsed().as_secs_f64(),
     };
-    let json = serde_json::to_vec_pretty(&summary).map_err(std::io::Error::other)?;
+    let json = serde_json::to_vec_pretty(&summary)?;
     crate::output::write_atomic(&out.join("summary.json"), &json)?;
     Ok(summary)
 }

@@ -118,7 +118,6 @@ fn min_med_max(mut v: Vec<f64>) -> (f64, f64, f64) {
 
 /// Runs the benchmark into `out` (created; `wells/` holds every well's case and survey).
 pub fn run(out: &Path, options: &CorpusOptions) -> Result<CorpusSummary, Error> {
-    let io = |e: String| Error::Io(std::io::Error::other(e));
     let clock = std::time::Instant::now();
     let wells_dir = out.join("wells");
     std::fs::create_dir_all(&wells_dir)?;
@@ -142,8 +141,8 @@ pub fn run(out: &Path, options: &CorpusOptions) -> Result<CorpusSummary, Error> 
                 return Ok(None);
             }
             let seed = options.first_seed + k as u64;
-            let well = write_well(seed, &wells_dir).map_err(io)?;
-            let r = run_well(&well, &static_options).map_err(io)?;
+            let well = write_well(seed, &wells_dir)?;
+            let r = run_well(&well, &static_options)?;
             if r.solved {
                 done.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
             }
@@ -317,7 +316,7 @@ pub fn run(out: &Path, options: &CorpusOptions) -> Result<CorpusSummary, Error> 
         &solved.iter().map(|r| r.hook_load_ratio).collect::<Vec<_>>(),
         &[("median", summary.hook_load_ratio.1)],
     )?;
-    let json = serde_json::to_vec_pretty(&summary).map_err(|e| io(e.to_string()))?;
+    let json = serde_json::to_vec_pretty(&summary)?;
     crate::output::write_atomic(&out.join("summary.json"), &json)?;
     Ok(summary)
 }
@@ -360,12 +359,11 @@ pub fn mesh(
     show_progress: bool,
 ) -> Result<Vec<MeshRow>, Error> {
     use crate::corpus::{mesh_study_seeds, remesh, MESHES};
-    let io = |e: String| Error::Io(std::io::Error::other(e));
     let dir = out.join("wells");
     std::fs::create_dir_all(&dir)?;
     let seeds = match seeds {
         Some(s) => s,
-        None => mesh_study_seeds(&dir).map_err(io)?,
+        None => mesh_study_seeds(&dir)?,
     };
     let bar = crate::output::progress_bar(
         show_progress,
@@ -374,10 +372,10 @@ pub fn mesh(
     );
     let mut rows = Vec::new();
     for &seed in &seeds {
-        let well = write_well(seed, &dir).map_err(io)?;
+        let well = write_well(seed, &dir)?;
         for &(el, bha) in &MESHES {
-            let w = remesh(&well, el, bha).map_err(io)?;
-            let r = run_well(&w, &StaticOptions::default()).map_err(io)?;
+            let w = remesh(&well, el, bha)?;
+            let r = run_well(&w, &StaticOptions::default())?;
             rows.push(MeshRow {
                 seed,
                 trajectory: w.spec.trajectory.name().to_string(),
@@ -490,7 +488,6 @@ pub fn tendency(
     show_progress: bool,
 ) -> Result<TendencyCorpusSummary, Error> {
     use rayon::prelude::*;
-    let io = |e: String| Error::Io(std::io::Error::other(e));
     let clock = std::time::Instant::now();
     let dir = out.join("wells");
     std::fs::create_dir_all(&dir)?;
@@ -502,7 +499,7 @@ pub fn tendency(
     let rows: Result<Vec<TendencyRow>, Error> = (first_seed..first_seed + wells as u64)
         .into_par_iter()
         .map(|seed| {
-            let well = crate::corpus::write_well(seed, &dir).map_err(io)?;
+            let well = crate::corpus::write_well(seed, &dir)?;
             let case = crate::case::load_case(&well.case_path)?;
             let m = &case.model;
             let t0 = std::time::Instant::now();
@@ -555,7 +552,7 @@ pub fn tendency(
         build_rate: min_med_max(with_wob.iter().map(|r| r.build_rate_deg_per_30m).collect()),
         wall_seconds: clock.elapsed().as_secs_f64(),
     };
-    let json = serde_json::to_vec_pretty(&summary).map_err(std::io::Error::other)?;
+    let json = serde_json::to_vec_pretty(&summary)?;
     crate::output::write_atomic(&out.join("summary.json"), &json)?;
     Ok(summary)
 }

@@ -155,8 +155,8 @@ type Positions = Vec<[f64; 3]>;
 /// Newton iterations of a run, and every variant's final positions.
 type RunOutcome = (usize, Vec<Positions>);
 
-fn io(e: impl std::fmt::Display) -> Error {
-    Error::Io(std::io::Error::other(e.to_string()))
+fn failed(e: impl std::fmt::Display) -> Error {
+    Error::failed(e)
 }
 
 /// `v` variants of the benchmark string, friction spread over 0.2 … 0.4.
@@ -187,15 +187,16 @@ fn run_cpu(
         .par_iter()
         .map(|m| {
             let mut d = Dynamics::new(m, *options, &|e| density[e]);
-            let mut s = d.initial_state(start.clone())?;
-            d.run(&mut s, t_end, &mut |_, _| {})?;
+            let mut s = d.initial_state(start.clone()).map_err(|e| e.to_string())?;
+            d.run(&mut s, t_end, &mut |_, _| {})
+                .map_err(|e| e.to_string())?;
             Ok((d.iterations.iter().sum(), s.q.x.clone()))
         })
         .collect();
     let mut its = 0;
     let mut xs = Vec::new();
     for r in out {
-        let (i, x) = r.map_err(io)?;
+        let (i, x) = r.map_err(failed)?;
         its += i;
         xs.push(x);
     }
@@ -229,7 +230,7 @@ fn run_gpu<T: GpuReal>(
             }
         },
     )
-    .map_err(io)?;
+    .map_err(failed)?;
     let its = r.iter().map(|x| x.iterations.iter().sum::<usize>()).sum();
     let n = models[0].nodes.len();
     let xs = match last {
@@ -297,17 +298,16 @@ pub fn run(
         vec!["CPU f64"]
     };
     for &n in node_counts {
-        let case = crate::case::parse_case(Path::new("bench.toml"), &bench_case_text(n))
-            .map_err(|e| io(format!("{e:?}")))?;
+        let case = crate::case::parse_case(Path::new("bench.toml"), &bench_case_text(n))?;
         let base = &case.model;
         let nodes = base.nodes.len();
         let start = solve_static(base, &StaticOptions::default())
-            .map_err(io)?
+            .map_err(failed)?
             .state;
         let options = case
             .dynamics
             .as_ref()
-            .ok_or_else(|| io("no [dynamics]"))?
+            .ok_or_else(|| failed("no [dynamics]"))?
             .integrator_options();
         let t_end = steps as f64 * options.dt;
         let density = case.element_density.clone();
@@ -383,18 +383,17 @@ pub fn run(
     let mut work_precision = Vec::new();
     if precision_nodes > 0 {
         let case =
-            crate::case::parse_case(Path::new("bench.toml"), &bench_case_text(precision_nodes))
-                .map_err(|e| io(format!("{e:?}")))?;
+            crate::case::parse_case(Path::new("bench.toml"), &bench_case_text(precision_nodes))?;
         let base = &case.model;
         let start = solve_static(base, &StaticOptions::default())
-            .map_err(io)?
+            .map_err(failed)?
             .state;
         let models = variants(base, 16);
         let density = case.element_density.clone();
         let mut options = case
             .dynamics
             .as_ref()
-            .ok_or_else(|| io("no [dynamics]"))?
+            .ok_or_else(|| failed("no [dynamics]"))?
             .integrator_options();
         let t_end = 0.02;
         options.dt = 0.5e-3 / 8.0;
@@ -467,7 +466,7 @@ pub fn run(
             cells,
             work_precision,
         };
-        let text = serde_json::to_string_pretty(&report).map_err(std::io::Error::other)?;
+        let text = serde_json::to_string_pretty(&report)?;
         write_atomic(p, text.as_bytes())?;
     }
     Ok(())

@@ -133,7 +133,7 @@ pub fn specialisation(pairs: usize, repeats: usize, json: Option<&Path>) -> Resu
         );
     }
     if let Some(path) = json {
-        let text = serde_json::to_string_pretty(&rows).map_err(std::io::Error::other)?;
+        let text = serde_json::to_string_pretty(&rows)?;
         write_atomic(path, text.as_bytes())?;
     }
     Ok(())

@@ -89,7 +89,7 @@ pub fn run(
         seconds: start.elapsed().as_secs_f64(),
         warnings: case.warnings.clone(),
     };
-    let json = serde_json::to_vec_pretty(&summary).map_err(std::io::Error::other)?;
+    let json = serde_json::to_vec_pretty(&summary)?;
     folder.finish(&json)?;
     Ok(summary)
 }

@@ -448,7 +448,7 @@ pub fn evaluate_queries(
                     serde_json::to_string(&OutputLine::from(o.response(site)))
                 }
             };
-            lines[k] = text.map_err(|e| Error::Io(std::io::Error::other(e)))?;
+            lines[k] = text.map_err(Error::from)?;
         }
     }
     Ok(lines)

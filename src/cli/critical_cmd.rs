@@ -60,8 +60,7 @@ pub fn run(
         &case,
         case.settings().statics(),
         options.show_progress,
-    )
-    .map_err(Error::failed)?;
+    )?;
     let first =
         crate::bha::tendency::bha_model_top(model, case.bha_length, &case.tendency.settings);
     let opts = CriticalOptions {
@@ -87,7 +86,7 @@ pub fn run(
         &opts,
     );
     let dir = folder.path();
-    let io = |e: csv::Error| Error::Io(std::io::Error::other(e));
+    let io = Error::from;
     let mut w = csv::Writer::from_writer(Vec::new());
     w.write_record(["mode", "frequency_hz", "lateral_share", "critical_rpm_1x"])
         .map_err(io)?;
@@ -100,9 +99,7 @@ pub fn run(
         ])
         .map_err(io)?;
     }
-    let bytes = w
-        .into_inner()
-        .map_err(|e| Error::Io(std::io::Error::other(e.to_string())))?;
+    let bytes = w.into_inner().map_err(Error::encode)?;
     crate::output::write_atomic(&dir.join("modes.csv"), &bytes)?;
     let mut w = csv::Writer::from_writer(Vec::new());
     w.write_record(["excitation", "mode", "frequency_hz", "rpm"])
@@ -116,9 +113,7 @@ pub fn run(
         ])
         .map_err(io)?;
     }
-    let bytes = w
-        .into_inner()
-        .map_err(|e| Error::Io(std::io::Error::other(e.to_string())))?;
+    let bytes = w.into_inner().map_err(Error::encode)?;
     crate::output::write_atomic(&dir.join("critical_speeds.csv"), &bytes)?;
     write_plots(&case.title, &cs, model.rotation_speed, &opts, dir)?;
     let summary = CriticalSummary {
@@ -137,7 +132,7 @@ pub fn run(
         .to_vec(),
         seconds: start.elapsed().as_secs_f64(),
     };
-    let json = serde_json::to_vec_pretty(&summary).map_err(std::io::Error::other)?;
+    let json = serde_json::to_vec_pretty(&summary)?;
     folder.finish(&json)?;
     Ok(summary)
 }

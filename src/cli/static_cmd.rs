@@ -254,7 +254,7 @@ pub fn run(
     if summary.strength.is_some() {
         tension_torque_plot(&case, &rows, dir)?;
     }
-    let json = serde_json::to_vec_pretty(&summary).map_err(std::io::Error::other)?;
+    let json = serde_json::to_vec_pretty(&summary)?;
     folder.finish(&json)?;
     Ok(summary)
 }

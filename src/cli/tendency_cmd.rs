@@ -100,13 +100,13 @@ pub fn run(
         seconds: start.elapsed().as_secs_f64(),
         warnings: case.warnings.clone(),
     };
-    let json = serde_json::to_vec_pretty(&summary).map_err(std::io::Error::other)?;
+    let json = serde_json::to_vec_pretty(&summary)?;
     folder.finish(&json)?;
     Ok(summary)
 }
 
 fn write_csv(path: &Path, axis: MapAxis, cells: &[MapCell]) -> Result<(), Error> {
-    let io = |e: csv::Error| Error::Io(std::io::Error::other(e));
+    let io = Error::from;
     let mut w = csv::Writer::from_writer(Vec::new());
     let mut header = vec![axis.column().to_string(), "weight_on_bit_n".to_string()];
     header.extend(
@@ -139,9 +139,7 @@ fn write_csv(path: &Path, axis: MapAxis, cells: &[MapCell]) -> Result<(), Error>
         row.push(t.notes.join("; "));
         w.write_record(&row).map_err(io)?;
     }
-    let bytes = w
-        .into_inner()
-        .map_err(|e| Error::Io(std::io::Error::other(e.to_string())))?;
+    let bytes = w.into_inner().map_err(Error::encode)?;
     crate::output::write_atomic(path, &bytes)?;
     Ok(())
 }

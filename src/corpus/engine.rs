@@ -40,33 +40,36 @@ pub struct EngineOutcome {
 /// Solves a corpus well through the ensemble engine on `path` (the same load path and
 /// Newton as the CPU solve, [`crate::solve::continuation`]). `Err` where the path cannot
 /// run here (no adapter, no f64).
-pub fn run_well_engine(well: &CorpusWell, path: EnginePath) -> Result<EngineOutcome, String> {
+pub fn run_well_engine(well: &CorpusWell, path: EnginePath) -> Result<EngineOutcome, Error> {
     use crate::engine::{solve_static_ensemble, EngineStatus, TwinPath};
     use crate::gpu::GpuPath;
-    let case = crate::case::load_case(&well.case_path).map_err(|e| e.to_string())?;
+    let case = crate::case::load_case(&well.case_path)?;
     let models = [case.model.clone()];
     let options = crate::solve::statics::StaticOptions::default();
     let clock = std::time::Instant::now();
     let results = match path {
-        EnginePath::Twin => {
-            solve_static_ensemble(&models, &TwinPath, &options).map_err(|e| e.to_string())?
-        }
+        EnginePath::Twin => solve_static_ensemble(&models, &TwinPath, &options)?,
         EnginePath::GpuF64 | EnginePath::GpuF32 => {
-            let ctx = crate::gpu::context::GpuContext::shared().map_err(|e| e.to_string())?;
+            let ctx = crate::gpu::context::GpuContext::shared()?;
             if path == EnginePath::GpuF64 {
                 if !ctx.has_f64 {
-                    return Err(format!("{} has no f64 in shaders", ctx.describe()));
+                    return Err(crate::error::GpuError::Unsupported(format!(
+                        "{} has no f64 in shaders",
+                        ctx.describe()
+                    ))
+                    .into());
                 }
-                solve_static_ensemble::<f64, _>(&models, &GpuPath(ctx), &options)
-                    .map_err(|e| e.to_string())?
+                solve_static_ensemble::<f64, _>(&models, &GpuPath(ctx), &options)?
             } else {
-                solve_static_ensemble::<f32, _>(&models, &GpuPath(ctx), &options)
-                    .map_err(|e| e.to_string())?
+                solve_static_ensemble::<f32, _>(&models, &GpuPath(ctx), &options)?
             }
         }
     };
     let seconds = clock.elapsed().as_secs_f64();
-    let r = results.into_iter().next().ok_or("no result")?;
+    let r = results
+        .into_iter()
+        .next()
+        .ok_or_else(|| Error::failed("the engine returned no result"))?;
     let (solved, error) = match &r.status {
         EngineStatus::Converged => (true, String::new()),
         EngineStatus::Failed(why) => (false, why.clone()),

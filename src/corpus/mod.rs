@@ -30,6 +30,8 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use serde::Serialize;
 
+use crate::error::Error;
+
 mod engine;
 pub use engine::{run_well_engine, EngineOutcome, EnginePath};
 
@@ -245,7 +247,7 @@ fn pick<T: Copy>(rng: &mut ChaCha8Rng, items: &[(T, f64)]) -> T {
 /// Draws well `seed` and writes it into `dir` (`well_<seed>.toml` and `.csv`). The weight on
 /// bit is drawn up to the soft-string sinusoidal-buckling limit of the string as meshed,
 /// so the case is read once without it first.
-pub fn write_well(seed: u64, dir: &Path) -> Result<CorpusWell, String> {
+pub fn write_well(seed: u64, dir: &Path) -> Result<CorpusWell, Error> {
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let trajectory = pick(
         &mut rng,
@@ -395,8 +397,9 @@ pub fn write_well(seed: u64, dir: &Path) -> Result<CorpusWell, String> {
     for s in &stations {
         csv.push_str(&format!("{:.2}, {:.4}, {:.4}\n", s[0], s[1], s[2]));
     }
-    std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
-    std::fs::write(dir.join(&csv_name), csv).map_err(|e| e.to_string())?;
+    std::fs::create_dir_all(dir)
+        .map_err(|e| std::io::Error::new(e.kind(), format!("{}: {e}", dir.display())))?;
+    std::fs::write(dir.join(&csv_name), csv)?;
     let max_inc = stations.iter().map(|s| s[1]).fold(0.0, f64::max);
     let (op_mode, rotating) = match mode {
         "drilling" => ("rotating", true),
@@ -454,12 +457,12 @@ pub fn write_well(seed: u64, dir: &Path) -> Result<CorpusWell, String> {
     let mut wob = 0.0;
     if on_bottom {
         let text = case_text(0.0);
-        let case = crate::case::parse_case(&case_path, &text).map_err(|e| e.to_string())?;
+        let case = crate::case::parse_case(&case_path, &text)?;
         let limit = buckling_limited_wob(&case, mode == "sliding").min(150e3);
         wob = (wob_fraction * limit / 100.0).round() * 100.0;
     }
     let text = case_text(wob);
-    crate::output::write_atomic(&case_path, text.as_bytes()).map_err(|e| e.to_string())?;
+    crate::output::write_atomic(&case_path, text.as_bytes())?;
     Ok(CorpusWell {
         spec: WellSpec {
             seed,
@@ -573,8 +576,8 @@ pub struct WellResult {
 pub fn run_well(
     well: &CorpusWell,
     options: &crate::solve::statics::StaticOptions,
-) -> Result<WellResult, String> {
-    let case = crate::case::load_case(&well.case_path).map_err(|e| e.to_string())?;
+) -> Result<WellResult, Error> {
+    let case = crate::case::load_case(&well.case_path)?;
     let model = &case.model;
     let soft = case.soft_string();
     let clock = std::time::Instant::now();
@@ -727,12 +730,12 @@ impl WellResult {
 
 /// The same well meshed anew: pipe elements of `element` m, BHA elements of `bha_element`
 /// m (the case file rewritten beside the original as `well_<seed>_<element>m.toml`).
-pub fn remesh(well: &CorpusWell, element: f64, bha_element: f64) -> Result<CorpusWell, String> {
-    let text = std::fs::read_to_string(&well.case_path).map_err(|e| e.to_string())?;
+pub fn remesh(well: &CorpusWell, element: f64, bha_element: f64) -> Result<CorpusWell, Error> {
+    let text = std::fs::read_to_string(&well.case_path)?;
     let head = text
         .split("[mesh]")
         .next()
-        .ok_or("no [mesh] table")?
+        .ok_or_else(|| Error::failed("a corpus case without its [mesh] table"))?
         .to_string();
     let text = format!(
         "{head}[mesh]\nelement_length = \"{element} m\"\nbha_element_length = \"{bha_element} m\"\n"
@@ -740,7 +743,7 @@ pub fn remesh(well: &CorpusWell, element: f64, bha_element: f64) -> Result<Corpu
     let path = well
         .case_path
         .with_file_name(format!("well_{}_{element}m.toml", well.spec.seed));
-    crate::output::write_atomic(&path, text.as_bytes()).map_err(|e| e.to_string())?;
+    crate::output::write_atomic(&path, text.as_bytes())?;
     let mut spec = well.spec.clone();
     spec.element_m = element;
     spec.bha_element_m = bha_element;
@@ -764,7 +767,7 @@ pub const MESHES: [(f64, f64); 7] = [
 /// The wells of the mesh-convergence study: from seed 0 on, the first build-and-hold, the
 /// first S-shaped and the first horizontal well drilling or rotating with a stabilizer
 /// and contact at every node (chosen by rule, not by outcome).
-pub fn mesh_study_seeds(dir: &Path) -> Result<Vec<u64>, String> {
+pub fn mesh_study_seeds(dir: &Path) -> Result<Vec<u64>, Error> {
     let mut out = Vec::new();
     for kind in [
         Trajectory::BuildAndHold,

@@ -244,7 +244,7 @@ pub fn run(
             seconds: start.elapsed().as_secs_f64(),
             results,
         };
-        let text = serde_json::to_vec(&chunk).map_err(|e| Error::Io(std::io::Error::other(e)))?;
+        let text = serde_json::to_vec(&chunk).map_err(Error::from)?;
         write_atomic(&path, &text)?;
         computed_here += 1;
     }
@@ -283,14 +283,14 @@ pub fn run(
     for c in 0..nchunks {
         let chunk = read_chunk(&chunk_path(out, c))?;
         if chunk.first != chunk_of(c).start || chunk.results.len() != chunk_of(c).len() {
-            return Err(Error::Io(std::io::Error::other(format!(
+            return Err(Error::Failed(format!(
                 "{}: holds {} variants from {}, not the chunk's {} from {}",
                 chunk_path(out, c).display(),
                 chunk.results.len(),
                 chunk.first,
                 chunk_of(c).len(),
                 chunk_of(c).start
-            ))));
+            )));
         }
         if chunk.backend == "gpu" {
             backend_name = "gpu";

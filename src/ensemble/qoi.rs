@@ -344,7 +344,7 @@ pub fn dynamic_variant_tracked(
     let energy_growth = (mass.is_some() && first > 0.0).then(|| second / first - 1.0);
     let cuts = dynamics.log.iter().filter(|l| l.contains("cut to")).count();
     if let Err(reason) = result {
-        let mut f = failed(name, reason, stabs.len());
+        let mut f = failed(name, reason.to_string(), stabs.len());
         f.step_cuts = cuts;
         return (f, energy_growth);
     }

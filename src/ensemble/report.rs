@@ -124,7 +124,7 @@ pub(crate) fn variants_csv(
     dynamic: bool,
 ) -> Result<Vec<u8>, Error> {
     let (ran_header, ran_rows) = ran_with(case, variants, stabs);
-    let io = |e: csv::Error| Error::Io(std::io::Error::other(e));
+    let io = Error::from;
     let mut keys: Vec<String> = Vec::new();
     for v in variants {
         for (k, _) in &v.overrides {
@@ -254,8 +254,7 @@ pub(crate) fn variants_csv(
         row.push(r.step_cuts.to_string());
         w.write_record(&row).map_err(io)?;
     }
-    w.into_inner()
-        .map_err(|e| Error::Io(std::io::Error::other(e.to_string())))
+    w.into_inner().map_err(Error::encode)
 }
 
 /// Statistics, sensitivities and plots of a `--samples` run.

@@ -140,9 +140,8 @@ pub(crate) fn chunk_path(out: &Path, c: usize) -> std::path::PathBuf {
 
 pub(crate) fn read_chunk(path: &Path) -> Result<Chunk, Error> {
     let text = std::fs::read(path)
-        .map_err(|e| Error::Io(std::io::Error::other(format!("{}: {e}", path.display()))))?;
-    serde_json::from_slice(&text)
-        .map_err(|e| Error::Io(std::io::Error::other(format!("{}: {e}", path.display()))))
+        .map_err(|e| std::io::Error::new(e.kind(), format!("{}: {e}", path.display())))?;
+    serde_json::from_slice(&text).map_err(|e| Error::encode(format!("{}: {e}", path.display())))
 }
 
 /// The files a run writes into its folder (what `--force` clears).
@@ -202,8 +201,7 @@ pub fn prepare_out(out: &Path, manifest: &Manifest, force: bool) -> Result<(), E
     }
     std::fs::create_dir_all(out.join("chunks"))
         .map_err(|e| out_error(out, format!("cannot create it: {e}")))?;
-    let text =
-        serde_json::to_vec_pretty(manifest).map_err(|e| Error::Io(std::io::Error::other(e)))?;
+    let text = serde_json::to_vec_pretty(manifest).map_err(Error::from)?;
     write_atomic(&out.join("run.json"), &text)
         .map_err(|e| out_error(out, format!("cannot write into it: {e}")))?;
     Ok(())

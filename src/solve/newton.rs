@@ -1,5 +1,5 @@
 //! The one Newton iteration of holewall: convergence test, line search, step acceptance,
-//! trace and tolerances per precision, for many variants at once with a mask.
+//! and tolerances per precision, for many variants at once with a mask.
 //!
 //! Every solver calls it — `solve_static` and the CPU integrator (one variant each), the
 //! static and dynamic ensemble engines (V variants, twin or GPU kernels) — through
@@ -304,7 +304,6 @@ pub struct Newton {
     pub solves: usize,
     /// Trials (residual-only evaluations) so far.
     pub trials: usize,
-    trace: bool,
     round: Round,
 }
 
@@ -327,7 +326,6 @@ impl Newton {
             tracks: vec![Track::default(); variants],
             solves: 0,
             trials: 0,
-            trace: std::env::var("HOLEWALL_DEBUG_NEWTON").is_ok(),
             round: Round::default(),
         }
     }
@@ -601,17 +599,6 @@ impl Newton {
             if ends[j] {
                 track.running = false;
                 events.push((j, Event::Converged(track.updates)));
-            }
-        }
-        if self.trace {
-            if let Some(j) = (0..v).find(|&j| alpha[j] != 0.0) {
-                eprintln!(
-                    "  newton variant {j}: residual {:.3e} step {:.3e} α {}; {} running",
-                    probe.measure[j],
-                    probe.step[j],
-                    alpha[j],
-                    self.tracks.iter().filter(|t| t.running).count()
-                );
             }
         }
         Ok(events)

@@ -35,6 +35,35 @@ use crate::solve::statics::{
 mod step;
 use step::CpuStep;
 
+/// Why a time step or the run of a [`Dynamics`] failed.
+#[derive(Clone, Debug, thiserror::Error)]
+pub enum DynamicError {
+    /// A step's Newton iteration ended without converging (why, from
+    /// [`crate::solve::newton::Event::Failed`]).
+    #[error("{0}")]
+    Step(String),
+    /// A step failed and cutting it again would go below the smallest step allowed.
+    #[error(
+        "t = {t:.6} s: step {step:.3e} s failed and cannot be cut below {min_dt:.1e} s: {reason}"
+    )]
+    Stalled {
+        /// Time reached (s).
+        t: f64,
+        /// The step that failed (s).
+        step: f64,
+        /// The smallest step allowed (s).
+        min_dt: f64,
+        /// Why its last try failed.
+        reason: String,
+    },
+    /// The machinery under a step failed (a linear solve, a kernel path).
+    #[error(transparent)]
+    System(#[from] crate::error::SystemError),
+    /// The solve for the initial accelerations failed.
+    #[error(transparent)]
+    Linear(#[from] crate::solve::chain::LinearSolveError),
+}
+
 /// Generalised-α parameters.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct AlphaParams {
@@ -325,7 +354,7 @@ impl<'a> Dynamics<'a> {
 
     /// The initial state: at rest in configuration `q` (e.g. the static equilibrium), with
     /// consistent accelerations.
-    pub fn initial_state(&mut self, q: StaticState) -> Result<DynamicState, String> {
+    pub fn initial_state(&mut self, q: StaticState) -> Result<DynamicState, DynamicError> {
         let n = self.model.nodes.len();
         self.initial_state_moving(q, vec![0.0; 6 * n])
     }
@@ -336,7 +365,7 @@ impl<'a> Dynamics<'a> {
         &mut self,
         q: StaticState,
         v: Option<Vec<f64>>,
-    ) -> Result<DynamicState, String> {
+    ) -> Result<DynamicState, DynamicError> {
         match v {
             Some(v) => self.initial_state_moving(q, v),
             None => self.initial_state(q),
@@ -349,7 +378,7 @@ impl<'a> Dynamics<'a> {
         &mut self,
         q: StaticState,
         v: Vec<f64>,
-    ) -> Result<DynamicState, String> {
+    ) -> Result<DynamicState, DynamicError> {
         let n = self.model.nodes.len();
         let mut s = DynamicState {
             t: 0.0,
@@ -398,7 +427,7 @@ impl<'a> Dynamics<'a> {
         let c = constraints(self.model);
         let mut rhs: Vec<f64> = r.iter().map(|x| -x).collect();
         constrain(&c, &mut rhs, &mut mass);
-        let mut dv = self.solver.solve(&mass, &rhs).map_err(|e| e.to_string())?;
+        let mut dv = self.solver.solve(&mass, &rhs)?;
         // Held nodes (the bit) solve in their hole frame: back to global axes.
         to_global(&c, &mut dv);
         for (x, d) in s.vdot.iter_mut().zip(&dv) {
@@ -632,7 +661,7 @@ impl<'a> Dynamics<'a> {
 
     /// Advances `s` by one step of size `h`; on failure `s` is unchanged. Newton on the
     /// accelerations `v̇_{n+1}` ([`crate::solve::newton`], dynamics settings).
-    pub fn step(&mut self, s: &mut DynamicState, h: f64) -> Result<usize, String> {
+    pub fn step(&mut self, s: &mut DynamicState, h: f64) -> Result<usize, DynamicError> {
         use crate::solve::newton::{Event, Newton, NewtonSettings};
         let settings =
             NewtonSettings::dynamics(self.options.max_iterations, self.options.tolerance, 8);
@@ -643,12 +672,7 @@ impl<'a> Dynamics<'a> {
         newton.start(0, floor, false);
         loop {
             // One variant: its first event ends the step.
-            if let Some((_, event)) = newton
-                .iterate(&mut sys)
-                .map_err(|e| e.to_string())?
-                .into_iter()
-                .next()
-            {
+            if let Some((_, event)) = newton.iterate(&mut sys)?.into_iter().next() {
                 return match event {
                     Event::Converged(its) => {
                         let vdot = sys.vdot.clone();
@@ -657,7 +681,7 @@ impl<'a> Dynamics<'a> {
                         *s = next;
                         Ok(its)
                     }
-                    Event::Failed(reason) => Err(reason),
+                    Event::Failed(reason) => Err(DynamicError::Step(reason)),
                 };
             }
         }
@@ -670,7 +694,7 @@ impl<'a> Dynamics<'a> {
         s: &mut DynamicState,
         t_end: f64,
         observe: &mut dyn FnMut(&Dynamics, &DynamicState),
-    ) -> Result<(), String> {
+    ) -> Result<(), DynamicError> {
         let mut h = self.options.dt;
         while s.t < t_end - 1e-12 {
             let step = h.min(t_end - s.t);
@@ -686,7 +710,12 @@ impl<'a> Dynamics<'a> {
                 }
                 Err(reason) => {
                     if step / 2.0 < self.options.min_dt {
-                        return Err(format!("t = {:.6} s: step {step:.3e} s failed and cannot be cut below {:.1e} s: {reason}", s.t, self.options.min_dt));
+                        return Err(DynamicError::Stalled {
+                            t: s.t,
+                            step,
+                            min_dt: self.options.min_dt,
+                            reason: reason.to_string(),
+                        });
                     }
                     h = step / 2.0;
                     self.log.push(format!(
