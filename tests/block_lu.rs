@@ -188,7 +188,7 @@ fn gpu_matches_the_twin_and_a_singular_variant_fails_alone() {
             let (x, _) = block_lu_gpu_form(ctx, &b64, 5, form).unwrap();
             assert_eq!(x, gpu, "{form:?} in chunks of 5");
         }
-        // Chunked dispatches (7 variants each) give the same numbers.
+        // Batched dispatches (7 variants each) give the same numbers.
         let (chunked, _) = block_lu_gpu_chunked(ctx, &b64, 7).unwrap();
         assert_eq!(chunked, gpu);
     }

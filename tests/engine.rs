@@ -108,7 +108,7 @@ fn a_failing_variant_fails_alone_in_the_engine() {
 
 #[test]
 fn stabilizer_moves_and_chunks_in_the_engine() {
-    use holewall::engine::Chunked;
+    use holewall::engine::Batched;
     let case = common::bed_case("1");
     // The stabilizer 1.5 m, 3 m and 4.5 m further from the bit than in the case, with
     // different friction: each variant's pairs sit at other nodes.
@@ -146,7 +146,7 @@ fn stabilizer_moves_and_chunks_in_the_engine() {
     };
     let chunked = solve_static_ensemble(
         &models,
-        &Chunked {
+        &Batched {
             inner: TwinPath,
             max: 2,
         },
@@ -159,7 +159,7 @@ fn stabilizer_moves_and_chunks_in_the_engine() {
         let gpu = solve_static_ensemble::<f64, _>(&models, &GpuPath(ctx), &options).unwrap();
         let gpu_chunked = solve_static_ensemble::<f64, _>(
             &models,
-            &Chunked {
+            &Batched {
                 inner: GpuPath(ctx),
                 max: 2,
             },
@@ -235,7 +235,7 @@ fn sites_kernel_equals_its_twin() {
     let Some(ctx) = common::gpu() else { return };
     if ctx.has_f64 {
         let gpu =
-            holewall::gpu::ensemble::gather_sites_gpu(ctx, &pair_node, &x, &at_pairs, v, &before)
+            holewall::gpu::batch::gather_sites_gpu(ctx, &pair_node, &x, &at_pairs, v, &before)
                 .unwrap();
         assert_eq!(gpu, twin);
     }

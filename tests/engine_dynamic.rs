@@ -418,7 +418,7 @@ fn dynamic_kernels_equal_their_twins() {
         &acc_twin,
     );
     let scale_gpu = inertial_scale_gpu(ctx, &mass, &vdot, n, v).unwrap();
-    let sites_gpu = holewall::gpu::ensemble::gather_sites_dynamic_gpu(
+    let sites_gpu = holewall::gpu::batch::gather_sites_dynamic_gpu(
         ctx,
         &pair_node,
         &pair_normals,

@@ -347,8 +347,8 @@ fn batches_larger_than_one_binding_are_chunked_and_exact() {
     let terms = ContactTerms::all(FrictionModel::Split, ContactMode::Dynamic);
     let batch = random_batch(11, 7, 13, FrictionModel::Split);
     let run =
-        holewall::gpu::contact::GpuContactRun::with_chunk_limit(ctx, &terms, &batch, 10).unwrap();
-    assert_eq!(run.num_chunks(), 10);
+        holewall::gpu::contact::GpuContactRun::with_part_limit(ctx, &terms, &batch, 10).unwrap();
+    assert_eq!(run.num_parts(), 10);
     run.dispatch().unwrap();
     let chunked = run.read().unwrap();
     let whole = contact_gpu(ctx, &terms, &batch).unwrap();
@@ -368,7 +368,7 @@ fn static_scenes_allocate_no_damping_outputs() {
         assert_eq!(holewall::kernels::contact::output_fields(&terms), fields);
         for limit in [usize::MAX, 10] {
             let run =
-                holewall::gpu::contact::GpuContactRun::with_chunk_limit(ctx, &terms, &batch, limit)
+                holewall::gpu::contact::GpuContactRun::with_part_limit(ctx, &terms, &batch, limit)
                     .unwrap();
             assert_eq!(run.output_bytes(), (fields * p * 8) as u64, "{mode:?}");
             run.dispatch().unwrap();

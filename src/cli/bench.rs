@@ -135,7 +135,7 @@ fn gpu_rows<T: GpuReal>(
     let run = GpuContactRun::new(ctx, terms, batch)?;
     let name = T::NAME;
     rows.push((
-        format!("GPU {name} resident ({} chunks)", run.num_chunks()),
+        format!("GPU {name} resident ({} parts)", run.num_parts()),
         median_seconds(repeats, || run.dispatch())?,
     ));
     rows.push((

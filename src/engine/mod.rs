@@ -9,17 +9,17 @@
 //! ones, the polish), through the one Newton ([`crate::solve::newton`]); all variants
 //! advance in the same dispatches, each at its own λ. A variant fails only where
 //! `solve_static` fails (below the smallest load step); the caller then re-runs it on the
-//! CPU and says so. Finished variants get α = 0, and once no more than half of a chunk is
-//! running the rest go on in a chunk of their own (compaction, bit for bit).
+//! CPU and says so. Finished variants get α = 0, and once no more than half of a batch is
+//! running the rest go on in a batch of their own (compaction, bit for bit).
 //!
 //! States are displacements `u` from a per-variant base (kept in f64 on the host):
 //! positions of kilometres would lose their millimetres in f32.
 //!
-//! Data stay where the path keeps them ([`Ensemble`]): on the GPU the configuration, the
-//! assembled systems and every intermediate live in buffers made once per chunk of
+//! Data stay where the path keeps them ([`ResidentStatic`]): on the GPU the configuration, the
+//! assembled systems and every intermediate live in buffers made once per batch of
 //! variants; the host reads four numbers and a status per variant per solve or trial
 //! (largest residual, largest step, `Δ·r`, `r·r`) and writes one α per variant. Variants are
-//! split into chunks that fit the adapter's binding limits ([`KernelPath::max_chunk`]).
+//! split into batches that fit the adapter's binding limits ([`KernelPath::max_batch`]).
 //!
 //! Stabilizer moves are allowed: every (site, variant) pair carries its own node and hole
 //! axis, so the variants need only share the mesh and the number of sites.
@@ -38,10 +38,10 @@ use crate::solve::statics::{
     constraint_tables, loaded_params, reference_force, split_loads, StaticOptions, StaticState,
 };
 
-/// What one chunk of variants shares and starts from, built once on the host.
+/// What one batch of variants shares and starts from, built once on the host.
 #[derive(Clone, Debug)]
-pub struct EnsembleTables<T> {
-    /// Variants V in the chunk.
+pub struct BatchTables<T> {
+    /// Variants V in the batch.
     pub num_variants: usize,
     /// Nodes n.
     pub num_nodes: usize,
@@ -85,7 +85,7 @@ pub struct EnsembleTables<T> {
     pub terms: ContactTerms,
 }
 
-impl<T: Real> EnsembleTables<T> {
+impl<T: Real> BatchTables<T> {
     /// Moves the base to `base` (displacements from `model`'s reference, `3 n V`), with
     /// the pairs' and the elements' tables formed from it in f64.
     pub fn set_base(&mut self, model: &Model, base: Vec<f64>) {
@@ -104,9 +104,9 @@ impl<T: Real> EnsembleTables<T> {
     }
 }
 
-/// A chunk of variants held by a kernel path: a current configuration with its assembled
+/// A batch of variants held by a kernel path: a current configuration with its assembled
 /// system, a step `Δ`, and one trial configuration.
-pub trait Ensemble<T> {
+pub trait ResidentStatic<T> {
     /// Sets the external loads (`6 n V`), the pairs' law parameters (`PARAMS_LEN · P`,
     /// field-major) and the elements' unstrained rotations (`6 (n − 1) V`, empty without a
     /// kink) of a load step.
@@ -133,7 +133,7 @@ pub trait Ensemble<T> {
         first: bool,
     ) -> Result<Norms<T>, crate::error::SystemError>;
     /// Makes the last trial (configuration and residual) the current one; its tangent is
-    /// formed by the next [`Ensemble::evaluate`].
+    /// formed by the next [`ResidentStatic::evaluate`].
     fn accept_trial(&mut self);
     /// Current += `α Δ` (its system must be evaluated again).
     fn commit(&mut self, alpha: &[T]) -> Result<(), crate::error::SystemError>;
@@ -147,13 +147,13 @@ pub trait Ensemble<T> {
     /// diagonal block (the systems must be evaluated again).
     fn set_shift(&mut self, shift: Option<&Shift<T>>) -> Result<(), crate::error::SystemError>;
     /// Moves the base to the current configuration, given as `tables` after
-    /// [`EnsembleTables::set_base`] with the host's sum of the old base and the current
+    /// [`BatchTables::set_base`] with the host's sum of the old base and the current
     /// displacements: the displacements from it are set to zero, the rotations kept (the
     /// system must be evaluated again).
-    fn rebase(&mut self, tables: &EnsembleTables<T>) -> Result<(), crate::error::SystemError>;
+    fn rebase(&mut self, tables: &BatchTables<T>) -> Result<(), crate::error::SystemError>;
 }
 
-/// A relaxation's proximal shift on a chunk ([`crate::solve::continuation`]'s
+/// A relaxation's proximal shift on a batch ([`crate::solve::continuation`]'s
 /// `Stage::Relax`, as the CPU solve's): the shift per variant and its anchor.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Shift<T> {
@@ -164,23 +164,23 @@ pub struct Shift<T> {
     pub anchor: Vec<T>,
 }
 
-/// A kernel path: makes the [`Ensemble`] of a chunk of variants.
+/// A kernel path: makes the [`ResidentStatic`] of a batch of variants.
 pub trait KernelPath<T> {
-    /// The most variants of `model` one chunk may hold.
-    fn max_chunk(&self, model: &Model) -> usize;
-    /// Uploads a chunk.
+    /// The most variants of `model` one batch may hold.
+    fn max_batch(&self, model: &Model) -> usize;
+    /// Uploads a batch.
     fn open<'a>(
         &'a self,
         model: &'a Model,
-        tables: &EnsembleTables<T>,
-    ) -> Result<Box<dyn Ensemble<T> + 'a>, crate::error::SystemError>;
-    /// Uploads a chunk for a dynamic run.
+        tables: &BatchTables<T>,
+    ) -> Result<Box<dyn ResidentStatic<T> + 'a>, crate::error::SystemError>;
+    /// Uploads a batch for a dynamic run.
     fn open_dynamic<'a>(
         &'a self,
         model: &'a Model,
-        tables: &EnsembleTables<T>,
+        tables: &BatchTables<T>,
         dynamic: &dynamic::DynamicTables<T>,
-    ) -> Result<Box<dyn dynamic::DynamicEnsemble<T> + 'a>, crate::error::SystemError>;
+    ) -> Result<Box<dyn dynamic::ResidentDynamic<T> + 'a>, crate::error::SystemError>;
 }
 
 /// One kernel of the evaluation chain.
@@ -261,7 +261,7 @@ pub fn solve_static_ensemble<T: Real + Send + Sync, P: KernelPath<T>>(
 }
 
 /// As [`solve_static_ensemble`], reporting the fraction done (0 … 1) after every iteration
-/// (for a progress bar). Chunks of [`KernelPath::max_chunk`] variants run one after another.
+/// (for a progress bar). Batches of [`KernelPath::max_batch`] variants run one after another.
 pub fn solve_static_ensemble_with_progress<T: Real + Send + Sync, P: KernelPath<T>>(
     models: &[Model],
     path: &P,
@@ -269,19 +269,19 @@ pub fn solve_static_ensemble_with_progress<T: Real + Send + Sync, P: KernelPath<
     progress: &mut dyn FnMut(f64),
 ) -> Result<Vec<EngineResult>, crate::error::SystemError> {
     check_same_mesh(models)?;
-    let chunk = path.max_chunk(&models[0]).max(1);
+    let batch = path.max_batch(&models[0]).max(1);
     let total = models.len();
     let mut results = Vec::with_capacity(total);
-    for (c, group) in models.chunks(chunk).enumerate() {
-        let done_before = (c * chunk) as f64 / total as f64;
+    for (c, group) in models.chunks(batch).enumerate() {
+        let done_before = (c * batch) as f64 / total as f64;
         let share = group.len() as f64 / total as f64;
         let mut report = |f: f64| progress(done_before + share * f);
-        results.extend(solve_chunk(group, path, options, &mut report)?);
+        results.extend(solve_batch(group, path, options, &mut report)?);
     }
     Ok(results)
 }
 
-fn solve_chunk<T: Real + Send + Sync, P: KernelPath<T>>(
+fn solve_batch<T: Real + Send + Sync, P: KernelPath<T>>(
     models: &[Model],
     path: &P,
     options: &StaticOptions,
@@ -302,8 +302,8 @@ fn solve_chunk<T: Real + Send + Sync, P: KernelPath<T>>(
         .map(|m| LoadPath::for_model(options, m, size == 4))
         .collect();
     let settings = options.newton(size, models);
-    // Compaction: once no more than half of a chunk's variants are still running, the
-    // others (finished) leave it — the running ones go on in a chunk of their own, each
+    // Compaction: once no more than half of a batch's variants are still running, the
+    // others (finished) leave it — the running ones go on in a batch of their own, each
     // exactly where it stands (state, restart point, Newton state), so no kernel works on
     // a finished variant for long and the answers do not depend on the compaction.
     let stop = |running: usize, total: usize| total >= COMPACT_MIN && 2 * running <= total;
@@ -430,13 +430,13 @@ fn verify_f32(
         .collect()
 }
 
-/// Chunks of fewer variants are not compacted (a new chunk costs more than it saves).
+/// Batches of fewer variants are not compacted (a new batch costs more than it saves).
 pub(crate) const COMPACT_MIN: usize = 4;
 
-/// Variant `j`'s configuration (f64, from the reference) in a chunk of `tables`.
+/// Variant `j`'s configuration (f64, from the reference) in a batch of `tables`.
 fn state_of<T: Real>(
     mesh: &Model,
-    tables: &EnsembleTables<T>,
+    tables: &BatchTables<T>,
     config: &ConfigBatch<T>,
     j: usize,
 ) -> StaticState {
@@ -484,32 +484,32 @@ pub(crate) fn trial_probe<T: Real>(r: &Norms<T>) -> TrialProbe {
     }
 }
 
-/// A kernel path with chunks of at most `max` variants (to test chunk boundaries, or to
+/// A kernel path with batches of at most `max` variants (to test batch boundaries, or to
 /// bound the memory a run takes).
-pub struct Chunked<P> {
+pub struct Batched<P> {
     /// The path.
     pub inner: P,
-    /// Most variants per chunk.
+    /// Most variants per batch.
     pub max: usize,
 }
 
-impl<T, P: KernelPath<T>> KernelPath<T> for Chunked<P> {
-    fn max_chunk(&self, model: &Model) -> usize {
-        self.inner.max_chunk(model).min(self.max)
+impl<T, P: KernelPath<T>> KernelPath<T> for Batched<P> {
+    fn max_batch(&self, model: &Model) -> usize {
+        self.inner.max_batch(model).min(self.max)
     }
     fn open<'a>(
         &'a self,
         model: &'a Model,
-        tables: &EnsembleTables<T>,
-    ) -> Result<Box<dyn Ensemble<T> + 'a>, crate::error::SystemError> {
+        tables: &BatchTables<T>,
+    ) -> Result<Box<dyn ResidentStatic<T> + 'a>, crate::error::SystemError> {
         self.inner.open(model, tables)
     }
     fn open_dynamic<'a>(
         &'a self,
         model: &'a Model,
-        tables: &EnsembleTables<T>,
+        tables: &BatchTables<T>,
         dynamic: &dynamic::DynamicTables<T>,
-    ) -> Result<Box<dyn dynamic::DynamicEnsemble<T> + 'a>, crate::error::SystemError> {
+    ) -> Result<Box<dyn dynamic::ResidentDynamic<T> + 'a>, crate::error::SystemError> {
         self.inner.open_dynamic(model, tables, dynamic)
     }
 }

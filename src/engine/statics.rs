@@ -1,17 +1,17 @@
-//! A chunk's static Newton system on a kernel path ([`EngineStatic`]): the
+//! A batch's static Newton system on a kernel path ([`EngineStatic`]): the
 //! [`StaticSystem`] that [`super::solve_static_ensemble`] steps through the load path.
 
 use super::*;
 
-/// A chunk's static Newton system on a kernel path, for [`solve_loads`]: per variant its
+/// A batch's static Newton system on a kernel path, for [`solve_loads`]: per variant its
 /// loads, its restart point (kept on the host in f64, as displacements from the reference
 /// and rotations) and its step floor. Saves, restores and load changes are gathered and
 /// carried out together before the next kernel work (one read and one write of the
 /// configuration); in f32 every save also moves the base to the current configuration.
 pub(super) struct EngineStatic<'a, T> {
     pub(super) models: Vec<&'a Model>,
-    pub(super) ensemble: Box<dyn Ensemble<T> + 'a>,
-    pub(super) tables: EnsembleTables<T>,
+    pub(super) ensemble: Box<dyn ResidentStatic<T> + 'a>,
+    pub(super) tables: BatchTables<T>,
     pub(super) loads: Vec<(Vec<f64>, Vec<f64>)>,
     pub(super) f_ref: Vec<f64>,
     f_ext: Vec<T>,
@@ -41,8 +41,8 @@ impl<'a, T: Real> EngineStatic<'a, T> {
     /// relaxations' shifts and anchors (none: no shift).
     pub(super) fn new(
         models: Vec<&'a Model>,
-        ensemble: Box<dyn Ensemble<T> + 'a>,
-        tables: EnsembleTables<T>,
+        ensemble: Box<dyn ResidentStatic<T> + 'a>,
+        tables: BatchTables<T>,
         saved: Option<Vec<(Vec<f64>, Vec<f64>)>>,
         shifts: Option<Vec<(f64, Vec<f64>)>>,
     ) -> Self {

@@ -1,4 +1,4 @@
-//! The tables of a chunk of variants (mesh, sections, frames, sites, constraints, loads), built
+//! The tables of a batch of variants (mesh, sections, frames, sites, constraints, loads), built
 //! once from the variants' models, all on the first one's mesh. Split from `engine/mod.rs`
 //! (issue 24: no file over 800 lines), behaviour unchanged.
 
@@ -31,21 +31,21 @@ pub(crate) fn check_same_mesh(models: &[Model]) -> Result<(), crate::error::Syst
     Ok(())
 }
 
-/// The tables of a chunk of variants (all on the first one's mesh).
+/// The tables of a batch of variants (all on the first one's mesh).
 pub fn ensemble_tables<T: Real>(
     models: &[Model],
-) -> Result<EnsembleTables<T>, crate::error::SystemError> {
+) -> Result<BatchTables<T>, crate::error::SystemError> {
     ensemble_tables_from(models, None)
 }
 
-/// As [`ensemble_tables`], the chunk starting from `start` (displacements from the
+/// As [`ensemble_tables`], the batch starting from `start` (displacements from the
 /// reference `3 n V`, rotations `9 n V`; none: each variant laid on the low side) — a
-/// compacted or re-tried chunk starts where its variants stand, and does not lay them out
+/// compacted or re-tried batch starts where its variants stand, and does not lay them out
 /// again.
 pub fn ensemble_tables_from<T: Real>(
     models: &[Model],
     start: Option<(Vec<T>, Vec<T>)>,
-) -> Result<EnsembleTables<T>, crate::error::SystemError> {
+) -> Result<BatchTables<T>, crate::error::SystemError> {
     check_same_mesh(models)?;
     let t = |x: f64| T::from_f64_lossy(x);
     let base = &models[0];
@@ -101,7 +101,7 @@ pub fn ensemble_tables_from<T: Real>(
     batch.pair_params = params;
     let terms = batch.required_terms(base.friction, ContactMode::Static);
     let node_ref: Vec<f64> = base.nodes.iter().flat_map(|nd| nd.position).collect();
-    let mut tables = EnsembleTables {
+    let mut tables = BatchTables {
         num_variants: v,
         num_nodes: n,
         num_sites: s_count,

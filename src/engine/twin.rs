@@ -14,7 +14,7 @@ use super::*;
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn twin_evaluate(
     model: &Model,
-    t: &EnsembleTables<f64>,
+    t: &BatchTables<f64>,
     contact_batch: &mut ContactBatch<f64>,
     x: &[f64],
     rot: &[f64],
@@ -121,9 +121,9 @@ pub(crate) struct AssemblyDynamic<'a> {
 /// The CPU twins, f64.
 pub struct TwinPath;
 
-struct TwinEnsemble<'a> {
+struct TwinStatic<'a> {
     model: &'a Model,
-    tables: EnsembleTables<f64>,
+    tables: BatchTables<f64>,
     contact: ContactBatch<f64>,
     f_ext: Vec<f64>,
     config: [ConfigBatch<f64>; 2],
@@ -138,7 +138,7 @@ struct TwinEnsemble<'a> {
     shift: Option<Shift<f64>>,
 }
 
-impl TwinEnsemble<'_> {
+impl TwinStatic<'_> {
     fn evaluate_slot(&mut self, slot: usize, tangent: bool) {
         let c = &self.config[slot];
         let system = twin_evaluate(
@@ -174,7 +174,7 @@ impl TwinEnsemble<'_> {
     }
 }
 
-impl Ensemble<f64> for TwinEnsemble<'_> {
+impl ResidentStatic<f64> for TwinStatic<'_> {
     fn set_loads(
         &mut self,
         f_ext: &[f64],
@@ -278,7 +278,7 @@ impl Ensemble<f64> for TwinEnsemble<'_> {
         self.system = [None, None];
         Ok(())
     }
-    fn rebase(&mut self, tables: &EnsembleTables<f64>) -> Result<(), crate::error::SystemError> {
+    fn rebase(&mut self, tables: &BatchTables<f64>) -> Result<(), crate::error::SystemError> {
         self.tables = tables.clone();
         self.refresh_walls();
         self.config[self.current].x.fill(0.0);
@@ -288,19 +288,19 @@ impl Ensemble<f64> for TwinEnsemble<'_> {
 }
 
 impl KernelPath<f64> for TwinPath {
-    fn max_chunk(&self, _model: &Model) -> usize {
+    fn max_batch(&self, _model: &Model) -> usize {
         usize::MAX
     }
     fn open<'a>(
         &'a self,
         model: &'a Model,
-        tables: &EnsembleTables<f64>,
-    ) -> Result<Box<dyn Ensemble<f64> + 'a>, crate::error::SystemError> {
+        tables: &BatchTables<f64>,
+    ) -> Result<Box<dyn ResidentStatic<f64> + 'a>, crate::error::SystemError> {
         let p = tables.pair_node.len();
         let mut contact = ContactBatch::new(1, p);
         contact.site_normals = tables.pair_normals.clone();
         contact.pair_state = tables.pair_state.clone();
-        let mut twin = TwinEnsemble {
+        let mut twin = TwinStatic {
             model,
             tables: tables.clone(),
             contact,
@@ -318,9 +318,9 @@ impl KernelPath<f64> for TwinPath {
     fn open_dynamic<'a>(
         &'a self,
         model: &'a Model,
-        tables: &EnsembleTables<f64>,
+        tables: &BatchTables<f64>,
         dynamic: &dynamic::DynamicTables<f64>,
-    ) -> Result<Box<dyn dynamic::DynamicEnsemble<f64> + 'a>, crate::error::SystemError> {
+    ) -> Result<Box<dyn dynamic::ResidentDynamic<f64> + 'a>, crate::error::SystemError> {
         Ok(Box::new(self.dynamic(model, tables, dynamic)))
     }
 }

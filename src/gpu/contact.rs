@@ -1,5 +1,5 @@
 //! Runs `shaders/contact.wgsl` (twin: `src/kernels/contact.rs`) on the GPU for a
-//! [`ContactBatch`], split into chunks that fit the adapter's binding limits.
+//! [`ContactBatch`], split into parts that fit the adapter's binding limits.
 
 use std::collections::BTreeSet;
 use std::marker::PhantomData;
@@ -110,7 +110,7 @@ pub fn contact_force_wgsl(
 /// Invocations per workgroup in `shaders/contact.wgsl`.
 const WORKGROUP: usize = 64;
 
-struct Chunk {
+struct Part {
     offset: usize,
     len: usize,
     _params: wgpu::Buffer,
@@ -125,11 +125,11 @@ struct Chunk {
 pub struct GpuContactRun<T: GpuReal> {
     ctx: &'static GpuContext,
     pipeline: Arc<wgpu::ComputePipeline>,
-    chunks: Vec<Chunk>,
+    parts: Vec<Part>,
     num_pairs: usize,
     /// Output fields the kernel writes ([`output_fields`]).
     fields: usize,
-    /// Where [`Self::read`] copies every chunk's outputs (made once).
+    /// Where [`Self::read`] copies every part's outputs (made once).
     staging: wgpu::Buffer,
     _real: PhantomData<T>,
 }
@@ -140,13 +140,13 @@ fn bytes_of_len<T>(n: usize) -> u64 {
 
 impl<T: GpuReal> GpuContactRun<T> {
     /// Compiles (or fetches from the cache) the kernel for `terms` and uploads `batch`, in
-    /// chunks as large as the adapter's binding limits allow.
+    /// parts as large as the adapter's binding limits allow.
     pub fn new(
         ctx: &'static GpuContext,
         terms: &ContactTerms,
         batch: &ContactBatch<T>,
     ) -> Result<Self, GpuError> {
-        Self::with_chunk_limit(ctx, terms, batch, usize::MAX)
+        Self::with_part_limit(ctx, terms, batch, usize::MAX)
     }
 
     /// As [`Self::new`] with the static kernel built `FORCE_ONLY` ([`contact_force_wgsl`]):
@@ -159,22 +159,22 @@ impl<T: GpuReal> GpuContactRun<T> {
         Self::build(ctx, terms, batch, usize::MAX, true)
     }
 
-    /// As [`Self::new`], with at most `max_chunk_pairs` pairs per chunk (tests use it to put
-    /// chunk boundaries inside a site).
-    pub fn with_chunk_limit(
+    /// As [`Self::new`], with at most `max_part_pairs` pairs per part (tests use it to put
+    /// part boundaries inside a site).
+    pub fn with_part_limit(
         ctx: &'static GpuContext,
         terms: &ContactTerms,
         batch: &ContactBatch<T>,
-        max_chunk_pairs: usize,
+        max_part_pairs: usize,
     ) -> Result<Self, GpuError> {
-        Self::build(ctx, terms, batch, max_chunk_pairs, false)
+        Self::build(ctx, terms, batch, max_part_pairs, false)
     }
 
     fn build(
         ctx: &'static GpuContext,
         terms: &ContactTerms,
         batch: &ContactBatch<T>,
-        max_chunk_pairs: usize,
+        max_part_pairs: usize,
         force_only: bool,
     ) -> Result<Self, GpuError> {
         require_precision::<T>(ctx)?;
@@ -194,7 +194,7 @@ impl<T: GpuReal> GpuContactRun<T> {
         let fields = output_fields(terms);
         let cap = (max_binding / (fields * size))
             .min(max_groups * WORKGROUP)
-            .min(max_chunk_pairs)
+            .min(max_part_pairs)
             .max(1);
         let num_pairs = batch.num_pairs();
         if batch.site_normals.len() * size > max_binding {
@@ -212,7 +212,7 @@ impl<T: GpuReal> GpuContactRun<T> {
             usage: wgpu::BufferUsages::STORAGE,
         });
         let layout = pipeline.get_bind_group_layout(0);
-        let mut chunks = Vec::new();
+        let mut parts = Vec::new();
         let mut offset = 0;
         while offset < num_pairs {
             let len = cap.min(num_pairs - offset);
@@ -289,7 +289,7 @@ impl<T: GpuReal> GpuContactRun<T> {
                     },
                 ],
             });
-            chunks.push(Chunk {
+            parts.push(Part {
                 offset,
                 len,
                 _params: params,
@@ -300,7 +300,7 @@ impl<T: GpuReal> GpuContactRun<T> {
             });
             offset += len;
         }
-        let reads: Vec<u64> = chunks
+        let reads: Vec<u64> = parts
             .iter()
             .flat_map(|c| {
                 [
@@ -313,7 +313,7 @@ impl<T: GpuReal> GpuContactRun<T> {
         Ok(GpuContactRun {
             ctx,
             pipeline,
-            chunks,
+            parts,
             num_pairs,
             fields,
             staging,
@@ -321,37 +321,37 @@ impl<T: GpuReal> GpuContactRun<T> {
         })
     }
 
-    /// Bytes of the output buffers on the device (every chunk): `fields × pairs × size`,
+    /// Bytes of the output buffers on the device (every part): `fields × pairs × size`,
     /// with [`output_fields`] of the scene — half for a static scene.
     pub fn output_bytes(&self) -> u64 {
-        self.chunks
+        self.parts
             .iter()
             .map(|c| bytes_of_len::<T>(self.fields * c.len))
             .sum()
     }
 
-    /// Number of chunks the batch was split into.
-    pub fn num_chunks(&self) -> usize {
-        self.chunks.len()
+    /// Number of parts the batch was split into.
+    pub fn num_parts(&self) -> usize {
+        self.parts.len()
     }
 
     /// Re-uploads the state (`d`, `v`, `omega`) of every pair; parameters stay.
     pub fn write_state(&self, batch: &ContactBatch<T>) {
         let p = self.num_pairs;
-        for chunk in &self.chunks {
-            let mut data = Vec::with_capacity(STATE_LEN * chunk.len);
+        for part in &self.parts {
+            let mut data = Vec::with_capacity(STATE_LEN * part.len);
             for k in 0..STATE_LEN {
                 data.extend_from_slice(
-                    &batch.pair_state[k * p + chunk.offset..k * p + chunk.offset + chunk.len],
+                    &batch.pair_state[k * p + part.offset..k * p + part.offset + part.len],
                 );
             }
             self.ctx
                 .queue
-                .write_buffer(&chunk.state, 0, bytemuck::cast_slice(&data));
+                .write_buffer(&part.state, 0, bytemuck::cast_slice(&data));
         }
     }
 
-    /// Runs the kernel over every chunk and waits for it to finish.
+    /// Runs the kernel over every part and waits for it to finish.
     pub fn dispatch(&self) -> Result<(), GpuError> {
         let mut encoder = self
             .ctx
@@ -365,9 +365,9 @@ impl<T: GpuReal> GpuContactRun<T> {
                 timestamp_writes: None,
             });
             pass.set_pipeline(&self.pipeline);
-            for chunk in &self.chunks {
-                pass.set_bind_group(0, &chunk.bind_group, &[]);
-                pass.dispatch_workgroups(chunk.len.div_ceil(WORKGROUP) as u32, 1, 1);
+            for part in &self.parts {
+                pass.set_bind_group(0, &part.bind_group, &[]);
+                pass.dispatch_workgroups(part.len.div_ceil(WORKGROUP) as u32, 1, 1);
             }
         }
         self.ctx.queue.submit([encoder.finish()]);
@@ -394,7 +394,7 @@ impl<T: GpuReal> GpuContactRun<T> {
                 label: Some("contact_read"),
             });
         let reads: Vec<(&wgpu::Buffer, u64)> = self
-            .chunks
+            .parts
             .iter()
             .flat_map(|c| {
                 [
@@ -404,16 +404,15 @@ impl<T: GpuReal> GpuContactRun<T> {
             })
             .collect();
         let bytes = readback::submit_and_read_into(self.ctx, encoder, &self.staging, &reads)?;
-        for (chunk, pair) in self.chunks.iter().zip(bytes.chunks_exact(2)) {
+        for (part, pair) in self.parts.iter().zip(bytes.chunks_exact(2)) {
             let values: Vec<T> = readback::values(&pair[0]);
             let flags: Vec<u32> = readback::values(&pair[1]);
             // Fields a static scene leaves out stay zero, as the twin's.
             for k in 0..self.fields {
-                out.values[k * p + chunk.offset..k * p + chunk.offset + chunk.len]
-                    .copy_from_slice(&values[k * chunk.len..(k + 1) * chunk.len]);
+                out.values[k * p + part.offset..k * p + part.offset + part.len]
+                    .copy_from_slice(&values[k * part.len..(k + 1) * part.len]);
             }
-            out.contact[chunk.offset..chunk.offset + chunk.len]
-                .copy_from_slice(&flags[..chunk.len]);
+            out.contact[part.offset..part.offset + part.len].copy_from_slice(&flags[..part.len]);
         }
         Ok(out)
     }

@@ -1,5 +1,5 @@
 //! Runs `shaders/dynamics.wgsl` (twin: `src/kernels/dynamics.rs`) one-shot, for tests; the
-//! engine binds the same kernels to resident buffers (`src/gpu/ensemble/`).
+//! engine binds the same kernels to resident buffers (`src/gpu/batch/`).
 
 use std::collections::BTreeSet;
 

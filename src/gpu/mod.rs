@@ -1,6 +1,7 @@
 //! The GPU path: wgpu context, shader composition, shared layouts, kernel runners.
 
 pub mod assemble;
+pub mod batch;
 pub mod beam;
 pub mod block_lu;
 pub mod ceilings;
@@ -9,7 +10,6 @@ pub mod contact;
 pub mod context;
 pub mod dispatch;
 pub mod dynamics;
-pub mod ensemble;
 pub mod layout;
 pub mod path;
 pub mod readback;

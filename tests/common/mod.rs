@@ -84,24 +84,25 @@ impl<'p> Counting<'p> {
 }
 
 impl holewall::engine::KernelPath<f64> for Counting<'_> {
-    fn max_chunk(&self, model: &holewall::model::Model) -> usize {
-        self.inner.max_chunk(model)
+    fn max_batch(&self, model: &holewall::model::Model) -> usize {
+        self.inner.max_batch(model)
     }
     fn open<'a>(
         &'a self,
         model: &'a holewall::model::Model,
-        tables: &holewall::engine::EnsembleTables<f64>,
-    ) -> Result<Box<dyn holewall::engine::Ensemble<f64> + 'a>, holewall::error::SystemError> {
+        tables: &holewall::engine::BatchTables<f64>,
+    ) -> Result<Box<dyn holewall::engine::ResidentStatic<f64> + 'a>, holewall::error::SystemError>
+    {
         self.opens.set(self.opens.get() + 1);
         self.inner.open(model, tables)
     }
     fn open_dynamic<'a>(
         &'a self,
         model: &'a holewall::model::Model,
-        tables: &holewall::engine::EnsembleTables<f64>,
+        tables: &holewall::engine::BatchTables<f64>,
         dynamic: &holewall::engine::dynamic::DynamicTables<f64>,
     ) -> Result<
-        Box<dyn holewall::engine::dynamic::DynamicEnsemble<f64> + 'a>,
+        Box<dyn holewall::engine::dynamic::ResidentDynamic<f64> + 'a>,
         holewall::error::SystemError,
     > {
         self.dynamic_opens.set(self.dynamic_opens.get() + 1);

@@ -9,7 +9,7 @@
 //! and re-tried on its own in half steps, recursively down to `min_dt`, while the others
 //! wait ([`run_dynamic_ensemble`]); only below `min_dt` does it fail, as the CPU
 //! integrator would. Within a step, once no more than half of the variants are still
-//! iterating, the stragglers go on in a chunk of their own. No kernel mixes variants: the
+//! iterating, the stragglers go on in a batch of their own. No kernel mixes variants: the
 //! others are unaffected, bit for bit.
 //!
 //! Supported: lumped mass, mass-proportional Rayleigh damping (`a0`), the table's spin and
@@ -31,14 +31,14 @@ use crate::solve::dynamics::{DynamicOptions, Dynamics};
 use crate::solve::statics::StaticState;
 
 use super::{
-    columns, ensemble_tables_from, negated, trial_probe, EnsembleTables, KernelPath, TwinPath,
+    columns, ensemble_tables_from, negated, trial_probe, BatchTables, KernelPath, TwinPath,
 };
 use crate::solve::newton::{Event, Newton, NewtonSettings, NewtonSystem, Probe, TrialProbe};
 
 mod twin;
 pub use twin::{options_coefficients, TwinDynamic};
 
-/// What a dynamic chunk adds to [`EnsembleTables`].
+/// What a dynamic batch adds to [`BatchTables`].
 #[derive(Clone, Debug)]
 pub struct DynamicTables<T> {
     /// Lumped nodal mass, `n` (shared: the variants share the mesh and densities).
@@ -55,7 +55,7 @@ pub struct DynamicTables<T> {
     /// ([`Model::unbalance`]); empty when no variant has one (the assembly is then built
     /// without it).
     pub unbalance: Vec<T>,
-    /// The state at t = 0 (displacements from the base, [`EnsembleTables::base`]: each
+    /// The state at t = 0 (displacements from the base, [`BatchTables::base`]: each
     /// variant's static equilibrium).
     pub start: DynamicBatch<T>,
 }
@@ -71,9 +71,9 @@ pub struct Iteration<T> {
     pub inertial: Vec<T>,
 }
 
-/// A chunk of variants held by a kernel path for a dynamic run: the state at `t_n`, the
+/// A batch of variants held by a kernel path for a dynamic run: the state at `t_n`, the
 /// Newton unknown `v̇_{n+1}`, a trial state and its system.
-pub trait DynamicEnsemble<T> {
+pub trait ResidentDynamic<T> {
     /// Starts a step: its coefficients and the top's kinematics per variant
     /// (`TOP_LEN · V`); the unknown starts at `v̇_n`.
     fn begin_step(
@@ -90,7 +90,7 @@ pub trait DynamicEnsemble<T> {
     /// The unknown `+= α Δ`.
     fn correct(&mut self, alpha: &[T]) -> Result<(), crate::error::SystemError>;
     /// The unknown becomes the last trial's candidate (a trial forms its residual only:
-    /// the next [`DynamicEnsemble::iterate`] evaluates the candidate's system).
+    /// the next [`ResidentDynamic::iterate`] evaluates the candidate's system).
     fn accept_trial(&mut self) -> Result<(), crate::error::SystemError>;
     /// Ends the step: the state at `t_{n+1}` from the unknown.
     fn end_step(&mut self) -> Result<(), crate::error::SystemError>;
@@ -100,7 +100,7 @@ pub trait DynamicEnsemble<T> {
     fn set_state(&mut self, state: &DynamicBatch<T>) -> Result<(), crate::error::SystemError>;
     /// The Newton unknown `v̇_{n+1}`, `6 n V`, read back (mid-step).
     fn unknown(&mut self) -> Result<Vec<T>, crate::error::SystemError>;
-    /// Replaces the Newton unknown (after [`DynamicEnsemble::begin_step`]).
+    /// Replaces the Newton unknown (after [`ResidentDynamic::begin_step`]).
     fn set_unknown(&mut self, vdot: &[T]) -> Result<(), crate::error::SystemError>;
 }
 
@@ -127,10 +127,10 @@ pub fn unsupported(options: &DynamicOptions) -> Option<String> {
     None
 }
 
-/// A chunk's start: its tables, each variant's force scale, and what moves the top.
+/// A batch's start: its tables, each variant's force scale, and what moves the top.
 struct Start<T> {
     tables: DynamicTables<T>,
-    /// The base: each variant's static equilibrium ([`EnsembleTables::base`]).
+    /// The base: each variant's static equilibrium ([`BatchTables::base`]).
     base: Vec<f64>,
     f_ref: Vec<f64>,
     driven: bool,
@@ -254,13 +254,13 @@ pub struct DynamicResult {
 }
 
 /// Runs every variant from its start `starts[j]` (configuration and velocities) to `t_end` in steps of
-/// `options.dt` on `path`, calling `observe(first_variant, t, state)` for each chunk after
+/// `options.dt` on `path`, calling `observe(first_variant, t, state)` for each batch after
 /// every `every`-th step (0: never). `density` gives each element's steel density.
 ///
 /// Step control per variant: a variant whose Newton fails on `t → t + h` is taken back to
-/// `t` and re-tried alone with the others that failed there — in a chunk of their own, in
+/// `t` and re-tried alone with the others that failed there — in a batch of their own, in
 /// two steps of `h/2` (cut again where those fail, down to `options.min_dt`) — while the
-/// rest wait; at `t + h` its state rejoins the chunk, which goes on with `h`. So the
+/// rest wait; at `t + h` its state rejoins the batch, which goes on with `h`. So the
 /// ensemble stays in lockstep at every step of `h` and no variant needs the CPU integrator
 /// unless a step below `min_dt` would be needed there too.
 #[allow(clippy::too_many_arguments)]
@@ -278,12 +278,12 @@ pub fn run_dynamic_ensemble<T: Real + Send + Sync, P: KernelPath<T>>(
         return Err(crate::error::SystemError::Unsupported(why));
     }
     super::check_same_mesh(models)?;
-    let chunk = path.max_chunk(&models[0]).max(1);
+    let batch = path.max_batch(&models[0]).max(1);
     let mut results = Vec::with_capacity(models.len());
-    for (c, (group, group_starts)) in models.chunks(chunk).zip(starts.chunks(chunk)).enumerate() {
-        let first = c * chunk;
+    for (c, (group, group_starts)) in models.chunks(batch).zip(starts.chunks(batch)).enumerate() {
+        let first = c * batch;
         let mut obs = |t: f64, s: &DynamicBatch<T>| observe(first, t, s);
-        results.extend(run_chunk(
+        results.extend(run_batch(
             group,
             group_starts,
             density,
@@ -328,13 +328,13 @@ fn put_batch_columns<T: Copy>(dst: &mut DynamicBatch<T>, pick: &[usize], src: &D
     put_columns(&mut dst.vdot, v, pick, &src.vdot);
 }
 
-/// What every span of a chunk shares: the chunk's tables, per variant its force scale,
+/// What every span of a batch shares: the batch's tables, per variant its force scale,
 /// step floor and top drive, and the outcome so far.
-struct Chunk<'a, T, P> {
+struct Batch<'a, T, P> {
     models: &'a [Model],
     path: &'a P,
     options: &'a DynamicOptions,
-    tables: EnsembleTables<T>,
+    tables: BatchTables<T>,
     dynamic: DynamicTables<T>,
     f_ref: Vec<f64>,
     floors: Vec<f64>,
@@ -349,7 +349,7 @@ struct Chunk<'a, T, P> {
 }
 
 #[allow(clippy::too_many_arguments)]
-fn run_chunk<T: Real + Send + Sync, P: KernelPath<T>>(
+fn run_batch<T: Real + Send + Sync, P: KernelPath<T>>(
     models: &[Model],
     starts: &[DynamicStart],
     density: &[f64],
@@ -367,7 +367,7 @@ fn run_chunk<T: Real + Send + Sync, P: KernelPath<T>>(
         driven,
         lowered,
     } = dynamic_tables::<T>(models, starts, density, options)?;
-    // The chunk's state is the dynamic start; the static tables need no start of their own.
+    // The batch's state is the dynamic start; the static tables need no start of their own.
     let static_start = (dynamic.start.u.clone(), dynamic.start.rot.clone());
     let mut tables = ensemble_tables_from::<T>(models, Some(static_start))?;
     // The contact terms of the dynamic scene (damping where some c > 0).
@@ -393,7 +393,7 @@ fn run_chunk<T: Real + Send + Sync, P: KernelPath<T>>(
         })
         .collect();
     let mut ensemble = path.open_dynamic(&models[0], &tables, &dynamic)?;
-    let mut chunk = Chunk {
+    let mut batch = Batch {
         models,
         path,
         options,
@@ -414,7 +414,7 @@ fn run_chunk<T: Real + Send + Sync, P: KernelPath<T>>(
     };
     let members: Vec<usize> = (0..v).collect();
     run_span(
-        &mut chunk,
+        &mut batch,
         ensemble.as_mut(),
         &members,
         0.0,
@@ -422,11 +422,11 @@ fn run_chunk<T: Real + Send + Sync, P: KernelPath<T>>(
         options.dt,
         Some((every, observe)),
     )?;
-    Ok(chunk
+    Ok(batch
         .status
         .into_iter()
-        .zip(chunk.iterations)
-        .zip(chunk.log)
+        .zip(batch.iterations)
+        .zip(batch.log)
         .map(|((status, iterations), log)| DynamicResult {
             status,
             iterations,
@@ -435,13 +435,13 @@ fn run_chunk<T: Real + Send + Sync, P: KernelPath<T>>(
         .collect())
 }
 
-/// Advances the chunk's variants `members` (the ensemble's variants, in order) from `t0`
-/// to `t_end` in steps of `h`; variants that fail a step are re-tried in a chunk of their
+/// Advances the batch's variants `members` (the ensemble's variants, in order) from `t0`
+/// to `t_end` in steps of `h`; variants that fail a step are re-tried in a batch of their
 /// own with half the step (recursively) and rejoin at its end.
 #[allow(clippy::type_complexity)]
 fn run_span<T: Real + Send + Sync, P: KernelPath<T>>(
-    chunk: &mut Chunk<'_, T, P>,
-    ensemble: &mut dyn DynamicEnsemble<T>,
+    batch: &mut Batch<'_, T, P>,
+    ensemble: &mut dyn ResidentDynamic<T>,
     members: &[usize],
     t0: f64,
     t_end: f64,
@@ -451,7 +451,7 @@ fn run_span<T: Real + Send + Sync, P: KernelPath<T>>(
     let t = |x: f64| T::from_f64_lossy(x);
     let m = members.len();
     let size = std::mem::size_of::<T>();
-    let options = chunk.options;
+    let options = batch.options;
     let p = options.alpha;
     let ratio = (1.0 - p.alpha_f) / (1.0 - p.alpha_m);
     let settings = NewtonSettings::dynamics(options.max_iterations, options.tolerance, size);
@@ -466,13 +466,13 @@ fn run_span<T: Real + Send + Sync, P: KernelPath<T>>(
             alpha_f: t(p.alpha_f),
             beta: t(p.beta),
             gamma: t(p.gamma),
-            top_fixed: chunk.tables.fixed[0],
-            driven: chunk.driven,
-            lowered: chunk.lowered,
+            top_fixed: batch.tables.fixed[0],
+            driven: batch.driven,
+            lowered: batch.lowered,
         };
         let mut top = vec![T::zero(); TOP_LEN * m];
         for (i, &j) in members.iter().enumerate() {
-            let d = &chunk.drives[j];
+            let d = &batch.drives[j];
             let (phi, phidot, phiddot) = d.table(t1);
             let (zh, zhdot, zhddot) = d.hook(t1);
             let r = crate::physics::beam::rotation_exp(&[0.0, 0.0, phi]);
@@ -480,7 +480,7 @@ fn run_span<T: Real + Send + Sync, P: KernelPath<T>>(
                 top[k * m + i] = t(*x);
             }
             // The hook's travel as a displacement of the top node: (z0 + z_h) − z0.
-            let z0 = chunk.models[j].nodes[0].position[2];
+            let z0 = batch.models[j].nodes[0].position[2];
             let travel = (z0 + zh) - z0;
             for (k, x) in [phidot, phiddot, travel, zhdot, zhddot]
                 .into_iter()
@@ -495,7 +495,7 @@ fn run_span<T: Real + Send + Sync, P: KernelPath<T>>(
         let deferred: Vec<usize> = (0..m)
             .filter(|&i| {
                 let j = members[i];
-                chunk.status[j] == DynamicStatus::Finished && chunk.step[j] < hh * (1.0 - 1e-9)
+                batch.status[j] == DynamicStatus::Finished && batch.step[j] < hh * (1.0 - 1e-9)
             })
             .collect();
         let at_n = if deferred.is_empty() {
@@ -505,23 +505,23 @@ fn run_span<T: Real + Send + Sync, P: KernelPath<T>>(
         };
         let mut newton = Newton::new(settings, m);
         for (i, &j) in members.iter().enumerate() {
-            if chunk.status[j] == DynamicStatus::Finished && !deferred.contains(&i) {
-                newton.start(i, chunk.floors[j], false);
+            if batch.status[j] == DynamicStatus::Finished && !deferred.contains(&i) {
+                newton.start(i, batch.floors[j], false);
             }
         }
         let hhb = hh * hh * p.beta * ratio;
         let (failed, before) =
-            solve_step(chunk, ensemble, members, &coefficients, &top, newton, hhb)?;
+            solve_step(batch, ensemble, members, &coefficients, &top, newton, hhb)?;
         // (local index, its sub-step) of every variant to take this step in sub-steps.
         let mut retry: Vec<(usize, f64)> = deferred
             .iter()
-            .map(|&i| (i, chunk.step[members[i]]))
+            .map(|&i| (i, batch.step[members[i]]))
             .collect();
         let cut = hh / 2.0;
         for (i, reason) in failed {
             let j = members[i];
             if cut < options.min_dt {
-                chunk.status[j] = DynamicStatus::Failed(
+                batch.status[j] = DynamicStatus::Failed(
                     t1,
                     format!(
                         "step {hh:.3e} s failed and cannot be cut below {:.1e} s: {reason}",
@@ -529,10 +529,10 @@ fn run_span<T: Real + Send + Sync, P: KernelPath<T>>(
                     ),
                 );
             } else {
-                chunk.log[j].push(format!(
+                batch.log[j].push(format!(
                     "t = {time:.6} s: step {hh:.3e} s failed ({reason}); cut to {cut:.3e} s"
                 ));
-                chunk.step[j] = cut;
+                batch.step[j] = cut;
                 retry.push((i, cut));
             }
         }
@@ -549,7 +549,7 @@ fn run_span<T: Real + Send + Sync, P: KernelPath<T>>(
                     retry.iter().filter(|r| r.1 == h_sub).map(|r| r.0).collect();
                 let again: Vec<usize> = group.iter().map(|&i| members[i]).collect();
                 let after = retry_alone(
-                    chunk,
+                    batch,
                     &again,
                     &batch_columns(&at_n, &group),
                     time,
@@ -566,8 +566,8 @@ fn run_span<T: Real + Send + Sync, P: KernelPath<T>>(
             if *every > 0 && step.is_multiple_of(*every) {
                 let mut s = ensemble.state()?;
                 // Displacements from the reference for the observer (summed in f64).
-                let v = chunk.tables.num_variants;
-                for (w, b) in s.u.iter_mut().zip(&chunk.tables.base) {
+                let v = batch.tables.num_variants;
+                for (w, b) in s.u.iter_mut().zip(&batch.tables.base) {
                     *w = t(b + w.to_f64_lossy());
                 }
                 debug_assert_eq!(v, m);
@@ -580,15 +580,15 @@ fn run_span<T: Real + Send + Sync, P: KernelPath<T>>(
 
 /// The Newton of one time step for the ensemble's running variants (started in `newton`),
 /// then the step's end (the state at `t_n + h`). Once no more than half of them are still
-/// running (ensembles of [`super::COMPACT_MIN`] or more), the stragglers go on in a chunk
+/// running (ensembles of [`super::COMPACT_MIN`] or more), the stragglers go on in a batch
 /// of their own exactly where they stand (state at `t_n`, Newton unknown, Newton state),
 /// bit for bit, so converged variants cost no more kernel work; their end state is
 /// written back. Returns the variants whose Newton failed (local index, reason) and, if
 /// any failed, every variant's state at `t_n`.
 #[allow(clippy::type_complexity)]
 fn solve_step<T: Real + Send + Sync, P: KernelPath<T>>(
-    chunk: &mut Chunk<'_, T, P>,
-    ensemble: &mut dyn DynamicEnsemble<T>,
+    batch: &mut Batch<'_, T, P>,
+    ensemble: &mut dyn ResidentDynamic<T>,
     members: &[usize],
     coefficients: &StepCoefficients<T>,
     top: &[T],
@@ -601,7 +601,7 @@ fn solve_step<T: Real + Send + Sync, P: KernelPath<T>>(
     {
         let mut sys = DynamicStep {
             ensemble: &mut *ensemble,
-            f_ref: members.iter().map(|&j| chunk.f_ref[j]).collect(),
+            f_ref: members.iter().map(|&j| batch.f_ref[j]).collect(),
             hhb,
         };
         while newton.any_running() {
@@ -609,11 +609,11 @@ fn solve_step<T: Real + Send + Sync, P: KernelPath<T>>(
                 match event {
                     Event::Converged(its) => {
                         let j = members[i];
-                        chunk.iterations[j].push(its);
+                        batch.iterations[j].push(its);
                         // As the CPU integrator: a cut step doubles after an easy one.
-                        if its <= 4 && chunk.step[j] < chunk.options.dt {
-                            chunk.step[j] = (2.0 * chunk.step[j]).min(chunk.options.dt);
-                            chunk.log[j].push(format!("step regrown to {:.3e} s", chunk.step[j]));
+                        if its <= 4 && batch.step[j] < batch.options.dt {
+                            batch.step[j] = (2.0 * batch.step[j]).min(batch.options.dt);
+                            batch.log[j].push(format!("step regrown to {:.3e} s", batch.step[j]));
                         }
                     }
                     Event::Failed(reason) => failed.push((i, reason)),
@@ -638,7 +638,7 @@ fn solve_step<T: Real + Send + Sync, P: KernelPath<T>>(
         let sub_members: Vec<usize> = s.iter().map(|&i| members[i]).collect();
         let unknown = ensemble.unknown()?;
         let sub_top = columns(top, m, &s);
-        let mut sub = open_subset(chunk, &sub_members, &batch_columns(at_n, &s))?;
+        let mut sub = open_subset(batch, &sub_members, &batch_columns(at_n, &s))?;
         sub.begin_step(coefficients, &sub_top)?;
         sub.set_unknown(&columns(&unknown, m, &s))?;
         let mut sub_newton = Newton::new(newton.settings, s.len());
@@ -646,7 +646,7 @@ fn solve_step<T: Real + Send + Sync, P: KernelPath<T>>(
             sub_newton.resume(k, newton.state(i));
         }
         let (sub_failed, _) = solve_step(
-            chunk,
+            batch,
             sub.as_mut(),
             &sub_members,
             coefficients,
@@ -666,21 +666,21 @@ fn solve_step<T: Real + Send + Sync, P: KernelPath<T>>(
     Ok((failed, before))
 }
 
-/// A chunk of the chunk's variants `members` (each with its tables, loads and base) at the
+/// A batch of the batch's variants `members` (each with its tables, loads and base) at the
 /// state `start`.
 fn open_subset<'c, T: Real + Send + Sync, P: KernelPath<T>>(
-    chunk: &Chunk<'c, T, P>,
+    batch: &Batch<'c, T, P>,
     members: &[usize],
     start: &DynamicBatch<T>,
-) -> Result<Box<dyn DynamicEnsemble<T> + 'c>, crate::error::SystemError> {
-    let v = chunk.tables.num_variants;
-    let models: Vec<Model> = members.iter().map(|&j| chunk.models[j].clone()).collect();
-    // The static start is not used by a dynamic chunk: the state is `start`.
+) -> Result<Box<dyn ResidentDynamic<T> + 'c>, crate::error::SystemError> {
+    let v = batch.tables.num_variants;
+    let models: Vec<Model> = members.iter().map(|&j| batch.models[j].clone()).collect();
+    // The static start is not used by a dynamic batch: the state is `start`.
     let mut tables =
         ensemble_tables_from::<T>(&models, Some((start.u.clone(), start.rot.clone())))?;
-    tables.terms = chunk.tables.terms;
-    tables.set_base(&models[0], columns(&chunk.tables.base, v, members));
-    let d = &chunk.dynamic;
+    tables.terms = batch.tables.terms;
+    tables.set_base(&models[0], columns(&batch.tables.base, v, members));
+    let d = &batch.dynamic;
     let dynamic = DynamicTables {
         mass: d.mass.clone(),
         inertia0: d.inertia0.clone(),
@@ -690,28 +690,28 @@ fn open_subset<'c, T: Real + Send + Sync, P: KernelPath<T>>(
         unbalance: columns(&d.unbalance, v, members),
         start: start.clone(),
     };
-    let path: &'c P = chunk.path;
-    path.open_dynamic(&chunk.models[members[0]], &tables, &dynamic)
+    let path: &'c P = batch.path;
+    path.open_dynamic(&batch.models[members[0]], &tables, &dynamic)
 }
 
-/// The chunk's variants `again`, at `start` (their state at `t0`), taken to `t1` in a chunk
+/// The batch's variants `again`, at `start` (their state at `t0`), taken to `t1` in a batch
 /// of their own with steps of `h`; their state at `t1`.
 fn retry_alone<T: Real + Send + Sync, P: KernelPath<T>>(
-    chunk: &mut Chunk<'_, T, P>,
+    batch: &mut Batch<'_, T, P>,
     again: &[usize],
     start: &DynamicBatch<T>,
     t0: f64,
     t1: f64,
     h: f64,
 ) -> Result<DynamicBatch<T>, crate::error::SystemError> {
-    let mut sub = open_subset(chunk, again, start)?;
-    run_span(chunk, sub.as_mut(), again, t0, t1, h, None)?;
+    let mut sub = open_subset(batch, again, start)?;
+    run_span(batch, sub.as_mut(), again, t0, t1, h, None)?;
     sub.state()
 }
 
-/// A dynamic chunk's step as a Newton system: the unknown is `v̇_{n+1}` of every variant.
+/// A dynamic batch's step as a Newton system: the unknown is `v̇_{n+1}` of every variant.
 struct DynamicStep<'e, T> {
-    ensemble: &'e mut dyn DynamicEnsemble<T>,
+    ensemble: &'e mut dyn ResidentDynamic<T>,
     f_ref: Vec<f64>,
     hhb: f64,
 }

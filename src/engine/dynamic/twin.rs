@@ -1,13 +1,13 @@
 //! The dynamic engine's CPU path: [`TwinDynamic`], the kernels' twins run in the engine's
-//! order on a dynamic chunk (the oracle of the GPU's dynamic chunk). Split from
+//! order on a dynamic batch (the oracle of the GPU's dynamic batch). Split from
 //! `engine/dynamic.rs` (issue 24: no file over 800 lines), behaviour unchanged.
 
 use super::*;
 
-/// The twins' dynamic chunk (f64).
+/// The twins' dynamic batch (f64).
 pub struct TwinDynamic<'a> {
     model: &'a Model,
-    tables: EnsembleTables<f64>,
+    tables: BatchTables<f64>,
     dynamic: DynamicTables<f64>,
     contact: ContactBatch<f64>,
     coefficients: Option<StepCoefficients<f64>>,
@@ -19,12 +19,8 @@ pub struct TwinDynamic<'a> {
 }
 
 impl<'a> TwinDynamic<'a> {
-    /// Holds a chunk on the CPU twins.
-    pub fn new(
-        model: &'a Model,
-        tables: &EnsembleTables<f64>,
-        dynamic: &DynamicTables<f64>,
-    ) -> Self {
+    /// Holds a batch on the CPU twins.
+    pub fn new(model: &'a Model, tables: &BatchTables<f64>, dynamic: &DynamicTables<f64>) -> Self {
         let p = tables.pair_node.len();
         let mut contact = ContactBatch::new(1, p);
         contact.site_normals = tables.pair_normals.clone();
@@ -85,7 +81,7 @@ pub fn options_coefficients<T: Real>(c: &StepCoefficients<T>) -> (T, T) {
     (c.h * c.gamma * ratio, c.h * c.h * c.beta * ratio)
 }
 
-impl DynamicEnsemble<f64> for TwinDynamic<'_> {
+impl ResidentDynamic<f64> for TwinDynamic<'_> {
     fn begin_step(
         &mut self,
         c: &StepCoefficients<f64>,
@@ -155,11 +151,11 @@ impl DynamicEnsemble<f64> for TwinDynamic<'_> {
 }
 
 impl TwinPath {
-    /// The twins' dynamic chunk.
+    /// The twins' dynamic batch.
     pub fn dynamic<'a>(
         &self,
         model: &'a Model,
-        tables: &EnsembleTables<f64>,
+        tables: &BatchTables<f64>,
         dynamic: &DynamicTables<f64>,
     ) -> TwinDynamic<'a> {
         TwinDynamic::new(model, tables, dynamic)

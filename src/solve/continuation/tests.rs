@@ -44,12 +44,12 @@ fn without_a_shift_scale_a_step_below_the_smallest_fails() {
     let (p, next) = stuck(None);
     assert_eq!(next, Next::Failed);
     assert!(matches!(p.error, Some(StaticError::LoadStep { .. })));
-    // In the load steps, not the gravity stage (no second start for it).
+    // In the load steps, not the gravity stage.
     assert!(!p.error.unwrap().in_gravity_stage());
 }
 
 #[test]
-fn a_gravity_stage_that_fails_says_so_for_a_second_start() {
+fn a_gravity_stage_that_fails_says_so() {
     let mut p = LoadPath::new(&StaticOptions::default(), true, true, false);
     let mut next = Next::Step;
     for _ in 0..100 {

@@ -418,58 +418,18 @@ pub fn reference_force(model: &Model) -> f64 {
 }
 
 /// Solves for static equilibrium at full load, from the undeformed configuration, or with
-/// contact sites from [`StaticState::on_low_side`] (and, where its gravity stage fails
-/// there, from [`second_start`]: [`solve_static_started`]).
+/// contact sites from [`StaticState::on_low_side`] ([`static_start`]).
 pub fn solve_static(model: &Model, options: &StaticOptions) -> Result<StaticSolution, StaticError> {
     solve_static_started(model, options, &mut |_| {})
 }
 
-/// The second start of a static solve whose gravity stage failed from [`static_start`]:
-/// the string laid as there, each node towards its own lateral load, without the turns
-/// around the wall at side flips ([`StaticState::on_low_side_without_turns`]); `None`
-/// where the first start turned none. Neither start is the better one for every well:
-/// measured on the 500 corpus wells (`holewall bench corpus --wells 500`), the start with
-/// the turns solved well 213 (0.5 m elements) and took 464 past its gravity stage, and
-/// lost wells 111, 118 (0.5 m) and 172 (15 m), which the one without them solves; as the
-/// first start the one without them also lost corpus well 28 (10 m, a fold: the load path
-/// is chaotic there).
-pub fn second_start(model: &Model) -> Option<StaticState> {
-    if model.sites.is_empty() {
-        None
-    } else {
-        StaticState::on_low_side_without_turns(model)
-    }
-}
-
-/// [`solve_static_monitored`] from [`static_start`], and where its gravity stage fails
-/// ([`StaticError::in_gravity_stage`]) once more from [`second_start`] (the log says so);
-/// `progress` sees both. Where both fail, the first start's error is returned.
+/// [`solve_static_monitored`] from [`static_start`]; `progress` sees the load factor.
 pub fn solve_static_started(
     model: &Model,
     options: &StaticOptions,
     progress: &mut dyn FnMut(f64),
 ) -> Result<StaticSolution, StaticError> {
-    let first = solve_static_monitored(model, static_start(model), options, progress);
-    match first {
-        Err(e) if e.in_gravity_stage() => match second_start(model) {
-            Some(start) => match solve_static_monitored(model, start, options, progress) {
-                Ok(mut sol) => {
-                    sol.log.insert(
-                        0,
-                        format!(
-                            "from the string laid in the hole: {e}; solved from the second \
-                             start, each node laid towards its own lateral load (no turns \
-                             around the wall at side flips)"
-                        ),
-                    );
-                    Ok(sol)
-                }
-                Err(_) => Err(e),
-            },
-            None => Err(e),
-        },
-        other => other,
-    }
+    solve_static_monitored(model, static_start(model), options, progress)
 }
 
 /// Where every static solve starts ([`solve_static`], the static command, the engine): the

@@ -33,24 +33,12 @@ impl StaticState {
     /// - **turning around the wall** where the lateral load flips side between
     ///   neighbouring nodes ([`turn_around_side_flips`]).
     ///
-    /// This is the first start ([`super::static_start`]);
-    /// [`StaticState::on_low_side_without_turns`] is the second.
+    /// This is where every static solve with contact sites starts
+    /// ([`super::static_start`]). (A second start without the turns, tried where the
+    /// gravity stage failed from this one, was removed in issue 24: since the gravity stage
+    /// relaxes, none of the 500 corpus wells reached it — the same wells solved with the
+    /// same Newton iterations, 167,033, without it.)
     pub fn on_low_side(model: &Model) -> StaticState {
-        Self::laid(model, true).0
-    }
-
-    /// As [`StaticState::on_low_side`], each node towards its own lateral load without the
-    /// turns at side flips; `None` where there is no flip (the start would be the first
-    /// one). The second start of a solve whose gravity stage failed from the first
-    /// ([`super::second_start`]).
-    pub fn on_low_side_without_turns(model: &Model) -> Option<StaticState> {
-        let (s, has_flip) = Self::laid(model, false);
-        has_flip.then_some(s)
-    }
-
-    /// The laid start; `turn_flips`: turn around the wall at side flips. Returns whether
-    /// the string has a side flip (turned or not).
-    fn laid(model: &Model, turn_flips: bool) -> (StaticState, bool) {
         use crate::solve::soft_string::{soft_string, Operation};
         let mut s = StaticState::initial(model);
         let n = model.nodes.len();
@@ -148,11 +136,7 @@ impl StaticState {
                 .find(|s| s.node == i)
                 .map_or(0.0, bending_length)
         };
-        let has_flip = if turn_flips {
-            turn_around_side_flips(model, &mut offset, site_length)
-        } else {
-            turn_around_side_flips(model, &mut offset.clone(), site_length)
-        };
+        turn_around_side_flips(model, &mut offset, site_length);
         // Offset `m_a + (m − m_a) g(s/L)` within L of an anchor (offset m_a), with
         // `g(x) = 2x − 2x³ + x⁴` the pinned beam's deflection (g(1) = 1, g'(1) = 0).
         let ramp = |x: f64| 2.0 * x - 2.0 * x.powi(3) + x.powi(4);
@@ -193,7 +177,7 @@ impl StaticState {
                 }
             }
         }
-        (s, has_flip)
+        s
     }
 
     /// The undeformed configuration (every node on the hole axis, no rotation).
@@ -215,13 +199,11 @@ impl StaticState {
 /// at least the neighbours) the direction rotates about the hole axis at a constant rate
 /// per metre from the one before the window to the one after it. The magnitudes (the
 /// depth on the wall) are the nodes' own; a node without an offset ends a window.
-/// Returns whether any window was turned.
 fn turn_around_side_flips(
     model: &Model,
     offset: &mut [Option<(Vec3<f64>, f64)>],
     bending_length: impl Fn(usize) -> f64,
-) -> bool {
-    let mut turned = false;
+) {
     let n = offset.len();
     let md = |i: usize| model.nodes[i].md;
     let lateral = |v: &Vec3<f64>, t: &Vec3<f64>| {
@@ -270,10 +252,8 @@ fn turn_around_side_flips(
                 o.0 = dir;
             }
         }
-        turned = true;
         i = b;
     }
-    turned
 }
 
 #[cfg(test)]
@@ -293,7 +273,7 @@ mod tests {
             (0..n).map(|i| Some((flipped(i), 0.05))).collect();
         offset[0] = None;
         let before = offset.clone();
-        assert!(turn_around_side_flips(&model, &mut offset, |_| 8.0));
+        turn_around_side_flips(&model, &mut offset, |_| 8.0);
         let dirs: Vec<Vec3<f64>> = offset[1..].iter().map(|o| o.unwrap().0).collect();
         for d in &dirs {
             assert!((dot(d, d).sqrt() - 1.0).abs() < 1e-12);
@@ -320,7 +300,7 @@ mod tests {
         // No flip, no change.
         let mut same: Vec<Option<(Vec3<f64>, f64)>> = (0..n).map(|_| Some((x, 0.05))).collect();
         let copy = same.clone();
-        assert!(!turn_around_side_flips(&model, &mut same, |_| 8.0));
+        turn_around_side_flips(&model, &mut same, |_| 8.0);
         assert_eq!(same, copy);
     }
 }

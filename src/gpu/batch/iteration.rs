@@ -1,6 +1,6 @@
-//! The static chunk's Newton iteration on the GPU ([`crate::engine::Ensemble`] for
-//! [`super::GpuEnsemble`]: evaluate, solve, trial, accept, commit, read and set the
-//! configuration, rebase) and the sites gather kernel. Split from `gpu/ensemble.rs`
+//! The static batch's Newton iteration on the GPU ([`crate::engine::ResidentStatic`] for
+//! [`super::GpuStatic`]: evaluate, solve, trial, accept, commit, read and set the
+//! configuration, rebase) and the sites gather kernel. Split from `gpu/batch/mod.rs`
 //! (issue 24: no file over 800 lines), behaviour unchanged.
 
 use super::*;
@@ -21,7 +21,7 @@ pub fn sites_wgsl_for(dynamic: bool, f64: bool) -> Result<String, GpuError> {
     crate::gpu::compose::compose_if("sites.wgsl", &[("DYNAMIC", dynamic)], f64)
 }
 
-impl<T: GpuReal> Ensemble<T> for GpuEnsemble<T> {
+impl<T: GpuReal> ResidentStatic<T> for GpuStatic<T> {
     fn set_loads(
         &mut self,
         f_ext: &[T],
@@ -196,7 +196,7 @@ impl<T: GpuReal> Ensemble<T> for GpuEnsemble<T> {
         Ok(())
     }
 
-    fn rebase(&mut self, tables: &EnsembleTables<T>) -> Result<(), crate::error::SystemError> {
+    fn rebase(&mut self, tables: &BatchTables<T>) -> Result<(), crate::error::SystemError> {
         let q = &self.ctx.queue;
         if !tables.pair_base.is_empty() {
             q.write_buffer(

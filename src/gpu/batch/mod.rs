@@ -1,5 +1,5 @@
-//! A chunk of variants resident on the GPU for the ensemble Newton iteration
-//! ([`crate::engine`]): every buffer and bind group is made once, when the chunk is opened;
+//! A batch of variants resident on the GPU for the ensemble Newton iteration
+//! ([`crate::engine`]): every buffer and bind group is made once, when the batch is opened;
 //! an iteration records the kernels (beam → sites → contact → assembly → block LU → norms,
 //! then update → … for a trial) into command buffers, and the host reads back only the
 //! four norms and the solve status per variant ([`Norms`]), and writes one α per variant.
@@ -14,7 +14,7 @@ use std::sync::Arc;
 use wgpu::util::DeviceExt;
 
 use crate::engine::Stage;
-use crate::engine::{Ensemble, EnsembleTables, Shift};
+use crate::engine::{BatchTables, ResidentStatic, Shift};
 use crate::error::GpuError;
 use crate::gpu::block_lu::LuForm;
 use crate::gpu::contact::{contact_wgsl, require_precision, GpuReal};
@@ -37,13 +37,13 @@ pub use iteration::{gather_sites_gpu, sites_trial_wgsl, sites_wgsl, sites_wgsl_f
 /// Status the block solve starts with; still there afterwards means it did not finish.
 const RUNNING: u32 = 2;
 
-/// Bytes per variant of every buffer of a chunk, for a chain of `n` nodes with `s` sites
+/// Bytes per variant of every buffer of a batch, for a chain of `n` nodes with `s` sites
 /// at `size`-byte floats: two configurations and two assembled systems, the base and its
 /// chords, element forces and tangents, contact inputs and outputs (all
-/// [`OUTPUT_LEN`] fields: the dynamic engine's; a static chunk holds
+/// [`OUTPUT_LEN`] fields: the dynamic engine's; a static batch holds
 /// [`crate::kernels::contact::output_fields`]), loads, the factorisation workspace, the
 /// step, and the per-variant scalars. (The shared tables — translation bases, sections,
-/// frames — are per chunk.)
+/// frames — are per batch.)
 pub fn bytes_per_variant(n: usize, s: usize, size: usize) -> usize {
     let m = n.saturating_sub(1);
     let reals = 2 * 12 * n            // x, rot: two slots
@@ -63,7 +63,7 @@ fn largest_binding_per_variant(n: usize, s: usize, size: usize) -> usize {
     size * (144 * m).max(36 * n).max(OUTPUT_LEN * s)
 }
 
-/// The most variants of `model` one chunk may hold on `ctx`: every binding within the
+/// The most variants of `model` one batch may hold on `ctx`: every binding within the
 /// adapter's limit, every dispatch within its workgroup count.
 pub fn max_variants(ctx: &GpuContext, model: &Model, size: usize) -> usize {
     let n = model.nodes.len();
@@ -98,7 +98,7 @@ struct Slot {
     system: [wgpu::Buffer; 4],
 }
 
-/// A relaxation's proximal shift on the GPU, made when a chunk first relaxes: the
+/// A relaxation's proximal shift on the GPU, made when a batch first relaxes: the
 /// assembly built `SHIFT` (full and trial forms), the shift per variant and the anchors,
 /// and each slot's bind groups of those kernels.
 struct ShiftParts {
@@ -132,8 +132,8 @@ struct Pipelines {
     update_trial: Arc<wgpu::ComputePipeline>,
 }
 
-/// A chunk of variants on the GPU (see the module docs).
-pub struct GpuEnsemble<T: GpuReal> {
+/// A batch of variants on the GPU (see the module docs).
+pub struct GpuStatic<T: GpuReal> {
     ctx: &'static GpuContext,
     p: Pipelines,
     slots: [Slot; 2],
@@ -237,13 +237,13 @@ fn dispatch(
     pass.dispatch_workgroups(invocations.div_ceil(WORKGROUP) as u32, 1, 1);
 }
 
-impl<T: GpuReal> GpuEnsemble<T> {
-    /// Compiles (or fetches) the kernels for the chunk's terms and precision and uploads
+impl<T: GpuReal> GpuStatic<T> {
+    /// Compiles (or fetches) the kernels for the batch's terms and precision and uploads
     /// its tables and start configuration.
     pub fn new(
         ctx: &'static GpuContext,
         model: &Model,
-        tables: &EnsembleTables<T>,
+        tables: &BatchTables<T>,
     ) -> Result<Self, GpuError> {
         let f64 = T::IS_F64;
         let kink = !tables.rest.is_empty();
@@ -379,7 +379,7 @@ impl<T: GpuReal> GpuEnsemble<T> {
             }
         };
         let slots = [make_slot(0), make_slot(1)];
-        Ok(GpuEnsemble {
+        Ok(GpuStatic {
             ctx,
             p: pipelines,
             slots,
@@ -398,7 +398,7 @@ impl<T: GpuReal> GpuEnsemble<T> {
         })
     }
 
-    /// The shift's kernels, buffers and bind groups (made once, at a chunk's first
+    /// The shift's kernels, buffers and bind groups (made once, at a batch's first
     /// relaxation).
     fn shift_parts(&self) -> Result<ShiftParts, GpuError> {
         let ctx = self.ctx;

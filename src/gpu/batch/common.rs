@@ -1,8 +1,8 @@
-//! The buffers every GPU chunk has, static or dynamic ([`Common`]), and their bind groups.
+//! The buffers every GPU batch has, static or dynamic ([`Common`]), and their bind groups.
 
 use super::*;
 
-/// The buffers every chunk has, static or dynamic: shared tables, contact and element
+/// The buffers every batch has, static or dynamic: shared tables, contact and element
 /// work, the block solve's workspace and step, the per-variant scalars, and the parameter blocks.
 pub(super) struct Common {
     pub(super) sections: wgpu::Buffer,
@@ -177,12 +177,12 @@ impl Common {
         bind(ctx, pipeline, "norms", &all)
     }
 
-    /// Checks the chunk against the adapter's limits and makes its common buffers; the
+    /// Checks the batch against the adapter's limits and makes its common buffers; the
     /// pair parameters and loads start as given (or empty, written per load step).
     pub(super) fn new<T: GpuReal>(
         ctx: &'static GpuContext,
         model: &Model,
-        tables: &EnsembleTables<T>,
+        tables: &BatchTables<T>,
         params: Option<&[T]>,
         f_ext: Option<&[T]>,
     ) -> Result<Self, GpuError> {

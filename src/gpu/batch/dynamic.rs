@@ -1,11 +1,11 @@
-//! The dynamic chunk of the GPU ensemble ([`crate::engine::dynamic`]): the state at `t_n`,
-//! the Newton unknown and a line-search candidate resident on the GPU, with the static chunk's
-//! buffers, pipelines and helpers ([`super`]). Split from `gpu/ensemble.rs` (issue 24: no file
+//! The dynamic batch of the GPU ensemble ([`crate::engine::dynamic`]): the state at `t_n`,
+//! the Newton unknown and a line-search candidate resident on the GPU, with the static batch's
+//! buffers, pipelines and helpers ([`super`]). Split from `gpu/batch/mod.rs` (issue 24: no file
 //! over 800 lines), behaviour unchanged.
 
 use super::*;
 
-/// A chunk of variants resident on the GPU for a dynamic run
+/// A batch of variants resident on the GPU for a dynamic run
 /// ([`crate::engine::dynamic`]): the state at `t_n`, the Newton unknown `v̇_{n+1}` and a
 /// candidate for the line search, one trial state and its system. Per iteration the host
 /// reads four norms, a status and the inertial scale per variant.
@@ -76,12 +76,12 @@ struct DynamicBuffers {
 }
 
 impl<T: GpuReal> GpuDynamic<T> {
-    /// Compiles (or fetches) the kernels for the chunk's terms and precision and uploads
+    /// Compiles (or fetches) the kernels for the batch's terms and precision and uploads
     /// its tables and start state.
     pub fn new(
         ctx: &'static GpuContext,
         model: &Model,
-        tables: &EnsembleTables<T>,
+        tables: &BatchTables<T>,
         dynamic: &crate::engine::dynamic::DynamicTables<T>,
     ) -> Result<Self, GpuError> {
         use crate::gpu::dynamics::{dynamics_wgsl, DynamicsKernel};
@@ -290,7 +290,7 @@ impl<T: GpuReal> GpuDynamic<T> {
     }
 }
 
-impl<T: GpuReal> crate::engine::dynamic::DynamicEnsemble<T> for GpuDynamic<T> {
+impl<T: GpuReal> crate::engine::dynamic::ResidentDynamic<T> for GpuDynamic<T> {
     fn begin_step(
         &mut self,
         c: &crate::kernels::dynamics::StepCoefficients<T>,
