@@ -88,7 +88,7 @@ impl<T: GpuReal> GpuDynamic<T> {
         let f64 = T::IS_F64;
         let kink = !tables.rest.is_empty();
         let (v, n) = (tables.num_variants, tables.num_nodes);
-        let (m, p) = (n.saturating_sub(1), tables.pair_node.len());
+        let p = tables.pair_node.len();
         let size = std::mem::size_of::<T>();
         let c = Common::new(
             ctx,
@@ -127,10 +127,7 @@ impl<T: GpuReal> GpuDynamic<T> {
         let inertia0 = storage(ctx, "inertia0", &dynamic.inertia0);
         let unbalance =
             (!dynamic.unbalance.is_empty()).then(|| storage(ctx, "unbalance", &dynamic.unbalance));
-        let diag = empty(ctx, "diag", 36 * n * v * size);
-        let upper = empty(ctx, "upper", 36 * m.max(1) * v * size);
-        let lower = empty(ctx, "lower", 36 * m.max(1) * v * size);
-        let rhs = empty(ctx, "rhs", 6 * n * v * size);
+        let [diag, upper, lower, rhs] = system_buffers(ctx, v, n, size);
         let st = &dynamic.start;
         let b = DynamicBuffers {
             coef: empty(ctx, "coef", 5 * size),

@@ -190,6 +190,18 @@ fn empty(ctx: &GpuContext, label: &str, bytes: usize) -> wgpu::Buffer {
     })
 }
 
+/// The block-tridiagonal system of `v` variants of `n` nodes, as the static and the dynamic
+/// batch hold it: diagonal, upper and lower 6×6 blocks and the right-hand side.
+fn system_buffers(ctx: &GpuContext, v: usize, n: usize, size: usize) -> [wgpu::Buffer; 4] {
+    let m = n.saturating_sub(1).max(1);
+    [
+        empty(ctx, "diag", 36 * n * v * size),
+        empty(ctx, "upper", 36 * m * v * size),
+        empty(ctx, "lower", 36 * m * v * size),
+        empty(ctx, "rhs", 6 * n * v * size),
+    ]
+}
+
 /// A kernel's parameter block (binding 0): read-only storage, not a uniform, which lavapipe
 /// would inline and recompile the kernel for at every dispatch (see `tests/shaders.rs`).
 fn param_block<U: bytemuck::Pod>(ctx: &GpuContext, label: &str, u: &U) -> wgpu::Buffer {
@@ -248,7 +260,7 @@ impl<T: GpuReal> GpuStatic<T> {
         let f64 = T::IS_F64;
         let kink = !tables.rest.is_empty();
         let (v, n) = (tables.num_variants, tables.num_nodes);
-        let (m, p) = (n.saturating_sub(1), tables.pair_node.len());
+        let p = tables.pair_node.len();
         let size = std::mem::size_of::<T>();
         let c = Common::new(ctx, model, tables, None, None)?;
         let pipelines = Pipelines {
@@ -293,10 +305,7 @@ impl<T: GpuReal> GpuStatic<T> {
         let make_slot = |k: usize| -> Slot {
             let (x, rot) = configs[k].clone();
             let (x_from, rot_from) = &configs[1 - k];
-            let diag = empty(ctx, "diag", 36 * n * v * size);
-            let upper = empty(ctx, "upper", 36 * m.max(1) * v * size);
-            let lower = empty(ctx, "lower", 36 * m.max(1) * v * size);
-            let rhs = empty(ctx, "rhs", 6 * n * v * size);
+            let [diag, upper, lower, rhs] = system_buffers(ctx, v, n, size);
             let beam = c.beam_group(ctx, &pipelines.beam, &x, &rot, false, false);
             let beam_force = c.beam_group(ctx, &pipelines.beam_force, &x, &rot, true, true);
             let sites = bind(
