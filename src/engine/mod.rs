@@ -201,7 +201,7 @@ pub enum Stage {
 /// The evaluation chain of a Newton iteration, described once: the kernels, in order,
 /// that turn a configuration into its constrained residual and tangent — static, or
 /// dynamic (predictor first, and dynamic sites and assembly). The twin path runs it in
-/// `twin_evaluate`, the GPU path records it (`gpu::ensemble`), both from this list.
+/// `twin_evaluate`, the GPU path records it (`gpu::batch`), both from this list.
 pub fn evaluation(dynamic: bool) -> &'static [Stage] {
     if dynamic {
         &[
