@@ -42,6 +42,7 @@ pub fn submit_and_read_into(
     staging: &wgpu::Buffer,
     reads: &[(&wgpu::Buffer, u64)],
 ) -> Result<Vec<Vec<u8>>, GpuError> {
+    let total: u64 = reads.iter().map(|r| slot(r.1)).sum::<u64>().max(4);
     let mut offset = 0;
     for &(buffer, bytes) in reads {
         if bytes > 0 {
@@ -50,14 +51,16 @@ pub fn submit_and_read_into(
         offset += slot(bytes);
     }
     ctx.queue.submit([encoder.finish()]);
-    staging.slice(..).map_async(wgpu::MapMode::Read, |_| {});
+    staging
+        .slice(..total)
+        .map_async(wgpu::MapMode::Read, |_| {});
     ctx.device
         .poll(wgpu::PollType::wait_indefinitely())
         .map_err(|e| GpuError::Device(e.to_string()))?;
     let mut out = Vec::with_capacity(reads.len());
     {
         let view = staging
-            .slice(..)
+            .slice(..total)
             .get_mapped_range()
             .map_err(|e| GpuError::Device(format!("map: {e}")))?;
         let mut offset = 0usize;
@@ -73,4 +76,29 @@ pub fn submit_and_read_into(
 /// The values in bytes read back (copied: a byte vector need not be aligned for `T`).
 pub fn values<T: bytemuck::Pod>(bytes: &[u8]) -> Vec<T> {
     bytemuck::pod_collect_to_vec(bytes)
+}
+
+/// A staging buffer kept by a runner that reads back at every iteration (the resident
+/// batches), made at the first read and grown when a read needs more: no buffer is made
+/// per read.
+#[derive(Default)]
+pub struct Staging(std::sync::Mutex<Option<wgpu::Buffer>>);
+
+impl Staging {
+    /// [`submit_and_read_into`] this buffer.
+    pub fn read(
+        &self,
+        ctx: &GpuContext,
+        encoder: wgpu::CommandEncoder,
+        reads: &[(&wgpu::Buffer, u64)],
+    ) -> Result<Vec<Vec<u8>>, GpuError> {
+        let sizes: Vec<u64> = reads.iter().map(|r| r.1).collect();
+        let need = sizes.iter().map(|&b| slot(b)).sum::<u64>().max(4);
+        let mut kept = self.0.lock().unwrap_or_else(|e| e.into_inner());
+        if kept.as_ref().is_none_or(|b| b.size() < need) {
+            *kept = Some(staging_buffer(ctx, "read", &sizes));
+        }
+        let staging = kept.as_ref().expect("made above");
+        submit_and_read_into(ctx, encoder, staging, reads)
+    }
 }

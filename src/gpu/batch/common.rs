@@ -5,6 +5,8 @@ use super::*;
 /// The buffers every batch has, static or dynamic: shared tables, contact and element
 /// work, the block solve's workspace and step, the per-variant scalars, and the parameter blocks.
 pub(super) struct Common {
+    /// Where every per-iteration read-back goes (one buffer, kept).
+    pub(super) staging: crate::gpu::readback::Staging,
     pub(super) sections: wgpu::Buffer,
     pub(super) frames: wgpu::Buffer,
     pub(super) chords: wgpu::Buffer,
@@ -209,6 +211,7 @@ impl Common {
             None => empty(ctx, label, len * size),
         };
         Ok(Common {
+            staging: Default::default(),
             sections: table("sections", crate::kernels::beam::section_table(model)),
             frames: table("frames", crate::kernels::beam::frame_table(model)),
             chords: storage(ctx, "chords", &tables.chords),

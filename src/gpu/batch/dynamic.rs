@@ -325,16 +325,19 @@ impl<T: GpuReal> crate::engine::dynamic::ResidentDynamic<T> for GpuDynamic<T> {
             dispatch(&mut pass, &self.p.scale, &self.g.scale, v);
         }
         let size = std::mem::size_of::<T>() as u64;
-        let out = submit_and_read(
-            self.ctx,
-            e,
-            &[
-                (&self.c.norms, 4 * v as u64 * size),
-                (&self.c.status, 4 * v as u64),
-                (&self.b.scale, v as u64 * size),
-            ],
-        )
-        .map_err(crate::error::SystemError::from)?;
+        let out = self
+            .c
+            .staging
+            .read(
+                self.ctx,
+                e,
+                &[
+                    (&self.c.norms, 4 * v as u64 * size),
+                    (&self.c.status, 4 * v as u64),
+                    (&self.b.scale, v as u64 * size),
+                ],
+            )
+            .map_err(crate::error::SystemError::from)?;
         let status: Vec<u32> = values(&out[1]);
         if status.contains(&RUNNING) {
             return Err(crate::error::SystemError::BlockSolve(
@@ -366,7 +369,10 @@ impl<T: GpuReal> crate::engine::dynamic::ResidentDynamic<T> for GpuDynamic<T> {
             dispatch(&mut pass, &self.p.norms, &self.g.norms_trial, v);
         }
         let size = std::mem::size_of::<T>() as u64;
-        let out = submit_and_read(self.ctx, e, &[(&self.c.norms, 4 * v as u64 * size)])
+        let out = self
+            .c
+            .staging
+            .read(self.ctx, e, &[(&self.c.norms, 4 * v as u64 * size)])
             .map_err(crate::error::SystemError::from)?;
         Ok(norms_from_bytes(&out[0]))
     }
@@ -447,12 +453,15 @@ impl<T: GpuReal> crate::engine::dynamic::ResidentDynamic<T> for GpuDynamic<T> {
     fn unknown(&mut self) -> Result<Vec<T>, crate::error::SystemError> {
         let size = std::mem::size_of::<T>() as u64;
         let bytes = 6 * (self.num_nodes * self.num_variants) as u64 * size;
-        let out = submit_and_read(
-            self.ctx,
-            encoder(self.ctx, "unknown"),
-            &[(&self.b.vdot_k, bytes)],
-        )
-        .map_err(crate::error::SystemError::from)?;
+        let out = self
+            .c
+            .staging
+            .read(
+                self.ctx,
+                encoder(self.ctx, "unknown"),
+                &[(&self.b.vdot_k, bytes)],
+            )
+            .map_err(crate::error::SystemError::from)?;
         Ok(values(&out[0]))
     }
 
@@ -470,18 +479,21 @@ impl<T: GpuReal> crate::engine::dynamic::ResidentDynamic<T> for GpuDynamic<T> {
         let size = std::mem::size_of::<T>() as u64;
         let nv = (n * v) as u64 * size;
         let b = &self.b;
-        let out = submit_and_read(
-            self.ctx,
-            encoder(self.ctx, "state"),
-            &[
-                (&b.u_n, 3 * nv),
-                (&b.rot_n, 9 * nv),
-                (&b.vel_n, 6 * nv),
-                (&b.acc_n, 6 * nv),
-                (&b.vdot_n, 6 * nv),
-            ],
-        )
-        .map_err(crate::error::SystemError::from)?;
+        let out = self
+            .c
+            .staging
+            .read(
+                self.ctx,
+                encoder(self.ctx, "state"),
+                &[
+                    (&b.u_n, 3 * nv),
+                    (&b.rot_n, 9 * nv),
+                    (&b.vel_n, 6 * nv),
+                    (&b.acc_n, 6 * nv),
+                    (&b.vdot_n, 6 * nv),
+                ],
+            )
+            .map_err(crate::error::SystemError::from)?;
         let cast = |bytes: &Vec<u8>| -> Vec<T> { bytemuck::cast_slice(bytes).to_vec() };
         Ok(crate::kernels::dynamics::DynamicBatch {
             num_variants: v,

@@ -148,15 +148,18 @@ impl<T: GpuReal> ResidentStatic<T> for GpuStatic<T> {
         let (v, n) = (self.num_variants, self.num_nodes);
         let s = &self.slots[self.current];
         let size = std::mem::size_of::<T>() as u64;
-        let out = submit_and_read(
-            self.ctx,
-            self.encoder("config"),
-            &[
-                (&s.x, 3 * (n * v) as u64 * size),
-                (&s.rot, 9 * (n * v) as u64 * size),
-            ],
-        )
-        .map_err(crate::error::SystemError::from)?;
+        let out = self
+            .c
+            .staging
+            .read(
+                self.ctx,
+                self.encoder("config"),
+                &[
+                    (&s.x, 3 * (n * v) as u64 * size),
+                    (&s.rot, 9 * (n * v) as u64 * size),
+                ],
+            )
+            .map_err(crate::error::SystemError::from)?;
         Ok(ConfigBatch {
             num_variants: v,
             num_nodes: n,

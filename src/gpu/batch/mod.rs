@@ -495,7 +495,7 @@ impl<T: GpuReal> GpuStatic<T> {
     ) -> Result<(Norms<T>, Vec<u32>), GpuError> {
         let v = self.num_variants;
         let norm_bytes = (4 * v * std::mem::size_of::<T>()) as u64;
-        let out = submit_and_read(
+        let out = self.c.staging.read(
             self.ctx,
             encoder,
             &[(&self.c.norms, norm_bytes), (&self.c.status, 4 * v as u64)],
