@@ -539,11 +539,25 @@ fn xy_chart<'a, 'b>(
     Ok(chart)
 }
 
+/// The plots' one typeface, DejaVu Sans (licence beside it), carried in the binary so that
+/// PNG text needs no font installed on the machine: registered once as "sans-serif", the
+/// family every plot names.
+const FONT: &[u8] = include_bytes!("fonts/DejaVuSans.ttf");
+
+fn register_font() {
+    static ONCE: std::sync::Once = std::sync::Once::new();
+    ONCE.call_once(|| {
+        // The bytes are a valid TrueType font (the test `the_carried_font_draws_text`).
+        let _ = plotters::style::register_font("sans-serif", FontStyle::Normal, FONT);
+    });
+}
+
 /// Writes a PNG through a temporary file and a rename (never half-written).
 fn atomic_png(
     path: &Path,
     draw: impl FnOnce(&Path) -> Result<(), Box<dyn std::error::Error>>,
 ) -> std::io::Result<()> {
+    register_font();
     let tmp = path.with_extension(format!("{}.tmp.png", std::process::id()));
     match draw(&tmp) {
         Ok(()) => std::fs::rename(&tmp, path),
@@ -596,6 +610,20 @@ pub type BandPoint = (f64, f64, f64, f64);
 
 #[cfg(test)]
 mod tests {
+    #[test]
+    fn the_carried_font_draws_text() {
+        use plotters::prelude::*;
+        assert!(
+            plotters::style::register_font("sans-serif", FontStyle::Normal, super::FONT).is_ok()
+        );
+        super::register_font();
+        let (w, h) = ("sans-serif", 15)
+            .into_font()
+            .box_size("kN·m, °/30 m, λ")
+            .expect("text measured with the carried font");
+        assert!(w > 50 && h > 5, "{w}×{h}");
+    }
+
     #[test]
     fn the_legend_goes_where_the_data_are_not() {
         use plotters::prelude::SeriesLabelPosition as P;
