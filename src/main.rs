@@ -601,17 +601,21 @@ fn main() -> ExitCode {
                 budget,
                 cpu_only,
                 precision_nodes,
+                lu_form,
                 json,
-            } => match cli::bench_ensemble::run(
-                &nodes,
-                &variants,
-                steps,
-                repeats,
-                budget,
-                !cpu_only,
-                precision_nodes,
-                json.as_deref(),
-            ) {
+            } => match {
+                cli::bench_cmd::LuFormArg::apply(lu_form);
+                cli::bench_ensemble::run(
+                    &nodes,
+                    &variants,
+                    steps,
+                    repeats,
+                    budget,
+                    !cpu_only,
+                    precision_nodes,
+                    json.as_deref(),
+                )
+            } {
                 Ok(()) => ExitCode::SUCCESS,
                 Err(e) => fail(&[e]),
             },
@@ -619,8 +623,12 @@ fn main() -> ExitCode {
                 case,
                 variants,
                 repeats,
+                lu_form,
                 json,
-            } => match cli::bench::statics(&case, variants.as_deref(), repeats, json.as_deref()) {
+            } => match {
+                cli::bench_cmd::LuFormArg::apply(lu_form);
+                cli::bench::statics(&case, variants.as_deref(), repeats, json.as_deref())
+            } {
                 Ok(()) => ExitCode::SUCCESS,
                 Err(e) => fail(&[e]),
             },

@@ -23,7 +23,13 @@ fn the_roofline_bench_measures_every_kernel_under_its_ceilings() {
         "--quiet",
     ]);
     assert_eq!(code, 0, "{stderr}");
-    assert!(stdout.contains("| block solve |"), "{stdout}");
+    // Both forms of the block solve, each named.
+    for form in ["serial", "lanes"] {
+        assert!(
+            stdout.contains(&format!("| block solve ({form}) |")),
+            "{stdout}"
+        );
+    }
     let r: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out.join("kernels.json")).unwrap()).unwrap();
     let c = &r["ceilings"];
@@ -34,8 +40,8 @@ fn the_roofline_bench_measures_every_kernel_under_its_ceilings() {
     let precisions = if ctx.has_f64 { 2 } else { 1 };
     assert_eq!(
         rows.len(),
-        4 * 2 * precisions,
-        "4 kernels × 2 sizes × precisions"
+        5 * 2 * precisions,
+        "4 kernels (the block solve in 2 forms) × 2 sizes × precisions"
     );
     for k in rows {
         let f = |key: &str| k[key].as_f64().unwrap_or(f64::NAN);
@@ -48,13 +54,20 @@ fn the_roofline_bench_measures_every_kernel_under_its_ceilings() {
         // Bytes are the bindings' sizes: at least the outputs the kernel writes.
         assert!(f("gbytes_per_s") > 0.0 && f("intensity") > 0.0, "{k}");
     }
-    // The block solve's counted FLOPs grow linearly in V at fixed n.
-    let lu: Vec<f64> = rows
-        .iter()
-        .filter(|k| k["kernel"] == "block solve" && k["precision"] == "f32")
-        .map(|k| k["flops"].as_f64().unwrap())
-        .collect();
-    assert!((lu[1] / lu[0] - 4.0).abs() < 1e-9, "{lu:?}");
+    // The block solve's counted FLOPs grow linearly in V at fixed n, in both forms.
+    for form in ["serial", "lanes"] {
+        let lu: Vec<f64> = rows
+            .iter()
+            .filter(|k| {
+                k["kernel"] == format!("block solve ({form})").as_str() && k["precision"] == "f32"
+            })
+            .map(|k| k["flops"].as_f64().unwrap())
+            .collect();
+        assert!(
+            lu.len() == 2 && (lu[1] / lu[0] - 4.0).abs() < 1e-9,
+            "{lu:?}"
+        );
+    }
     for f in ["kernels.md", "roofline.png"] {
         assert!(out.join(f).exists(), "{f}");
     }

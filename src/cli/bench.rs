@@ -341,7 +341,11 @@ pub fn statics(
     ));
     let mut adapter = "none".to_string();
     if let Ok(ctx) = GpuContext::shared() {
-        adapter = ctx.describe();
+        adapter = format!(
+            "{}; block solve: {:?}",
+            ctx.describe(),
+            crate::gpu::block_lu::LuForm::for_adapter(ctx)
+        );
         if ctx.has_f64 {
             let t = median_seconds::<Error>(repeats, || {
                 let r = solve_static_ensemble::<f64, _>(&models, &GpuPath(ctx), &options)?;

@@ -64,6 +64,10 @@ pub enum BenchCommand {
         /// Nodes of the work-precision runs (0: none).
         #[arg(long, default_value_t = 100)]
         precision_nodes: usize,
+        /// The block solve's form on the GPU: the adapter's choice (default), or one forced
+        /// (serial: one invocation per variant; lanes: eight), to compare them on a device.
+        #[arg(long, value_enum)]
+        lu_form: Option<LuFormArg>,
         /// Also write the results as JSON here.
         #[arg(long)]
         json: Option<PathBuf>,
@@ -79,6 +83,10 @@ pub enum BenchCommand {
         /// Timed repeats per path (the median is reported).
         #[arg(long, default_value_t = 3)]
         repeats: usize,
+        /// The block solve's form on the GPU: the adapter's choice (default), or one forced
+        /// (serial: one invocation per variant; lanes: eight), to compare them on a device.
+        #[arg(long, value_enum)]
+        lu_form: Option<LuFormArg>,
         /// Also write the results as JSON here.
         #[arg(long)]
         json: Option<PathBuf>,
@@ -228,5 +236,25 @@ pub fn positive_seconds(s: &str) -> Result<f64, String> {
     match s.parse::<f64>() {
         Ok(x) if x.is_finite() && x > 0.0 => Ok(x),
         _ => Err(format!("{s:?}: allowed: a number of seconds > 0")),
+    }
+}
+
+/// `--lu-form`: a forced form of the GPU block solve ([`crate::gpu::block_lu::LuForm`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum LuFormArg {
+    /// One invocation per variant (the blocks in registers).
+    Serial,
+    /// Eight invocations per variant, a row per lane.
+    Lanes,
+}
+
+impl LuFormArg {
+    /// Forces `form` for the rest of the process (`None`: the adapter's choice).
+    pub fn apply(form: Option<LuFormArg>) {
+        use crate::gpu::block_lu::{force_lu_form, LuForm};
+        force_lu_form(form.map(|f| match f {
+            LuFormArg::Serial => LuForm::Serial,
+            LuFormArg::Lanes => LuForm::Lanes,
+        }));
     }
 }

@@ -286,7 +286,15 @@ pub fn run(
     } else {
         None
     };
-    let adapter = ctx.map(|c| c.describe()).unwrap_or_else(|| "none".into());
+    let adapter = ctx
+        .map(|c| {
+            format!(
+                "{}; block solve: {:?}",
+                c.describe(),
+                crate::gpu::block_lu::LuForm::for_adapter(c)
+            )
+        })
+        .unwrap_or_else(|| "none".into());
     let mut cells: Vec<Cell> = Vec::new();
     // Counted once: the element's operations do not depend on the cell.
     let e = super::bench::element_flops();

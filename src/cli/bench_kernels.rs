@@ -13,6 +13,7 @@ use std::path::Path;
 use serde::Serialize;
 
 use crate::error::Error;
+use crate::gpu::block_lu::LuForm;
 use crate::gpu::contact::GpuReal;
 use crate::gpu::dispatch::KernelTiming;
 use crate::gpu::GpuContext;
@@ -264,15 +265,22 @@ fn run_size<T: GpuReal>(
         c.assemble * v as f64,
         r.map_err(|e| e.to_string()).and_then(|_| of(t)),
     ));
-    // The block-tridiagonal solve.
+    // The block-tridiagonal solve, in both forms (the engine runs the adapter's:
+    // `LuForm::for_adapter`); the names say which.
     let b = cast_chain(&chain_batch(n, v), to_t);
-    let (r, t) =
-        crate::gpu::dispatch::timed(repeats, || crate::gpu::block_lu::block_lu_gpu::<T>(ctx, &b));
-    rows.push((
-        "block solve".into(),
-        c.block_lu * v as f64,
-        r.map_err(|e| e.to_string()).and_then(|_| of(t)),
-    ));
+    for (form, name) in [
+        (LuForm::Serial, "block solve (serial)"),
+        (LuForm::Lanes, "block solve (lanes)"),
+    ] {
+        let (r, t) = crate::gpu::dispatch::timed(repeats, || {
+            crate::gpu::block_lu::block_lu_gpu_form::<T>(ctx, &b, usize::MAX, form)
+        });
+        rows.push((
+            name.into(),
+            c.block_lu * v as f64,
+            r.map_err(|e| e.to_string()).and_then(|_| of(t)),
+        ));
+    }
     rows
 }
 

@@ -83,7 +83,164 @@ pub fn block_lu_wgsl(f64: bool, form: LuForm) -> Result<String, GpuError> {
     let text = compose("block_lu.wgsl", &flags, f64)?;
     // The written-out walk is the same text every time: made once per process.
     static FORWARD: std::sync::OnceLock<String> = std::sync::OnceLock::new();
-    Ok(text.replace("    //@FORWARD\n", FORWARD.get_or_init(serial_forward)))
+    static LANES_FORWARD: std::sync::OnceLock<String> = std::sync::OnceLock::new();
+    Ok(text
+        .replace("    //@FORWARD\n", FORWARD.get_or_init(serial_forward))
+        .replace(
+            "    //@LANES_FORWARD\n",
+            LANES_FORWARD.get_or_init(lanes_forward),
+        ))
+}
+
+/// The lane form's forward walk (see `shaders/block_lu.wgsl`), written out: this lane's row
+/// of the augmented block as 13 scalars `w{c}` and the permutation of partial pivoting as six
+/// scalars `pm{q}` (the same in every lane of a variant), every loop over the six columns and
+/// thirteen entries unrolled. A lane's row indexed at run time (`row[col]`) is a private
+/// array in memory on a GPU — local memory on NVIDIA; the first H100 run measured this form
+/// at 2.6 ms for a 21-node chain (issue 27). The pivot column and row still pass through
+/// workgroup memory, where indexing at run time costs nothing extra. The operations and
+/// their order are the loop form's, so the results are the twin's bit for bit.
+fn lanes_forward() -> String {
+    use std::fmt::Write;
+    let mut s = String::new();
+    let w = &mut s;
+    let _ = writeln!(
+        w,
+        "    for (var i = dims.begin; i < dims.end; i = i + 1u) {{"
+    );
+    for c in 0..13 {
+        let _ = writeln!(w, "        var w{c} = real(0.0);");
+    }
+    let _ = writeln!(w, "        if (live) {{");
+    for c in 0..6 {
+        let _ = writeln!(w, "            w{c} = diag[blk(i, 6u * r + {c}u, v)];");
+    }
+    let _ = writeln!(w, "            if (i + 1u < n) {{");
+    for c in 0..6 {
+        let _ = writeln!(
+            w,
+            "                w{} = upper[blk(i, 6u * r + {c}u, v)];",
+            6 + c
+        );
+    }
+    let _ = writeln!(w, "            }}");
+    let _ = writeln!(w, "            w12 = rhs[vec_at(i, r, v)];");
+    let _ = writeln!(w, "            if (i > 0u) {{");
+    for k in 0..6 {
+        let _ = writeln!(w, "                {{");
+        let _ = writeln!(
+            w,
+            "                    let l = lower[blk(i - 1u, 6u * r + {k}u, v)];"
+        );
+        for c in 0..6 {
+            let _ = writeln!(
+                w,
+                "                    w{c} = w{c} - l * px[36u * slot + {}u];",
+                6 * k + c
+            );
+        }
+        let _ = writeln!(
+            w,
+            "                    w12 = w12 - l * pz[6u * slot + {k}u];"
+        );
+        let _ = writeln!(w, "                }}");
+    }
+    let _ = writeln!(w, "            }}");
+    let _ = writeln!(w, "        }}");
+    for q in 0..6 {
+        let _ = writeln!(w, "        var pm{q} = {q}u;");
+    }
+    let _ = writeln!(w, "        var bad = false;");
+    for col in 0..6 {
+        let _ = writeln!(w, "        workgroupBarrier();");
+        let _ = writeln!(w, "        if (live) {{ pcol[6u * slot + r] = w{col}; }}");
+        let _ = writeln!(w, "        workgroupBarrier();");
+        let _ = writeln!(w, "        {{");
+        let _ = writeln!(w, "            var piv = pm{col};");
+        let _ = writeln!(w, "            if (live) {{");
+        let _ = writeln!(w, "                var p = {col}u;");
+        let _ = writeln!(
+            w,
+            "                var best = abs(pcol[6u * slot + pm{col}]);"
+        );
+        for q in col + 1..6 {
+            let _ = writeln!(
+                w,
+                "                if (abs(pcol[6u * slot + pm{q}]) > best) {{ p = {q}u; best = abs(pcol[6u * slot + pm{q}]); }}"
+            );
+        }
+        for q in col + 1..6 {
+            let _ = writeln!(
+                w,
+                "                if (p == {q}u) {{ let t = pm{col}; pm{col} = pm{q}; pm{q} = t; }}"
+            );
+        }
+        let _ = writeln!(w, "                piv = pm{col};");
+        let _ = writeln!(w, "                let pivot = pcol[6u * slot + piv];");
+        let _ = writeln!(w, "                if (bad_pivot(pivot)) {{ bad = true; }}");
+        let _ = writeln!(w, "                if (r == piv) {{");
+        let _ = writeln!(w, "                    let inv = real(1.0) / pivot;");
+        for c in col..13 {
+            let _ = writeln!(
+                w,
+                "                    w{c} = w{c} * inv; prow[13u * slot + {c}u] = w{c};"
+            );
+        }
+        let _ = writeln!(w, "                }}");
+        let _ = writeln!(w, "            }}");
+        let _ = writeln!(w, "            workgroupBarrier();");
+        let _ = writeln!(w, "            if (live && r != piv) {{");
+        let _ = writeln!(w, "                let f = w{col};");
+        for c in col..13 {
+            let _ = writeln!(
+                w,
+                "                w{c} = w{c} - f * prow[13u * slot + {c}u];"
+            );
+        }
+        let _ = writeln!(w, "            }}");
+        let _ = writeln!(w, "        }}");
+    }
+    let _ = writeln!(w, "        if (live && bad) {{");
+    let _ = writeln!(
+        w,
+        "            // Singular: the twin's zero solution, and the variant stops here."
+    );
+    let _ = writeln!(w, "            if (r == 0u) {{ status[v] = 1u; }}");
+    let _ = writeln!(
+        w,
+        "            for (var k = r; k < 6u * n; k = k + 6u) {{ x[k * dims.num_variants + v] = real(0.0); }}"
+    );
+    let _ = writeln!(w, "            live = false;");
+    let _ = writeln!(w, "        }}");
+    let _ = writeln!(w, "        workgroupBarrier();");
+    let _ = writeln!(w, "        if (live) {{");
+    let _ = writeln!(w, "            // This lane's row is row q of X_i and z_i.");
+    let _ = writeln!(w, "            var q = 0u;");
+    for k in 0..6 {
+        let _ = writeln!(w, "            if (pm{k} == r) {{ q = {k}u; }}");
+    }
+    for c in 0..6 {
+        let _ = writeln!(
+            w,
+            "            px[36u * slot + 6u * q + {c}u] = w{};",
+            6 + c
+        );
+    }
+    let _ = writeln!(w, "            if (i + 1u < n) {{");
+    for c in 0..6 {
+        let _ = writeln!(
+            w,
+            "                work_x[blk(i, 6u * q + {c}u, v)] = w{};",
+            6 + c
+        );
+    }
+    let _ = writeln!(w, "            }}");
+    let _ = writeln!(w, "            pz[6u * slot + q] = w12;");
+    let _ = writeln!(w, "            work_z[vec_at(i, q, v)] = w12;");
+    let _ = writeln!(w, "        }}");
+    let _ = writeln!(w, "        workgroupBarrier();");
+    let _ = writeln!(w, "    }}");
+    s
 }
 
 /// The serial form's forward walk (see `shaders/block_lu.wgsl`), written out: the augmented
