@@ -603,9 +603,9 @@ fn main() -> ExitCode {
                 precision_nodes,
                 lu_form,
                 json,
-            } => match {
+            } => {
                 cli::bench_cmd::LuFormArg::apply(lu_form);
-                cli::bench_ensemble::run(
+                let r = cli::bench_ensemble::run(
                     &nodes,
                     &variants,
                     steps,
@@ -614,24 +614,25 @@ fn main() -> ExitCode {
                     !cpu_only,
                     precision_nodes,
                     json.as_deref(),
-                )
-            } {
-                Ok(()) => ExitCode::SUCCESS,
-                Err(e) => fail(&[e]),
-            },
+                );
+                match r {
+                    Ok(()) => ExitCode::SUCCESS,
+                    Err(e) => fail(&[e]),
+                }
+            }
             BenchCommand::Statics {
                 case,
                 variants,
                 repeats,
                 lu_form,
                 json,
-            } => match {
+            } => {
                 cli::bench_cmd::LuFormArg::apply(lu_form);
-                cli::bench::statics(&case, variants.as_deref(), repeats, json.as_deref())
-            } {
-                Ok(()) => ExitCode::SUCCESS,
-                Err(e) => fail(&[e]),
-            },
+                match cli::bench::statics(&case, variants.as_deref(), repeats, json.as_deref()) {
+                    Ok(()) => ExitCode::SUCCESS,
+                    Err(e) => fail(&[e]),
+                }
+            }
             BenchCommand::Device {
                 out,
                 cases,
