@@ -32,8 +32,15 @@ pub struct KernelRow {
     pub variants: usize,
     /// Nodes per variant.
     pub nodes: usize,
-    /// Median seconds per run (all its passes).
+    /// Median seconds per run (all its passes): between the device's timestamps at the start
+    /// and end of the compute pass where the adapter has them (`timed_by`), else from the
+    /// submission to the end of the wait on the host's clock.
     pub seconds: f64,
+    /// Median seconds per run on the host's clock (submission to the end of the wait): the
+    /// kernel plus the round trip.
+    pub host_seconds: f64,
+    /// "device" (timestamps) or "host" (clock): what `seconds` is.
+    pub timed_by: String,
     /// Floating-point operations per run (counted on the twin).
     pub flops: f64,
     /// Bytes its bindings hold.
@@ -180,8 +187,17 @@ fn median(mut x: Vec<f64>) -> f64 {
     x.get(x.len() / 2).copied().unwrap_or(f64::NAN)
 }
 
-/// A kernel's name, its FLOPs per run and (median seconds, bytes) or why it did not run.
-type Measured = (String, f64, Result<(f64, f64), String>);
+/// A kernel's median seconds per run (kernel, host clock), whether the first is the device's
+/// timestamps, and its bytes.
+struct Timed {
+    seconds: f64,
+    host_seconds: f64,
+    by_device: bool,
+    bytes: f64,
+}
+
+/// A kernel's name, its FLOPs per run and its times, or why it did not run.
+type Measured = (String, f64, Result<Timed, String>);
 
 /// The kernels at one size and precision.
 fn run_size<T: GpuReal>(
@@ -192,21 +208,24 @@ fn run_size<T: GpuReal>(
     c: &Counts,
 ) -> Vec<Measured> {
     use crate::physics::contact::{ContactMode, ContactTerms, FrictionModel};
-    let of = |t: Vec<KernelTiming>| -> Result<(f64, f64), String> {
-        let seconds = median(
-            (0..repeats)
-                .map(|r| {
-                    t.iter()
-                        .map(|k| k.seconds.get(r).copied().unwrap_or(0.0))
-                        .sum()
-                })
-                .collect(),
-        );
+    let of = |t: Vec<KernelTiming>| -> Result<Timed, String> {
+        let total = |f: &dyn Fn(&KernelTiming) -> &[f64]| {
+            median(
+                (0..repeats)
+                    .map(|r| t.iter().map(|k| f(k).get(r).copied().unwrap_or(0.0)).sum())
+                    .collect(),
+            )
+        };
         let bytes: u64 = t.iter().map(|k| k.bytes_in + k.bytes_out).sum();
         if t.is_empty() {
             Err("no dispatch".into())
         } else {
-            Ok((seconds, bytes as f64))
+            Ok(Timed {
+                seconds: total(&|k| k.kernel_seconds()),
+                host_seconds: total(&|k| &k.seconds),
+                by_device: t.iter().all(|k| !k.device_seconds.is_empty()),
+                bytes: bytes as f64,
+            })
         }
     };
     let to_t = |x: f64| T::from_f64_lossy(x);
@@ -228,7 +247,13 @@ fn run_size<T: GpuReal>(
             let size = std::mem::size_of::<T>();
             let input =
                 (cast.site_normals.len() + cast.pair_params.len() + cast.pair_state.len()) * size;
-            Ok((median(s), (input as u64 + run.output_bytes()) as f64))
+            let seconds = median(s);
+            Ok(Timed {
+                seconds,
+                host_seconds: seconds,
+                by_device: false,
+                bytes: (input as u64 + run.output_bytes()) as f64,
+            })
         });
     rows.push((
         "contact".into(),
@@ -331,10 +356,19 @@ pub fn run(
                 ceilings.fma_gflops_f32
             };
             for (kernel, flops, r) in got {
-                let (seconds, bytes, note) = match r {
-                    Ok((s, b)) => (s, b, String::new()),
-                    Err(e) => (f64::NAN, f64::NAN, e),
+                let (t, note) = match r {
+                    Ok(t) => (t, String::new()),
+                    Err(e) => (
+                        Timed {
+                            seconds: f64::NAN,
+                            host_seconds: f64::NAN,
+                            by_device: false,
+                            bytes: f64::NAN,
+                        },
+                        e,
+                    ),
                 };
+                let (seconds, bytes) = (t.seconds, t.bytes);
                 let gflops = flops / seconds / 1e9;
                 let intensity = flops / bytes;
                 rows.push(KernelRow {
@@ -343,6 +377,8 @@ pub fn run(
                     variants: v,
                     nodes,
                     seconds,
+                    host_seconds: t.host_seconds,
+                    timed_by: if t.by_device { "device" } else { "host" }.into(),
                     flops,
                     bytes,
                     gflops,
@@ -447,9 +483,11 @@ pub fn markdown(r: &KernelsReport) -> String {
     let c = &r.ceilings;
     let mut s = format!(
         "Device: {}\n\nCeilings measured here: FMA f32 {:.1} GFLOP/s, FMA f64 {}, copy {:.1} GB/s \
-         (read + write).\n\n\
-         | kernel | precision | V | nodes | median (ms) | GFLOP/s | of FMA | GB/s | of copy | FLOP/B | roof (GFLOP/s) | note |\n\
-         |---|---|---|---|---|---|---|---|---|---|---|---|\n",
+         (read + write). \"median\": the kernel's time, by the device's timestamps at the compute \
+         pass's start and end where \"timed by\" says device, else by the host's clock; \"host\": \
+         from submission to the end of the wait (kernel and round trip).\n\n\
+         | kernel | precision | V | nodes | median (ms) | timed by | host (ms) | GFLOP/s | of FMA | GB/s | of copy | FLOP/B | roof (GFLOP/s) | note |\n\
+         |---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
         r.device,
         c.fma_gflops_f32,
         c.fma_gflops_f64
@@ -458,12 +496,14 @@ pub fn markdown(r: &KernelsReport) -> String {
     );
     for k in &r.rows {
         s.push_str(&format!(
-            "| {} | {} | {} | {} | {:.3} | {:.2} | {:.0} % | {:.2} | {:.0} % | {:.2} | {:.1} | {} |\n",
+            "| {} | {} | {} | {} | {:.3} | {} | {:.3} | {:.2} | {:.0} % | {:.2} | {:.0} % | {:.2} | {:.1} | {} |\n",
             k.kernel,
             k.precision,
             k.variants,
             k.nodes,
             k.seconds * 1e3,
+            k.timed_by,
+            k.host_seconds * 1e3,
             k.gflops,
             100.0 * k.fraction_of_fma,
             k.gbytes_per_s,

@@ -104,7 +104,7 @@ pub fn measure(ctx: &GpuContext, repeats: usize) -> Result<Ceilings, GpuError> {
                 )
             });
             r?;
-            let seconds = fastest(t.into_iter().flat_map(|k| k.seconds).collect());
+            let seconds = fastest(t.iter().flat_map(|k| k.kernel_seconds().to_vec()).collect());
             if seconds >= MIN_SECONDS || iterations >= 1 << 15 {
                 let flops = (invocations * iterations as usize * CHAINS * LANES * 2) as f64;
                 return Ok(flops / seconds / 1e9);
@@ -116,12 +116,12 @@ pub fn measure(ctx: &GpuContext, repeats: usize) -> Result<Ceilings, GpuError> {
     let fma_gflops_f64 = if ctx.has_f64 { Some(fma(true)?) } else { None };
     let pipeline = ctx.pipeline("ceiling_copy", COPY_WGSL)?;
     let largest = (ctx.max_binding_bytes() as usize).min(1 << 30) / 16 * 16;
-    let mut bytes = largest.min(4 << 20);
+    let mut bytes = largest.min(32 << 20);
     loop {
         let words = bytes / 16;
         let src = vec![1u8; bytes];
         // Grid-stride: a GPU's one-dimensional dispatch holds 65,535 workgroups.
-        let threads = words.min(1 << 20);
+        let threads = words.min(65_535 * 64);
         let params = [words as u32, threads as u32];
         let (r, t) = timed(repeats, || {
             run_once(
@@ -135,7 +135,7 @@ pub fn measure(ctx: &GpuContext, repeats: usize) -> Result<Ceilings, GpuError> {
             )
         });
         r?;
-        let seconds = fastest(t.into_iter().flat_map(|k| k.seconds).collect());
+        let seconds = fastest(t.iter().flat_map(|k| k.kernel_seconds().to_vec()).collect());
         if seconds >= MIN_SECONDS || bytes * 2 > largest {
             return Ok(Ceilings {
                 fma_gflops_f32,

@@ -50,6 +50,9 @@ pub struct GpuContext {
     pub limits: wgpu::Limits,
     /// Whether `f64` kernels can run (`SHADER_F64`).
     pub has_f64: bool,
+    /// Whether the device writes timestamps at the start and end of a compute pass
+    /// (`TIMESTAMP_QUERY`): the benches' device-side kernel times.
+    pub has_timestamps: bool,
     pipelines: Mutex<HashMap<String, Arc<wgpu::ComputePipeline>>>,
 }
 
@@ -97,6 +100,10 @@ impl GpuContext {
         if has_f64 {
             required_features |= wgpu::Features::SHADER_F64;
         }
+        let has_timestamps = adapter.features().contains(wgpu::Features::TIMESTAMP_QUERY);
+        if has_timestamps {
+            required_features |= wgpu::Features::TIMESTAMP_QUERY;
+        }
         let limits = adapter.limits();
         let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
             label: Some("holewall"),
@@ -114,6 +121,7 @@ impl GpuContext {
             info,
             limits,
             has_f64,
+            has_timestamps,
             pipelines: Mutex::new(HashMap::new()),
         })
     }

@@ -37,8 +37,13 @@ impl Out<'_> {
 pub struct KernelTiming {
     /// The kernel's label.
     pub label: String,
-    /// Seconds per repeat (all of the kernel's passes).
+    /// Seconds per repeat (all of the kernel's passes), on the host's clock: submission to
+    /// the end of the wait.
     pub seconds: Vec<f64>,
+    /// Seconds per repeat between the device's timestamps at the start and the end of the
+    /// compute pass (the kernel alone, without the submission and the wait); empty where the
+    /// adapter has no `TIMESTAMP_QUERY`.
+    pub device_seconds: Vec<f64>,
     /// Bytes of its inputs (parameters included).
     pub bytes_in: u64,
     /// Bytes of its outputs.
@@ -52,6 +57,18 @@ pub struct KernelTiming {
 thread_local! {
     static TIMING: std::cell::RefCell<Option<(usize, Vec<KernelTiming>)>> =
         const { std::cell::RefCell::new(None) };
+}
+
+impl KernelTiming {
+    /// The kernel's own seconds per repeat: the device's timestamps where it has them, else
+    /// the host's clock.
+    pub fn kernel_seconds(&self) -> &[f64] {
+        if self.device_seconds.is_empty() {
+            &self.seconds
+        } else {
+            &self.device_seconds
+        }
+    }
 }
 
 /// Runs `f` with every dispatch of this module timed `repeats` times after its first (the
@@ -170,14 +187,19 @@ pub fn run_passes(
             })
         })
         .collect();
-    // An encoder holding every pass of the kernel (the first run, and each timed repeat).
-    let passes = || {
+    // An encoder holding every pass of the kernel (the first run, and each timed repeat,
+    // then with timestamps at the compute pass's start and end where the device has them).
+    let passes = |stamps: Option<&wgpu::QuerySet>| {
         let mut encoder =
             device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(label) });
         {
             let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
                 label: Some(label),
-                timestamp_writes: None,
+                timestamp_writes: stamps.map(|query_set| wgpu::ComputePassTimestampWrites {
+                    query_set,
+                    beginning_of_pass_write_index: Some(0),
+                    end_of_pass_write_index: Some(1),
+                }),
             });
             pass.set_pipeline(pipeline);
             for bg in &bind_groups {
@@ -192,7 +214,7 @@ pub fn run_passes(
         .zip(&output_bytes)
         .map(|(b, &bytes)| (b, bytes as u64))
         .collect();
-    let result = crate::gpu::readback::submit_and_read(ctx, passes(), &reads)?;
+    let result = crate::gpu::readback::submit_and_read(ctx, passes(None), &reads)?;
     if let Some(repeats) = TIMING.with(|t| t.borrow().as_ref().map(|t| t.0)) {
         // The outputs' first contents, to restore before each timed run.
         let pristine: Vec<(usize, wgpu::Buffer)> = initial
@@ -216,7 +238,22 @@ pub fn run_passes(
                 .map(|_| ())
                 .map_err(|e| GpuError::Device(e.to_string()))
         };
+        let stamps = ctx.has_timestamps.then(|| {
+            let set = device.create_query_set(&wgpu::QuerySetDescriptor {
+                label: Some(label),
+                ty: wgpu::QueryType::Timestamp,
+                count: 2,
+            });
+            let resolved = device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size: 16,
+                usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
+                mapped_at_creation: false,
+            });
+            (set, resolved)
+        });
         let mut seconds = Vec::with_capacity(repeats);
+        let mut device_seconds = Vec::new();
         for _ in 0..repeats {
             if !pristine.is_empty() {
                 let mut e = device
@@ -227,15 +264,25 @@ pub fn run_passes(
                 ctx.queue.submit([e.finish()]);
                 wait()?;
             }
-            let e = passes();
+            let e = passes(stamps.as_ref().map(|s| &s.0));
             let clock = std::time::Instant::now();
             ctx.queue.submit([e.finish()]);
             wait()?;
             seconds.push(clock.elapsed().as_secs_f64());
+            if let Some((set, resolved)) = &stamps {
+                let mut e = device
+                    .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(label) });
+                e.resolve_query_set(set, 0..2, resolved, 0);
+                let got = crate::gpu::readback::submit_and_read(ctx, e, &[(resolved, 16)])?;
+                let ticks: Vec<u64> = crate::gpu::readback::values(&got[0]);
+                let period_ns = f64::from(ctx.queue.get_timestamp_period());
+                device_seconds.push(ticks[1].saturating_sub(ticks[0]) as f64 * period_ns * 1e-9);
+            }
         }
         let timing = KernelTiming {
             label: label.to_string(),
             seconds,
+            device_seconds,
             bytes_in: (params.iter().map(|p| p.len()).sum::<usize>() + input_bytes) as u64,
             bytes_out: output_bytes.iter().sum::<usize>() as u64,
             invocations,
