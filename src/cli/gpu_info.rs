@@ -35,6 +35,14 @@ pub fn run(pairs: usize) -> Result<(), Error> {
     }
     let ctx = GpuContext::shared()?;
     println!(
+        "\nfused multiply-add (a·b + c contracted to one rounding): {}",
+        if ctx.fuses_multiply_add()? {
+            "yes — kernels agree with their twins to rounding, not to the bit"
+        } else {
+            "no"
+        }
+    );
+    println!(
         "\nself-check on {} with {pairs} random (variant, site) pairs per configuration:",
         ctx.describe()
     );

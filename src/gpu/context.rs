@@ -53,6 +53,8 @@ pub struct GpuContext {
     /// Whether the device writes timestamps at the start and end of a compute pass
     /// (`TIMESTAMP_QUERY`): the benches' device-side kernel times.
     pub has_timestamps: bool,
+    /// Whether the driver fuses `a·b + c` into one rounding ([`GpuContext::fuses_multiply_add`]).
+    fuses: std::sync::OnceLock<Result<bool, GpuError>>,
     pipelines: Mutex<HashMap<String, Arc<wgpu::ComputePipeline>>>,
 }
 
@@ -122,8 +124,43 @@ impl GpuContext {
             limits,
             has_f64,
             has_timestamps,
+            fuses: std::sync::OnceLock::new(),
             pipelines: Mutex::new(HashMap::new()),
         })
+    }
+
+    /// Whether the driver contracts a multiply and an add into a fused multiply-add (one
+    /// rounding) — WGSL allows it and has no way to forbid it. Measured once by a probe:
+    /// `a·a − b` with `a = 1 + 2⁻¹²`, `b = 1 + 2⁻¹¹` from a buffer is 2⁻²⁴ fused and 0 rounded
+    /// twice. NVIDIA's Vulkan driver fuses (seen on an H100), lavapipe does not. Where it
+    /// fuses, two builds of one formula (a kernel and its twin, or two forms of a kernel)
+    /// agree to rounding, not to the bit, and the tests compare them so.
+    pub fn fuses_multiply_add(&self) -> Result<bool, GpuError> {
+        self.fuses
+            .get_or_init(|| {
+                let wgsl = "@group(0) @binding(0) var<storage, read> params: array<u32>;\n\
+                    @group(0) @binding(1) var<storage, read> x: array<f32>;\n\
+                    @group(0) @binding(2) var<storage, read_write> y: array<f32>;\n\
+                    @compute @workgroup_size(64)\n\
+                    fn main(@builtin(global_invocation_id) gid: vec3<u32>) {\n\
+                    \x20   if (gid.x == params[0]) { y[0] = x[0] * x[1] + x[2]; }\n\
+                    }\n";
+                let pipeline = self.pipeline("fma_probe", wgsl)?;
+                let a = 1.0f32 + 2f32.powi(-12);
+                let x = [a, a, -(1.0f32 + 2f32.powi(-11))];
+                let out = crate::gpu::dispatch::run_once(
+                    self,
+                    &pipeline,
+                    "fma_probe",
+                    bytemuck::cast_slice(&[0u32]),
+                    &[bytemuck::cast_slice(&x)],
+                    &[crate::gpu::dispatch::Out::Empty(4)],
+                    1,
+                )?;
+                let y: Vec<f32> = crate::gpu::readback::values(&out[0]);
+                Ok(y[0] != 0.0)
+            })
+            .clone()
     }
 
     /// One line naming the adapter, for reports.

@@ -18,6 +18,51 @@ pub fn gpu() -> Option<&'static GpuContext> {
     }
 }
 
+/// Whether the adapter fuses `a·b + c` into one rounding
+/// ([`GpuContext::fuses_multiply_add`]: NVIDIA does, lavapipe does not). Where it does, two
+/// builds of one formula — a kernel and its twin, two forms or two specialisations of a
+/// kernel — agree to rounding, not to the bit.
+pub fn fuses(ctx: &GpuContext) -> bool {
+    ctx.fuses_multiply_add()
+        .expect("the multiply-add probe runs")
+}
+
+/// Normwise relative difference max|a − b| / max|b| (0 when both are all zero).
+pub fn rel_diff<T: Copy + Into<f64>>(a: &[T], b: &[T]) -> f64 {
+    assert_eq!(a.len(), b.len());
+    let scale = b.iter().fold(0.0f64, |m, y| m.max((*y).into().abs()));
+    let diff = a
+        .iter()
+        .zip(b)
+        .fold(0.0f64, |m, (x, y)| m.max(((*x).into() - (*y).into()).abs()));
+    if diff == 0.0 {
+        0.0
+    } else {
+        diff / scale
+    }
+}
+
+/// `a` equals `b` to the bit where the adapter does not fuse multiply-adds; where it does,
+/// within `rel` normwise — the bound the test already holds the kernel to against its twin,
+/// which both sides meet, so no looser.
+pub fn assert_same<T: Copy + Into<f64> + PartialEq + std::fmt::Debug>(
+    ctx: &GpuContext,
+    a: &[T],
+    b: &[T],
+    rel: f64,
+    what: &str,
+) {
+    if fuses(ctx) {
+        let d = rel_diff(a, b);
+        assert!(
+            d <= rel,
+            "{what}: {d:.3e} > {rel:.1e} (fused multiply-adds)"
+        );
+    } else {
+        assert_eq!(a, b, "{what}");
+    }
+}
+
 /// The 60 m test bed (`tests/data/extreme_base.toml`: BHA and pipe on the low side of a 60°
 /// hole, contact at every node) with friction, blade diameter, wall stiffness, exponent
 /// and regularisation speed filled in.
