@@ -441,6 +441,20 @@ fn force_only_kernel_gives_the_full_kernels_forces() {
                         assert!(a[6..].iter().all(|x| *x == 0.0), "no K written");
                     }
                     if fuses {
+                        // The full kernel on these terms first (the diagnosis, if the lean
+                        // one is off: is the full kernel off too?).
+                        let st = compare_outputs(
+                            &b64,
+                            &terms,
+                            &twin64,
+                            &|i| (full.fields(i), full.contact[i]),
+                            f64::EPSILON / 2.0,
+                            F64_BOUND,
+                        );
+                        eprintln!(
+                            "{terms:?}: full kernel f64 against the twin: max ratio {:.3e}, {} over",
+                            st.max_ratio, st.over_bound
+                        );
                         // Two builds of one formula, each contracted its own way: the lean
                         // `g` (with the full kernel's K) within the kernel's bound of the twin.
                         compare(

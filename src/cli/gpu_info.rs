@@ -94,7 +94,8 @@ pub fn run(pairs: usize) -> Result<(), Error> {
         }
     }
     println!(
-        "f64 max rel: largest normwise relative error against the CPU f64 twin over pairs in contact;\n\
+        "f64 max rel: largest normwise relative error against the CPU f64 twin over pairs in contact (per quantity, relative to\n\
+         the larger of the block and its natural scale);\n\
          err/uκ: error relative to each quantity's natural scale, over unit roundoff × condition number;\n\
          bounds {F64_BOUND} (f64) and {F32_BOUND} (f32), on pairs with u·κ ≤ 1e-3 (docs/contact-element.md, Accuracy);\n\
          f32 med/99%: median and 99th percentile of the f32 error relative to the natural scale."
