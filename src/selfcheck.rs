@@ -331,9 +331,10 @@ fn pair_state(
     d: &Vec3<f64>,
     v: &Vec3<f64>,
     p: &ContactParams<f64>,
+    spring: crate::physics::contact::SpringLaw,
     damping: bool,
 ) -> Option<PairState> {
-    use crate::physics::contact::{elastic_force, SpringLaw};
+    use crate::physics::contact::elastic_force;
     use crate::physics::vec3::sub;
     let d_t = sub(d, &scale(n, dot(d, n)));
     let r = dot(&d_t, &d_t).sqrt();
@@ -342,7 +343,7 @@ fn pair_state(
         return None;
     }
     let u = scale(&d_t, 1.0 / r);
-    let (f_e, df_e) = elastic_force(delta, p, SpringLaw::PowerBlend);
+    let (f_e, df_e) = elastic_force(delta, p, spring);
     let v_u = dot(v, &u);
     let f_d = if damping { p.wall_damping * v_u } else { 0.0 };
     let normal = f_e + f_d;
@@ -374,6 +375,11 @@ fn pair_state(
 ///   the scale of the slip speeds: the regularised sign has slope `2/eps`, and `∂φ/∂s`
 ///   (in `K`, `C`) slope `2/eps²`.
 ///
+/// `terms` are those the compared outputs were evaluated with; its spring law is the one that counts: a linear or hard-spring
+/// build ignores `m < 1`'s blend or `m` itself, and its scales and κ must too (the power
+/// law's, used for a linear build, under-estimate its force where `delta < 1` — found on an
+/// H100, where a linear build's rounding then read 6e6 times its bound).
+///
 /// Returns `None` where the pair has no contact force (all outputs are exactly zero on
 /// every path, or the contact flag itself sits within rounding of `delta = 0`).
 #[allow(clippy::neg_cmp_op_on_partial_ord)]
@@ -383,9 +389,11 @@ pub fn condition_number(
     v: &Vec3<f64>,
     omega: f64,
     p: &ContactParams<f64>,
-    friction: bool,
-    damping: bool,
+    terms: &crate::physics::contact::ContactTerms,
 ) -> Option<f64> {
+    let friction = terms.friction.is_some();
+    let damping = terms.damping && terms.mode == crate::physics::contact::ContactMode::Dynamic;
+    let spring = terms.spring;
     let PairState {
         r,
         delta,
@@ -395,7 +403,7 @@ pub fn condition_number(
         normal,
         speed,
         ..
-    } = pair_state(n, d, v, p, damping)?;
+    } = pair_state(n, d, v, p, spring, damping)?;
     let d_len = dot(d, d).sqrt();
     let axial = d_len / r;
     // The rounding of d itself (≈ u·|d| in each component) moves delta: |d|/delta, not r/delta.
@@ -423,10 +431,12 @@ pub fn term_scales(
     d: &Vec3<f64>,
     v: &Vec3<f64>,
     p: &ContactParams<f64>,
-    friction: bool,
-    dynamic: bool,
-    damping: bool,
+    terms: &crate::physics::contact::ContactTerms,
 ) -> Option<[f64; 4]> {
+    let friction = terms.friction.is_some();
+    let dynamic = terms.mode == crate::physics::contact::ContactMode::Dynamic;
+    let damping = terms.damping && dynamic;
+    let spring = terms.spring;
     let PairState {
         r,
         df_e,
@@ -434,7 +444,7 @@ pub fn term_scales(
         normal,
         speed,
         ..
-    } = pair_state(n, d, v, p, damping)?;
+    } = pair_state(n, d, v, p, spring, damping)?;
     let c = if damping { p.wall_damping } else { 0.0 };
     let mu = if friction { p.mu_t + p.mu_l } else { 0.0 };
     let arm = 1.0 + p.disk_radius;
@@ -509,10 +519,6 @@ pub fn compare_outputs(
     unit_roundoff: f64,
     bound: f64,
 ) -> ErrorStats {
-    use crate::physics::contact::ContactMode;
-    let dynamic = terms.mode == ContactMode::Dynamic;
-    let friction = terms.friction.is_some();
-    let damping = terms.damping && dynamic;
     let mut st = ErrorStats {
         pairs: batch.num_pairs(),
         ..Default::default()
@@ -522,8 +528,8 @@ pub fn compare_outputs(
         let p = batch.params(i);
         let n = batch.site_normal(i / batch.num_variants);
         let (fields, flag) = other(i);
-        let Some(kappa) = condition_number(&n, &d, &v, omega, &p, friction, damping)
-            .filter(|k| unit_roundoff * k <= 1e-3)
+        let Some(kappa) =
+            condition_number(&n, &d, &v, omega, &p, terms).filter(|k| unit_roundoff * k <= 1e-3)
         else {
             continue;
         };
@@ -531,7 +537,7 @@ pub fn compare_outputs(
         if flag != reference.contact[i] {
             st.flag_mismatches += 1;
         }
-        let Some(scales) = term_scales(&n, &d, &v, &p, friction, dynamic, damping) else {
+        let Some(scales) = term_scales(&n, &d, &v, &p, terms) else {
             continue;
         };
         let scaled = scaled_errors(&reference.fields(i), &fields, &scales);
@@ -643,4 +649,44 @@ pub fn contact_comparison(
         evals_per_s_gpu_f32: p as f64 / t32,
         evals_per_s_gpu_f64: t64.map(|t| p as f64 / t),
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::physics::contact::{ContactMode, ContactTerms, SpringLaw};
+
+    /// The error measures follow the law the outputs were evaluated with: the twin's outputs of
+    /// a linear, a hard and a blended build, each perturbed by a few roundings (as a driver that
+    /// fuses multiply-adds leaves them), are within the bound of their own law. Measured with
+    /// the power law's scales, the linear build read 6e6 times its bound (an H100 run).
+    #[test]
+    fn a_builds_rounding_is_within_the_bound_of_its_own_law() {
+        let batch = random_batch(11, 40, 60, FrictionModel::Split);
+        for spring in [SpringLaw::Linear, SpringLaw::Power, SpringLaw::PowerBlend] {
+            let mut terms = ContactTerms::all(FrictionModel::Split, ContactMode::Static);
+            terms.spring = spring;
+            terms.damping = false;
+            let mut reference = crate::kernels::contact::ContactOutputs::new(batch.num_pairs());
+            crate::kernels::contact::contact(&terms, &batch, &mut reference);
+            let u = f64::EPSILON / 2.0;
+            let st = compare_outputs(
+                &batch,
+                &terms,
+                &reference,
+                &|i| {
+                    let f = reference.fields(i).map(|x| x * (1.0 + 4.0 * u));
+                    (f, reference.contact[i])
+                },
+                u,
+                F64_BOUND,
+            );
+            assert!(st.checked > 100, "{spring:?}: {} checked", st.checked);
+            assert_eq!(
+                st.over_bound, 0,
+                "{spring:?}: max ratio {:.3e}",
+                st.max_ratio
+            );
+        }
+    }
 }

@@ -202,24 +202,8 @@ fn jacobians_match_central_differences() {
                 };
                 let analytic_f64 = evaluate(&n, &s.d, &s.v, s.omega, &s.params, &terms);
                 if let (Some(kappa), Some(scales)) = (
-                    crate::selfcheck::condition_number(
-                        &n,
-                        &s.d,
-                        &s.v,
-                        s.omega,
-                        &s.params,
-                        true,
-                        mode == ContactMode::Dynamic,
-                    ),
-                    term_scales(
-                        &n,
-                        &s.d,
-                        &s.v,
-                        &s.params,
-                        true,
-                        mode == ContactMode::Dynamic,
-                        mode == ContactMode::Dynamic,
-                    ),
+                    crate::selfcheck::condition_number(&n, &s.d, &s.v, s.omega, &s.params, &terms),
+                    term_scales(&n, &s.d, &s.v, &s.params, &terms),
                 ) {
                     let e = crate::selfcheck::scaled_errors(
                         &response_fields(&analytic),
@@ -240,8 +224,7 @@ fn jacobians_match_central_differences() {
                 // blocks that vanish by cancellation, e.g. C at the seam |s| = eps, where the
                 // f64 slip speed itself carries a rounding error of u·|v|/eps relative to eps:
                 // such a block is held to 1e-11 of that scale instead of 1e-6 of itself.
-                let dynamic = mode == ContactMode::Dynamic;
-                let floors = term_scales(&n, &s.d, &s.v, &s.params, true, dynamic, dynamic)
+                let floors = term_scales(&n, &s.d, &s.v, &s.params, &terms)
                     .map(|sc| sc.map(|x| 1e-5 * x))
                     .unwrap_or([0.0; 4]);
                 let errs = block_errors(&fd, &a, &floors);
