@@ -540,7 +540,8 @@ pub fn compare_outputs(
         let Some(scales) = term_scales(&n, &d, &v, &p, terms) else {
             continue;
         };
-        let scaled = scaled_errors(&reference.fields(i), &fields, &scales);
+        let reference_fields = reference.fields(i);
+        let scaled = scaled_errors(&reference_fields, &fields, &scales);
         let mut over = false;
         for q in 0..4 {
             let ratio = scaled[q] / (unit_roundoff * kappa);
@@ -552,13 +553,9 @@ pub fn compare_outputs(
             // natural scale there, which relative to the block alone reads 1e4 or infinite
             // (seen on an H100).
             let (lo, hi) = QUANTITIES[q];
-            let block = max_abs(&reference.fields(i)[lo..hi]);
-            let normwise = relative_difference(
-                &reference.fields(i),
-                &fields,
-                (lo, hi),
-                block.max(scales[q]),
-            );
+            let block = max_abs(&reference_fields[lo..hi]);
+            let normwise =
+                relative_difference(&reference_fields, &fields, (lo, hi), block.max(scales[q]));
             st.max_normwise = st.max_normwise.max(normwise);
             if kappa <= 1e3 {
                 st.max_normwise_well = st.max_normwise_well.max(normwise);

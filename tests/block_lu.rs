@@ -185,9 +185,16 @@ fn gpu_matches_the_twin_and_a_singular_variant_fails_alone() {
         for form in [LuForm::Serial, LuForm::Lanes] {
             let (x, s) = block_lu_gpu_form(ctx, &b64, usize::MAX, form).unwrap();
             assert_eq!(s, gst, "{form:?}");
-            common::assert_same(ctx, &x, &gpu, 1e-12, &format!("{form:?}"));
+            common::assert_same(ctx, &x, &gpu, relative_error, 1e-12, &format!("{form:?}"));
             let (x, _) = block_lu_gpu_form(ctx, &b64, 5, form).unwrap();
-            common::assert_same(ctx, &x, &gpu, 1e-12, &format!("{form:?} in chunks of 5"));
+            common::assert_same(
+                ctx,
+                &x,
+                &gpu,
+                relative_error,
+                1e-12,
+                &format!("{form:?} in chunks of 5"),
+            );
         }
         // Batched dispatches (7 variants each) give the same numbers: the same kernel on the
         // same data, so the same bits on any driver.
@@ -253,6 +260,7 @@ fn gpu_matches_the_twin_and_a_singular_variant_fails_alone() {
                 ctx,
                 &bb.unpack(&gpu_bad64, j),
                 &bb.unpack(&cpu_bad, j),
+                relative_error,
                 1e-12,
                 &format!("GPU f64 variant {j}"),
             );

@@ -27,36 +27,23 @@ pub fn fuses(ctx: &GpuContext) -> bool {
         .expect("the multiply-add probe runs")
 }
 
-/// Normwise relative difference max|a − b| / max|b| (0 when both are all zero).
-pub fn rel_diff<T: Copy + Into<f64>>(a: &[T], b: &[T]) -> f64 {
-    assert_eq!(a.len(), b.len());
-    let scale = b.iter().fold(0.0f64, |m, y| m.max((*y).into().abs()));
-    let diff = a
-        .iter()
-        .zip(b)
-        .fold(0.0f64, |m, (x, y)| m.max(((*x).into() - (*y).into()).abs()));
-    if diff == 0.0 {
-        0.0
-    } else {
-        diff / scale
-    }
-}
-
 /// `a` equals `b` to the bit where the adapter does not fuse multiply-adds; where it does,
-/// within `rel` normwise — the bound the test already holds the kernel to against its twin,
-/// which both sides meet, so no looser.
+/// `measure(a, b) ≤ bound` — the measure and the bound the test already holds the kernel to
+/// against its twin, which both sides meet, so no looser.
 pub fn assert_same<T: Copy + Into<f64> + PartialEq + std::fmt::Debug>(
     ctx: &GpuContext,
     a: &[T],
     b: &[T],
-    rel: f64,
+    measure: impl Fn(&[f64], &[f64]) -> f64,
+    bound: f64,
     what: &str,
 ) {
     if fuses(ctx) {
-        let d = rel_diff(a, b);
+        let up = |x: &[T]| x.iter().map(|&y| y.into()).collect::<Vec<f64>>();
+        let d = measure(&up(a), &up(b));
         assert!(
-            d <= rel,
-            "{what}: {d:.3e} > {rel:.1e} (fused multiply-adds)"
+            d <= bound,
+            "{what}: {d:.3e} > {bound:.1e} (fused multiply-adds)"
         );
     } else {
         assert_eq!(a, b, "{what}");
