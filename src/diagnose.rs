@@ -121,9 +121,16 @@ pub struct LockUp {
 /// before the surface. An FE static solve of such a load finds no equilibrium (its load
 /// steps fold before the full load).
 pub fn lock_up(case: &Case) -> Option<LockUp> {
+    lock_up_at(case, 1.0)
+}
+
+/// [`lock_up`] with the friction coefficients and the bit loads scaled by `lambda` (the
+/// FE load path's factor of its second stage,
+/// [`crate::solve::continuation::LoadTarget`]).
+pub fn lock_up_at(case: &Case, lambda: f64) -> Option<LockUp> {
     let model = &case.model;
     let mid = |e: usize| 0.5 * (model.nodes[e].md + model.nodes[e + 1].md);
-    let friction_at = |md: f64| case.hole_at(md).friction;
+    let friction_at = |md: f64| lambda * case.hole_at(md).friction;
     let extra = |e: usize, tension: f64| -> f64 {
         let f = -tension;
         if f <= 0.0 || !f.is_finite() {
@@ -142,12 +149,12 @@ pub fn lock_up(case: &Case) -> Option<LockUp> {
             r * f * f / (4.0 * ei)
         }
     };
-    let profile = crate::solve::soft_string::soft_string_loaded(
-        model,
-        &case.operation(),
-        &friction_at,
-        Some(&extra),
-    );
+    let mut op = case.operation();
+    op.weight_on_bit *= lambda;
+    op.torque_on_bit *= lambda;
+    op.friction *= lambda;
+    let profile =
+        crate::solve::soft_string::soft_string_loaded(model, &op, &friction_at, Some(&extra));
     (0..model.elements.len()).rev().find_map(|e| {
         let f = -profile.tension[e];
         let (_, h) = critical_loads(model, e, case.hole_at(mid(e)).diameter);
@@ -158,6 +165,28 @@ pub fn lock_up(case: &Case) -> Option<LockUp> {
         })
     })
 }
+
+/// The load factor at which the string starts to lock up ([`lock_up_at`]): the smallest
+/// `λ` in (0, 1] whose friction and bit loads run the buckled soft string away, to
+/// [`LOCK_UP_FRACTION_TOLERANCE`] (bisection: more friction and more WOB only add
+/// compression). `None` where it does not lock up at the full loads. An FE load path folds
+/// near it where its mesh follows the helix.
+pub fn lock_up_fraction(case: &Case) -> Option<f64> {
+    lock_up_at(case, 1.0)?;
+    let (mut free, mut locked) = (0.0, 1.0);
+    while locked - free > LOCK_UP_FRACTION_TOLERANCE {
+        let mid = 0.5 * (free + locked);
+        if lock_up_at(case, mid).is_some() {
+            locked = mid;
+        } else {
+            free = mid;
+        }
+    }
+    Some(locked)
+}
+
+/// The width of the interval [`lock_up_fraction`] returns the top of.
+pub const LOCK_UP_FRACTION_TOLERANCE: f64 = 1e-3;
 
 /// The largest WOB that keeps every element below its helical buckling load, if the
 /// compression of each element falls one for one with the WOB (soft string, top clamped).
@@ -224,6 +253,102 @@ pub fn unsupported_buckling(case: &Case, tension: &[f64]) -> Option<(f64, f64, f
     }
     let critical = LUBINSKI_FIRST_ORDER * (el.section.bending_stiffness() * w * w).cbrt();
     (compression > critical).then_some((model.nodes[top].md, compression, critical))
+}
+
+/// A node of a solved string is reported as through the wall when its lateral offset
+/// passes its radial clearance by more than this (m): 1 mm, under a tenth of the smallest
+/// clearance a corpus well draws, above the microns a wall spring lets a contact node in.
+pub const THROUGH_WALL_TOLERANCE: f64 = 1e-3;
+
+/// Where a solved string lies outside the hole at nodes that have no contact site
+/// ([`through_wall`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ThroughWall {
+    /// MD of the node furthest outside (m).
+    pub md: f64,
+    /// How far it is outside: lateral offset less radial clearance (m).
+    pub excess_m: f64,
+    /// Nodes outside by more than [`THROUGH_WALL_TOLERANCE`].
+    pub nodes: usize,
+    /// MD of the shallowest and the deepest of them (m).
+    pub first_md: f64,
+    /// See `first_md`.
+    pub last_md: f64,
+}
+
+/// The nodes of a solved configuration `x` of `model` (a case's, or a variant's of it)
+/// that lie outside the hole of `case` and have no contact site to hold them: each node's
+/// lateral offset — its displacement from the hole axis with the part along the axis
+/// removed, as a contact site measures it — against the radial clearance of the wider of
+/// its two elements (tool joints included). With `contact.sites = "stabilizers"` only
+/// the stabilizers meet the wall; a string compressed past its buckling load between them
+/// bows out through the wall, and the FE answer (its side forces above all) is then an
+/// equilibrium of a string in no hole. `None` where no node is outside by more than
+/// [`THROUGH_WALL_TOLERANCE`].
+pub fn through_wall(
+    case: &Case,
+    model: &Model,
+    x: &[crate::physics::vec3::Vec3<f64>],
+) -> Option<ThroughWall> {
+    use crate::physics::vec3::{dot, scale, sub};
+    let mut held = vec![false; model.nodes.len()];
+    for site in &model.sites {
+        held[site.node] = true;
+    }
+    let n = model.nodes.len();
+    let mut out: Option<ThroughWall> = None;
+    for (i, node) in model.nodes.iter().enumerate() {
+        if held[i] {
+            continue;
+        }
+        let d = sub(&x[i], &node.position);
+        let d_t = sub(&d, &scale(&node.hole_axis, dot(&d, &node.hole_axis)));
+        let offset = dot(&d_t, &d_t).sqrt();
+        let diameter = [i.checked_sub(1), (i + 1 < n).then_some(i)]
+            .into_iter()
+            .flatten()
+            .map(|e| model.elements[e].contact_diameter)
+            .fold(0.0, f64::max);
+        let excess = offset - 0.5 * (case.hole_at(node.md).diameter - diameter);
+        if excess <= THROUGH_WALL_TOLERANCE {
+            continue;
+        }
+        let t = out.get_or_insert(ThroughWall {
+            md: node.md,
+            excess_m: excess,
+            nodes: 0,
+            first_md: node.md,
+            last_md: node.md,
+        });
+        t.nodes += 1;
+        t.last_md = node.md;
+        if excess > t.excess_m {
+            t.excess_m = excess;
+            t.md = node.md;
+        }
+    }
+    out
+}
+
+/// [`through_wall`]'s warning for a solved FE profile, `None` where the string is in the
+/// hole.
+pub fn through_wall_warning(
+    case: &Case,
+    model: &Model,
+    x: &[crate::physics::vec3::Vec3<f64>],
+) -> Option<String> {
+    let t = through_wall(case, model, x)?;
+    Some(format!(
+        "the string lies outside the hole at {} nodes without a contact site between MD \
+         {:.0} m and {:.0} m, up to {:.0} mm beyond the wall (at MD {:.0} m): nothing holds \
+         it there (contact.sites = \"stabilizers\"), so this is the equilibrium of a string \
+         in no hole — its side forces and bending above all; use contact.sites = \"all_nodes\"",
+        t.nodes,
+        t.first_md,
+        t.last_md,
+        1e3 * t.excess_m,
+        t.md,
+    ))
 }
 
 /// A failed static solve's message with the likely reason, from the case's soft-string
@@ -425,6 +550,131 @@ mod tests {
         assert_eq!(lock_up(&horizontal(0.05, 20.0)), None);
     }
 
+    /// The load factor at which the string starts to lock up: where the helix's Riccati
+    /// runaway (friction and WOB both scaled by `λ`: `a = λ μ w`, `b = λ μ r / (4 EI)`,
+    /// `F₀ = λ WOB`, WOB 600 kN) reaches the surface, 2,500 m from the bit — solved here by bisection on
+    /// the closed form, against [`lock_up_fraction`]'s bisection on the soft string.
+    #[test]
+    fn lock_up_fraction_is_where_the_riccati_runaway_reaches_the_surface() {
+        let wob = 600e3;
+        let case = horizontal(0.3, wob / 1e3);
+        let model = &case.model;
+        let e = model.elements.len() - 1;
+        let el = &model.elements[e];
+        let hole = case.hole_at(model.nodes[e].md).diameter;
+        let (_, h) = critical_loads(model, e, hole);
+        let (mu, w) = (0.3, el.buoyed_weight_per_length);
+        let r = 0.5 * (hole - el.contact_diameter);
+        let ei = el.section.bending_stiffness();
+        let length = model.nodes.last().unwrap().md - model.nodes[0].md;
+        let runaway = |lambda: f64| {
+            let (a, b) = (lambda * mu * w, lambda * mu * r / (4.0 * ei));
+            let (k, scale) = ((a * b).sqrt(), (a / b).sqrt());
+            ((LOCK_UP_RATIO * h / scale).atan() - (lambda * wob / scale).atan()) / k
+        };
+        let (mut lo, mut hi) = (1e-3, 1.0);
+        assert!(runaway(hi) < length && runaway(lo) > length);
+        for _ in 0..60 {
+            let mid = 0.5 * (lo + hi);
+            if runaway(mid) < length {
+                hi = mid;
+            } else {
+                lo = mid;
+            }
+        }
+        let closed = hi;
+        assert!(
+            closed * wob > h,
+            "the closed form needs the WOB past the helical load at λ = {closed}"
+        );
+        let fraction = lock_up_fraction(&case).expect("locks up at full load");
+        eprintln!("lock-up from λ = {fraction:.4}; closed form {closed:.4}");
+        assert!(
+            (fraction - closed).abs() <= 0.02 * closed,
+            "lock-up from λ = {fraction:.4}; closed form {closed:.4}"
+        );
+        assert!(lock_up_at(&case, fraction).is_some());
+        assert!(lock_up_at(&case, fraction - 2.0 * LOCK_UP_FRACTION_TOLERANCE).is_none());
+        assert_eq!(lock_up_fraction(&horizontal(0.05, 20.0)), None);
+    }
+
+    /// A solved string is outside the hole where a node without a contact site lies
+    /// further from the axis than its clearance, and only there.
+    #[test]
+    fn through_wall_finds_a_node_past_its_clearance() {
+        let case = vertical_bha(50.0, "stabilizers");
+        let model = &case.model;
+        let mut x: Vec<_> = model.nodes.iter().map(|n| n.position).collect();
+        assert_eq!(through_wall(&case, model, &x), None);
+        let held: Vec<usize> = model.sites.iter().map(|s| s.node).collect();
+        let free = (1..model.nodes.len() - 1)
+            .rev()
+            .find(|i| !held.contains(i) && !held.contains(&(i + 1)) && !held.contains(&(i - 1)))
+            .expect("a free node");
+        let node = &model.nodes[free];
+        let diameter = model.elements[free - 1]
+            .contact_diameter
+            .max(model.elements[free].contact_diameter);
+        let clearance = 0.5 * (case.hole_at(node.md).diameter - diameter);
+        // A lateral axis: across the hole axis.
+        let t = node.hole_axis;
+        let across = if t[0].abs() < 0.9 {
+            [0.0, -t[2], t[1]]
+        } else {
+            [-t[2], 0.0, t[0]]
+        };
+        let norm = across.iter().map(|a| a * a).sum::<f64>().sqrt();
+        let place = |x: &mut Vec<[f64; 3]>, offset: f64, along: f64| {
+            x[free] = std::array::from_fn(|k| {
+                node.position[k] + offset * across[k] / norm + along * t[k]
+            });
+        };
+        // At the wall, and metres along the axis: inside.
+        place(&mut x, clearance + 0.5 * THROUGH_WALL_TOLERANCE, 3.0);
+        assert_eq!(through_wall(&case, model, &x), None);
+        place(&mut x, clearance + 0.02, 0.0);
+        let t = through_wall(&case, model, &x).expect("20 mm outside");
+        assert_eq!(
+            (t.nodes, t.md, t.first_md, t.last_md),
+            (1, node.md, node.md, node.md)
+        );
+        assert!((t.excess_m - 0.02).abs() < 1e-9, "{}", t.excess_m);
+        // A site's node is held by the wall: never reported.
+        let site = held[0];
+        x[free] = node.position;
+        x[site][0] += 1.0;
+        assert_eq!(through_wall(&case, model, &x), None);
+    }
+
+    /// A string held by the wall at its stabilizer only, in a straight hole 1° off
+    /// vertical: above the stabilizer 870 m of pipe hang as a cable from the top (clamped
+    /// on the axis), and the weight's component across the hole, `w sin 1°`, sags it by
+    /// `w sin θ L² / (8 T)` ≈ metres — through the wall, which [`through_wall`] reports.
+    /// With contact at every node the wall holds it; in a vertical hole nothing pushes it
+    /// off the axis.
+    #[test]
+    fn a_string_held_only_at_its_stabilizer_sags_through_the_wall() {
+        let solve = |case: &Case| {
+            let sol = crate::solve::statics::solve_static(
+                &case.model,
+                &crate::solve::statics::StaticOptions::default(),
+            )
+            .expect("solves");
+            through_wall(case, &case.model, &sol.state.x)
+        };
+        assert_eq!(solve(&vertical_bha(15.0, "stabilizers")), None);
+        let t = solve(&inclined_bha("stabilizers")).expect("sags through the wall");
+        eprintln!(
+            "{} nodes outside, up to {:.0} mm at MD {:.0} m",
+            t.nodes,
+            1e3 * t.excess_m,
+            t.md
+        );
+        assert!(t.excess_m > 0.5, "{} m", t.excess_m);
+        assert!(t.md > 100.0 && t.md < 873.0, "in the pipe: MD {}", t.md);
+        assert_eq!(solve(&inclined_bha("all_nodes")), None);
+    }
+
     /// A failed solve of a load that locks up says so, with where.
     #[test]
     fn a_failure_that_locks_up_says_so() {
@@ -453,7 +703,16 @@ mod tests {
     /// A vertical 6⅛ in hole drilled at `wob_kn` on a near-bit stabilizer and 5 × 2¼ in
     /// collars (corpus well 439's BHA), contact at `sites`.
     fn vertical_bha(wob_kn: f64, sites: &str) -> Case {
-        let text = format!(
+        crate::case::parse_case(
+            std::path::Path::new("v.toml"),
+            &vertical_bha_text(wob_kn, sites),
+        )
+        .unwrap()
+    }
+
+    /// [`vertical_bha`]'s case file.
+    fn vertical_bha_text(wob_kn: f64, sites: &str) -> String {
+        format!(
             "[well]\nprofile = \"vertical\"\ntotal_md = \"1000 m\"\n\
              [[hole]]\nbottom_md = \"1000 m\"\ndiameter = \"6.125 in\"\nfriction = 0.25\n\
              [mud]\ndensity = \"1.278 sg\"\n\
@@ -463,8 +722,28 @@ mod tests {
              [[string]]\nkind = \"drill_pipe\"\nlength = \"872 m\"\nod = \"4 in\"\nid = \"3.34 in\"\n\
              [operation]\nmode = \"rotating\"\nrpm = \"120 rpm\"\nweight_on_bit = \"{wob_kn} kN\"\n\
              [contact]\nsites = \"{sites}\"\n[mesh]\nelement_length = \"10 m\"\nbha_element_length = \"0.5 m\"\n"
+        )
+    }
+
+    /// [`vertical_bha`]'s string at 15 kN in a straight hole 1° off vertical.
+    fn inclined_bha(sites: &str) -> Case {
+        static CALLS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+        let call = CALLS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        let dir =
+            std::env::temp_dir().join(format!("holewall_inclined_{}_{call}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        std::fs::write(
+            dir.join("s.csv"),
+            "md, inclination, azimuth\n0, 1, 0\n1000, 1, 0\n",
+        )
+        .unwrap();
+        let text = vertical_bha_text(15.0, sites).replace(
+            "profile = \"vertical\"",
+            "profile = \"survey\"\nsurvey = \"s.csv\"",
         );
-        crate::case::parse_case(std::path::Path::new("v.toml"), &text).unwrap()
+        let case = crate::case::parse_case(&dir.join("s.toml"), &text).unwrap();
+        let _ = std::fs::remove_dir_all(&dir);
+        case
     }
 
     /// Lubinski's first-order load of the collars, from their sizes alone (E 207 GPa, steel

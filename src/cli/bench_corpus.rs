@@ -86,6 +86,14 @@ pub struct CorpusSummary {
     /// Solved wells whose load locks up by that soft string (the FE answer, on a mesh that
     /// may not resolve the helix, disagrees with it: read its warning).
     pub solved_locking_up: usize,
+    /// Failed lock-up wells: (seed, the load factor the FE reached, the factor at which
+    /// the buckled soft string locks up, [`crate::diagnose::lock_up_fraction`]). Where
+    /// the two agree, the FE's fold is the lock-up the physics predicts.
+    pub lock_up_factors: Vec<(u64, f64, f64)>,
+    /// Solved wells whose FE string lies outside the hole where no contact site holds it
+    /// (`contact.sites = "stabilizers"`: [`crate::diagnose::through_wall`]), with how far
+    /// (mm): an equilibrium of a string in no hole, counted in `solved` but not an answer.
+    pub solved_through_wall: Vec<(u64, f64)>,
     /// Time per well (s), every well.
     pub seconds: Spread,
     /// Time per well (s), wells meshed with 10 m pipe elements.
@@ -242,6 +250,16 @@ pub fn run(out: &Path, options: &CorpusOptions) -> Result<CorpusSummary, Error> 
             .filter(|r| !r.solved && r.lock_up_md_m.is_finite())
             .count(),
         solved_locking_up: solved.iter().filter(|r| r.lock_up_md_m.is_finite()).count(),
+        lock_up_factors: results
+            .iter()
+            .filter(|r| !r.solved && r.lock_up_fraction.is_finite())
+            .map(|r| (r.spec.seed, r.fe_reached, r.lock_up_fraction))
+            .collect(),
+        solved_through_wall: solved
+            .iter()
+            .filter(|r| r.through_wall_mm > 0.0)
+            .map(|r| (r.spec.seed, r.through_wall_mm))
+            .collect(),
         seconds: spread(
             &results
                 .iter()
@@ -278,8 +296,14 @@ pub fn run(out: &Path, options: &CorpusOptions) -> Result<CorpusSummary, Error> 
     if !engine_rows.is_empty() {
         crate::output::write_csv_rows(&out.join("engine.csv"), &engine_rows)?;
     }
-    let classes = ["solved", "solved by relaxation", "failed"];
+    let classes = [
+        "solved",
+        "solved by relaxation",
+        "failed",
+        "solved outside the hole",
+    ];
     let class = |r: &WellResult| match (r.solved, r.relaxed) {
+        (true, _) if r.through_wall_mm > 0.0 => 3,
         (true, false) => 0,
         (true, true) => 1,
         (false, _) => 2,

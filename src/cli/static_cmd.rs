@@ -101,6 +101,7 @@ pub fn run(
     let mut solver_log = Vec::new();
     let mut bit = None;
     let mut tendency = None;
+    let mut through_wall = None;
     let (rows, hook, torque, its) = match which {
         StaticModel::Fe => {
             let sol = solve_with_progress(
@@ -112,6 +113,7 @@ pub fn run(
             )
             .map_err(Error::failed)?;
             let (rows, hook, torque, w) = fe_rows(model, &sol);
+            through_wall = crate::diagnose::through_wall_warning(&case, model, &sol.state.x);
             wob = w;
             solver_log = sol.log.clone();
             bit = Some(crate::bha::bit_loads_of(model, &sol));
@@ -215,6 +217,10 @@ pub fn run(
     let mut warnings = case.warnings.clone();
     if let StaticModel::Fe = which {
         if let Some(w) = crate::diagnose::unresolved_helix(&case, &axial) {
+            eprintln!("holewall: warning: {w}");
+            warnings.push(w);
+        }
+        if let Some(w) = through_wall {
             eprintln!("holewall: warning: {w}");
             warnings.push(w);
         }

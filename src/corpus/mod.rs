@@ -554,6 +554,15 @@ pub struct WellResult {
     /// Where a soft string carrying its buckled shape's wall force locks up (MD, m; NaN
     /// where it does not: [`crate::diagnose::lock_up`]).
     pub lock_up_md_m: f64,
+    /// The load factor (friction and bit loads) at which that soft string starts to lock up
+    /// (NaN where it does not: [`crate::diagnose::lock_up_fraction`]).
+    pub lock_up_fraction: f64,
+    /// The load factor the FE solve reached: 1 when solved, where its load path stopped
+    /// when not ([`crate::solve::statics::StaticError::reached`]; 0 in the gravity stage).
+    pub fe_reached: f64,
+    /// Solved: how far the FE string lies outside the hole where no contact site holds it
+    /// (mm; 0 inside it: [`crate::diagnose::through_wall`]). NaN when not solved.
+    pub through_wall_mm: f64,
     /// FE / soft-string hook load.
     pub hook_load_ratio: f64,
     /// FE surface torque (N·m).
@@ -603,6 +612,9 @@ pub fn run_well(
         soft_hook_load_n: soft.hook_load(),
         helical_drag_n: crate::diagnose::helical_drag(&case, &soft.tension),
         lock_up_md_m: crate::diagnose::lock_up(&case).map_or(f64::NAN, |l| l.md),
+        lock_up_fraction: crate::diagnose::lock_up_fraction(&case).unwrap_or(f64::NAN),
+        fe_reached: 0.0,
+        through_wall_mm: f64::NAN,
         hook_load_ratio: f64::NAN,
         fe_torque_nm: f64::NAN,
         soft_torque_nm: soft.surface_torque(),
@@ -616,6 +628,9 @@ pub fn run_well(
         Ok(sol) => {
             let (_, hook, torque, _) = crate::profile::fe_rows(model, &sol);
             r.solved = true;
+            r.fe_reached = 1.0;
+            r.through_wall_mm = crate::diagnose::through_wall(&case, model, &sol.state.x)
+                .map_or(0.0, |t| 1e3 * t.excess_m);
             r.load_steps = sol.iterations.len();
             r.step_cuts = sol.log.len();
             r.relaxed = sol
@@ -644,6 +659,7 @@ pub fn run_well(
             }
         }
         Err(e) => {
+            r.fe_reached = e.reached();
             r.error = crate::diagnose::static_failure(&case, &e);
         }
     }
@@ -680,6 +696,9 @@ pub struct WellRow {
     soft_hook_load_n: f64,
     helical_drag_n: f64,
     lock_up_md_m: f64,
+    lock_up_fraction: f64,
+    fe_reached: f64,
+    through_wall_mm: f64,
     hook_load_ratio: f64,
     fe_torque_nm: f64,
     soft_torque_nm: f64,
@@ -719,6 +738,9 @@ impl WellResult {
             soft_hook_load_n: self.soft_hook_load_n,
             helical_drag_n: self.helical_drag_n,
             lock_up_md_m: self.lock_up_md_m,
+            lock_up_fraction: self.lock_up_fraction,
+            fe_reached: self.fe_reached,
+            through_wall_mm: self.through_wall_mm,
             hook_load_ratio: self.hook_load_ratio,
             fe_torque_nm: self.fe_torque_nm,
             soft_torque_nm: self.soft_torque_nm,
