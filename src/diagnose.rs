@@ -660,7 +660,11 @@ mod tests {
                 &crate::solve::statics::StaticOptions::default(),
             )
             .expect("solves");
-            through_wall(case, &case.model, &sol.state.x)
+            let t = through_wall(case, &case.model, &sol.state.x);
+            // The ensemble's QoI of the same equilibrium.
+            let q = crate::ensemble::qoi::static_result(case, "v", &case.model, &sol);
+            assert_eq!(q.string.outside_hole_m, Some(t.map_or(0.0, |t| t.excess_m)));
+            t
         };
         assert_eq!(solve(&vertical_bha(15.0, "stabilizers")), None);
         let t = solve(&inclined_bha("stabilizers")).expect("sags through the wall");

@@ -49,6 +49,11 @@ pub struct StringQoi {
     /// Stick-slip severity over the second half of a dynamic run: (max − min)/mean of the
     /// bit's spin about the hole axis.
     pub stick_slip_severity: Option<f64>,
+    /// How far the static equilibrium lies outside the hole where no contact site holds it
+    /// (m; 0 inside it: [`crate::diagnose::through_wall`]) — with contact at the
+    /// stabilizers only, an answer for a string in no hole.
+    #[serde(default)]
+    pub outside_hole_m: Option<f64>,
 }
 
 /// How a variant ended.
@@ -245,6 +250,9 @@ pub fn static_result(
         sinusoidal_buckling: Some(sinusoidal),
         helical_buckling: Some(helical),
         stick_slip_severity: None,
+        outside_hole_m: Some(
+            crate::diagnose::through_wall(case, model, &sol.state.x).map_or(0.0, |t| t.excess_m),
+        ),
     };
     let travel = crate::rig::Travel::of_axial_speed(model.axial_speed);
     VariantResult {
@@ -477,6 +485,7 @@ impl DynamicObserver {
             sinusoidal_buckling: None,
             helical_buckling: None,
             stick_slip_severity: severity,
+            outside_hole_m: None,
         };
         finished(
             name,
@@ -549,6 +558,9 @@ pub fn qoi_columns(
         }));
         q.push(col("helical_buckling".into(), Unit::Ratio, &|r| {
             as_number(r.string.helical_buckling)
+        }));
+        q.push(col("outside_hole".into(), Unit::Ratio, &|r| {
+            as_number(r.string.outside_hole_m.map(|m| m > 0.0))
         }));
     }
     for k in 0..stabs {

@@ -158,7 +158,9 @@ pub(crate) fn variants_csv(
     if dynamic {
         header.push("stick_slip_severity".into());
     } else {
-        header.extend(["sinusoidal_buckling", "helical_buckling"].map(String::from));
+        header.extend(
+            ["sinusoidal_buckling", "helical_buckling", "outside_hole_m"].map(String::from),
+        );
         header.extend(crate::bha::BIT_COLUMNS.map(String::from));
     }
     for k in 1..=stabs {
@@ -227,6 +229,7 @@ pub(crate) fn variants_csv(
         } else {
             row.push(flag(r.string.sinusoidal_buckling));
             row.push(flag(r.string.helical_buckling));
+            row.push(opt(r.string.outside_hole_m));
             match &r.bit {
                 Some(b) => row.extend(b.columns().map(fmt)),
                 None => row.extend(crate::bha::BIT_COLUMNS.map(|_| String::new())),

@@ -79,6 +79,7 @@ pub fn quantity_words(name: &str) -> String {
         .replace('_', " ");
     let words = match words.as_str() {
         "sinusoidal buckling" | "helical buckling" => format!("{words} (1 = buckled)"),
+        "outside hole" => "string outside the hole between contact sites (1 = outside)".into(),
         _ => words,
     };
     match stab {
@@ -379,5 +380,9 @@ mod tests {
             "largest side force per unit length"
         );
         assert_eq!(w("helical_buckling"), "helical buckling (1 = buckled)");
+        assert_eq!(
+            w("outside_hole"),
+            "string outside the hole between contact sites (1 = outside)"
+        );
     }
 }
