@@ -11,13 +11,14 @@ mod common;
 
 use holewall::corpus::{run_well, run_well_engine, write_well, EnginePath, WellResult};
 
-/// Solved of the first 50 seeds: 49 where a load step that fails at the smallest step
+/// Solved of the first 50 seeds: 50 with a relaxation budget of 20,000 Newton iterations
+/// (seed 44, horizontal, sliding, 2 m elements, settles after 13,689); 49 where a load step that fails at the smallest step
 /// first tries the rest of the load at once (seed 28) and a step whose residual has not
 /// halved in 80 iterations is cut; 48 with a relaxation that settles where its residual
 /// stalls at 2–3e-9 of the force scale (seed 0 too); 47 with the relaxation past a fold
 /// (seed 17 relaxed); 46 with the prestressed start and 200 Newton iterations per step (42
 /// with 100); the solver before issue 22 (low-side start, 40 iterations) solved 30.
-const SOLVED_AT_LEAST: usize = 49;
+const SOLVED_AT_LEAST: usize = 50;
 const WELLS: u64 = 50;
 
 fn corpus() -> (
