@@ -262,6 +262,7 @@ pub fn run(
             step_cut: 0,
             failed: 0,
             failures: Vec::new(),
+            outside_hole: 0,
             solved_by_engine: 0,
             solved_by_cpu: 0,
             seconds: 0.0,
@@ -359,6 +360,10 @@ pub fn run(
             .filter(|r| r.status == Status::Failed)
             .map(|r| (r.name.clone(), r.reason.clone()))
             .collect(),
+        outside_hole: results
+            .iter()
+            .filter(|r| r.status != Status::Failed && r.string.outside_hole_m > Some(0.0))
+            .count(),
         solved_by_engine: results
             .iter()
             .filter(|r| r.status != Status::Failed && r.solved_by == SolvedBy::Engine)

@@ -40,6 +40,9 @@ pub struct EnsembleSummary {
     pub failed: usize,
     /// Names and reasons of the failed variants.
     pub failures: Vec<(String, String)>,
+    /// Solved static variants whose equilibrium lies outside the hole where no contact site
+    /// holds it (`variants.csv`: `outside_hole_m`; [`crate::diagnose::through_wall`]).
+    pub outside_hole: usize,
     /// Variants the kernel engine solved.
     pub solved_by_engine: usize,
     /// Variants the CPU solved: all of them on the CPU backend; on the GPU backend, the
@@ -65,6 +68,14 @@ impl EnsembleSummary {
             .collect();
         if let Some(note) = &self.backend_note {
             n.push(format!("note: {note}"));
+        }
+        if self.outside_hole > 0 {
+            n.push(format!(
+                "warning: {} of {} variants solved with the string outside the hole between \
+                 its contact sites (variants.csv: outside_hole_m): equilibria of a string in no \
+                 hole, whose side forces mean nothing; contact.sites = \"all_nodes\" holds it",
+                self.outside_hole, self.variants
+            ));
         }
         if self.backend == "gpu" && self.solved_by_cpu > 0 {
             n.push(format!(
