@@ -1,0 +1,303 @@
+//! Tests of [`super`]: closed forms of lock-up and buckling, the outside-the-hole check.
+
+use super::*;
+
+/// A straight horizontal 8.5 in hole, 5 in drill pipe slid in with `wob` at the bit.
+fn horizontal(friction: f64, wob_kn: f64) -> Case {
+    // One folder per call: the tests run in parallel and each removes its own.
+    static CALLS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+    let call = CALLS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    let dir = std::env::temp_dir().join(format!("holewall_lockup_{}_{call}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(
+        dir.join("h.csv"),
+        "md, inclination, azimuth\n0, 90, 0\n3000, 90, 0\n",
+    )
+    .unwrap();
+    let text = format!(
+        "[well]\nprofile = \"survey\"\nsurvey = \"h.csv\"\ntotal_md = \"2500 m\"\n\
+         [[hole]]\nbottom_md = \"2500 m\"\ndiameter = \"8.5 in\"\nfriction = {friction}\n\
+         [mud]\ndensity = \"1.2 sg\"\n\
+         [[string]]\nkind = \"drill_pipe\"\nlength = \"2500 m\"\nod = \"5 in\"\nid = \"4.276 in\"\n\
+         [operation]\nmode = \"sliding\"\nweight_on_bit = \"{wob_kn} kN\"\n\
+         [mesh]\nelement_length = \"2 m\"\n"
+    );
+    let case = crate::case::parse_case(&dir.join("h.toml"), &text).unwrap();
+    let _ = std::fs::remove_dir_all(&dir);
+    case
+}
+
+/// Past the helical load in a horizontal hole the compression obeys
+/// `dF/ds = μ w + μ r F² / (4 EI)` up from the bit (slid in: friction against the push),
+/// so `F(s) = √(a/b) tan(√(ab) s + atan(F₀ √(b/a)))`, `a = μ w`, `b = μ r / (4 EI)`:
+/// it reaches `LOCK_UP_RATIO` helical loads at a distance from the bit in closed form.
+#[test]
+fn lock_up_runs_away_where_the_helix_riccati_does() {
+    let case = horizontal(0.3, 250.0);
+    let model = &case.model;
+    let e = model.elements.len() - 1;
+    let el = &model.elements[e];
+    let hole = case.hole_at(model.nodes[e].md).diameter;
+    let (_, h) = critical_loads(model, e, hole);
+    assert!(
+        250e3 > h,
+        "the WOB must start past the helical load ({h} N)"
+    );
+    let (mu, w) = (0.3, el.buoyed_weight_per_length);
+    let r = 0.5 * (hole - el.contact_diameter);
+    let (a, b) = (mu * w, mu * r / (4.0 * el.section.bending_stiffness()));
+    let (k, scale) = ((a * b).sqrt(), (a / b).sqrt());
+    let closed = ((LOCK_UP_RATIO * h / scale).atan() - (250e3 / scale).atan()) / k;
+    let lu = lock_up(&case).expect("slid in past its helical load, the string locks up");
+    let bit = model.nodes.last().unwrap().md;
+    let from_bit = bit - lu.md;
+    eprintln!("lock-up {from_bit:.1} m from the bit, closed form {closed:.1} m");
+    assert!(
+        (from_bit - closed).abs() <= 2.0 + 0.01 * closed,
+        "lock-up {from_bit:.1} m from the bit; closed form {closed:.1} m"
+    );
+    assert!(lu.helical_n == h && lu.compression_n > h);
+    // Without friction nothing resists the push: no lock-up; nor with the WOB below
+    // the sinusoidal load and little friction over this length.
+    assert_eq!(lock_up(&horizontal(0.0, 250.0)), None);
+    assert_eq!(lock_up(&horizontal(0.05, 20.0)), None);
+}
+
+/// The load factor at which the string starts to lock up: where the helix's Riccati
+/// runaway (friction and WOB both scaled by `λ`: `a = λ μ w`, `b = λ μ r / (4 EI)`,
+/// `F₀ = λ WOB`, WOB 600 kN) reaches the surface, 2,500 m from the bit — solved here by bisection on
+/// the closed form, against [`lock_up_fraction`]'s bisection on the soft string.
+#[test]
+fn lock_up_fraction_is_where_the_riccati_runaway_reaches_the_surface() {
+    let wob = 600e3;
+    let case = horizontal(0.3, wob / 1e3);
+    let model = &case.model;
+    let e = model.elements.len() - 1;
+    let el = &model.elements[e];
+    let hole = case.hole_at(model.nodes[e].md).diameter;
+    let (_, h) = critical_loads(model, e, hole);
+    let (mu, w) = (0.3, el.buoyed_weight_per_length);
+    let r = 0.5 * (hole - el.contact_diameter);
+    let ei = el.section.bending_stiffness();
+    let length = model.nodes.last().unwrap().md - model.nodes[0].md;
+    let runaway = |lambda: f64| {
+        let (a, b) = (lambda * mu * w, lambda * mu * r / (4.0 * ei));
+        let (k, scale) = ((a * b).sqrt(), (a / b).sqrt());
+        ((LOCK_UP_RATIO * h / scale).atan() - (lambda * wob / scale).atan()) / k
+    };
+    let (mut lo, mut hi) = (1e-3, 1.0);
+    assert!(runaway(hi) < length && runaway(lo) > length);
+    for _ in 0..60 {
+        let mid = 0.5 * (lo + hi);
+        if runaway(mid) < length {
+            hi = mid;
+        } else {
+            lo = mid;
+        }
+    }
+    let closed = hi;
+    assert!(
+        closed * wob > h,
+        "the closed form needs the WOB past the helical load at λ = {closed}"
+    );
+    let fraction = lock_up_fraction(&case).expect("locks up at full load");
+    eprintln!("lock-up from λ = {fraction:.4}; closed form {closed:.4}");
+    assert!(
+        (fraction - closed).abs() <= 0.02 * closed,
+        "lock-up from λ = {fraction:.4}; closed form {closed:.4}"
+    );
+    assert!(lock_up_at(&case, fraction).is_some());
+    assert!(lock_up_at(&case, fraction - 2.0 * LOCK_UP_FRACTION_TOLERANCE).is_none());
+    assert_eq!(lock_up_fraction(&horizontal(0.05, 20.0)), None);
+}
+
+/// A solved string is outside the hole where a node without a contact site lies
+/// further from the axis than its clearance, and only there.
+#[test]
+fn through_wall_finds_a_node_past_its_clearance() {
+    let case = vertical_bha(50.0, "stabilizers");
+    let model = &case.model;
+    let mut x: Vec<_> = model.nodes.iter().map(|n| n.position).collect();
+    assert_eq!(through_wall(&case, model, &x), None);
+    let held: Vec<usize> = model.sites.iter().map(|s| s.node).collect();
+    let free = (1..model.nodes.len() - 1)
+        .rev()
+        .find(|i| !held.contains(i) && !held.contains(&(i + 1)) && !held.contains(&(i - 1)))
+        .expect("a free node");
+    let node = &model.nodes[free];
+    let diameter = model.elements[free - 1]
+        .contact_diameter
+        .max(model.elements[free].contact_diameter);
+    let clearance = 0.5 * (case.hole_at(node.md).diameter - diameter);
+    // A lateral axis: across the hole axis.
+    let t = node.hole_axis;
+    let across = if t[0].abs() < 0.9 {
+        [0.0, -t[2], t[1]]
+    } else {
+        [-t[2], 0.0, t[0]]
+    };
+    let norm = across.iter().map(|a| a * a).sum::<f64>().sqrt();
+    let place = |x: &mut Vec<[f64; 3]>, offset: f64, along: f64| {
+        x[free] =
+            std::array::from_fn(|k| node.position[k] + offset * across[k] / norm + along * t[k]);
+    };
+    // At the wall, and metres along the axis: inside.
+    place(&mut x, clearance + 0.5 * THROUGH_WALL_TOLERANCE, 3.0);
+    assert_eq!(through_wall(&case, model, &x), None);
+    place(&mut x, clearance + 0.02, 0.0);
+    let t = through_wall(&case, model, &x).expect("20 mm outside");
+    assert_eq!(
+        (t.nodes, t.md, t.first_md, t.last_md),
+        (1, node.md, node.md, node.md)
+    );
+    assert!((t.excess_m - 0.02).abs() < 1e-9, "{}", t.excess_m);
+    // A site's node is held by the wall: never reported.
+    let site = held[0];
+    x[free] = node.position;
+    x[site][0] += 1.0;
+    assert_eq!(through_wall(&case, model, &x), None);
+}
+
+/// A string held by the wall at its stabilizer only, in a straight hole 1° off
+/// vertical: above the stabilizer 870 m of pipe hang as a cable from the top (clamped
+/// on the axis), and the weight's component across the hole, `w sin 1°`, sags it by
+/// `w sin θ L² / (8 T)` ≈ metres — through the wall, which [`through_wall`] reports.
+/// With contact at every node the wall holds it; in a vertical hole nothing pushes it
+/// off the axis.
+#[test]
+fn a_string_held_only_at_its_stabilizer_sags_through_the_wall() {
+    let solve = |case: &Case| {
+        let sol = crate::solve::statics::solve_static(
+            &case.model,
+            &crate::solve::statics::StaticOptions::default(),
+        )
+        .expect("solves");
+        let t = through_wall(case, &case.model, &sol.state.x);
+        // The ensemble's QoI of the same equilibrium.
+        let q = crate::ensemble::qoi::static_result(case, "v", &case.model, &sol);
+        assert_eq!(q.string.outside_hole_m, Some(t.map_or(0.0, |t| t.excess_m)));
+        t
+    };
+    assert_eq!(solve(&vertical_bha(15.0, "stabilizers")), None);
+    let t = solve(&inclined_bha("stabilizers")).expect("sags through the wall");
+    eprintln!(
+        "{} nodes outside, up to {:.0} mm at MD {:.0} m",
+        t.nodes,
+        1e3 * t.excess_m,
+        t.md
+    );
+    assert!(t.excess_m > 0.5, "{} m", t.excess_m);
+    assert!(t.md > 100.0 && t.md < 873.0, "in the pipe: MD {}", t.md);
+    assert_eq!(solve(&inclined_bha("all_nodes")), None);
+}
+
+/// A failed solve of a load that locks up says so, with where.
+#[test]
+fn a_failure_that_locks_up_says_so() {
+    let error = StaticError::LoadStep {
+        stage: "applying the bit loads and friction (stage 2)".into(),
+        from: 0.5,
+        step: 1e-4,
+        min: 1e-4,
+        reason: "Newton did not converge".into(),
+        at_md: Some(1200.0),
+    };
+    let case = horizontal(0.3, 250.0);
+    let lu = lock_up(&case).unwrap();
+    let msg = static_failure(&case, &error);
+    assert!(
+        msg.contains("lock-up: a soft string") && msg.contains(&format!("MD {:.0} m", lu.md)),
+        "{msg}"
+    );
+    // Below the runaway: no lock-up line (a hole horizontal from the surface has no
+    // weight to push with, which the weight indicator's line says).
+    let weak = static_failure(&horizontal(0.05, 20.0), &error);
+    assert!(!weak.contains("lock-up: a soft string"), "{weak}");
+    assert!(weak.contains("must be pushed from the surface"), "{weak}");
+}
+
+/// A vertical 6⅛ in hole drilled at `wob_kn` on a near-bit stabilizer and 5 × 2¼ in
+/// collars (corpus well 439's BHA), contact at `sites`.
+fn vertical_bha(wob_kn: f64, sites: &str) -> Case {
+    crate::case::parse_case(
+        std::path::Path::new("v.toml"),
+        &vertical_bha_text(wob_kn, sites),
+    )
+    .unwrap()
+}
+
+/// [`vertical_bha`]'s case file.
+fn vertical_bha_text(wob_kn: f64, sites: &str) -> String {
+    format!(
+        "[well]\nprofile = \"vertical\"\ntotal_md = \"1000 m\"\n\
+         [[hole]]\nbottom_md = \"1000 m\"\ndiameter = \"6.125 in\"\nfriction = 0.25\n\
+         [mud]\ndensity = \"1.278 sg\"\n\
+         [[string]]\nkind = \"bit\"\nlength = \"0.3 m\"\nod = \"5 in\"\nid = \"2.25 in\"\n\
+         [[string]]\nkind = \"stabilizer\"\nlength = \"1.5 m\"\nod = \"5 in\"\nid = \"2.25 in\"\nblade_diameter = \"6 in\"\n\
+         [[string]]\nkind = \"collar\"\nlength = \"126.2 m\"\nod = \"5 in\"\nid = \"2.25 in\"\n\
+         [[string]]\nkind = \"drill_pipe\"\nlength = \"872 m\"\nod = \"4 in\"\nid = \"3.34 in\"\n\
+         [operation]\nmode = \"rotating\"\nrpm = \"120 rpm\"\nweight_on_bit = \"{wob_kn} kN\"\n\
+         [contact]\nsites = \"{sites}\"\n[mesh]\nelement_length = \"10 m\"\nbha_element_length = \"0.5 m\"\n"
+    )
+}
+
+/// [`vertical_bha`]'s string at 15 kN in a straight hole 1° off vertical.
+fn inclined_bha(sites: &str) -> Case {
+    static CALLS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+    let call = CALLS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    let dir = std::env::temp_dir().join(format!("holewall_inclined_{}_{call}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(
+        dir.join("s.csv"),
+        "md, inclination, azimuth\n0, 1, 0\n1000, 1, 0\n",
+    )
+    .unwrap();
+    let text = vertical_bha_text(15.0, sites).replace(
+        "profile = \"vertical\"",
+        "profile = \"survey\"\nsurvey = \"s.csv\"",
+    );
+    let case = crate::case::parse_case(&dir.join("s.toml"), &text).unwrap();
+    let _ = std::fs::remove_dir_all(&dir);
+    case
+}
+
+/// Lubinski's first-order load of the collars, from their sizes alone (E 207 GPa, steel
+/// 7850 kg/m³ — the case defaults — in 1.278 sg mud): `1.94 (EI w²)^⅓` ≈ 19.9 kN. The
+/// check fires at 28.8 kN (well 439) with contact at the stabilizers only, not at 15 kN,
+/// and not with contact at every node.
+#[test]
+fn unsupported_collars_past_lubinskis_load_are_named() {
+    let (od, id): (f64, f64) = (5.0 * 0.0254, 2.25 * 0.0254);
+    let ei = 207e9 * std::f64::consts::PI / 64.0 * (od.powi(4) - id.powi(4));
+    let w = std::f64::consts::PI / 4.0 * (od * od - id * id) * 9.80665 * (7850.0 - 1278.0);
+    let hand = 1.94 * (ei * w * w).cbrt();
+    let case = vertical_bha(28.8, "stabilizers");
+    let (md, f, critical) = unsupported_buckling(&case, &case.soft_string().tension)
+        .expect("28.8 kN on unsupported collars passes Lubinski's load");
+    eprintln!("stabilizer at MD {md:.1} m: {f:.0} N against {critical:.0} N (hand {hand:.0} N)");
+    assert!(
+        (critical - hand).abs() <= 1e-3 * hand,
+        "{critical} vs {hand}"
+    );
+    assert!((19e3..21e3).contains(&critical), "{critical}");
+    // The compression at the stabilizer: the WOB less the bit's and stabilizer's weight.
+    assert!(f < 28.8e3 && f > 28.8e3 - 1.9 * w * 1.1, "{f}");
+    let error = StaticError::LoadStep {
+        stage: "applying the bit loads and friction (stage 2)".into(),
+        from: 0.5,
+        step: 1e-4,
+        min: 1e-4,
+        reason: "r".into(),
+        at_md: None,
+    };
+    let msg = static_failure(&case, &error);
+    assert!(
+        msg.contains("Lubinski") && msg.contains("all_nodes"),
+        "{msg}"
+    );
+    let light = vertical_bha(15.0, "stabilizers");
+    assert!(unsupported_buckling(&light, &light.soft_string().tension).is_none());
+    let walled = vertical_bha(28.8, "all_nodes");
+    assert!(unsupported_buckling(&walled, &walled.soft_string().tension).is_none());
+    assert!(!static_failure(&walled, &error).contains("Lubinski"));
+}
