@@ -220,6 +220,10 @@ pub fn run(
             eprintln!("holewall: warning: {w}");
             warnings.push(w);
         }
+        if let Some(w) = crate::diagnose::locked_up_warning(&case, hook) {
+            eprintln!("holewall: warning: {w}");
+            warnings.push(w);
+        }
         if let Some(w) = through_wall {
             eprintln!("holewall: warning: {w}");
             warnings.push(w);

@@ -203,6 +203,29 @@ fn helical_free_wob(case: &Case, axial: &[f64]) -> f64 {
         .max(0.0)
 }
 
+/// A warning for a solved FE profile of a load that locks up ([`lock_up`]): the FE found
+/// an equilibrium at the full load (often on a mesh too coarse for the helix, which
+/// [`unresolved_helix`] says), but the buckled soft string runs away from the load factor
+/// [`lock_up_fraction`] on; `hook_load` is the FE's (N; below zero, the push the surface
+/// must give). `None` where the load does not lock up.
+pub fn locked_up_warning(case: &Case, hook_load: f64) -> Option<String> {
+    let lu = lock_up(case)?;
+    let from = lock_up_fraction(case).unwrap_or(1.0);
+    Some(format!(
+        "the load locks up: a soft string carrying its buckled shape's wall force (Mitchell) \
+         runs away at MD {:.0} m, from {:.0} % of the friction and bit loads on; this \
+         equilibrium (hook load {:.1} kN{}) is one the string does not reach by being run in",
+        lu.md,
+        100.0 * from,
+        hook_load / 1e3,
+        if hook_load < 0.0 {
+            ": pushed from the surface"
+        } else {
+            ""
+        }
+    ))
+}
+
 /// A warning for a solved FE profile (nodal axial forces, tension +) whose compression
 /// passes the helical buckling load where the elements are too long for the helix (fewer
 /// than 4 per pitch): the answer is an equilibrium of the mesh, which carries less of the

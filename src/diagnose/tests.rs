@@ -191,6 +191,23 @@ fn a_string_held_only_at_its_stabilizer_sags_through_the_wall() {
     assert_eq!(solve(&inclined_bha("all_nodes")), None);
 }
 
+/// A solved profile of a load that locks up warns, with where and from which load factor;
+/// one that does not lock up does not.
+#[test]
+fn a_solved_load_that_locks_up_warns() {
+    let case = horizontal(0.3, 600.0);
+    let lu = lock_up(&case).unwrap();
+    let from = lock_up_fraction(&case).unwrap();
+    let w = locked_up_warning(&case, -7.0e6).expect("locks up");
+    assert!(
+        w.contains(&format!("MD {:.0} m", lu.md))
+            && w.contains(&format!("from {:.0} %", 100.0 * from))
+            && w.contains("-7000.0 kN: pushed from the surface"),
+        "{w}"
+    );
+    assert_eq!(locked_up_warning(&horizontal(0.05, 20.0), 1e5), None);
+}
+
 /// A failed solve of a load that locks up says so, with where.
 #[test]
 fn a_failure_that_locks_up_says_so() {
