@@ -172,7 +172,11 @@ pub fn lock_up_at(case: &Case, lambda: f64) -> Option<LockUp> {
 /// compression). `None` where it does not lock up at the full loads. An FE load path folds
 /// near it where its mesh follows the helix.
 pub fn lock_up_fraction(case: &Case) -> Option<f64> {
-    lock_up_at(case, 1.0)?;
+    lock_up_at(case, 1.0).map(|_| lock_up_onset(case))
+}
+
+/// [`lock_up_fraction`] of a case known to lock up at the full loads.
+fn lock_up_onset(case: &Case) -> f64 {
     let (mut free, mut locked) = (0.0, 1.0);
     while locked - free > LOCK_UP_FRACTION_TOLERANCE {
         let mid = 0.5 * (free + locked);
@@ -182,7 +186,7 @@ pub fn lock_up_fraction(case: &Case) -> Option<f64> {
             free = mid;
         }
     }
-    Some(locked)
+    locked
 }
 
 /// The width of the interval [`lock_up_fraction`] returns the top of.
@@ -210,7 +214,7 @@ fn helical_free_wob(case: &Case, axial: &[f64]) -> f64 {
 /// must give). `None` where the load does not lock up.
 pub fn locked_up_warning(case: &Case, hook_load: f64) -> Option<String> {
     let lu = lock_up(case)?;
-    let from = lock_up_fraction(case).unwrap_or(1.0);
+    let from = lock_up_onset(case);
     Some(format!(
         "the load locks up: a soft string carrying its buckled shape's wall force (Mitchell) \
          runs away at MD {:.0} m, from {:.0} % of the friction and bit loads on; this \

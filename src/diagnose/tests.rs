@@ -2,29 +2,32 @@
 
 use super::*;
 
-/// A straight horizontal 8.5 in hole, 5 in drill pipe slid in with `wob` at the bit.
-fn horizontal(friction: f64, wob_kn: f64) -> Case {
-    // One folder per call: the tests run in parallel and each removes its own.
+/// The case `text` parsed beside a survey file `survey.csv` holding `survey`, in a folder
+/// of its own (the tests run in parallel and each removes its own).
+fn with_survey(survey: &str, text: &str) -> Case {
     static CALLS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
     let call = CALLS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-    let dir = std::env::temp_dir().join(format!("holewall_lockup_{}_{call}", std::process::id()));
+    let dir = std::env::temp_dir().join(format!("holewall_diagnose_{}_{call}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
-    std::fs::write(
-        dir.join("h.csv"),
-        "md, inclination, azimuth\n0, 90, 0\n3000, 90, 0\n",
-    )
-    .unwrap();
-    let text = format!(
-        "[well]\nprofile = \"survey\"\nsurvey = \"h.csv\"\ntotal_md = \"2500 m\"\n\
-         [[hole]]\nbottom_md = \"2500 m\"\ndiameter = \"8.5 in\"\nfriction = {friction}\n\
-         [mud]\ndensity = \"1.2 sg\"\n\
-         [[string]]\nkind = \"drill_pipe\"\nlength = \"2500 m\"\nod = \"5 in\"\nid = \"4.276 in\"\n\
-         [operation]\nmode = \"sliding\"\nweight_on_bit = \"{wob_kn} kN\"\n\
-         [mesh]\nelement_length = \"2 m\"\n"
-    );
-    let case = crate::case::parse_case(&dir.join("h.toml"), &text).unwrap();
+    std::fs::write(dir.join("survey.csv"), survey).unwrap();
+    let case = crate::case::parse_case(&dir.join("case.toml"), text).unwrap();
     let _ = std::fs::remove_dir_all(&dir);
     case
+}
+
+/// A straight horizontal 8.5 in hole, 5 in drill pipe slid in with `wob` at the bit.
+fn horizontal(friction: f64, wob_kn: f64) -> Case {
+    with_survey(
+        "md, inclination, azimuth\n0, 90, 0\n3000, 90, 0\n",
+        &format!(
+            "[well]\nprofile = \"survey\"\nsurvey = \"survey.csv\"\ntotal_md = \"2500 m\"\n\
+             [[hole]]\nbottom_md = \"2500 m\"\ndiameter = \"8.5 in\"\nfriction = {friction}\n\
+             [mud]\ndensity = \"1.2 sg\"\n\
+             [[string]]\nkind = \"drill_pipe\"\nlength = \"2500 m\"\nod = \"5 in\"\nid = \"4.276 in\"\n\
+             [operation]\nmode = \"sliding\"\nweight_on_bit = \"{wob_kn} kN\"\n\
+             [mesh]\nelement_length = \"2 m\"\n"
+        ),
+    )
 }
 
 /// Past the helical load in a horizontal hole the compression obeys
@@ -260,22 +263,13 @@ fn vertical_bha_text(wob_kn: f64, sites: &str) -> String {
 
 /// [`vertical_bha`]'s string at 15 kN in a straight hole 1° off vertical.
 fn inclined_bha(sites: &str) -> Case {
-    static CALLS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
-    let call = CALLS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-    let dir = std::env::temp_dir().join(format!("holewall_inclined_{}_{call}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    std::fs::write(
-        dir.join("s.csv"),
+    with_survey(
         "md, inclination, azimuth\n0, 1, 0\n1000, 1, 0\n",
+        &vertical_bha_text(15.0, sites).replace(
+            "profile = \"vertical\"",
+            "profile = \"survey\"\nsurvey = \"survey.csv\"",
+        ),
     )
-    .unwrap();
-    let text = vertical_bha_text(15.0, sites).replace(
-        "profile = \"vertical\"",
-        "profile = \"survey\"\nsurvey = \"s.csv\"",
-    );
-    let case = crate::case::parse_case(&dir.join("s.toml"), &text).unwrap();
-    let _ = std::fs::remove_dir_all(&dir);
-    case
 }
 
 /// Lubinski's first-order load of the collars, from their sizes alone (E 207 GPa, steel
