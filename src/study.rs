@@ -20,6 +20,7 @@ use crate::case::{load_case, Case};
 use crate::ensemble::qoi::{Status, VariantResult};
 use crate::ensemble::Variant;
 use crate::error::{Error, InputError};
+use crate::keys::{Key, Value};
 use crate::output::RunFolder;
 
 /// Options of `holewall study precision`.
@@ -451,34 +452,39 @@ pub struct StabilitySummary {
     pub map: Vec<StabilityCell>,
 }
 
-/// A cell: (parameter, value, overrides as (key, value), time-step factor).
-type Cell = (String, String, Vec<(String, String)>, f64);
+/// A cell: (parameter, value in words, overrides, time-step factor).
+type Cell = (String, String, Vec<(Key, Value)>, f64);
+
+/// The override of key `name` (one of the study's own) by the SI value `x`.
+fn set(name: &str, x: f64) -> (Key, Value) {
+    (
+        Key::parse(name).expect("the study's keys are keys"),
+        Value::Number(x),
+    )
+}
 
 /// The cells: one parameter at a time around the case (wall stiffness 1e5 … 1e11, spring
 /// exponent 2/3, 1, 3/2, ε 1e-6 … 1e-1, friction 0 … 1, the first stabilizer's clearance
 /// 0 … nominal, WOB ½ … 8 × the case's, the time step 1 … 16 × the case's) and the wall
-/// stiffness × exponent grid. (parameter, value, overrides as a variants-CSV row, dt factor).
+/// stiffness × exponent grid. (parameter, value, overrides, dt factor).
 fn stability_cells(case: &Case) -> Vec<Cell> {
     let mut cells = Vec::new();
-    let one = |p: &str, v: String| (p.to_string(), v.clone(), vec![(p.to_string(), v)], 1.0);
-    for m in ["0.6667", "1", "1.5"] {
-        for k in ["1e5", "1e6", "1e7", "1e8", "1e9", "1e10", "1e11"] {
+    let one = |p: &str, x: f64, text: String| (p.to_string(), text, vec![set(p, x)], 1.0);
+    for (m, m_text) in [(2.0 / 3.0, "0.6667"), (1.0, "1"), (1.5, "1.5")] {
+        for k in [1e5, 1e6, 1e7, 1e8, 1e9, 1e10, 1e11] {
             cells.push((
-                format!("k_e at m = {m}"),
-                format!("{k} N/m^m"),
-                vec![
-                    ("k_e".to_string(), k.to_string()),
-                    ("m".to_string(), m.to_string()),
-                ],
+                format!("k_e at m = {m_text}"),
+                format!("{k:e} N/m^m"),
+                vec![set("k_e", k), set("m", m)],
                 1.0,
             ));
         }
     }
-    for e in ["1e-6", "1e-4", "1e-2", "1e-1"] {
-        cells.push(one("eps", e.into()));
+    for e in [1e-6, 1e-4, 1e-2, 1e-1] {
+        cells.push(one("eps", e, format!("{e:e}")));
     }
-    for mu in ["0", "0.2", "0.5", "1"] {
-        cells.push(one("mu", mu.into()));
+    for mu in [0.0, 0.2, 0.5, 1.0] {
+        cells.push(one("mu", mu, format!("{mu}")));
     }
     if let Some(site) = case.model.sites.iter().find(|s| s.stabilizer) {
         let hole = 2.0 * site.hole_radius;
@@ -487,7 +493,7 @@ fn stability_cells(case: &Case) -> Vec<Cell> {
             cells.push((
                 "stab1 clearance".into(),
                 format!("{:.2} mm", 1e3 * f * site.params.clearance),
-                vec![("stab1.blade".into(), format!("{blade}"))],
+                vec![set("stab1.blade", blade)],
                 1.0,
             ));
         }
@@ -498,7 +504,7 @@ fn stability_cells(case: &Case) -> Vec<Cell> {
             cells.push((
                 "wob".into(),
                 format!("{:.0} kN", f * wob / 1e3),
-                vec![("wob".into(), format!("{}", f * wob))],
+                vec![set("wob", f * wob)],
                 1.0,
             ));
         }
@@ -548,17 +554,15 @@ pub fn stability(
                 d.duration = duration;
                 d.output_interval = d.output_interval.max(d.time_step).min(duration);
             }
-            let header: Vec<&str> = overrides.iter().map(|(k, _)| k.as_str()).collect();
-            let row: Vec<&str> = overrides.iter().map(|(_, v)| v.as_str()).collect();
-            let text = format!("{}\n{}\n", header.join(","), row.join(","));
             let clock = std::time::Instant::now();
-            let result = if overrides.is_empty() {
-                Ok(this.model.clone())
-            } else {
-                crate::ensemble::variants_from_csv_text("stability", &text)
-                    .map_err(|e| e.to_string())
-                    .and_then(|v| crate::ensemble::apply(&this, &v[0]))
-            }
+            let result = crate::ensemble::apply(
+                &this,
+                &Variant {
+                    name: "cell".into(),
+                    overrides: overrides.clone(),
+                },
+            )
+            .map_err(|e| e.to_string())
             .map(|model| match analysis {
                 "static" => (
                     crate::ensemble::qoi::static_variant(&this, "cell", &model),

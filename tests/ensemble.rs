@@ -112,6 +112,7 @@ fn stabilizer_layout_moves_the_site() {
     let too_wide = variants_from_csv_text("v.csv", "stab1.blade\n9 in\n").unwrap();
     assert!(apply(&case, &too_wide[0])
         .unwrap_err()
+        .to_string()
         .contains("wider than the hole"));
 }
 

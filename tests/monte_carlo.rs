@@ -339,11 +339,14 @@ fn broomstick_of_the_shipped_case() {
     );
     let v = holewall::ensemble::variants_from_grid(grid);
     assert_eq!(
-        (v[0].overrides[0].1, v[1].overrides[0].1),
+        (v[0].overrides[0].1.si(), v[1].overrides[0].1.si()),
         (0.15, 0.15),
         "mu slowest"
     );
-    assert_eq!((v[0].overrides[1].1, v[1].overrides[1].1), (600.0, 800.0));
+    assert_eq!(
+        (v[0].overrides[1].1.si(), v[1].overrides[1].1.si()),
+        (600.0, 800.0)
+    );
     // Bad modes and depths are refused with file, line and key.
     let e = holewall::ensemble::variants_from_csv_text("v.csv", "mode\nspinning\n").unwrap_err();
     assert_eq!((e.line, e.key.as_str()), (2, "mode"));
@@ -423,7 +426,14 @@ fn rank_correlated_inputs() {
     let col = |name: &str| -> Vec<f64> {
         variants
             .iter()
-            .map(|v| v.overrides.iter().find(|(k, _)| k.name == name).unwrap().1)
+            .map(|v| {
+                v.overrides
+                    .iter()
+                    .find(|(k, _)| k.name == name)
+                    .unwrap()
+                    .1
+                    .si()
+            })
             .collect()
     };
     let rho = holewall::uq::sensitivity::spearman(&col("mu"), &col("wob"));
@@ -524,6 +534,7 @@ fn candidate_stabilizer_layouts() {
     let v = holewall::ensemble::variants_from_csv_text("v.csv", "layout\n3\n").unwrap();
     assert!(holewall::ensemble::apply(&case, &v[0])
         .unwrap_err()
+        .to_string()
         .contains("layout 3"));
     let bad = text.replace("\"stab1.from_bit\" = \"1.8 m\"", "mu = 0.3");
     std::fs::write(&path, bad).unwrap();
@@ -556,6 +567,7 @@ fn sampled_rpm_and_bend_stay_in_si() {
     let rpm = std::f64::consts::TAU / 60.0;
     for v in &variants {
         for (key, value) in &v.overrides {
+            let value = &value.si();
             match key.name.as_str() {
                 "rpm" => assert!((80.0 * rpm..=120.0 * rpm).contains(value), "{value}"),
                 "bend" => assert!(

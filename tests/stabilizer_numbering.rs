@@ -41,7 +41,7 @@ fn plot_labels_and_ensemble_keys_name_the_same_stabilizer() {
         let key = Key::parse(&format!("k_e.stab{k}")).unwrap();
         let variant = Variant {
             name: "v".into(),
-            overrides: vec![(key, 1.2345e7)],
+            overrides: vec![(key, holewall::ensemble::Value::Number(1.2345e7))],
         };
         let varied = apply(&case, &variant).unwrap();
         let changed: Vec<usize> = (0..model.sites.len())

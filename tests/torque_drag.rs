@@ -167,15 +167,15 @@ fn off_bottom_like(case: &holewall::case::Case, mode: &str) -> f64 {
 
 #[test]
 fn friction_per_hole_section_as_variant_keys() {
-    use holewall::ensemble::{apply, Key, Variant};
+    use holewall::ensemble::{apply, Key, Value, Variant};
     // build_and_hold: 9⅝ in casing to 500 m (μ 0.2), 8½ in open hole below (μ 0.3).
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("cases/build_and_hold.toml");
     let case = holewall::case::load_case(&path).unwrap();
     let variant = Variant {
         name: "v".into(),
         overrides: vec![
-            (Key::parse("mu.cased").unwrap(), 0.1),
-            (Key::parse("mu.open").unwrap(), 0.45),
+            (Key::parse("mu.cased").unwrap(), Value::Number(0.1)),
+            (Key::parse("mu.open").unwrap(), Value::Number(0.45)),
         ],
     };
     let m = apply(&case, &variant).unwrap();
@@ -199,7 +199,7 @@ fn friction_per_hole_section_as_variant_keys() {
     // By section number: hole2 is the open hole here; a third section does not exist.
     let v2 = Variant {
         name: "v2".into(),
-        overrides: vec![(Key::parse("mu_l.hole2").unwrap(), 0.05)],
+        overrides: vec![(Key::parse("mu_l.hole2").unwrap(), Value::Number(0.05))],
     };
     let m2 = apply(&case, &v2).unwrap();
     assert!(m2
@@ -208,16 +208,16 @@ fn friction_per_hole_section_as_variant_keys() {
         .all(|s| (m2.nodes[s.node].md > 500.0) == (s.params.mu_l == 0.05)));
     let v3 = Variant {
         name: "v3".into(),
-        overrides: vec![(Key::parse("mu.hole3").unwrap(), 0.2)],
+        overrides: vec![(Key::parse("mu.hole3").unwrap(), Value::Number(0.2))],
     };
-    let e = apply(&case, &v3).unwrap_err();
+    let e = apply(&case, &v3).unwrap_err().to_string();
     assert!(
         e.contains("mu.hole3") && e.contains("2 [[hole]] sections"),
         "{e}"
     );
     // Malformed section keys are refused with the key forms.
     for bad in ["mu.hole0", "mu.casing", "wob.cased"] {
-        let e = Key::parse(bad).unwrap_err();
+        let e = Key::parse(bad).unwrap_err().to_string();
         assert!(e.contains(".cased"), "{bad}: {e}");
     }
 }
@@ -892,7 +892,7 @@ fn a_depth_and_mode_variant_is_the_case_file_edited() {
         name: "deep".into(),
         overrides: vec![key("depth", "1600 m")],
     };
-    let e = variant_case(&case, &deep).unwrap_err();
+    let e = variant_case(&case, &deep).unwrap_err().to_string();
     assert!(e.contains("above the bit at 1600 m"), "{e}");
     println!("{e}");
 }

@@ -39,7 +39,7 @@
 use serde::Serialize;
 
 use crate::case::Case;
-use crate::ensemble::{Key, Variant, MODES};
+use crate::ensemble::{Key, Value, Variant};
 use crate::error::{Error, InputError};
 
 /// Fine-grid points per unknown for the posterior.
@@ -105,19 +105,22 @@ pub fn unknowns(case: &Case) -> Vec<Key> {
 /// The variant of `station` with the friction factors `mu` (one per key of `keys`).
 pub fn station_variant(name: String, station: &Station, keys: &[Key], mu: &[f64]) -> Variant {
     let key = |n: &str| Key::parse(n).expect("a known key");
-    let mode = key("mode");
-    let code = MODES
-        .iter()
-        .position(|m| *m == station.mode.model_mode())
-        .unwrap_or(0) as f64;
-    let mut overrides = vec![(key("depth"), station.bit_md), (mode, code)];
+    let number = |n: &str, x: f64| (key(n), Value::Number(x));
+    let mut overrides = vec![
+        number("depth", station.bit_md),
+        (key("mode"), Value::Mode(station.mode.model_mode())),
+    ];
     if station.mode == MeasuredMode::Drilling {
-        overrides.push((key("wob"), station.wob));
+        overrides.push(number("wob", station.wob));
     }
     if let Some(r) = station.rpm {
-        overrides.push((key("rpm"), r));
+        overrides.push(number("rpm", r));
     }
-    overrides.extend(keys.iter().cloned().zip(mu.iter().copied()));
+    overrides.extend(
+        keys.iter()
+            .cloned()
+            .zip(mu.iter().map(|&m| Value::Number(m))),
+    );
     Variant { name, overrides }
 }
 

@@ -45,7 +45,8 @@ impl Ctx<'_> {
                 }
                 *x
             }
-            Quantity::Number(x) => {
+            Quantity::Si(x) if x.is_finite() => *x,
+            Quantity::Number(x) | Quantity::Si(x) => {
                 return Err(self.err(
                     q.span(),
                     key,
@@ -88,6 +89,7 @@ impl Ctx<'_> {
         let written = match q.get_ref() {
             Quantity::Text(t) => t.clone(),
             Quantity::Number(x) => crate::units::show(*x),
+            Quantity::Si(x) => format!("{} kg/m3", crate::units::show(*x)),
         };
         match crate::units::fluid_density_trap(v, &written) {
             Some(m) => Err(self.err(q.span(), key, m)),
@@ -104,6 +106,7 @@ impl Ctx<'_> {
     ) -> Result<f64, InputError> {
         let v = match q.get_ref() {
             Quantity::Number(x) => *x,
+            Quantity::Si(x) => x.to_degrees(),
             Quantity::Text(t) => parse_angle_deg(t)
                 .map_err(|e| self.err(q.span(), key, format!("{e}; allowed: {range}")))?,
         };

@@ -1,6 +1,7 @@
 //! The readers of `[dynamics]` and `[ensemble]` (with its uncertain inputs).
 
 use super::*;
+use crate::uq::distribution::DistributionError;
 
 pub(super) fn ensemble_settings(
     ctx: &Ctx,
@@ -34,20 +35,15 @@ pub(super) fn ensemble_settings(
     written.sort_by_key(|(_, v)| v.span().start);
     for (name, values) in written {
         let key_name = format!("ensemble.grid.{name}");
-        let key =
-            crate::keys::Key::parse(name).map_err(|m| ctx.err(values.span(), &key_name, m))?;
+        let key = crate::keys::Key::parse(name)
+            .map_err(|m| ctx.err(values.span(), &key_name, m.to_string()))?;
         if values.get_ref().is_empty() {
             return Err(ctx.err(values.span(), &key_name, "no values"));
         }
         let mut list = Vec::new();
         for q in values.get_ref() {
-            let text = match q {
-                Quantity::Number(x) => x.to_string(),
-                Quantity::Text(t) => t.clone(),
-            };
             list.push(
-                key.value(&text)
-                    .map_err(|m| ctx.err(values.span(), &key_name, m))?,
+                key_value(&key, q).map_err(|m| ctx.err(values.span(), &key_name, m.to_string()))?,
             );
         }
         grid.push((key, list));
@@ -59,10 +55,10 @@ pub(super) fn ensemble_settings(
     for (name, spec) in written {
         let key_name = format!("ensemble.uncertain.{name}");
         let err = |m: String| ctx.err(spec.span(), &key_name, m);
-        let key = crate::keys::Key::parse(name).map_err(err)?;
+        let key = crate::keys::Key::parse(name).map_err(|m| err(m.to_string()))?;
         uncertain.push((
             key.clone(),
-            uncertain_distribution(&key, spec.get_ref()).map_err(err)?,
+            uncertain_distribution(&key, spec.get_ref()).map_err(|m| err(m.to_string()))?,
         ));
     }
     let correlation = match &e.correlation {
@@ -104,7 +100,7 @@ pub(super) fn ensemble_settings(
             let err = |m: String| ctx.err(list.span(), &key_name, m);
             let mut set = Vec::new();
             for (name, q) in layout {
-                let key = crate::keys::Key::parse(name).map_err(err)?;
+                let key = crate::keys::Key::parse(name).map_err(|m| err(m.to_string()))?;
                 if !matches!(
                     key.param,
                     crate::keys::Param::FromBit | crate::keys::Param::Blade
@@ -113,13 +109,9 @@ pub(super) fn ensemble_settings(
                         "{name}: a layout sets stabK.from_bit and stabK.blade only"
                     )));
                 }
-                let text = match q {
-                    Quantity::Number(x) => x.to_string(),
-                    Quantity::Text(t) => t.clone(),
-                };
                 set.push((
                     key.clone(),
-                    key.value(&text).map_err(|m| err(format!("{name}: {m}")))?,
+                    key_value(&key, q).map_err(|m| err(format!("{name}: {m}")))?,
                 ));
             }
             if set.is_empty() {
@@ -138,51 +130,92 @@ pub(super) fn ensemble_settings(
     })
 }
 
+/// The value of `q` for `key`: a bare number as a case file writes it
+/// ([`crate::keys::Key::number`]), a quantity with its unit or a mode's name
+/// ([`crate::keys::Key::value`]).
+fn key_value(
+    key: &crate::keys::Key,
+    q: &Quantity,
+) -> Result<crate::keys::Value, crate::keys::KeyError> {
+    match q {
+        Quantity::Number(x) => key.number(*x),
+        Quantity::Text(t) => key.value(t),
+        Quantity::Si(x) => key.si(*x),
+    }
+}
+
 /// The distribution of `[ensemble.uncertain]` entry `u` of key `key`; every value given is
-/// parsed and range-checked as the key's own values.
+/// parsed and range-checked as the key's own values (a mode's values are their codes).
 pub(super) fn uncertain_distribution(
     key: &crate::keys::Key,
     u: &UncertainSpec,
-) -> Result<crate::uq::Distribution, String> {
+) -> Result<crate::uq::Distribution, DistributionError> {
     use crate::uq::Distribution;
-    let text = |q: &Quantity| match q {
-        Quantity::Number(x) => x.to_string(),
-        Quantity::Text(t) => t.clone(),
+    let value =
+        |q: &Option<Quantity>, field: &'static str| -> Result<Option<f64>, DistributionError> {
+            q.as_ref()
+                .map(|q| {
+                    key_value(key, q)
+                        .map(|v| v.si())
+                        .map_err(|source| DistributionError::Value { field, source })
+                })
+                .transpose()
+        };
+    let dist = u.dist.as_str();
+    let need = |x: Option<f64>, field: &'static str| {
+        x.ok_or_else(|| DistributionError::Needs {
+            dist: dist.to_string(),
+            field,
+        })
     };
-    let value = |q: &Option<Quantity>, field: &str| -> Result<Option<f64>, String> {
-        q.as_ref()
-            .map(|q| key.value(&text(q)).map_err(|m| format!("{field}: {m}")))
-            .transpose()
-    };
-    let need = |x: Option<f64>, field: &str| x.ok_or_else(|| format!("{} needs {field}", u.dist));
     let (min, max) = (value(&u.min, "min")?, value(&u.max, "max")?);
-    let unused = |fields: &[(&str, bool)]| -> Result<(), String> {
+    let unused = |fields: &[(&'static str, bool)]| -> Result<(), DistributionError> {
         match fields.iter().find(|(_, given)| *given) {
-            Some((f, _)) => Err(format!("{} takes no {f}", u.dist)),
+            Some((f, _)) => Err(DistributionError::TakesNo {
+                dist: dist.to_string(),
+                field: f,
+            }),
             None => Ok(()),
         }
     };
-    let d = match u.dist.as_str() {
+    let d = match dist {
         "uniform" => {
-            unused(&[("mean", u.mean.is_some()), ("sd", u.sd.is_some()), ("median", u.median.is_some()), ("sigma", u.sigma.is_some()), ("mode", u.mode.is_some()), ("values", u.values.is_some()), ("weights", u.weights.is_some())])?;
+            unused(&[
+                ("mean", u.mean.is_some()),
+                ("sd", u.sd.is_some()),
+                ("median", u.median.is_some()),
+                ("sigma", u.sigma.is_some()),
+                ("mode", u.mode.is_some()),
+                ("values", u.values.is_some()),
+                ("weights", u.weights.is_some()),
+            ])?;
             Distribution::Uniform {
                 min: need(min, "min")?,
                 max: need(max, "max")?,
             }
         }
         "normal" => {
-            unused(&[("median", u.median.is_some()), ("sigma", u.sigma.is_some()), ("mode", u.mode.is_some()), ("values", u.values.is_some()), ("weights", u.weights.is_some())])?;
+            unused(&[
+                ("median", u.median.is_some()),
+                ("sigma", u.sigma.is_some()),
+                ("mode", u.mode.is_some()),
+                ("values", u.values.is_some()),
+                ("weights", u.weights.is_some()),
+            ])?;
             let sd = match &u.sd {
                 // A spread: the key's unit, but not its range (σ of a friction factor
                 // may be 0.05, of a WOB 7 kN).
-                Some(q) => {
-                    let t = text(q);
-                    match t.trim().parse::<f64>() {
-                        Ok(x) => x,
-                        Err(_) => key.value(&t).map_err(|m| format!("sd: {m}"))?,
-                    }
-                }
-                None => return Err("normal needs sd".into()),
+                Some(Quantity::Number(x) | Quantity::Si(x)) => *x,
+                Some(q @ Quantity::Text(t)) => match t.trim().parse::<f64>() {
+                    Ok(x) => x,
+                    Err(_) => key_value(key, q)
+                        .map_err(|source| DistributionError::Value {
+                            field: "sd",
+                            source,
+                        })?
+                        .si(),
+                },
+                None => need(None, "sd")?,
             };
             Distribution::Normal {
                 mean: need(value(&u.mean, "mean")?, "mean")?,
@@ -192,14 +225,29 @@ pub(super) fn uncertain_distribution(
             }
         }
         "lognormal" => {
-            unused(&[("min", u.min.is_some()), ("max", u.max.is_some()), ("mean", u.mean.is_some()), ("sd", u.sd.is_some()), ("mode", u.mode.is_some()), ("values", u.values.is_some()), ("weights", u.weights.is_some())])?;
+            unused(&[
+                ("min", u.min.is_some()),
+                ("max", u.max.is_some()),
+                ("mean", u.mean.is_some()),
+                ("sd", u.sd.is_some()),
+                ("mode", u.mode.is_some()),
+                ("values", u.values.is_some()),
+                ("weights", u.weights.is_some()),
+            ])?;
             Distribution::LogNormal {
                 median: need(value(&u.median, "median")?, "median")?,
-                sigma: u.sigma.ok_or("lognormal needs sigma (of the logarithm)")?,
+                sigma: need(u.sigma, "sigma (of the logarithm)")?,
             }
         }
         "triangular" => {
-            unused(&[("mean", u.mean.is_some()), ("sd", u.sd.is_some()), ("median", u.median.is_some()), ("sigma", u.sigma.is_some()), ("values", u.values.is_some()), ("weights", u.weights.is_some())])?;
+            unused(&[
+                ("mean", u.mean.is_some()),
+                ("sd", u.sd.is_some()),
+                ("median", u.median.is_some()),
+                ("sigma", u.sigma.is_some()),
+                ("values", u.values.is_some()),
+                ("weights", u.weights.is_some()),
+            ])?;
             Distribution::Triangular {
                 min: need(min, "min")?,
                 mode: need(value(&u.mode, "mode")?, "mode")?,
@@ -207,23 +255,38 @@ pub(super) fn uncertain_distribution(
             }
         }
         "discrete" => {
-            unused(&[("min", u.min.is_some()), ("max", u.max.is_some()), ("mean", u.mean.is_some()), ("sd", u.sd.is_some()), ("median", u.median.is_some()), ("sigma", u.sigma.is_some()), ("mode", u.mode.is_some())])?;
-            let values = u
-                .values
-                .as_ref()
-                .ok_or("discrete needs values")?
-                .iter()
-                .map(|q| key.value(&text(q)))
-                .collect::<Result<Vec<f64>, String>>()
-                .map_err(|m| format!("values: {m}"))?;
+            unused(&[
+                ("min", u.min.is_some()),
+                ("max", u.max.is_some()),
+                ("mean", u.mean.is_some()),
+                ("sd", u.sd.is_some()),
+                ("median", u.median.is_some()),
+                ("sigma", u.sigma.is_some()),
+                ("mode", u.mode.is_some()),
+            ])?;
+            let values = match &u.values {
+                None => {
+                    return Err(DistributionError::Needs {
+                        dist: dist.to_string(),
+                        field: "values",
+                    })
+                }
+                Some(list) => list
+                    .iter()
+                    .map(|q| {
+                        key_value(key, q).map(|v| v.si()).map_err(|source| {
+                            DistributionError::Value {
+                                field: "values",
+                                source,
+                            }
+                        })
+                    })
+                    .collect::<Result<Vec<f64>, _>>()?,
+            };
             let weights = u.weights.clone().unwrap_or_else(|| vec![1.0; values.len()]);
             Distribution::Discrete { values, weights }
         }
-        other => {
-            return Err(format!(
-                "unknown distribution {other:?}; allowed: uniform, normal, lognormal, triangular, discrete"
-            ))
-        }
+        other => return Err(DistributionError::Unknown(other.to_string())),
     };
     d.check()?;
     Ok(d)
@@ -426,7 +489,7 @@ pub(super) fn tendency_settings(
             .iter()
             .map(|q| {
                 let text = match q {
-                    Quantity::Number(x) => x.to_string(),
+                    Quantity::Number(x) | Quantity::Si(x) => x.to_string(),
                     Quantity::Text(t) => t.clone(),
                 };
                 let v = parse(&text)

@@ -11,6 +11,10 @@ pub enum Quantity {
     Number(f64),
     /// Text with a unit.
     Text(String),
+    /// A value already in SI set by the program, not read from a file (a variant's rotary
+    /// speed, [`crate::ensemble::variant_case`]): no unit to read, no bare-number trap.
+    #[serde(skip)]
+    Si(f64),
 }
 
 pub(crate) type Q = Spanned<Quantity>;
@@ -126,8 +130,8 @@ pub struct ComponentSpec {
 #[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct OperationSpec {
-    /// `rotating`, `tripping_in`, `tripping_out`, `sliding`.
-    pub mode: Spanned<String>,
+    /// `rotating`, `tripping_in`, `tripping_out`, `sliding`, `reaming`, `back_reaming`.
+    pub mode: Spanned<crate::keys::Mode>,
     /// Weight on bit (default 0).
     pub weight_on_bit: Option<Q>,
     /// Torque on bit (default 0).
@@ -399,7 +403,7 @@ pub struct EnsembleSettings {
     /// What each variant runs.
     pub analysis: Analysis,
     /// Grid (key, values), in the order written (the first key varies slowest).
-    pub grid: Vec<(crate::keys::Key, Vec<f64>)>,
+    pub grid: Vec<(crate::keys::Key, Vec<crate::keys::Value>)>,
     /// Variants with full time series.
     pub series: Vec<String>,
     /// Uncertain inputs: (key, distribution), in the order written (`[ensemble.uncertain]`).
@@ -407,5 +411,5 @@ pub struct EnsembleSettings {
     /// Their rank correlation matrix (identity unless `ensemble.correlation` is given).
     pub correlation: Option<nalgebra::DMatrix<f64>>,
     /// Candidate stabilizer layouts (`ensemble.layouts`), picked by the `layout` key.
-    pub layouts: Vec<Vec<(crate::keys::Key, f64)>>,
+    pub layouts: Vec<Vec<(crate::keys::Key, crate::keys::Value)>>,
 }

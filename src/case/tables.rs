@@ -435,38 +435,37 @@ pub(super) fn read_operation(ctx: &Ctx, spec: &CaseSpec) -> Result<Operation, In
             "give either weight_on_bit (top clamped) or hook_load (bit on bottom), not both",
         ));
     }
-    let mode = op.mode.get_ref().as_str();
-    let rotates = matches!(mode, "rotating" | "reaming" | "back_reaming");
-    match (mode, &op.rpm) {
-        (_, None) if rotates => {
+    let mode = *op.mode.get_ref();
+    let rotates = mode.rotates();
+    match &op.rpm {
+        None if rotates => {
             return Err(ctx.err(
                 op.mode.span(),
                 "operation.rpm",
                 format!(
-                    "mode = {mode:?} needs the rotary speed: add rpm = \"90 rpm\" (or the \
+                    "mode = \"{mode}\" needs the rotary speed: add rpm = \"90 rpm\" (or the \
                      value you rotate at) to [operation]"
                 ),
             ))
         }
-        (_, Some(q)) if rotates && rpm == 0.0 => {
+        Some(q) if rotates && rpm == 0.0 => {
             return Err(ctx.err(
                 q.span(),
                 "operation.rpm",
                 format!(
-                    "mode = {mode:?} at 0 rpm has no rotation, hence no torque: give the \
+                    "mode = \"{mode}\" at 0 rpm has no rotation, hence no torque: give the \
                      rotary speed (> 0), or mode = \"sliding\" / \"tripping_in\" / \
                      \"tripping_out\""
                 ),
             ))
         }
-        ("tripping_in" | "tripping_out" | "sliding", Some(q)) if rpm != 0.0 => {
+        Some(q) if !rotates && rpm != 0.0 => {
             return Err(ctx.err(
                 q.span(),
                 "operation.rpm",
                 format!(
-                    "mode = {:?} does not rotate the string, so this rpm would be ignored: \
-                     remove rpm, or use mode = \"rotating\"",
-                    op.mode.get_ref()
+                    "mode = \"{mode}\" does not rotate the string, so this rpm would be ignored: \
+                     remove rpm, or use mode = \"rotating\""
                 ),
             ))
         }
@@ -474,24 +473,8 @@ pub(super) fn read_operation(ctx: &Ctx, spec: &CaseSpec) -> Result<Operation, In
     }
     // Reaming (running in while rotating) and back-reaming (pulling out while rotating):
     // both speeds, the friction split by the velocity's direction at each contact.
-    let (axial_speed, rotation_speed) = match mode {
-        "rotating" => (0.0, rpm),
-        "tripping_in" => (speed, 0.0),
-        "tripping_out" => (-speed, 0.0),
-        "sliding" => (speed, 0.0),
-        "reaming" => (speed, rpm),
-        "back_reaming" => (-speed, rpm),
-        other => {
-            return Err(ctx.err(
-                op.mode.span(),
-                "operation.mode",
-                format!(
-                    "unknown mode {other:?}; allowed: {}",
-                    crate::keys::MODES.join(", ")
-                ),
-            ))
-        }
-    };
+    let axial_speed = mode.axial_direction() * speed;
+    let rotation_speed = if rotates { rpm } else { 0.0 };
     Ok(Operation {
         wob,
         tob,

@@ -58,7 +58,7 @@ pub fn run(
                 mc.sobol_indices,
                 correlation.as_ref(),
             )
-                .map_err(|m| cli_error("ensemble.uncertain", m))?
+                .map_err(|m| cli_error("ensemble.uncertain", m.to_string()))?
         }
         None => match crate::ensemble::case_variants(&case, variants_file)? {
             Some(v) => v,
@@ -168,7 +168,7 @@ pub fn run(
                     .unwrap_or_else(|| case_path.display().to_string()),
                 line: 0,
                 key: format!("variant {}", v.name),
-                message: e,
+                message: e.to_string(),
             }
             .into());
         }
@@ -523,7 +523,7 @@ fn whirl_maps(
         v.overrides
             .iter()
             .find(|(x, _)| x.name == k.name)
-            .map_or(f64::NAN, |(_, x)| *x)
+            .map_or(f64::NAN, |(_, x)| x.si())
     };
     let label = |k: &crate::keys::Key| {
         let (_, unit) = Unit::of_key(k).display();

@@ -45,19 +45,20 @@ impl MeasuredMode {
     }
 
     /// The model's operation (a `mode` key's value).
-    pub fn model_mode(self) -> &'static str {
+    pub fn model_mode(self) -> crate::keys::Mode {
+        use crate::keys::Mode;
         match self {
-            MeasuredMode::PickUp => "tripping_out",
-            MeasuredMode::SlackOff => "tripping_in",
-            MeasuredMode::Rotating | MeasuredMode::Drilling => "rotating",
-            MeasuredMode::Reaming => "reaming",
-            MeasuredMode::BackReaming => "back_reaming",
+            MeasuredMode::PickUp => Mode::TrippingOut,
+            MeasuredMode::SlackOff => Mode::TrippingIn,
+            MeasuredMode::Rotating | MeasuredMode::Drilling => Mode::Rotating,
+            MeasuredMode::Reaming => Mode::Reaming,
+            MeasuredMode::BackReaming => Mode::BackReaming,
         }
     }
 
     /// Whether the string rotates (a surface torque is measured).
     pub fn rotates(self) -> bool {
-        !matches!(self, MeasuredMode::PickUp | MeasuredMode::SlackOff)
+        self.model_mode().rotates()
     }
 }
 

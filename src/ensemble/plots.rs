@@ -36,12 +36,17 @@ fn key_axis(key: &crate::keys::Key) -> (String, f64) {
     }
 }
 
-/// A key's value in a legend: `mode` by name, else `name value unit` (`wob 44.5 kN`).
-fn key_value_text(key: &crate::keys::Key, v: f64) -> String {
-    match (key.param, key_unit(key)) {
-        (crate::ensemble::Param::Mode, _) => key.format(v),
-        (_, (Some(u), k)) => format!("{} {} {u}", key.name, crate::plots::tick(&(v * k))),
-        (_, (None, _)) => format!("{} {}", key.name, crate::plots::tick(&v)),
+/// A key's value in a legend: a mode by name, a layout by number, else `name value unit`
+/// (`wob 44.5 kN`).
+fn key_value_text(key: &crate::keys::Key, v: crate::keys::Value) -> String {
+    use crate::keys::Value;
+    match (v, key_unit(key)) {
+        (Value::Mode(m), _) => m.to_string(),
+        (Value::Layout(k), _) => format!("{} {k}", key.name),
+        (Value::Number(v), (Some(u), k)) => {
+            format!("{} {} {u}", key.name, crate::plots::tick(&(v * k)))
+        }
+        (Value::Number(v), (None, _)) => format!("{} {}", key.name, crate::plots::tick(&v)),
     }
 }
 
@@ -71,7 +76,7 @@ fn lines_over(
         let Some(y) = pick(r).filter(|h| h.is_finite()) else {
             continue;
         };
-        let point = (xv * key_axis(xk).1, y * scale);
+        let point = (xv.si() * key_axis(xk).1, y * scale);
         match lines.iter_mut().find(|(l, _)| *l == label) {
             Some((_, pts)) => pts.push(point),
             None => lines.push((label, vec![point])),
@@ -86,13 +91,12 @@ fn lines_over(
 /// The numeric keys the variants vary (positions in each variant's overrides; not `mode` or
 /// `layout`).
 fn varied_keys(variants: &[Variant]) -> Vec<usize> {
-    use crate::ensemble::Param;
     let Some(first) = variants.first() else {
         return Vec::new();
     };
     (0..first.overrides.len())
         .filter(|&i| {
-            let numeric = !matches!(first.overrides[i].0.param, Param::Mode | Param::Layout);
+            let numeric = matches!(first.overrides[i].1, crate::keys::Value::Number(_));
             numeric
                 && variants
                     .iter()
@@ -112,7 +116,7 @@ fn strongest_key(
     let effect = |i: usize| -> f64 {
         let mut means: Vec<(f64, f64, usize)> = Vec::new();
         for (v, r) in variants.iter().zip(results) {
-            let (Some(x), Some(y)) = (v.overrides.get(i).map(|o| o.1), pick(r)) else {
+            let (Some(x), Some(y)) = (v.overrides.get(i).map(|o| o.1.si()), pick(r)) else {
                 continue;
             };
             if !y.is_finite() {
@@ -463,7 +467,7 @@ pub(crate) fn broomstick(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::keys::Key;
+    use crate::keys::{Key, Value};
 
     /// A 3 × 3 grid of `mu` and `wob` whose neutral point follows the WOB alone.
     fn grid() -> (Vec<Variant>, Vec<VariantResult>) {
@@ -474,7 +478,10 @@ mod tests {
             for w in [40e3, 60e3, 80e3] {
                 variants.push(Variant {
                     name: format!("{}", variants.len()),
-                    overrides: vec![(mu.clone(), m), (wob.clone(), w)],
+                    overrides: vec![
+                        (mu.clone(), Value::Number(m)),
+                        (wob.clone(), Value::Number(w)),
+                    ],
                 });
                 let mut r = crate::ensemble::qoi::failed("v", String::new(), 0);
                 r.neutral_point_from_bit_m = Some(w / 1e3 + 0.01 * m);
@@ -499,7 +506,7 @@ mod tests {
         assert_eq!(xs, vec![40.0, 60.0, 80.0]);
         assert_eq!(key_axis(&variants[0].overrides[1].0).0, "wob (kN)");
         assert_eq!(
-            key_value_text(&variants[0].overrides[1].0, 44_482.0),
+            key_value_text(&variants[0].overrides[1].0, Value::Number(44_482.0)),
             "wob 44.48 kN"
         );
     }

@@ -203,9 +203,9 @@ pub(crate) fn variants_csv(
                 v.overrides
                     .iter()
                     .find(|(key, _)| &key.name == k)
-                    .map(|(key, x)| {
-                        if x.is_finite() {
-                            key.format(*x)
+                    .map(|(_, x)| {
+                        if x.si().is_finite() {
+                            x.to_string()
                         } else {
                             String::new()
                         }
@@ -292,7 +292,7 @@ pub(crate) fn uncertainty_report(
         .map(|(k, key)| {
             (
                 key.clone(),
-                variants.iter().map(|v| v.overrides[k].1).collect(),
+                variants.iter().map(|v| v.overrides[k].1.si()).collect(),
             )
         })
         .collect();

@@ -8,7 +8,7 @@ use super::qoi::*;
 use crate::backend::Precision;
 use crate::case::{Analysis, Case};
 use crate::ensemble::{apply, Variant};
-use crate::error::{Error, InputError};
+use crate::error::{Error, InputError, SystemError};
 use crate::model::Model;
 use crate::solve::dynamics::{DynamicState, Dynamics};
 
@@ -22,7 +22,7 @@ pub fn run_static_gpu<T: crate::gpu::contact::GpuReal>(
     variants: &[Variant],
     ctx: &'static crate::gpu::GpuContext,
     bar: &indicatif::ProgressBar,
-) -> Result<Result<Vec<VariantResult>, String>, Error> {
+) -> Result<Result<Vec<VariantResult>, SystemError>, Error> {
     use crate::engine::{solve_static_ensemble_with_progress, EngineStatus};
     use crate::gpu::GpuPath;
     let models: Vec<Model> = variants
@@ -31,12 +31,12 @@ pub fn run_static_gpu<T: crate::gpu::contact::GpuReal>(
         .collect::<Result<_, _>>()
         .map_err(Error::failed)?;
     if !models.iter().all(|m| same_mesh(case, m)) {
-        return Ok(Err(
+        return Ok(Err(SystemError::Unsupported(
             "the variants differ in their mesh or number of contact sites".into(),
-        ));
+        )));
     }
     if let Err(e) = crate::engine::check_same_mesh(&models) {
-        return Ok(Err(e.to_string()));
+        return Ok(Err(e));
     }
     let results = solve_static_ensemble_with_progress::<T, _>(
         &models,
@@ -77,16 +77,16 @@ pub fn run_dynamic_gpu<T: crate::gpu::contact::GpuReal>(
     variants: &[Variant],
     ctx: &'static crate::gpu::GpuContext,
     bar: &indicatif::ProgressBar,
-) -> Result<Result<Vec<VariantResult>, String>, Error> {
+) -> Result<Result<Vec<VariantResult>, SystemError>, Error> {
     use crate::engine::dynamic::{run_dynamic_ensemble, unsupported, DynamicStatus};
     use crate::engine::{solve_static_ensemble, EngineStatus};
     use crate::gpu::GpuPath;
     let Some(settings) = case.dynamics.clone() else {
-        return Ok(Err("no [dynamics] table".into()));
+        return Ok(Err(SystemError::Unsupported("no [dynamics] table".into())));
     };
     let options = case.settings().dynamics();
     if let Some(why) = unsupported(&options) {
-        return Ok(Err(why));
+        return Ok(Err(SystemError::Unsupported(why)));
     }
     let models: Vec<Model> = variants
         .iter()
@@ -94,12 +94,12 @@ pub fn run_dynamic_gpu<T: crate::gpu::contact::GpuReal>(
         .collect::<Result<_, _>>()
         .map_err(Error::failed)?;
     if !models.iter().all(|m| same_mesh(case, m)) {
-        return Ok(Err(
+        return Ok(Err(SystemError::Unsupported(
             "the variants differ in their mesh or number of contact sites".into(),
-        ));
+        )));
     }
     if let Err(e) = crate::engine::check_same_mesh(&models) {
-        return Ok(Err(e.to_string()));
+        return Ok(Err(e));
     }
     let path = GpuPath(ctx);
     let statics = solve_static_ensemble::<T, _>(&models, &path, &case.settings().statics())

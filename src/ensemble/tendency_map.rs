@@ -107,7 +107,7 @@ pub fn tendency_map(
                         crate::keys::Key::parse("stab1.from_bit").expect("stab1.from_bit is a key");
                     let variant = crate::ensemble::Variant {
                         name: String::new(),
-                        overrides: vec![(key, x)],
+                        overrides: vec![(key, crate::keys::Value::Number(x))],
                     };
                     // The distance the stabilizer got: its site's node nearest the asked.
                     let model = crate::ensemble::apply(case, &variant);
@@ -132,7 +132,7 @@ pub fn tendency_map(
             let t = match model {
                 Ok(m) => tendency(&m, case.bha_length, w, toolface, &settings),
                 Err(e) => Tendency {
-                    notes: vec![e],
+                    notes: vec![e.to_string()],
                     settings,
                     ..Default::default()
                 },

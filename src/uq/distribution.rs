@@ -99,72 +99,172 @@ impl std::fmt::Display for Distribution {
     }
 }
 
+/// Why a distribution cannot be read ([`crate::case`]'s `[ensemble.uncertain]`) or is not
+/// a distribution ([`Distribution::check`]).
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum DistributionError {
+    /// Not a distribution this module has.
+    #[error(
+        "unknown distribution {0:?}; allowed: uniform, normal, lognormal, triangular, discrete"
+    )]
+    Unknown(String),
+    /// A parameter the distribution needs is missing.
+    #[error("{dist} needs {field}")]
+    Needs {
+        /// The distribution.
+        dist: String,
+        /// The missing parameter.
+        field: &'static str,
+    },
+    /// A parameter the distribution does not take.
+    #[error("{dist} takes no {field}")]
+    TakesNo {
+        /// The distribution.
+        dist: String,
+        /// The parameter given.
+        field: &'static str,
+    },
+    /// A value that is not a value of its key.
+    #[error("{field}: {source}")]
+    Value {
+        /// The parameter (`min`, `values`, …).
+        field: &'static str,
+        /// Why.
+        source: crate::keys::KeyError,
+    },
+    /// A parameter that is not finite.
+    #[error("{0} must be finite")]
+    NotFinite(&'static str),
+    /// A parameter that must be positive (and finite).
+    #[error("{what} must be positive and finite, not {value}")]
+    NotPositive {
+        /// The parameter.
+        what: &'static str,
+        /// Its value.
+        value: f64,
+    },
+    /// `min ≥ max`.
+    #[error("min ({min}) must be below max ({max})")]
+    MinNotBelowMax {
+        /// The lower bound.
+        min: f64,
+        /// The upper bound.
+        max: f64,
+    },
+    /// A normal law's truncation that holds no probability.
+    #[error("the truncation [{min}, {max}] holds no probability of the normal law")]
+    EmptyTruncation {
+        /// The lower bound.
+        min: f64,
+        /// The upper bound.
+        max: f64,
+    },
+    /// A triangular law's points out of order.
+    #[error("need min ≤ mode ≤ max and min < max ({min}, {mode}, {max})")]
+    Triangular {
+        /// The lower bound.
+        min: f64,
+        /// The mode.
+        mode: f64,
+        /// The upper bound.
+        max: f64,
+    },
+    /// A discrete law without values.
+    #[error("no values")]
+    NoValues,
+    /// A discrete law's weights not one per value.
+    #[error("{weights} weights for {values} values")]
+    WeightCount {
+        /// Weights given.
+        weights: usize,
+        /// Values given.
+        values: usize,
+    },
+}
+
 impl Distribution {
-    /// Checks the parameters; the message names what is wrong.
-    pub fn check(&self) -> Result<(), String> {
-        let finite = |x: f64, what: &str| {
+    /// Checks the parameters; the error names what is wrong.
+    pub fn check(&self) -> Result<(), DistributionError> {
+        use DistributionError as E;
+        let finite = |x: f64, what: &'static str| {
             if x.is_finite() {
                 Ok(())
             } else {
-                Err(format!("{what} must be finite"))
+                Err(E::NotFinite(what))
+            }
+        };
+        let ordered = |min: f64, max: f64| {
+            if min < max {
+                Ok(())
+            } else {
+                Err(E::MinNotBelowMax { min, max })
+            }
+        };
+        let positive = |x: f64, what: &'static str| {
+            if x.is_finite() && x > 0.0 {
+                Ok(())
+            } else {
+                Err(E::NotPositive { what, value: x })
             }
         };
         match self {
             Distribution::Uniform { min, max } => {
                 finite(*min, "min")?;
                 finite(*max, "max")?;
-                if min >= max {
-                    return Err(format!("min ({min}) must be below max ({max})"));
-                }
+                ordered(*min, *max)?;
             }
             Distribution::Normal { mean, sd, min, max } => {
                 finite(*mean, "mean")?;
-                if !(sd.is_finite() && *sd > 0.0) {
-                    return Err(format!("sd must be positive and finite, not {sd}"));
-                }
-                if min >= max {
-                    return Err(format!("min ({min}) must be below max ({max})"));
-                }
-                let n = Normal::new(*mean, *sd).map_err(|e| e.to_string())?;
+                positive(*sd, "sd")?;
+                ordered(*min, *max)?;
+                let n = Normal::new(*mean, *sd).map_err(|_| E::NotPositive {
+                    what: "sd",
+                    value: *sd,
+                })?;
                 if n.cdf(*max) - n.cdf(*min) < 1e-12 {
-                    return Err(format!(
-                        "the truncation [{min}, {max}] holds no probability of the normal law"
-                    ));
+                    return Err(E::EmptyTruncation {
+                        min: *min,
+                        max: *max,
+                    });
                 }
             }
             Distribution::LogNormal { median, sigma } => {
-                if !(median.is_finite() && *median > 0.0) {
-                    return Err(format!("median must be positive, not {median}"));
-                }
-                if !(sigma.is_finite() && *sigma > 0.0) {
-                    return Err(format!("sigma must be positive, not {sigma}"));
-                }
+                positive(*median, "median")?;
+                positive(*sigma, "sigma")?;
             }
             Distribution::Triangular { min, mode, max } => {
                 finite(*min, "min")?;
                 finite(*max, "max")?;
                 if !(min < max && (*min..=*max).contains(mode)) {
-                    return Err(format!(
-                        "need min ≤ mode ≤ max and min < max ({min}, {mode}, {max})"
-                    ));
+                    return Err(E::Triangular {
+                        min: *min,
+                        mode: *mode,
+                        max: *max,
+                    });
                 }
             }
             Distribution::Discrete { values, weights } => {
                 if values.is_empty() {
-                    return Err("no values".into());
+                    return Err(E::NoValues);
                 }
                 if weights.len() != values.len() {
-                    return Err(format!(
-                        "{} weights for {} values",
-                        weights.len(),
-                        values.len()
-                    ));
+                    return Err(E::WeightCount {
+                        weights: weights.len(),
+                        values: values.len(),
+                    });
                 }
                 if weights.iter().any(|w| !(w.is_finite() && *w > 0.0)) {
-                    return Err("weights must be positive".into());
+                    return Err(E::NotPositive {
+                        what: "every weight",
+                        value: weights
+                            .iter()
+                            .copied()
+                            .find(|w| !(w.is_finite() && *w > 0.0))
+                            .unwrap_or(f64::NAN),
+                    });
                 }
                 if values.iter().any(|v| !v.is_finite()) {
-                    return Err("values must be finite".into());
+                    return Err(E::NotFinite("every value"));
                 }
             }
         }

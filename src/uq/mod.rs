@@ -9,5 +9,5 @@ pub mod sampling;
 pub mod sensitivity;
 pub mod stats;
 
-pub use distribution::Distribution;
-pub use sampling::{unit_samples, Sampling};
+pub use distribution::{Distribution, DistributionError};
+pub use sampling::{unit_samples, Sampling, SamplingError};

@@ -22,6 +22,57 @@ pub enum Sampling {
     Sobol,
 }
 
+/// Why a set of samples cannot be drawn.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum SamplingError {
+    /// More Sobol samples than `sobol_burley` indexes.
+    #[error("Sobol sampling takes at most {SOBOL_MAX_SAMPLES} samples, not {0}")]
+    TooManySobolSamples(usize),
+    /// More Sobol dimensions than `sobol_burley` has.
+    #[error("Sobol sampling takes at most {max} inputs, not {0}", max = sobol_burley::NUM_DIMENSIONS)]
+    TooManySobolInputs(usize),
+    /// Too few samples for a rank correlation of this many inputs.
+    #[error("rank correlation needs more samples than inputs + 1 ({samples} for {inputs})")]
+    TooFewForCorrelation {
+        /// Samples.
+        samples: usize,
+        /// Inputs.
+        inputs: usize,
+    },
+    /// A correlation matrix that is not positive definite.
+    #[error("the correlation matrix is not positive definite")]
+    NotPositiveDefinite,
+    /// The normal scores of a rank correlation are degenerate.
+    #[error("the scores are degenerate")]
+    DegenerateScores,
+    /// No uncertain inputs to sample.
+    #[error("no uncertain inputs: add an [ensemble.uncertain] table")]
+    NoInputs,
+    /// No samples asked for.
+    #[error("--samples must be at least 1")]
+    NoSamples,
+    /// Sobol indices asked of another sampling.
+    #[error("Sobol indices need --sampling sobol (the Saltelli design is built on Sobol points)")]
+    IndicesNeedSobol,
+    /// A correlation asked of Sobol points.
+    #[error("ensemble.correlation reorders the samples, which breaks Sobol points' structure: use --sampling lhs or random")]
+    CorrelationBreaksSobol,
+    /// A drawn value outside its key's range.
+    #[error("sample {sample}: {key} drew {value} from a {dist}, outside the key's range ({range}); truncate the distribution")]
+    OutOfRange {
+        /// The sample's index (0-based).
+        sample: usize,
+        /// The key.
+        key: String,
+        /// The value drawn (SI).
+        value: f64,
+        /// The distribution, in words.
+        dist: String,
+        /// The key's range, in words.
+        range: &'static str,
+    },
+}
+
 /// The largest sample count Sobol sampling takes (`sobol_burley`'s index range).
 pub const SOBOL_MAX_SAMPLES: usize = 1 << 16;
 
@@ -43,7 +94,7 @@ pub fn unit_samples(
     d: usize,
     seed: u64,
     method: Sampling,
-) -> Result<Vec<Vec<f64>>, String> {
+) -> Result<Vec<Vec<f64>>, SamplingError> {
     match method {
         Sampling::Random => Ok((0..n)
             .map(|i| {
@@ -76,15 +127,10 @@ pub fn unit_samples(
         }
         Sampling::Sobol => {
             if n > SOBOL_MAX_SAMPLES {
-                return Err(format!(
-                    "Sobol sampling takes at most {SOBOL_MAX_SAMPLES} samples, not {n}"
-                ));
+                return Err(SamplingError::TooManySobolSamples(n));
             }
             if d > sobol_burley::NUM_DIMENSIONS as usize {
-                return Err(format!(
-                    "Sobol sampling takes at most {} inputs, not {d}",
-                    sobol_burley::NUM_DIMENSIONS
-                ));
+                return Err(SamplingError::TooManySobolInputs(d));
             }
             let seed32 = (seed ^ (seed >> 32)) as u32;
             Ok((0..n)
@@ -239,22 +285,23 @@ pub fn iman_conover(
     u: &mut [Vec<f64>],
     target: &nalgebra::DMatrix<f64>,
     seed: u64,
-) -> Result<(), String> {
+) -> Result<(), SamplingError> {
     use nalgebra::DMatrix;
     use statrs::distribution::{ContinuousCDF, Normal};
     let n = u.len();
     let d = target.nrows();
     if n < d + 2 {
-        return Err(format!(
-            "rank correlation needs more samples than inputs + 1 ({n} for {d})"
-        ));
+        return Err(SamplingError::TooFewForCorrelation {
+            samples: n,
+            inputs: d,
+        });
     }
     let p = target
         .clone()
         .cholesky()
-        .ok_or("the correlation matrix is not positive definite")?
+        .ok_or(SamplingError::NotPositiveDefinite)?
         .l();
-    let normal = Normal::new(0.0, 1.0).map_err(|e| e.to_string())?;
+    let normal = Normal::new(0.0, 1.0).map_err(|_| SamplingError::DegenerateScores)?;
     let scores: Vec<f64> = (1..=n)
         .map(|i| normal.inverse_cdf(i as f64 / (n as f64 + 1.0)))
         .collect();
@@ -276,8 +323,8 @@ pub fn iman_conover(
     let cov = centred.transpose() * &centred / (n as f64 - 1.0);
     let sd: Vec<f64> = (0..d).map(|k| cov[(k, k)].sqrt()).collect();
     let t = DMatrix::from_fn(d, d, |a, b| cov[(a, b)] / (sd[a] * sd[b]));
-    let q = t.cholesky().ok_or("the scores are degenerate")?.l();
-    let q_inv = q.try_inverse().ok_or("the scores are degenerate")?;
+    let q = t.cholesky().ok_or(SamplingError::DegenerateScores)?.l();
+    let q_inv = q.try_inverse().ok_or(SamplingError::DegenerateScores)?;
     let s = &p * q_inv;
     let target_scores = &r * s.transpose();
     for k in 0..d {

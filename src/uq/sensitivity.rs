@@ -161,7 +161,11 @@ pub struct SobolIndex {
 /// `A` (n), `B` (n), then `AB_i` for each input i (n each: `A` with column i from `B`), from
 /// one Owen-scrambled Sobol sequence of 2d dimensions (`A` the first d, `B` the next d).
 /// `n (d + 2)` points.
-pub fn saltelli_design(n: usize, d: usize, seed: u64) -> Result<Vec<Vec<f64>>, String> {
+pub fn saltelli_design(
+    n: usize,
+    d: usize,
+    seed: u64,
+) -> Result<Vec<Vec<f64>>, super::sampling::SamplingError> {
     let ab = super::unit_samples(n, 2 * d, seed, super::Sampling::Sobol)?;
     let a: Vec<Vec<f64>> = ab.iter().map(|p| p[..d].to_vec()).collect();
     let b: Vec<Vec<f64>> = ab.iter().map(|p| p[d..].to_vec()).collect();
