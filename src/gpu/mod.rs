@@ -10,6 +10,7 @@ pub mod contact;
 pub mod context;
 pub mod dispatch;
 pub mod dynamics;
+pub mod kernel;
 pub mod layout;
 pub mod path;
 pub mod readback;

@@ -84,7 +84,7 @@ impl<T: GpuReal> GpuDynamic<T> {
         tables: &BatchTables<T>,
         dynamic: &crate::engine::dynamic::DynamicTables<T>,
     ) -> Result<Self, GpuError> {
-        use crate::gpu::dynamics::{dynamics_wgsl, DynamicsKernel};
+        use crate::gpu::dynamics::DynamicsKernel;
         let f64 = T::IS_F64;
         let kink = !tables.rest.is_empty();
         let (v, n) = (tables.num_variants, tables.num_nodes);
@@ -97,31 +97,27 @@ impl<T: GpuReal> GpuDynamic<T> {
             Some(&dynamic.pair_params),
             Some(&dynamic.f_ext),
         )?;
+        let k = |kernel: Kernel| kernel.pipeline(ctx, f64);
         let pl = DynamicPipelines {
-            predict: ctx.pipeline("predict", &dynamics_wgsl(DynamicsKernel::Predict, f64)?)?,
-            accelerate: ctx.pipeline(
-                "accelerate",
-                &dynamics_wgsl(DynamicsKernel::Accelerate, f64)?,
-            )?,
-            scale: ctx.pipeline("scale", &dynamics_wgsl(DynamicsKernel::Scale, f64)?)?,
-            beam: ctx.pipeline("beam", &crate::gpu::beam::beam_wgsl(f64, false, kink)?)?,
-            beam_force: ctx
-                .pipeline("beam_force", &crate::gpu::beam::beam_wgsl(f64, true, kink)?)?,
-            sites: ctx.pipeline("sites", &sites_wgsl_for(true, f64)?)?,
-            contact: ctx.pipeline("contact", &contact_wgsl(&tables.terms, f64)?)?,
-            assemble: ctx.pipeline(
-                "assemble",
-                &crate::gpu::assemble::assemble_wgsl_with(
-                    true,
-                    !dynamic.unbalance.is_empty(),
-                    f64,
-                )?,
-            )?,
-            block_lu: ctx.pipeline(
-                "block_lu",
-                &crate::gpu::block_lu::block_lu_wgsl(f64, LuForm::for_adapter(ctx))?,
-            )?,
-            norms: ctx.pipeline("norms", &crate::gpu::update::update_wgsl(true, f64)?)?,
+            predict: k(Kernel::Dynamics(DynamicsKernel::Predict))?,
+            accelerate: k(Kernel::Dynamics(DynamicsKernel::Accelerate))?,
+            scale: k(Kernel::Dynamics(DynamicsKernel::Scale))?,
+            beam: k(Kernel::Beam {
+                force_only: false,
+                kink,
+            })?,
+            beam_force: k(Kernel::Beam {
+                force_only: true,
+                kink,
+            })?,
+            sites: k(Kernel::Sites { dynamic: true })?,
+            contact: k(Kernel::Contact(&tables.terms))?,
+            assemble: k(Kernel::Assemble {
+                dynamic: true,
+                unbalance: !dynamic.unbalance.is_empty(),
+            })?,
+            block_lu: k(Kernel::BlockLu(LuForm::for_adapter(ctx)))?,
+            norms: k(Kernel::Norms { trial: false })?,
         };
         let mass = storage(ctx, "mass", &dynamic.mass);
         let inertia0 = storage(ctx, "inertia0", &dynamic.inertia0);
@@ -519,7 +515,7 @@ pub fn gather_sites_dynamic_gpu<T: GpuReal>(
 ) -> Result<Vec<T>, GpuError> {
     let (u, vel, num_variants) = (&state.u, &state.vel, state.num_variants);
     require_precision::<T>(ctx)?;
-    let pipeline = ctx.pipeline("sites", &sites_wgsl_for(true, T::IS_F64)?)?;
+    let pipeline = Kernel::Sites { dynamic: true }.pipeline(ctx, T::IS_F64)?;
     let dims = ContactDims {
         num_pairs: pair_node.len() as u32,
         num_variants: num_variants as u32,

@@ -13,12 +13,12 @@ pub fn sites_wgsl(f64: bool) -> Result<String, GpuError> {
 /// The WGSL text of the static sites gather built `MASKED` (the engine's line-search
 /// trials: one invocation per (site, listed variant) of the compacted list `[A, v_0, …]`).
 pub fn sites_trial_wgsl(f64: bool) -> Result<String, GpuError> {
-    crate::gpu::compose::compose_if("sites.wgsl", &[("MASKED", true)], f64)
+    Kernel::SitesTrial.wgsl(f64)
 }
 
 /// The WGSL text of the static or dynamic sites gather at a precision.
 pub fn sites_wgsl_for(dynamic: bool, f64: bool) -> Result<String, GpuError> {
-    crate::gpu::compose::compose_if("sites.wgsl", &[("DYNAMIC", dynamic)], f64)
+    Kernel::Sites { dynamic }.wgsl(f64)
 }
 
 impl<T: GpuReal> ResidentStatic<T> for GpuStatic<T> {
@@ -229,7 +229,7 @@ pub fn gather_sites_gpu<T: GpuReal>(
     pair_state: &[T],
 ) -> Result<Vec<T>, GpuError> {
     require_precision::<T>(ctx)?;
-    let pipeline = ctx.pipeline("sites", &sites_wgsl(T::IS_F64)?)?;
+    let pipeline = Kernel::Sites { dynamic: false }.pipeline(ctx, T::IS_F64)?;
     let dims = ContactDims {
         num_pairs: pair_node.len() as u32,
         num_variants: num_variants as u32,

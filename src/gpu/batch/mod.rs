@@ -17,8 +17,9 @@ use crate::engine::Stage;
 use crate::engine::{BatchTables, ResidentStatic, Shift};
 use crate::error::GpuError;
 use crate::gpu::block_lu::LuForm;
-use crate::gpu::contact::{contact_wgsl, require_precision, GpuReal};
+use crate::gpu::contact::{require_precision, GpuReal};
 use crate::gpu::dispatch::WORKGROUP;
+use crate::gpu::kernel::Kernel;
 use crate::gpu::layout::{AssembleDims, BeamDims, ChainDims, ContactDims};
 use crate::gpu::readback::{submit_and_read, values};
 use crate::gpu::GpuContext;
@@ -263,36 +264,27 @@ impl<T: GpuReal> GpuStatic<T> {
         let p = tables.pair_node.len();
         let size = std::mem::size_of::<T>();
         let c = Common::new(ctx, model, tables, None, None)?;
+        let k = |kernel: Kernel| kernel.pipeline(ctx, f64);
         let pipelines = Pipelines {
-            beam: ctx.pipeline("beam", &crate::gpu::beam::beam_wgsl(f64, false, kink)?)?,
-            beam_force: ctx
-                .pipeline("beam_trial", &crate::gpu::beam::beam_trial_wgsl(f64, kink)?)?,
-            sites: ctx.pipeline("sites", &sites_wgsl(f64)?)?,
-            sites_trial: ctx.pipeline("sites_trial", &iteration::sites_trial_wgsl(f64)?)?,
-            contact: ctx.pipeline("contact", &contact_wgsl(&tables.terms, f64)?)?,
-            contact_force: ctx.pipeline(
-                "contact_trial",
-                &crate::gpu::contact::contact_force_wgsl(&tables.terms, f64, true)?,
-            )?,
-            assemble: ctx.pipeline("assemble", &crate::gpu::assemble::assemble_wgsl(f64)?)?,
-            assemble_force: ctx.pipeline(
-                "assemble_trial",
-                &crate::gpu::assemble::assemble_force_wgsl(f64, true)?,
-            )?,
-            block_lu: ctx.pipeline(
-                "block_lu",
-                &crate::gpu::block_lu::block_lu_wgsl(f64, LuForm::for_adapter(ctx))?,
-            )?,
-            norms: ctx.pipeline("norms", &crate::gpu::update::update_wgsl(true, f64)?)?,
-            norms_trial: ctx.pipeline(
-                "norms_trial",
-                &crate::gpu::update::update_wgsl_with(true, f64, false, true)?,
-            )?,
-            update: ctx.pipeline("update", &crate::gpu::update::update_wgsl(false, f64)?)?,
-            update_trial: ctx.pipeline(
-                "update_trial",
-                &crate::gpu::update::update_wgsl_with(false, f64, true, true)?,
-            )?,
+            beam: k(Kernel::Beam {
+                force_only: false,
+                kink,
+            })?,
+            beam_force: k(Kernel::BeamTrial { kink })?,
+            sites: k(Kernel::Sites { dynamic: false })?,
+            sites_trial: k(Kernel::SitesTrial)?,
+            contact: k(Kernel::Contact(&tables.terms))?,
+            contact_force: k(Kernel::ContactTrial(&tables.terms))?,
+            assemble: k(Kernel::Assemble {
+                dynamic: false,
+                unbalance: false,
+            })?,
+            assemble_force: k(Kernel::AssembleTrial)?,
+            block_lu: k(Kernel::BlockLu(LuForm::for_adapter(ctx)))?,
+            norms: k(Kernel::Norms { trial: false })?,
+            norms_trial: k(Kernel::Norms { trial: true })?,
+            update: k(Kernel::Update { trial: false })?,
+            update_trial: k(Kernel::Update { trial: true })?,
         };
         let contact = c.contact_group(ctx, &pipelines.contact, false);
         let contact_force = c.contact_group(ctx, &pipelines.contact_force, true);
@@ -414,14 +406,8 @@ impl<T: GpuReal> GpuStatic<T> {
         let f64 = T::IS_F64;
         let size = std::mem::size_of::<T>();
         let (v, n) = (self.num_variants, self.num_nodes);
-        let assemble = ctx.pipeline(
-            "assemble_shift",
-            &crate::gpu::assemble::assemble_shift_wgsl(f64, false, false)?,
-        )?;
-        let assemble_force = ctx.pipeline(
-            "assemble_trial_shift",
-            &crate::gpu::assemble::assemble_shift_wgsl(f64, true, true)?,
-        )?;
+        let assemble = Kernel::AssembleShift { trial: false }.pipeline(ctx, f64)?;
+        let assemble_force = Kernel::AssembleShift { trial: true }.pipeline(ctx, f64)?;
         let shift = empty(ctx, "shift", v * size);
         let anchor = empty(ctx, "anchor", 3 * n * v * size);
         let c = &self.c;

@@ -1,0 +1,138 @@
+//! Every kernel the GPU batches run, declared once ([`Kernel`]): its label and its WGSL
+//! source (the shader file and the features it is built with) for a precision. The static
+//! and the dynamic batch ask for their pipelines here, and bind each kernel's buffers through
+//! the one binding list per kernel of `gpu/batch/common.rs`.
+
+use std::sync::Arc;
+
+use crate::error::GpuError;
+use crate::gpu::block_lu::LuForm;
+use crate::gpu::dynamics::DynamicsKernel;
+use crate::gpu::GpuContext;
+use crate::physics::contact::ContactTerms;
+
+/// A kernel of the evaluation chain (beam → sites → contact → assembly → block solve →
+/// norms, the update, the dynamic integrator's), as a batch builds it.
+#[derive(Clone, Copy, Debug)]
+pub enum Kernel<'a> {
+    /// Element forces and tangents, or (`force_only`) forces alone; `kink`: a scene with a
+    /// bent sub (the unstrained rotations bound).
+    Beam {
+        /// Forces alone.
+        force_only: bool,
+        /// A scene with a kink.
+        kink: bool,
+    },
+    /// The line-search trials' beam kernel: forces alone, for the listed variants.
+    BeamTrial {
+        /// A scene with a kink.
+        kink: bool,
+    },
+    /// The sites gather: static, or dynamic (with the sites' velocities).
+    Sites {
+        /// The dynamic form.
+        dynamic: bool,
+    },
+    /// The line-search trials' sites gather (listed variants).
+    SitesTrial,
+    /// The contact kernel specialised to the scene's terms.
+    Contact(&'a ContactTerms),
+    /// The line-search trials' contact kernel: forces alone, listed variants.
+    ContactTrial(&'a ContactTerms),
+    /// The assembly: static, or dynamic with (`unbalance`) the mass-imbalance terms.
+    Assemble {
+        /// The dynamic form.
+        dynamic: bool,
+        /// The mass-imbalance terms (dynamic only).
+        unbalance: bool,
+    },
+    /// The line-search trials' assembly: the residual alone, listed variants.
+    AssembleTrial,
+    /// The assembly with a relaxation's proximal shift: the full system, or (`trial`) the
+    /// trials' residual.
+    AssembleShift {
+        /// The trials' form.
+        trial: bool,
+    },
+    /// The block-tridiagonal solve in the adapter's form.
+    BlockLu(LuForm),
+    /// The residual and step norms; `trial`: for the listed variants.
+    Norms {
+        /// The trials' form.
+        trial: bool,
+    },
+    /// The configuration update; `trial`: out of place, for the listed variants.
+    Update {
+        /// The trials' form.
+        trial: bool,
+    },
+    /// One of the generalised-α integrator's kernels.
+    Dynamics(DynamicsKernel),
+}
+
+impl Kernel<'_> {
+    /// The pipeline's label (in messages and GPU captures).
+    pub fn label(&self) -> &'static str {
+        match self {
+            Kernel::Beam {
+                force_only: false, ..
+            } => "beam",
+            Kernel::Beam { .. } => "beam_force",
+            Kernel::BeamTrial { .. } => "beam_trial",
+            Kernel::Sites { .. } => "sites",
+            Kernel::SitesTrial => "sites_trial",
+            Kernel::Contact(_) => "contact",
+            Kernel::ContactTrial(_) => "contact_trial",
+            Kernel::Assemble { .. } => "assemble",
+            Kernel::AssembleTrial => "assemble_trial",
+            Kernel::AssembleShift { trial: false } => "assemble_shift",
+            Kernel::AssembleShift { trial: true } => "assemble_trial_shift",
+            Kernel::BlockLu(_) => "block_lu",
+            Kernel::Norms { trial: false } => "norms",
+            Kernel::Norms { trial: true } => "norms_trial",
+            Kernel::Update { trial: false } => "update",
+            Kernel::Update { trial: true } => "update_trial",
+            Kernel::Dynamics(DynamicsKernel::Predict) => "predict",
+            Kernel::Dynamics(DynamicsKernel::Accelerate) => "accelerate",
+            Kernel::Dynamics(DynamicsKernel::Scale) => "scale",
+        }
+    }
+
+    /// The WGSL text at a precision.
+    pub fn wgsl(&self, f64: bool) -> Result<String, GpuError> {
+        use crate::gpu::{assemble, beam, block_lu, contact, dynamics, update};
+        let sites = |feature: &'static str| {
+            crate::gpu::compose::compose_if("sites.wgsl", &[(feature, true)], f64)
+        };
+        match *self {
+            Kernel::Beam { force_only, kink } => beam::beam_wgsl(f64, force_only, kink),
+            Kernel::BeamTrial { kink } => beam::beam_trial_wgsl(f64, kink),
+            Kernel::Sites { dynamic: true } => sites("DYNAMIC"),
+            Kernel::Sites { dynamic: false } => {
+                crate::gpu::compose::compose_if("sites.wgsl", &[], f64)
+            }
+            Kernel::SitesTrial => sites("MASKED"),
+            Kernel::Contact(terms) => contact::contact_wgsl(terms, f64),
+            Kernel::ContactTrial(terms) => contact::contact_force_wgsl(terms, f64, true),
+            Kernel::Assemble { dynamic, unbalance } => {
+                assemble::assemble_wgsl_with(dynamic, unbalance, f64)
+            }
+            Kernel::AssembleTrial => assemble::assemble_force_wgsl(f64, true),
+            Kernel::AssembleShift { trial } => assemble::assemble_shift_wgsl(f64, trial, trial),
+            Kernel::BlockLu(form) => block_lu::block_lu_wgsl(f64, form),
+            Kernel::Norms { trial } => update::update_wgsl_with(true, f64, false, trial),
+            Kernel::Update { trial } => update::update_wgsl_with(false, f64, trial, trial),
+            Kernel::Dynamics(k) => dynamics::dynamics_wgsl(k, f64),
+        }
+    }
+
+    /// Its compute pipeline on `ctx` at a precision (compiled once per source text:
+    /// [`GpuContext::pipeline`]).
+    pub fn pipeline(
+        &self,
+        ctx: &GpuContext,
+        f64: bool,
+    ) -> Result<Arc<wgpu::ComputePipeline>, GpuError> {
+        ctx.pipeline(self.label(), &self.wgsl(f64)?)
+    }
+}
