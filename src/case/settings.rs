@@ -168,40 +168,46 @@ pub(super) fn uncertain_distribution(
             field,
         })
     };
-    let (min, max) = (value(&u.min, "min")?, value(&u.max, "max")?);
-    let unused = |fields: &[(&'static str, bool)]| -> Result<(), DistributionError> {
-        match fields.iter().find(|(_, given)| *given) {
-            Some((f, _)) => Err(DistributionError::TakesNo {
-                dist: dist.to_string(),
-                field: f,
-            }),
-            None => Ok(()),
-        }
+    enum Law {
+        Uniform,
+        Normal,
+        LogNormal,
+        Triangular,
+        Discrete,
+    }
+    // The parameters each distribution takes; any other given is refused.
+    let (law, takes): (Law, &[&str]) = match dist {
+        "uniform" => (Law::Uniform, &["min", "max"]),
+        "normal" => (Law::Normal, &["mean", "sd", "min", "max"]),
+        "lognormal" => (Law::LogNormal, &["median", "sigma"]),
+        "triangular" => (Law::Triangular, &["min", "mode", "max"]),
+        "discrete" => (Law::Discrete, &["values", "weights"]),
+        other => return Err(DistributionError::Unknown(other.to_string())),
     };
-    let d = match dist {
-        "uniform" => {
-            unused(&[
-                ("mean", u.mean.is_some()),
-                ("sd", u.sd.is_some()),
-                ("median", u.median.is_some()),
-                ("sigma", u.sigma.is_some()),
-                ("mode", u.mode.is_some()),
-                ("values", u.values.is_some()),
-                ("weights", u.weights.is_some()),
-            ])?;
-            Distribution::Uniform {
-                min: need(min, "min")?,
-                max: need(max, "max")?,
-            }
-        }
-        "normal" => {
-            unused(&[
-                ("median", u.median.is_some()),
-                ("sigma", u.sigma.is_some()),
-                ("mode", u.mode.is_some()),
-                ("values", u.values.is_some()),
-                ("weights", u.weights.is_some()),
-            ])?;
+    let given = [
+        ("min", u.min.is_some()),
+        ("max", u.max.is_some()),
+        ("mean", u.mean.is_some()),
+        ("sd", u.sd.is_some()),
+        ("median", u.median.is_some()),
+        ("sigma", u.sigma.is_some()),
+        ("mode", u.mode.is_some()),
+        ("values", u.values.is_some()),
+        ("weights", u.weights.is_some()),
+    ];
+    if let Some((field, _)) = given.iter().find(|(f, g)| *g && !takes.contains(f)) {
+        return Err(DistributionError::TakesNo {
+            dist: dist.to_string(),
+            field,
+        });
+    }
+    let (min, max) = (value(&u.min, "min")?, value(&u.max, "max")?);
+    let d = match law {
+        Law::Uniform => Distribution::Uniform {
+            min: need(min, "min")?,
+            max: need(max, "max")?,
+        },
+        Law::Normal => {
             let sd = match &u.sd {
                 // A spread: the key's unit, but not its range (σ of a friction factor
                 // may be 0.05, of a WOB 7 kN).
@@ -224,46 +230,16 @@ pub(super) fn uncertain_distribution(
                 max: max.unwrap_or(f64::INFINITY),
             }
         }
-        "lognormal" => {
-            unused(&[
-                ("min", u.min.is_some()),
-                ("max", u.max.is_some()),
-                ("mean", u.mean.is_some()),
-                ("sd", u.sd.is_some()),
-                ("mode", u.mode.is_some()),
-                ("values", u.values.is_some()),
-                ("weights", u.weights.is_some()),
-            ])?;
-            Distribution::LogNormal {
-                median: need(value(&u.median, "median")?, "median")?,
-                sigma: need(u.sigma, "sigma (of the logarithm)")?,
-            }
-        }
-        "triangular" => {
-            unused(&[
-                ("mean", u.mean.is_some()),
-                ("sd", u.sd.is_some()),
-                ("median", u.median.is_some()),
-                ("sigma", u.sigma.is_some()),
-                ("values", u.values.is_some()),
-                ("weights", u.weights.is_some()),
-            ])?;
-            Distribution::Triangular {
-                min: need(min, "min")?,
-                mode: need(value(&u.mode, "mode")?, "mode")?,
-                max: need(max, "max")?,
-            }
-        }
-        "discrete" => {
-            unused(&[
-                ("min", u.min.is_some()),
-                ("max", u.max.is_some()),
-                ("mean", u.mean.is_some()),
-                ("sd", u.sd.is_some()),
-                ("median", u.median.is_some()),
-                ("sigma", u.sigma.is_some()),
-                ("mode", u.mode.is_some()),
-            ])?;
+        Law::LogNormal => Distribution::LogNormal {
+            median: need(value(&u.median, "median")?, "median")?,
+            sigma: need(u.sigma, "sigma (of the logarithm)")?,
+        },
+        Law::Triangular => Distribution::Triangular {
+            min: need(min, "min")?,
+            mode: need(value(&u.mode, "mode")?, "mode")?,
+            max: need(max, "max")?,
+        },
+        Law::Discrete => {
             let values = match &u.values {
                 None => {
                     return Err(DistributionError::Needs {
@@ -286,7 +262,6 @@ pub(super) fn uncertain_distribution(
             let weights = u.weights.clone().unwrap_or_else(|| vec![1.0; values.len()]);
             Distribution::Discrete { values, weights }
         }
-        other => return Err(DistributionError::Unknown(other.to_string())),
     };
     d.check()?;
     Ok(d)
