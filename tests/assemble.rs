@@ -4,7 +4,8 @@
 
 mod common;
 
-use holewall::gpu::assemble::{assemble_gpu, assemble_residual_gpu};
+use common::runners::assemble_residual_gpu;
+use holewall::gpu::assemble::assemble_gpu;
 use holewall::kernels::assemble::{assemble, assemble_residual, AssemblyInputs, NO_SITE};
 use holewall::kernels::contact::{response_fields, OUTPUT_LEN};
 use holewall::physics::beam::{force_and_tangent, ElementState};

@@ -235,8 +235,7 @@ fn sites_kernel_equals_its_twin() {
     let Some(ctx) = common::gpu() else { return };
     if ctx.has_f64 {
         let gpu =
-            holewall::gpu::batch::gather_sites_gpu(ctx, &pair_node, &x, &at_pairs, v, &before)
-                .unwrap();
+            common::runners::gather_sites_gpu(ctx, &pair_node, &x, &at_pairs, v, &before).unwrap();
         assert_eq!(gpu, twin);
     }
 }

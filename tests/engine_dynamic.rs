@@ -217,8 +217,8 @@ fn widen(b: &DynamicBatch<f32>) -> DynamicBatch<f64> {
 
 #[test]
 fn dynamic_kernels_equal_their_twins() {
+    use common::runners::{accelerate_gpu, inertial_scale_gpu, predict_gpu};
     use holewall::gpu::assemble::assemble_gpu;
-    use holewall::gpu::dynamics::{accelerate_gpu, inertial_scale_gpu, predict_gpu};
     use holewall::kernels::assemble::{assemble, AssemblyInputs, DynamicInputs, NO_SITE};
     use holewall::kernels::dynamics::{
         accelerate, inertial_scale, predict, StepCoefficients, TOP_LEN,
@@ -418,7 +418,7 @@ fn dynamic_kernels_equal_their_twins() {
         &acc_twin,
     );
     let scale_gpu = inertial_scale_gpu(ctx, &mass, &vdot, n, v).unwrap();
-    let sites_gpu = holewall::gpu::batch::gather_sites_dynamic_gpu(
+    let sites_gpu = common::runners::gather_sites_dynamic_gpu(
         ctx,
         &pair_node,
         &pair_normals,

@@ -5,7 +5,7 @@
 
 mod common;
 
-use holewall::gpu::update::{norms_gpu, update_gpu};
+use common::runners::{norms_gpu, update_gpu};
 use holewall::kernels::update::{norms, update, ConfigBatch, UpdateWalls};
 use holewall::physics::beam::rotation_exp;
 use rand::{Rng, SeedableRng};

@@ -56,45 +56,10 @@ pub fn assemble_shift_wgsl(f64: bool, force_only: bool, masked: bool) -> Result<
     )
 }
 
-/// The static residual of every variant on the GPU (the kernel built `FORCE_ONLY`), laid
-/// out as the twin's `rhs`.
-pub fn assemble_residual_gpu<T: GpuReal>(
-    ctx: &'static GpuContext,
-    a: &AssemblyInputs<T>,
-) -> Result<Vec<T>, GpuError> {
-    crate::gpu::contact::require_precision::<T>(ctx)?;
-    if a.dynamic.is_some() {
-        return Err(GpuError::Unsupported(
-            "the residual-only assembly is static".into(),
-        ));
-    }
-    let (n, nv) = (a.num_nodes, a.num_variants);
-    let size = std::mem::size_of::<T>();
-    let wgsl = match a.shift {
-        Some(_) => assemble_shift_wgsl(T::IS_F64, true, false)?,
-        None => assemble_force_wgsl(T::IS_F64, false)?,
-    };
-    let pipeline = ctx.pipeline("assemble_force", &wgsl)?;
-    let (dims, inputs) = static_bindings(a, false);
-    // The shift's bindings follow the output in the kernel: passed after it (read only).
-    let mut outputs = vec![Out::Empty(6 * n * nv * size)];
-    outputs.extend(shift_bindings(a));
-    let out = run_once(
-        ctx,
-        &pipeline,
-        "assemble_force",
-        bytemuck::bytes_of(&dims),
-        &inputs,
-        &outputs,
-        n * nv,
-    )?;
-    Ok(crate::gpu::readback::values(&out[0]))
-}
-
 /// The shift's inputs of `a` (`shift`, `anchor`, `x`), empty without one: bound after
 /// the kernel's outputs, so passed as outputs that start with them (the kernel only reads
 /// them).
-fn shift_bindings<T: GpuReal>(a: &AssemblyInputs<T>) -> Vec<Out<'_>> {
+pub fn shift_bindings<T: GpuReal>(a: &AssemblyInputs<T>) -> Vec<Out<'_>> {
     a.shift
         .iter()
         .flat_map(|sh| {
@@ -109,7 +74,10 @@ fn shift_bindings<T: GpuReal>(a: &AssemblyInputs<T>) -> Vec<Out<'_>> {
 
 /// The dimensions and the static inputs (bindings 1–8, or 1–7 without the tangents) of
 /// the assembly of `a`.
-fn static_bindings<T: GpuReal>(a: &AssemblyInputs<T>, tangent: bool) -> (AssembleDims, Vec<&[u8]>) {
+pub fn static_bindings<T: GpuReal>(
+    a: &AssemblyInputs<T>,
+    tangent: bool,
+) -> (AssembleDims, Vec<&[u8]>) {
     let dims = AssembleDims {
         num_variants: a.num_variants as u32,
         num_nodes: a.num_nodes as u32,

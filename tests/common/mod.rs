@@ -3,6 +3,8 @@
 
 use holewall::gpu::GpuContext;
 
+pub mod runners;
+
 /// The shared GPU context. With `HOLEWALL_REQUIRE_GPU=1` (CI) a missing adapter fails the
 /// test; otherwise the test is skipped, loudly.
 pub fn gpu() -> Option<&'static GpuContext> {

@@ -21,7 +21,7 @@ use crate::gpu::contact::{require_precision, GpuReal};
 use crate::gpu::dispatch::WORKGROUP;
 use crate::gpu::kernel::Kernel;
 use crate::gpu::layout::{AssembleDims, BeamDims, ChainDims, ContactDims};
-use crate::gpu::readback::{submit_and_read, values};
+use crate::gpu::readback::values;
 use crate::gpu::GpuContext;
 use crate::kernels::contact::{OUTPUT_LEN, STATE_LEN};
 use crate::kernels::update::{ConfigBatch, Norms};
@@ -32,8 +32,8 @@ mod common;
 mod dynamic;
 mod iteration;
 use common::Common;
-pub use dynamic::{gather_sites_dynamic_gpu, GpuDynamic};
-pub use iteration::{gather_sites_gpu, sites_trial_wgsl, sites_wgsl, sites_wgsl_for};
+pub use dynamic::GpuDynamic;
+pub use iteration::{sites_trial_wgsl, sites_wgsl, sites_wgsl_for};
 
 /// Status the block solve starts with; still there afterwards means it did not finish.
 const RUNNING: u32 = 2;
@@ -214,8 +214,9 @@ fn param_block<U: bytemuck::Pod>(ctx: &GpuContext, label: &str, u: &U) -> wgpu::
         })
 }
 
-/// A bind group with `buffers` at bindings 0, 1, … in order.
-fn bind(
+/// A bind group with `buffers` at bindings 0, 1, … in order (the batches', and the
+/// one-shot runners' of the tests).
+pub fn bind(
     ctx: &GpuContext,
     pipeline: &wgpu::ComputePipeline,
     label: &str,
@@ -236,7 +237,8 @@ fn bind(
     })
 }
 
-fn dispatch(
+/// Records `pipeline` on `group` for `invocations` invocations (none: nothing).
+pub fn dispatch(
     pass: &mut wgpu::ComputePass,
     pipeline: &wgpu::ComputePipeline,
     group: &wgpu::BindGroup,
@@ -512,7 +514,8 @@ fn record_chain<'b>(
     }
 }
 
-fn encoder(ctx: &GpuContext, label: &str) -> wgpu::CommandEncoder {
+/// A command encoder on `ctx`'s device.
+pub fn encoder(ctx: &GpuContext, label: &str) -> wgpu::CommandEncoder {
     ctx.device
         .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(label) })
 }
