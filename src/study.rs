@@ -20,7 +20,7 @@ use crate::case::{load_case, Case};
 use crate::ensemble::qoi::{Status, VariantResult};
 use crate::ensemble::Variant;
 use crate::error::{Error, InputError};
-use crate::keys::{Key, Value};
+use crate::keys::Key;
 use crate::output::RunFolder;
 
 /// Options of `holewall study precision`.
@@ -452,15 +452,12 @@ pub struct StabilitySummary {
     pub map: Vec<StabilityCell>,
 }
 
-/// A cell: (parameter, value in words, overrides, time-step factor).
-type Cell = (String, String, Vec<(Key, Value)>, f64);
+/// A cell: (parameter, value in words, overrides (key, SI value), time-step factor).
+type Cell = (String, String, Vec<(Key, f64)>, f64);
 
 /// The override of key `name` (one of the study's own) by the SI value `x`.
-fn set(name: &str, x: f64) -> (Key, Value) {
-    (
-        Key::parse(name).expect("the study's keys are keys"),
-        Value::Number(x),
-    )
+fn set(name: &str, x: f64) -> (Key, f64) {
+    (Key::parse(name).expect("the study's keys are keys"), x)
 }
 
 /// The cells: one parameter at a time around the case (wall stiffness 1e5 … 1e11, spring
@@ -470,7 +467,7 @@ fn set(name: &str, x: f64) -> (Key, Value) {
 fn stability_cells(case: &Case) -> Vec<Cell> {
     let mut cells = Vec::new();
     let one = |p: &str, x: f64, text: String| (p.to_string(), text, vec![set(p, x)], 1.0);
-    for (m, m_text) in [(2.0 / 3.0, "0.6667"), (1.0, "1"), (1.5, "1.5")] {
+    for (m, m_text) in [(0.6667, "0.6667"), (1.0, "1"), (1.5, "1.5")] {
         for k in [1e5, 1e6, 1e7, 1e8, 1e9, 1e10, 1e11] {
             cells.push((
                 format!("k_e at m = {m_text}"),
@@ -555,21 +552,29 @@ pub fn stability(
                 d.output_interval = d.output_interval.max(d.time_step).min(duration);
             }
             let clock = std::time::Instant::now();
-            let result = crate::ensemble::apply(
-                &this,
-                &Variant {
-                    name: "cell".into(),
-                    overrides: overrides.clone(),
-                },
-            )
-            .map_err(|e| e.to_string())
-            .map(|model| match analysis {
-                "static" => (
-                    crate::ensemble::qoi::static_variant(&this, "cell", &model),
-                    None,
-                ),
-                _ => crate::ensemble::qoi::dynamic_variant_tracked(&this, "cell", &model, true),
-            });
+            // Each value checked against its key's range, as a variant's.
+            let result = overrides
+                .iter()
+                .map(|(k, x)| k.si(*x).map(|v| (k.clone(), v)))
+                .collect::<Result<Vec<_>, _>>()
+                .map_err(|e| e.to_string())
+                .and_then(|overrides| {
+                    crate::ensemble::apply(
+                        &this,
+                        &Variant {
+                            name: "cell".into(),
+                            overrides,
+                        },
+                    )
+                    .map_err(|e| e.to_string())
+                })
+                .map(|model| match analysis {
+                    "static" => (
+                        crate::ensemble::qoi::static_variant(&this, "cell", &model),
+                        None,
+                    ),
+                    _ => crate::ensemble::qoi::dynamic_variant_tracked(&this, "cell", &model, true),
+                });
             bar.inc(1);
             let seconds = clock.elapsed().as_secs_f64();
             match result {
