@@ -159,18 +159,24 @@ pub fn run(
         Some(p) => crate::ensemble::measured::read_measured(p)?,
         None => Vec::new(),
     };
-    // Check every variant against the case before any work.
+    // Check every variant against the case before any work, keeping what it runs with
+    // for `variants.csv` (the report does not build the model again).
+    let stabs = case.model.stabilizer_sites().len();
+    let mut ran_rows = Vec::with_capacity(variants.len());
     for v in &variants {
-        if let Err(e) = apply(&case, v) {
-            return Err(InputError {
-                source_name: variants_file
-                    .map(|p| p.display().to_string())
-                    .unwrap_or_else(|| case_path.display().to_string()),
-                line: 0,
-                key: format!("variant {}", v.name),
-                message: e.to_string(),
+        match apply(&case, v) {
+            Ok(model) => ran_rows.push(crate::ensemble::report::ran_row(&model, stabs)),
+            Err(e) => {
+                return Err(InputError {
+                    source_name: variants_file
+                        .map(|p| p.display().to_string())
+                        .unwrap_or_else(|| case_path.display().to_string()),
+                    line: 0,
+                    key: format!("variant {}", v.name),
+                    message: e.to_string(),
+                }
+                .into())
             }
-            .into());
         }
     }
     // The output folder, checked (and the run's manifest written) before any work.
@@ -304,12 +310,11 @@ pub fn run(
         seconds += chunk.seconds;
         results.extend(chunk.results);
     }
-    let stabs = case.model.stabilizer_sites().len();
     let dynamic = analysis == Analysis::Dynamic;
     let mut outputs = vec!["variants.csv".to_string()];
     write_atomic(
         &out.join("variants.csv"),
-        &variants_csv(&case, &variants, &results, stabs, dynamic)?,
+        &variants_csv(&case, &variants, &ran_rows, &results, stabs, dynamic)?,
     )?;
     let uncertainty = match monte_carlo {
         Some(mc) => {

@@ -9,6 +9,7 @@ use super::qoi::*;
 use crate::case::Case;
 use crate::ensemble::Variant;
 use crate::error::Error;
+use crate::model::Model;
 
 /// The command's summary.
 #[derive(Clone, Debug, Serialize)]
@@ -127,14 +128,17 @@ pub(crate) fn fmt(x: f64) -> String {
     }
 }
 
+/// `variants.csv`: per variant its overrides, what it ran with (`ran_rows`, [`ran_row`]) and
+/// its quantities.
 pub(crate) fn variants_csv(
     case: &Case,
     variants: &[Variant],
+    ran_rows: &[Vec<String>],
     results: &[VariantResult],
     stabs: usize,
     dynamic: bool,
 ) -> Result<Vec<u8>, Error> {
-    let (ran_header, ran_rows) = ran_with(case, variants, stabs);
+    let ran_header = ran_header(stabs);
     let io = Error::from;
     let mut keys: Vec<String> = Vec::new();
     for v in variants {
@@ -195,7 +199,12 @@ pub(crate) fn variants_csv(
     header.extend(["newton_iterations_per_step", "step_cuts"].map(String::from));
     let mut w = csv::Writer::from_writer(Vec::new());
     w.write_record(&header).map_err(io)?;
-    for (i, ((v, r), ran)) in variants.iter().zip(results).zip(ran_rows).enumerate() {
+    for (i, ((v, r), ran)) in variants
+        .iter()
+        .zip(results)
+        .zip(ran_rows.iter().cloned())
+        .enumerate()
+    {
         let mut row = vec![i.to_string(), v.name.clone()];
         let overrides_end = row.len() + keys.len();
         for k in &keys {
@@ -302,10 +311,10 @@ pub(crate) fn uncertainty_report(
     Ok((report, files))
 }
 
-/// The values every variant ran with (not only its overrides), SI: bit depth, rotary speed,
-/// weight and torque on bit, and per stabilizer its distance from the bit, blade diameter,
-/// friction and wall stiffness — read from the variant's own model.
-fn ran_with(case: &Case, variants: &[Variant], stabs: usize) -> (Vec<String>, Vec<Vec<String>>) {
+/// The columns of what every variant ran with (not only its overrides), SI: bit depth,
+/// rotary speed, weight and torque on bit, and per stabilizer its distance from the bit,
+/// blade diameter, friction and wall stiffness ([`ran_row`]).
+fn ran_header(stabs: usize) -> Vec<String> {
     let mut header: Vec<String> = [
         "ran.bit_md_m",
         "ran.rotation_speed_rad_s",
@@ -319,34 +328,31 @@ fn ran_with(case: &Case, variants: &[Variant], stabs: usize) -> (Vec<String>, Ve
             header.push(format!("ran.stab{k}.{f}"));
         }
     }
-    let rows = variants
-        .iter()
-        .map(|v| match crate::ensemble::apply(case, v) {
-            Err(_) => vec![String::new(); header.len()],
-            Ok(m) => {
-                let bit = m.nodes.last().map_or(f64::NAN, |n| n.md);
-                let mut row = vec![
-                    fmt(bit),
-                    fmt(m.rotation_speed),
-                    fmt(m.weight_on_bit),
-                    fmt(m.torque_on_bit),
-                ];
-                let sites = m.stabilizer_sites();
-                for k in 0..stabs {
-                    match sites.get(k).map(|&s| &m.sites[s]) {
-                        Some(site) => row.extend([
-                            fmt(bit - m.nodes[site.node].md),
-                            fmt(2.0 * site.params.disk_radius),
-                            fmt(site.params.mu_t),
-                            fmt(site.params.mu_l),
-                            fmt(site.params.wall_stiffness),
-                        ]),
-                        None => row.extend(vec![String::new(); 5]),
-                    }
-                }
-                row
-            }
-        })
-        .collect();
-    (header, rows)
+    header
+}
+
+/// One variant's row of [`ran_header`], read from the model it runs (`holewall ensemble`
+/// records it when it checks the variant, so the report does not build the model again).
+pub(crate) fn ran_row(m: &Model, stabs: usize) -> Vec<String> {
+    let bit = m.nodes.last().map_or(f64::NAN, |n| n.md);
+    let mut row = vec![
+        fmt(bit),
+        fmt(m.rotation_speed),
+        fmt(m.weight_on_bit),
+        fmt(m.torque_on_bit),
+    ];
+    let sites = m.stabilizer_sites();
+    for k in 0..stabs {
+        match sites.get(k).map(|&s| &m.sites[s]) {
+            Some(site) => row.extend([
+                fmt(bit - m.nodes[site.node].md),
+                fmt(2.0 * site.params.disk_radius),
+                fmt(site.params.mu_t),
+                fmt(site.params.mu_l),
+                fmt(site.params.wall_stiffness),
+            ]),
+            None => row.extend(vec![String::new(); 5]),
+        }
+    }
+    row
 }
