@@ -171,23 +171,110 @@ pub fn fe_rows(
     (rows, hook, torque, wob)
 }
 
-/// The FE static solution of a case, with a progress bar (load factor reached) when
-/// `show_progress`, within `options.max_seconds`; a failure says why
-/// ([`crate::diagnose::static_failure`]).
-pub fn solve_with_progress(
+/// How many times [`solve_in_hole`] solves a string again with contact added where it met
+/// the wall, before it gives its answer as it is (warned: [`crate::diagnose::through_wall`]).
+pub const WALL_ROUNDS: usize = 4;
+
+/// The words a solution's log says sites were added with ([`solve_in_hole`]).
+pub const WALL_CONTACT: &str = "contact added where the string met the wall";
+
+/// The FE static solution of `model` (the case's, or a variant's of it) with the string
+/// held in the hole wherever it meets the wall. Where the case has contact sites at its
+/// stabilizers only (`contact.sites = "stabilizers"`), a compressed or sagging string
+/// between them can bow out through the wall, which nothing there stops
+/// ([`crate::diagnose::through_wall`]); so every node a solution puts beyond the wall
+/// ([`crate::diagnose::beyond_wall`]) gets a pipe-body contact site — the case's wall law
+/// ([`Case::contact`]), the disk of the wider adjacent element (tool joints included), the
+/// hole section's friction — and the string is solved again from the start, at most
+/// [`WALL_ROUNDS`] times. `model` keeps the sites added, and the solution's log says where
+/// (every later output — profile, contact sites, a dynamic run from it — sees them).
+/// `options.max_seconds` bounds all the solves together.
+///
+/// `add(model, nodes)` gives `model` its sites at `nodes` ([`add_wall_sites`] for a case's
+/// model; a variant's applies its own overrides to them too,
+/// [`crate::ensemble::apply_with_sites`]).
+pub fn solve_in_hole(
     case: &Case,
+    model: &mut Model,
+    add: &mut dyn FnMut(&mut Model, &[usize]),
+    options: &crate::solve::statics::StaticOptions,
+    progress: &mut dyn FnMut(f64),
+) -> Result<crate::solve::statics::StaticSolution, crate::solve::statics::StaticError> {
+    let clock = std::time::Instant::now();
+    let mut notes = Vec::new();
+    let mut round = 0;
+    loop {
+        let mut options = *options;
+        options.max_seconds = options
+            .max_seconds
+            .map(|s| (s - clock.elapsed().as_secs_f64()).max(0.0));
+        let mut sol = crate::solve::statics::solve_static_started(model, &options, progress)?;
+        let beyond = crate::diagnose::beyond_wall(case, model, &sol.state.x);
+        if beyond.is_empty() || round == WALL_ROUNDS {
+            sol.log.extend(notes);
+            return Ok(sol);
+        }
+        round += 1;
+        let nodes: Vec<usize> = beyond.iter().map(|(i, _)| *i).collect();
+        let (first, last) = (
+            model.nodes[nodes[0]].md,
+            model.nodes[nodes[nodes.len() - 1]].md,
+        );
+        let deepest = beyond.iter().map(|(_, e)| *e).fold(0.0, f64::max);
+        add(model, &nodes);
+        notes.push(format!(
+            "{WALL_CONTACT}: {} pipe-body nodes between MD {first:.0} m and {last:.0} m (up \
+             to {:.0} mm beyond it without), solved again",
+            nodes.len(),
+            1e3 * deepest
+        ));
+    }
+}
+
+/// Pipe-body contact sites at `nodes` of `model` (the case's or a variant's of it), as
+/// [`solve_in_hole`] adds them where the string meets the wall: the case's wall law, the
+/// disk of the wider adjacent element (tool joints included: the radius
+/// [`crate::diagnose::beyond_wall`] measures the clearance with), the hole section's
+/// diameter and friction.
+pub fn add_wall_sites(case: &Case, model: &mut Model, nodes: &[usize]) {
+    let radii: Vec<f64> = (0..model.nodes.len())
+        .map(|i| model.pipe_radius_at(i))
+        .collect();
+    crate::model::add_sites(
+        model,
+        nodes,
+        |md| 0.5 * case.hole_at(md).diameter,
+        |i| radii[i],
+        |md| case.hole_at(md).friction,
+        &case.contact,
+        false,
+    );
+    model.sites.sort_by_key(|s| s.node);
+}
+
+/// The FE static solution of a case, with a progress bar (load factor reached) when
+/// `show_progress`, within `options.max_seconds`, with the string held in the hole wherever
+/// it meets the wall ([`solve_in_hole`]: the case's model keeps the sites added); a failure
+/// says why ([`crate::diagnose::static_failure`]).
+pub fn solve_with_progress(
+    case: &mut Case,
     options: crate::solve::statics::StaticOptions,
     show_progress: bool,
 ) -> Result<crate::solve::statics::StaticSolution, crate::error::Error> {
-    let model = &case.model;
     let bar = crate::output::progress_bar(
         show_progress,
         1000,
         "{bar:40} {percent:>3}% of the loads (static), {elapsed} elapsed",
     );
-    let solved = crate::solve::statics::solve_static_started(model, &options, &mut |lambda| {
-        bar.set_position((1000.0 * lambda) as u64)
-    });
+    let mut model = case.model.clone();
+    let solved = solve_in_hole(
+        case,
+        &mut model,
+        &mut |m, nodes| add_wall_sites(case, m, nodes),
+        &options,
+        &mut |lambda| bar.set_position((1000.0 * lambda) as u64),
+    );
     bar.finish_and_clear();
+    case.model = model;
     solved.map_err(|e| crate::error::Error::Failed(crate::diagnose::static_failure(case, &e)))
 }

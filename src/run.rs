@@ -180,15 +180,19 @@ pub fn run_case(case: &Case, out: &Path, run_options: RunOptions) -> Result<RunS
     let settings = case.dynamics.clone().ok_or_else(|| {
         Error::Input(InputError { source_name: case_path.display().to_string(), line: 1, key: "dynamics".into(), message: "holewall run needs a [dynamics] table (duration, time_step, …); see cases/README.md".into() })
     })?;
-    let model = &case.model;
+    // The static start gives the model contact sites wherever the string meets the wall
+    // (`profile::solve_in_hole`); the run is of that model.
+    let mut held = case.clone();
     let start = crate::profile::solve_with_progress(
-        case,
+        &mut held,
         case.settings()
             .with_max_seconds(run_options.max_seconds)
             .statics(),
         show_progress,
     )
     .map_err(|e| Error::failed(format!("static start: {e}")))?;
+    let case = &held;
+    let model = &case.model;
     let options = case.settings().dynamics();
     let density = case.element_density.clone();
     let mut dynamics = Dynamics::new(model, options, &|e| density[e]);

@@ -557,20 +557,19 @@ pub fn stability(
                 .iter()
                 .map(|(k, x)| k.si(*x).map(|v| (k.clone(), v)))
                 .collect::<Result<Vec<_>, _>>()
-                .map_err(|e| e.to_string())
-                .and_then(|overrides| {
-                    crate::ensemble::apply(
-                        &this,
-                        &Variant {
-                            name: "cell".into(),
-                            overrides,
-                        },
-                    )
-                    .map_err(|e| e.to_string())
+                .map(|overrides| Variant {
+                    name: "cell".into(),
+                    overrides,
                 })
-                .map(|model| match analysis {
+                .map_err(|e| e.to_string())
+                .and_then(|variant| {
+                    crate::ensemble::apply(&this, &variant)
+                        .map(|model| (variant, model))
+                        .map_err(|e| e.to_string())
+                })
+                .map(|(variant, model)| match analysis {
                     "static" => (
-                        crate::ensemble::qoi::static_variant(&this, "cell", &model),
+                        crate::ensemble::qoi::static_variant_of(&this, &variant, &model),
                         None,
                     ),
                     _ => crate::ensemble::qoi::dynamic_variant_tracked(&this, "cell", &model, true),

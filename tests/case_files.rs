@@ -655,9 +655,9 @@ fn runs_can_be_bounded_in_wall_time() {
     ]);
     assert_eq!(code, 2);
     // The FE solve's budget: stopped after its first iteration, with how far it got.
-    let case = holewall::case::load_case(&root().join("cases/build_and_hold.toml")).unwrap();
+    let mut case = holewall::case::load_case(&root().join("cases/build_and_hold.toml")).unwrap();
     let e = holewall::profile::solve_with_progress(
-        &case,
+        &mut case,
         holewall::solve::statics::StaticOptions {
             max_seconds: Some(1e-9),
             ..Default::default()

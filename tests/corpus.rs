@@ -4,7 +4,8 @@
 //!
 //! What fails here is a result, not noise: the count of solved wells may only rise (raise
 //! `SOLVED_AT_LEAST` with the solver), a well solved outside its hole
-//! (`holewall::diagnose::through_wall`) does not count as solved, and every solved well must
+//! (`holewall::diagnose::through_wall`: after `profile::solve_in_hole` added contact where
+//! the string met the wall, none should be) does not count as solved, and every solved well must
 //! agree with the soft string on the hook load as a stiff string does.
 
 mod common;
@@ -204,10 +205,11 @@ fn corpus_wells_through_the_engine_match_the_cpu() {
 /// start could not pass (each failed with it: the relaxation spent its budget), and that the
 /// floor of 1e-5 (`continuation::RELAX_FLOOR`) solves: seed 206 (horizontal, tripping in,
 /// 10 m elements) relaxes past a fold of the load steps, seed 372 (near-vertical, sliding,
-/// stabilizer-only contact) in the gravity stage. Both must end relaxed, with the hook load
-/// within 7 % of the soft string's. Seed 372's answer lies metres outside its hole above the
-/// stabilizers, which nothing holds there (`diagnose::through_wall`): it must be reported
-/// so, and 206's (contact at every node) must not.
+/// stabilizer-only contact) in the gravity stage. Both must solve (206 relaxed), with the
+/// hook load within 7 % of the soft string's. Seed 372's string meets the wall above its stabilizers,
+/// where it has no contact site (it lay metres outside its hole before contact was added
+/// there: `diagnose::through_wall`): it must end in the hole with sites added there
+/// (`profile::solve_in_hole`), and 206 (contact at every node) with none.
 #[test]
 fn folds_beyond_the_sample_solve_by_relaxation() {
     let dir = tempdir::Dir::new("corpus_folds");
@@ -225,12 +227,17 @@ fn folds_beyond_the_sample_solve_by_relaxation() {
             r.error
         );
         assert!(r.solved, "seed {seed}: {}", r.error);
-        assert!(r.relaxed, "seed {seed}: solved without relaxing");
+        // 372 relaxes in its first solve; held at the wall, its last solve needs none.
+        assert!(
+            r.relaxed || seed == 372,
+            "seed {seed}: solved without relaxing"
+        );
+        assert_eq!(r.through_wall_mm, 0.0, "seed {seed}: outside the hole");
         assert_eq!(
-            r.through_wall_mm > 1e3,
+            r.wall_sites > 0,
             seed == 372,
-            "seed {seed}: {} mm outside the hole",
-            r.through_wall_mm
+            "seed {seed}: {} sites added at the wall",
+            r.wall_sites
         );
         assert!(
             (r.hook_load_ratio - 1.0).abs() <= 0.07,

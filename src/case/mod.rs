@@ -52,6 +52,10 @@ pub struct Case {
     pub element_density: Vec<f64>,
     /// `[dynamics]`, if given.
     pub dynamics: Option<DynamicsSettings>,
+    /// The `[contact]` wall law (stiffness, exponent, damping, ε): that of every site the
+    /// case makes, and of those a static solve adds where the string meets the wall
+    /// ([`crate::profile::solve_in_hole`]).
+    pub contact: ContactSettings,
     /// `[ensemble]`, if given.
     pub ensemble: Option<EnsembleSettings>,
     /// `[tendency]`, with its defaults when absent.
@@ -634,6 +638,7 @@ fn build_case(path: &Path, mut source: CaseSource) -> Result<Case, InputError> {
         mud_inside_density: mud_inside,
         element_density,
         dynamics,
+        contact: settings,
         warnings,
     })
 }

@@ -52,15 +52,13 @@ pub fn run(
     options: CriticalCommandOptions,
 ) -> Result<CriticalSummary, Error> {
     let start = std::time::Instant::now();
-    let case = load_case(case_path)?;
+    let mut case = load_case(case_path)?;
     super::print_warnings(&case);
     let folder = RunFolder::prepare(out)?.with_report("critical-speeds", case_path);
+    let statics = case.settings().statics();
+    let sol = crate::profile::solve_with_progress(&mut case, statics, options.show_progress)?;
+    let case = case;
     let model = &case.model;
-    let sol = crate::profile::solve_with_progress(
-        &case,
-        case.settings().statics(),
-        options.show_progress,
-    )?;
     let first =
         crate::bha::tendency::bha_model_top(model, case.bha_length, &case.tendency.settings);
     let opts = CriticalOptions {

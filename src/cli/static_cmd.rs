@@ -92,9 +92,25 @@ pub fn run(
     options: StaticCommandOptions,
 ) -> Result<Summary, Error> {
     let start = std::time::Instant::now();
-    let case = load_case(case_path)?;
+    let mut case = load_case(case_path)?;
     super::print_warnings(&case);
     let folder = RunFolder::prepare(out)?.with_report("static", case_path);
+    // The FE solve first: it gives the case's model contact sites wherever the string meets
+    // the wall (`profile::solve_in_hole`), and every output below reads that model.
+    let fe = match which {
+        StaticModel::Fe => {
+            let statics = case
+                .settings()
+                .with_max_seconds(options.max_seconds)
+                .statics();
+            Some(
+                solve_with_progress(&mut case, statics, options.show_progress)
+                    .map_err(Error::failed)?,
+            )
+        }
+        StaticModel::SoftString => None,
+    };
+    let case = case;
     let model = &case.model;
     let n = model.nodes.len();
     let mut wob = model.weight_on_bit;
@@ -104,14 +120,7 @@ pub fn run(
     let mut through_wall = None;
     let (rows, hook, torque, its) = match which {
         StaticModel::Fe => {
-            let sol = solve_with_progress(
-                &case,
-                case.settings()
-                    .with_max_seconds(options.max_seconds)
-                    .statics(),
-                options.show_progress,
-            )
-            .map_err(Error::failed)?;
+            let sol = fe.ok_or(Error::failed("no FE solution"))?;
             let (rows, hook, torque, w) = fe_rows(model, &sol);
             through_wall = crate::diagnose::through_wall_warning(&case, model, &sol.state.x);
             wob = w;

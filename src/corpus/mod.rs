@@ -565,6 +565,9 @@ pub struct WellResult {
     /// Solved: how far the FE string lies outside the hole where no contact site holds it
     /// (mm; 0 inside it: [`crate::diagnose::through_wall`]). NaN when not solved.
     pub through_wall_mm: f64,
+    /// Pipe-body contact sites the solve added where the string met the wall
+    /// ([`crate::profile::solve_in_hole`]; 0 with contact at every node).
+    pub wall_sites: usize,
     /// FE / soft-string hook load.
     pub hook_load_ratio: f64,
     /// FE surface torque (N·m).
@@ -588,16 +591,25 @@ pub fn run_well(
     well: &CorpusWell,
     options: &crate::solve::statics::StaticOptions,
 ) -> Result<WellResult, Error> {
-    let case = crate::case::load_case(&well.case_path)?;
-    let model = &case.model;
+    let mut case = crate::case::load_case(&well.case_path)?;
     let soft = case.soft_string();
     let clock = std::time::Instant::now();
-    // Every Newton iteration the load path runs, those of failed tries and relaxation
-    // sub-solves included (the progress callback is called once per iteration).
+    // Every Newton iteration the load path runs, those of failed tries, relaxation
+    // sub-solves and solves again with contact added at the wall included (the progress
+    // callback is called once per iteration).
     let mut newton_iterations = 0usize;
-    let solved = crate::solve::statics::solve_static_started(model, options, &mut |_| {
-        newton_iterations += 1
-    });
+    let mut model = case.model.clone();
+    let sites_before = model.sites.len();
+    let solved = crate::profile::solve_in_hole(
+        &case,
+        &mut model,
+        &mut |m, nodes| crate::profile::add_wall_sites(&case, m, nodes),
+        options,
+        &mut |_| newton_iterations += 1,
+    );
+    let wall_sites = model.sites.len() - sites_before;
+    case.model = model;
+    let model = &case.model;
     let seconds = clock.elapsed().as_secs_f64();
     let rotating = model.rotation_speed != 0.0;
     let mut r = WellResult {
@@ -617,6 +629,7 @@ pub fn run_well(
         lock_up_fraction: crate::diagnose::lock_up_fraction(&case).unwrap_or(f64::NAN),
         fe_reached: 0.0,
         through_wall_mm: f64::NAN,
+        wall_sites,
         hook_load_ratio: f64::NAN,
         fe_torque_nm: f64::NAN,
         soft_torque_nm: soft.surface_torque(),
@@ -634,7 +647,11 @@ pub fn run_well(
             r.through_wall_mm = crate::diagnose::through_wall(&case, model, &sol.state.x)
                 .map_or(0.0, |t| 1e3 * t.excess_m);
             r.load_steps = sol.iterations.len();
-            r.step_cuts = sol.log.len();
+            r.step_cuts = sol
+                .log
+                .iter()
+                .filter(|l| !l.starts_with(crate::profile::WALL_CONTACT))
+                .count();
             r.relaxed = sol
                 .log
                 .iter()

@@ -317,13 +317,44 @@ pub fn through_wall(
     model: &Model,
     x: &[crate::physics::vec3::Vec3<f64>],
 ) -> Option<ThroughWall> {
+    let mut out: Option<ThroughWall> = None;
+    for (i, excess) in beyond_wall(case, model, x) {
+        if excess <= THROUGH_WALL_TOLERANCE {
+            continue;
+        }
+        let md = model.nodes[i].md;
+        let t = out.get_or_insert(ThroughWall {
+            md,
+            excess_m: excess,
+            nodes: 0,
+            first_md: md,
+            last_md: md,
+        });
+        t.nodes += 1;
+        t.last_md = md;
+        if excess > t.excess_m {
+            t.excess_m = excess;
+            t.md = md;
+        }
+    }
+    out
+}
+
+/// Every node of `x` without a contact site that lies beyond the wall of `case`'s hole at
+/// all, with how far (m), measured as [`through_wall`] measures it (there: only those
+/// beyond [`THROUGH_WALL_TOLERANCE`] count). The nodes a static solve gives contact sites
+/// ([`crate::profile::solve_in_hole`]).
+pub fn beyond_wall(
+    case: &Case,
+    model: &Model,
+    x: &[crate::physics::vec3::Vec3<f64>],
+) -> Vec<(usize, f64)> {
     use crate::physics::vec3::{dot, scale, sub};
     let mut held = vec![false; model.nodes.len()];
     for site in &model.sites {
         held[site.node] = true;
     }
-    let n = model.nodes.len();
-    let mut out: Option<ThroughWall> = None;
+    let mut out = Vec::new();
     for (i, node) in model.nodes.iter().enumerate() {
         if held[i] {
             continue;
@@ -331,27 +362,9 @@ pub fn through_wall(
         let d = sub(&x[i], &node.position);
         let d_t = sub(&d, &scale(&node.hole_axis, dot(&d, &node.hole_axis)));
         let offset = dot(&d_t, &d_t).sqrt();
-        let diameter = [i.checked_sub(1), (i + 1 < n).then_some(i)]
-            .into_iter()
-            .flatten()
-            .map(|e| model.elements[e].contact_diameter)
-            .fold(0.0, f64::max);
-        let excess = offset - 0.5 * (case.hole_at(node.md).diameter - diameter);
-        if excess <= THROUGH_WALL_TOLERANCE {
-            continue;
-        }
-        let t = out.get_or_insert(ThroughWall {
-            md: node.md,
-            excess_m: excess,
-            nodes: 0,
-            first_md: node.md,
-            last_md: node.md,
-        });
-        t.nodes += 1;
-        t.last_md = node.md;
-        if excess > t.excess_m {
-            t.excess_m = excess;
-            t.md = node.md;
+        let excess = offset - (0.5 * case.hole_at(node.md).diameter - model.pipe_radius_at(i));
+        if excess > 0.0 {
+            out.push((i, excess));
         }
     }
     out
@@ -367,14 +380,15 @@ pub fn through_wall_warning(
     let t = through_wall(case, model, x)?;
     Some(format!(
         "the string lies outside the hole at {} nodes without a contact site between MD \
-         {:.0} m and {:.0} m, up to {:.0} mm beyond the wall (at MD {:.0} m): nothing holds \
-         it there (contact.sites = \"stabilizers\"), so this is the equilibrium of a string \
+         {:.0} m and {:.0} m, up to {:.0} mm beyond the wall (at MD {:.0} m), after contact \
+         was added where it met the wall {} times: this is the equilibrium of a string partly \
          in no hole — its side forces and bending above all; use contact.sites = \"all_nodes\"",
         t.nodes,
         t.first_md,
         t.last_md,
         1e3 * t.excess_m,
         t.md,
+        crate::profile::WALL_ROUNDS,
     ))
 }
 

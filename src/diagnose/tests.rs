@@ -194,6 +194,61 @@ fn a_string_held_only_at_its_stabilizer_sags_through_the_wall() {
     assert_eq!(solve(&inclined_bha("all_nodes")), None);
 }
 
+/// The same string solved as every command solves it (`profile::solve_in_hole`): contact
+/// is added where it met the wall and it is solved again, in the hole, to the equilibrium
+/// of contact at every node (hook load to 1e-9, every node's position to 1e-6 m); the log
+/// says where. A string that stays in the hole gets no site.
+#[test]
+fn a_string_that_meets_the_wall_is_held_there() {
+    let held = |case: &Case| {
+        let mut model = case.model.clone();
+        let sol = crate::profile::solve_in_hole(
+            case,
+            &mut model,
+            &mut |m, nodes| crate::profile::add_wall_sites(case, m, nodes),
+            &crate::solve::statics::StaticOptions::default(),
+            &mut |_| {},
+        )
+        .expect("solves");
+        (model, sol)
+    };
+    let case = inclined_bha("stabilizers");
+    let (model, sol) = held(&case);
+    let added = model.sites.len() - case.model.sites.len();
+    eprintln!("{added} sites added; log {:?}", sol.log);
+    assert!(added > 10, "{added}");
+    assert_eq!(through_wall(&case, &model, &sol.state.x), None);
+    assert!(crate::diagnose::beyond_wall(&case, &model, &sol.state.x).is_empty());
+    assert!(sol
+        .log
+        .iter()
+        .any(|l| l.starts_with(crate::profile::WALL_CONTACT)));
+    let every = inclined_bha("all_nodes");
+    let reference = crate::solve::statics::solve_static(
+        &every.model,
+        &crate::solve::statics::StaticOptions::default(),
+    )
+    .expect("solves");
+    let hook = |m: &Model, s| crate::profile::fe_rows(m, s).1;
+    let (a, b) = (hook(&model, &sol), hook(&every.model, &reference));
+    assert!((a / b - 1.0).abs() < 1e-9, "{a} vs {b}");
+    let far = sol
+        .state
+        .x
+        .iter()
+        .zip(&reference.state.x)
+        .map(|(p, q)| (0..3).map(|k| (p[k] - q[k]).abs()).fold(0.0, f64::max))
+        .fold(0.0, f64::max);
+    assert!(far < 1e-6, "{far} m");
+    let vertical = vertical_bha(15.0, "stabilizers");
+    let (model, sol) = held(&vertical);
+    assert_eq!(model.sites.len(), vertical.model.sites.len());
+    assert!(!sol
+        .log
+        .iter()
+        .any(|l| l.starts_with(crate::profile::WALL_CONTACT)));
+}
+
 /// A solved profile of a load that locks up warns, with where and from which load factor;
 /// one that does not lock up does not.
 #[test]

@@ -204,10 +204,44 @@ pub(crate) fn finished(
     }
 }
 
-/// Static equilibrium of one variant's model.
+/// Static equilibrium of one model of the case (its own, or one made from it), held in the
+/// hole wherever it meets the wall ([`crate::profile::solve_in_hole`]: sites added there
+/// take the case's wall law).
 pub fn static_variant(case: &Case, name: &str, model: &Model) -> VariantResult {
-    match solve_static(model, &case.settings().statics()) {
-        Ok(sol) => static_result(case, name, model, &sol),
+    solve_held(case, name, model.clone(), &mut |m, nodes| {
+        crate::profile::add_wall_sites(case, m, nodes)
+    })
+}
+
+/// Static equilibrium of variant `v`'s model (`model`, [`crate::ensemble::apply`]), held in
+/// the hole wherever it meets the wall: the sites added there get the variant's overrides
+/// too ([`crate::ensemble::apply_with_sites`]).
+pub fn static_variant_of(
+    case: &Case,
+    v: &crate::ensemble::Variant,
+    model: &Model,
+) -> VariantResult {
+    let mut extra = Vec::new();
+    solve_held(case, &v.name, model.clone(), &mut |m, nodes| {
+        extra.extend_from_slice(nodes);
+        match crate::ensemble::apply_with_sites(case, v, &extra) {
+            Ok(with) => *m = with,
+            // Not reached: the variant applied to this case already, and pipe-body sites
+            // make none of its overrides fail; the sites then keep the case's law.
+            Err(_) => crate::profile::add_wall_sites(case, m, nodes),
+        }
+    })
+}
+
+fn solve_held(
+    case: &Case,
+    name: &str,
+    mut model: Model,
+    add: &mut dyn FnMut(&mut Model, &[usize]),
+) -> VariantResult {
+    let options = case.settings().statics();
+    match crate::profile::solve_in_hole(case, &mut model, add, &options, &mut |_| {}) {
+        Ok(sol) => static_result(case, name, &model, &sol),
         Err(e) => failed(name, e.to_string(), model.stabilizer_sites().len()),
     }
 }

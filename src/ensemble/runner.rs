@@ -49,6 +49,19 @@ pub fn run_static_gpu<T: crate::gpu::contact::GpuReal>(
         .into_par_iter()
         .zip(models.par_iter().zip(variants.par_iter()))
         .map(|(r, (m, v))| match r.status {
+            // The engine holds the string at its contact sites only: one that met the wall
+            // between them is solved again on the CPU with contact added there.
+            EngineStatus::Converged
+                if !crate::diagnose::beyond_wall(case, m, &r.state.x).is_empty() =>
+            {
+                let mut again = static_variant_of(case, v, m);
+                again.reason = format!(
+                    "GPU: the string met the wall between its contact sites; re-run on the \
+                     CPU: {}",
+                    again.reason
+                );
+                again
+            }
             EngineStatus::Converged => {
                 let mut sol = crate::solve::statics::solution_at(m, r.state);
                 sol.iterations = r.iterations;
@@ -58,7 +71,7 @@ pub fn run_static_gpu<T: crate::gpu::contact::GpuReal>(
                 done
             }
             EngineStatus::Failed(why) => {
-                let mut again = static_variant(case, &v.name, m);
+                let mut again = static_variant_of(case, v, m);
                 again.reason = format!("GPU: {why}; re-run on the CPU: {}", again.reason);
                 again
             }
@@ -229,7 +242,7 @@ pub fn run_variants_cpu(
             let r = match apply(case, v) {
                 Err(e) => failed(&v.name, format!("variant: {e}"), stabs),
                 Ok(model) => match analysis {
-                    Analysis::Static => static_variant(case, &v.name, &model),
+                    Analysis::Static => static_variant_of(case, v, &model),
                     Analysis::Dynamic => dynamic_variant(case, &v.name, &model),
                 },
             };

@@ -237,6 +237,17 @@ pub fn variants_from_grid(grid: &[(Key, Vec<Value>)]) -> Vec<Variant> {
 /// stabilizer's site goes to the node nearest its new distance from the bit; a pipe-body
 /// site there, if any, takes the old node), then values, in column order.
 pub fn apply(case: &Case, variant: &Variant) -> Result<Model, VariantError> {
+    apply_with_sites(case, variant, &[])
+}
+
+/// As [`apply`], with pipe-body contact sites at the nodes `extra` too
+/// ([`crate::profile::add_wall_sites`], where a solve found the variant's string beyond the
+/// wall: [`crate::profile::solve_in_hole`]) before the overrides, which so reach them.
+pub fn apply_with_sites(
+    case: &Case,
+    variant: &Variant,
+    extra: &[usize],
+) -> Result<Model, VariantError> {
     let rebuilt;
     let case = match variant_case(case, variant)? {
         Some(c) => {
@@ -278,7 +289,8 @@ pub fn apply(case: &Case, variant: &Variant) -> Result<Model, VariantError> {
         _ => variant,
     };
     let mut model = case.model.clone();
-    let stabs = case.model.stabilizer_sites();
+    crate::profile::add_wall_sites(case, &mut model, extra);
+    let stabs = model.stabilizer_sites();
     let stab = |k: usize| -> Result<usize, VariantError> {
         stabs
             .get(k - 1)
