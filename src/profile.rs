@@ -186,7 +186,9 @@ pub const WALL_CONTACT: &str = "contact added where the string met the wall";
 /// ([`crate::diagnose::beyond_wall`]) gets a pipe-body contact site — the case's wall law
 /// ([`Case::contact`]), the disk of the wider adjacent element (tool joints included), the
 /// hole section's friction — and the string is solved again from the start, at most
-/// [`WALL_ROUNDS`] times. `model` keeps the sites added, and the solution's log says where
+/// [`WALL_ROUNDS`] times. A solve that fails with nodes lacking a site is tried once more
+/// with a site at every node (the string may have failed crossing the wall on its way to
+/// the loads). `model` keeps the sites added, and the solution's log says where
 /// (every later output — profile, contact sites, a dynamic run from it — sees them).
 /// `options.max_seconds` bounds all the solves together.
 ///
@@ -203,12 +205,38 @@ pub fn solve_in_hole(
     let clock = std::time::Instant::now();
     let mut notes = Vec::new();
     let mut round = 0;
+    let mut everywhere = false;
     loop {
         let mut options = *options;
         options.max_seconds = options
             .max_seconds
             .map(|s| (s - clock.elapsed().as_secs_f64()).max(0.0));
-        let mut sol = crate::solve::statics::solve_static_started(model, &options, progress)?;
+        let mut sol = match crate::solve::statics::solve_static_started(model, &options, progress) {
+            Ok(sol) => sol,
+            // A string held at a few sites that fails may fail crossing the wall on its
+            // way to the loads (a solution would have gone through it): contact at every
+            // node it has none at, once, as `contact.sites = "all_nodes"` gives it.
+            Err(e) => {
+                let free: Vec<usize> = (1..model.nodes.len())
+                    .filter(|&i| !model.sites.iter().any(|s| s.node == i))
+                    .collect();
+                let spent = matches!(e, crate::solve::statics::StaticError::Budget { .. });
+                if spent || free.is_empty() || round == WALL_ROUNDS || everywhere {
+                    return Err(e);
+                }
+                round += 1;
+                everywhere = true;
+                add(model, &free);
+                notes.push(format!(
+                    "{WALL_CONTACT}: the solve with contact at {} sites failed ({}); \
+                     contact given to the other {} nodes, solved again",
+                    model.sites.len() - free.len(),
+                    e.to_string().lines().next().unwrap_or_default(),
+                    free.len()
+                ));
+                continue;
+            }
+        };
         let beyond = crate::diagnose::beyond_wall(case, model, &sol.state.x);
         if beyond.is_empty() || round == WALL_ROUNDS {
             sol.log.extend(notes);
