@@ -171,9 +171,7 @@ pub fn fe_rows(
     (rows, hook, torque, wob)
 }
 
-/// How many times [`solve_in_hole`] solves a string again with contact added where it met
-/// the wall, before it gives its answer as it is (warned: [`crate::diagnose::through_wall`]).
-pub const WALL_ROUNDS: usize = 4;
+pub use crate::diagnose::WALL_ROUNDS;
 
 /// The words a solution's log says sites were added with ([`solve_in_hole`]).
 pub const WALL_CONTACT: &str = "contact added where the string met the wall";

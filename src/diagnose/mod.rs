@@ -287,6 +287,11 @@ pub fn unsupported_buckling(case: &Case, tension: &[f64]) -> Option<(f64, f64, f
 /// clearance a corpus well draws, above the microns a wall spring lets a contact node in.
 pub const THROUGH_WALL_TOLERANCE: f64 = 1e-3;
 
+/// How many times a static solve gives a string contact where it met the wall and solves it
+/// again ([`crate::profile::solve_in_hole`]) before it gives its answer as it is (then
+/// warned: [`through_wall_warning`]).
+pub const WALL_ROUNDS: usize = 4;
+
 /// Where a solved string lies outside the hole at nodes that have no contact site
 /// ([`through_wall`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -388,7 +393,7 @@ pub fn through_wall_warning(
         t.last_md,
         1e3 * t.excess_m,
         t.md,
-        crate::profile::WALL_ROUNDS,
+        WALL_ROUNDS,
     ))
 }
 
