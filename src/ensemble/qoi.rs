@@ -10,7 +10,6 @@ use crate::model::Model;
 use crate::physics::vec3::{dot, scale, sub};
 use crate::profile::{fe_rows, neutral_point, neutral_point_of, nodal_axial_forces};
 use crate::solve::dynamics::{DynamicState, Dynamics};
-use crate::solve::statics::solve_static;
 
 /// Per-stabilizer quantities of interest.
 #[derive(Clone, Debug, Default, Serialize, Deserialize, PartialEq)]
@@ -221,8 +220,23 @@ pub fn static_variant_of(
     v: &crate::ensemble::Variant,
     model: &Model,
 ) -> VariantResult {
+    solve_held(
+        case,
+        &v.name,
+        model.clone(),
+        &mut variant_wall_sites(case, v),
+    )
+}
+
+/// How variant `v`'s model gets sites where its string meets the wall
+/// ([`crate::profile::solve_in_hole`]): the variant applied again with every node added so
+/// far ([`crate::ensemble::apply_with_sites`]), so its overrides reach them.
+fn variant_wall_sites<'a>(
+    case: &'a Case,
+    v: &'a crate::ensemble::Variant,
+) -> impl FnMut(&mut Model, &[usize]) + 'a {
     let mut extra = Vec::new();
-    solve_held(case, &v.name, model.clone(), &mut |m, nodes| {
+    move |m: &mut Model, nodes: &[usize]| {
         extra.extend_from_slice(nodes);
         match crate::ensemble::apply_with_sites(case, v, &extra) {
             Ok(with) => *m = with,
@@ -230,7 +244,7 @@ pub fn static_variant_of(
             // make none of its overrides fail; the sites then keep the case's law.
             Err(_) => crate::profile::add_wall_sites(case, m, nodes),
         }
-    })
+    }
 }
 
 fn solve_held(
@@ -326,14 +340,60 @@ pub fn dynamic_variant_tracked(
     model: &Model,
     track_energy: bool,
 ) -> (VariantResult, Option<f64>) {
-    let stabs = model.stabilizer_sites();
+    dynamic_held(case, name, model, track_energy, &mut |m, nodes| {
+        crate::profile::add_wall_sites(case, m, nodes)
+    })
+}
+
+/// [`dynamic_variant`] of variant `v` (its model `model`): the sites its static start adds
+/// where the string meets the wall get the variant's overrides too, as
+/// [`static_variant_of`]'s.
+pub fn dynamic_variant_of(
+    case: &Case,
+    v: &crate::ensemble::Variant,
+    model: &Model,
+) -> VariantResult {
+    dynamic_held(
+        case,
+        &v.name,
+        model,
+        false,
+        &mut variant_wall_sites(case, v),
+    )
+    .0
+}
+
+/// A dynamic run from the static start held in the hole wherever the string meets the wall
+/// ([`crate::profile::solve_in_hole`], `add` giving the sites), of the model with those
+/// sites, as `holewall run` runs a case.
+fn dynamic_held(
+    case: &Case,
+    name: &str,
+    model: &Model,
+    track_energy: bool,
+    add: &mut dyn FnMut(&mut Model, &[usize]),
+) -> (VariantResult, Option<f64>) {
     let Some(settings) = case.dynamics.clone() else {
         return (
-            failed(name, "no [dynamics] table".into(), stabs.len()),
+            failed(
+                name,
+                "no [dynamics] table".into(),
+                model.stabilizer_sites().len(),
+            ),
             None,
         );
     };
-    let start = match solve_static(model, &case.settings().statics()) {
+    let mut held = model.clone();
+    let solved = crate::profile::solve_in_hole(
+        case,
+        &mut held,
+        add,
+        &case.settings().statics(),
+        &mut |_| {},
+    );
+    let model = &held;
+    let stabs = model.stabilizer_sites();
+    let start = match solved {
         Ok(s) => s,
         Err(e) => {
             return (

@@ -117,9 +117,13 @@ pub fn run_dynamic_gpu<T: crate::gpu::contact::GpuReal>(
     let path = GpuPath(ctx);
     let statics = solve_static_ensemble::<T, _>(&models, &path, &case.settings().statics())
         .map_err(|e| Error::failed(format!("GPU engine: {e}")))?;
-    // Variants whose static start failed on the GPU run wholly on the CPU.
+    // Variants whose static start failed on the GPU, or met the wall between the contact
+    // sites the engine holds the string at, run wholly on the CPU (held there).
     let on_gpu: Vec<usize> = (0..models.len())
-        .filter(|&j| statics[j].status == EngineStatus::Converged)
+        .filter(|&j| {
+            statics[j].status == EngineStatus::Converged
+                && crate::diagnose::beyond_wall(case, &models[j], &statics[j].state.x).is_empty()
+        })
         .collect();
     let gpu_models: Vec<Model> = on_gpu.iter().map(|&j| models[j].clone()).collect();
     // The case's initial offset and kick on each static equilibrium, as the CPU runs do.
@@ -202,7 +206,7 @@ pub fn run_dynamic_gpu<T: crate::gpu::contact::GpuReal>(
                     DynamicStatus::Failed(t, why) => format!("failed at t = {t:.6} s: {why}"),
                     DynamicStatus::Finished => "no initial state".into(),
                 };
-                let mut again = dynamic_variant(case, name, &models[j]);
+                let mut again = dynamic_variant_of(case, &variants[j], &models[j]);
                 again.reason = format!("GPU: {why}; re-run on the CPU: {}", again.reason);
                 again
             }
@@ -215,9 +219,11 @@ pub fn run_dynamic_gpu<T: crate::gpu::contact::GpuReal>(
             r.unwrap_or_else(|| {
                 let why = match &statics[j].status {
                     EngineStatus::Failed(w) => w.clone(),
-                    EngineStatus::Converged => String::new(),
+                    EngineStatus::Converged => {
+                        "the string met the wall between its contact sites".into()
+                    }
                 };
-                let mut again = dynamic_variant(case, &variants[j].name, &models[j]);
+                let mut again = dynamic_variant_of(case, &variants[j], &models[j]);
                 again.reason = format!(
                     "GPU static start: {why}; re-run on the CPU: {}",
                     again.reason
@@ -243,7 +249,7 @@ pub fn run_variants_cpu(
                 Err(e) => failed(&v.name, format!("variant: {e}"), stabs),
                 Ok(model) => match analysis {
                     Analysis::Static => static_variant_of(case, v, &model),
-                    Analysis::Dynamic => dynamic_variant(case, &v.name, &model),
+                    Analysis::Dynamic => dynamic_variant_of(case, v, &model),
                 },
             };
             bar.inc(1);
