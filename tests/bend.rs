@@ -382,6 +382,9 @@ fn the_dynamic_engine_runs_a_bent_collar_as_the_cpu_does() {
     }
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
     let text = std::fs::read_to_string(root.join("cases/spinup_short.toml")).unwrap();
+    // Contact at every node: with the stabilizers' alone the bent collar meets the wall
+    // between them (7 and 43 mm beyond it at 0.5° and 1°), and its static start is held
+    // there on the CPU (`profile::solve_in_hole`), which the engine's own sites cannot.
     let text = text
         .replacen(
             "length = \"9.25 m\"",
@@ -389,17 +392,73 @@ fn the_dynamic_engine_runs_a_bent_collar_as_the_cpu_does() {
             1,
         )
         .replace("duration = \"1 s\"", "duration = \"0.3 s\"")
-        .replace("ramp_time = \"0.5 s\"", "ramp_time = \"0.1 s\"");
-    assert!(text.contains("bend ="));
+        .replace("ramp_time = \"0.5 s\"", "ramp_time = \"0.1 s\"")
+        .replace("sites = \"stabilizers\"", "sites = \"all_nodes\"");
+    assert!(text.contains("bend =") && text.contains("all_nodes"));
     let grid = "\n[ensemble]\nanalysis = \"dynamic\"\n\n[ensemble.grid]\nbend = [0.5, 1]\n";
     let (dir, worst) = common::engine_against_cpu("bend-dyn", &format!("{text}{grid}"));
-    let lateral = common::variants_column(&dir.join("cpu"), "stab1_max_lateral_m");
+    // The bend acts: the stabilizer's side force at 1° is not that at 0.5° (14.8 and 9.7 kN).
+    let side = common::variants_column(&dir.join("cpu"), "stab1_max_side_force_n");
     assert!(
-        lateral[1] > lateral[0] && lateral[0] > 0.0,
-        "the bend moves the stabilizer: {lateral:?}"
+        (side[1] / side[0] - 1.0).abs() > 0.1 && side[0] > 0.0,
+        "the bend changes the stabilizer's side force: {side:?}"
     );
     eprintln!(
         "bent spin-up, GPU dynamic engine vs CPU integrator: worst relative difference {worst:.1e}"
     );
     assert!(worst <= 1e-6, "{worst:e}");
+}
+
+/// The same bent spin-up with contact at the stabilizers only: each variant's bent collar
+/// meets the wall between its sites (7 and 43 mm beyond it unheld), which the engine's own
+/// sites cannot hold, so the GPU run gives both variants to the CPU, whose static start
+/// holds the collar there (`profile::solve_in_hole`), and the results are the CPU run's.
+#[test]
+fn a_bent_collar_that_meets_the_wall_runs_on_the_cpu() {
+    if common::gpu().is_none() {
+        return;
+    }
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let text = std::fs::read_to_string(root.join("cases/spinup_short.toml"))
+        .unwrap()
+        .replacen(
+            "length = \"9.25 m\"",
+            "length = \"9.25 m\"\nbend = \"1 deg\"\nbend_toolface = \"30 deg\"",
+            1,
+        )
+        .replace("duration = \"1 s\"", "duration = \"0.1 s\"")
+        .replace("ramp_time = \"0.5 s\"", "ramp_time = \"0.05 s\"");
+    let grid = "\n[ensemble]\nanalysis = \"dynamic\"\n\n[ensemble.grid]\nbend = [0.5, 1]\n";
+    let dir = std::env::temp_dir().join(format!("holewall-bend-wall-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let case = dir.join("bent.toml");
+    std::fs::write(&case, format!("{text}{grid}")).unwrap();
+    let run = |backend, out: &str| {
+        holewall::ensemble::job::run(
+            &case,
+            None,
+            backend,
+            holewall::backend::Precision::F64,
+            &dir.join(out),
+            false,
+            &Default::default(),
+        )
+        .unwrap()
+    };
+    let cpu = run(holewall::backend::BackendChoice::Cpu, "cpu");
+    let gpu = run(holewall::backend::BackendChoice::Gpu, "gpu");
+    assert_eq!((cpu.failed, gpu.failed), (0, 0));
+    assert_eq!(
+        gpu.solved_by_engine, 0,
+        "the engine cannot hold the collar at the wall"
+    );
+    for name in ["stab1_max_side_force_n", "max_surface_torque_nm"] {
+        let (c, g) = (
+            common::variants_column(&dir.join("cpu"), name),
+            common::variants_column(&dir.join("gpu"), name),
+        );
+        assert_eq!(c, g, "{name}");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
 }

@@ -147,47 +147,52 @@ pub fn run_dynamic_gpu<T: crate::gpu::contact::GpuReal>(
             last[j] = Some(s);
         }
     }
-    let results = run_dynamic_ensemble::<T, _>(
-        &gpu_models,
-        &starts,
-        density,
-        &path,
-        &options,
-        settings.duration,
-        1,
-        &mut |first, t, batch| {
-            let (v, n) = (batch.num_variants, batch.num_nodes);
-            for j in 0..v {
-                let g = first + j;
-                let Some(state) = last[g].as_mut() else {
-                    continue;
-                };
-                let m = &gpu_models[g];
-                state.t = t;
-                for i in 0..n {
-                    for k in 0..3 {
-                        state.q.x[i][k] =
-                            m.nodes[i].position[k] + batch.u[(3 * i + k) * v + j].to_f64_lossy();
-                    }
-                    for r in 0..3 {
-                        for c in 0..3 {
-                            state.q.rot[i][r][c] =
-                                batch.rot[(9 * i + 3 * r + c) * v + j].to_f64_lossy();
+    // None left for the engine: every variant runs on the CPU below.
+    let results = if gpu_models.is_empty() {
+        Vec::new()
+    } else {
+        run_dynamic_ensemble::<T, _>(
+            &gpu_models,
+            &starts,
+            density,
+            &path,
+            &options,
+            settings.duration,
+            1,
+            &mut |first, t, batch| {
+                let (v, n) = (batch.num_variants, batch.num_nodes);
+                for j in 0..v {
+                    let g = first + j;
+                    let Some(state) = last[g].as_mut() else {
+                        continue;
+                    };
+                    let m = &gpu_models[g];
+                    state.t = t;
+                    for i in 0..n {
+                        for k in 0..3 {
+                            state.q.x[i][k] = m.nodes[i].position[k]
+                                + batch.u[(3 * i + k) * v + j].to_f64_lossy();
+                        }
+                        for r in 0..3 {
+                            for c in 0..3 {
+                                state.q.rot[i][r][c] =
+                                    batch.rot[(9 * i + 3 * r + c) * v + j].to_f64_lossy();
+                            }
+                        }
+                        for k in 0..6 {
+                            let idx = (6 * i + k) * v + j;
+                            state.v[6 * i + k] = batch.vel[idx].to_f64_lossy();
+                            state.a[6 * i + k] = batch.acc[idx].to_f64_lossy();
+                            state.vdot[6 * i + k] = batch.vdot[idx].to_f64_lossy();
                         }
                     }
-                    for k in 0..6 {
-                        let idx = (6 * i + k) * v + j;
-                        state.v[6 * i + k] = batch.vel[idx].to_f64_lossy();
-                        state.a[6 * i + k] = batch.acc[idx].to_f64_lossy();
-                        state.vdot[6 * i + k] = batch.vdot[idx].to_f64_lossy();
-                    }
+                    observers[g].observe(m, &cpu[g], state);
                 }
-                observers[g].observe(m, &cpu[g], state);
-            }
-            bar.set_position(((t / settings.duration) * variants.len() as f64) as u64);
-        },
-    )
-    .map_err(|e| Error::failed(format!("GPU engine: {e}")))?;
+                bar.set_position(((t / settings.duration) * variants.len() as f64) as u64);
+            },
+        )
+        .map_err(|e| Error::failed(format!("GPU engine: {e}")))?
+    };
     let mut out: Vec<Option<VariantResult>> = vec![None; models.len()];
     for (&j, ((r, obs), state)) in on_gpu
         .iter()
