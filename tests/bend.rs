@@ -429,25 +429,7 @@ fn a_bent_collar_that_meets_the_wall_runs_on_the_cpu() {
         .replace("duration = \"1 s\"", "duration = \"0.1 s\"")
         .replace("ramp_time = \"0.5 s\"", "ramp_time = \"0.05 s\"");
     let grid = "\n[ensemble]\nanalysis = \"dynamic\"\n\n[ensemble.grid]\nbend = [0.5, 1]\n";
-    let dir = std::env::temp_dir().join(format!("holewall-bend-wall-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    let case = dir.join("bent.toml");
-    std::fs::write(&case, format!("{text}{grid}")).unwrap();
-    let run = |backend, out: &str| {
-        holewall::ensemble::job::run(
-            &case,
-            None,
-            backend,
-            holewall::backend::Precision::F64,
-            &dir.join(out),
-            false,
-            &Default::default(),
-        )
-        .unwrap()
-    };
-    let cpu = run(holewall::backend::BackendChoice::Cpu, "cpu");
-    let gpu = run(holewall::backend::BackendChoice::Gpu, "gpu");
+    let (dir, cpu, gpu) = common::on_cpu_and_gpu("bend-wall", &format!("{text}{grid}"));
     assert_eq!((cpu.failed, gpu.failed), (0, 0));
     assert_eq!(
         gpu.solved_by_engine, 0,

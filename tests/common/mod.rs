@@ -167,13 +167,18 @@ pub fn variants_column(out: &std::path::Path, name: &str) -> Vec<f64> {
         .collect()
 }
 
-/// Runs the case `text` (with its `[ensemble]` table) on the CPU and on the GPU engine in
-/// f64, in a fresh folder named after `label`; asserts that nothing failed and that the
-/// engine ran every variant itself (no CPU fallback). Returns the folder, the CPU's and the
-/// engine's `stabilizer 1 lateral, side force, surface torque` columns' worst relative
-/// difference, printed with each column.
+/// Runs the ensemble of case `text` (with its `[ensemble]` table) on the CPU backend and on
+/// the GPU in f64, into `cpu/` and `gpu/` of a fresh folder named after `label`: the folder
+/// and both summaries.
 #[allow(dead_code)]
-pub fn engine_against_cpu(label: &str, text: &str) -> (std::path::PathBuf, f64) {
+pub fn on_cpu_and_gpu(
+    label: &str,
+    text: &str,
+) -> (
+    std::path::PathBuf,
+    holewall::ensemble::report::EnsembleSummary,
+    holewall::ensemble::report::EnsembleSummary,
+) {
     let dir = std::env::temp_dir().join(format!("holewall-{label}-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).unwrap();
@@ -193,6 +198,17 @@ pub fn engine_against_cpu(label: &str, text: &str) -> (std::path::PathBuf, f64) 
     };
     let cpu = run(holewall::backend::BackendChoice::Cpu, "cpu");
     let gpu = run(holewall::backend::BackendChoice::Gpu, "gpu");
+    (dir, cpu, gpu)
+}
+
+/// Runs the case `text` (with its `[ensemble]` table) on the CPU and on the GPU engine in
+/// f64 ([`on_cpu_and_gpu`]); asserts that nothing failed and that the
+/// engine ran every variant itself (no CPU fallback). Returns the folder, the CPU's and the
+/// engine's `stabilizer 1 lateral, side force, surface torque` columns' worst relative
+/// difference, printed with each column.
+#[allow(dead_code)]
+pub fn engine_against_cpu(label: &str, text: &str) -> (std::path::PathBuf, f64) {
+    let (dir, cpu, gpu) = on_cpu_and_gpu(label, text);
     assert_eq!((cpu.failed, gpu.failed), (0, 0));
     assert_eq!(gpu.backend, "gpu");
     assert_eq!(gpu.solved_by_engine, gpu.variants, "{:?}", gpu.backend_note);
