@@ -31,11 +31,35 @@
 @group(0) @binding(11) var<storage, read> anchor: array<real>;
 @group(0) @binding(12) var<storage, read> x_now: array<real>;
 #endif
+#if DYNAMIC
+// The dynamic residual alone (the dynamic engine's trials): its inputs after the output
+// and the list, as the full kernel's (no hole axes: they enter the matrix only).
+@group(0) @binding(10) var<storage, read> dyn_coef: array<real>;
+@group(0) @binding(11) var<storage, read> node_mass: array<real>;
+@group(0) @binding(12) var<storage, read> inertia0: array<real>;
+@group(0) @binding(13) var<storage, read> rot: array<real>;
+@group(0) @binding(14) var<storage, read> vel: array<real>;
+@group(0) @binding(15) var<storage, read> vdot: array<real>;
+#if UNBALANCE
+@group(0) @binding(16) var<storage, read> unbalance: array<real>;
+#endif
+#endif
 #else
 #if SHIFT
 @group(0) @binding(9) var<storage, read> shift: array<real>;
 @group(0) @binding(10) var<storage, read> anchor: array<real>;
 @group(0) @binding(11) var<storage, read> x_now: array<real>;
+#endif
+#if DYNAMIC
+@group(0) @binding(9) var<storage, read> dyn_coef: array<real>;
+@group(0) @binding(10) var<storage, read> node_mass: array<real>;
+@group(0) @binding(11) var<storage, read> inertia0: array<real>;
+@group(0) @binding(12) var<storage, read> rot: array<real>;
+@group(0) @binding(13) var<storage, read> vel: array<real>;
+@group(0) @binding(14) var<storage, read> vdot: array<real>;
+#if UNBALANCE
+@group(0) @binding(15) var<storage, read> unbalance: array<real>;
+#endif
 #endif
 #endif
 #else
@@ -228,8 +252,9 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
 #if DYNAMIC
     let hg = dyn_coef[0];
-    let hhb = dyn_coef[1];
     let a0 = dyn_coef[2];
+#if !FORCE_ONLY
+    let hhb = dyn_coef[1];
     for (var k = 0u; k < 36u; k = k + 1u) {
         d[k] = hhb * d[k];
         u[k] = hhb * u[k];
@@ -247,6 +272,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
             }
         }
     }
+#endif
     // J = R J0 Rᵀ.
     var rj: array<array<real, 3>, 3>;
     for (var a = 0u; a < 3u; a = a + 1u) {
@@ -283,6 +309,11 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         jwd[a] = s2;
     }
     let gyro = vec3<real>(w.y * jw.z - w.z * jw.y, w.z * jw.x - w.x * jw.z, w.x * jw.y - w.y * jw.x);
+    for (var k = 0u; k < 3u; k = k + 1u) {
+        r[k] = r[k] + m * vdot[(6u * i + k) * nv + v] + a0 * m * vel[(6u * i + k) * nv + v];
+        r[3u + k] = r[3u + k] + jwd[k] + gyro[k];
+    }
+#if !FORCE_ONLY
     // Rows of [ω]× and [Jω]×.
     let sw = array<vec3<real>, 3>(
         vec3<real>(real(0.0), -w.z, w.y),
@@ -295,8 +326,6 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         vec3<real>(-jw.y, jw.x, real(0.0)),
     );
     for (var k = 0u; k < 3u; k = k + 1u) {
-        r[k] = r[k] + m * vdot[(6u * i + k) * nv + v] + a0 * m * vel[(6u * i + k) * nv + v];
-        r[3u + k] = r[3u + k] + jwd[k] + gyro[k];
         d[6u * k + k] = d[6u * k + k] + m + hg * a0 * m;
         for (var c = 0u; c < 3u; c = c + 1u) {
             // ∂(ω × Jω)/∂ω = [ω]× J − [Jω]×.
@@ -307,6 +336,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
             d[6u * (3u + k) + 3u + c] = d[6u * (3u + k) + 3u + c] + jm[k][c] + hg * (swj - sjw[k][c]);
         }
     }
+#endif
 #if UNBALANCE
     // U = R U0; d = U/M: M (ω̇ × d + ω × (ω × d)) and U × (ẍ + ω̇ × d + ω × (ω × d)), with
     // their derivatives by v̇ and (times hγ') by ω.
@@ -324,6 +354,11 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         let wxd = cross(w, dd);
         let a_rel = cross(wd, dd) + cross(w, wxd);
         let moment = cross(uu, xdd + a_rel);
+        for (var a = 0u; a < 3u; a = a + 1u) {
+            r[a] = r[a] + m * a_rel[a];
+            r[3u + a] = r[3u + a] + moment[a];
+        }
+#if !FORCE_ONLY
         let su = skew3(uu);
         let sd = skew3(dd);
         let swd = skew3(wxd);
@@ -335,14 +370,13 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         let su_sd = mul3(su, sd);
         let su_dw = mul3(su, dw);
         for (var a = 0u; a < 3u; a = a + 1u) {
-            r[a] = r[a] + m * a_rel[a];
-            r[3u + a] = r[3u + a] + moment[a];
             for (var b = 0u; b < 3u; b = b + 1u) {
                 d[6u * a + 3u + b] = d[6u * a + 3u + b] - su[a][b] + hg * m * dw[a][b];
                 d[6u * (3u + a) + b] = d[6u * (3u + a) + b] + su[a][b];
                 d[6u * (3u + a) + 3u + b] = d[6u * (3u + a) + 3u + b] - su_sd[a][b] + hg * su_dw[a][b];
             }
         }
+#endif
     }
 #endif
 #endif

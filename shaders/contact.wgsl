@@ -56,12 +56,13 @@ fn put3(field: u32, i: u32, x: vec3<real>) {
 
 // Output fields of the scene: g (6), K (18) and, in dynamics, C (18), c_omega (6). A
 // static scene's buffer holds only the first 24 (src/kernels/contact.rs `output_fields`).
-// Built FORCE_ONLY (static line-search trials): g alone; the K fields are not written.
-#if DYNAMIC
-const OUT_FIELDS: u32 = 48u;
-#else
+// Built FORCE_ONLY (the line-search trials, static or dynamic): g alone; the K, C and
+// c_omega fields are not written.
 #if FORCE_ONLY
 const OUT_FIELDS: u32 = 6u;
+#else
+#if DYNAMIC
+const OUT_FIELDS: u32 = 48u;
 #else
 const OUT_FIELDS: u32 = 24u;
 #endif
@@ -246,12 +247,14 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     kf_t = kf_t + (fric_f * sigma - u * (a_t / r)) * normal;
     km_t = (fric_m * sigma + u * (rd * a_l / r)) * normal;
 #if DYNAMIC
+#if !FORCE_ONLY
     let fric_f_l = t * (mu_t * fr.d_dsl.x) + n * (mu_l * fr.d_dsl.y);
     let fric_m_l = (n * (mu_t * fr.d_dsl.x) - t * (mu_l * fr.d_dsl.y)) * rd;
     cf_t = fric_f;
     cf_n = fric_f_l;
     cm_t = fric_m;
     cm_n = fric_m_l;
+#endif
 #endif
 #endif
 
@@ -268,6 +271,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     put3(21u, i, dn_dx * dir_m.z + t * km_t.z);
 #endif
 #if DYNAMIC
+#if !FORCE_ONLY
     let dn_dv = u * dn_dv_u;
     put3(24u, i, dn_dv * dir_f.x + (t * cf_t.x + n * cf_n.x) * normal);
     put3(27u, i, dn_dv * dir_f.y + (t * cf_t.y + n * cf_n.y) * normal);
@@ -281,6 +285,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
 #else
     put3(42u, i, vec3<real>(real(0.0)));
     put3(45u, i, vec3<real>(real(0.0)));
+#endif
 #endif
 #endif
 }

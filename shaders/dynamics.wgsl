@@ -4,7 +4,8 @@
 // at t_{n+1} from the state at t_n and the Newton unknown v̇_{n+1} (top node: prescribed
 // accelerations written into v̇ first, the table's and hook's kinematics after);
 // ACCEL, one invocation per (node, variant): v̇_out = v̇ + α (B Δv_u, Δv_θ);
-// SCALE, one invocation per variant: max_i m_i |v̇_u,i|. Layouts as in the twin.
+// SCALE, one invocation per variant: max_i m_i |v̇_u,i|. Layouts as in the twin. PREDICT and
+// ACCEL built MASKED (the line-search trials) run for the listed variants alone.
 #include "shared/layout.wgsl"
 
 @group(0) @binding(0) var<storage, read> dims: ChainDims;
@@ -25,6 +26,11 @@
 @group(0) @binding(11) var<storage, read_write> rot_1: array<real>;
 @group(0) @binding(12) var<storage, read_write> vel_1: array<real>;
 @group(0) @binding(13) var<storage, read_write> acc_1: array<real>;
+#if MASKED
+// Built MASKED (the engine's line-search trials): the variants still searching, compacted:
+// [A, v_0, …, v_{A−1}]; one invocation per (node, listed variant), the others untouched.
+@group(0) @binding(14) var<storage, read> searching: array<u32>;
+#endif
 #endif
 #if ACCEL
 @group(0) @binding(1) var<storage, read> basis: array<real>;
@@ -32,6 +38,9 @@
 @group(0) @binding(3) var<storage, read> delta: array<real>;
 @group(0) @binding(4) var<storage, read> alpha: array<real>;
 @group(0) @binding(5) var<storage, read_write> vdot_out: array<real>;
+#if MASKED
+@group(0) @binding(6) var<storage, read> searching: array<u32>;
+#endif
 #endif
 #if SCALE
 @group(0) @binding(1) var<storage, read> node_mass: array<real>;
@@ -46,11 +55,20 @@
 fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let nv = dims.num_variants;
     let n = dims.num_nodes;
+#if MASKED
+    let count = searching[0];
+    if (gid.x >= n * count) {
+        return;
+    }
+    let i = gid.x / count;
+    let v = searching[1u + gid.x % count];
+#else
     if (gid.x >= n * nv) {
         return;
     }
     let i = gid.x / nv;
     let v = gid.x % nv;
+#endif
     let h = coef[0];
     let alpha_m = coef[1];
     let alpha_f = coef[2];
@@ -131,11 +149,20 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
 fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let nv = dims.num_variants;
     let n = dims.num_nodes;
+#if MASKED
+    let count = searching[0];
+    if (gid.x >= n * count) {
+        return;
+    }
+    let i = gid.x / count;
+    let v = searching[1u + gid.x % count];
+#else
     if (gid.x >= n * nv) {
         return;
     }
     let i = gid.x / nv;
     let v = gid.x % nv;
+#endif
     for (var r = 0u; r < 3u; r = r + 1u) {
         var s = real(0.0);
         for (var k = 0u; k < 3u; k = k + 1u) {

@@ -16,15 +16,19 @@
 @group(0) @binding(2) var<storage, read> u: array<real>;
 @group(0) @binding(3) var<storage, read> pair_base: array<real>;
 @group(0) @binding(4) var<storage, read_write> pair_state: array<real>;
-#if MASKED
-// Built MASKED (static; the engine's line-search trials): the variants still searching,
-// compacted: [A, v_0, …, v_{A−1}]; one invocation per (site, searching variant).
-@group(0) @binding(5) var<storage, read> searching: array<u32>;
-#endif
 #if DYNAMIC
 // Node velocities [(6 · node + k) · V + variant] (ẋ, ω) and the pairs' hole axes.
 @group(0) @binding(5) var<storage, read> vel: array<real>;
 @group(0) @binding(6) var<storage, read> pair_normals: array<real>;
+#if MASKED
+// Built MASKED (the engine's line-search trials, static or dynamic): the variants still
+// searching, compacted: [A, v_0, …, v_{A−1}]; one invocation per (site, searching variant).
+@group(0) @binding(7) var<storage, read> searching: array<u32>;
+#endif
+#else
+#if MASKED
+@group(0) @binding(5) var<storage, read> searching: array<u32>;
+#endif
 #endif
 
 @compute @workgroup_size(64)

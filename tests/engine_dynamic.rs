@@ -219,7 +219,9 @@ fn widen(b: &DynamicBatch<f32>) -> DynamicBatch<f64> {
 fn dynamic_kernels_equal_their_twins() {
     use common::runners::{accelerate_gpu, inertial_scale_gpu, predict_gpu};
     use holewall::gpu::assemble::assemble_gpu;
-    use holewall::kernels::assemble::{assemble, AssemblyInputs, DynamicInputs, NO_SITE};
+    use holewall::kernels::assemble::{
+        assemble, assemble_residual, AssemblyInputs, DynamicInputs, NO_SITE,
+    };
     use holewall::kernels::dynamics::{
         accelerate, inertial_scale, predict, StepCoefficients, TOP_LEN,
     };
@@ -396,6 +398,14 @@ fn dynamic_kernels_equal_their_twins() {
             );
         }
     }
+    // The trials' residual alone (twin of the kernel built FORCE_ONLY) is the full
+    // assembly's residual to the bit, with and without the imbalance, without reading the
+    // element tangents.
+    for (inputs, full) in [(&a, &asm_twin), (&a_u, &asm_u)] {
+        let mut bare = inputs.clone();
+        bare.elem_tangent = Vec::new();
+        assert_eq!(assemble_residual(&bare), full.rhs);
+    }
     let Some(ctx) = common::gpu() else { return };
     if !ctx.has_f64 {
         return;
@@ -454,6 +464,26 @@ fn dynamic_kernels_equal_their_twins() {
     ];
     eprintln!("GPU f64 vs twin, dynamic assembly with a mass imbalance: {d_u:?}");
     assert!(d_u.iter().all(|&d| d <= 1e-12), "{d_u:?}");
+    // The line-search trials' residual alone (built FORCE_ONLY): the full kernel's
+    // residual, the same sums in the same order — to the bit where the driver does not
+    // fuse multiply-adds, else within the full kernel's bound of the twin.
+    for (inputs, full, twin_rhs) in [
+        (&a, &asm_gpu, &asm_twin.rhs),
+        (&a_u, &asm_u_gpu, &asm_u.rhs),
+    ] {
+        let mut bare = inputs.clone();
+        bare.elem_tangent = Vec::new();
+        let lean = common::runners::assemble_residual_gpu(ctx, &bare).unwrap();
+        common::assert_same(
+            ctx,
+            &lean,
+            &full.rhs,
+            rel,
+            1e-12,
+            "GPU residual alone = full",
+        );
+        assert!(rel(&lean, twin_rhs) <= 1e-12);
+    }
 }
 
 #[test]

@@ -87,7 +87,7 @@ fn every_contact_specialisation_validates() {
                         };
                         let wgsl = contact_wgsl(&terms, f64).unwrap();
                         validate(&wgsl).unwrap_or_else(|e| panic!("{terms:?} f64={f64}: {e}"));
-                        if mode == ContactMode::Static {
+                        {
                             // The trials' kernels: force only, with and without the list.
                             for masked in [false, true] {
                                 let lean =
@@ -139,6 +139,10 @@ fn composer_handles_nesting_else_and_errors() {
 fn engine_kernels_validate_in_both_precisions() {
     use holewall::gpu::block_lu::LuForm;
     use holewall::gpu::dynamics::DynamicsKernel;
+    use holewall::gpu::kernel::Kernel;
+    assert!(Kernel::DynamicsTrial(DynamicsKernel::Scale)
+        .wgsl(false)
+        .is_err());
     for f64 in [false, true] {
         for wgsl in [
             holewall::gpu::block_lu::block_lu_wgsl(f64, LuForm::Serial).unwrap(),
@@ -164,6 +168,29 @@ fn engine_kernels_validate_in_both_precisions() {
             holewall::gpu::dynamics::dynamics_wgsl(DynamicsKernel::Predict, f64).unwrap(),
             holewall::gpu::dynamics::dynamics_wgsl(DynamicsKernel::Accelerate, f64).unwrap(),
             holewall::gpu::dynamics::dynamics_wgsl(DynamicsKernel::Scale, f64).unwrap(),
+            // The dynamic trials' kernels (listed variants, residual alone).
+            Kernel::DynamicsTrial(DynamicsKernel::Predict)
+                .wgsl(f64)
+                .unwrap(),
+            Kernel::DynamicsTrial(DynamicsKernel::Accelerate)
+                .wgsl(f64)
+                .unwrap(),
+            Kernel::SitesTrial { dynamic: true }.wgsl(f64).unwrap(),
+            Kernel::AssembleTrial {
+                dynamic: true,
+                unbalance: false,
+            }
+            .wgsl(f64)
+            .unwrap(),
+            Kernel::AssembleTrial {
+                dynamic: true,
+                unbalance: true,
+            }
+            .wgsl(f64)
+            .unwrap(),
+            holewall::gpu::assemble::assemble_force_wgsl_with(true, false, f64, false).unwrap(),
+            holewall::gpu::assemble::assemble_force_wgsl_with(true, true, f64, false).unwrap(),
+            holewall::gpu::assemble::assemble_wgsl_with(true, true, f64).unwrap(),
         ] {
             validate(&wgsl).unwrap_or_else(|e| panic!("f64={f64}: {e}"));
             assert_eq!(wgsl.contains("f64"), f64, "precision leak, f64={f64}");

@@ -7,8 +7,8 @@ use super::*;
 
 /// The twins' run of [`evaluation`] on a configuration (`x` displacements from the base,
 /// `rot`): the constrained system — its residual alone where `tangent` is false (the
-/// beam stage forms forces only; in statics the blocks are then left empty, as the
-/// assembly built `FORCE_ONLY` leaves them; in dynamics they are meaningless). `dynamic`: the predicted trial state and the dynamic
+/// beam stage forms forces only and the blocks are left empty, as the assembly built
+/// `FORCE_ONLY` leaves them, static or dynamic). `dynamic`: the predicted trial state and the dynamic
 /// assembly's inputs (the predictor itself is run by the caller, which owns the step's
 /// state). `shift`: a relaxation's shift per variant and anchor (static only).
 #[allow(clippy::too_many_arguments)]
@@ -87,10 +87,10 @@ pub(crate) fn twin_evaluate(
                         x: x.to_vec(),
                     }),
                 };
-                system = Some(if tangent || inputs.dynamic.is_some() {
+                system = Some(if tangent {
                     assemble(&inputs)
                 } else {
-                    // A static trial: the residual alone (the kernel built `FORCE_ONLY`).
+                    // A trial: the residual alone (the kernel built `FORCE_ONLY`).
                     ChainBatch {
                         num_variants: v,
                         num_nodes: n,

@@ -34,9 +34,28 @@ pub fn assemble_wgsl_with(dynamic: bool, unbalance: bool, f64: bool) -> Result<S
 /// `masked`: one invocation per (node, listed variant) of the compacted list of searching
 /// variants `[A, v_0, …]` (binding 9); the others are skipped.
 pub fn assemble_force_wgsl(f64: bool, masked: bool) -> Result<String, GpuError> {
+    assemble_force_wgsl_with(false, false, f64, masked)
+}
+
+/// The WGSL text of the assembly built `FORCE_ONLY`, static or (`dynamic`, with
+/// `unbalance` the mass-imbalance terms) dynamic: the residual alone (twin:
+/// [`crate::kernels::assemble::assemble_residual`]), the same sums in the same order as the
+/// full kernel's. The dynamic inputs (`dyn_coef`, mass, inertia, rotations, velocities,
+/// accelerations, imbalance) are bound after the output (and the list, `masked`).
+pub fn assemble_force_wgsl_with(
+    dynamic: bool,
+    unbalance: bool,
+    f64: bool,
+    masked: bool,
+) -> Result<String, GpuError> {
     compose_if(
         "assemble.wgsl",
-        &[("FORCE_ONLY", true), ("MASKED", masked)],
+        &[
+            ("FORCE_ONLY", true),
+            ("MASKED", masked),
+            ("DYNAMIC", dynamic),
+            ("UNBALANCE", dynamic && unbalance),
+        ],
         f64,
     )
 }

@@ -80,22 +80,17 @@ pub fn contact_wgsl(terms: &ContactTerms, f64: bool) -> Result<String, GpuError>
     compose("contact.wgsl", &flags, f64)
 }
 
-/// The WGSL text of the static contact kernel built `FORCE_ONLY` (line-search trials):
-/// the force and moment `g` (fields 0–5) and the contact flag alone; the stiffness fields
-/// are not written. Dynamic scenes have none (their trials need the whole response).
-/// `masked`: one invocation per (site, listed variant) of the compacted list of searching
-/// variants `[A, v_0, …]` (binding 6; pairs `site · V + v`, V = `mask_variants`); the
-/// other pairs are skipped.
+/// The WGSL text of the contact kernel built `FORCE_ONLY` (line-search trials, static or
+/// dynamic): the force and moment `g` (fields 0–5; in a dynamic scene with the wall's
+/// damping and the friction of the sites' velocities) and the contact flag alone; the
+/// stiffness and damping fields are not written. `masked`: one invocation per (site,
+/// listed variant) of the compacted list of searching variants `[A, v_0, …]` (binding 6;
+/// pairs `site · V + v`, V = `mask_variants`); the other pairs are skipped.
 pub fn contact_force_wgsl(
     terms: &ContactTerms,
     f64: bool,
     masked: bool,
 ) -> Result<String, GpuError> {
-    if terms.mode == ContactMode::Dynamic {
-        return Err(GpuError::Unsupported(
-            "the force-only contact kernel is static".into(),
-        ));
-    }
     let mut flags = contact_flags(terms);
     flags.insert("FORCE_ONLY");
     if masked {

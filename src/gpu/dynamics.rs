@@ -20,9 +20,28 @@ pub enum DynamicsKernel {
 
 /// The WGSL text of one kernel at a precision.
 pub fn dynamics_wgsl(kernel: DynamicsKernel, f64: bool) -> Result<String, GpuError> {
+    dynamics_wgsl_with(kernel, f64, false)
+}
+
+/// The WGSL text of one kernel at a precision; `masked` (the predictor and the correction
+/// only: the line-search trials): one invocation per (node, listed variant) of the
+/// compacted list `[A, v_0, …]`, its last binding; the other variants are left as they are.
+pub fn dynamics_wgsl_with(
+    kernel: DynamicsKernel,
+    f64: bool,
+    masked: bool,
+) -> Result<String, GpuError> {
+    if masked && kernel == DynamicsKernel::Scale {
+        return Err(GpuError::Unsupported(
+            "the force scale has no masked form".into(),
+        ));
+    }
     let mut flags = BTreeSet::new();
     if f64 {
         flags.insert("F64");
+    }
+    if masked {
+        flags.insert("MASKED");
     }
     flags.insert(match kernel {
         DynamicsKernel::Predict => "PREDICT",

@@ -33,8 +33,11 @@ pub enum Kernel<'a> {
         /// The dynamic form.
         dynamic: bool,
     },
-    /// The line-search trials' sites gather (listed variants).
-    SitesTrial,
+    /// The line-search trials' sites gather (listed variants): static, or dynamic.
+    SitesTrial {
+        /// The dynamic form.
+        dynamic: bool,
+    },
     /// The contact kernel specialised to the scene's terms.
     Contact(&'a ContactTerms),
     /// The line-search trials' contact kernel: forces alone, listed variants.
@@ -46,8 +49,14 @@ pub enum Kernel<'a> {
         /// The mass-imbalance terms (dynamic only).
         unbalance: bool,
     },
-    /// The line-search trials' assembly: the residual alone, listed variants.
-    AssembleTrial,
+    /// The line-search trials' assembly: the residual alone, listed variants; static, or
+    /// dynamic with (`unbalance`) the mass-imbalance terms.
+    AssembleTrial {
+        /// The dynamic form.
+        dynamic: bool,
+        /// The mass-imbalance terms (dynamic only).
+        unbalance: bool,
+    },
     /// The assembly with a relaxation's proximal shift: the full system, or (`trial`) the
     /// trials' residual.
     AssembleShift {
@@ -68,6 +77,8 @@ pub enum Kernel<'a> {
     },
     /// One of the generalised-α integrator's kernels.
     Dynamics(DynamicsKernel),
+    /// The line-search trials' predictor or correction (listed variants).
+    DynamicsTrial(DynamicsKernel),
 }
 
 impl Kernel<'_> {
@@ -80,11 +91,13 @@ impl Kernel<'_> {
             Kernel::Beam { .. } => "beam_force",
             Kernel::BeamTrial { .. } => "beam_trial",
             Kernel::Sites { .. } => "sites",
-            Kernel::SitesTrial => "sites_trial",
+            Kernel::SitesTrial { dynamic: false } => "sites_trial",
+            Kernel::SitesTrial { dynamic: true } => "sites_dynamic_trial",
             Kernel::Contact(_) => "contact",
             Kernel::ContactTrial(_) => "contact_trial",
             Kernel::Assemble { .. } => "assemble",
-            Kernel::AssembleTrial => "assemble_trial",
+            Kernel::AssembleTrial { dynamic: false, .. } => "assemble_trial",
+            Kernel::AssembleTrial { dynamic: true, .. } => "assemble_dynamic_trial",
             Kernel::AssembleShift { trial: false } => "assemble_shift",
             Kernel::AssembleShift { trial: true } => "assemble_trial_shift",
             Kernel::BlockLu(_) => "block_lu",
@@ -95,34 +108,41 @@ impl Kernel<'_> {
             Kernel::Dynamics(DynamicsKernel::Predict) => "predict",
             Kernel::Dynamics(DynamicsKernel::Accelerate) => "accelerate",
             Kernel::Dynamics(DynamicsKernel::Scale) => "scale",
+            Kernel::DynamicsTrial(DynamicsKernel::Predict) => "predict_trial",
+            Kernel::DynamicsTrial(DynamicsKernel::Accelerate) => "accelerate_trial",
+            Kernel::DynamicsTrial(DynamicsKernel::Scale) => "scale_trial",
         }
     }
 
     /// The WGSL text at a precision.
     pub fn wgsl(&self, f64: bool) -> Result<String, GpuError> {
         use crate::gpu::{assemble, beam, block_lu, contact, dynamics, update};
-        let sites = |feature: &'static str| {
-            crate::gpu::compose::compose_if("sites.wgsl", &[(feature, true)], f64)
+        let sites = |dynamic: bool, masked: bool| {
+            crate::gpu::compose::compose_if(
+                "sites.wgsl",
+                &[("DYNAMIC", dynamic), ("MASKED", masked)],
+                f64,
+            )
         };
         match *self {
             Kernel::Beam { force_only, kink } => beam::beam_wgsl(f64, force_only, kink),
             Kernel::BeamTrial { kink } => beam::beam_trial_wgsl(f64, kink),
-            Kernel::Sites { dynamic: true } => sites("DYNAMIC"),
-            Kernel::Sites { dynamic: false } => {
-                crate::gpu::compose::compose_if("sites.wgsl", &[], f64)
-            }
-            Kernel::SitesTrial => sites("MASKED"),
+            Kernel::Sites { dynamic } => sites(dynamic, false),
+            Kernel::SitesTrial { dynamic } => sites(dynamic, true),
             Kernel::Contact(terms) => contact::contact_wgsl(terms, f64),
             Kernel::ContactTrial(terms) => contact::contact_force_wgsl(terms, f64, true),
             Kernel::Assemble { dynamic, unbalance } => {
                 assemble::assemble_wgsl_with(dynamic, unbalance, f64)
             }
-            Kernel::AssembleTrial => assemble::assemble_force_wgsl(f64, true),
+            Kernel::AssembleTrial { dynamic, unbalance } => {
+                assemble::assemble_force_wgsl_with(dynamic, unbalance, f64, true)
+            }
             Kernel::AssembleShift { trial } => assemble::assemble_shift_wgsl(f64, trial, trial),
             Kernel::BlockLu(form) => block_lu::block_lu_wgsl(f64, form),
             Kernel::Norms { trial } => update::update_wgsl_with(true, f64, false, trial),
             Kernel::Update { trial } => update::update_wgsl_with(false, f64, trial, trial),
             Kernel::Dynamics(k) => dynamics::dynamics_wgsl(k, f64),
+            Kernel::DynamicsTrial(k) => dynamics::dynamics_wgsl_with(k, f64, true),
         }
     }
 

@@ -169,7 +169,8 @@ fn clear_fixed<T: Real>(blk: &mut [T; 36], row_mask: u32, col_mask: u32) {
 
 /// One (node, variant) invocation: residual (6), diagonal (36), and, below the last node,
 /// upper and lower (36 each). With `tangent` false (the kernel built `FORCE_ONLY`, static
-/// only) the residual alone: the element tangents are not read and the blocks stay zero.
+/// or dynamic) the residual alone: the element tangents are not read and the blocks stay
+/// zero.
 fn node_blocks<T: Real>(
     a: &AssemblyInputs<T>,
     i: usize,
@@ -228,14 +229,16 @@ fn node_blocks<T: Real>(
             }
         }
     }
-    if let Some(dy) = a.dynamic.as_ref().filter(|_| tangent) {
+    if let Some(dy) = a.dynamic.as_ref() {
         let [hg, hhb, a0] = dy.coefficients;
-        for k in 0..36 {
-            d[k] = hhb * d[k];
-            u[k] = hhb * u[k];
-            l[k] = hhb * l[k];
+        if tangent {
+            for k in 0..36 {
+                d[k] = hhb * d[k];
+                u[k] = hhb * u[k];
+                l[k] = hhb * l[k];
+            }
         }
-        if s != NO_SITE {
+        if tangent && s != NO_SITE {
             let p = s as usize * nv + v;
             if a.contact_flag[p] != 0 {
                 for k in 0..6 {
@@ -296,6 +299,9 @@ fn node_blocks<T: Real>(
         for k in 0..3 {
             r[k] = r[k] + m * acc(k) + a0 * m * vel(k);
             r[3 + k] = r[3 + k] + jwd[k] + gyro[k];
+            if !tangent {
+                continue;
+            }
             d[6 * k + k] = d[6 * k + k] + m + hg * a0 * m;
             for c in 0..3 {
                 // ∂(ω × Jω)/∂ω = [ω]× J − [Jω]×.
@@ -323,6 +329,9 @@ fn node_blocks<T: Real>(
                 );
                 for a in 0..6 {
                     r[a] = r[a] + ru[a];
+                    if !tangent {
+                        continue;
+                    }
                     for b in 0..6 {
                         d[6 * a + b] = d[6 * a + b] + ju[a][b];
                     }
@@ -415,12 +424,11 @@ pub fn assemble<T: Real + Send + Sync>(a: &AssemblyInputs<T>) -> ChainBatch<T> {
     out
 }
 
-/// The static residual alone of every variant (twin of the kernel built `FORCE_ONLY`, the
-/// line-search trials'): `rhs` as [`assemble`] gives it, without reading the element
-/// tangents (`a.elem_tangent` may be empty). Panics on dynamic inputs (the dynamic
-/// residual is not split from its matrix).
+/// The residual alone of every variant, static or dynamic (twin of the kernel built
+/// `FORCE_ONLY`, the line-search trials'): `rhs` as [`assemble`] gives it, the same sums in
+/// the same order, without reading the element tangents (`a.elem_tangent` may be empty)
+/// or forming a block.
 pub fn assemble_residual<T: Real + Send + Sync>(a: &AssemblyInputs<T>) -> Vec<T> {
-    assert!(a.dynamic.is_none(), "the residual-only assembly is static");
     let (n, nv) = (a.num_nodes, a.num_variants);
     let per: Vec<[T; 6]> = (0..n * nv)
         .into_par_iter()

@@ -6,7 +6,8 @@
 
 use holewall::error::GpuError;
 use holewall::gpu::assemble::{
-    assemble_force_wgsl, assemble_shift_wgsl, shift_bindings, static_bindings,
+    assemble_force_wgsl, assemble_force_wgsl_with, assemble_shift_wgsl, shift_bindings,
+    static_bindings,
 };
 use holewall::gpu::batch::{bind, dispatch, encoder};
 use holewall::gpu::contact::{require_precision, GpuReal};
@@ -223,29 +224,45 @@ pub fn norms_gpu<T: GpuReal>(
     Ok(Norms::from_rows(&rows))
 }
 
-/// The static residual of every variant on the GPU (the kernel built `FORCE_ONLY`), laid
-/// out as the twin's `rhs`.
+/// The residual of every variant on the GPU (the kernel built `FORCE_ONLY`, static or
+/// dynamic), laid out as the twin's `rhs`.
 pub fn assemble_residual_gpu<T: GpuReal>(
     ctx: &'static GpuContext,
     a: &AssemblyInputs<T>,
 ) -> Result<Vec<T>, GpuError> {
     require_precision::<T>(ctx)?;
-    if a.dynamic.is_some() {
-        return Err(GpuError::Unsupported(
-            "the residual-only assembly is static".into(),
-        ));
-    }
     let (n, nv) = (a.num_nodes, a.num_variants);
     let size = std::mem::size_of::<T>();
-    let wgsl = match a.shift {
-        Some(_) => assemble_shift_wgsl(T::IS_F64, true, false)?,
-        None => assemble_force_wgsl(T::IS_F64, false)?,
+    let wgsl = match (&a.shift, &a.dynamic) {
+        (Some(_), _) => assemble_shift_wgsl(T::IS_F64, true, false)?,
+        (None, Some(dy)) => {
+            assemble_force_wgsl_with(true, !dy.unbalance.is_empty(), T::IS_F64, false)?
+        }
+        (None, None) => assemble_force_wgsl(T::IS_F64, false)?,
     };
     let pipeline = ctx.pipeline("assemble_force", &wgsl)?;
     let (dims, inputs) = static_bindings(a, false);
-    // The shift's bindings follow the output in the kernel: passed after it (read only).
+    // The shift's or the dynamic inputs follow the output in the kernel: passed after it
+    // (read only).
     let mut outputs = vec![Out::Empty(6 * n * nv * size)];
     outputs.extend(shift_bindings(a));
+    if let Some(dy) = &a.dynamic {
+        outputs.extend(
+            [
+                &dy.coefficients[..],
+                &dy.mass,
+                &dy.inertia0,
+                &dy.rot,
+                &dy.vel,
+                &dy.vdot,
+            ]
+            .into_iter()
+            .map(|x| Out::From(bytemuck::cast_slice(x))),
+        );
+        if !dy.unbalance.is_empty() {
+            outputs.push(Out::From(bytemuck::cast_slice(&dy.unbalance)));
+        }
+    }
     let out = run_once(
         ctx,
         &pipeline,

@@ -84,9 +84,17 @@ pub trait ResidentDynamic<T> {
     /// Predicts at the unknown, evaluates and solves: the norms of the residual and the
     /// correction `Δ` (α = 1), the solve's status and the inertial force scale per variant.
     fn iterate(&mut self) -> Result<Iteration<T>, crate::error::SystemError>;
-    /// The residual at `v̇ + α Δ` (line search; the force-only beam kernel): its norms
-    /// with `Δ`, `α`.
-    fn trial(&mut self, alpha: &[T]) -> Result<Norms<T>, crate::error::SystemError>;
+    /// The residual at `v̇ + α Δ` (line search; the residual alone): its norms with `Δ`,
+    /// `α`, read for the variants in `search`. `first`: the search's first trial — every
+    /// variant's candidate is set (α = 0: the unknown); after it only the searching
+    /// variants' candidates move, every other keeps its own (as
+    /// [`crate::solve::newton::NewtonSystem::trial`]), and a path may evaluate only those.
+    fn trial(
+        &mut self,
+        alpha: &[T],
+        search: &[bool],
+        first: bool,
+    ) -> Result<Norms<T>, crate::error::SystemError>;
     /// The unknown `+= α Δ`.
     fn correct(&mut self, alpha: &[T]) -> Result<(), crate::error::SystemError>;
     /// The unknown becomes the last trial's candidate (a trial forms its residual only:
@@ -741,10 +749,10 @@ impl<T: Real> NewtonSystem for DynamicStep<'_, T> {
     fn trial(
         &mut self,
         alpha: &[f64],
-        _: &[bool],
-        _: bool,
+        search: &[bool],
+        first: bool,
     ) -> Result<TrialProbe, crate::error::SystemError> {
-        let r = self.ensemble.trial(&negated::<T>(alpha))?;
+        let r = self.ensemble.trial(&negated::<T>(alpha), search, first)?;
         Ok(trial_probe(&r))
     }
     fn accept(

@@ -107,7 +107,15 @@ impl ResidentDynamic<f64> for TwinDynamic<'_> {
             inertial,
         })
     }
-    fn trial(&mut self, alpha: &[f64]) -> Result<Norms<f64>, crate::error::SystemError> {
+    fn trial(
+        &mut self,
+        alpha: &[f64],
+        _: &[bool],
+        _: bool,
+    ) -> Result<Norms<f64>, crate::error::SystemError> {
+        // Every variant is moved and evaluated: the searching ones' residuals are those the
+        // GPU forms for them alone, the others' trial points those it keeps (each at its
+        // accepted α).
         let (v, n) = (self.tables.num_variants, self.tables.num_nodes);
         let cand = accelerate(&self.tables.basis, &self.unknown, &self.delta, alpha, n, v);
         let sys = self.evaluate_at(cand, false)?;

@@ -8,7 +8,9 @@ use super::*;
 /// A batch of variants resident on the GPU for a dynamic run
 /// ([`crate::engine::dynamic`]): the state at `t_n`, the Newton unknown `v̇_{n+1}` and a
 /// candidate for the line search, one trial state and its system. Per iteration the host
-/// reads four norms, a status and the inertial scale per variant.
+/// reads four norms, a status and the inertial scale per variant. A line-search trial
+/// forms the residual alone (the kernels built `FORCE_ONLY`) of the variants still
+/// searching (built `MASKED`, the list `[A, v_0, …]`): only they pay for it (issue 27).
 pub struct GpuDynamic<T: GpuReal> {
     ctx: &'static GpuContext,
     p: DynamicPipelines,
@@ -35,24 +37,45 @@ struct DynamicPipelines {
     assemble: Arc<wgpu::ComputePipeline>,
     block_lu: Arc<wgpu::ComputePipeline>,
     norms: Arc<wgpu::ComputePipeline>,
-    /// The beam kernel built `FORCE_ONLY` (line-search trials).
-    beam_force: Arc<wgpu::ComputePipeline>,
+    /// The line-search trials' kernels: the residual alone, for the listed variants.
+    trial: TrialPipelines,
+}
+
+/// The dynamic line-search trials' kernels: the correction and the predictor at the
+/// candidate, beam forces, sites, contact forces and the residual, each built `MASKED`
+/// (one invocation per item and listed variant); `FORCE_ONLY` where it has a matrix part.
+struct TrialPipelines {
+    accelerate: Arc<wgpu::ComputePipeline>,
+    predict: Arc<wgpu::ComputePipeline>,
+    beam: Arc<wgpu::ComputePipeline>,
+    sites: Arc<wgpu::ComputePipeline>,
+    contact: Arc<wgpu::ComputePipeline>,
+    assemble: Arc<wgpu::ComputePipeline>,
+    norms: Arc<wgpu::ComputePipeline>,
+}
+
+/// The trials' bind groups (every one with the list `c.active` last).
+struct TrialGroups {
+    accelerate: wgpu::BindGroup,
+    predict: wgpu::BindGroup,
+    beam: wgpu::BindGroup,
+    sites: wgpu::BindGroup,
+    contact: wgpu::BindGroup,
+    assemble: wgpu::BindGroup,
+    norms: wgpu::BindGroup,
 }
 
 struct DynamicGroups {
     predict_unknown: wgpu::BindGroup,
-    predict_candidate: wgpu::BindGroup,
     accelerate: wgpu::BindGroup,
     scale: wgpu::BindGroup,
     beam: wgpu::BindGroup,
-    beam_force: wgpu::BindGroup,
     sites: wgpu::BindGroup,
     contact: wgpu::BindGroup,
-    assemble_unknown: wgpu::BindGroup,
-    assemble_candidate: wgpu::BindGroup,
+    assemble: wgpu::BindGroup,
     lu: Vec<wgpu::BindGroup>,
     norms_iterate: wgpu::BindGroup,
-    norms_trial: wgpu::BindGroup,
+    trial: TrialGroups,
 }
 
 struct DynamicBuffers {
@@ -106,10 +129,7 @@ impl<T: GpuReal> GpuDynamic<T> {
                 force_only: false,
                 kink,
             })?,
-            beam_force: k(Kernel::Beam {
-                force_only: true,
-                kink,
-            })?,
+
             sites: k(Kernel::Sites { dynamic: true })?,
             contact: k(Kernel::Contact(&tables.terms))?,
             assemble: k(Kernel::Assemble {
@@ -118,6 +138,18 @@ impl<T: GpuReal> GpuDynamic<T> {
             })?,
             block_lu: k(Kernel::BlockLu(LuForm::for_adapter(ctx)))?,
             norms: k(Kernel::Norms { trial: false })?,
+            trial: TrialPipelines {
+                accelerate: k(Kernel::DynamicsTrial(DynamicsKernel::Accelerate))?,
+                predict: k(Kernel::DynamicsTrial(DynamicsKernel::Predict))?,
+                beam: k(Kernel::BeamTrial { kink })?,
+                sites: k(Kernel::SitesTrial { dynamic: true })?,
+                contact: k(Kernel::ContactTrial(&tables.terms))?,
+                assemble: k(Kernel::AssembleTrial {
+                    dynamic: true,
+                    unbalance: !dynamic.unbalance.is_empty(),
+                })?,
+                norms: k(Kernel::Norms { trial: true })?,
+            },
         };
         let mass = storage(ctx, "mass", &dynamic.mass);
         let inertia0 = storage(ctx, "inertia0", &dynamic.inertia0);
@@ -143,52 +175,86 @@ impl<T: GpuReal> GpuDynamic<T> {
             vel_1: storage(ctx, "vel_1", &st.vel),
             acc_1: storage(ctx, "acc_1", &st.acc),
         };
-        let predict = |vdot: &wgpu::Buffer| {
-            bind(
-                ctx,
-                &pl.predict,
-                "predict",
-                &[
-                    &c.chain_dims,
-                    &b.coef,
-                    &b.flags,
-                    &b.top,
-                    &b.u_n,
-                    &b.rot_n,
-                    &b.vel_n,
-                    &b.acc_n,
-                    &b.vdot_n,
-                    vdot,
-                    &b.u_1,
-                    &b.rot_1,
-                    &b.vel_1,
-                    &b.acc_1,
-                ],
-            )
-        };
-        let inputs = c.assembly_inputs(true);
-        let assemble = |vdot: &wgpu::Buffer| {
-            let mut dynamic_inputs = vec![
-                &b.dyn_coef,
-                &mass,
-                &inertia0,
+        let predict_inputs = |vdot| {
+            vec![
+                &c.chain_dims,
+                &b.coef,
+                &b.flags,
+                &b.top,
+                &b.u_n,
+                &b.rot_n,
+                &b.vel_n,
+                &b.acc_n,
+                &b.vdot_n,
+                vdot,
+                &b.u_1,
                 &b.rot_1,
                 &b.vel_1,
-                vdot,
-                &c.normals,
-            ];
-            dynamic_inputs.extend(&unbalance);
-            dynamic_inputs.extend([&diag, &upper, &lower, &rhs]);
-            bind(
+                &b.acc_1,
+            ]
+        };
+        let mut assemble = c.assembly_inputs(true);
+        assemble.extend([
+            &b.dyn_coef,
+            &mass,
+            &inertia0,
+            &b.rot_1,
+            &b.vel_1,
+            &b.vdot_k,
+            &c.normals,
+        ]);
+        assemble.extend(&unbalance);
+        assemble.extend([&diag, &upper, &lower, &rhs]);
+        // The trials' residual: the static inputs, the output and the list, then the
+        // dynamic inputs (at the candidate).
+        let mut assemble_trial = c.assembly_inputs(false);
+        assemble_trial.extend([&rhs, &c.active]);
+        assemble_trial.extend([&b.dyn_coef, &mass, &inertia0, &b.rot_1, &b.vel_1, &b.vdot_c]);
+        assemble_trial.extend(&unbalance);
+        let tp = &pl.trial;
+        let trial = TrialGroups {
+            accelerate: bind(
                 ctx,
-                &pl.assemble,
-                "assemble",
-                &[&inputs[..], &dynamic_inputs[..]].concat(),
-            )
+                &tp.accelerate,
+                "accelerate_trial",
+                &[
+                    &c.chain_dims,
+                    &c.basis,
+                    &b.vdot_k,
+                    &c.delta,
+                    &c.alpha,
+                    &b.vdot_c,
+                    &c.active,
+                ],
+            ),
+            predict: bind(
+                ctx,
+                &tp.predict,
+                "predict_trial",
+                &[&predict_inputs(&b.vdot_c)[..], &[&c.active]].concat(),
+            ),
+            beam: c.beam_group(ctx, &tp.beam, &b.u_1, &b.rot_1, true, true),
+            sites: bind(
+                ctx,
+                &tp.sites,
+                "sites_trial",
+                &[
+                    &c.sites_dims,
+                    &c.pair_node,
+                    &b.u_1,
+                    &c.pair_base,
+                    &c.pair_state,
+                    &b.vel_1,
+                    &c.normals,
+                    &c.active,
+                ],
+            ),
+            contact: c.contact_group(ctx, &tp.contact, true),
+            assemble: bind(ctx, &tp.assemble, "assemble_trial", &assemble_trial),
+            norms: c.norms_group(ctx, &tp.norms, &c.alpha, &rhs, true),
         };
         let g = DynamicGroups {
-            predict_unknown: predict(&b.vdot_k),
-            predict_candidate: predict(&b.vdot_c),
+            predict_unknown: bind(ctx, &pl.predict, "predict", &predict_inputs(&b.vdot_k)),
             accelerate: bind(
                 ctx,
                 &pl.accelerate,
@@ -209,7 +275,6 @@ impl<T: GpuReal> GpuDynamic<T> {
                 &[&c.chain_dims, &mass, &b.vdot_k, &b.scale],
             ),
             beam: c.beam_group(ctx, &pl.beam, &b.u_1, &b.rot_1, false, false),
-            beam_force: c.beam_group(ctx, &pl.beam_force, &b.u_1, &b.rot_1, true, false),
             sites: bind(
                 ctx,
                 &pl.sites,
@@ -225,11 +290,10 @@ impl<T: GpuReal> GpuDynamic<T> {
                 ],
             ),
             contact: c.contact_group(ctx, &pl.contact, false),
-            assemble_unknown: assemble(&b.vdot_k),
-            assemble_candidate: assemble(&b.vdot_c),
+            assemble: bind(ctx, &pl.assemble, "assemble", &assemble),
             lu: c.lu_groups(ctx, &pl.block_lu, [&diag, &upper, &lower, &rhs]),
             norms_iterate: c.norms_group(ctx, &pl.norms, &c.ones, &rhs, false),
-            norms_trial: c.norms_group(ctx, &pl.norms, &c.alpha, &rhs, false),
+            trial,
         };
         Ok(GpuDynamic {
             ctx,
@@ -250,30 +314,28 @@ impl<T: GpuReal> GpuDynamic<T> {
         })
     }
 
-    /// Records predict (at the unknown or the candidate), beam, sites, contact, assembly:
-    /// at the unknown the system, at a (line-search) candidate its residual alone.
-    fn record_evaluate(&self, pass: &mut wgpu::ComputePass, candidate: bool) {
+    /// Records predict, beam, sites, contact, assembly: at the unknown the system of every
+    /// variant (`trial` None); at the candidate (a line-search trial of the `Some(A)`
+    /// variants listed in `c.active`) the residual alone of those.
+    fn record_evaluate(&self, pass: &mut wgpu::ComputePass, trial: Option<usize>) {
         let (g, p) = (&self.g, &self.p);
-        let (predict, assemble) = if candidate {
-            (&g.predict_candidate, &g.assemble_candidate)
-        } else {
-            (&g.predict_unknown, &g.assemble_unknown)
-        };
-        record_chain(
-            pass,
-            true,
-            self.num_nodes,
-            self.num_variants,
-            self.num_pairs,
-            |stage| match stage {
-                Stage::Predict => Some((&*p.predict, predict)),
-                Stage::Beam if candidate => Some((&*p.beam_force, &g.beam_force)),
-                Stage::Beam => Some((&*p.beam, &g.beam)),
-                Stage::Sites => Some((&*p.sites, &g.sites)),
-                Stage::Contact => Some((&*p.contact, &g.contact)),
-                Stage::Assemble => Some((&*p.assemble, assemble)),
-            },
-        );
+        let (tg, tp) = (&g.trial, &p.trial);
+        let v = trial.unwrap_or(self.num_variants);
+        let pairs = self.num_pairs / self.num_variants.max(1) * v;
+        record_chain(pass, true, self.num_nodes, v, pairs, |stage| {
+            Some(match (stage, trial.is_some()) {
+                (Stage::Predict, false) => (&*p.predict, &g.predict_unknown),
+                (Stage::Beam, false) => (&*p.beam, &g.beam),
+                (Stage::Sites, false) => (&*p.sites, &g.sites),
+                (Stage::Contact, false) => (&*p.contact, &g.contact),
+                (Stage::Assemble, false) => (&*p.assemble, &g.assemble),
+                (Stage::Predict, true) => (&*tp.predict, &tg.predict),
+                (Stage::Beam, true) => (&*tp.beam, &tg.beam),
+                (Stage::Sites, true) => (&*tp.sites, &tg.sites),
+                (Stage::Contact, true) => (&*tp.contact, &tg.contact),
+                (Stage::Assemble, true) => (&*tp.assemble, &tg.assemble),
+            })
+        });
     }
 
     fn copy_all(encoder: &mut wgpu::CommandEncoder, pairs: &[(&wgpu::Buffer, &wgpu::Buffer)]) {
@@ -313,7 +375,7 @@ impl<T: GpuReal> crate::engine::dynamic::ResidentDynamic<T> for GpuDynamic<T> {
         self.c.reset_status(&mut e, v);
         {
             let mut pass = e.begin_compute_pass(&Default::default());
-            self.record_evaluate(&mut pass, false);
+            self.record_evaluate(&mut pass, None);
             for group in &self.g.lu {
                 dispatch(&mut pass, &self.p.block_lu, group, self.lu_lanes * v);
             }
@@ -347,22 +409,33 @@ impl<T: GpuReal> crate::engine::dynamic::ResidentDynamic<T> for GpuDynamic<T> {
         })
     }
 
-    fn trial(&mut self, alpha: &[T]) -> Result<Norms<T>, crate::error::SystemError> {
+    fn trial(
+        &mut self,
+        alpha: &[T],
+        search: &[bool],
+        first: bool,
+    ) -> Result<Norms<T>, crate::error::SystemError> {
         let v = self.num_variants;
-        self.ctx
-            .queue
-            .write_buffer(&self.c.alpha, 0, bytemuck::cast_slice(alpha));
+        let q = &self.ctx.queue;
+        q.write_buffer(&self.c.alpha, 0, bytemuck::cast_slice(alpha));
+        // The variants still searching, compacted: [A, v_0, …, v_{A−1}].
+        let list = super::search_list(search);
+        let count = list.len() - 1;
+        q.write_buffer(&self.c.active, 0, bytemuck::cast_slice(&list));
         let mut e = encoder(self.ctx, "trial");
         {
+            // The candidate of every variant on a search's first trial (α = 0: the
+            // unknown), of the searching ones after; the residual of the searching ones.
             let mut pass = e.begin_compute_pass(&Default::default());
-            dispatch(
-                &mut pass,
-                &self.p.accelerate,
-                &self.g.accelerate,
-                self.num_nodes * v,
-            );
-            self.record_evaluate(&mut pass, true);
-            dispatch(&mut pass, &self.p.norms, &self.g.norms_trial, v);
+            let n = self.num_nodes;
+            if first {
+                dispatch(&mut pass, &self.p.accelerate, &self.g.accelerate, n * v);
+            } else {
+                let (p, g) = (&self.p.trial.accelerate, &self.g.trial.accelerate);
+                dispatch(&mut pass, p, g, n * count);
+            }
+            self.record_evaluate(&mut pass, Some(count));
+            dispatch(&mut pass, &self.p.trial.norms, &self.g.trial.norms, count);
         }
         let size = std::mem::size_of::<T>() as u64;
         let out = self

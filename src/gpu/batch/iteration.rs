@@ -13,7 +13,7 @@ pub fn sites_wgsl(f64: bool) -> Result<String, GpuError> {
 /// The WGSL text of the static sites gather built `MASKED` (the engine's line-search
 /// trials: one invocation per (site, listed variant) of the compacted list `[A, v_0, …]`).
 pub fn sites_trial_wgsl(f64: bool) -> Result<String, GpuError> {
-    Kernel::SitesTrial.wgsl(f64)
+    Kernel::SitesTrial { dynamic: false }.wgsl(f64)
 }
 
 /// The WGSL text of the static or dynamic sites gather at a precision.
@@ -89,10 +89,8 @@ impl<T: GpuReal> ResidentStatic<T> for GpuStatic<T> {
         let q = &self.ctx.queue;
         q.write_buffer(&self.c.alpha, 0, bytemuck::cast_slice(alpha));
         // The variants still searching, compacted: [A, v_0, …, v_{A−1}].
-        let mut list: Vec<u32> = vec![0];
-        list.extend((0..v as u32).filter(|&j| search[j as usize]));
+        let list = super::search_list(search);
         let count = list.len() - 1;
-        list[0] = count as u32;
         q.write_buffer(&self.c.active, 0, bytemuck::cast_slice(&list));
         let mut encoder = self.encoder("trial");
         let b = &self.slots[other];

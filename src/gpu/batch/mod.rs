@@ -274,14 +274,17 @@ impl<T: GpuReal> GpuStatic<T> {
             })?,
             beam_force: k(Kernel::BeamTrial { kink })?,
             sites: k(Kernel::Sites { dynamic: false })?,
-            sites_trial: k(Kernel::SitesTrial)?,
+            sites_trial: k(Kernel::SitesTrial { dynamic: false })?,
             contact: k(Kernel::Contact(&tables.terms))?,
             contact_force: k(Kernel::ContactTrial(&tables.terms))?,
             assemble: k(Kernel::Assemble {
                 dynamic: false,
                 unbalance: false,
             })?,
-            assemble_force: k(Kernel::AssembleTrial)?,
+            assemble_force: k(Kernel::AssembleTrial {
+                dynamic: false,
+                unbalance: false,
+            })?,
             block_lu: k(Kernel::BlockLu(LuForm::for_adapter(ctx)))?,
             norms: k(Kernel::Norms { trial: false })?,
             norms_trial: k(Kernel::Norms { trial: true })?,
@@ -512,6 +515,15 @@ fn record_chain<'b>(
             );
         }
     }
+}
+
+/// The variants still searching (`search[j]`), compacted as the kernels built `MASKED`
+/// read them: `[A, v_0, …, v_{A−1}]`.
+fn search_list(search: &[bool]) -> Vec<u32> {
+    let mut list: Vec<u32> = vec![0];
+    list.extend((0..search.len() as u32).filter(|&j| search[j as usize]));
+    list[0] = (list.len() - 1) as u32;
+    list
 }
 
 /// A command encoder on `ctx`'s device.
