@@ -177,13 +177,25 @@ fn dynamic_tables<T: Real>(
     let mut mass = Vec::new();
     let mut inertia0 = Vec::new();
     let mut top = (false, false);
-    for (j, (m, (q, vel))) in models.iter().zip(starts).enumerate() {
-        let mut d = Dynamics::new(m, *options, &|e| density[e]);
-        let s = d
-            .initial_state_with(q.clone(), vel.clone())
-            .map_err(|e| crate::error::SystemError::Linear(format!("the initial state: {e}")))?;
-        f_ref.push(d.reference_force());
+    // Each variant's consistent initial state (a solve with its mass), in parallel: on the
+    // host, before any kernel, this was the largest serial part of a large batch (issue 27).
+    use rayon::prelude::*;
+    let initial: Vec<_> = models
+        .par_iter()
+        .zip(starts)
+        .map(|(m, (q, vel))| {
+            let mut d = Dynamics::new(m, *options, &|e| density[e]);
+            let s = d.initial_state_with(q.clone(), vel.clone()).map_err(|e| {
+                crate::error::SystemError::Linear(format!("the initial state: {e}"))
+            })?;
+            let loads = crate::solve::statics::external_loads(m);
+            Ok((s, d.reference_force(), loads))
+        })
+        .collect::<Result<_, crate::error::SystemError>>()?;
+    for (j, (m, (s, reference, loads))) in models.iter().zip(initial).enumerate() {
+        f_ref.push(reference);
         if j == 0 {
+            let d = Dynamics::new(m, *options, &|e| density[e]);
             let (ms, js) = d.lumped();
             mass = ms.iter().map(|&x| t(x)).collect();
             inertia0 = js.iter().flatten().flatten().map(|&x| t(x)).collect();
@@ -210,7 +222,6 @@ fn dynamic_tables<T: Real>(
                 start.vdot[idx] = t(s.vdot[6 * i + k]);
             }
         }
-        let loads = crate::solve::statics::external_loads(m);
         for dof in 0..6 * n {
             f_ext[dof * v + j] = t(loads[dof]);
         }
