@@ -89,11 +89,19 @@
 @group(0) @binding(18) var<storage, read_write> out_upper: array<real>;
 @group(0) @binding(19) var<storage, read_write> out_lower: array<real>;
 @group(0) @binding(20) var<storage, read_write> out_rhs: array<real>;
+#if MASKED
+// Built MASKED (the dynamic engine's Newton iterations): the variants still iterating,
+// compacted: [A, v_0, …, v_{A−1}]; the others are skipped.
+@group(0) @binding(21) var<storage, read> searching: array<u32>;
+#endif
 #else
 @group(0) @binding(16) var<storage, read_write> out_diag: array<real>;
 @group(0) @binding(17) var<storage, read_write> out_upper: array<real>;
 @group(0) @binding(18) var<storage, read_write> out_lower: array<real>;
 @group(0) @binding(19) var<storage, read_write> out_rhs: array<real>;
+#if MASKED
+@group(0) @binding(20) var<storage, read> searching: array<u32>;
+#endif
 #endif
 const OUT_C: u32 = 24u;
 const OUT_C_OMEGA: u32 = 42u;

@@ -47,6 +47,10 @@
 @group(0) @binding(7) var<storage, read_write> elem_force: array<real>;
 #if !FORCE_ONLY
 @group(0) @binding(8) var<storage, read_write> elem_tangent: array<real>;
+#if MASKED
+// The variants still iterating, compacted: [A, v_0, …, v_{A−1}].
+@group(0) @binding(9) var<storage, read> searching: array<u32>;
+#endif
 #else
 #if MASKED
 // The variants still searching, compacted: [A, v_0, …, v_{A−1}].
@@ -57,6 +61,10 @@
 @group(0) @binding(6) var<storage, read_write> elem_force: array<real>;
 #if !FORCE_ONLY
 @group(0) @binding(7) var<storage, read_write> elem_tangent: array<real>;
+#if MASKED
+// The variants still iterating, compacted: [A, v_0, …, v_{A−1}].
+@group(0) @binding(8) var<storage, read> searching: array<u32>;
+#endif
 #else
 #if MASKED
 // The variants still searching, compacted: [A, v_0, …, v_{A−1}].
@@ -296,8 +304,9 @@ fn spun(t: Triad, axis: vec3<real>) -> Triad {
 fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let nv = dims.num_variants;
 #if MASKED
-    // Built MASKED with FORCE_ONLY (the engine's line-search trials): one invocation per
-    // (element, searching variant); the other variants' forces are left as they were.
+    // Built MASKED (the engines' line-search trials, with FORCE_ONLY; the dynamic engine's
+    // Newton iterations, with the tangent): one invocation per (element, listed variant);
+    // the other variants' outputs are left as they were.
     let count = searching[0];
     if (gid.x >= dims.num_elements * count) {
         return;

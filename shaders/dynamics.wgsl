@@ -4,8 +4,9 @@
 // at t_{n+1} from the state at t_n and the Newton unknown v̇_{n+1} (top node: prescribed
 // accelerations written into v̇ first, the table's and hook's kinematics after);
 // ACCEL, one invocation per (node, variant): v̇_out = v̇ + α (B Δv_u, Δv_θ);
-// SCALE, one invocation per variant: max_i m_i |v̇_u,i|. Layouts as in the twin. PREDICT and
-// ACCEL built MASKED (the line-search trials) run for the listed variants alone.
+// SCALE, one invocation per variant: max_i m_i |v̇_u,i|. Layouts as in the twin. Built
+// MASKED (the dynamic engine's trials and iterations) each runs for the listed variants
+// [A, v_0, …] alone (its last binding).
 #include "shared/layout.wgsl"
 
 @group(0) @binding(0) var<storage, read> dims: ChainDims;
@@ -46,6 +47,9 @@
 @group(0) @binding(1) var<storage, read> node_mass: array<real>;
 @group(0) @binding(2) var<storage, read> vdot_in: array<real>;
 @group(0) @binding(3) var<storage, read_write> scale_out: array<real>;
+#if MASKED
+@group(0) @binding(4) var<storage, read> searching: array<u32>;
+#endif
 #endif
 
 #if PREDICT
@@ -183,10 +187,17 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
 @compute @workgroup_size(64)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let nv = dims.num_variants;
+#if MASKED
+    if (gid.x >= searching[0]) {
+        return;
+    }
+    let v = searching[1u + gid.x];
+#else
     let v = gid.x;
     if (v >= nv) {
         return;
     }
+#endif
     var s = real(0.0);
     for (var i = 0u; i < dims.num_nodes; i = i + 1u) {
         for (var k = 0u; k < 3u; k = k + 1u) {

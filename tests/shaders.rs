@@ -97,6 +97,11 @@ fn every_contact_specialisation_validates() {
                                     panic!("{terms:?} force only, masked {masked}: {e}")
                                 });
                                 assert_eq!(lean.contains("f64"), f64);
+                                let masked_full =
+                                    holewall::gpu::contact::contact_masked_wgsl(&terms, f64)
+                                        .unwrap();
+                                validate(&masked_full)
+                                    .unwrap_or_else(|e| panic!("{terms:?} masked: {e}"));
                             }
                         }
                         assert_no_uniform(&wgsl);
@@ -140,9 +145,6 @@ fn engine_kernels_validate_in_both_precisions() {
     use holewall::gpu::block_lu::LuForm;
     use holewall::gpu::dynamics::DynamicsKernel;
     use holewall::gpu::kernel::Kernel;
-    assert!(Kernel::DynamicsTrial(DynamicsKernel::Scale)
-        .wgsl(false)
-        .is_err());
     for f64 in [false, true] {
         for wgsl in [
             holewall::gpu::block_lu::block_lu_wgsl(f64, LuForm::Serial).unwrap(),
@@ -169,10 +171,10 @@ fn engine_kernels_validate_in_both_precisions() {
             holewall::gpu::dynamics::dynamics_wgsl(DynamicsKernel::Accelerate, f64).unwrap(),
             holewall::gpu::dynamics::dynamics_wgsl(DynamicsKernel::Scale, f64).unwrap(),
             // The dynamic trials' kernels (listed variants, residual alone).
-            Kernel::DynamicsTrial(DynamicsKernel::Predict)
+            Kernel::DynamicsMasked(DynamicsKernel::Predict)
                 .wgsl(f64)
                 .unwrap(),
-            Kernel::DynamicsTrial(DynamicsKernel::Accelerate)
+            Kernel::DynamicsMasked(DynamicsKernel::Accelerate)
                 .wgsl(f64)
                 .unwrap(),
             Kernel::SitesTrial { dynamic: true }.wgsl(f64).unwrap(),
@@ -191,6 +193,18 @@ fn engine_kernels_validate_in_both_precisions() {
             holewall::gpu::assemble::assemble_force_wgsl_with(true, false, f64, false).unwrap(),
             holewall::gpu::assemble::assemble_force_wgsl_with(true, true, f64, false).unwrap(),
             holewall::gpu::assemble::assemble_wgsl_with(true, true, f64).unwrap(),
+            // The dynamic iterations' kernels (listed variants, the whole system).
+            Kernel::DynamicsMasked(DynamicsKernel::Scale)
+                .wgsl(f64)
+                .unwrap(),
+            Kernel::BeamMasked { kink: false }.wgsl(f64).unwrap(),
+            Kernel::BeamMasked { kink: true }.wgsl(f64).unwrap(),
+            Kernel::AssembleMasked { unbalance: false }
+                .wgsl(f64)
+                .unwrap(),
+            Kernel::AssembleMasked { unbalance: true }
+                .wgsl(f64)
+                .unwrap(),
         ] {
             validate(&wgsl).unwrap_or_else(|e| panic!("f64={f64}: {e}"));
             assert_eq!(wgsl.contains("f64"), f64, "precision leak, f64={f64}");

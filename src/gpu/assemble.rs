@@ -29,6 +29,21 @@ pub fn assemble_wgsl_with(dynamic: bool, unbalance: bool, f64: bool) -> Result<S
     )
 }
 
+/// The WGSL text of the dynamic assembly (system and residual) built `MASKED`: the listed
+/// variants `[A, v_0, …]` alone (bound after the outputs), one invocation per (node, listed
+/// variant); with `unbalance` the mass-imbalance terms.
+pub fn assemble_dynamic_masked_wgsl(unbalance: bool, f64: bool) -> Result<String, GpuError> {
+    compose_if(
+        "assemble.wgsl",
+        &[
+            ("UNBALANCE", unbalance),
+            ("DYNAMIC", true),
+            ("MASKED", true),
+        ],
+        f64,
+    )
+}
+
 /// The WGSL text of the static assembly built `FORCE_ONLY` (the residual alone, for the
 /// line-search trials; twin: [`crate::kernels::assemble::assemble_residual`]).
 /// `masked`: one invocation per (node, listed variant) of the compacted list of searching

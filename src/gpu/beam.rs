@@ -24,9 +24,16 @@ pub fn beam_wgsl(f64: bool, force_only: bool, kink: bool) -> Result<String, GpuE
 /// invocation per (element, listed variant) of the compacted list of searching variants
 /// `[A, v_0, …]` (the last binding); the other variants are skipped.
 pub fn beam_trial_wgsl(f64: bool, kink: bool) -> Result<String, GpuError> {
+    beam_masked_wgsl(f64, true, kink)
+}
+
+/// The beam kernel built `MASKED`: forces and tangents (or `force_only` forces alone) of the
+/// listed variants `[A, v_0, …]` (the last binding), one invocation per (element, listed
+/// variant); the other variants' outputs are left as they were.
+pub fn beam_masked_wgsl(f64: bool, force_only: bool, kink: bool) -> Result<String, GpuError> {
     compose_if(
         "beam.wgsl",
-        &[("FORCE_ONLY", true), ("MASKED", true), ("KINK", kink)],
+        &[("FORCE_ONLY", force_only), ("MASKED", true), ("KINK", kink)],
         f64,
     )
 }

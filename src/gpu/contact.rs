@@ -102,6 +102,18 @@ pub fn contact_force_wgsl(
     compose("contact.wgsl", &flags, f64)
 }
 
+/// The WGSL text of the contact kernel specialised to `terms` built `MASKED` (the dynamic
+/// engine's Newton iterations): the whole response of the listed variants `[A, v_0, …]`
+/// (binding 6; pairs `site · V + v`, V = `mask_variants`); the other pairs are skipped.
+pub fn contact_masked_wgsl(terms: &ContactTerms, f64: bool) -> Result<String, GpuError> {
+    let mut flags = contact_flags(terms);
+    flags.insert("MASKED");
+    if f64 {
+        flags.insert("F64");
+    }
+    compose("contact.wgsl", &flags, f64)
+}
+
 /// Invocations per workgroup in `shaders/contact.wgsl`.
 const WORKGROUP: usize = 64;
 

@@ -23,19 +23,14 @@ pub fn dynamics_wgsl(kernel: DynamicsKernel, f64: bool) -> Result<String, GpuErr
     dynamics_wgsl_with(kernel, f64, false)
 }
 
-/// The WGSL text of one kernel at a precision; `masked` (the predictor and the correction
-/// only: the line-search trials): one invocation per (node, listed variant) of the
-/// compacted list `[A, v_0, …]`, its last binding; the other variants are left as they are.
+/// The WGSL text of one kernel at a precision; `masked` (the dynamic engine's trials and
+/// iterations): one invocation per item and listed variant of the compacted list
+/// `[A, v_0, …]`, its last binding; the other variants are left as they are.
 pub fn dynamics_wgsl_with(
     kernel: DynamicsKernel,
     f64: bool,
     masked: bool,
 ) -> Result<String, GpuError> {
-    if masked && kernel == DynamicsKernel::Scale {
-        return Err(GpuError::Unsupported(
-            "the force scale has no masked form".into(),
-        ));
-    }
     let mut flags = BTreeSet::new();
     if f64 {
         flags.insert("F64");

@@ -28,6 +28,11 @@ pub enum Kernel<'a> {
         /// A scene with a kink.
         kink: bool,
     },
+    /// The dynamic iterations' beam kernel: forces and tangents of the listed variants.
+    BeamMasked {
+        /// A scene with a kink.
+        kink: bool,
+    },
     /// The sites gather: static, or dynamic (with the sites' velocities).
     Sites {
         /// The dynamic form.
@@ -42,6 +47,8 @@ pub enum Kernel<'a> {
     Contact(&'a ContactTerms),
     /// The line-search trials' contact kernel: forces alone, listed variants.
     ContactTrial(&'a ContactTerms),
+    /// The dynamic iterations' contact kernel: the whole response, listed variants.
+    ContactMasked(&'a ContactTerms),
     /// The assembly: static, or dynamic with (`unbalance`) the mass-imbalance terms.
     Assemble {
         /// The dynamic form.
@@ -55,6 +62,12 @@ pub enum Kernel<'a> {
         /// The dynamic form.
         dynamic: bool,
         /// The mass-imbalance terms (dynamic only).
+        unbalance: bool,
+    },
+    /// The dynamic iterations' assembly (system and residual) of the listed variants, with
+    /// (`unbalance`) the mass-imbalance terms.
+    AssembleMasked {
+        /// The mass-imbalance terms.
         unbalance: bool,
     },
     /// The assembly with a relaxation's proximal shift: the full system, or (`trial`) the
@@ -77,8 +90,9 @@ pub enum Kernel<'a> {
     },
     /// One of the generalised-α integrator's kernels.
     Dynamics(DynamicsKernel),
-    /// The line-search trials' predictor or correction (listed variants).
-    DynamicsTrial(DynamicsKernel),
+    /// One of the integrator's kernels for the listed variants (the dynamic engine's trials
+    /// and iterations).
+    DynamicsMasked(DynamicsKernel),
 }
 
 impl Kernel<'_> {
@@ -90,14 +104,17 @@ impl Kernel<'_> {
             } => "beam",
             Kernel::Beam { .. } => "beam_force",
             Kernel::BeamTrial { .. } => "beam_trial",
+            Kernel::BeamMasked { .. } => "beam_masked",
             Kernel::Sites { .. } => "sites",
             Kernel::SitesTrial { dynamic: false } => "sites_trial",
             Kernel::SitesTrial { dynamic: true } => "sites_dynamic_trial",
             Kernel::Contact(_) => "contact",
             Kernel::ContactTrial(_) => "contact_trial",
+            Kernel::ContactMasked(_) => "contact_masked",
             Kernel::Assemble { .. } => "assemble",
             Kernel::AssembleTrial { dynamic: false, .. } => "assemble_trial",
             Kernel::AssembleTrial { dynamic: true, .. } => "assemble_dynamic_trial",
+            Kernel::AssembleMasked { .. } => "assemble_masked",
             Kernel::AssembleShift { trial: false } => "assemble_shift",
             Kernel::AssembleShift { trial: true } => "assemble_trial_shift",
             Kernel::BlockLu(_) => "block_lu",
@@ -108,9 +125,9 @@ impl Kernel<'_> {
             Kernel::Dynamics(DynamicsKernel::Predict) => "predict",
             Kernel::Dynamics(DynamicsKernel::Accelerate) => "accelerate",
             Kernel::Dynamics(DynamicsKernel::Scale) => "scale",
-            Kernel::DynamicsTrial(DynamicsKernel::Predict) => "predict_trial",
-            Kernel::DynamicsTrial(DynamicsKernel::Accelerate) => "accelerate_trial",
-            Kernel::DynamicsTrial(DynamicsKernel::Scale) => "scale_trial",
+            Kernel::DynamicsMasked(DynamicsKernel::Predict) => "predict_masked",
+            Kernel::DynamicsMasked(DynamicsKernel::Accelerate) => "accelerate_masked",
+            Kernel::DynamicsMasked(DynamicsKernel::Scale) => "scale_masked",
         }
     }
 
@@ -127,22 +144,27 @@ impl Kernel<'_> {
         match *self {
             Kernel::Beam { force_only, kink } => beam::beam_wgsl(f64, force_only, kink),
             Kernel::BeamTrial { kink } => beam::beam_trial_wgsl(f64, kink),
+            Kernel::BeamMasked { kink } => beam::beam_masked_wgsl(f64, false, kink),
             Kernel::Sites { dynamic } => sites(dynamic, false),
             Kernel::SitesTrial { dynamic } => sites(dynamic, true),
             Kernel::Contact(terms) => contact::contact_wgsl(terms, f64),
             Kernel::ContactTrial(terms) => contact::contact_force_wgsl(terms, f64, true),
+            Kernel::ContactMasked(terms) => contact::contact_masked_wgsl(terms, f64),
             Kernel::Assemble { dynamic, unbalance } => {
                 assemble::assemble_wgsl_with(dynamic, unbalance, f64)
             }
             Kernel::AssembleTrial { dynamic, unbalance } => {
                 assemble::assemble_force_wgsl_with(dynamic, unbalance, f64, true)
             }
+            Kernel::AssembleMasked { unbalance } => {
+                assemble::assemble_dynamic_masked_wgsl(unbalance, f64)
+            }
             Kernel::AssembleShift { trial } => assemble::assemble_shift_wgsl(f64, trial, trial),
             Kernel::BlockLu(form) => block_lu::block_lu_wgsl(f64, form),
             Kernel::Norms { trial } => update::update_wgsl_with(true, f64, false, trial),
             Kernel::Update { trial } => update::update_wgsl_with(false, f64, trial, trial),
             Kernel::Dynamics(k) => dynamics::dynamics_wgsl(k, f64),
-            Kernel::DynamicsTrial(k) => dynamics::dynamics_wgsl_with(k, f64, true),
+            Kernel::DynamicsMasked(k) => dynamics::dynamics_wgsl_with(k, f64, true),
         }
     }
 

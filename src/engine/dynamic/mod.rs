@@ -8,9 +8,9 @@
 //! (non-finite residual, singular matrix, no convergence in the iterations) is taken back
 //! and re-tried on its own in half steps, recursively down to `min_dt`, while the others
 //! wait ([`run_dynamic_ensemble`]); only below `min_dt` does it fail, as the CPU
-//! integrator would. Within a step, once no more than half of the variants are still
-//! iterating, the stragglers go on in a batch of their own. No kernel mixes variants: the
-//! others are unaffected, bit for bit.
+//! integrator would. Within a step, each Newton iteration and line-search trial works on the
+//! variants still iterating (searching) alone. No kernel mixes variants: the others are
+//! unaffected, bit for bit.
 //!
 //! Supported: lumped mass, mass-proportional Rayleigh damping (`a0`), the table's spin and
 //! the hook's travel at the top, every contact law. Not here (the caller runs those on the
@@ -82,8 +82,10 @@ pub trait ResidentDynamic<T> {
         top: &[T],
     ) -> Result<(), crate::error::SystemError>;
     /// Predicts at the unknown, evaluates and solves: the norms of the residual and the
-    /// correction `Δ` (α = 1), the solve's status and the inertial force scale per variant.
-    fn iterate(&mut self) -> Result<Iteration<T>, crate::error::SystemError>;
+    /// correction `Δ` (α = 1), the solve's status and the inertial force scale per variant,
+    /// read for the variants `running` (a path may work on those alone: the others have
+    /// converged or failed, and their unknowns stay as they are).
+    fn iterate(&mut self, running: &[bool]) -> Result<Iteration<T>, crate::error::SystemError>;
     /// The residual at `v̇ + α Δ` (line search; the residual alone): its norms with `Δ`,
     /// `α`, read for the variants in `search`. `first`: the search's first trial — every
     /// variant's candidate is set (α = 0: the unknown); after it only the searching
@@ -106,10 +108,6 @@ pub trait ResidentDynamic<T> {
     fn state(&mut self) -> Result<DynamicBatch<T>, crate::error::SystemError>;
     /// Replaces the state at `t_n` (between steps).
     fn set_state(&mut self, state: &DynamicBatch<T>) -> Result<(), crate::error::SystemError>;
-    /// The Newton unknown `v̇_{n+1}`, `6 n V`, read back (mid-step).
-    fn unknown(&mut self) -> Result<Vec<T>, crate::error::SystemError>;
-    /// Replaces the Newton unknown (after [`ResidentDynamic::begin_step`]).
-    fn set_unknown(&mut self, vdot: &[T]) -> Result<(), crate::error::SystemError>;
 }
 
 /// How a variant's dynamic run ended.
@@ -529,8 +527,7 @@ fn run_span<T: Real + Send + Sync, P: KernelPath<T>>(
             }
         }
         let hhb = hh * hh * p.beta * ratio;
-        let (failed, before) =
-            solve_step(batch, ensemble, members, &coefficients, &top, newton, hhb)?;
+        let (failed, before) = solve_step(batch, ensemble, members, newton, hhb)?;
         // (local index, its sub-step) of every variant to take this step in sub-steps.
         let mut retry: Vec<(usize, f64)> = deferred
             .iter()
@@ -598,32 +595,31 @@ fn run_span<T: Real + Send + Sync, P: KernelPath<T>>(
 }
 
 /// The Newton of one time step for the ensemble's running variants (started in `newton`),
-/// then the step's end (the state at `t_n + h`). Once no more than half of them are still
-/// running (ensembles of [`super::COMPACT_MIN`] or more), the stragglers go on in a batch
-/// of their own exactly where they stand (state at `t_n`, Newton unknown, Newton state),
-/// bit for bit, so converged variants cost no more kernel work; their end state is
-/// written back. Returns the variants whose Newton failed (local index, reason) and, if
-/// any failed, every variant's state at `t_n`.
+/// then the step's end (the state at `t_n + h`). Each iteration is asked of the variants
+/// still running alone ([`ResidentDynamic::iterate`]): on the GPU the kernels work on those
+/// (built `MASKED`), so a converged variant costs no more kernel work and nothing leaves
+/// the device (issue 27; a batch of the stragglers was opened on the host before, their
+/// state read back and written again). Returns the variants whose Newton failed (local
+/// index, reason) and, if any failed, every variant's state at `t_n`.
 #[allow(clippy::type_complexity)]
 fn solve_step<T: Real + Send + Sync, P: KernelPath<T>>(
     batch: &mut Batch<'_, T, P>,
     ensemble: &mut dyn ResidentDynamic<T>,
     members: &[usize],
-    coefficients: &StepCoefficients<T>,
-    top: &[T],
     mut newton: Newton,
     hhb: f64,
 ) -> Result<(Vec<(usize, String)>, Option<DynamicBatch<T>>), crate::error::SystemError> {
     let m = members.len();
     let mut failed = Vec::new();
-    let mut compact = false;
     {
         let mut sys = DynamicStep {
             ensemble: &mut *ensemble,
             f_ref: members.iter().map(|&j| batch.f_ref[j]).collect(),
             hhb,
+            running: vec![true; m],
         };
         while newton.any_running() {
+            sys.running = (0..m).map(|i| newton.is_running(i)).collect();
             for (i, event) in newton.iterate(&mut sys)? {
                 match event {
                     Event::Converged(its) => {
@@ -638,50 +634,15 @@ fn solve_step<T: Real + Send + Sync, P: KernelPath<T>>(
                     Event::Failed(reason) => failed.push((i, reason)),
                 }
             }
-            let running = newton.running_count();
-            if m >= super::COMPACT_MIN && running > 0 && 2 * running <= m {
-                compact = true;
-                break;
-            }
         }
     }
-    // Every variant's state at t_n, where one failed or stragglers move.
-    let before = if failed.is_empty() && !compact {
+    // Every variant's state at t_n, where one failed.
+    let before = if failed.is_empty() {
         None
     } else {
         Some(ensemble.state()?)
     };
-    let mut moved = None;
-    if let (true, Some(at_n)) = (compact, before.as_ref()) {
-        let s: Vec<usize> = (0..m).filter(|&i| newton.is_running(i)).collect();
-        let sub_members: Vec<usize> = s.iter().map(|&i| members[i]).collect();
-        let unknown = ensemble.unknown()?;
-        let sub_top = columns(top, m, &s);
-        let mut sub = open_subset(batch, &sub_members, &batch_columns(at_n, &s))?;
-        sub.begin_step(coefficients, &sub_top)?;
-        sub.set_unknown(&columns(&unknown, m, &s))?;
-        let mut sub_newton = Newton::new(newton.settings, s.len());
-        for (k, &i) in s.iter().enumerate() {
-            sub_newton.resume(k, newton.state(i));
-        }
-        let (sub_failed, _) = solve_step(
-            batch,
-            sub.as_mut(),
-            &sub_members,
-            coefficients,
-            &sub_top,
-            sub_newton,
-            hhb,
-        )?;
-        failed.extend(sub_failed.into_iter().map(|(k, why)| (s[k], why)));
-        moved = Some((s, sub.state()?));
-    }
     ensemble.end_step()?;
-    if let Some((s, after)) = moved {
-        let mut now = ensemble.state()?;
-        put_batch_columns(&mut now, &s, &after);
-        ensemble.set_state(&now)?;
-    }
     Ok((failed, before))
 }
 
@@ -733,6 +694,8 @@ struct DynamicStep<'e, T> {
     ensemble: &'e mut dyn ResidentDynamic<T>,
     f_ref: Vec<f64>,
     hhb: f64,
+    /// The variants Newton is iterating on (set before each iteration).
+    running: Vec<bool>,
 }
 
 impl<T: Real> NewtonSystem for DynamicStep<'_, T> {
@@ -744,7 +707,7 @@ impl<T: Real> NewtonSystem for DynamicStep<'_, T> {
             norms,
             status,
             inertial,
-        } = self.ensemble.iterate()?;
+        } = self.ensemble.iterate(&self.running)?;
         let f = |x: &T| x.to_f64_lossy();
         Ok(Probe {
             // Scale: the loads, or the inertial forces if larger (a whirling string).

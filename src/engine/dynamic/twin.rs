@@ -92,7 +92,9 @@ impl ResidentDynamic<f64> for TwinDynamic<'_> {
         self.unknown = self.state.vdot.clone();
         Ok(())
     }
-    fn iterate(&mut self) -> Result<Iteration<f64>, crate::error::SystemError> {
+    fn iterate(&mut self, _: &[bool]) -> Result<Iteration<f64>, crate::error::SystemError> {
+        // Every variant is evaluated and solved (the GPU forms the running ones alone; the
+        // others' unknowns do not move, and their outputs are not read).
         let sys = self.evaluate_at(self.unknown.clone(), true)?;
         // The top's prescribed accelerations, as the predictor wrote them.
         self.unknown = self.trial.vdot.clone();
@@ -147,13 +149,6 @@ impl ResidentDynamic<f64> for TwinDynamic<'_> {
     }
     fn set_state(&mut self, state: &DynamicBatch<f64>) -> Result<(), crate::error::SystemError> {
         self.state = state.clone();
-        Ok(())
-    }
-    fn unknown(&mut self) -> Result<Vec<f64>, crate::error::SystemError> {
-        Ok(self.unknown.clone())
-    }
-    fn set_unknown(&mut self, vdot: &[f64]) -> Result<(), crate::error::SystemError> {
-        self.unknown = vdot.to_vec();
         Ok(())
     }
 }

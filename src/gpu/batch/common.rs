@@ -53,7 +53,7 @@ pub(super) struct Common {
 impl Common {
     /// The beam kernel's bind group on configuration (`x`, `rot`); `force_only`: for the
     /// kernel built `FORCE_ONLY`, which has no tangent binding; `masked`: built `MASKED`
-    /// too (the activity mask last).
+    /// (the list of variants last).
     pub(super) fn beam_group(
         &self,
         ctx: &GpuContext,
@@ -75,7 +75,8 @@ impl Common {
         all.push(&self.elem_force);
         if !force_only {
             all.push(&self.elem_tangent);
-        } else if masked {
+        }
+        if masked {
             all.push(&self.active);
         }
         bind(ctx, pipeline, "beam", &all)

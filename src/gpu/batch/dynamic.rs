@@ -39,6 +39,33 @@ struct DynamicPipelines {
     norms: Arc<wgpu::ComputePipeline>,
     /// The line-search trials' kernels: the residual alone, for the listed variants.
     trial: TrialPipelines,
+    /// The Newton iterations' kernels for the listed variants (those still iterating),
+    /// where the predictor, sites and norms are the trials' own.
+    beam_masked: Arc<wgpu::ComputePipeline>,
+    contact_masked: Arc<wgpu::ComputePipeline>,
+    assemble_masked: Arc<wgpu::ComputePipeline>,
+    scale_masked: Arc<wgpu::ComputePipeline>,
+}
+
+/// The Newton iterations' bind groups for the listed variants (`c.active` last).
+struct IterateGroups {
+    predict: wgpu::BindGroup,
+    beam: wgpu::BindGroup,
+    contact: wgpu::BindGroup,
+    assemble: wgpu::BindGroup,
+    norms: wgpu::BindGroup,
+    scale: wgpu::BindGroup,
+}
+
+/// What one evaluation records ([`GpuDynamic::record_evaluate`]).
+#[derive(Clone, Copy)]
+enum Evaluation {
+    /// The system of every variant at the unknown.
+    All,
+    /// The system of the `A` variants listed (those still iterating).
+    Listed(usize),
+    /// The residual of the `A` variants listed at the candidate (a line-search trial).
+    Trial(usize),
 }
 
 /// The dynamic line-search trials' kernels: the correction and the predictor at the
@@ -76,6 +103,7 @@ struct DynamicGroups {
     lu: Vec<wgpu::BindGroup>,
     norms_iterate: wgpu::BindGroup,
     trial: TrialGroups,
+    listed: IterateGroups,
 }
 
 struct DynamicBuffers {
@@ -139,8 +167,8 @@ impl<T: GpuReal> GpuDynamic<T> {
             block_lu: k(Kernel::BlockLu(LuForm::for_adapter(ctx)))?,
             norms: k(Kernel::Norms { trial: false })?,
             trial: TrialPipelines {
-                accelerate: k(Kernel::DynamicsTrial(DynamicsKernel::Accelerate))?,
-                predict: k(Kernel::DynamicsTrial(DynamicsKernel::Predict))?,
+                accelerate: k(Kernel::DynamicsMasked(DynamicsKernel::Accelerate))?,
+                predict: k(Kernel::DynamicsMasked(DynamicsKernel::Predict))?,
                 beam: k(Kernel::BeamTrial { kink })?,
                 sites: k(Kernel::SitesTrial { dynamic: true })?,
                 contact: k(Kernel::ContactTrial(&tables.terms))?,
@@ -150,6 +178,12 @@ impl<T: GpuReal> GpuDynamic<T> {
                 })?,
                 norms: k(Kernel::Norms { trial: true })?,
             },
+            beam_masked: k(Kernel::BeamMasked { kink })?,
+            contact_masked: k(Kernel::ContactMasked(&tables.terms))?,
+            assemble_masked: k(Kernel::AssembleMasked {
+                unbalance: !dynamic.unbalance.is_empty(),
+            })?,
+            scale_masked: k(Kernel::DynamicsMasked(DynamicsKernel::Scale))?,
         };
         let mass = storage(ctx, "mass", &dynamic.mass);
         let inertia0 = storage(ctx, "inertia0", &dynamic.inertia0);
@@ -253,6 +287,29 @@ impl<T: GpuReal> GpuDynamic<T> {
             assemble: bind(ctx, &tp.assemble, "assemble_trial", &assemble_trial),
             norms: c.norms_group(ctx, &tp.norms, &c.alpha, &rhs, true),
         };
+        let listed = IterateGroups {
+            predict: bind(
+                ctx,
+                &tp.predict,
+                "predict_masked",
+                &[&predict_inputs(&b.vdot_k)[..], &[&c.active]].concat(),
+            ),
+            beam: c.beam_group(ctx, &pl.beam_masked, &b.u_1, &b.rot_1, false, true),
+            contact: c.contact_group(ctx, &pl.contact_masked, true),
+            assemble: bind(
+                ctx,
+                &pl.assemble_masked,
+                "assemble_masked",
+                &[&assemble[..], &[&c.active]].concat(),
+            ),
+            norms: c.norms_group(ctx, &tp.norms, &c.ones, &rhs, true),
+            scale: bind(
+                ctx,
+                &pl.scale_masked,
+                "scale_masked",
+                &[&c.chain_dims, &mass, &b.vdot_k, &b.scale, &c.active],
+            ),
+        };
         let g = DynamicGroups {
             predict_unknown: bind(ctx, &pl.predict, "predict", &predict_inputs(&b.vdot_k)),
             accelerate: bind(
@@ -294,6 +351,7 @@ impl<T: GpuReal> GpuDynamic<T> {
             lu: c.lu_groups(ctx, &pl.block_lu, [&diag, &upper, &lower, &rhs]),
             norms_iterate: c.norms_group(ctx, &pl.norms, &c.ones, &rhs, false),
             trial,
+            listed,
         };
         Ok(GpuDynamic {
             ctx,
@@ -315,25 +373,35 @@ impl<T: GpuReal> GpuDynamic<T> {
     }
 
     /// Records predict, beam, sites, contact, assembly: at the unknown the system of every
-    /// variant (`trial` None); at the candidate (a line-search trial of the `Some(A)`
-    /// variants listed in `c.active`) the residual alone of those.
-    fn record_evaluate(&self, pass: &mut wgpu::ComputePass, trial: Option<usize>) {
+    /// variant, or of the variants listed in `c.active`; at the candidate (a line-search
+    /// trial) the residual alone of the listed ones.
+    fn record_evaluate(&self, pass: &mut wgpu::ComputePass, what: Evaluation) {
         let (g, p) = (&self.g, &self.p);
-        let (tg, tp) = (&g.trial, &p.trial);
-        let v = trial.unwrap_or(self.num_variants);
+        let (tg, tp, lg) = (&g.trial, &p.trial, &g.listed);
+        let v = match what {
+            Evaluation::All => self.num_variants,
+            Evaluation::Listed(a) | Evaluation::Trial(a) => a,
+        };
         let pairs = self.num_pairs / self.num_variants.max(1) * v;
         record_chain(pass, true, self.num_nodes, v, pairs, |stage| {
-            Some(match (stage, trial.is_some()) {
-                (Stage::Predict, false) => (&*p.predict, &g.predict_unknown),
-                (Stage::Beam, false) => (&*p.beam, &g.beam),
-                (Stage::Sites, false) => (&*p.sites, &g.sites),
-                (Stage::Contact, false) => (&*p.contact, &g.contact),
-                (Stage::Assemble, false) => (&*p.assemble, &g.assemble),
-                (Stage::Predict, true) => (&*tp.predict, &tg.predict),
-                (Stage::Beam, true) => (&*tp.beam, &tg.beam),
-                (Stage::Sites, true) => (&*tp.sites, &tg.sites),
-                (Stage::Contact, true) => (&*tp.contact, &tg.contact),
-                (Stage::Assemble, true) => (&*tp.assemble, &tg.assemble),
+            Some(match (what, stage) {
+                (Evaluation::All, Stage::Predict) => (&*p.predict, &g.predict_unknown),
+                (Evaluation::All, Stage::Beam) => (&*p.beam, &g.beam),
+                (Evaluation::All, Stage::Sites) => (&*p.sites, &g.sites),
+                (Evaluation::All, Stage::Contact) => (&*p.contact, &g.contact),
+                (Evaluation::All, Stage::Assemble) => (&*p.assemble, &g.assemble),
+                (Evaluation::Listed(_), Stage::Predict) => (&*tp.predict, &lg.predict),
+                (Evaluation::Listed(_), Stage::Beam) => (&*p.beam_masked, &lg.beam),
+                // The sites gather at the unknown and at the candidate reads the same
+                // trial state (`u_1`, `vel_1`).
+                (Evaluation::Listed(_), Stage::Sites) => (&*tp.sites, &tg.sites),
+                (Evaluation::Listed(_), Stage::Contact) => (&*p.contact_masked, &lg.contact),
+                (Evaluation::Listed(_), Stage::Assemble) => (&*p.assemble_masked, &lg.assemble),
+                (Evaluation::Trial(_), Stage::Predict) => (&*tp.predict, &tg.predict),
+                (Evaluation::Trial(_), Stage::Beam) => (&*tp.beam, &tg.beam),
+                (Evaluation::Trial(_), Stage::Sites) => (&*tp.sites, &tg.sites),
+                (Evaluation::Trial(_), Stage::Contact) => (&*tp.contact, &tg.contact),
+                (Evaluation::Trial(_), Stage::Assemble) => (&*tp.assemble, &tg.assemble),
             })
         });
     }
@@ -369,18 +437,47 @@ impl<T: GpuReal> crate::engine::dynamic::ResidentDynamic<T> for GpuDynamic<T> {
 
     fn iterate(
         &mut self,
+        running: &[bool],
     ) -> Result<crate::engine::dynamic::Iteration<T>, crate::error::SystemError> {
         let v = self.num_variants;
         let mut e = encoder(self.ctx, "iterate");
-        self.c.reset_status(&mut e, v);
+        // Every variant iterating: the kernels over all of them. Else only the listed ones
+        // (built `MASKED`): the block solve skips a variant whose status starts at
+        // SINGULAR, so the others start there and the listed ones at RUNNING.
+        let listed = (!running.iter().all(|&r| r)).then(|| {
+            let list = super::search_list(running);
+            let q = &self.ctx.queue;
+            q.write_buffer(&self.c.active, 0, bytemuck::cast_slice(&list));
+            let start: Vec<u32> = running
+                .iter()
+                .map(|&r| if r { RUNNING } else { SINGULAR })
+                .collect();
+            q.write_buffer(&self.c.status, 0, bytemuck::cast_slice(&start));
+            list.len() - 1
+        });
+        if listed.is_none() {
+            self.c.reset_status(&mut e, v);
+        }
         {
             let mut pass = e.begin_compute_pass(&Default::default());
-            self.record_evaluate(&mut pass, None);
-            for group in &self.g.lu {
-                dispatch(&mut pass, &self.p.block_lu, group, self.lu_lanes * v);
+            let (g, p) = (&self.g, &self.p);
+            match listed {
+                None => self.record_evaluate(&mut pass, Evaluation::All),
+                Some(a) => self.record_evaluate(&mut pass, Evaluation::Listed(a)),
             }
-            dispatch(&mut pass, &self.p.norms, &self.g.norms_iterate, v);
-            dispatch(&mut pass, &self.p.scale, &self.g.scale, v);
+            for group in &g.lu {
+                dispatch(&mut pass, &p.block_lu, group, self.lu_lanes * v);
+            }
+            match listed {
+                None => {
+                    dispatch(&mut pass, &p.norms, &g.norms_iterate, v);
+                    dispatch(&mut pass, &p.scale, &g.scale, v);
+                }
+                Some(a) => {
+                    dispatch(&mut pass, &p.trial.norms, &g.listed.norms, a);
+                    dispatch(&mut pass, &p.scale_masked, &g.listed.scale, a);
+                }
+            }
         }
         let size = std::mem::size_of::<T>() as u64;
         let out = self
@@ -434,7 +531,7 @@ impl<T: GpuReal> crate::engine::dynamic::ResidentDynamic<T> for GpuDynamic<T> {
                 let (p, g) = (&self.p.trial.accelerate, &self.g.trial.accelerate);
                 dispatch(&mut pass, p, g, n * count);
             }
-            self.record_evaluate(&mut pass, Some(count));
+            self.record_evaluate(&mut pass, Evaluation::Trial(count));
             dispatch(&mut pass, &self.p.trial.norms, &self.g.trial.norms, count);
         }
         let size = std::mem::size_of::<T>() as u64;
@@ -516,28 +613,6 @@ impl<T: GpuReal> crate::engine::dynamic::ResidentDynamic<T> for GpuDynamic<T> {
         ] {
             q.write_buffer(buffer, 0, bytemuck::cast_slice(data));
         }
-        Ok(())
-    }
-
-    fn unknown(&mut self) -> Result<Vec<T>, crate::error::SystemError> {
-        let size = std::mem::size_of::<T>() as u64;
-        let bytes = 6 * (self.num_nodes * self.num_variants) as u64 * size;
-        let out = self
-            .c
-            .staging
-            .read(
-                self.ctx,
-                encoder(self.ctx, "unknown"),
-                &[(&self.b.vdot_k, bytes)],
-            )
-            .map_err(crate::error::SystemError::from)?;
-        Ok(values(&out[0]))
-    }
-
-    fn set_unknown(&mut self, vdot: &[T]) -> Result<(), crate::error::SystemError> {
-        self.ctx
-            .queue
-            .write_buffer(&self.b.vdot_k, 0, bytemuck::cast_slice(vdot));
         Ok(())
     }
 

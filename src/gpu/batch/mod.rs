@@ -37,6 +37,7 @@ pub use iteration::{sites_trial_wgsl, sites_wgsl, sites_wgsl_for};
 
 /// Status the block solve starts with; still there afterwards means it did not finish.
 const RUNNING: u32 = 2;
+use crate::kernels::block_lu::SINGULAR;
 
 /// Bytes per variant of every buffer of a batch, for a chain of `n` nodes with `s` sites
 /// at `size`-byte floats: two configurations and two assembled systems, the base and its
