@@ -249,6 +249,77 @@ fn a_string_that_meets_the_wall_is_held_there() {
         .any(|l| l.starts_with(crate::profile::WALL_CONTACT)));
 }
 
+/// A solve that fails while nodes lack a site is tried once more with a site at every node
+/// (`profile::solve_in_hole`): here the static solve is made to fail whenever a node other
+/// than the top has none, so the retry is what solves it — to the all-nodes equilibrium,
+/// saying so. A solve that fails with every node held, or runs out of its time budget, is
+/// not tried again.
+#[test]
+fn a_failed_solve_is_tried_once_more_with_contact_at_every_node() {
+    use crate::solve::statics::{StaticError, StaticOptions};
+    let case = vertical_bha(15.0, "stabilizers");
+    let n = case.model.nodes.len();
+    assert!(case.model.sites.len() < n - 1, "the case must lack sites");
+    let failure = || StaticError::LoadStep {
+        stage: "a load step".into(),
+        from: 0.5,
+        step: 0.0,
+        min: 0.0,
+        reason: "made to fail".into(),
+        at_md: None,
+    };
+    let run = |fails: &dyn Fn(&Model) -> Option<StaticError>| {
+        let mut model = case.model.clone();
+        let mut calls = 0;
+        let out = crate::profile::hold_in_hole(
+            &case,
+            &mut model,
+            &mut |m, nodes| crate::profile::add_wall_sites(&case, m, nodes),
+            &StaticOptions::default(),
+            &mut |m, o| {
+                calls += 1;
+                match fails(m) {
+                    Some(e) => Err(e),
+                    None => crate::solve::statics::solve_static(m, o),
+                }
+            },
+        );
+        (model, out, calls)
+    };
+    let held_everywhere =
+        |m: &Model| (1..m.nodes.len()).all(|i| m.sites.iter().any(|s| s.node == i));
+    let (model, out, calls) = run(&|m| (!held_everywhere(m)).then(failure));
+    let sol = out.expect("the retry with every node held solves");
+    assert_eq!(calls, 2);
+    assert!(held_everywhere(&model));
+    assert!(sol
+        .log
+        .iter()
+        .any(|l| l.starts_with(crate::profile::WALL_CONTACT)
+            && l.contains("failed")
+            && l.contains("made to fail")));
+    let every = vertical_bha(15.0, "all_nodes");
+    let reference = crate::solve::statics::solve_static(&every.model, &StaticOptions::default())
+        .expect("solves");
+    let hook = |m: &Model, s| crate::profile::fe_rows(m, s).1;
+    let (a, b) = (hook(&model, &sol), hook(&every.model, &reference));
+    assert!((a / b - 1.0).abs() < 1e-9, "{a} vs {b}");
+    // Failing with every node held too: the error, after the one retry.
+    let (_, out, calls) = run(&|_| Some(failure()));
+    assert!(matches!(out, Err(StaticError::LoadStep { .. })));
+    assert_eq!(calls, 2);
+    // The time budget spent: no retry.
+    let (model, out, calls) = run(&|_| {
+        Some(StaticError::Budget {
+            seconds: 1.0,
+            reached: 0.3,
+        })
+    });
+    assert!(matches!(out, Err(StaticError::Budget { .. })));
+    assert_eq!(calls, 1);
+    assert_eq!(model.sites.len(), case.model.sites.len());
+}
+
 /// A solved profile of a load that locks up warns, with where and from which load factor;
 /// one that does not lock up does not.
 #[test]
