@@ -10,6 +10,9 @@
 // its two elements and its contact site, so no two invocations write the same entry, then
 // applies the constraints to the blocks it owns. Layouts as in the twin's documentation.
 #include "shared/layout.wgsl"
+#if MASKED
+#include "shared/listed.wgsl"
+#endif
 
 @group(0) @binding(0) var<storage, read> dims: AssembleDims;
 @group(0) @binding(1) var<storage, read> elem_force: array<real>;
@@ -191,13 +194,13 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let nv = dims.num_variants;
     let n = dims.num_nodes;
 #if MASKED
-    // One invocation per (node, searching variant).
-    let count = searching[0];
-    if (gid.x >= n * count) {
+    // One invocation per (node, listed variant).
+    let at = listed(gid.x, n);
+    if (at.x >= n) {
         return;
     }
-    let i = gid.x / count;
-    let v = searching[1u + gid.x % count];
+    let i = at.x;
+    let v = at.y;
 #else
     if (gid.x >= n * nv) {
         return;

@@ -27,6 +27,9 @@
 // Built with KINK the moments act on the rotations from each element's unstrained ones
 // (a bent sub: physics::beam::ElementStiffness::rest), read per (element, variant).
 #include "shared/layout.wgsl"
+#if MASKED
+#include "shared/listed.wgsl"
+#endif
 
 @group(0) @binding(0) var<storage, read> dims: BeamDims;
 // Node displacements, [(3 i + k) V + v]; rotations, [(9 i + 3 r + c) V + v].
@@ -307,12 +310,12 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     // Built MASKED (the engines' line-search trials, with FORCE_ONLY; the dynamic engine's
     // Newton iterations, with the tangent): one invocation per (element, listed variant);
     // the other variants' outputs are left as they were.
-    let count = searching[0];
-    if (gid.x >= dims.num_elements * count) {
+    let at = listed(gid.x, dims.num_elements);
+    if (at.x >= dims.num_elements) {
         return;
     }
-    let e = gid.x / count;
-    let v = searching[1u + gid.x % count];
+    let e = at.x;
+    let v = at.y;
 #else
     if (gid.x >= dims.num_elements * nv) {
         return;

@@ -7,6 +7,9 @@
 //   F64, POW (m ≠ 1 somewhere), BLEND (m < 1 somewhere), DAMPING (dynamic and c > 0
 //   somewhere), DYNAMIC, FRICTION, SPLIT / COUPLED.
 #include "shared/layout.wgsl"
+#if MASKED
+#include "shared/listed.wgsl"
+#endif
 #if F64
 #if POW
 #include "shared/math_f64.wgsl"
@@ -134,11 +137,12 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
 #if MASKED
     // One invocation per (site, searching variant): pair site · V + v (the engine's pairs,
     // pair_offset 0).
-    let count = searching[0];
-    if (gid.x >= (dims.num_pairs / dims.mask_variants) * count) {
+    let sites = dims.num_pairs / dims.mask_variants;
+    let at = listed(gid.x, sites);
+    if (at.x >= sites) {
         return;
     }
-    let i = (gid.x / count) * dims.mask_variants + searching[1u + gid.x % count];
+    let i = at.x * dims.mask_variants + at.y;
 #else
     let i = gid.x;
     if (i >= dims.num_pairs) {

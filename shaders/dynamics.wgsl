@@ -8,6 +8,9 @@
 // MASKED (the dynamic engine's trials and iterations) each runs for the listed variants
 // [A, v_0, …] alone (its last binding).
 #include "shared/layout.wgsl"
+#if MASKED
+#include "shared/listed.wgsl"
+#endif
 
 @group(0) @binding(0) var<storage, read> dims: ChainDims;
 #if PREDICT
@@ -60,12 +63,12 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let nv = dims.num_variants;
     let n = dims.num_nodes;
 #if MASKED
-    let count = searching[0];
-    if (gid.x >= n * count) {
+    let at = listed(gid.x, n);
+    if (at.x >= n) {
         return;
     }
-    let i = gid.x / count;
-    let v = searching[1u + gid.x % count];
+    let i = at.x;
+    let v = at.y;
 #else
     if (gid.x >= n * nv) {
         return;
@@ -154,12 +157,12 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let nv = dims.num_variants;
     let n = dims.num_nodes;
 #if MASKED
-    let count = searching[0];
-    if (gid.x >= n * count) {
+    let at = listed(gid.x, n);
+    if (at.x >= n) {
         return;
     }
-    let i = gid.x / count;
-    let v = searching[1u + gid.x % count];
+    let i = at.x;
+    let v = at.y;
 #else
     if (gid.x >= n * nv) {
         return;
@@ -188,10 +191,11 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
 fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let nv = dims.num_variants;
 #if MASKED
-    if (gid.x >= searching[0]) {
+    let at = listed(gid.x, 1u);
+    if (at.x >= 1u) {
         return;
     }
-    let v = searching[1u + gid.x];
+    let v = at.y;
 #else
     let v = gid.x;
     if (v >= nv) {

@@ -6,6 +6,9 @@
 // velocity and spin fields (3–6) as the host wrote them; with DYNAMIC also those, from the
 // node's velocity and its spin about the hole axis.
 #include "shared/layout.wgsl"
+#if MASKED
+#include "shared/listed.wgsl"
+#endif
 
 @group(0) @binding(0) var<storage, read> dims: ContactDims;
 // Node of each pair.
@@ -36,12 +39,12 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let p = dims.num_pairs;
     let nv = dims.num_variants;
 #if MASKED
-    let count = searching[0];
-    if (gid.x >= (p / nv) * count) {
+    let at = listed(gid.x, p / nv);
+    if (at.x >= p / nv) {
         return;
     }
-    let v = searching[1u + gid.x % count];
-    let i = (gid.x / count) * nv + v;
+    let v = at.y;
+    let i = at.x * nv + v;
 #else
     let i = gid.x;
     if (i >= p) {

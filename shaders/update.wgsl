@@ -4,6 +4,9 @@
 // x += α B Δu, R ← exp([α Δθ]×) R with the series exponential of the twin.
 // `norms`: one invocation per variant: largest |r| and largest |α Δ|, Δ · r and r · r.
 #include "shared/layout.wgsl"
+#if MASKED
+#include "shared/listed.wgsl"
+#endif
 
 // Composed twice: without NORMS the entry point `main` is the update, with NORMS the norms.
 @group(0) @binding(0) var<storage, read> dims: ChainDims;
@@ -92,12 +95,12 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let n = dims.num_nodes;
 #if MASKED
     // One invocation per (node, listed variant).
-    let count = searching[0];
-    if (gid.x >= n * count) {
+    let at = listed(gid.x, n);
+    if (at.x >= n) {
         return;
     }
-    let i = gid.x / count;
-    let v = searching[1u + gid.x % count];
+    let i = at.x;
+    let v = at.y;
 #else
     if (gid.x >= n * nv) {
         return;
@@ -157,10 +160,11 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
 fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let nv = dims.num_variants;
 #if MASKED
-    if (gid.x >= searching[0]) {
+    let at = listed(gid.x, 1u);
+    if (at.x >= 1u) {
         return;
     }
-    let v = searching[1u + gid.x];
+    let v = at.y;
 #else
     let v = gid.x;
     if (v >= nv) {

@@ -35,6 +35,10 @@ pub const SHADERS: &[(&str, &str)] = &[
         include_str!("../../shaders/shared/rotation_exp.wgsl"),
     ),
     (
+        "shared/listed.wgsl",
+        include_str!("../../shaders/shared/listed.wgsl"),
+    ),
+    (
         "shared/layout.wgsl",
         include_str!("../../shaders/shared/layout.wgsl"),
     ),

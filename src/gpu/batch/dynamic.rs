@@ -8,9 +8,10 @@ use super::*;
 /// A batch of variants resident on the GPU for a dynamic run
 /// ([`crate::engine::dynamic`]): the state at `t_n`, the Newton unknown `v̇_{n+1}` and a
 /// candidate for the line search, one trial state and its system. Per iteration the host
-/// reads four norms, a status and the inertial scale per variant. A line-search trial
-/// forms the residual alone (the kernels built `FORCE_ONLY`) of the variants still
-/// searching (built `MASKED`, the list `[A, v_0, …]`): only they pay for it (issue 27).
+/// reads four norms, a status and the inertial scale per variant. An iteration forms the
+/// system of the variants still iterating, a line-search trial the residual alone (the
+/// kernels built `FORCE_ONLY`) of those still searching — the kernels built `MASKED` on the
+/// list `[A, v_0, …]` where not every variant is: only they pay for it (issue 27).
 pub struct GpuDynamic<T: GpuReal> {
     ctx: &'static GpuContext,
     p: DynamicPipelines,
@@ -157,7 +158,6 @@ impl<T: GpuReal> GpuDynamic<T> {
                 force_only: false,
                 kink,
             })?,
-
             sites: k(Kernel::Sites { dynamic: true })?,
             contact: k(Kernel::Contact(&tables.terms))?,
             assemble: k(Kernel::Assemble {
