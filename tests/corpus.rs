@@ -201,6 +201,46 @@ fn corpus_wells_through_the_engine_match_the_cpu() {
     assert_eq!(checked, 3);
 }
 
+/// The engine holds a string in the hole where it meets the wall as the CPU run does
+/// (`profile::solve_in_hole`'s policy, each solve the engine's): corpus seed 94 (vertical,
+/// contact at its stabilizers, 135 nodes) meets the wall between them; on every path the
+/// engine adds the CPU run's sites and ends at its hook load.
+#[test]
+fn the_engine_holds_a_stabilizer_contact_well_in_the_hole_as_the_cpu_does() {
+    let dir = tempdir::Dir::new("corpus_engine_wall");
+    let well = write_well(94, dir.path()).unwrap();
+    assert_eq!(well.spec.sites, "stabilizers");
+    let cpu = run_well(&well, &Default::default()).unwrap();
+    assert!(
+        cpu.solved && cpu.wall_sites > 0,
+        "{} sites added",
+        cpu.wall_sites
+    );
+    let mut paths = vec![EnginePath::Twin];
+    if let Some(ctx) = common::gpu() {
+        if ctx.has_f64 {
+            paths.push(EnginePath::GpuF64);
+        }
+        paths.push(EnginePath::GpuF32);
+    }
+    for path in paths {
+        let e = run_well_engine(&well, path).unwrap();
+        let diff = ((e.hook_load_n - cpu.fe_hook_load_n) / cpu.fe_hook_load_n).abs();
+        eprintln!(
+            "seed 94 {path:?}: {} sites added (CPU {}), hook load vs CPU {diff:.2e}",
+            e.wall_sites, cpu.wall_sites
+        );
+        assert!(e.solved, "{path:?}: {}", e.error);
+        assert_eq!(e.wall_sites, cpu.wall_sites, "{path:?}");
+        let tol = if path == EnginePath::GpuF32 {
+            1e-5
+        } else {
+            1e-9
+        };
+        assert!(diff <= tol, "{path:?}: hook load off by {diff:e}");
+    }
+}
+
 /// Two folds beyond the first 50 seeds that a relaxation whose shift stops at 1e-3 of its
 /// start could not pass (each failed with it: the relaxation spent its budget), and that the
 /// floor of 1e-5 (`continuation::RELAX_FLOOR`) solves: seed 206 (horizontal, tripping in,

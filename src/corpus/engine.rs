@@ -33,61 +33,112 @@ pub struct EngineOutcome {
     pub seconds: f64,
     /// Engine hook load (N).
     pub hook_load_n: f64,
+    /// Pipe-body contact sites added where the engine's string met the wall (as the CPU
+    /// run's `wall_sites`).
+    pub wall_sites: usize,
     /// Why it failed (empty when solved).
     pub error: String,
 }
 
 /// Solves a corpus well through the ensemble engine on `path` (the same load path and
-/// Newton as the CPU solve, [`crate::solve::continuation`]). `Err` where the path cannot
-/// run here (no adapter, no f64).
+/// Newton as the CPU solve, [`crate::solve::continuation`]), held in the hole where it meets
+/// the wall by the CPU run's policy ([`crate::profile::solve_in_hole`]'s, each solve of it
+/// the engine's): the engine answers on the model the CPU answers on. `Err` where the path
+/// cannot run here (no adapter, no f64).
 pub fn run_well_engine(well: &CorpusWell, path: EnginePath) -> Result<EngineOutcome, Error> {
-    use crate::engine::{solve_static_ensemble, EngineStatus, TwinPath};
+    use crate::engine::{solve_static_ensemble, EngineResult, EngineStatus, TwinPath};
     use crate::gpu::GpuPath;
+    use crate::solve::statics::{StaticError, StaticOptions};
     let case = crate::case::load_case(&well.case_path)?;
-    let models = [case.model.clone()];
-    let options = crate::solve::statics::StaticOptions::default();
-    let clock = std::time::Instant::now();
-    let results = match path {
-        EnginePath::Twin => solve_static_ensemble(&models, &TwinPath, &options)?,
+    let ctx = match path {
+        EnginePath::Twin => None,
         EnginePath::GpuF64 | EnginePath::GpuF32 => {
             let ctx = crate::gpu::context::GpuContext::shared()?;
-            if path == EnginePath::GpuF64 {
-                if !ctx.has_f64 {
-                    return Err(crate::error::GpuError::Unsupported(format!(
-                        "{} has no f64 in shaders",
-                        ctx.describe()
-                    ))
-                    .into());
-                }
-                solve_static_ensemble::<f64, _>(&models, &GpuPath(ctx), &options)?
-            } else {
-                solve_static_ensemble::<f32, _>(&models, &GpuPath(ctx), &options)?
+            if path == EnginePath::GpuF64 && !ctx.has_f64 {
+                return Err(crate::error::GpuError::Unsupported(format!(
+                    "{} has no f64 in shaders",
+                    ctx.describe()
+                ))
+                .into());
             }
+            Some(ctx)
         }
     };
+    let engine =
+        |m: &crate::model::Model, options: &StaticOptions| -> Result<EngineResult, Error> {
+            let models = [m.clone()];
+            let results = match (path, ctx) {
+                (EnginePath::GpuF64, Some(ctx)) => {
+                    solve_static_ensemble::<f64, _>(&models, &GpuPath(ctx), options)?
+                }
+                (EnginePath::GpuF32, Some(ctx)) => {
+                    solve_static_ensemble::<f32, _>(&models, &GpuPath(ctx), options)?
+                }
+                _ => solve_static_ensemble(&models, &TwinPath, options)?,
+            };
+            results
+                .into_iter()
+                .next()
+                .ok_or_else(|| Error::failed("the engine returned no result"))
+        };
+    let mut model = case.model.clone();
+    let (mut iterations, mut step_cuts) = (0, 0);
+    let mut unavailable = None;
+    let clock = std::time::Instant::now();
+    let held = crate::profile::hold_in_hole(
+        &case,
+        &mut model,
+        &mut |m, nodes| crate::profile::add_wall_sites(&case, m, nodes),
+        &StaticOptions::default(),
+        &mut |m, options| {
+            let failed = |reason: String| StaticError::LoadStep {
+                stage: "the engine's solve".into(),
+                from: 0.0,
+                step: 0.0,
+                min: 0.0,
+                reason,
+                at_md: None,
+            };
+            match engine(m, options) {
+                Ok(r) => {
+                    iterations += r.iterations.iter().sum::<usize>();
+                    step_cuts += r.log.len();
+                    match r.status {
+                        EngineStatus::Converged => {
+                            Ok(crate::solve::statics::solution_at(m, r.state))
+                        }
+                        EngineStatus::Failed(why) => Err(failed(why)),
+                    }
+                }
+                Err(e) => {
+                    // A path that cannot run: no retry can help (the policy retries no
+                    // spent budget); the error is returned below.
+                    unavailable = Some(e);
+                    Err(StaticError::Budget {
+                        seconds: 0.0,
+                        reached: 0.0,
+                    })
+                }
+            }
+        },
+    );
+    if let Some(e) = unavailable {
+        return Err(e);
+    }
     let seconds = clock.elapsed().as_secs_f64();
-    let r = results
-        .into_iter()
-        .next()
-        .ok_or_else(|| Error::failed("the engine returned no result"))?;
-    let (solved, error) = match &r.status {
-        EngineStatus::Converged => (true, String::new()),
-        EngineStatus::Failed(why) => (false, why.clone()),
-    };
-    let hook_load_n = if solved {
-        let sol = crate::solve::statics::solution_at(&case.model, r.state.clone());
-        crate::profile::fe_rows(&case.model, &sol).1
-    } else {
-        f64::NAN
+    let (solved, error, hook_load_n) = match held {
+        Ok(sol) => (true, String::new(), crate::profile::fe_rows(&model, &sol).1),
+        Err(e) => (false, e.to_string(), f64::NAN),
     };
     Ok(EngineOutcome {
         seed: well.spec.seed,
         path,
         solved,
-        iterations: r.iterations.iter().sum(),
-        step_cuts: r.log.len(),
+        iterations,
+        step_cuts,
         seconds,
         hook_load_n,
+        wall_sites: model.sites.len() - case.model.sites.len(),
         error,
     })
 }
