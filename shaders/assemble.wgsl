@@ -10,9 +10,7 @@
 // its two elements and its contact site, so no two invocations write the same entry, then
 // applies the constraints to the blocks it owns. Layouts as in the twin's documentation.
 #include "shared/layout.wgsl"
-#if MASKED
 #include "shared/listed.wgsl"
-#endif
 
 @group(0) @binding(0) var<storage, read> dims: AssembleDims;
 @group(0) @binding(1) var<storage, read> elem_force: array<real>;
@@ -193,21 +191,13 @@ fn clear_fixed(blk: ptr<function, array<real, 36>>, row_mask: u32, col_mask: u32
 fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let nv = dims.num_variants;
     let n = dims.num_nodes;
-#if MASKED
-    // One invocation per (node, listed variant).
-    let at = listed(gid.x, n);
+    // One invocation per (node, variant), or built MASKED per (node, listed variant).
+    let at = item_of(gid.x, n, nv);
     if (at.x >= n) {
         return;
     }
     let i = at.x;
     let v = at.y;
-#else
-    if (gid.x >= n * nv) {
-        return;
-    }
-    let i = gid.x / nv;
-    let v = gid.x % nv;
-#endif
     let pairs = dims.num_sites * nv;
     var r: array<real, 6>;
 #if !FORCE_ONLY

@@ -27,9 +27,7 @@
 // Built with KINK the moments act on the rotations from each element's unstrained ones
 // (a bent sub: physics::beam::ElementStiffness::rest), read per (element, variant).
 #include "shared/layout.wgsl"
-#if MASKED
 #include "shared/listed.wgsl"
-#endif
 
 @group(0) @binding(0) var<storage, read> dims: BeamDims;
 // Node displacements, [(3 i + k) V + v]; rotations, [(9 i + 3 r + c) V + v].
@@ -306,23 +304,15 @@ fn spun(t: Triad, axis: vec3<real>) -> Triad {
 @compute @workgroup_size(64)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let nv = dims.num_variants;
-#if MASKED
-    // Built MASKED (the engines' line-search trials, with FORCE_ONLY; the dynamic engine's
-    // Newton iterations, with the tangent): one invocation per (element, listed variant);
-    // the other variants' outputs are left as they were.
-    let at = listed(gid.x, dims.num_elements);
+    // One invocation per (element, variant); built MASKED (the engines' line-search trials,
+    // with FORCE_ONLY; the dynamic engine's Newton iterations, with the tangent) per
+    // (element, listed variant), the other variants' outputs left as they were.
+    let at = item_of(gid.x, dims.num_elements, nv);
     if (at.x >= dims.num_elements) {
         return;
     }
     let e = at.x;
     let v = at.y;
-#else
-    if (gid.x >= dims.num_elements * nv) {
-        return;
-    }
-    let e = gid.x / nv;
-    let v = gid.x % nv;
-#endif
     let base = vec3<real>(chord[(4u * e) * nv + v], chord[(4u * e + 1u) * nv + v], chord[(4u * e + 2u) * nv + v]);
     let stretch = chord[(4u * e + 3u) * nv + v];
     let k = vec3<real>(section[4u * e], section[4u * e + 1u], section[4u * e + 2u]);

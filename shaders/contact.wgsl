@@ -7,9 +7,7 @@
 //   F64, POW (m ≠ 1 somewhere), BLEND (m < 1 somewhere), DAMPING (dynamic and c > 0
 //   somewhere), DYNAMIC, FRICTION, SPLIT / COUPLED.
 #include "shared/layout.wgsl"
-#if MASKED
 #include "shared/listed.wgsl"
-#endif
 #if F64
 #if POW
 #include "shared/math_f64.wgsl"
@@ -138,7 +136,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     // One invocation per (site, searching variant): pair site · V + v (the engine's pairs,
     // pair_offset 0).
     let sites = dims.num_pairs / dims.mask_variants;
-    let at = listed(gid.x, sites);
+    let at = item_of(gid.x, sites, dims.mask_variants);
     if (at.x >= sites) {
         return;
     }

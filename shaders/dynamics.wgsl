@@ -8,9 +8,7 @@
 // MASKED (the dynamic engine's trials and iterations) each runs for the listed variants
 // [A, v_0, …] alone (its last binding).
 #include "shared/layout.wgsl"
-#if MASKED
 #include "shared/listed.wgsl"
-#endif
 
 @group(0) @binding(0) var<storage, read> dims: ChainDims;
 #if PREDICT
@@ -62,20 +60,12 @@
 fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let nv = dims.num_variants;
     let n = dims.num_nodes;
-#if MASKED
-    let at = listed(gid.x, n);
+    let at = item_of(gid.x, n, nv);
     if (at.x >= n) {
         return;
     }
     let i = at.x;
     let v = at.y;
-#else
-    if (gid.x >= n * nv) {
-        return;
-    }
-    let i = gid.x / nv;
-    let v = gid.x % nv;
-#endif
     let h = coef[0];
     let alpha_m = coef[1];
     let alpha_f = coef[2];
@@ -156,20 +146,12 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
 fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let nv = dims.num_variants;
     let n = dims.num_nodes;
-#if MASKED
-    let at = listed(gid.x, n);
+    let at = item_of(gid.x, n, nv);
     if (at.x >= n) {
         return;
     }
     let i = at.x;
     let v = at.y;
-#else
-    if (gid.x >= n * nv) {
-        return;
-    }
-    let i = gid.x / nv;
-    let v = gid.x % nv;
-#endif
     for (var r = 0u; r < 3u; r = r + 1u) {
         var s = real(0.0);
         for (var k = 0u; k < 3u; k = k + 1u) {
@@ -190,18 +172,11 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
 @compute @workgroup_size(64)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let nv = dims.num_variants;
-#if MASKED
-    let at = listed(gid.x, 1u);
+    let at = item_of(gid.x, 1u, nv);
     if (at.x >= 1u) {
         return;
     }
     let v = at.y;
-#else
-    let v = gid.x;
-    if (v >= nv) {
-        return;
-    }
-#endif
     var s = real(0.0);
     for (var i = 0u; i < dims.num_nodes; i = i + 1u) {
         for (var k = 0u; k < 3u; k = k + 1u) {

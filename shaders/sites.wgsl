@@ -6,9 +6,7 @@
 // velocity and spin fields (3–6) as the host wrote them; with DYNAMIC also those, from the
 // node's velocity and its spin about the hole axis.
 #include "shared/layout.wgsl"
-#if MASKED
 #include "shared/listed.wgsl"
-#endif
 
 @group(0) @binding(0) var<storage, read> dims: ContactDims;
 // Node of each pair.
@@ -38,20 +36,12 @@
 fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let p = dims.num_pairs;
     let nv = dims.num_variants;
-#if MASKED
-    let at = listed(gid.x, p / nv);
+    let at = item_of(gid.x, p / nv, nv);
     if (at.x >= p / nv) {
         return;
     }
     let v = at.y;
     let i = at.x * nv + v;
-#else
-    let i = gid.x;
-    if (i >= p) {
-        return;
-    }
-    let v = i % nv;
-#endif
     let node = pair_node[i];
     for (var k = 0u; k < 3u; k = k + 1u) {
         pair_state[k * p + i] = pair_base[3u * i + k] + u[(3u * node + k) * nv + v];

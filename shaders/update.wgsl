@@ -4,9 +4,7 @@
 // x += α B Δu, R ← exp([α Δθ]×) R with the series exponential of the twin.
 // `norms`: one invocation per variant: largest |r| and largest |α Δ|, Δ · r and r · r.
 #include "shared/layout.wgsl"
-#if MASKED
 #include "shared/listed.wgsl"
-#endif
 
 // Composed twice: without NORMS the entry point `main` is the update, with NORMS the norms.
 @group(0) @binding(0) var<storage, read> dims: ChainDims;
@@ -93,21 +91,13 @@ fn wall_following_step(d: vec3<real>, t: vec3<real>, du: vec3<real>, min_radius:
 fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let nv = dims.num_variants;
     let n = dims.num_nodes;
-#if MASKED
-    // One invocation per (node, listed variant).
-    let at = listed(gid.x, n);
+    // One invocation per (node, variant), or built MASKED per (node, listed variant).
+    let at = item_of(gid.x, n, nv);
     if (at.x >= n) {
         return;
     }
     let i = at.x;
     let v = at.y;
-#else
-    if (gid.x >= n * nv) {
-        return;
-    }
-    let i = gid.x / nv;
-    let v = gid.x % nv;
-#endif
     let al = alpha[v];
     let du = vec3<real>(
         al * delta[(6u * i) * nv + v],
@@ -159,18 +149,11 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
 @compute @workgroup_size(64)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let nv = dims.num_variants;
-#if MASKED
-    let at = listed(gid.x, 1u);
+    let at = item_of(gid.x, 1u, nv);
     if (at.x >= 1u) {
         return;
     }
     let v = at.y;
-#else
-    let v = gid.x;
-    if (v >= nv) {
-        return;
-    }
-#endif
     var r = real(0.0);
     var d = real(0.0);
     var dot_dr = real(0.0);
