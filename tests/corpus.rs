@@ -144,6 +144,19 @@ fn corpus_sample_solves_and_agrees_with_the_soft_string() {
     );
 }
 
+/// The engine paths this machine runs: the twins, and the GPU in f64 (where the adapter has
+/// it) and f32 where there is an adapter.
+fn engine_paths() -> Vec<EnginePath> {
+    let mut paths = vec![EnginePath::Twin];
+    if let Some(ctx) = common::gpu() {
+        if ctx.has_f64 {
+            paths.push(EnginePath::GpuF64);
+        }
+        paths.push(EnginePath::GpuF32);
+    }
+    paths
+}
+
 #[test]
 fn corpus_wells_through_the_engine_match_the_cpu() {
     let dir = tempdir::Dir::new("corpus_engine");
@@ -167,14 +180,7 @@ fn corpus_wells_through_the_engine_match_the_cpu() {
         if !cpu.solved {
             continue;
         }
-        let mut paths = vec![EnginePath::Twin];
-        if let Some(ctx) = common::gpu() {
-            if ctx.has_f64 {
-                paths.push(EnginePath::GpuF64);
-            }
-            paths.push(EnginePath::GpuF32);
-        }
-        for path in paths {
+        for path in engine_paths() {
             let e = run_well_engine(&well, path).unwrap();
             let diff = ((e.hook_load_n - cpu.fe_hook_load_n) / cpu.fe_hook_load_n).abs();
             eprintln!(
@@ -216,14 +222,7 @@ fn the_engine_holds_a_stabilizer_contact_well_in_the_hole_as_the_cpu_does() {
         "{} sites added",
         cpu.wall_sites
     );
-    let mut paths = vec![EnginePath::Twin];
-    if let Some(ctx) = common::gpu() {
-        if ctx.has_f64 {
-            paths.push(EnginePath::GpuF64);
-        }
-        paths.push(EnginePath::GpuF32);
-    }
-    for path in paths {
+    for path in engine_paths() {
         let e = run_well_engine(&well, path).unwrap();
         let diff = ((e.hook_load_n - cpu.fe_hook_load_n) / cpu.fe_hook_load_n).abs();
         eprintln!(
