@@ -46,7 +46,7 @@ pub struct EngineOutcome {
 /// the engine's): the engine answers on the model the CPU answers on. `Err` where the path
 /// cannot run here (no adapter, no f64).
 pub fn run_well_engine(well: &CorpusWell, path: EnginePath) -> Result<EngineOutcome, Error> {
-    use crate::engine::{solve_static_ensemble, EngineResult, EngineStatus, TwinPath};
+    use crate::engine::{solve_static_ensemble, EngineResult, TwinPath};
     use crate::gpu::GpuPath;
     use crate::solve::statics::{StaticError, StaticOptions};
     let case = crate::case::load_case(&well.case_path)?;
@@ -103,12 +103,7 @@ pub fn run_well_engine(well: &CorpusWell, path: EnginePath) -> Result<EngineOutc
                 Ok(r) => {
                     iterations += r.iterations.iter().sum::<usize>();
                     step_cuts += r.log.len();
-                    match r.status {
-                        EngineStatus::Converged => {
-                            Ok(crate::solve::statics::solution_at(m, r.state))
-                        }
-                        EngineStatus::Failed(why) => Err(failed(why)),
-                    }
+                    r.into_solution(m).map_err(failed)
                 }
                 Err(e) => {
                     // A path that cannot run: no retry can help (the policy retries no

@@ -250,6 +250,25 @@ pub struct EngineResult {
     pub doubtful: bool,
 }
 
+impl EngineResult {
+    /// The converged answer as the CPU solve gives one, for `model` (the variant it was
+    /// solved for), with its iterations per load step and log; `Err` with why it failed.
+    pub fn into_solution(
+        self,
+        model: &Model,
+    ) -> Result<crate::solve::statics::StaticSolution, String> {
+        match self.status {
+            EngineStatus::Converged => {
+                let mut sol = crate::solve::statics::solution_at(model, self.state);
+                sol.iterations = self.iterations;
+                sol.log = self.log;
+                Ok(sol)
+            }
+            EngineStatus::Failed(why) => Err(why),
+        }
+    }
+}
+
 /// Static equilibrium of every variant through `path`. All models share the mesh and the
 /// number of sites; stabilizers may sit at other nodes per variant.
 pub fn solve_static_ensemble<T: Real + Send + Sync, P: KernelPath<T>>(

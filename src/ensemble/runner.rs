@@ -62,19 +62,18 @@ pub fn run_static_gpu<T: crate::gpu::contact::GpuReal>(
                 );
                 again
             }
-            EngineStatus::Converged => {
-                let mut sol = crate::solve::statics::solution_at(m, r.state);
-                sol.iterations = r.iterations;
-                sol.log = r.log;
-                let mut done = static_result(case, &v.name, m, &sol);
-                done.solved_by = SolvedBy::Engine;
-                done
-            }
-            EngineStatus::Failed(why) => {
-                let mut again = static_variant_of(case, v, m);
-                again.reason = format!("GPU: {why}; re-run on the CPU: {}", again.reason);
-                again
-            }
+            _ => match r.into_solution(m) {
+                Ok(sol) => {
+                    let mut done = static_result(case, &v.name, m, &sol);
+                    done.solved_by = SolvedBy::Engine;
+                    done
+                }
+                Err(why) => {
+                    let mut again = static_variant_of(case, v, m);
+                    again.reason = format!("GPU: {why}; re-run on the CPU: {}", again.reason);
+                    again
+                }
+            },
         })
         .collect()))
 }

@@ -15,11 +15,9 @@ use crate::physics::contact::ContactTerms;
 /// norms, the update, the dynamic integrator's), as a batch builds it.
 #[derive(Clone, Copy, Debug)]
 pub enum Kernel<'a> {
-    /// Element forces and tangents, or (`force_only`) forces alone; `kink`: a scene with a
-    /// bent sub (the unstrained rotations bound).
+    /// Element forces and tangents of every variant; `kink`: a scene with a bent sub (the
+    /// unstrained rotations bound).
     Beam {
-        /// Forces alone.
-        force_only: bool,
         /// A scene with a kink.
         kink: bool,
     },
@@ -99,10 +97,7 @@ impl Kernel<'_> {
     /// The pipeline's label (in messages and GPU captures).
     pub fn label(&self) -> &'static str {
         match self {
-            Kernel::Beam {
-                force_only: false, ..
-            } => "beam",
-            Kernel::Beam { .. } => "beam_force",
+            Kernel::Beam { .. } => "beam",
             Kernel::BeamTrial { .. } => "beam_trial",
             Kernel::BeamMasked { .. } => "beam_masked",
             Kernel::Sites { .. } => "sites",
@@ -142,7 +137,7 @@ impl Kernel<'_> {
             )
         };
         match *self {
-            Kernel::Beam { force_only, kink } => beam::beam_wgsl(f64, force_only, kink),
+            Kernel::Beam { kink } => beam::beam_wgsl(f64, false, kink),
             Kernel::BeamTrial { kink } => beam::beam_trial_wgsl(f64, kink),
             Kernel::BeamMasked { kink } => beam::beam_masked_wgsl(f64, false, kink),
             Kernel::Sites { dynamic } => sites(dynamic, false),

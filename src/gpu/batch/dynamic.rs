@@ -154,10 +154,7 @@ impl<T: GpuReal> GpuDynamic<T> {
             predict: k(Kernel::Dynamics(DynamicsKernel::Predict))?,
             accelerate: k(Kernel::Dynamics(DynamicsKernel::Accelerate))?,
             scale: k(Kernel::Dynamics(DynamicsKernel::Scale))?,
-            beam: k(Kernel::Beam {
-                force_only: false,
-                kink,
-            })?,
+            beam: k(Kernel::Beam { kink })?,
             sites: k(Kernel::Sites { dynamic: true })?,
             contact: k(Kernel::Contact(&tables.terms))?,
             assemble: k(Kernel::Assemble {

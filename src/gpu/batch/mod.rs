@@ -269,10 +269,7 @@ impl<T: GpuReal> GpuStatic<T> {
         let c = Common::new(ctx, model, tables, None, None)?;
         let k = |kernel: Kernel| kernel.pipeline(ctx, f64);
         let pipelines = Pipelines {
-            beam: k(Kernel::Beam {
-                force_only: false,
-                kink,
-            })?,
+            beam: k(Kernel::Beam { kink })?,
             beam_force: k(Kernel::BeamTrial { kink })?,
             sites: k(Kernel::Sites { dynamic: false })?,
             sites_trial: k(Kernel::SitesTrial { dynamic: false })?,
