@@ -16,7 +16,8 @@
 @group(0) @binding(1) var<storage, read> coef: array<real>;
 // [top_fixed | driven << 8 | lowered << 9].
 @group(0) @binding(2) var<storage, read> step_flags: array<u32>;
-// Per variant [f · V + v]: table rotation (9), φ̇, φ̈, hook travel, speed, acceleration.
+// Per variant [f · V + v]: table rotation (9), its angular velocity and acceleration (3
+// each, about the top's hole axis), the hook's travel, speed and acceleration (3 each).
 @group(0) @binding(3) var<storage, read> top: array<real>;
 @group(0) @binding(4) var<storage, read> u_n: array<real>;
 @group(0) @binding(5) var<storage, read> rot_n: array<real>;
@@ -80,11 +81,13 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
                 vdot[k * nv + v] = real(0.0);
             }
         }
-        if (driven) {
-            vdot[5u * nv + v] = top[10u * nv + v];
-        }
-        if (lowered) {
-            vdot[2u * nv + v] = top[13u * nv + v];
+        for (var k = 0u; k < 3u; k = k + 1u) {
+            if (driven) {
+                vdot[(3u + k) * nv + v] = top[(12u + k) * nv + v];
+            }
+            if (lowered) {
+                vdot[k * nv + v] = top[(21u + k) * nv + v];
+            }
         }
     }
     let one = real(1.0);
@@ -119,13 +122,15 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
             for (var k = 0u; k < 9u; k = k + 1u) {
                 r1[k] = top[k * nv + v];
             }
-            v1[3] = real(0.0);
-            v1[4] = real(0.0);
-            v1[5] = top[9u * nv + v];
+            for (var k = 0u; k < 3u; k = k + 1u) {
+                v1[3u + k] = top[(9u + k) * nv + v];
+            }
         }
         if (lowered) {
-            u1[2] = top[11u * nv + v];
-            v1[2] = top[12u * nv + v];
+            for (var k = 0u; k < 3u; k = k + 1u) {
+                u1[k] = top[(15u + k) * nv + v];
+                v1[k] = top[(18u + k) * nv + v];
+            }
         }
     }
     for (var k = 0u; k < 3u; k = k + 1u) {

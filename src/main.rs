@@ -673,6 +673,25 @@ fn main() -> ExitCode {
                 out,
                 quiet,
             } => print_summary(cli::bench_calibrate::run(&out, wells, first_seed, !quiet)),
+            BenchCommand::DynamicCorpus {
+                cases,
+                first_seed,
+                engine_sample,
+                engine_max_nodes,
+                max_seconds,
+                out,
+                quiet,
+            } => print_summary(cli::bench_dynamic_corpus::run(
+                &out,
+                &cli::bench_dynamic_corpus::DynamicCorpusOptions {
+                    cases,
+                    first_seed,
+                    engine_sample,
+                    engine_max_nodes,
+                    max_seconds,
+                    show_progress: !quiet,
+                },
+            )),
             BenchCommand::TendencyCorpus {
                 wells,
                 first_seed,

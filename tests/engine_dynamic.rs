@@ -278,8 +278,34 @@ fn dynamic_kernels_equal_their_twins() {
     let mut twin_vdot = vdot.clone();
     let mut twin = state.clone();
     predict(&c, &top, &state, &mut twin_vdot, &mut twin);
-    assert_eq!(twin_vdot[5 * v], top[10 * v], "the table's φ̈ written");
-    assert_eq!(twin_vdot[v], 0.0, "a fixed DOF of the top is held");
+    // The top's prescribed accelerations, vectors along its hole axis: the table's ω̇ and the
+    // hook's acceleration (every DOF of the top is prescribed here, fixed or not).
+    for k in 0..3 {
+        assert_eq!(
+            twin_vdot[(3 + k) * v],
+            top[(12 + k) * v],
+            "the table's ω̇ written"
+        );
+        assert_eq!(
+            twin_vdot[k * v],
+            top[(21 + k) * v],
+            "the hook's acceleration written"
+        );
+    }
+    // Neither driven nor lowered: a fixed DOF of the top is held, a free one left alone.
+    let held = StepCoefficients {
+        driven: false,
+        lowered: false,
+        ..c
+    };
+    let (mut held_vdot, mut held_state) = (vdot.clone(), state.clone());
+    predict(&held, &top, &state, &mut held_vdot, &mut held_state);
+    assert_eq!(held_vdot[v], 0.0, "a fixed DOF of the top is held");
+    assert_eq!(
+        held_vdot[2 * v],
+        vdot[2 * v],
+        "a free DOF of the top is left alone"
+    );
     // The rotation part against the CPU integrator's Rodrigues exponential.
     let basis: Vec<f64> = (0..n)
         .flat_map(|i| {

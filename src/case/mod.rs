@@ -486,6 +486,26 @@ fn build_case(path: &Path, mut source: CaseSource) -> Result<Case, InputError> {
         unbalance: vec![],
         bends: vec![],
     };
+    // A hook-load top moves along global z (`solve::statics::constraints`): the well's top
+    // must be vertical. (A clamped top may lie in an inclined hole — the bottom of a string
+    // modelled alone: the table then turns it about its own hole axis.)
+    if let (Some(_), Some(q)) = (hook, &spec.operation.hook_load) {
+        let tilt = model.nodes[0].hole_axis[2]
+            .clamp(-1.0, 1.0)
+            .acos()
+            .to_degrees();
+        if tilt > 1.0 {
+            return Err(ctx.err(
+                q.span(),
+                "operation.hook_load",
+                format!(
+                    "a hook load moves the top along the vertical, but the well's top is \
+                     inclined {tilt:.1}° (the survey's first station): start the survey \
+                     vertical at MD 0, or give weight_on_bit instead (the top is then clamped)"
+                ),
+            ));
+        }
+    }
     // Stabilizers: a site at the node nearest each stabilizer's middle.
     let mut stab_nodes = Vec::new();
     let mut bottom = bit_md;

@@ -168,6 +168,34 @@ pub enum BenchCommand {
         #[arg(long)]
         quiet: bool,
     },
+    /// The dynamic run (`holewall run`, CPU f64) on a corpus of BHA runs drawn from seeds:
+    /// solved / total, step cuts, Newton iterations per step, wall time per simulated
+    /// second (dynamic_corpus.csv, summary.json, plots); the first `--engine-sample` cases
+    /// also through the GPU engine in f64 and f32, against the CPU run (engine.csv).
+    DynamicCorpus {
+        /// Cases (seeds first-seed, first-seed + 1, …).
+        #[arg(long, default_value_t = 100)]
+        cases: usize,
+        /// First seed.
+        #[arg(long, default_value_t = 0)]
+        first_seed: u64,
+        /// Cases also run through the GPU engine (the first solved ones of at most
+        /// --engine-max-nodes nodes with lumped mass).
+        #[arg(long, default_value_t = 0)]
+        engine_sample: usize,
+        /// Largest mesh (nodes) of the engine sample.
+        #[arg(long, default_value_t = 400)]
+        engine_max_nodes: usize,
+        /// Start no new case after this many seconds (the rest are reported as not run).
+        #[arg(long, value_parser = positive_seconds)]
+        max_seconds: Option<f64>,
+        /// Output folder (created; cases/ holds each case and its survey).
+        #[arg(long)]
+        out: PathBuf,
+        /// No progress bar.
+        #[arg(long)]
+        quiet: bool,
+    },
     /// Friction calibration on corpus wells: synthetic loads at friction factors drawn
     /// from each seed, recovered within the 95 % intervals?; the same loads on a 30 %
     /// heavier drill pipe rejected? (calibrate_corpus.csv, summary.json).

@@ -41,7 +41,7 @@ pub struct Spread {
     pub worst_seed: Option<u64>,
 }
 
-fn spread(values: &[(u64, f64)]) -> Spread {
+pub(crate) fn spread(values: &[(u64, f64)]) -> Spread {
     let mut v: Vec<(u64, f64)> = values.iter().copied().filter(|x| x.1.is_finite()).collect();
     v.sort_by(|a, b| a.1.total_cmp(&b.1));
     if v.is_empty() {

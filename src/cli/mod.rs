@@ -5,6 +5,7 @@ pub mod bench_calibrate;
 pub mod bench_cmd;
 pub mod bench_corpus;
 pub mod bench_device;
+pub mod bench_dynamic_corpus;
 pub mod bench_ensemble;
 pub mod bench_kernels;
 pub mod bench_specialisation;

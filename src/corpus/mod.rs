@@ -32,6 +32,7 @@ use serde::Serialize;
 
 use crate::error::Error;
 
+pub mod dynamic;
 mod engine;
 mod row;
 pub use engine::{run_well_engine, EngineOutcome, EnginePath};

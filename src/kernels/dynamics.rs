@@ -32,9 +32,10 @@ use rayon::prelude::*;
 use crate::kernels::update::rotation_exp_series;
 use crate::physics::Real;
 
-/// Per-variant top kinematics fields: the table's rotation (9, row-major), φ̇, φ̈, the
-/// hook's travel along z, its speed and acceleration.
-pub const TOP_LEN: usize = 14;
+/// Per-variant top kinematics fields: the table's rotation (9, row-major), its angular
+/// velocity and acceleration (3 each: `φ̇ n₀`, `φ̈ n₀`, about the top's hole axis `n₀`), the
+/// hook's travel, speed and acceleration (3 each, along `n₀`).
+pub const TOP_LEN: usize = 24;
 
 /// Generalised-α coefficients of one step, and what drives the top node.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -53,7 +54,7 @@ pub struct StepCoefficients<T> {
     pub top_fixed: u32,
     /// The table turns the top node (clamped or hook-load tops).
     pub driven: bool,
-    /// The hook lowers the top node along z.
+    /// The hook lowers the top node along its hole axis.
     pub lowered: bool,
 }
 
@@ -95,11 +96,13 @@ fn prescribe_top<T: Real>(c: &StepCoefficients<T>, top: &[T], vdot: &mut [T], nv
             vdot[k * nv + v] = T::zero();
         }
     }
-    if c.driven {
-        vdot[5 * nv + v] = top[10 * nv + v];
-    }
-    if c.lowered {
-        vdot[2 * nv + v] = top[13 * nv + v];
+    for k in 0..3 {
+        if c.driven {
+            vdot[(3 + k) * nv + v] = top[(12 + k) * nv + v];
+        }
+        if c.lowered {
+            vdot[k * nv + v] = top[(21 + k) * nv + v];
+        }
     }
 }
 
@@ -146,13 +149,15 @@ fn predict_node<T: Real>(
             for k in 0..9 {
                 r1[k] = top[k * nv + v];
             }
-            v1[3] = T::zero();
-            v1[4] = T::zero();
-            v1[5] = top[9 * nv + v];
+            for k in 0..3 {
+                v1[3 + k] = top[(9 + k) * nv + v];
+            }
         }
         if c.lowered {
-            u1[2] = top[11 * nv + v];
-            v1[2] = top[12 * nv + v];
+            for k in 0..3 {
+                u1[k] = top[(15 + k) * nv + v];
+                v1[k] = top[(18 + k) * nv + v];
+            }
         }
     }
     (u1, r1, v1, a1)

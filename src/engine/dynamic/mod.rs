@@ -492,18 +492,23 @@ fn run_span<T: Real + Send + Sync, P: KernelPath<T>>(
             let d = &batch.drives[j];
             let (phi, phidot, phiddot) = d.table(t1);
             let (zh, zhdot, zhddot) = d.hook(t1);
-            let r = crate::physics::beam::rotation_exp(&[0.0, 0.0, phi]);
+            let top0 = &batch.models[j].nodes[0];
+            let n0 = top0.hole_axis;
+            let r = crate::physics::beam::rotation_exp(&crate::physics::vec3::scale(&n0, phi));
             for (k, x) in r.iter().flatten().enumerate() {
                 top[k * m + i] = t(*x);
             }
-            // The hook's travel as a displacement of the top node: (z0 + z_h) − z0.
-            let z0 = batch.models[j].nodes[0].position[2];
-            let travel = (z0 + zh) - z0;
-            for (k, x) in [phidot, phiddot, travel, zhdot, zhddot]
-                .into_iter()
-                .enumerate()
-            {
-                top[(9 + k) * m + i] = t(x);
+            for k in 0..3 {
+                // The hook's travel as a displacement of the top node: (x₀ + z_h n₀) − x₀.
+                let x0 = top0.position[k];
+                let travel = (x0 + zh * n0[k]) - x0;
+                for (f, x) in [phidot, phiddot].into_iter().enumerate() {
+                    top[(9 + 3 * f + k) * m + i] = t(x * n0[k]);
+                }
+                top[(15 + k) * m + i] = t(travel);
+                for (f, x) in [zhdot, zhddot].into_iter().enumerate() {
+                    top[(18 + 3 * f + k) * m + i] = t(x * n0[k]);
+                }
             }
         }
         ensemble.begin_step(&coefficients, &top)?;

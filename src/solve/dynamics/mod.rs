@@ -15,9 +15,10 @@
 //! about the hole axis). Mass: lumped, with rotary inertia (`J = R J₀ Rᵀ`), or consistent
 //! (see [`DynamicOptions::mass`]).
 //!
-//! The top node is clamped to the rotary table, whose rotation about the (vertical) axis is
+//! The top node is clamped to the rotary table, whose rotation about the top's hole axis `n₀`
+//! (vertical at a rig; inclined where a case models the bottom of a string alone) is
 //! prescribed: a ramp from rest to the operation's speed over `ramp_time`; the hook holds it
-//! or lowers it at the ROP (ramped the same way).
+//! or lowers it along `n₀` at the ROP (ramped the same way).
 
 // Index loops over 3×3 and 6×6 blocks read like the formulas.
 #![allow(clippy::needless_range_loop)]
@@ -387,10 +388,13 @@ impl<'a> Dynamics<'a> {
             vdot: vec![0.0; 6 * n],
             a: vec![0.0; 6 * n],
         };
-        if self.table_driven() {
-            s.vdot[5] = self.table(0.0).2;
+        let n0 = self.model.nodes[0].hole_axis;
+        for k in 0..3 {
+            if self.table_driven() {
+                s.vdot[3 + k] = self.table(0.0).2 * n0[k];
+            }
+            s.vdot[k] = self.hook(0.0).2 * n0[k];
         }
-        s.vdot[2] = self.hook(0.0).2;
         // M v̇ = f_ext − f_int − g: one linear solve with the mass as the matrix.
         let (r, _) = self.residual_and_matrix(&s, 0.0, 0.0, false);
         // Convergence is judged against the larger of the loads and the initial internal

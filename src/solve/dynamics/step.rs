@@ -61,11 +61,14 @@ impl<'s, 'a> CpuStep<'s, 'a> {
                 vd[k] = 0.0;
             }
         }
-        if self.driven {
-            vd[5] = self.table.2;
-        }
-        if self.lowered {
-            vd[2] = self.hook.2;
+        let n0 = self.d.model.nodes[0].hole_axis;
+        for k in 0..3 {
+            if self.driven {
+                vd[3 + k] = self.table.2 * n0[k];
+            }
+            if self.lowered {
+                vd[k] = self.hook.2 * n0[k];
+            }
         }
     }
 
@@ -97,15 +100,20 @@ impl<'s, 'a> CpuStep<'s, 'a> {
                 &s.q.rot[i],
             );
         }
+        // The table turns the top about its hole axis n₀, and the hook lowers it along n₀.
+        let top = &self.d.model.nodes[0];
+        let n0 = top.hole_axis;
         if self.driven {
-            tr.q.rot[0] = rotation_exp(&[0.0, 0.0, self.table.0]);
-            tr.v[3] = 0.0;
-            tr.v[4] = 0.0;
-            tr.v[5] = self.table.1;
+            tr.q.rot[0] = rotation_exp(&crate::physics::vec3::scale(&n0, self.table.0));
+            for k in 0..3 {
+                tr.v[3 + k] = self.table.1 * n0[k];
+            }
         }
         if self.lowered {
-            tr.q.x[0][2] = self.d.model.nodes[0].position[2] + self.hook.0;
-            tr.v[2] = self.hook.1;
+            for k in 0..3 {
+                tr.q.x[0][k] = top.position[k] + self.hook.0 * n0[k];
+                tr.v[k] = self.hook.1 * n0[k];
+            }
         }
     }
 
