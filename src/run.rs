@@ -36,7 +36,8 @@ pub struct RunSummary {
     pub stopped_early: Option<String>,
     /// Per stabilizer, its whirl over the run's second half ([`crate::whirl`]), with `whirl`.
     pub whirl: Vec<SiteWhirl>,
-    /// Why the run's second half (where whirl is analysed) is not a steady state
+    /// An offset start scaled down to stay in the hole ([`crate::case::Case::offset_scale`]),
+    /// and why the run's second half (where whirl is analysed) is not a steady state
     /// ([`crate::whirl::run_notes`]); also on stderr.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub analysis_notes: Vec<String>,
@@ -196,6 +197,23 @@ pub fn run_case(case: &Case, out: &Path, run_options: RunOptions) -> Result<RunS
     let options = case.settings().dynamics();
     let density = case.element_density.clone();
     let mut dynamics = Dynamics::new(model, options, &|e| density[e]);
+    // An offset start that would put the BHA through its wall is scaled down: say so.
+    let offset = settings.initial_lateral_offset;
+    let share = case.offset_scale(model, &start.state);
+    let offset_note = (offset != 0.0 && share < 1.0).then(|| {
+        format!(
+            "initial_lateral_offset: {:.2} mm would start the BHA beyond its wall from where it \
+             rests; the run starts {:.2} mm off its equilibrium{} (the largest half sine that \
+             stays in the hole)",
+            1e3 * offset,
+            1e3 * offset * share.abs(),
+            if share < 0.0 {
+                ", the other way (off the wall)"
+            } else {
+                ""
+            }
+        )
+    });
     let (q0, v0) = case.dynamic_start(model, start.state);
     let mut s = dynamics.initial_state_with(q0, v0).map_err(Error::failed)?;
     let want = |name: &str| settings.outputs.iter().any(|o| o == name);
@@ -584,7 +602,12 @@ pub fn run_case(case: &Case, out: &Path, run_options: RunOptions) -> Result<RunS
         .filter(|r| r[0] >= 0.5 * t_end)
         .map(|r| r[2])
         .collect();
-    let analysis_notes = crate::whirl::run_notes(settings.ramp_time, 0.5 * t_end, &late_torque);
+    let mut analysis_notes: Vec<String> = offset_note.into_iter().collect();
+    analysis_notes.extend(crate::whirl::run_notes(
+        settings.ramp_time,
+        0.5 * t_end,
+        &late_torque,
+    ));
     let summary = RunSummary {
         analysis_notes,
         warnings: case.warnings.clone(),

@@ -535,6 +535,51 @@ fn survey_messages_name_the_csv_line_and_refuse_a_partial_survey() {
     }
 }
 
+/// A hook-load top moves along the vertical: in a well whose top is inclined (a survey
+/// starting at 30°) it is refused with its key, line and what to do, exit code 2; the same
+/// survey with the top clamped (weight on bit) solves.
+#[test]
+fn a_hook_load_needs_a_vertical_top() {
+    let dir = scratch("hook-inclined");
+    std::fs::write(
+        dir.join("survey.csv"),
+        "md,inclination,azimuth\n0,30,0\n400,30,0\n",
+    )
+    .unwrap();
+    let inclined = GOOD.replace(
+        "profile = \"vertical\"",
+        "profile = \"survey\"\nsurvey = \"survey.csv\"",
+    );
+    let hook = inclined.replace("weight_on_bit = \"20 klbf\"", "hook_load = \"200 kN\"");
+    let case = write_case(&dir, &hook);
+    let line = hook
+        .lines()
+        .position(|l| l.starts_with("hook_load"))
+        .unwrap()
+        + 1;
+    let (code, _, stderr) = holewall(&[
+        "static",
+        case.to_str().unwrap(),
+        "--out",
+        dir.join("out").to_str().unwrap(),
+    ]);
+    assert_eq!(code, 2, "{stderr}");
+    assert!(
+        stderr.contains(&format!(":{line}: operation.hook_load:"))
+            && stderr.contains("inclined 30.0°")
+            && stderr.contains("weight_on_bit instead"),
+        "{stderr}"
+    );
+    let case = write_case(&dir, &inclined);
+    let (code, _, stderr) = holewall(&[
+        "static",
+        case.to_str().unwrap(),
+        "--out",
+        dir.join("clamped").to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{stderr}");
+}
+
 /// `--out` (issue 15, part 3): checked before computing, the run written whole into a fresh
 /// folder, an earlier run replaced as a whole (no stale files), anything else refused.
 #[test]

@@ -650,3 +650,67 @@ fn the_dynamic_engine_turns_an_inclined_top_as_the_cpu_does() {
     );
     assert!(worst <= 1e-6, "{worst:e}");
 }
+
+/// An offset start in an inclined hole, where the BHA rests on the low side
+/// (`Case::offset_scale`): the half sine applied is the largest that keeps every node with a
+/// contact site in the hole — none past its clearance or deeper than at rest — here lifting
+/// the BHA off its wall (the offset's own direction points into it). The spin-up string in
+/// a straight 60° hole, contact at every node, 3 mm asked.
+#[test]
+fn an_offset_start_stays_in_the_hole_in_an_inclined_hole() {
+    use holewall::solve::statics::{solve_static, StaticOptions};
+    let dir = common::scratch_dir("offset-inclined", "case");
+    std::fs::write(
+        dir.join("straight.csv"),
+        "md_m, inclination_deg, azimuth_deg\n0, 60, 30\n60, 60, 30\n",
+    )
+    .unwrap();
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let text = std::fs::read_to_string(root.join("cases/spinup_short.toml"))
+        .unwrap()
+        .replace(
+            "profile = \"vertical\"",
+            "profile = \"survey\"\nsurvey = \"straight.csv\"",
+        )
+        .replace("sites = \"stabilizers\"", "sites = \"all_nodes\"")
+        .replace(
+            "rho_inf = 0.8",
+            "rho_inf = 0.8\ninitial_lateral_offset = \"3 mm\"",
+        );
+    let case = holewall::case::parse_case(&dir.join("case.toml"), &text).unwrap();
+    let m = &case.model;
+    let rest = solve_static(m, &StaticOptions::default()).unwrap().state;
+    let share = case.offset_scale(m, &rest);
+    let (q, _) = case.dynamic_start(m, rest.clone());
+    let lateral = |x: &[f64; 3], i: usize| {
+        let nd = &m.nodes[i];
+        let d: Vec<f64> = (0..3).map(|k| x[k] - nd.position[k]).collect();
+        let along: f64 = (0..3).map(|k| d[k] * nd.hole_axis[k]).sum();
+        (0..3)
+            .map(|k| (d[k] - along * nd.hole_axis[k]).powi(2))
+            .sum::<f64>()
+            .sqrt()
+    };
+    let (mut moved, mut tight) = (0.0f64, f64::INFINITY);
+    for site in &m.sites {
+        let i = site.node;
+        let (before, after) = (lateral(&rest.x[i], i), lateral(&q.x[i], i));
+        let room = site.params.clearance.max(before);
+        assert!(after <= room + 1e-12, "node {i}: {after} m past {room} m");
+        let step: f64 = (0..3).map(|k| (q.x[i][k] - rest.x[i][k]).powi(2)).sum();
+        moved = moved.max(step.sqrt());
+        tight = tight.min(room - after);
+    }
+    eprintln!(
+        "offset share {share:.3}: largest move {moved:.2e} m, tightest room left {tight:.1e} m"
+    );
+    assert!(
+        share < 0.0 && share > -1.0,
+        "lifted off the wall, scaled: {share}"
+    );
+    assert!(moved > 1e-3, "the start moved the BHA: {moved}");
+    assert!(
+        tight.abs() < 1e-9,
+        "the largest half sine touches the far wall: {tight}"
+    );
+}

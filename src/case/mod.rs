@@ -157,7 +157,8 @@ impl Case {
     /// The start of a dynamic run of `model` from its static equilibrium `q`: the BHA's
     /// initial lateral offset (`[dynamics].initial_lateral_offset`: a half sine from the bit
     /// to the first drill pipe, towards each node frame's first lateral axis) applied to
-    /// `q`, and the initial velocities (6 per node) of the BHA's lateral kick
+    /// `q` (scaled down where it would start a node beyond its wall: [`Case::offset_scale`]),
+    /// and the initial velocities (6 per node) of the BHA's lateral kick
     /// (`initial_lateral_velocity`, the same direction, uniform), `None` without one. Every
     /// dynamic run (`holewall run`, the ensemble's CPU runs) starts here.
     pub fn dynamic_start(
@@ -180,9 +181,13 @@ impl Case {
         };
         let in_bha = |i: usize| i > 0 && i < last && model.nodes[i].md >= top - 1e-9;
         if d.initial_lateral_offset != 0.0 {
-            for i in (0..n).filter(|&i| in_bha(i)) {
+            let shape = |i: usize| {
                 let s = (bit_md - model.nodes[i].md) / bha;
-                let w = d.initial_lateral_offset * (std::f64::consts::PI * s).sin();
+                (std::f64::consts::PI * s).sin()
+            };
+            let scale = self.offset_scale(model, &q);
+            for i in (0..n).filter(|&i| in_bha(i)) {
+                let w = scale * d.initial_lateral_offset * shape(i);
                 for (x, a) in q.x[i].iter_mut().zip(lateral(i)) {
                     *x += w * a;
                 }
@@ -199,6 +204,78 @@ impl Case {
             }
         }
         (q, Some(v))
+    }
+
+    /// The share (−1…1) of `[dynamics].initial_lateral_offset` that [`Case::dynamic_start`]
+    /// applies to the static equilibrium `q` of `model`: all of it unless it would put a
+    /// node with a contact site beyond its wall (past its clearance, or deeper than it lies
+    /// in `q`) — in an inclined hole the BHA rests on the low side, and an offset towards
+    /// the wall would start the run millimetres deep in a stiff wall (the dynamic corpus's
+    /// offset starts rang at up to 4 MN and cut their first steps). The half sine is kept,
+    /// scaled down to the largest that stays in the hole; where the other way round (away
+    /// from the wall it rests on) goes further, that way (a negative share): the BHA lifted
+    /// off its wall and let go. 1 without an offset.
+    pub fn offset_scale(
+        &self,
+        model: &crate::model::Model,
+        q: &crate::solve::statics::StaticState,
+    ) -> f64 {
+        let forward = self.offset_room(model, q, 1.0);
+        if forward >= 1.0 {
+            return 1.0;
+        }
+        let back = self.offset_room(model, q, -1.0);
+        if back > forward {
+            -back
+        } else {
+            forward
+        }
+    }
+
+    /// The largest share (0–1) of the offset applied with `sign` that keeps every node with
+    /// a site in the hole ([`Case::offset_scale`]).
+    fn offset_room(
+        &self,
+        model: &crate::model::Model,
+        q: &crate::solve::statics::StaticState,
+        sign: f64,
+    ) -> f64 {
+        let Some(d) = self.dynamics.as_ref() else {
+            return 1.0;
+        };
+        let n = model.nodes.len();
+        let bit_md = model.nodes.last().map_or(self.bit_md, |nd| nd.md);
+        let bha = self.bha_length.max(1e-9);
+        let last = if model.bit_lateral_fixed { n - 1 } else { n };
+        let mut scale = 1.0f64;
+        for site in &model.sites {
+            let i = site.node;
+            let nd = &model.nodes[i];
+            if i == 0 || i >= last || nd.md < bit_md - bha - 1e-9 {
+                continue;
+            }
+            let s = (bit_md - nd.md) / bha;
+            let w = sign * d.initial_lateral_offset * (std::f64::consts::PI * s).sin();
+            let f = &nd.frame0;
+            // Lateral position p in the hole and the offset b (⊥ the hole axis).
+            let dx: [f64; 3] = std::array::from_fn(|k| q.x[i][k] - nd.position[k]);
+            let along: f64 = (0..3).map(|k| dx[k] * nd.hole_axis[k]).sum();
+            let p: [f64; 3] = std::array::from_fn(|k| dx[k] - along * nd.hole_axis[k]);
+            let b: [f64; 3] = std::array::from_fn(|k| w * f[k][1]);
+            let (pp, pb, bb) = (
+                (0..3).map(|k| p[k] * p[k]).sum::<f64>(),
+                (0..3).map(|k| p[k] * b[k]).sum::<f64>(),
+                (0..3).map(|k| b[k] * b[k]).sum::<f64>(),
+            );
+            if bb == 0.0 {
+                continue;
+            }
+            // The largest λ with |p + λ b| ≤ max(clearance, |p|).
+            let c2 = site.params.clearance.powi(2).max(pp);
+            let root = (pb * pb - bb * (pp - c2)).max(0.0).sqrt();
+            scale = scale.min(((-pb + root) / bb).max(0.0));
+        }
+        scale.clamp(0.0, 1.0)
     }
 
     /// The hole diameter at `md` (m).
