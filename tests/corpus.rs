@@ -389,3 +389,101 @@ fn slick_pendulum_tangency_matches_the_closed_form_on_fine_meshes() {
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// Dynamic cases of the dynamic corpus (`holewall bench dynamic-corpus`, 100 cases there) in
+/// CI: the first `DYNAMIC_SAMPLE` seeds whose mesh has at most 150 nodes (chosen by rule,
+/// not by outcome), each run as `holewall run` runs it. Every one must run to its end with
+/// a finite state; step cuts are printed (a result to report), and an offset start must
+/// not begin beyond the wall (`Case::offset_scale`).
+const DYNAMIC_SAMPLE: usize = 12;
+
+fn dynamic_sample(
+    dir: &std::path::Path,
+    count: usize,
+    max_nodes: usize,
+) -> Vec<holewall::corpus::dynamic::DynamicCase> {
+    (0..1000u64)
+        .map(|seed| holewall::corpus::dynamic::write_dynamic_case(seed, dir).unwrap())
+        .filter(|c| {
+            holewall::case::load_case(&c.case_path)
+                .unwrap()
+                .model
+                .nodes
+                .len()
+                <= max_nodes
+        })
+        .take(count)
+        .collect()
+}
+
+#[test]
+fn dynamic_corpus_sample_runs_to_the_end() {
+    use holewall::corpus::dynamic::run_case_dynamic;
+    let dir = tempdir::Dir::new("dynamic_corpus");
+    let cases = dynamic_sample(dir.path(), DYNAMIC_SAMPLE, 150);
+    let mut cut = 0;
+    for case in &cases {
+        let r = run_case_dynamic(case).unwrap();
+        eprintln!(
+            "dynamic seed {} ({} {}, {} nodes, {} s in {} ms steps): solved {}, {} cuts, {:.1} iterations per step, {:.1} s; {}",
+            r.spec.seed,
+            r.spec.class,
+            r.spec.hole,
+            r.nodes,
+            r.spec.duration_s,
+            1e3 * r.spec.time_step_s,
+            r.solved,
+            r.step_cuts,
+            r.iterations_per_step,
+            r.seconds,
+            r.reason
+        );
+        assert!(r.solved, "dynamic seed {}: {}", r.spec.seed, r.reason);
+        cut += usize::from(r.step_cuts > 0);
+    }
+    eprintln!(
+        "dynamic corpus sample: {} / {} run to the end, {cut} with step cuts",
+        cases.len(),
+        cases.len()
+    );
+}
+
+/// The smallest of the dynamic corpus through the GPU engine, f64 and f32, against the CPU
+/// integrator (the first seed of at most 80 nodes; lumped mass, which the engine runs):
+/// solved by the engine itself, hook load and largest surface torque to solver tolerance in
+/// f64.
+#[test]
+fn a_dynamic_corpus_case_through_the_engine_matches_the_cpu() {
+    use holewall::corpus::dynamic::{run_case_dynamic, run_case_engine};
+    if common::gpu().is_none() {
+        return;
+    }
+    let dir = tempdir::Dir::new("dynamic_corpus_engine");
+    let case = dynamic_sample(dir.path(), 40, 80)
+        .into_iter()
+        .find(|c| c.spec.mass == "lumped")
+        .unwrap();
+    let cpu = run_case_dynamic(&case).unwrap();
+    assert!(cpu.solved, "{}", cpu.reason);
+    for f32 in [false, true] {
+        let e = run_case_engine(&case, &cpu, f32).unwrap();
+        eprintln!(
+            "dynamic seed {} {}: by engine {}, {} cuts ({} on the CPU), hook load {:.1e}, torque {:.1e}, stab1 force {:.1e} off the CPU's, same whirl {}, {:.1} s; {}",
+            e.seed,
+            e.path,
+            e.by_engine,
+            e.step_cuts,
+            cpu.step_cuts,
+            e.hook_load_rel,
+            e.torque_rel,
+            e.stab1_force_rel,
+            e.same_whirl,
+            e.seconds,
+            e.reason
+        );
+        assert!(e.solved && e.by_engine, "{}", e.reason);
+        let tol = if f32 { 1e-3 } else { 1e-6 };
+        assert!(e.hook_load_rel <= tol, "{}: {}", e.path, e.hook_load_rel);
+        assert!(e.torque_rel <= tol, "{}: {}", e.path, e.torque_rel);
+    }
+}
