@@ -8,6 +8,7 @@
 
 #![warn(missing_docs)]
 
+pub mod allocator;
 pub mod atomic_file;
 pub mod backend;
 pub mod bha;

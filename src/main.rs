@@ -341,6 +341,7 @@ fn print_ensemble_summary(
 }
 
 fn main() -> ExitCode {
+    holewall::allocator::keep_freed_memory();
     let args = Args::parse();
     holewall::display_units::set(args.units);
     match args.command {

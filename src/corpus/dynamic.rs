@@ -237,47 +237,21 @@ pub fn write_dynamic_case(seed: u64, dir: &Path) -> Result<DynamicCase, Error> {
     };
 
     // The string from the bit up.
-    let tube = |kind: &str, len: f64, od: f64, id: f64, extra: &str| {
-        format!(
-            "[[string]]\nkind = \"{kind}\"\nlength = \"{len} m\"\nod = \"{od} in\"\nid = \"{id} in\"\n{extra}"
-        )
-    };
     let (cod, cid) = collar;
     let collar_extra = if eccentricity_mm > 0.0 {
         format!("mass_eccentricity = \"{eccentricity_mm:.2} mm\"\n")
     } else {
         String::new()
     };
-    let mut comps = vec![tube("bit", 0.3, cod, cid, "")];
-    let mut used = 0.3;
-    if bend > 0.0 {
-        let motor_len = rng.random_range(6.0f64..9.0).round();
-        comps.push(tube(
-            "motor",
-            motor_len,
-            cod,
-            cid,
-            &format!(
-                "bend = \"{bend:.2} deg\"\nbend_from_bottom = \"{:.1} m\"\n",
-                rng.random_range(1.0..2.5)
-            ),
-        ));
-        used += motor_len;
-    }
-    for (k, (ug, gap)) in under_gauge.iter().zip(&spacing).enumerate() {
-        if k > 0 {
-            comps.push(tube("collar", *gap, cod, cid, &collar_extra));
-            used += gap;
-        }
-        comps.push(tube(
-            "stabilizer",
-            1.5,
-            cod,
-            cid,
-            &format!("blade_diameter = \"{:.4} in\"\n", size.hole_in - ug),
-        ));
-        used += 1.5;
-    }
+    let (mut comps, mut used) = bha_bottom(
+        &mut rng,
+        collar,
+        size.hole_in,
+        bend,
+        &under_gauge,
+        &spacing,
+        &collar_extra,
+    );
     let rest = (collar_len - used).max(9.0).round();
     comps.push(tube("collar", rest, cod, cid, &collar_extra));
     used += rest;

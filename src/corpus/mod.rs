@@ -247,6 +247,60 @@ fn pick<T: Copy>(rng: &mut ChaCha8Rng, items: &[(T, f64)]) -> T {
     items[items.len() - 1].0
 }
 
+/// A `[[string]]` table of a tube `len` m long, `od` × `id` in, with `extra` lines.
+fn tube(kind: &str, len: f64, od: f64, id: f64, extra: &str) -> String {
+    format!(
+        "[[string]]\nkind = \"{kind}\"\nlength = \"{len} m\"\nod = \"{od} in\"\nid = \"{id} in\"\n{extra}"
+    )
+}
+
+/// The bottom of a drawn BHA, from the bit up (both corpora): the bit; a bent motor housing
+/// where `bend` > 0 (its length, 6–9 m, and the bend's height, 1–2.5 m, drawn from `rng`);
+/// then a 1.5 m stabilizer per `under_gauge` entry (blade that much under `hole_in`), the
+/// ones above the first `spacing` m of collar apart (`collar_extra` on those collars).
+/// Returns the tables and their length (m).
+fn bha_bottom(
+    rng: &mut ChaCha8Rng,
+    (cod, cid): (f64, f64),
+    hole_in: f64,
+    bend: f64,
+    under_gauge: &[f64],
+    spacing: &[f64],
+    collar_extra: &str,
+) -> (Vec<String>, f64) {
+    let mut comps = vec![tube("bit", 0.3, cod, cid, "")];
+    let mut used = 0.3;
+    if bend > 0.0 {
+        let motor_len = rng.random_range(6.0f64..9.0).round();
+        comps.push(tube(
+            "motor",
+            motor_len,
+            cod,
+            cid,
+            &format!(
+                "bend = \"{bend:.2} deg\"\nbend_from_bottom = \"{:.1} m\"\n",
+                rng.random_range(1.0..2.5)
+            ),
+        ));
+        used += motor_len;
+    }
+    for (k, (ug, gap)) in under_gauge.iter().zip(spacing).enumerate() {
+        if k > 0 {
+            comps.push(tube("collar", *gap, cod, cid, collar_extra));
+            used += gap;
+        }
+        comps.push(tube(
+            "stabilizer",
+            1.5,
+            cod,
+            cid,
+            &format!("blade_diameter = \"{:.4} in\"\n", hole_in - ug),
+        ));
+        used += 1.5;
+    }
+    (comps, used)
+}
+
 /// Draws well `seed` and writes it into `dir` (`well_<seed>.toml` and `.csv`). The weight on
 /// bit is drawn up to the soft-string sinusoidal-buckling limit of the string as meshed,
 /// so the case is read once without it first.
@@ -336,49 +390,16 @@ pub fn write_well(seed: u64, dir: &Path) -> Result<CorpusWell, Error> {
         .collect();
 
     // The string from the bit up.
-    let mut comps: Vec<String> = Vec::new();
-    let tube = |kind: &str, len: f64, od: f64, id: f64, extra: &str| {
-        format!(
-            "[[string]]\nkind = \"{kind}\"\nlength = \"{len} m\"\nod = \"{od} in\"\nid = \"{id} in\"\n{extra}"
-        )
-    };
+    let (mut comps, mut used) = bha_bottom(
+        &mut rng,
+        collar,
+        size.hole_in,
+        bend,
+        &under_gauge,
+        &spacing,
+        "",
+    );
     let (cod, cid) = collar;
-    comps.push(tube("bit", 0.3, cod, cid, ""));
-    let mut used = 0.3;
-    let motor_len = if bend > 0.0 {
-        rng.random_range(6.0f64..9.0).round()
-    } else {
-        0.0
-    };
-    if bend > 0.0 {
-        comps.push(tube(
-            "motor",
-            motor_len,
-            cod,
-            cid,
-            &format!(
-                "bend = \"{bend:.2} deg\"\nbend_from_bottom = \"{:.1} m\"\n",
-                rng.random_range(1.0..2.5)
-            ),
-        ));
-        used += motor_len;
-    }
-    for (k, (ug, gap)) in under_gauge.iter().zip(&spacing).enumerate() {
-        let gap = if k == 0 { 0.0 } else { *gap };
-        if gap > 0.0 {
-            comps.push(tube("collar", gap, cod, cid, ""));
-            used += gap;
-        }
-        let blade = size.hole_in - ug;
-        comps.push(tube(
-            "stabilizer",
-            1.5,
-            cod,
-            cid,
-            &format!("blade_diameter = \"{blade:.4} in\"\n"),
-        ));
-        used += 1.5;
-    }
     let rest = (collar_len - used).max(9.0);
     comps.push(tube("collar", rest, cod, cid, ""));
     used += rest;
