@@ -270,14 +270,7 @@ pub fn write_dynamic_case(seed: u64, dir: &Path) -> Result<DynamicCase, Error> {
     };
 
     let name = format!("dyn_{seed}");
-    let csv_name = format!("{name}.csv");
-    let mut csv = String::from("md_m, inclination_deg, azimuth_deg\n");
-    for s in &stations {
-        csv.push_str(&format!("{:.2}, {:.4}, {:.4}\n", s[0], s[1], s[2]));
-    }
-    std::fs::create_dir_all(dir)
-        .map_err(|e| std::io::Error::new(e.kind(), format!("{}: {e}", dir.display())))?;
-    std::fs::write(dir.join(&csv_name), csv)?;
+    let csv_name = write_survey(dir, &name, &stations)?;
     let max_inc = stations.iter().map(|s| s[1]).fold(0.0, f64::max);
     let case_text = |wob: f64| {
         let mut t = format!(

@@ -247,6 +247,20 @@ fn pick<T: Copy>(rng: &mut ChaCha8Rng, items: &[(T, f64)]) -> T {
     items[items.len() - 1].0
 }
 
+/// Writes `stations` (MD, inclination, azimuth; m, deg) as the survey CSV `<name>.csv` in
+/// `dir` (created), as a user's survey is written; returns the file's name.
+fn write_survey(dir: &Path, name: &str, stations: &[[f64; 3]]) -> Result<String, Error> {
+    let csv_name = format!("{name}.csv");
+    let mut csv = String::from("md_m, inclination_deg, azimuth_deg\n");
+    for s in stations {
+        csv.push_str(&format!("{:.2}, {:.4}, {:.4}\n", s[0], s[1], s[2]));
+    }
+    std::fs::create_dir_all(dir)
+        .map_err(|e| std::io::Error::new(e.kind(), format!("{}: {e}", dir.display())))?;
+    std::fs::write(dir.join(&csv_name), csv)?;
+    Ok(csv_name)
+}
+
 /// A `[[string]]` table of a tube `len` m long, `od` × `id` in, with `extra` lines.
 fn tube(kind: &str, len: f64, od: f64, id: f64, extra: &str) -> String {
     format!(
@@ -416,14 +430,7 @@ pub fn write_well(seed: u64, dir: &Path) -> Result<CorpusWell, Error> {
     ));
 
     let name = format!("well_{seed}");
-    let csv_name = format!("{name}.csv");
-    let mut csv = String::from("md_m, inclination_deg, azimuth_deg\n");
-    for s in &stations {
-        csv.push_str(&format!("{:.2}, {:.4}, {:.4}\n", s[0], s[1], s[2]));
-    }
-    std::fs::create_dir_all(dir)
-        .map_err(|e| std::io::Error::new(e.kind(), format!("{}: {e}", dir.display())))?;
-    std::fs::write(dir.join(&csv_name), csv)?;
+    let csv_name = write_survey(dir, &name, &stations)?;
     let max_inc = stations.iter().map(|s| s[1]).fold(0.0, f64::max);
     let (op_mode, rotating) = match mode {
         "drilling" => ("rotating", true),
