@@ -8,7 +8,9 @@
 //!   5–25 m apart, blades up to ½ in under gauge), a bent motor housing (0.5–2°) in one case
 //!   in eight, a mass imbalance in one in five — with drill pipe above it. Four cases in five
 //!   are a **section** (the bottom 40–300 m of the string, its top clamped where the section
-//!   is cut); one in five is the **whole string** of a 1,000–3,000 m well;
+//!   is cut); one in five is a **whole string** of 1,000–3,000 m in the same kind of hole
+//!   — its survey, like a section's, at the hole's inclination from MD 0 (no vertical
+//!   kick-off from a rig: wells of that shape are the static corpus's, not drawn here);
 //! - **hole**: vertical, tangent (10–70°), building (2–8°/30 m) or horizontal (86–92°), the
 //!   stations every 10 m with dogleg noise (σ 0.05–0.3°); friction 0.1–0.4; mud 1.0–1.8 sg;
 //! - **operation**: rotating off bottom or drilling (WOB up to 1.2 × the soft string's
@@ -117,8 +119,8 @@ fn survey_of(rng: &mut ChaCha8Rng, hole: &str, total_md: f64) -> Vec<[f64; 3]> {
     };
     let mut out = Vec::new();
     let mut md = 0.0f64;
-    // A whole string's survey starts vertical and reaches the section's trajectory by a
-    // build from a kick-off above the BHA.
+    // The hole's inclination from MD 0, for a whole string too (its top then lies in the
+    // inclined hole: no vertical kick-off above it; module docs).
     loop {
         let plan = if inc0 == 0.0 {
             0.0
