@@ -170,24 +170,18 @@ impl Case {
             return (q, None);
         };
         let n = model.nodes.len();
-        let bit_md = model.nodes.last().map_or(self.bit_md, |nd| nd.md);
-        let bha = self.bha_length.max(1e-9);
-        let top = bit_md - bha;
-        // Not the clamped top, nor the bit when it is held laterally.
-        let last = if model.bit_lateral_fixed { n - 1 } else { n };
         let lateral = |i: usize| -> [f64; 3] {
             let f = &model.nodes[i].frame0;
             [f[0][1], f[1][1], f[2][1]]
         };
-        let in_bha = |i: usize| i > 0 && i < last && model.nodes[i].md >= top - 1e-9;
+        let in_bha = |i: usize| self.bha_half_sine(model, i).is_some();
         if d.initial_lateral_offset != 0.0 {
-            let shape = |i: usize| {
-                let s = (bit_md - model.nodes[i].md) / bha;
-                (std::f64::consts::PI * s).sin()
-            };
             let scale = self.offset_scale(model, &q);
-            for i in (0..n).filter(|&i| in_bha(i)) {
-                let w = scale * d.initial_lateral_offset * shape(i);
+            for i in 0..n {
+                let Some(shape) = self.bha_half_sine(model, i) else {
+                    continue;
+                };
+                let w = scale * d.initial_lateral_offset * shape;
                 for (x, a) in q.x[i].iter_mut().zip(lateral(i)) {
                     *x += w * a;
                 }
@@ -204,6 +198,21 @@ impl Case {
             }
         }
         (q, Some(v))
+    }
+
+    /// The half sine of the initial offset and kick at node `i`, `sin(π s)` with `s` its
+    /// height above the bit over the BHA's length; `None` outside the BHA, at the clamped
+    /// top, and at the bit when it is held laterally (nodes the start does not move).
+    fn bha_half_sine(&self, model: &crate::model::Model, i: usize) -> Option<f64> {
+        let n = model.nodes.len();
+        let bit_md = model.nodes.last().map_or(self.bit_md, |nd| nd.md);
+        let bha = self.bha_length.max(1e-9);
+        let last = if model.bit_lateral_fixed { n - 1 } else { n };
+        let md = model.nodes[i].md;
+        (i > 0 && i < last && md >= bit_md - bha - 1e-9).then(|| {
+            let s = (bit_md - md) / bha;
+            (std::f64::consts::PI * s).sin()
+        })
     }
 
     /// The share (−1…1) of `[dynamics].initial_lateral_offset` that [`Case::dynamic_start`]
@@ -243,19 +252,14 @@ impl Case {
         let Some(d) = self.dynamics.as_ref() else {
             return 1.0;
         };
-        let n = model.nodes.len();
-        let bit_md = model.nodes.last().map_or(self.bit_md, |nd| nd.md);
-        let bha = self.bha_length.max(1e-9);
-        let last = if model.bit_lateral_fixed { n - 1 } else { n };
         let mut scale = 1.0f64;
         for site in &model.sites {
             let i = site.node;
             let nd = &model.nodes[i];
-            if i == 0 || i >= last || nd.md < bit_md - bha - 1e-9 {
+            let Some(shape) = self.bha_half_sine(model, i) else {
                 continue;
-            }
-            let s = (bit_md - nd.md) / bha;
-            let w = sign * d.initial_lateral_offset * (std::f64::consts::PI * s).sin();
+            };
+            let w = sign * d.initial_lateral_offset * shape;
             let f = &nd.frame0;
             // Lateral position p in the hole and the offset b (⊥ the hole axis).
             let dx: [f64; 3] = std::array::from_fn(|k| q.x[i][k] - nd.position[k]);
