@@ -7,9 +7,10 @@
 // spin through η and n):
 //   f_x₂ = −f_x₁ = N e1 + ((η V₁ + V₂) e3 − V₃ e2)/l,  f_θᵢ = R_r v̄_i − V₁/(2n)·(b_i × e3).
 // The consistent tangent is that force in dual numbers (value, derivative) — here
-// vec2<real>, vectors as (value, derivative) pairs of vec3<real> — once per column k: DOF k
-// seeded as a translation or a left spin (I + [ε e]×)·triad. K_jk = ∂f_j/∂Δ_k. Built with
-// FORCE_ONLY it evaluates the force alone (line-search trials: 1/12 of the work and no
+// vec2<real>, vectors as (value, derivative) pairs of vec3<real> — once per seed: a DOF
+// seeded as a translation or a left spin (I + [ε e]×)·triad. K_jk = ∂f_j/∂Δ_k; nine seeds
+// give the twelve columns (node 1's translation columns are node 2's negated). Built with
+// FORCE_ONLY it evaluates the force alone (line-search trials: 1/9 of the work and no
 // tangent written). Outputs in the assembly's layout: [(12 e + j) V + v] and
 // [(144 e + 12 j + k) V + v].
 //
@@ -352,24 +353,28 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
 #endif
     let zero = vec3<real>(real(0.0));
 #if FORCE_ONLY
-    let columns = 1u;
+    let seeds = 1u;
 #else
-    let columns = 12u;
+    // Nine passes, not twelve: the element sees the translations only through x₂ − x₁, so
+    // node 1's translation columns are node 2's negated, exactly (a seed of −1 negates every
+    // derivative without changing a rounding; the twin's DualN<9> carries the same nine).
+    let seeds = 9u;
 #endif
-    for (var col = 0u; col < columns; col = col + 1u) {
-        // Seed: DOF col (the force alone: none).
+    for (var seed = 0u; seed < seeds; seed++) {
+        // Seed k: 0–2 node 2's translations (columns 6–8), 3–5 node 1's spins (columns
+        // 3–5), 6–8 node 2's spins (columns 9–11); the force alone: none.
         var dd = zero;
         var spin = array<vec3<real>, 2>(zero, zero);
 #if !FORCE_ONLY
-        let node = col / 6u;
-        let axis = col % 6u;
+        let node = select(1u, 0u, seed >= 3u && seed < 6u);
         var unit = zero;
-        unit[axis % 3u] = real(1.0);
-        if (axis < 3u) {
-            dd = select(-unit, unit, node == 1u);
+        unit[seed % 3u] = real(1.0);
+        if (seed < 3u) {
+            dd = unit;
         } else {
             spin[node] = unit;
         }
+        let col = select(select(seed + 3u, seed, seed < 6u), seed + 6u, seed < 3u);
 #endif
         let d = DV(d0, dd);
 #if F64
@@ -384,11 +389,14 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         let out = array<DV, 4>(f.x1, f.t1, f.x2, f.t2);
         for (var j = 0u; j < 12u; j = j + 1u) {
             let part = out[j / 3u];
-            if (col == 0u) {
+            if (seed == 0u) {
                 elem_force[(12u * e + j) * nv + v] = part.v[j % 3u];
             }
 #if !FORCE_ONLY
             elem_tangent[(144u * e + 12u * j + col) * nv + v] = part.d[j % 3u];
+            if (seed < 3u) {
+                elem_tangent[(144u * e + 12u * j + seed) * nv + v] = -part.d[j % 3u];
+            }
 #endif
         }
     }

@@ -12,7 +12,8 @@ fn pow2_f64(e: i32) -> f64 {
         k = -k;
     }
     var result = 1.0lf;
-    loop {
+    // |e| < 2^31: at most 31 rounds (every loop in a kernel is counted: src/gpu/loops.rs).
+    for (var round = 0u; round < 32u; round++) {
         if (k == 0) {
             break;
         }
@@ -36,14 +37,16 @@ fn ln_f64(x_in: f64) -> f64 {
     var e: i32 = 0;
     let up = pow2_f64(100);
     let down = pow2_f64(-100);
-    loop {
+    // A positive finite x needs at most 10 rounds of 2^±100 (4.9e-324 → 1e-30, 1.8e308 →
+    // 1e30), then at most 2 halvings or doublings; the bounds end the loops on 0, ∞ or NaN.
+    for (var round = 0u; round < 16u; round++) {
         if (x >= 1.0e-30lf) {
             break;
         }
         x = x * up;
         e = e - 100;
     }
-    loop {
+    for (var round = 0u; round < 16u; round++) {
         if (x <= 1.0e30lf) {
             break;
         }
@@ -54,14 +57,14 @@ fn ln_f64(x_in: f64) -> f64 {
     let est = i32(floor(log2(f32(x))));
     x = x * pow2_f64(-est);
     e = e + est;
-    loop {
+    for (var round = 0u; round < 8u; round++) {
         if (x < 1.4142135623730951lf) {
             break;
         }
         x = x * 0.5lf;
         e = e + 1;
     }
-    loop {
+    for (var round = 0u; round < 8u; round++) {
         if (x >= 0.7071067811865476lf) {
             break;
         }

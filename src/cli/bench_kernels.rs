@@ -175,7 +175,7 @@ fn counts(n: usize) -> Counts {
     let block_lu = counted(|| crate::kernels::block_lu::block_lu(&b));
     Counts {
         contact_per_pair: contact,
-        // The kernel's form: the closed form one dual direction at a time (12 passes).
+        // The kernel's form: the closed form one dual direction at a time (9 passes).
         beam_per_element: super::bench::element_flops().by_direction as f64,
         assemble,
         block_lu,

@@ -53,8 +53,13 @@ const COPY_WGSL: &str = "@group(0) @binding(0) var<storage, read> params: array<
 @group(0) @binding(2) var<storage, read_write> dst: array<vec4<f32>>;
 @compute @workgroup_size(64)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
-    for (var i = gid.x; i < params[0]; i = i + params[1]) {
-        dst[i] = src[i];
+    // Grid-stride, counted (src/gpu/loops.rs): rounds of params[1] invocations.
+    let rounds = (params[0] + params[1] - 1u) / params[1];
+    for (var k = 0u; k < rounds; k++) {
+        let i = gid.x + k * params[1];
+        if (i < params[0]) {
+            dst[i] = src[i];
+        }
     }
 }
 ";

@@ -130,7 +130,8 @@ fn expand(
     Ok(())
 }
 
-/// Validates WGSL with naga (no GPU needed), with `f64` allowed.
+/// Validates WGSL with naga (no GPU needed), with `f64` allowed, and checks that its every
+/// loop is counted ([`crate::gpu::loops::check`]).
 pub fn validate(wgsl: &str) -> Result<(), GpuError> {
     let module =
         naga::front::wgsl::parse_str(wgsl).map_err(|e| GpuError::Shader(e.emit_to_string(wgsl)))?;
@@ -141,5 +142,6 @@ pub fn validate(wgsl: &str) -> Result<(), GpuError> {
     validator
         .validate(&module)
         .map_err(|e| GpuError::Shader(e.emit_to_string(wgsl)))?;
-    Ok(())
+    // What the GPU context requires before it compiles without loop bounding.
+    crate::gpu::loops::check(wgsl).map_err(GpuError::Shader)
 }

@@ -197,13 +197,25 @@ impl GpuContext {
         if let Some(p) = cache.get(wgsl) {
             return Ok(p.clone());
         }
+        // Every loop counted (proved here, once per source text): the kernel compiles
+        // without wgpu's loop bounding, whose extra exit kept the driver from unrolling the
+        // loops over a block's entries (src/gpu/loops.rs). Bounds checks stay on.
+        crate::gpu::loops::check(wgsl).map_err(|e| GpuError::Shader(format!("{label}: {e}")))?;
         let scope = self.device.push_error_scope(wgpu::ErrorFilter::Validation);
-        let module = self
-            .device
-            .create_shader_module(wgpu::ShaderModuleDescriptor {
-                label: Some(label),
-                source: wgpu::ShaderSource::Wgsl(wgsl.into()),
-            });
+        let mut checks = wgpu::ShaderRuntimeChecks::checked();
+        checks.force_loop_bounding = false;
+        // SAFETY: `force_loop_bounding = false` requires that the shader has no loop that
+        // never ends; `loops::check` has just proved every loop counted (WGSL has no
+        // recursion). Every other check is kept.
+        let module = unsafe {
+            self.device.create_shader_module_trusted(
+                wgpu::ShaderModuleDescriptor {
+                    label: Some(label),
+                    source: wgpu::ShaderSource::Wgsl(wgsl.into()),
+                },
+                checks,
+            )
+        };
         let pipeline = self
             .device
             .create_compute_pipeline(&wgpu::ComputePipelineDescriptor {

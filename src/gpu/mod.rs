@@ -12,6 +12,7 @@ pub mod dispatch;
 pub mod dynamics;
 pub mod kernel;
 pub mod layout;
+pub mod loops;
 pub mod path;
 pub mod readback;
 pub mod update;

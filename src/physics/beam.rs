@@ -425,8 +425,10 @@ pub fn force_and_tangent_closed<T: Trig>(
 }
 
 /// [`force_and_tangent_closed`] one direction at a time, as `shaders/beam.wgsl` runs it
-/// (12 passes of [`element_force`] on [`Dual`]: fewer registers, the value part computed
-/// 12 times); the same numbers. For the benchmark and the test of that identity.
+/// (9 passes of [`element_force`] on [`Dual`], one per seed — node 2's translations, node
+/// 1's spins, node 2's spins — and node 1's translation columns as node 2's negated: fewer
+/// registers, the value part computed 9 times); the same numbers. For the FLOP count of the
+/// kernel, the benchmark and the test of that identity.
 #[allow(clippy::needless_range_loop)]
 pub fn force_and_tangent_by_direction<T: Trig>(
     x: &[[T; 3]; 2],
@@ -438,9 +440,15 @@ pub fn force_and_tangent_by_direction<T: Trig>(
     let kd = k.map(Dual::constant);
     let mut force = [T::zero(); 12];
     let mut tangent = [[T::zero(); 12]; 12];
-    for col in 0..12 {
+    for seed in 0..9 {
         let mut xs = x.map(|p| p.map(Dual::constant));
         let mut ts = triad.map(|m| m.map(|r| r.map(Dual::constant)));
+        // The kernel's columns: seed 0–2 → 6–8, 3–5 → 3–5, 6–8 → 9–11.
+        let col = match seed {
+            0..3 => seed + 6,
+            3..6 => seed,
+            _ => seed + 3,
+        };
         let (node, axis) = (col / 6, col % 6);
         if axis < 3 {
             xs[node][axis].d = T::one();
@@ -454,6 +462,9 @@ pub fn force_and_tangent_by_direction<T: Trig>(
         let f = element_force(&xs, &ts, &cd, &kd);
         for j in 0..12 {
             tangent[j][col] = f[j].d;
+            if seed < 3 {
+                tangent[j][seed] = T::zero() - f[j].d;
+            }
         }
         force = f.map(|v| v.re);
     }

@@ -223,6 +223,29 @@ fn closed_form_equals_the_hyper_dual_oracle() {
 }
 
 #[test]
+fn the_kernels_nine_passes_equal_the_one_pass_form_bit_for_bit() {
+    // shaders/beam.wgsl's form (one seed at a time, node 1's translation columns negated
+    // from node 2's) against the CPU's DualN<9> pass, f64 and f32, near π and near 0.
+    for (rel, seed) in [(2.5, 12345), (3.1, 777), (1e-4, 99)] {
+        for s in random_states(30, rel, seed) {
+            let form = Chord::Positions { length0: 9.0 };
+            let k = ElementStiffness::of(&section(), 9.0);
+            let one = force_and_tangent_closed(&s.x, &s.triad, &form, &k);
+            let nine = force_and_tangent_by_direction(&s.x, &s.triad, &form, &k);
+            assert_eq!(one, nine, "f64, rel {rel}");
+            let x32 = s.x.map(|p| p.map(|v| v as f32));
+            let t32 = s.triad.map(|m| m.map(|r| r.map(|v| v as f32)));
+            let (f32_form, k32) = (form.map(|v| v as f32), k.map(|v| v as f32));
+            assert_eq!(
+                force_and_tangent_closed(&x32, &t32, &f32_form, &k32),
+                force_and_tangent_by_direction(&x32, &t32, &f32_form, &k32),
+                "f32, rel {rel}"
+            );
+        }
+    }
+}
+
+#[test]
 fn closed_form_in_f32_keeps_the_f64_digits() {
     // The same states as displacements from a base chord (the f32 engine's form):
     // the f32 force and tangent against the f64 ones, relative to their largest entry.
