@@ -150,8 +150,8 @@ impl<T: Trig> Trig for Dual<T> {
 
 /// A dual number with `N` derivative directions at once, `a + Σ b_k ε_k` (ε_j ε_k = 0): one
 /// evaluation gives the value and the derivative along `N` directions, the value part and
-/// every transcendental computed once (the CPU form of the element tangent: 12 directions
-/// in one pass; the GPU kernel runs the directions one by one on [`Dual`] to keep its
+/// every transcendental computed once (the CPU form of the element tangent: 9 directions
+/// in one pass; the GPU kernel runs the same 9 one by one on [`Dual`] to keep its
 /// registers).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct DualN<T, const N: usize> {
