@@ -416,6 +416,45 @@ fn dynamic_sample(
         .collect()
 }
 
+/// Dynamic corpus seed 12: contact at the stabilizers only, in a deviated hole, whose static
+/// start meets the wall between the sites. The dynamic engine used to hand such a variant
+/// wholly to the CPU; now its start is held at the wall on the CPU (sites added, as the CPU
+/// run's) and its dynamics run on the engine, f64 within 1e-6 of the CPU run and f32 within
+/// 1e-3.
+#[test]
+fn a_dynamic_corpus_case_that_meets_the_wall_runs_on_the_engine() {
+    use holewall::corpus::dynamic::{run_case_dynamic, run_case_engine, write_dynamic_case};
+    if common::gpu().is_none() {
+        return;
+    }
+    let dir = tempdir::Dir::new("dynamic_corpus_wall");
+    let case = write_dynamic_case(12, dir.path()).unwrap();
+    let loaded = holewall::case::load_case(&case.case_path).unwrap();
+    assert!(
+        loaded.model.sites.iter().all(|s| s.stabilizer),
+        "seed 12 is no longer a stabilizer-contact case"
+    );
+    let cpu = run_case_dynamic(&case).unwrap();
+    assert!(cpu.solved, "{}", cpu.reason);
+    for f32 in [false, true] {
+        let e = run_case_engine(&case, &cpu, f32).unwrap();
+        eprintln!(
+            "dynamic seed 12 {}: by engine {}, hook load {:.1e}, torque {:.1e}, stab1 force {:.1e} off the CPU's; {}",
+            e.path, e.by_engine, e.hook_load_rel, e.torque_rel, e.stab1_force_rel, e.reason
+        );
+        assert!(e.solved && e.by_engine, "{}", e.reason);
+        let tol = if f32 { 1e-3 } else { 1e-6 };
+        assert!(e.hook_load_rel <= tol, "{}: {}", e.path, e.hook_load_rel);
+        assert!(e.torque_rel <= tol, "{}: {}", e.path, e.torque_rel);
+        assert!(
+            e.stab1_force_rel <= 10.0 * tol,
+            "{}: {}",
+            e.path,
+            e.stab1_force_rel
+        );
+    }
+}
+
 #[test]
 fn dynamic_corpus_sample_runs_to_the_end() {
     use holewall::corpus::dynamic::run_case_dynamic;

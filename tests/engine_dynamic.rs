@@ -894,3 +894,75 @@ fn variants_still_iterating_go_on_alone_bit_for_bit() {
         check("GPU f64", &gpu);
     }
 }
+
+/// A site the dynamic engine's batch holds only for another variant (a variant whose static
+/// start added it at the wall: `ensemble::runner`'s batch of wall sites) lies beyond any wall
+/// (`ABSENT_SITE_CLEARANCE`): the run is bit for bit the run without the site, twin and GPU
+/// f64. The site is the pipe-body site bearing hardest at the start, so the same site with
+/// its own clearance changes the run (checked: the comparison would see a site that acts).
+#[test]
+fn a_site_held_for_another_variant_adds_nothing() {
+    use holewall::ensemble::runner::ABSENT_SITE_CLEARANCE;
+    let (case, models, starts) = bed_variants("mu,wob\n0.3,20 kN\n");
+    let settings = case.dynamics.clone().unwrap();
+    let options = settings.integrator_options();
+    let t_end = 0.01;
+    let full = &models[0];
+    // The pipe-body site bearing hardest at the start: the one whose absence shows.
+    let sol = solve_static(full, &StaticOptions::default()).unwrap();
+    let (bearing, _) = sol
+        .contact
+        .iter()
+        .enumerate()
+        .filter(|(k, c)| c.0 && !full.sites[*k].stabilizer)
+        .max_by(|a, b| a.1 .1.total_cmp(&b.1 .1))
+        .unwrap();
+    let node = full.sites[bearing].node;
+    let mut without = full.clone();
+    without.sites.retain(|s| s.node != node);
+    let mut absent = full.clone();
+    absent.sites[bearing].params.clearance = ABSENT_SITE_CLEARANCE;
+    let start = std::slice::from_ref(&starts[0]);
+    let density = &case.element_density;
+    let runs = |path: &dyn Fn(&Model) -> Outcome| (path(&without), path(&absent), path(full));
+    let twin = |m: &Model| {
+        collect(
+            std::slice::from_ref(m),
+            start,
+            density,
+            &TwinPath,
+            &options,
+            t_end,
+        )
+    };
+    let (a, b, c) = runs(&twin);
+    assert_eq!(a.0, b.0);
+    assert_eq!(
+        (&a.1.u, &a.1.vel),
+        (&b.1.u, &b.1.vel),
+        "twin: an absent site changed the run"
+    );
+    assert_ne!(
+        a.1.u, c.1.u,
+        "the site chosen does not bear: the test shows nothing"
+    );
+    if let Some(ctx) = common::gpu() {
+        let gpu = |m: &Model| {
+            collect(
+                std::slice::from_ref(m),
+                start,
+                density,
+                &GpuPath(ctx),
+                &options,
+                t_end,
+            )
+        };
+        let (a, b, _) = runs(&gpu);
+        assert_eq!(a.0, b.0);
+        assert_eq!(
+            (&a.1.u, &a.1.vel),
+            (&b.1.u, &b.1.vel),
+            "GPU: an absent site changed the run"
+        );
+    }
+}

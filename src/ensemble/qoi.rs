@@ -228,6 +228,27 @@ pub fn static_variant_of(
     )
 }
 
+/// Variant `v`'s static start held in the hole, as [`dynamic_variant_of`] starts it on the
+/// CPU: its model with the sites added where the string met the wall (with the variant's
+/// overrides), and the equilibrium. For the dynamic engine, whose own static start holds
+/// the string at the batch's sites only.
+pub(crate) fn held_start_of(
+    case: &Case,
+    v: &crate::ensemble::Variant,
+    model: &Model,
+) -> Result<(Model, crate::solve::statics::StaticState), String> {
+    let mut held = model.clone();
+    let sol = crate::profile::solve_in_hole(
+        case,
+        &mut held,
+        &mut variant_wall_sites(case, v),
+        &case.settings().statics(),
+        &mut |_| {},
+    )
+    .map_err(|e| e.to_string())?;
+    Ok((held, sol.state))
+}
+
 /// How variant `v`'s model gets sites where its string meets the wall
 /// ([`crate::profile::solve_in_hole`]): the variant applied again with every node added so
 /// far ([`crate::ensemble::apply_with_sites`]), so its overrides reach them.

@@ -11,6 +11,7 @@ use crate::ensemble::{apply, Variant};
 use crate::error::{Error, InputError, SystemError};
 use crate::model::Model;
 use crate::solve::dynamics::{DynamicState, Dynamics};
+use crate::solve::statics::StaticState;
 
 /// Static equilibria of every variant through the GPU kernels (in `T`), the variants that
 /// fail there re-run on the CPU with step control (their reason says so). Stabilizer
@@ -116,20 +117,42 @@ pub fn run_dynamic_gpu<T: crate::gpu::contact::GpuReal>(
     let path = GpuPath(ctx);
     let statics = solve_static_ensemble::<T, _>(&models, &path, &case.settings().statics())
         .map_err(|e| Error::failed(format!("GPU engine: {e}")))?;
-    // Variants whose static start failed on the GPU, or met the wall between the contact
-    // sites the engine holds the string at, run wholly on the CPU (held there).
-    let on_gpu: Vec<usize> = (0..models.len())
-        .filter(|&j| {
+    // A variant whose static start met the wall between the batch's sites is started on
+    // the CPU, held there as the CPU run holds it (sites added with the variant's
+    // overrides); one whose start failed on the GPU, or could not be held, runs wholly on
+    // the CPU.
+    let met: Vec<bool> = (0..models.len())
+        .map(|j| {
             statics[j].status == EngineStatus::Converged
-                && crate::diagnose::beyond_wall(case, &models[j], &statics[j].state.x).is_empty()
+                && !crate::diagnose::beyond_wall(case, &models[j], &statics[j].state.x).is_empty()
         })
         .collect();
-    let gpu_models: Vec<Model> = on_gpu.iter().map(|&j| models[j].clone()).collect();
-    // The case's initial offset and kick on each static equilibrium, as the CPU runs do.
-    let starts: Vec<_> = on_gpu
-        .iter()
-        .map(|&j| case.dynamic_start(&models[j], statics[j].state.clone()))
+    let held: Vec<Option<(Model, StaticState)>> = (0..models.len())
+        .into_par_iter()
+        .map(|j| {
+            met[j]
+                .then(|| held_start_of(case, &variants[j], &models[j]).ok())
+                .flatten()
+        })
         .collect();
+    let on_gpu: Vec<usize> = (0..models.len())
+        .filter(|&j| statics[j].status == EngineStatus::Converged && (!met[j] || held[j].is_some()))
+        .collect();
+    // Each variant's own model (with its sites added at the wall) and start.
+    let (gpu_models, static_starts): (Vec<Model>, Vec<StaticState>) = on_gpu
+        .iter()
+        .map(|&j| match &held[j] {
+            Some((m, state)) => (m.clone(), state.clone()),
+            None => (models[j].clone(), statics[j].state.clone()),
+        })
+        .unzip();
+    // The case's initial offset and kick on each static equilibrium, as the CPU runs do.
+    let starts: Vec<_> = gpu_models
+        .iter()
+        .zip(static_starts)
+        .map(|(m, state)| case.dynamic_start(m, state))
+        .collect();
+    let batch_models = wall_batch(case, variants, &on_gpu, &models, &gpu_models)?;
     let density = &case.element_density;
     let mut cpu: Vec<Dynamics> = gpu_models
         .iter()
@@ -151,7 +174,7 @@ pub fn run_dynamic_gpu<T: crate::gpu::contact::GpuReal>(
         Vec::new()
     } else {
         run_dynamic_ensemble::<T, _>(
-            &gpu_models,
+            &batch_models,
             &starts,
             density,
             &path,
@@ -201,8 +224,21 @@ pub fn run_dynamic_gpu<T: crate::gpu::contact::GpuReal>(
         out[j] = Some(match (r.status, state) {
             (DynamicStatus::Finished, Some(state)) => {
                 // The engine's step cuts, as the CPU integrator's log would give them.
-                let mut done = obs.finish(case, name, &models[j], &state, &r.log, &r.iterations);
+                let model = held[j].as_ref().map_or(&models[j], |(m, _)| m);
+                let mut done = obs.finish(case, name, model, &state, &r.log, &r.iterations);
                 done.solved_by = SolvedBy::Engine;
+                if held[j].is_some() {
+                    done.reason = format!(
+                        "static start on the CPU, held where the string met the wall between \
+                         the contact sites ({} sites added); dynamics on the engine{}",
+                        model.sites.len() - models[j].sites.len(),
+                        if done.reason.is_empty() {
+                            String::new()
+                        } else {
+                            format!("; {}", done.reason)
+                        }
+                    );
+                }
                 done
             }
             (status, _) => {
@@ -224,7 +260,9 @@ pub fn run_dynamic_gpu<T: crate::gpu::contact::GpuReal>(
                 let why = match &statics[j].status {
                     EngineStatus::Failed(w) => w.clone(),
                     EngineStatus::Converged => {
-                        "the string met the wall between its contact sites".into()
+                        "the string met the wall between its contact sites, and could not be \
+                         held there"
+                            .into()
                     }
                 };
                 let mut again = dynamic_variant_of(case, &variants[j], &models[j]);
@@ -326,4 +364,51 @@ pub(crate) fn same_mesh(case: &Case, m: &Model) -> bool {
             .iter()
             .zip(&case.model.nodes)
             .all(|(a, b)| a.md == b.md)
+}
+
+/// A site the batch holds for another variant: a clearance no string reaches, so it never
+/// touches the wall and adds nothing — as if the variant had no site there (m).
+pub const ABSENT_SITE_CLEARANCE: f64 = 1e3;
+
+/// The models the dynamic engine runs for the variants `on_gpu` (their own models
+/// `own`, with the sites each static start added where it met the wall): one set of sites
+/// for the batch — the case's and every variant's added ones, each with the variant's
+/// overrides ([`crate::ensemble::apply_with_sites`]) — where a variant's sites that are not
+/// its own lie beyond any wall ([`ABSENT_SITE_CLEARANCE`]). No site added: the own models.
+fn wall_batch(
+    case: &Case,
+    variants: &[Variant],
+    on_gpu: &[usize],
+    models: &[Model],
+    own: &[Model],
+) -> Result<Vec<Model>, Error> {
+    let nodes_of = |m: &Model| {
+        m.sites
+            .iter()
+            .map(|s| s.node)
+            .collect::<std::collections::BTreeSet<_>>()
+    };
+    let mut added = std::collections::BTreeSet::new();
+    for (&j, m) in on_gpu.iter().zip(own) {
+        added.extend(nodes_of(m).difference(&nodes_of(&models[j])).copied());
+    }
+    if added.is_empty() {
+        return Ok(own.to_vec());
+    }
+    let added: Vec<usize> = added.into_iter().collect();
+    on_gpu
+        .iter()
+        .zip(own)
+        .map(|(&j, m)| {
+            let mine = nodes_of(m);
+            let mut batch = crate::ensemble::apply_with_sites(case, &variants[j], &added)
+                .map_err(Error::failed)?;
+            for site in &mut batch.sites {
+                if !mine.contains(&site.node) {
+                    site.params.clearance = ABSENT_SITE_CLEARANCE;
+                }
+            }
+            Ok(batch)
+        })
+        .collect()
 }
