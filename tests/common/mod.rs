@@ -156,14 +156,16 @@ pub fn weightless_collar(l: f64, elements: usize) -> holewall::model::Model {
 /// A column of an ensemble's `variants.csv` in `out`, as numbers.
 #[allow(dead_code)]
 pub fn variants_column(out: &std::path::Path, name: &str) -> Vec<f64> {
-    let csv = std::fs::read_to_string(out.join("variants.csv")).unwrap();
-    let mut rows = csv.lines();
-    let header: Vec<&str> = rows.next().unwrap().split(',').collect();
-    let k = header
+    // A CSV reader: a reason holds commas, quoted.
+    let mut csv = csv::Reader::from_path(out.join("variants.csv")).unwrap();
+    let k = csv
+        .headers()
+        .unwrap()
         .iter()
-        .position(|h| *h == name)
+        .position(|h| h == name)
         .unwrap_or_else(|| panic!("no column {name}"));
-    rows.map(|r| r.split(',').nth(k).unwrap().parse().unwrap())
+    csv.records()
+        .map(|r| r.unwrap()[k].parse().unwrap())
         .collect()
 }
 
