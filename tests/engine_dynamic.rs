@@ -924,45 +924,26 @@ fn a_site_held_for_another_variant_adds_nothing() {
     absent.sites[bearing].params.clearance = ABSENT_SITE_CLEARANCE;
     let start = std::slice::from_ref(&starts[0]);
     let density = &case.element_density;
-    let runs = |path: &dyn Fn(&Model) -> Outcome| (path(&without), path(&absent), path(full));
-    let twin = |m: &Model| {
-        collect(
-            std::slice::from_ref(m),
-            start,
-            density,
-            &TwinPath,
-            &options,
-            t_end,
-        )
-    };
-    let (a, b, c) = runs(&twin);
-    assert_eq!(a.0, b.0);
-    assert_eq!(
-        (&a.1.u, &a.1.vel),
-        (&b.1.u, &b.1.vel),
-        "twin: an absent site changed the run"
-    );
-    assert_ne!(
-        a.1.u, c.1.u,
-        "the site chosen does not bear: the test shows nothing"
-    );
-    if let Some(ctx) = common::gpu() {
-        let gpu = |m: &Model| {
-            collect(
-                std::slice::from_ref(m),
-                start,
-                density,
-                &GpuPath(ctx),
-                &options,
-                t_end,
-            )
-        };
-        let (a, b, _) = runs(&gpu);
+    // Without the site, with it absent, with it present: on one kernel path.
+    let runs = |path: &dyn Fn(&[Model]) -> Outcome, label: &str| {
+        let run = |m: &Model| path(std::slice::from_ref(m));
+        let (a, b, c) = (run(&without), run(&absent), run(full));
         assert_eq!(a.0, b.0);
         assert_eq!(
             (&a.1.u, &a.1.vel),
             (&b.1.u, &b.1.vel),
-            "GPU: an absent site changed the run"
+            "{label}: an absent site changed the run"
+        );
+        assert_ne!(a.1.u, c.1.u, "{label}: the site chosen does not bear");
+    };
+    runs(
+        &|m| collect(m, start, density, &TwinPath, &options, t_end),
+        "twin",
+    );
+    if let Some(ctx) = common::gpu() {
+        runs(
+            &|m| collect(m, start, density, &GpuPath(ctx), &options, t_end),
+            "GPU f64",
         );
     }
 }
