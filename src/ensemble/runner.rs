@@ -83,7 +83,7 @@ pub fn run_static_gpu<T: crate::gpu::contact::GpuReal>(
 /// through the static engine, then lockstep generalised-α steps, every step observed for
 /// the quantities of interest. A variant whose static start meets the wall between the
 /// contact sites is started on the CPU, held there, and runs on the engine with its sites
-/// added ([`wall_batch`]). A variant that fails on the GPU (static start or a step)
+/// added (`wall_batch`). A variant that fails on the GPU (static start or a step)
 /// re-runs on the CPU with step control (its reason says so). `Err` with the reason when
 /// the case needs what only the CPU integrator has (consistent mass, stiffness-
 /// proportional damping): the caller runs the CPU then.
