@@ -13,10 +13,10 @@
 //! MUST ensure"), which [`check`] proves of a shader's text before
 //! [`crate::gpu::GpuContext::pipeline`] compiles it: no `loop` or `while`, and every `for`
 //! of the form `for (var k = …; k < B (or ≤ B); k++ | k += L | k = k + L)` with `L` a
-//! positive integer literal, neither `k` nor a name in `B` assigned (or its address
-//! taken) in the loop's body, `k` not declared again there. WGSL has no recursion, so such
-//! a shader ends. (A bound within `L` of the type's largest value could wrap the counter;
-//! the kernels' bounds are sizes of buffers, far below it.)
+//! positive integer literal, neither `k` nor a name in `B` assigned (an element of it
+//! included, or its address taken) in the loop's body, `k` not declared again there. WGSL
+//! has no recursion, so such a shader ends. (A bound within `L` of the type's largest value
+//! could wrap the counter; the kernels' bounds are sizes of buffers, far below it.)
 
 /// A token of WGSL text: an identifier, a number or a punctuation mark, with its line.
 #[derive(Clone, Debug, PartialEq)]
@@ -222,7 +222,13 @@ pub fn check(wgsl: &str) -> Result<(), String> {
                 continue;
             }
             let before = if j > 0 { body[j - 1].text.as_str() } else { "" };
-            let after = body.get(j + 1).map_or("", |t| t.text.as_str());
+            // An element written (`b[i] = …`) counts as the name written.
+            let after_at = if body.get(j + 1).is_some_and(|t| t.text == "[") {
+                closing(body, j + 1).map_or(j + 1, |close| close + 1)
+            } else {
+                j + 1
+            };
+            let after = body.get(after_at).map_or("", |t| t.text.as_str());
             if before == "." {
                 continue;
             }
@@ -252,6 +258,7 @@ mod tests {
     fn counted_loops_pass() {
         for ok in [
             "fn f() { for (var k = 0u; k < 6u; k = k + 1u) { a[k] = b[k]; } }",
+            "fn f() { for (var k = 0u; k < b[0]; k++) { a[k] = b[k]; } }",
             "fn f() { for (var k = r; k < 6u * n; k = k + 6u) { x[k] = 0.0; } }",
             "fn f() { for (var i = dims.begin; i < dims.end; i++) { s.i = 1; } }",
             "fn f() { for (var k = 0u; k <= 13u; k += 2u) { if (k == 3u) { break; } } }",
@@ -284,6 +291,10 @@ mod tests {
             (
                 "fn f() { for (var k = 0u; k < n; k++) { n += 1u; } }",
                 "`n`",
+            ),
+            (
+                "fn f() { for (var k = 0u; k < b[0]; k++) { b[0] = 9u; } }",
+                "`b`",
             ),
             ("fn f() { for (var k = 0u; k < n; k++) { g(&k); } }", "`k`"),
             (
