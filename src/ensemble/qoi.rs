@@ -207,7 +207,7 @@ pub(crate) fn finished(
 /// hole wherever it meets the wall ([`crate::profile::solve_in_hole`]: sites added there
 /// take the case's wall law).
 pub fn static_variant(case: &Case, name: &str, model: &Model) -> VariantResult {
-    solve_held(case, name, model.clone(), &mut |m, nodes| {
+    solve_held(case, name, model, &mut |m, nodes| {
         crate::profile::add_wall_sites(case, m, nodes)
     })
 }
@@ -220,12 +220,7 @@ pub fn static_variant_of(
     v: &crate::ensemble::Variant,
     model: &Model,
 ) -> VariantResult {
-    solve_held(
-        case,
-        &v.name,
-        model.clone(),
-        &mut variant_wall_sites(case, v),
-    )
+    solve_held(case, &v.name, model, &mut variant_wall_sites(case, v))
 }
 
 /// Variant `v`'s static start held in the hole, as [`dynamic_variant_of`] starts it on the
@@ -237,16 +232,33 @@ pub(crate) fn held_start_of(
     v: &crate::ensemble::Variant,
     model: &Model,
 ) -> Result<(Model, crate::solve::statics::StaticState), String> {
+    let (held, solved) = held_start(case, model, &mut variant_wall_sites(case, v));
+    solved
+        .map(|sol| (held, sol.state))
+        .map_err(|e| e.to_string())
+}
+
+/// The static start of `model` held in the hole wherever the string meets the wall
+/// ([`crate::profile::solve_in_hole`], `add` giving the sites): the model with those sites,
+/// and the solve. The one start of every static and dynamic variant, on the CPU and, for
+/// those that meet the wall, the dynamic engine's ([`held_start_of`]).
+fn held_start(
+    case: &Case,
+    model: &Model,
+    add: &mut dyn FnMut(&mut Model, &[usize]),
+) -> (
+    Model,
+    Result<crate::solve::statics::StaticSolution, crate::solve::statics::StaticError>,
+) {
     let mut held = model.clone();
-    let sol = crate::profile::solve_in_hole(
+    let solved = crate::profile::solve_in_hole(
         case,
         &mut held,
-        &mut variant_wall_sites(case, v),
+        add,
         &case.settings().statics(),
         &mut |_| {},
-    )
-    .map_err(|e| e.to_string())?;
-    Ok((held, sol.state))
+    );
+    (held, solved)
 }
 
 /// How variant `v`'s model gets sites where its string meets the wall
@@ -271,11 +283,11 @@ fn variant_wall_sites<'a>(
 fn solve_held(
     case: &Case,
     name: &str,
-    mut model: Model,
+    model: &Model,
     add: &mut dyn FnMut(&mut Model, &[usize]),
 ) -> VariantResult {
-    let options = case.settings().statics();
-    match crate::profile::solve_in_hole(case, &mut model, add, &options, &mut |_| {}) {
+    let (model, solved) = held_start(case, model, add);
+    match solved {
         Ok(sol) => static_result(case, name, &model, &sol),
         Err(e) => failed(name, e.to_string(), model.stabilizer_sites().len()),
     }
@@ -404,14 +416,7 @@ fn dynamic_held(
             None,
         );
     };
-    let mut held = model.clone();
-    let solved = crate::profile::solve_in_hole(
-        case,
-        &mut held,
-        add,
-        &case.settings().statics(),
-        &mut |_| {},
-    );
+    let (held, solved) = held_start(case, model, add);
     let model = &held;
     let stabs = model.stabilizer_sites();
     let start = match solved {
