@@ -410,11 +410,12 @@ fn the_dynamic_engine_runs_a_bent_collar_as_the_cpu_does() {
 }
 
 /// The same bent spin-up with contact at the stabilizers only: each variant's bent collar
-/// meets the wall between its sites (7 and 43 mm beyond it unheld). The GPU run holds each
-/// variant's static start there on the CPU (`profile::solve_in_hole`, as the CPU run) and
-/// runs both on the engine, in one batch holding both variants' added sites (each the
-/// other's as absent ones: `ensemble::runner`); the results are the CPU run's within 1e-6.
-/// (Before stop 47 the engine gave both variants to the CPU.)
+/// meets the wall between its sites (7 and 43 mm beyond it unheld). The GPU run solves each
+/// variant's static start on the engine with guard sites at every node, keeping those in
+/// contact (`ensemble::runner`, as `profile::solve_in_hole` on the CPU), and runs both on
+/// the engine, in one batch holding both variants' kept sites (each the other's as absent
+/// ones); the results are the CPU run's within 1e-6. (Before stop 47 the engine gave both
+/// variants to the CPU; stops 47–48 solved their starts on the CPU.)
 #[test]
 fn a_bent_collar_that_meets_the_wall_runs_on_the_engine_held_there() {
     if common::gpu().is_none() {

@@ -287,11 +287,6 @@ pub fn unsupported_buckling(case: &Case, tension: &[f64]) -> Option<(f64, f64, f
 /// clearance a corpus well draws, above the microns a wall spring lets a contact node in.
 pub const THROUGH_WALL_TOLERANCE: f64 = 1e-3;
 
-/// How many times a static solve gives a string contact where it met the wall and solves it
-/// again ([`crate::profile::solve_in_hole`]) before it gives its answer as it is (then
-/// warned: [`through_wall_warning`]).
-pub const WALL_ROUNDS: usize = 4;
-
 /// Where a solved string lies outside the hole at nodes that have no contact site
 /// ([`through_wall`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -385,15 +380,13 @@ pub fn through_wall_warning(
     let t = through_wall(case, model, x)?;
     Some(format!(
         "the string lies outside the hole at {} nodes without a contact site between MD \
-         {:.0} m and {:.0} m, up to {:.0} mm beyond the wall (at MD {:.0} m), after contact \
-         was added where it met the wall {} times: this is the equilibrium of a string partly \
+         {:.0} m and {:.0} m, up to {:.0} mm beyond the wall (at MD {:.0} m): this is the equilibrium of a string partly \
          in no hole — its side forces and bending above all; use contact.sites = \"all_nodes\"",
         t.nodes,
         t.first_md,
         t.last_md,
         1e3 * t.excess_m,
         t.md,
-        WALL_ROUNDS,
     ))
 }
 

@@ -194,10 +194,12 @@ fn a_string_held_only_at_its_stabilizer_sags_through_the_wall() {
     assert_eq!(solve(&inclined_bha("all_nodes")), None);
 }
 
-/// The same string solved as every command solves it (`profile::solve_in_hole`): contact
-/// is added where it met the wall and it is solved again, in the hole, to the equilibrium
-/// of contact at every node (hook load to 1e-9, every node's position to 1e-6 m); the log
-/// says where. A string that stays in the hole gets no site.
+/// The same string solved as every command solves it (`profile::solve_in_hole`): with a
+/// guard site at every node, keeping those in contact — in the hole, at the equilibrium of
+/// contact at every node (hook load to 1e-9, every node's position to 1e-6 m), and, to the
+/// solve's tolerance, an equilibrium of the model with only the sites kept (a guard in
+/// contact dropped would leave its force out); the log says where. A string that stays in
+/// the hole keeps no guard and has the equilibrium of its own sites.
 #[test]
 fn a_string_that_meets_the_wall_is_held_there() {
     let held = |case: &Case| {
@@ -215,10 +217,24 @@ fn a_string_that_meets_the_wall_is_held_there() {
     let case = inclined_bha("stabilizers");
     let (model, sol) = held(&case);
     let added = model.sites.len() - case.model.sites.len();
-    eprintln!("{added} sites added; log {:?}", sol.log);
+    eprintln!("{added} sites kept; log {:?}", sol.log);
     assert!(added > 10, "{added}");
+    assert!(
+        added < model.nodes.len() - 1 - case.model.sites.len(),
+        "every guard kept"
+    );
+    assert_eq!(sol.contact.len(), model.sites.len());
+    assert!(sol.contact[..]
+        .iter()
+        .zip(&model.sites)
+        .all(|(c, s)| c.0 || s.stabilizer));
     assert_eq!(through_wall(&case, &model, &sol.state.x), None);
     assert!(crate::diagnose::beyond_wall(&case, &model, &sol.state.x).is_empty());
+    let measure = crate::solve::statics::residual_measure_at(&model, &sol.state);
+    assert!(
+        measure < 1e-8,
+        "residual of the kept sites' model {measure:e}"
+    );
     assert!(sol
         .log
         .iter()
@@ -247,37 +263,42 @@ fn a_string_that_meets_the_wall_is_held_there() {
         .log
         .iter()
         .any(|l| l.starts_with(crate::profile::WALL_CONTACT)));
+    let own = crate::solve::statics::solve_static(
+        &vertical.model,
+        &crate::solve::statics::StaticOptions::default(),
+    )
+    .expect("solves");
+    let (a, b) = (hook(&model, &sol), hook(&vertical.model, &own));
+    assert!((a / b - 1.0).abs() < 1e-9, "{a} vs {b}");
 }
 
-/// A solve that fails while nodes lack a site is tried once more with a site at every node
-/// (`profile::solve_in_hole`): here the static solve is made to fail whenever a node other
-/// than the top has none, so the retry is what solves it — to the all-nodes equilibrium,
-/// saying so. A solve that fails with every node held, or runs out of its time budget, is
-/// not tried again.
+/// A guarded solve that fails (`profile::hold_in_hole`) is tried with the model's own sites,
+/// whose answer is taken where it lies in the hole, saying so; where it lies beyond the
+/// wall, or fails too, the guarded solve's error is the answer. A solve that runs out of
+/// its time budget is not tried again.
 #[test]
-fn a_failed_solve_is_tried_once_more_with_contact_at_every_node() {
+fn a_guarded_solve_that_fails_is_tried_with_the_models_own_sites() {
     use crate::solve::statics::{StaticError, StaticOptions};
-    let case = vertical_bha(15.0, "stabilizers");
-    let n = case.model.nodes.len();
-    assert!(case.model.sites.len() < n - 1, "the case must lack sites");
-    let failure = || StaticError::LoadStep {
+    let failure = |why: &str| StaticError::LoadStep {
         stage: "a load step".into(),
         from: 0.5,
         step: 0.0,
         min: 0.0,
-        reason: "made to fail".into(),
+        reason: why.into(),
         at_md: None,
     };
-    let run = |fails: &dyn Fn(&Model) -> Option<StaticError>| {
+    let held_everywhere =
+        |m: &Model| (1..m.nodes.len()).all(|i| m.sites.iter().any(|s| s.node == i));
+    let run = |case: &Case, fails: &dyn Fn(&Model) -> Option<StaticError>| {
         let mut model = case.model.clone();
-        let mut calls = 0;
+        let mut calls = Vec::new();
         let out = crate::profile::hold_in_hole(
-            &case,
+            case,
             &mut model,
-            &mut |m, nodes| crate::profile::add_wall_sites(&case, m, nodes),
+            &mut |m, nodes| crate::profile::add_wall_sites(case, m, nodes),
             &StaticOptions::default(),
             &mut |m, o| {
-                calls += 1;
+                calls.push(held_everywhere(m));
                 match fails(m) {
                     Some(e) => Err(e),
                     None => crate::solve::statics::solve_static(m, o),
@@ -286,37 +307,49 @@ fn a_failed_solve_is_tried_once_more_with_contact_at_every_node() {
         );
         (model, out, calls)
     };
-    let held_everywhere =
-        |m: &Model| (1..m.nodes.len()).all(|i| m.sites.iter().any(|s| s.node == i));
-    let (model, out, calls) = run(&|m| (!held_everywhere(m)).then(failure));
-    let sol = out.expect("the retry with every node held solves");
-    assert_eq!(calls, 2);
-    assert!(held_everywhere(&model));
-    assert!(sol
-        .log
-        .iter()
-        .any(|l| l.starts_with(crate::profile::WALL_CONTACT)
-            && l.contains("failed")
-            && l.contains("made to fail")));
-    let every = vertical_bha(15.0, "all_nodes");
-    let reference = crate::solve::statics::solve_static(&every.model, &StaticOptions::default())
-        .expect("solves");
-    let hook = |m: &Model, s| crate::profile::fe_rows(m, s).1;
-    let (a, b) = (hook(&model, &sol), hook(&every.model, &reference));
-    assert!((a / b - 1.0).abs() < 1e-9, "{a} vs {b}");
-    // Failing with every node held too: the error, after the one retry.
-    let (_, out, calls) = run(&|_| Some(failure()));
+    let case = vertical_bha(15.0, "stabilizers");
+    assert!(
+        case.model.sites.len() < case.model.nodes.len() - 1,
+        "the case must lack sites"
+    );
+    // The guarded solve first, and only it where it solves.
+    let (model, out, calls) = run(&case, &|_| None);
+    out.expect("solves");
+    assert_eq!(calls, [true]);
+    assert_eq!(model.sites.len(), case.model.sites.len());
+    // Guarded fails; the string at its own sites stays in the hole: taken, said.
+    let (model, out, calls) = run(&case, &|m| {
+        held_everywhere(m).then(|| failure("guards made to fail"))
+    });
+    let sol = out.expect("the model's own sites solve, in the hole");
+    assert_eq!(calls, [true, false]);
+    assert_eq!(model.sites.len(), case.model.sites.len());
+    assert!(sol.log.iter().any(
+        |l| l.contains("guard site at every node failed") && l.contains("guards made to fail")
+    ));
+    // Both fail: the guarded solve's error.
+    let (_, out, calls) = run(&case, &|m| {
+        Some(failure(if held_everywhere(m) { "guarded" } else { "own" }))
+    });
+    assert!(matches!(out, Err(StaticError::LoadStep { ref reason, .. }) if reason == "guarded"));
+    assert_eq!(calls, [true, false]);
+    // The own sites' answer lies beyond the wall (the inclined string): the error.
+    let inclined = inclined_bha("stabilizers");
+    let (model, out, calls) = run(&inclined, &|m| {
+        held_everywhere(m).then(|| failure("guarded"))
+    });
     assert!(matches!(out, Err(StaticError::LoadStep { .. })));
-    assert_eq!(calls, 2);
+    assert_eq!(calls, [true, false]);
+    assert_eq!(model.sites.len(), inclined.model.sites.len());
     // The time budget spent: no retry.
-    let (model, out, calls) = run(&|_| {
+    let (model, out, calls) = run(&case, &|_| {
         Some(StaticError::Budget {
             seconds: 1.0,
             reached: 0.3,
         })
     });
     assert!(matches!(out, Err(StaticError::Budget { .. })));
-    assert_eq!(calls, 1);
+    assert_eq!(calls, [true]);
     assert_eq!(model.sites.len(), case.model.sites.len());
 }
 

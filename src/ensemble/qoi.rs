@@ -223,25 +223,10 @@ pub fn static_variant_of(
     solve_held(case, &v.name, model, &mut variant_wall_sites(case, v))
 }
 
-/// Variant `v`'s static start held in the hole, as [`dynamic_variant_of`] starts it on the
-/// CPU: its model with the sites added where the string met the wall (with the variant's
-/// overrides), and the equilibrium. For the dynamic engine, whose own static start holds
-/// the string at the batch's sites only.
-pub(crate) fn held_start_of(
-    case: &Case,
-    v: &crate::ensemble::Variant,
-    model: &Model,
-) -> Result<(Model, crate::solve::statics::StaticState), String> {
-    let (held, solved) = held_start(case, model, &mut variant_wall_sites(case, v));
-    solved
-        .map(|sol| (held, sol.state))
-        .map_err(|e| e.to_string())
-}
-
 /// The static start of `model` held in the hole wherever the string meets the wall
 /// ([`crate::profile::solve_in_hole`], `add` giving the sites): the model with those sites,
-/// and the solve. The one start of every static and dynamic variant, on the CPU and, for
-/// those that meet the wall, the dynamic engine's ([`held_start_of`]).
+/// and the solve. The one start of every static and dynamic variant on the CPU (the
+/// engine's solves the same guarded models: `ensemble::runner`).
 fn held_start(
     case: &Case,
     model: &Model,

@@ -13,8 +13,10 @@ use crate::model::Model;
 use crate::solve::dynamics::{DynamicState, Dynamics};
 use crate::solve::statics::StaticState;
 
-/// Static equilibria of every variant through the GPU kernels (in `T`), the variants that
-/// fail there re-run on the CPU with step control (their reason says so). Stabilizer
+/// Static equilibria of every variant through the GPU kernels (in `T`), held in the hole as
+/// the CPU holds them (guard sites at every node without one, those in contact kept:
+/// `guarded_models`, [`crate::profile::keep_touching`]); the variants that fail there re-run
+/// on the CPU with step control (their reason says so). Stabilizer
 /// moves run there too (each pair carries its node). `Err` with the reason when the
 /// variants do not share the number of sites, or need what only the CPU has: the caller
 /// runs the CPU and says why.
@@ -24,7 +26,7 @@ pub fn run_static_gpu<T: crate::gpu::contact::GpuReal>(
     ctx: &'static crate::gpu::GpuContext,
     bar: &indicatif::ProgressBar,
 ) -> Result<Result<Vec<VariantResult>, SystemError>, Error> {
-    use crate::engine::{solve_static_ensemble_with_progress, EngineStatus};
+    use crate::engine::solve_static_ensemble_with_progress;
     use crate::gpu::GpuPath;
     let models: Vec<Model> = variants
         .iter()
@@ -36,11 +38,12 @@ pub fn run_static_gpu<T: crate::gpu::contact::GpuReal>(
             "the variants differ in their mesh or number of contact sites".into(),
         )));
     }
-    if let Err(e) = crate::engine::check_same_mesh(&models) {
-        return Ok(Err(e));
-    }
+    let guarded = match guarded_models(case, variants, &models) {
+        Ok(g) => g,
+        Err(e) => return Ok(Err(e)),
+    };
     let results = solve_static_ensemble_with_progress::<T, _>(
-        &models,
+        &guarded,
         &GpuPath(ctx),
         &case.settings().statics(),
         &mut |f| bar.set_position((f * variants.len() as f64) as u64),
@@ -48,42 +51,34 @@ pub fn run_static_gpu<T: crate::gpu::contact::GpuReal>(
     .map_err(|e| Error::failed(format!("GPU engine: {e}")))?;
     Ok(Ok(results
         .into_par_iter()
-        .zip(models.par_iter().zip(variants.par_iter()))
-        .map(|(r, (m, v))| match r.status {
-            // The engine holds the string at its contact sites only: one that met the wall
-            // between them is solved again on the CPU with contact added there.
-            EngineStatus::Converged
-                if !crate::diagnose::beyond_wall(case, m, &r.state.x).is_empty() =>
-            {
+        .zip(
+            models
+                .par_iter()
+                .zip(guarded.par_iter().zip(variants.par_iter())),
+        )
+        .map(|(r, (m, (g, v)))| match r.into_solution(g) {
+            Ok(sol) => {
+                // Held in the hole as the CPU holds it: the guards in contact kept.
+                let (held, sol) = crate::profile::keep_touching(m, g.clone(), sol);
+                let mut done = static_result(case, &v.name, &held, &sol);
+                done.solved_by = SolvedBy::Engine;
+                done
+            }
+            Err(why) => {
                 let mut again = static_variant_of(case, v, m);
-                again.reason = format!(
-                    "GPU: the string met the wall between its contact sites; re-run on the \
-                     CPU: {}",
-                    again.reason
-                );
+                again.reason = format!("GPU: {why}; re-run on the CPU: {}", again.reason);
                 again
             }
-            _ => match r.into_solution(m) {
-                Ok(sol) => {
-                    let mut done = static_result(case, &v.name, m, &sol);
-                    done.solved_by = SolvedBy::Engine;
-                    done
-                }
-                Err(why) => {
-                    let mut again = static_variant_of(case, v, m);
-                    again.reason = format!("GPU: {why}; re-run on the CPU: {}", again.reason);
-                    again
-                }
-            },
         })
         .collect()))
 }
 
 /// The `[dynamics]` runs of every variant through the GPU engine (in `T`): static starts
 /// through the static engine, then lockstep generalised-α steps, every step observed for
-/// the quantities of interest. A variant whose static start meets the wall between the
-/// contact sites is started on the CPU, held there, and runs on the engine with its sites
-/// added (`wall_batch`). A variant that fails on the GPU (static start or a step)
+/// the quantities of interest. Each static start is held in the hole as the CPU holds it
+/// (guards at every node without a site, those in contact kept), and a variant that kept
+/// sites runs on the engine with them (`wall_batch`). A variant that fails on the GPU
+/// (static start or a step)
 /// re-runs on the CPU with step control (its reason says so). `Err` with the reason when
 /// the case needs what only the CPU integrator has (consistent mass, stiffness-
 /// proportional damping): the caller runs the CPU then.
@@ -113,39 +108,34 @@ pub fn run_dynamic_gpu<T: crate::gpu::contact::GpuReal>(
             "the variants differ in their mesh or number of contact sites".into(),
         )));
     }
-    if let Err(e) = crate::engine::check_same_mesh(&models) {
-        return Ok(Err(e));
-    }
+    let guarded = match guarded_models(case, variants, &models) {
+        Ok(g) => g,
+        Err(e) => return Ok(Err(e)),
+    };
     let path = GpuPath(ctx);
-    let statics = solve_static_ensemble::<T, _>(&models, &path, &case.settings().statics())
+    let statics = solve_static_ensemble::<T, _>(&guarded, &path, &case.settings().statics())
         .map_err(|e| Error::failed(format!("GPU engine: {e}")))?;
-    // A variant whose static start met the wall between the batch's sites is started on
-    // the CPU, held there as the CPU run holds it (sites added with the variant's
-    // overrides); one whose start failed on the GPU, or could not be held, runs wholly on
-    // the CPU.
-    let met: Vec<bool> = (0..models.len())
-        .map(|j| {
-            statics[j].status == EngineStatus::Converged
-                && !crate::diagnose::beyond_wall(case, &models[j], &statics[j].state.x).is_empty()
+    // Each variant's static start held in the hole as the CPU run holds it (the guards in
+    // contact kept, with the variant's overrides); one whose start failed on the GPU runs
+    // wholly on the CPU.
+    let held: Vec<Option<Model>> = statics
+        .par_iter()
+        .zip(models.par_iter().zip(guarded.par_iter()))
+        .map(|(r, (m, g))| match r.status {
+            EngineStatus::Converged => {
+                let sol = crate::solve::statics::solution_at(g, r.state.clone());
+                Some(crate::profile::keep_touching(m, g.clone(), sol).0)
+            }
+            EngineStatus::Failed(_) => None,
         })
         .collect();
-    let held: Vec<Option<(Model, StaticState)>> = (0..models.len())
-        .into_par_iter()
-        .map(|j| {
-            met[j]
-                .then(|| held_start_of(case, &variants[j], &models[j]).ok())
-                .flatten()
-        })
-        .collect();
-    let on_gpu: Vec<usize> = (0..models.len())
-        .filter(|&j| statics[j].status == EngineStatus::Converged && (!met[j] || held[j].is_some()))
-        .collect();
-    // Each variant's own model (with its sites added at the wall) and start.
+    let on_gpu: Vec<usize> = (0..models.len()).filter(|&j| held[j].is_some()).collect();
+    // Each variant's own model (with the sites kept at the wall) and start.
     let (gpu_models, static_starts): (Vec<Model>, Vec<StaticState>) = on_gpu
         .iter()
-        .map(|&j| match &held[j] {
-            Some((m, state)) => (m.clone(), state.clone()),
-            None => (models[j].clone(), statics[j].state.clone()),
+        .map(|&j| {
+            let m = held[j].clone().expect("on the GPU: held");
+            (m, statics[j].state.clone())
         })
         .unzip();
     // The case's initial offset and kick on each static equilibrium, as the CPU runs do.
@@ -226,14 +216,14 @@ pub fn run_dynamic_gpu<T: crate::gpu::contact::GpuReal>(
         out[j] = Some(match (r.status, state) {
             (DynamicStatus::Finished, Some(state)) => {
                 // The engine's step cuts, as the CPU integrator's log would give them.
-                let model = held[j].as_ref().map_or(&models[j], |(m, _)| m);
+                let model = held[j].as_ref().unwrap_or(&models[j]);
                 let mut done = obs.finish(case, name, model, &state, &r.log, &r.iterations);
                 done.solved_by = SolvedBy::Engine;
-                if held[j].is_some() {
+                let kept = model.sites.len() - models[j].sites.len();
+                if kept > 0 {
                     done.reason = format!(
-                        "static start on the CPU, held where the string met the wall between \
-                         the contact sites ({} sites added); dynamics on the engine{}",
-                        model.sites.len() - models[j].sites.len(),
+                        "static start held where the string met the wall between the contact \
+                         sites ({kept} sites kept); dynamics on the engine{}",
                         if done.reason.is_empty() {
                             String::new()
                         } else {
@@ -261,11 +251,7 @@ pub fn run_dynamic_gpu<T: crate::gpu::contact::GpuReal>(
             r.unwrap_or_else(|| {
                 let why = match &statics[j].status {
                     EngineStatus::Failed(w) => w.clone(),
-                    EngineStatus::Converged => {
-                        "the string met the wall between its contact sites, and could not be \
-                         held there"
-                            .into()
-                    }
+                    EngineStatus::Converged => "no start".into(),
                 };
                 let mut again = dynamic_variant_of(case, &variants[j], &models[j]);
                 again.reason = format!(
@@ -276,6 +262,33 @@ pub fn run_dynamic_gpu<T: crate::gpu::contact::GpuReal>(
             })
         })
         .collect()))
+}
+
+/// The models the engine solves for `variants` (`own`: each variant's model): each with a
+/// guard site at every node it has none at, with the variant's overrides, as
+/// [`crate::profile::solve_in_hole`] solves a model on the CPU (its answer then kept by
+/// [`crate::profile::keep_touching`]); `own` where every node has a site. `Err` where the
+/// guarded models do not share a mesh (the caller runs the CPU).
+fn guarded_models(
+    case: &Case,
+    variants: &[Variant],
+    own: &[Model],
+) -> Result<Vec<Model>, SystemError> {
+    let guarded: Vec<Model> = variants
+        .iter()
+        .zip(own)
+        .map(|(v, m)| {
+            let free = crate::profile::unheld_nodes(m);
+            if free.is_empty() {
+                Ok(m.clone())
+            } else {
+                crate::ensemble::apply_with_sites(case, v, &free)
+            }
+        })
+        .collect::<Result<_, _>>()
+        .map_err(|e| SystemError::Unsupported(format!("variant: {e}")))?;
+    crate::engine::check_same_mesh(&guarded)?;
+    Ok(guarded)
 }
 
 /// Runs every variant on the CPU (rayon over variants); results in variant order.
