@@ -29,8 +29,8 @@ use crate::physics::mass::MassKind;
 use crate::physics::vec3::{cross, dot, sub, Vec3};
 use crate::solve::chain::{BlockTridiagonal, ChainSolver};
 use crate::solve::statics::{
-    constrain, constrain_residual, constraints, element_responses, external_loads, reference_force,
-    to_global, StaticState,
+    constrain, constrain_residual, constraints, external_loads, for_each_element_response,
+    reference_force, to_global, StaticState,
 };
 
 mod step;
@@ -457,17 +457,14 @@ impl<'a> Dynamics<'a> {
         let mut k_t = BlockTridiagonal::zeros(n);
         let mut s_mat = BlockTridiagonal::zeros(n);
         let with_tangent = with_matrix || self.k0.is_none();
-        for (i, (f, k)) in element_responses(model, &s.q, with_tangent)
-            .into_iter()
-            .enumerate()
-        {
+        for_each_element_response(model, &s.q, with_tangent, |i, f, k| {
             for j in 0..12 {
                 r[6 * i + j] += f[j];
             }
             if let Some(k) = k {
-                k_t.add_element(i, &k);
+                k_t.add_element(i, k);
             }
-        }
+        });
         if self.k0.is_none() {
             self.k0 = Some(k_t.clone());
         }

@@ -177,17 +177,14 @@ fn assemble(
         *r = -lambda * f;
     }
     let with_tangent = tangent.is_some();
-    for (i, (f, k)) in element_responses(model, state, with_tangent)
-        .into_iter()
-        .enumerate()
-    {
+    for_each_element_response(model, state, with_tangent, |i, f, k| {
         if let (Some(t), Some(k)) = (tangent.as_deref_mut(), k) {
-            t.add_element(i, &k);
+            t.add_element(i, k);
         }
         for j in 0..12 {
             residual[6 * i + j] += f[j];
         }
-    }
+    });
     for site in &model.sites {
         let out = site_response(model, state, site);
         if !out.contact {
@@ -204,40 +201,60 @@ fn assemble(
     }
 }
 
-/// An element's internal force and, if asked for, its tangent.
-pub(crate) type ElementResponse = ([f64; 12], Option<[[f64; 12]; 12]>);
-
-/// Internal force (12) and, if asked, tangent (12×12) of every element at a
-/// configuration, computed in parallel over elements (rayon); summed by the caller in
-/// element order, so the result does not depend on the thread count.
-pub(crate) fn element_responses(
+/// Internal force (12) and, if `with_tangent`, tangent (12×12) of every element at a
+/// configuration, computed in parallel over elements (rayon) and handed to `sink` in
+/// element order (so sums do not depend on the thread count). A force-only call (a line
+/// search's trial) forms no tangent storage at all.
+pub(crate) fn for_each_element_response(
     model: &Model,
     state: &StaticState,
     with_tangent: bool,
-) -> Vec<ElementResponse> {
+    mut sink: impl FnMut(usize, &[f64; 12], Option<&[[f64; 12]; 12]>),
+) {
     use rayon::prelude::*;
-    model
-        .elements
-        .par_iter()
-        .enumerate()
-        .map(|(i, e)| {
-            let es = ElementState {
-                x: [state.x[i], state.x[i + 1]],
-                triad: [
-                    mat_mul(&state.rot[i], &model.nodes[i].frame0),
-                    mat_mul(&state.rot[i + 1], &model.nodes[i + 1].frame0),
-                ],
-            };
-            let k = model.element_stiffness(i);
-            let form = Chord::Positions { length0: e.length0 };
-            if with_tangent {
-                let (f, t) = force_and_tangent_closed(&es.x, &es.triad, &form, &k);
-                (f, Some(t))
-            } else {
-                (element_force(&es.x, &es.triad, &form, &k), None)
-            }
-        })
-        .collect()
+    let element = |i: usize| {
+        let e = &model.elements[i];
+        let es = ElementState {
+            x: [state.x[i], state.x[i + 1]],
+            triad: [
+                mat_mul(&state.rot[i], &model.nodes[i].frame0),
+                mat_mul(&state.rot[i + 1], &model.nodes[i + 1].frame0),
+            ],
+        };
+        (
+            es,
+            model.element_stiffness(i),
+            Chord::Positions { length0: e.length0 },
+        )
+    };
+    // Elements per rayon task: a few hundred microseconds of work, not one element's.
+    const MIN_LEN: usize = 32;
+    let count = model.elements.len();
+    if with_tangent {
+        let out: Vec<([f64; 12], [[f64; 12]; 12])> = (0..count)
+            .into_par_iter()
+            .with_min_len(MIN_LEN)
+            .map(|i| {
+                let (es, k, form) = element(i);
+                force_and_tangent_closed(&es.x, &es.triad, &form, &k)
+            })
+            .collect();
+        for (i, (f, k)) in out.iter().enumerate() {
+            sink(i, f, Some(k));
+        }
+    } else {
+        let out: Vec<[f64; 12]> = (0..count)
+            .into_par_iter()
+            .with_min_len(MIN_LEN)
+            .map(|i| {
+                let (es, k, form) = element(i);
+                element_force(&es.x, &es.triad, &form, &k)
+            })
+            .collect();
+        for (i, f) in out.iter().enumerate() {
+            sink(i, f, None);
+        }
+    }
 }
 
 /// Applies the translation bases and fixed DOFs to a residual (only).
