@@ -227,30 +227,25 @@ pub(crate) fn for_each_element_response(
             Chord::Positions { length0: e.length0 },
         )
     };
-    // Elements per rayon task: a few hundred microseconds of work, not one element's.
-    const MIN_LEN: usize = 32;
+    // Every element in parallel, in tasks of 32 (a few hundred microseconds of work, not
+    // one element's), in element order.
+    fn each<R: Send>(count: usize, f: impl Fn(usize) -> R + Sync + Send) -> Vec<R> {
+        (0..count).into_par_iter().with_min_len(32).map(f).collect()
+    }
     let count = model.elements.len();
     if with_tangent {
-        let out: Vec<([f64; 12], [[f64; 12]; 12])> = (0..count)
-            .into_par_iter()
-            .with_min_len(MIN_LEN)
-            .map(|i| {
-                let (es, k, form) = element(i);
-                force_and_tangent_closed(&es.x, &es.triad, &form, &k)
-            })
-            .collect();
+        let out = each(count, |i| {
+            let (es, k, form) = element(i);
+            force_and_tangent_closed(&es.x, &es.triad, &form, &k)
+        });
         for (i, (f, k)) in out.iter().enumerate() {
             sink(i, f, Some(k));
         }
     } else {
-        let out: Vec<[f64; 12]> = (0..count)
-            .into_par_iter()
-            .with_min_len(MIN_LEN)
-            .map(|i| {
-                let (es, k, form) = element(i);
-                element_force(&es.x, &es.triad, &form, &k)
-            })
-            .collect();
+        let out = each(count, |i| {
+            let (es, k, form) = element(i);
+            element_force(&es.x, &es.triad, &form, &k)
+        });
         for (i, f) in out.iter().enumerate() {
             sink(i, f, None);
         }
