@@ -33,7 +33,7 @@ pub struct EngineOutcome {
     pub seconds: f64,
     /// Engine hook load (N).
     pub hook_load_n: f64,
-    /// Pipe-body contact sites added where the engine's string met the wall (as the CPU
+    /// Pipe-body contact sites kept where the engine's string lies on the wall (as the CPU
     /// run's `wall_sites`).
     pub wall_sites: usize,
     /// Why it failed (empty when solved).

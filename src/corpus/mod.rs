@@ -594,8 +594,8 @@ pub struct WellResult {
     /// Solved: how far the FE string lies outside the hole where no contact site holds it
     /// (mm; 0 inside it: [`crate::diagnose::through_wall`]). NaN when not solved.
     pub through_wall_mm: f64,
-    /// Pipe-body contact sites the solve added where the string met the wall
-    /// ([`crate::profile::solve_in_hole`]; 0 with contact at every node).
+    /// Pipe-body contact sites the solve kept where the string lies on the wall (its guards
+    /// in contact: [`crate::profile::solve_in_hole`]; 0 with contact at every node).
     pub wall_sites: usize,
     /// FE / soft-string hook load.
     pub hook_load_ratio: f64,
