@@ -26,9 +26,8 @@
 //!   leaves the noise band: a full step along a soft direction (a pinned stabilizer with
 //!   μ = 1 on a 1e10 N/m wall) can jump from 4e-4 of the force scale to 150.
 //! - **Failure** per variant: a non-finite residual, a singular tangent, or no convergence
-//!   within `max_iterations` updates, or a residual that has not halved in
-//!   [`STATIC_STALL_ITERATIONS`] (statics) or [`DYNAMIC_STALL_ITERATIONS`] (dynamics). The
-//!   failing variant stops; the others go on.
+//!   within `max_iterations` updates, or (statics) a residual that has not halved in
+//!   [`STATIC_STALL_ITERATIONS`]. The failing variant stops; the others go on.
 
 /// Which step the convergence test looks at.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -104,20 +103,6 @@ pub const FOLD_LEVEL: f64 = 1e-4;
 /// after 20 flat iterations, 179 → 2,193 iterations; 10 instead of 20 lost nothing on
 /// seeds 0–49 but slowed well 28 (1,966 → 3,086).
 pub const FOLD_STALL_ITERATIONS: usize = 20;
-
-/// Dynamics: a time step's Newton solve that has not halved its residual in this many
-/// updates fails (and the step is cut) instead of running on to `max_iterations`. A step
-/// that cannot converge falls to 1e-6–1e-5 of the force scale in 6–8 updates and then
-/// repeats itself at a contact's onset (`cases/bent_housing.toml`, 2 s of it: 32 such
-/// steps, each run to the 30-iteration limit; 981 in the 8 s run, more than half its Newton
-/// iterations). Of the 1,017 steps there that converged, none went more than 4 updates
-/// without halving its residual. 8 also cut the steps of a friction regularised at 1e-6 m/s
-/// (`tests/engine_dynamic.rs`, `a_variant_whose_step_fails_is_cut_on_its_own_in_the_engine`)
-/// where the CPU integrator and the engine then parted by 4.6e-5 (slow steps near the
-/// limit, decided by rounding); 12 keeps them together to 1e-10. The 8 s bent-housing run:
-/// 100 s → 67 s, 981 → 919 cuts, its time series within a quarter of the 2 ms step's own
-/// error against a 1 ms run (surface torque 2.1 % of its range apart, 8.6 % from 1 ms).
-pub const DYNAMIC_STALL_ITERATIONS: usize = 12;
 
 /// The unit roundoff of a float type of `size` bytes.
 pub fn unit_roundoff(size: usize) -> f64 {
@@ -198,7 +183,7 @@ impl NewtonSettings {
                 fallback_halvings: 24,
             },
             noise_band_at_floor: size == 4,
-            stall_iterations: DYNAMIC_STALL_ITERATIONS,
+            stall_iterations: usize::MAX,
             fold_level: 0.0,
         }
     }
