@@ -423,7 +423,7 @@ fn dynamic_sample(
 /// 1e-3.
 #[test]
 fn a_dynamic_corpus_case_that_meets_the_wall_runs_on_the_engine() {
-    use holewall::corpus::dynamic::{run_case_dynamic, run_case_engine, write_dynamic_case};
+    use holewall::corpus::dynamic::write_dynamic_case;
     if common::gpu().is_none() {
         return;
     }
@@ -434,18 +434,13 @@ fn a_dynamic_corpus_case_that_meets_the_wall_runs_on_the_engine() {
         loaded.model.sites.iter().all(|s| s.stabilizer),
         "seed 12 is no longer a stabilizer-contact case"
     );
-    let cpu = run_case_dynamic(&case).unwrap();
-    assert!(cpu.solved, "{}", cpu.reason);
-    for f32 in [false, true] {
-        let e = run_case_engine(&case, &cpu, f32).unwrap();
+    let (_, rows) = cpu_and_engine(&case);
+    for (f32, e) in rows {
         eprintln!(
             "dynamic seed 12 {}: by engine {}, hook load {:.1e}, torque {:.1e}, stab1 force {:.1e} off the CPU's; {}",
             e.path, e.by_engine, e.hook_load_rel, e.torque_rel, e.stab1_force_rel, e.reason
         );
-        assert!(e.solved && e.by_engine, "{}", e.reason);
-        let tol = if f32 { 1e-3 } else { 1e-6 };
-        assert!(e.hook_load_rel <= tol, "{}: {}", e.path, e.hook_load_rel);
-        assert!(e.torque_rel <= tol, "{}: {}", e.path, e.torque_rel);
+        let tol = assert_engine_matches_cpu(&e, f32);
         assert!(
             e.stab1_force_rel <= 10.0 * tol,
             "{}: {}",
@@ -493,7 +488,6 @@ fn dynamic_corpus_sample_runs_to_the_end() {
 /// f64.
 #[test]
 fn a_dynamic_corpus_case_through_the_engine_matches_the_cpu() {
-    use holewall::corpus::dynamic::{run_case_dynamic, run_case_engine};
     if common::gpu().is_none() {
         return;
     }
@@ -502,10 +496,8 @@ fn a_dynamic_corpus_case_through_the_engine_matches_the_cpu() {
         .into_iter()
         .find(|c| c.spec.mass == "lumped")
         .unwrap();
-    let cpu = run_case_dynamic(&case).unwrap();
-    assert!(cpu.solved, "{}", cpu.reason);
-    for f32 in [false, true] {
-        let e = run_case_engine(&case, &cpu, f32).unwrap();
+    let (cpu, rows) = cpu_and_engine(&case);
+    for (f32, e) in rows {
         eprintln!(
             "dynamic seed {} {}: by engine {}, {} cuts ({} on the CPU), hook load {:.1e}, torque {:.1e}, stab1 force {:.1e} off the CPU's, same whirl {}, {:.1} s; {}",
             e.seed,
@@ -520,9 +512,34 @@ fn a_dynamic_corpus_case_through_the_engine_matches_the_cpu() {
             e.seconds,
             e.reason
         );
-        assert!(e.solved && e.by_engine, "{}", e.reason);
-        let tol = if f32 { 1e-3 } else { 1e-6 };
-        assert!(e.hook_load_rel <= tol, "{}: {}", e.path, e.hook_load_rel);
-        assert!(e.torque_rel <= tol, "{}: {}", e.path, e.torque_rel);
+        assert_engine_matches_cpu(&e, f32);
     }
+}
+
+/// A dynamic corpus case run on the CPU (which must solve it), then through the engine in
+/// f64 and in f32: the CPU row and each engine row with its `f32` flag.
+fn cpu_and_engine(
+    case: &holewall::corpus::dynamic::DynamicCase,
+) -> (
+    holewall::corpus::dynamic::DynamicRow,
+    Vec<(bool, holewall::corpus::dynamic::DynamicEngineRow)>,
+) {
+    use holewall::corpus::dynamic::{run_case_dynamic, run_case_engine};
+    let cpu = run_case_dynamic(case).unwrap();
+    assert!(cpu.solved, "{}", cpu.reason);
+    let rows = [false, true]
+        .into_iter()
+        .map(|f32| (f32, run_case_engine(case, &cpu, f32).unwrap()))
+        .collect();
+    (cpu, rows)
+}
+
+/// A dynamic corpus case's engine row against its CPU run: run by the engine itself, hook
+/// load and largest surface torque within 1e-6 (f64) or 1e-3 (f32); returns that tolerance.
+fn assert_engine_matches_cpu(e: &holewall::corpus::dynamic::DynamicEngineRow, f32: bool) -> f64 {
+    assert!(e.solved && e.by_engine, "{}", e.reason);
+    let tol = if f32 { 1e-3 } else { 1e-6 };
+    assert!(e.hook_load_rel <= tol, "{}: {}", e.path, e.hook_load_rel);
+    assert!(e.torque_rel <= tol, "{}: {}", e.path, e.torque_rel);
+    tol
 }

@@ -251,7 +251,8 @@ pub fn run_dynamic_gpu<T: crate::gpu::contact::GpuReal>(
             r.unwrap_or_else(|| {
                 let why = match &statics[j].status {
                     EngineStatus::Failed(w) => w.clone(),
-                    EngineStatus::Converged => "no start".into(),
+                    // Not reached: a converged start is held and runs on the engine.
+                    EngineStatus::Converged => "not run on the engine".into(),
                 };
                 let mut again = dynamic_variant_of(case, &variants[j], &models[j]);
                 again.reason = format!(
