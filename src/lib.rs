@@ -36,6 +36,7 @@ pub mod selfcheck;
 pub mod solve;
 pub mod strength;
 pub mod study;
+pub mod tally;
 pub mod units;
 pub mod uq;
 pub mod well;

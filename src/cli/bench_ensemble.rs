@@ -127,7 +127,27 @@ struct Cell {
     newton_iterations_per_step: Option<f64>,
     effective_gflops: Option<f64>,
     effective_gbytes_per_s: Option<f64>,
+    /// Where a GPU run's time went: the median run's ([`crate::tally`]).
+    split: Option<Split>,
     note: String,
+}
+
+/// A GPU run's wall time split ([`crate::tally`]): the batches' setup, the host's waits on
+/// read-backs (the device's work, the copies and the round trips), and the host's own
+/// work between them; with the read-backs per time step.
+#[derive(Serialize, Clone, Copy)]
+struct Split {
+    setup_s: f64,
+    wait_s: f64,
+    /// Of the waits, the device's own time in the stamped passes (None: no timestamps).
+    device_s: Option<f64>,
+    /// Of the device's time, the line-search trials'.
+    trial_device_s: Option<f64>,
+    /// Line-search trial passes per time step.
+    trials_per_step: f64,
+    host_s: f64,
+    readbacks_per_step: f64,
+    kbytes_read_per_step: f64,
 }
 
 #[derive(Serialize)]
@@ -151,6 +171,24 @@ struct Report {
 
 /// Positions per node of one variant.
 type Positions = Vec<[f64; 3]>;
+
+/// The split of the run of median wall time among `runs` (wall seconds, tally).
+fn median_split(runs: &[(f64, crate::tally::Tally)], steps: usize) -> Option<Split> {
+    let mut sorted: Vec<_> = runs.to_vec();
+    sorted.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let &(wall, d) = sorted.get(sorted.len() / 2)?;
+    let steps = steps.max(1) as f64;
+    Some(Split {
+        setup_s: d.setup_s,
+        wait_s: d.wait_s,
+        device_s: (d.device_s > 0.0).then_some(d.device_s),
+        trial_device_s: (d.device_s > 0.0).then_some(d.trial_device_s),
+        trials_per_step: d.trials as f64 / steps,
+        host_s: wall - d.setup_s - d.wait_s,
+        readbacks_per_step: d.readbacks as f64 / steps,
+        kbytes_read_per_step: d.bytes_read as f64 / 1e3 / steps,
+    })
+}
 
 /// Newton iterations of a run, and every variant's final positions.
 type RunOutcome = (usize, Vec<Positions>);
@@ -334,6 +372,7 @@ pub fn run(
                     newton_iterations_per_step: None,
                     effective_gflops: None,
                     effective_gbytes_per_s: None,
+                    split: None,
                     note: String::new(),
                 };
                 if let Some(r) = rate.get(path) {
@@ -346,7 +385,10 @@ pub fn run(
                     }
                 }
                 let mut its = 0;
+                // Each run's wall time and tally (the first is median_seconds' warm-up).
+                let mut tallies = Vec::new();
                 let t = median_seconds::<Error>(repeats, || {
+                    let (before, wall) = (crate::tally::Tally::now(), std::time::Instant::now());
                     its = match (path, ctx) {
                         ("GPU f64", Some(c)) => {
                             run_gpu::<f64>(c, &models, &start, &density, &options, t_end)?.0
@@ -356,8 +398,13 @@ pub fn run(
                         }
                         _ => run_cpu(&models, &start, &density, &options, t_end)?.0,
                     };
+                    let d = crate::tally::Tally::now().since(&before);
+                    tallies.push((wall.elapsed().as_secs_f64(), d));
                     Ok(())
                 })?;
+                if path.starts_with("GPU") {
+                    cell.split = median_split(&tallies[1..], steps);
+                }
                 let size = if path.ends_with("f32") { 4 } else { 8 };
                 let per_it = its as f64 / (v * steps) as f64;
                 let s = base.sites.len();
@@ -453,6 +500,38 @@ pub fn run(
             f(c.effective_gbytes_per_s, 2),
             c.note
         );
+    }
+    if cells.iter().any(|c| c.split.is_some()) {
+        println!(
+            "\nWhere a GPU run's time goes (the median run): setup of the batches, the host \
+             waiting on read-backs (the device's work, copies, round trips), the host's own \
+             work between them"
+        );
+        println!(
+            "| nodes | variants | path | run (s) | setup (s) | waiting (s) | of it, passes on \
+             the device (s) | of those, trials (s) | host (s) | read-backs/step | \
+             trials/step | kB read/step |"
+        );
+        println!("|---|---|---|---|---|---|---|---|---|---|---|---|");
+        for c in &cells {
+            if let Some(s) = c.split {
+                println!(
+                    "| {} | {} | {} | {:.3} | {:.3} | {:.3} | {} | {} | {:.3} | {:.1} | {:.1} | {:.1} |",
+                    c.nodes,
+                    c.variants,
+                    c.path,
+                    s.setup_s + s.wait_s + s.host_s,
+                    s.setup_s,
+                    s.wait_s,
+                    s.device_s.map_or("–".into(), |d| format!("{d:.3}")),
+                    s.trial_device_s.map_or("–".into(), |d| format!("{d:.3}")),
+                    s.host_s,
+                    s.readbacks_per_step,
+                    s.trials_per_step,
+                    s.kbytes_read_per_step
+                );
+            }
+        }
     }
     if !work_precision.is_empty() {
         println!("\n| path | step (s) | run time (s) | max relative error |");

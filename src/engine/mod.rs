@@ -306,12 +306,14 @@ fn solve_batch<T: Real + Send + Sync, P: KernelPath<T>>(
     options: &StaticOptions,
     progress: &mut dyn FnMut(f64),
 ) -> Result<Vec<EngineResult>, crate::error::SystemError> {
+    let setup = std::time::Instant::now();
     let tables = ensemble_tables::<T>(models)?;
     let v = tables.num_variants;
     // The mesh every variant shares (the kernels read sections and frames from it).
     let mesh = &models[0];
     let size = std::mem::size_of::<T>();
     let ensemble = path.open(mesh, &tables)?;
+    crate::tally::add_setup(setup.elapsed());
     let mut sys = EngineStatic::new(models.iter().collect(), ensemble, tables, None, None);
     // f32 solves full load a second time from its own converged state as base: the
     // answer's last digits are then f32's rounding of millimetres, not of the string's

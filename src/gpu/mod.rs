@@ -13,6 +13,7 @@ pub mod dynamics;
 pub mod kernel;
 pub mod layout;
 pub mod loops;
+pub mod pass_clock;
 pub mod path;
 pub mod readback;
 pub mod update;

@@ -50,6 +50,7 @@ pub fn submit_and_read_into(
         }
         offset += slot(bytes);
     }
+    let submitted = std::time::Instant::now();
     ctx.queue.submit([encoder.finish()]);
     staging
         .slice(..total)
@@ -70,6 +71,7 @@ pub fn submit_and_read_into(
         }
     }
     staging.unmap();
+    crate::tally::add_readback(total, submitted.elapsed());
     Ok(out)
 }
 

@@ -377,6 +377,7 @@ fn run_batch<T: Real + Send + Sync, P: KernelPath<T>>(
     observe: &mut dyn FnMut(f64, &DynamicBatch<T>),
 ) -> Result<Vec<DynamicResult>, crate::error::SystemError> {
     super::check_same_mesh(models)?;
+    let setup = std::time::Instant::now();
     let Start {
         tables: dynamic,
         base,
@@ -410,14 +411,16 @@ fn run_batch<T: Real + Send + Sync, P: KernelPath<T>>(
         })
         .collect();
     let mut ensemble = path.open_dynamic(&models[0], &tables, &dynamic)?;
+    let drives = models
+        .iter()
+        .map(|m| Dynamics::new(m, *options, &|e| density[e]))
+        .collect();
+    crate::tally::add_setup(setup.elapsed());
     let mut batch = Batch {
         models,
         path,
         options,
-        drives: models
-            .iter()
-            .map(|m| Dynamics::new(m, *options, &|e| density[e]))
-            .collect(),
+        drives,
         tables,
         dynamic,
         f_ref,

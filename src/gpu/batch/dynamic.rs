@@ -4,6 +4,7 @@
 //! over 800 lines), behaviour unchanged.
 
 use super::*;
+use crate::gpu::pass_clock::PassClock;
 
 /// A batch of variants resident on the GPU for a dynamic run
 /// ([`crate::engine::dynamic`]): the state at `t_n`, the Newton unknown `v̇_{n+1}` and a
@@ -24,6 +25,8 @@ pub struct GpuDynamic<T: GpuReal> {
     c: Common,
     /// Invocations per variant of the block solve ([`LuForm`]).
     lu_lanes: usize,
+    /// The device's time of the passes read back ([`crate::tally`]), where it has stamps.
+    clock: Option<crate::gpu::pass_clock::PassClock>,
     _keep: Vec<wgpu::Buffer>,
     _real: PhantomData<T>,
 }
@@ -361,6 +364,7 @@ impl<T: GpuReal> GpuDynamic<T> {
             a0: T::from_f64_lossy(dynamic.a0),
             c,
             lu_lanes: LuForm::for_adapter(ctx).lanes(),
+            clock: crate::gpu::pass_clock::PassClock::new(ctx, "dynamic pass"),
             _keep: [mass, inertia0, diag, upper, lower, rhs]
                 .into_iter()
                 .chain(unbalance)
@@ -456,7 +460,7 @@ impl<T: GpuReal> crate::engine::dynamic::ResidentDynamic<T> for GpuDynamic<T> {
             self.c.reset_status(&mut e, v);
         }
         {
-            let mut pass = e.begin_compute_pass(&Default::default());
+            let mut pass = PassClock::pass(self.clock.as_ref(), &mut e);
             let (g, p) = (&self.g, &self.p);
             match listed {
                 None => self.record_evaluate(&mut pass, Evaluation::All),
@@ -477,19 +481,20 @@ impl<T: GpuReal> crate::engine::dynamic::ResidentDynamic<T> for GpuDynamic<T> {
             }
         }
         let size = std::mem::size_of::<T>() as u64;
+        let mut reads = vec![
+            (&self.c.norms, 4 * v as u64 * size),
+            (&self.c.status, 4 * v as u64),
+            (&self.b.scale, v as u64 * size),
+        ];
+        reads.extend(self.clock.as_ref().map(|c| c.resolve(&mut e)));
         let out = self
             .c
             .staging
-            .read(
-                self.ctx,
-                e,
-                &[
-                    (&self.c.norms, 4 * v as u64 * size),
-                    (&self.c.status, 4 * v as u64),
-                    (&self.b.scale, v as u64 * size),
-                ],
-            )
+            .read(self.ctx, e, &reads)
             .map_err(crate::error::SystemError::from)?;
+        if let (Some(c), Some(stamps)) = (&self.clock, out.get(3)) {
+            c.record(stamps, false);
+        }
         let status: Vec<u32> = values(&out[1]);
         if status.contains(&RUNNING) {
             return Err(crate::error::SystemError::BlockSolve(
@@ -520,7 +525,7 @@ impl<T: GpuReal> crate::engine::dynamic::ResidentDynamic<T> for GpuDynamic<T> {
         {
             // The candidate of every variant on a search's first trial (α = 0: the
             // unknown), of the searching ones after; the residual of the searching ones.
-            let mut pass = e.begin_compute_pass(&Default::default());
+            let mut pass = PassClock::pass(self.clock.as_ref(), &mut e);
             let n = self.num_nodes;
             if first {
                 dispatch(&mut pass, &self.p.accelerate, &self.g.accelerate, n * v);
@@ -532,11 +537,16 @@ impl<T: GpuReal> crate::engine::dynamic::ResidentDynamic<T> for GpuDynamic<T> {
             dispatch(&mut pass, &self.p.trial.norms, &self.g.trial.norms, count);
         }
         let size = std::mem::size_of::<T>() as u64;
+        let mut reads = vec![(&self.c.norms, 4 * v as u64 * size)];
+        reads.extend(self.clock.as_ref().map(|c| c.resolve(&mut e)));
         let out = self
             .c
             .staging
-            .read(self.ctx, e, &[(&self.c.norms, 4 * v as u64 * size)])
+            .read(self.ctx, e, &reads)
             .map_err(crate::error::SystemError::from)?;
+        if let (Some(c), Some(stamps)) = (&self.clock, out.get(1)) {
+            c.record(stamps, true);
+        }
         Ok(norms_from_bytes(&out[0]))
     }
 

@@ -1,0 +1,117 @@
+//! Where an engine run's time goes: process-wide counters that the benchmarks read before
+//! and after a run (issue 27: on a real GPU the dynamic engine's time was not in its
+//! kernels, and a wall clock alone cannot say where it was).
+//!
+//! Counted: every read-back of device buffers ([`crate::gpu::readback`], the one place they
+//! happen) with the time the host waited for it — from the submission to the bytes in hand,
+//! so the device's work on everything submitted before it, the copy and the round trip —
+//! and the bytes read; the device's own time in the passes it stamps; and the setup of every engine batch (its tables, the variants'
+//! initial states, the upload) before its first step. The rest of a run's wall time is the
+//! host's own: recording and submitting work, the Newton decisions between read-backs.
+//! The counters only grow; [`Tally::since`] takes the difference of two snapshots.
+//! Runs on other threads at the same time add to the same counters.
+
+use std::sync::atomic::{AtomicU64, Ordering};
+
+static READBACKS: AtomicU64 = AtomicU64::new(0);
+static WAIT_NANOS: AtomicU64 = AtomicU64::new(0);
+static BYTES_READ: AtomicU64 = AtomicU64::new(0);
+static SETUP_NANOS: AtomicU64 = AtomicU64::new(0);
+static DEVICE_NANOS: AtomicU64 = AtomicU64::new(0);
+static TRIAL_NANOS: AtomicU64 = AtomicU64::new(0);
+static TRIALS: AtomicU64 = AtomicU64::new(0);
+
+/// A snapshot of the counters.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Tally {
+    /// Read-backs of device buffers (host round trips that wait for the device).
+    pub readbacks: u64,
+    /// Seconds the host waited in them.
+    pub wait_s: f64,
+    /// Bytes they read.
+    pub bytes_read: u64,
+    /// Seconds spent setting engine batches up before their first step.
+    pub setup_s: f64,
+    /// Seconds of the device's own work in the resident batches' stamped passes
+    /// ([`crate::gpu::pass_clock`]; 0 where the adapter has no timestamps): of the waits,
+    /// the part that is the kernels, not the round trip.
+    pub device_s: f64,
+    /// Of `device_s`, the line-search trials' passes.
+    pub trial_device_s: f64,
+    /// Line-search trial passes stamped.
+    pub trials: u64,
+}
+
+impl Tally {
+    /// The counters now.
+    pub fn now() -> Self {
+        Tally {
+            readbacks: READBACKS.load(Ordering::Relaxed),
+            wait_s: WAIT_NANOS.load(Ordering::Relaxed) as f64 * 1e-9,
+            bytes_read: BYTES_READ.load(Ordering::Relaxed),
+            setup_s: SETUP_NANOS.load(Ordering::Relaxed) as f64 * 1e-9,
+            device_s: DEVICE_NANOS.load(Ordering::Relaxed) as f64 * 1e-9,
+            trial_device_s: TRIAL_NANOS.load(Ordering::Relaxed) as f64 * 1e-9,
+            trials: TRIALS.load(Ordering::Relaxed),
+        }
+    }
+
+    /// What was counted between `before` and this snapshot.
+    pub fn since(&self, before: &Tally) -> Tally {
+        Tally {
+            readbacks: self.readbacks - before.readbacks,
+            wait_s: self.wait_s - before.wait_s,
+            bytes_read: self.bytes_read - before.bytes_read,
+            setup_s: self.setup_s - before.setup_s,
+            device_s: self.device_s - before.device_s,
+            trial_device_s: self.trial_device_s - before.trial_device_s,
+            trials: self.trials - before.trials,
+        }
+    }
+}
+
+fn nanos(d: std::time::Duration) -> u64 {
+    u64::try_from(d.as_nanos()).unwrap_or(u64::MAX)
+}
+
+/// Counts one read-back of `bytes` for which the host waited `waited`.
+pub fn add_readback(bytes: u64, waited: std::time::Duration) {
+    READBACKS.fetch_add(1, Ordering::Relaxed);
+    BYTES_READ.fetch_add(bytes, Ordering::Relaxed);
+    WAIT_NANOS.fetch_add(nanos(waited), Ordering::Relaxed);
+}
+
+/// Counts `took` of an engine batch's setup.
+pub fn add_setup(took: std::time::Duration) {
+    SETUP_NANOS.fetch_add(nanos(took), Ordering::Relaxed);
+}
+
+/// Counts `took` of the device's own work in a stamped pass (`trial`: a line-search
+/// trial's).
+pub fn add_device(took: std::time::Duration, trial: bool) {
+    DEVICE_NANOS.fetch_add(nanos(took), Ordering::Relaxed);
+    if trial {
+        TRIAL_NANOS.fetch_add(nanos(took), Ordering::Relaxed);
+        TRIALS.fetch_add(1, Ordering::Relaxed);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_snapshot_difference_counts_what_was_added_between() {
+        let before = Tally::now();
+        add_readback(48, std::time::Duration::from_millis(3));
+        add_readback(16, std::time::Duration::from_millis(1));
+        add_setup(std::time::Duration::from_millis(5));
+        add_device(std::time::Duration::from_millis(2), true);
+        let d = Tally::now().since(&before);
+        // Other tests may read back at the same time: at least what was added here.
+        assert!(d.readbacks >= 2 && d.bytes_read >= 64);
+        assert!(d.wait_s >= 4e-3 - 1e-12 && d.setup_s >= 5e-3 - 1e-12);
+        assert!(d.device_s >= 2e-3 - 1e-12 && d.trial_device_s >= 2e-3 - 1e-12);
+        assert!(d.trials >= 1);
+    }
+}
