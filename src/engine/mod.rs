@@ -540,7 +540,7 @@ mod statics;
 mod tables;
 mod twin;
 use statics::EngineStatic;
-pub(crate) use tables::check_same_mesh;
+pub(crate) use tables::{check_same_mesh, variant_fastest};
 pub use tables::{ensemble_tables, ensemble_tables_from};
 pub use twin::TwinPath;
 pub(crate) use twin::{twin_evaluate, AssemblyDynamic};

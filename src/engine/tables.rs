@@ -31,6 +31,38 @@ pub(crate) fn check_same_mesh(models: &[Model]) -> Result<(), crate::error::Syst
     Ok(())
 }
 
+/// A table of `rows` rows of `v` values each, variant-fastest (`[r v + j] = value(r, j)`),
+/// filled in parallel in blocks of `block` rows (a node's, say): within a block each
+/// variant's values are taken together, so a variant's data is read close together and
+/// every write lands in the block's rows. Writing a variant's column at a time strides by
+/// `v` on every write; at V = 4096 that serial transpose was most of a dynamic batch's
+/// setup (issue 27, `docs/performance.md`).
+pub(crate) fn variant_fastest<X: Copy + Default + Send + Sync>(
+    rows: usize,
+    v: usize,
+    block: usize,
+    value: impl Fn(usize, usize) -> X + Sync,
+) -> Vec<X> {
+    use rayon::prelude::*;
+    let mut out = vec![X::default(); rows * v];
+    if v == 0 {
+        return out;
+    }
+    let block = block.max(1);
+    out.par_chunks_mut(block * v)
+        .enumerate()
+        .for_each(|(b, chunk)| {
+            let first = b * block;
+            let count = chunk.len() / v;
+            for j in 0..v {
+                for r in 0..count {
+                    chunk[r * v + j] = value(first + r, j);
+                }
+            }
+        });
+    out
+}
+
 /// The tables of a batch of variants (all on the first one's mesh).
 pub fn ensemble_tables<T: Real>(
     models: &[Model],
@@ -51,37 +83,46 @@ pub fn ensemble_tables_from<T: Real>(
     let base = &models[0];
     let (v, n, s_count) = (models.len(), base.nodes.len(), base.sites.len());
     let (basis, fixed) = constraint_tables(base);
-    let given = start.is_some();
-    let (x, rot) =
-        start.unwrap_or_else(|| (vec![T::zero(); 3 * n * v], vec![T::zero(); 9 * n * v]));
-    let mut start = ConfigBatch {
+    let (x, rot) = match start {
+        Some(given) => given,
+        None => {
+            // Each variant laid on the low side (in parallel), then the tables a node at a
+            // time ([`variant_fastest`]).
+            use rayon::prelude::*;
+            let laid: Vec<_> = models
+                .par_iter()
+                .map(crate::solve::statics::static_start)
+                .collect();
+            (
+                variant_fastest(3 * n, v, 3, |r, j| {
+                    t(laid[j].x[r / 3][r % 3] - base.nodes[r / 3].position[r % 3])
+                }),
+                variant_fastest(
+                    9 * n,
+                    v,
+                    9,
+                    |r, j| t(laid[j].rot[r / 9][(r % 9) / 3][r % 3]),
+                ),
+            )
+        }
+    };
+    let start = ConfigBatch {
         num_variants: v,
         num_nodes: n,
         x,
         rot,
         basis: basis.iter().map(|&b| t(b)).collect(),
     };
-    for (j, m) in models.iter().enumerate().filter(|_| !given) {
-        let s = crate::solve::statics::static_start(m);
-        for i in 0..n {
-            for k in 0..3 {
-                start.x[(3 * i + k) * v + j] = t(s.x[i][k] - base.nodes[i].position[k]);
-            }
-            for r in 0..3 {
-                for c in 0..3 {
-                    start.rot[(9 * i + 3 * r + c) * v + j] = t(s.rot[i][r][c]);
-                }
-            }
-        }
-    }
     let p = s_count * v;
     let mut node_site = vec![NO_SITE; n * v];
     let mut pair_node = vec![0u32; p];
     let mut pair_normals = vec![T::zero(); 3 * p];
     let mut pair_state = vec![T::zero(); STATE_LEN * p];
     let mut params = vec![T::zero(); PARAMS_LEN * p];
-    for (j, m) in models.iter().enumerate() {
-        for (k, site) in m.sites.iter().enumerate() {
+    // Site by site, every variant's in turn: the pair tables are written in order.
+    for k in 0..s_count {
+        for (j, m) in models.iter().enumerate() {
+            let site = &m.sites[k];
             let i = k * v + j;
             node_site[site.node * v + j] = k as u32;
             pair_node[i] = site.node as u32;

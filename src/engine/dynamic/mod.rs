@@ -31,7 +31,8 @@ use crate::solve::dynamics::{DynamicOptions, Dynamics};
 use crate::solve::statics::StaticState;
 
 use super::{
-    columns, ensemble_tables_from, negated, trial_probe, BatchTables, KernelPath, TwinPath,
+    columns, ensemble_tables_from, negated, trial_probe, variant_fastest, BatchTables, KernelPath,
+    TwinPath,
 };
 use crate::solve::newton::{Event, Newton, NewtonSettings, NewtonSystem, Probe, TrialProbe};
 
@@ -149,36 +150,27 @@ struct Start<T> {
 pub type DynamicStart = (StaticState, Option<Vec<f64>>);
 
 /// The start of every variant: the CPU integrator's initial state (consistent
-/// accelerations) from its start configuration and velocities, and its force scale.
-fn dynamic_tables<T: Real>(
-    models: &[Model],
+/// accelerations) from its start configuration and velocities, its force scale, and the
+/// integrator set up for it (the batch's top drive).
+fn dynamic_tables<'a, T: Real>(
+    models: &'a [Model],
     starts: &[DynamicStart],
     density: &[f64],
     options: &DynamicOptions,
-) -> Result<Start<T>, crate::error::SystemError> {
+) -> Result<(Start<T>, Vec<Dynamics<'a>>), crate::error::SystemError> {
     let t = |x: f64| T::from_f64_lossy(x);
     let (v, n) = (models.len(), models[0].nodes.len());
-    let p = models[0].sites.len() * v;
-    let mut start = DynamicBatch {
-        num_variants: v,
-        num_nodes: n,
-        u: vec![T::zero(); 3 * n * v],
-        rot: vec![T::zero(); 9 * n * v],
-        vel: vec![T::zero(); 6 * n * v],
-        acc: vec![T::zero(); 6 * n * v],
-        vdot: vec![T::zero(); 6 * n * v],
-    };
-    let mut base = vec![0.0; 3 * n * v];
-    let mut f_ref = Vec::with_capacity(v);
-    let mut f_ext = vec![T::zero(); 6 * n * v];
-    let mut pair_params = vec![T::zero(); PARAMS_LEN * p];
-    let mut mass = Vec::new();
-    let mut inertia0 = Vec::new();
-    let mut top = (false, false);
+    let s_count = models[0].sites.len();
     // Each variant's consistent initial state (a solve with its mass), in parallel: on the
     // host, before any kernel, this was the largest serial part of a large batch (issue 27).
     use rayon::prelude::*;
-    let initial: Vec<_> = models
+    type Initial<'a> = (
+        Dynamics<'a>,
+        crate::solve::dynamics::DynamicState,
+        Vec<f64>,
+        Vec<[f64; PARAMS_LEN]>,
+    );
+    let initial: Vec<Initial<'a>> = models
         .par_iter()
         .zip(starts)
         .map(|(m, (q, vel))| {
@@ -187,76 +179,73 @@ fn dynamic_tables<T: Real>(
                 crate::error::SystemError::Linear(format!("the initial state: {e}"))
             })?;
             let loads = crate::solve::statics::external_loads(m);
-            Ok((s, d.reference_force(), loads))
+            let params = m.sites.iter().map(|x| x.params.to_array()).collect();
+            Ok((d, s, loads, params))
         })
         .collect::<Result<_, crate::error::SystemError>>()?;
-    for (j, (m, (s, reference, loads))) in models.iter().zip(initial).enumerate() {
-        f_ref.push(reference);
-        if j == 0 {
-            let d = Dynamics::new(m, *options, &|e| density[e]);
-            let (ms, js) = d.lumped();
-            mass = ms.iter().map(|&x| t(x)).collect();
-            inertia0 = js.iter().flatten().flatten().map(|&x| t(x)).collect();
-            top = d.top_motion();
+    // The tables, variant-fastest, filled a node (or a field) at a time in parallel.
+    let from_reference =
+        |i: usize, k: usize, j: usize| initial[j].1.q.x[i][k] - models[j].nodes[i].position[k];
+    // The base: each node's start, the top's reference (its motion is the top drive's).
+    let base = variant_fastest(3 * n, v, 3, |r, j| {
+        if r < 3 {
+            0.0
+        } else {
+            from_reference(r / 3, r % 3, j)
         }
-        for i in 0..n {
-            for k in 0..3 {
-                let at = (3 * i + k) * v + j;
-                let from_reference = s.q.x[i][k] - m.nodes[i].position[k];
-                if i > 0 {
-                    base[at] = from_reference;
-                }
-                start.u[at] = t(from_reference - base[at]);
-            }
-            for r in 0..3 {
-                for c in 0..3 {
-                    start.rot[(9 * i + 3 * r + c) * v + j] = t(s.q.rot[i][r][c]);
-                }
-            }
-            for k in 0..6 {
-                let idx = (6 * i + k) * v + j;
-                start.vel[idx] = t(s.v[6 * i + k]);
-                start.acc[idx] = t(s.a[6 * i + k]);
-                start.vdot[idx] = t(s.vdot[6 * i + k]);
-            }
-        }
-        for dof in 0..6 * n {
-            f_ext[dof * v + j] = t(loads[dof]);
-        }
-        for (k, site) in m.sites.iter().enumerate() {
-            for (f, x) in site.params.to_array().into_iter().enumerate() {
-                pair_params[f * p + k * v + j] = t(x);
-            }
-        }
-    }
+    });
+    let state =
+        |rows: usize, f: &(dyn Fn(&crate::solve::dynamics::DynamicState, usize) -> f64 + Sync)| {
+            variant_fastest(rows, v, rows / n, |r, j| t(f(&initial[j].1, r)))
+        };
+    let start = DynamicBatch {
+        num_variants: v,
+        num_nodes: n,
+        u: variant_fastest(3 * n, v, 3, |r, j| {
+            t(from_reference(r / 3, r % 3, j) - base[r * v + j])
+        }),
+        rot: state(9 * n, &|s, r| s.q.rot[r / 9][(r % 9) / 3][r % 3]),
+        vel: state(6 * n, &|s, r| s.v[r]),
+        acc: state(6 * n, &|s, r| s.a[r]),
+        vdot: state(6 * n, &|s, r| s.vdot[r]),
+    };
+    let f_ext = variant_fastest(6 * n, v, 6, |r, j| t(initial[j].2[r]));
+    // Law parameters per pair, field-major: row `f S + k` is field f of site k.
+    let pair_params = variant_fastest(PARAMS_LEN * s_count, v, s_count, |r, j| {
+        t(initial[j].3[r % s_count][r / s_count])
+    });
     let unbalance = if models.iter().any(Model::has_unbalance) {
-        let mut u = vec![T::zero(); 3 * n * v];
-        for (j, m) in models.iter().enumerate() {
-            for (i, ui) in m.unbalance.iter().enumerate().take(n) {
-                for k in 0..3 {
-                    u[(3 * i + k) * v + j] = t(ui[k]);
-                }
-            }
-        }
-        u
+        variant_fastest(3 * n, v, 3, |r, j| {
+            models[j]
+                .unbalance
+                .get(r / 3)
+                .map_or(T::zero(), |u| t(u[r % 3]))
+        })
     } else {
         Vec::new()
     };
-    Ok(Start {
-        tables: DynamicTables {
-            mass,
-            inertia0,
-            a0: options.rayleigh.0,
-            f_ext,
-            pair_params,
-            unbalance,
-            start,
-        },
+    let d0 = &initial[0].0;
+    let (ms, js) = d0.lumped();
+    let top = d0.top_motion();
+    let tables = DynamicTables {
+        mass: ms.iter().map(|&x| t(x)).collect(),
+        inertia0: js.iter().flatten().flatten().map(|&x| t(x)).collect(),
+        a0: options.rayleigh.0,
+        f_ext,
+        pair_params,
+        unbalance,
+        start,
+    };
+    let f_ref = initial.iter().map(|x| x.0.reference_force()).collect();
+    let drives = initial.into_iter().map(|x| x.0).collect();
+    let start = Start {
+        tables,
         base,
         f_ref,
         driven: top.0,
         lowered: top.1,
-    })
+    };
+    Ok((start, drives))
 }
 
 /// One variant's dynamic result.
@@ -378,13 +367,16 @@ fn run_batch<T: Real + Send + Sync, P: KernelPath<T>>(
 ) -> Result<Vec<DynamicResult>, crate::error::SystemError> {
     super::check_same_mesh(models)?;
     let setup = std::time::Instant::now();
-    let Start {
-        tables: dynamic,
-        base,
-        f_ref,
-        driven,
-        lowered,
-    } = dynamic_tables::<T>(models, starts, density, options)?;
+    let (
+        Start {
+            tables: dynamic,
+            base,
+            f_ref,
+            driven,
+            lowered,
+        },
+        drives,
+    ) = dynamic_tables::<T>(models, starts, density, options)?;
     // The batch's state is the dynamic start; the static tables need no start of their own.
     let static_start = (dynamic.start.u.clone(), dynamic.start.rot.clone());
     let mut tables = ensemble_tables_from::<T>(models, Some(static_start))?;
@@ -396,25 +388,30 @@ fn run_batch<T: Real + Send + Sync, P: KernelPath<T>>(
     tables.set_base(&models[0], base);
     let size = std::mem::size_of::<T>();
     // Step floors: f64 from the positions, f32 from the motion off the base.
-    let floors = (0..v)
-        .map(|j| {
-            let largest = (0..tables.node_ref.len()).fold(0.0f64, |m, k| {
-                let w = dynamic.start.u[k * v + j].to_f64_lossy();
-                let x = if size == 4 {
-                    w
-                } else {
-                    tables.node_ref[k] + tables.base[k * v + j] + w
-                };
-                m.max(x.abs())
-            });
-            NewtonSettings::step_floor(size, largest)
-        })
+    // (Row by row: the rows are variant-fastest.)
+    let mut largest = vec![0.0f64; v];
+    for (k, (row, base)) in dynamic
+        .start
+        .u
+        .chunks_exact(v)
+        .zip(tables.base.chunks_exact(v))
+        .enumerate()
+    {
+        for ((m, w), b) in largest.iter_mut().zip(row).zip(base) {
+            let w = w.to_f64_lossy();
+            let x = if size == 4 {
+                w
+            } else {
+                tables.node_ref[k] + b + w
+            };
+            *m = m.max(x.abs());
+        }
+    }
+    let floors = largest
+        .into_iter()
+        .map(|l| NewtonSettings::step_floor(size, l))
         .collect();
     let mut ensemble = path.open_dynamic(&models[0], &tables, &dynamic)?;
-    let drives = models
-        .iter()
-        .map(|m| Dynamics::new(m, *options, &|e| density[e]))
-        .collect();
     crate::tally::add_setup(setup.elapsed());
     let mut batch = Batch {
         models,

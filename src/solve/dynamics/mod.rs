@@ -456,7 +456,10 @@ impl<'a> Dynamics<'a> {
         let mut r: Vec<f64> = self.f_ext.iter().map(|f| -lambda * f).collect();
         let mut k_t = BlockTridiagonal::zeros(n);
         let mut s_mat = BlockTridiagonal::zeros(n);
-        let with_tangent = with_matrix || self.k0.is_none();
+        // The initial tangent `K₀` (stiffness-proportional damping's, at the first call) is
+        // formed only where that damping is asked for (`a1 ≠ 0`).
+        let first_k0 = self.k0.is_none() && self.options.rayleigh.1 != 0.0;
+        let with_tangent = with_matrix || first_k0;
         for_each_element_response(model, &s.q, with_tangent, |i, f, k| {
             for j in 0..12 {
                 r[6 * i + j] += f[j];
@@ -465,7 +468,7 @@ impl<'a> Dynamics<'a> {
                 k_t.add_element(i, k);
             }
         });
-        if self.k0.is_none() {
+        if first_k0 {
             self.k0 = Some(k_t.clone());
         }
         // Inertia and gyroscopic moments.
