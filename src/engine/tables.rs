@@ -115,29 +115,51 @@ pub fn ensemble_tables_from<T: Real>(
     };
     let p = s_count * v;
     let mut node_site = vec![NO_SITE; n * v];
-    let mut pair_node = vec![0u32; p];
-    let mut pair_normals = vec![T::zero(); 3 * p];
-    let mut pair_state = vec![T::zero(); STATE_LEN * p];
-    let mut params = vec![T::zero(); PARAMS_LEN * p];
-    // Site by site, every variant's in turn: the pair tables are written in order.
-    for k in 0..s_count {
-        for (j, m) in models.iter().enumerate() {
-            let site = &m.sites[k];
-            let i = k * v + j;
+    for (j, m) in models.iter().enumerate() {
+        for (k, site) in m.sites.iter().enumerate() {
             node_site[site.node * v + j] = k as u32;
-            pair_node[i] = site.node as u32;
-            let axis = m.nodes[site.node].hole_axis;
-            let len = (axis[0] * axis[0] + axis[1] * axis[1] + axis[2] * axis[2]).sqrt();
-            for a in 0..3 {
-                pair_normals[3 * i + a] = t(axis[a] / len);
-                pair_state[(3 + a) * p + i] = t(axis[a] * m.axial_speed);
-            }
-            pair_state[6 * p + i] = t(m.rotation_speed);
-            for (f, x) in site.params.to_array().into_iter().enumerate() {
-                params[f * p + i] = t(x);
-            }
         }
     }
+    // The pair tables, `[k V + j]` per field: site by site, in parallel
+    // ([`variant_fastest`]), each model's law parameters taken once.
+    use rayon::prelude::*;
+    let arrays: Vec<Vec<[f64; PARAMS_LEN]>> = models
+        .par_iter()
+        .map(|m| m.sites.iter().map(|x| x.params.to_array()).collect())
+        .collect();
+    let normal = |k: usize, j: usize| {
+        let m = &models[j];
+        let axis = m.nodes[m.sites[k].node].hole_axis;
+        let len = (axis[0] * axis[0] + axis[1] * axis[1] + axis[2] * axis[2]).sqrt();
+        (axis, len)
+    };
+    let pair_node = variant_fastest(s_count, v, 1, |k, j| models[j].sites[k].node as u32);
+    // Pair-major: the three components of a pair's normal together.
+    let mut pair_normals = vec![T::zero(); 3 * p];
+    pair_normals
+        .par_chunks_mut(3 * v)
+        .enumerate()
+        .for_each(|(k, chunk)| {
+            for (j, out) in chunk.chunks_exact_mut(3).enumerate() {
+                let (axis, len) = normal(k, j);
+                for a in 0..3 {
+                    out[a] = t(axis[a] / len);
+                }
+            }
+        });
+    // Fields 3–5 the axial speed along the hole's axis, 6 the rotation speed.
+    let pair_state = variant_fastest(STATE_LEN * s_count, v, s_count, |r, j| {
+        let (f, k) = (r / s_count.max(1), r % s_count.max(1));
+        let m = &models[j];
+        match f {
+            3..=5 => t(m.nodes[m.sites[k].node].hole_axis[f - 3] * m.axial_speed),
+            6 => t(m.rotation_speed),
+            _ => T::zero(),
+        }
+    });
+    let params = variant_fastest(PARAMS_LEN * s_count, v, s_count, |r, j| {
+        t(arrays[j][r % s_count.max(1)][r / s_count.max(1)])
+    });
     let mut batch = ContactBatch::<T>::new(1, p);
     batch.pair_params = params;
     let terms = batch.required_terms(base.friction, ContactMode::Static);
