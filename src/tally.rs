@@ -17,6 +17,7 @@ static READBACKS: AtomicU64 = AtomicU64::new(0);
 static WAIT_NANOS: AtomicU64 = AtomicU64::new(0);
 static BYTES_READ: AtomicU64 = AtomicU64::new(0);
 static SETUP_NANOS: AtomicU64 = AtomicU64::new(0);
+static OPEN_NANOS: AtomicU64 = AtomicU64::new(0);
 static DEVICE_NANOS: AtomicU64 = AtomicU64::new(0);
 static TRIAL_NANOS: AtomicU64 = AtomicU64::new(0);
 static TRIALS: AtomicU64 = AtomicU64::new(0);
@@ -32,6 +33,9 @@ pub struct Tally {
     pub bytes_read: u64,
     /// Seconds spent setting engine batches up before their first step.
     pub setup_s: f64,
+    /// Of `setup_s`, opening the batches on their kernel path (on a GPU: allocating its
+    /// buffers and uploading the tables and the state).
+    pub open_s: f64,
     /// Seconds of the device's own work in the resident batches' stamped passes
     /// ([`crate::gpu::pass_clock`]; 0 where the adapter has no timestamps): of the waits,
     /// the part that is the kernels, not the round trip.
@@ -50,6 +54,7 @@ impl Tally {
             wait_s: WAIT_NANOS.load(Ordering::Relaxed) as f64 * 1e-9,
             bytes_read: BYTES_READ.load(Ordering::Relaxed),
             setup_s: SETUP_NANOS.load(Ordering::Relaxed) as f64 * 1e-9,
+            open_s: OPEN_NANOS.load(Ordering::Relaxed) as f64 * 1e-9,
             device_s: DEVICE_NANOS.load(Ordering::Relaxed) as f64 * 1e-9,
             trial_device_s: TRIAL_NANOS.load(Ordering::Relaxed) as f64 * 1e-9,
             trials: TRIALS.load(Ordering::Relaxed),
@@ -63,6 +68,7 @@ impl Tally {
             wait_s: self.wait_s - before.wait_s,
             bytes_read: self.bytes_read - before.bytes_read,
             setup_s: self.setup_s - before.setup_s,
+            open_s: self.open_s - before.open_s,
             device_s: self.device_s - before.device_s,
             trial_device_s: self.trial_device_s - before.trial_device_s,
             trials: self.trials - before.trials,
@@ -81,9 +87,10 @@ pub fn add_readback(bytes: u64, waited: std::time::Duration) {
     WAIT_NANOS.fetch_add(nanos(waited), Ordering::Relaxed);
 }
 
-/// Counts `took` of an engine batch's setup.
-pub fn add_setup(took: std::time::Duration) {
+/// Counts `took` of an engine batch's setup, `opening` of it the opening on the kernel path.
+pub fn add_setup(took: std::time::Duration, opening: std::time::Duration) {
     SETUP_NANOS.fetch_add(nanos(took), Ordering::Relaxed);
+    OPEN_NANOS.fetch_add(nanos(opening), Ordering::Relaxed);
 }
 
 /// Counts `took` of the device's own work in a stamped pass (`trial`: a line-search
@@ -105,12 +112,16 @@ mod tests {
         let before = Tally::now();
         add_readback(48, std::time::Duration::from_millis(3));
         add_readback(16, std::time::Duration::from_millis(1));
-        add_setup(std::time::Duration::from_millis(5));
+        add_setup(
+            std::time::Duration::from_millis(5),
+            std::time::Duration::from_millis(1),
+        );
         add_device(std::time::Duration::from_millis(2), true);
         let d = Tally::now().since(&before);
         // Other tests may read back at the same time: at least what was added here.
         assert!(d.readbacks >= 2 && d.bytes_read >= 64);
         assert!(d.wait_s >= 4e-3 - 1e-12 && d.setup_s >= 5e-3 - 1e-12);
+        assert!(d.open_s >= 1e-3 - 1e-12);
         assert!(d.device_s >= 2e-3 - 1e-12 && d.trial_device_s >= 2e-3 - 1e-12);
         assert!(d.trials >= 1);
     }

@@ -138,6 +138,8 @@ struct Cell {
 #[derive(Serialize, Clone, Copy)]
 struct Split {
     setup_s: f64,
+    /// Of the setup, opening the batches on the GPU (buffers made, tables and state uploaded).
+    open_s: f64,
     wait_s: f64,
     /// Of the waits, the device's own time in the stamped passes (None: no timestamps).
     device_s: Option<f64>,
@@ -180,6 +182,7 @@ fn median_split(runs: &[(f64, crate::tally::Tally)], steps: usize) -> Option<Spl
     let steps = steps.max(1) as f64;
     Some(Split {
         setup_s: d.setup_s,
+        open_s: d.open_s,
         wait_s: d.wait_s,
         device_s: (d.device_s > 0.0).then_some(d.device_s),
         trial_device_s: (d.device_s > 0.0).then_some(d.trial_device_s),
@@ -508,20 +511,21 @@ pub fn run(
              work between them"
         );
         println!(
-            "| nodes | variants | path | run (s) | setup (s) | waiting (s) | of it, passes on \
+            "| nodes | variants | path | run (s) | setup (s) | of it, opening on the GPU (s) | waiting (s) | of it, passes on \
              the device (s) | of those, trials (s) | host (s) | read-backs/step | \
              trials/step | kB read/step |"
         );
-        println!("|---|---|---|---|---|---|---|---|---|---|---|---|");
+        println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|");
         for c in &cells {
             if let Some(s) = c.split {
                 println!(
-                    "| {} | {} | {} | {:.3} | {:.3} | {:.3} | {} | {} | {:.3} | {:.1} | {:.1} | {:.1} |",
+                    "| {} | {} | {} | {:.3} | {:.3} | {:.3} | {:.3} | {} | {} | {:.3} | {:.1} | {:.1} | {:.1} |",
                     c.nodes,
                     c.variants,
                     c.path,
                     s.setup_s + s.wait_s + s.host_s,
                     s.setup_s,
+                    s.open_s,
                     s.wait_s,
                     s.device_s.map_or("–".into(), |d| format!("{d:.3}")),
                     s.trial_device_s.map_or("–".into(), |d| format!("{d:.3}")),

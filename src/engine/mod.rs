@@ -312,8 +312,9 @@ fn solve_batch<T: Real + Send + Sync, P: KernelPath<T>>(
     // The mesh every variant shares (the kernels read sections and frames from it).
     let mesh = &models[0];
     let size = std::mem::size_of::<T>();
+    let opening = std::time::Instant::now();
     let ensemble = path.open(mesh, &tables)?;
-    crate::tally::add_setup(setup.elapsed());
+    crate::tally::add_setup(setup.elapsed(), opening.elapsed());
     let mut sys = EngineStatic::new(models.iter().collect(), ensemble, tables, None, None);
     // f32 solves full load a second time from its own converged state as base: the
     // answer's last digits are then f32's rounding of millimetres, not of the string's

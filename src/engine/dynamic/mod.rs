@@ -411,8 +411,9 @@ fn run_batch<T: Real + Send + Sync, P: KernelPath<T>>(
         .into_iter()
         .map(|l| NewtonSettings::step_floor(size, l))
         .collect();
+    let opening = std::time::Instant::now();
     let mut ensemble = path.open_dynamic(&models[0], &tables, &dynamic)?;
-    crate::tally::add_setup(setup.elapsed());
+    crate::tally::add_setup(setup.elapsed(), opening.elapsed());
     let mut batch = Batch {
         models,
         path,
