@@ -127,7 +127,9 @@ struct Cell {
     newton_iterations_per_step: Option<f64>,
     effective_gflops: Option<f64>,
     effective_gbytes_per_s: Option<f64>,
-    /// Where a GPU run's time went: the median run's ([`crate::tally`]).
+    /// Where a GPU run's time went: the median run's ([`crate::tally`]; in the report's
+    /// `splits`, a table of its own).
+    #[serde(skip)]
     split: Option<Split>,
     note: String,
 }
@@ -137,6 +139,9 @@ struct Cell {
 /// work between them; with the read-backs per time step.
 #[derive(Serialize, Clone, Copy)]
 struct Split {
+    nodes: usize,
+    variants: usize,
+    path: &'static str,
     setup_s: f64,
     /// Of the setup, opening the batches on the GPU (buffers made, tables and state uploaded).
     open_s: f64,
@@ -168,6 +173,8 @@ struct Report {
     repeats: usize,
     budget_s: f64,
     cells: Vec<Cell>,
+    /// Where each GPU cell's median run spent its time.
+    splits: Vec<Split>,
     work_precision: Vec<Precision>,
 }
 
@@ -175,12 +182,19 @@ struct Report {
 type Positions = Vec<[f64; 3]>;
 
 /// The split of the run of median wall time among `runs` (wall seconds, tally).
-fn median_split(runs: &[(f64, crate::tally::Tally)], steps: usize) -> Option<Split> {
+fn median_split(
+    cell: (usize, usize, &'static str),
+    runs: &[(f64, crate::tally::Tally)],
+    steps: usize,
+) -> Option<Split> {
     let mut sorted: Vec<_> = runs.to_vec();
     sorted.sort_by(|a, b| a.0.total_cmp(&b.0));
     let &(wall, d) = sorted.get(sorted.len() / 2)?;
     let steps = steps.max(1) as f64;
     Some(Split {
+        nodes: cell.0,
+        variants: cell.1,
+        path: cell.2,
         setup_s: d.setup_s,
         open_s: d.open_s,
         wait_s: d.wait_s,
@@ -406,7 +420,7 @@ pub fn run(
                     Ok(())
                 })?;
                 if path.starts_with("GPU") {
-                    cell.split = median_split(&tallies[1..], steps);
+                    cell.split = median_split((nodes, v, path), &tallies[1..], steps);
                 }
                 let size = if path.ends_with("f32") { 4 } else { 8 };
                 let per_it = its as f64 / (v * steps) as f64;
@@ -554,6 +568,7 @@ pub fn run(
             steps,
             repeats,
             budget_s,
+            splits: cells.iter().filter_map(|c| c.split).collect(),
             cells,
             work_precision,
         };
