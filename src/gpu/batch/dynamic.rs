@@ -130,6 +130,21 @@ struct DynamicBuffers {
     acc_1: wgpu::Buffer,
 }
 
+impl DynamicBuffers {
+    /// The state at `t_n` beside its counterpart at `t_{n+1}` (the trial state, and the
+    /// unknown for `v̇`), pair by pair: a batch's start copies the first into the second, a
+    /// step's end the second into the first.
+    fn steps(&self) -> [(&wgpu::Buffer, &wgpu::Buffer); 5] {
+        [
+            (&self.u_n, &self.u_1),
+            (&self.rot_n, &self.rot_1),
+            (&self.vel_n, &self.vel_1),
+            (&self.acc_n, &self.acc_1),
+            (&self.vdot_n, &self.vdot_k),
+        ]
+    }
+}
+
 impl<T: GpuReal> GpuDynamic<T> {
     /// Compiles (or fetches) the kernels for the batch's terms and precision and uploads
     /// its tables and start state.
@@ -212,17 +227,8 @@ impl<T: GpuReal> GpuDynamic<T> {
         // The unknown, the candidate and the trial state start as the state: uploaded once,
         // copied on the device (at V = 4096 the uploads were a large part of the setup).
         let mut e = encoder(ctx, "dynamic start");
-        Self::copy_all(
-            &mut e,
-            &[
-                (&b.vdot_n, &b.vdot_k),
-                (&b.vdot_n, &b.vdot_c),
-                (&b.u_n, &b.u_1),
-                (&b.rot_n, &b.rot_1),
-                (&b.vel_n, &b.vel_1),
-                (&b.acc_n, &b.acc_1),
-            ],
-        );
+        Self::copy_all(&mut e, &b.steps());
+        Self::copy_all(&mut e, &[(&b.vdot_n, &b.vdot_c)]);
         ctx.queue.submit([e.finish()]);
         let predict_inputs = |vdot| {
             vec![
@@ -605,17 +611,7 @@ impl<T: GpuReal> crate::engine::dynamic::ResidentDynamic<T> for GpuDynamic<T> {
                 self.num_nodes * self.num_variants,
             );
         }
-        let b = &self.b;
-        Self::copy_all(
-            &mut e,
-            &[
-                (&b.u_1, &b.u_n),
-                (&b.rot_1, &b.rot_n),
-                (&b.vel_1, &b.vel_n),
-                (&b.acc_1, &b.acc_n),
-                (&b.vdot_k, &b.vdot_n),
-            ],
-        );
+        Self::copy_all(&mut e, &self.b.steps().map(|(at_n, next)| (next, at_n)));
         self.ctx.queue.submit([e.finish()]);
         Ok(())
     }
