@@ -189,3 +189,32 @@ pub fn ensemble_tables_from<T: Real>(
     tables.set_base(base, vec![0.0; 3 * n * v]);
     Ok(tables)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::variant_fastest;
+
+    /// Every entry where the column-at-a-time loop it replaced put it, for blocks that do
+    /// and do not divide the rows, one variant and many.
+    #[test]
+    fn variant_fastest_puts_every_value_where_a_column_loop_would() {
+        for (rows, v, block) in [
+            (7, 5, 3),
+            (6, 1, 6),
+            (12, 33, 4),
+            (1, 9, 9),
+            (0, 4, 2),
+            (5, 3, 0),
+        ] {
+            let value = |r: usize, j: usize| (1000 * r + j) as u64;
+            let got = variant_fastest(rows, v, block, value);
+            let mut want = vec![0u64; rows * v];
+            for j in 0..v {
+                for r in 0..rows {
+                    want[r * v + j] = value(r, j);
+                }
+            }
+            assert_eq!(got, want, "rows {rows}, v {v}, block {block}");
+        }
+    }
+}
