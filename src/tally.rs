@@ -21,6 +21,20 @@ static OPEN_NANOS: AtomicU64 = AtomicU64::new(0);
 static DEVICE_NANOS: AtomicU64 = AtomicU64::new(0);
 static TRIAL_NANOS: AtomicU64 = AtomicU64::new(0);
 static TRIALS: AtomicU64 = AtomicU64::new(0);
+static STARTS_NANOS: AtomicU64 = AtomicU64::new(0);
+static DYNAMICS_NANOS: AtomicU64 = AtomicU64::new(0);
+static OBSERVE_NANOS: AtomicU64 = AtomicU64::new(0);
+
+/// A phase of an ensemble job on the engine ([`add_phase`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Phase {
+    /// The variants' static starts solved on the engine (and held in the hole).
+    StaticStarts,
+    /// The dynamic runs on the engine, observation included.
+    Dynamics,
+    /// Of those, observing the variants' states at every output step.
+    Observing,
+}
 
 /// A snapshot of the counters.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -44,6 +58,12 @@ pub struct Tally {
     pub trial_device_s: f64,
     /// Line-search trial passes stamped.
     pub trials: u64,
+    /// Seconds of [`Phase::StaticStarts`].
+    pub static_starts_s: f64,
+    /// Seconds of [`Phase::Dynamics`].
+    pub dynamics_s: f64,
+    /// Seconds of [`Phase::Observing`].
+    pub observing_s: f64,
 }
 
 impl Tally {
@@ -58,6 +78,9 @@ impl Tally {
             device_s: DEVICE_NANOS.load(Ordering::Relaxed) as f64 * 1e-9,
             trial_device_s: TRIAL_NANOS.load(Ordering::Relaxed) as f64 * 1e-9,
             trials: TRIALS.load(Ordering::Relaxed),
+            static_starts_s: STARTS_NANOS.load(Ordering::Relaxed) as f64 * 1e-9,
+            dynamics_s: DYNAMICS_NANOS.load(Ordering::Relaxed) as f64 * 1e-9,
+            observing_s: OBSERVE_NANOS.load(Ordering::Relaxed) as f64 * 1e-9,
         }
     }
 
@@ -72,6 +95,9 @@ impl Tally {
             device_s: self.device_s - before.device_s,
             trial_device_s: self.trial_device_s - before.trial_device_s,
             trials: self.trials - before.trials,
+            static_starts_s: self.static_starts_s - before.static_starts_s,
+            dynamics_s: self.dynamics_s - before.dynamics_s,
+            observing_s: self.observing_s - before.observing_s,
         }
     }
 }
@@ -103,6 +129,16 @@ pub fn add_device(took: std::time::Duration, trial: bool) {
     }
 }
 
+/// Counts `took` of an ensemble job's `phase`.
+pub fn add_phase(phase: Phase, took: std::time::Duration) {
+    let counter = match phase {
+        Phase::StaticStarts => &STARTS_NANOS,
+        Phase::Dynamics => &DYNAMICS_NANOS,
+        Phase::Observing => &OBSERVE_NANOS,
+    };
+    counter.fetch_add(nanos(took), Ordering::Relaxed);
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -117,6 +153,7 @@ mod tests {
             std::time::Duration::from_millis(1),
         );
         add_device(std::time::Duration::from_millis(2), true);
+        add_phase(Phase::Observing, std::time::Duration::from_millis(3));
         let d = Tally::now().since(&before);
         // Other tests may read back at the same time: at least what was added here.
         assert!(d.readbacks >= 2 && d.bytes_read >= 64);
@@ -124,5 +161,6 @@ mod tests {
         assert!(d.open_s >= 1e-3 - 1e-12);
         assert!(d.device_s >= 2e-3 - 1e-12 && d.trial_device_s >= 2e-3 - 1e-12);
         assert!(d.trials >= 1);
+        assert!(d.observing_s >= 3e-3 - 1e-12);
     }
 }

@@ -26,6 +26,7 @@ pub fn run(
     options: &EnsembleOptions,
 ) -> Result<EnsembleSummary, Error> {
     let monte_carlo = options.monte_carlo.as_ref();
+    let tally = crate::tally::Tally::now();
     let case = load_case(case_path)?;
     let settings = case.ensemble.clone();
     let cli_error = |key: &str, message: String| -> Error {
@@ -272,6 +273,7 @@ pub fn run(
             solved_by_engine: 0,
             solved_by_cpu: 0,
             seconds: 0.0,
+            engine_seconds: super::report::EngineSeconds::since(&tally),
             uncertainty: None,
             outputs: vec![format!(
                 "shard {k}/{n}: chunks {}..{} in {}/chunks; `holewall merge` gives the whole run",
@@ -378,6 +380,7 @@ pub fn run(
             .filter(|r| r.status != Status::Failed && r.solved_by == SolvedBy::Cpu)
             .count(),
         seconds,
+        engine_seconds: super::report::EngineSeconds::since(&tally),
         uncertainty,
         outputs,
     };

@@ -51,10 +51,38 @@ pub struct EnsembleSummary {
     pub solved_by_cpu: usize,
     /// Wall time of the variant runs (s).
     pub seconds: f64,
+    /// Of the variant runs computed in this invocation, the engine's phases (s): its static
+    /// starts, its dynamic runs and, of those, observing the states ([`crate::tally`]);
+    /// absent where the engine did not run.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub engine_seconds: Option<EngineSeconds>,
     /// Statistics and sensitivities of the quantities of interest (`--samples` runs).
     pub uncertainty: Option<crate::uq::report::UncertaintyReport>,
     /// Files written.
     pub outputs: Vec<String>,
+}
+
+/// The engine's phases in an ensemble run ([`EnsembleSummary::engine_seconds`]).
+#[derive(Clone, Copy, Debug, Serialize)]
+pub struct EngineSeconds {
+    /// The variants' static starts on the engine (held in the hole).
+    pub static_starts: f64,
+    /// The dynamic runs on the engine, observation included.
+    pub dynamics: f64,
+    /// Of those, observing the variants' states at every output step.
+    pub observing: f64,
+}
+
+impl EngineSeconds {
+    /// The phases counted between `before` and now, if the engine ran.
+    pub fn since(before: &crate::tally::Tally) -> Option<Self> {
+        let d = crate::tally::Tally::now().since(before);
+        (d.static_starts_s + d.dynamics_s > 0.0).then_some(EngineSeconds {
+            static_starts: d.static_starts_s,
+            dynamics: d.dynamics_s,
+            observing: d.observing_s,
+        })
+    }
 }
 
 impl EnsembleSummary {

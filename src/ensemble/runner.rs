@@ -113,6 +113,7 @@ pub fn run_dynamic_gpu<T: crate::gpu::contact::GpuReal>(
         Err(e) => return Ok(Err(e)),
     };
     let path = GpuPath(ctx);
+    let starts_clock = std::time::Instant::now();
     let statics = solve_static_ensemble::<T, _>(&guarded, &path, &case.settings().statics())
         .map_err(|e| Error::failed(format!("GPU engine: {e}")))?;
     // Each variant's static start held in the hole as the CPU run holds it (the guards in
@@ -129,6 +130,7 @@ pub fn run_dynamic_gpu<T: crate::gpu::contact::GpuReal>(
             EngineStatus::Failed(_) => None,
         })
         .collect();
+    crate::tally::add_phase(crate::tally::Phase::StaticStarts, starts_clock.elapsed());
     let on_gpu: Vec<usize> = (0..models.len()).filter(|&j| held[j].is_some()).collect();
     // Each variant's own model (with the sites kept at the wall) and start.
     let (gpu_models, static_starts): (Vec<Model>, Vec<StaticState>) = on_gpu
@@ -162,6 +164,7 @@ pub fn run_dynamic_gpu<T: crate::gpu::contact::GpuReal>(
         }
     }
     // None left for the engine: every variant runs on the CPU below.
+    let dynamics_clock = std::time::Instant::now();
     let results = if gpu_models.is_empty() {
         Vec::new()
     } else {
@@ -174,6 +177,7 @@ pub fn run_dynamic_gpu<T: crate::gpu::contact::GpuReal>(
             settings.duration,
             1,
             &mut |first, t, batch| {
+                let observing = std::time::Instant::now();
                 let (v, n) = (batch.num_variants, batch.num_nodes);
                 for j in 0..v {
                     let g = first + j;
@@ -203,10 +207,12 @@ pub fn run_dynamic_gpu<T: crate::gpu::contact::GpuReal>(
                     observers[g].observe(m, &cpu[g], state);
                 }
                 bar.set_position(((t / settings.duration) * variants.len() as f64) as u64);
+                crate::tally::add_phase(crate::tally::Phase::Observing, observing.elapsed());
             },
         )
         .map_err(|e| Error::failed(format!("GPU engine: {e}")))?
     };
+    crate::tally::add_phase(crate::tally::Phase::Dynamics, dynamics_clock.elapsed());
     let mut out: Vec<Option<VariantResult>> = vec![None; models.len()];
     for (&j, ((r, obs), state)) in on_gpu
         .iter()
