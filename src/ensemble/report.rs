@@ -51,9 +51,10 @@ pub struct EnsembleSummary {
     pub solved_by_cpu: usize,
     /// Wall time of the variant runs (s).
     pub seconds: f64,
-    /// Of the variant runs computed in this invocation, the engine's phases (s): its static
-    /// starts, its dynamic runs and, of those, observing the states ([`crate::tally`]);
-    /// absent where the engine did not run.
+    /// Of the dynamic variant runs computed in this invocation on the engine, its phases
+    /// (s): the static starts, the dynamic runs and, of those, observing the states
+    /// ([`crate::tally`]); absent where no dynamic run used the engine (a static ensemble
+    /// included).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub engine_seconds: Option<EngineSeconds>,
     /// Statistics and sensitivities of the quantities of interest (`--samples` runs).
