@@ -189,18 +189,11 @@ pub fn run_passes(
         .collect();
     // An encoder holding every pass of the kernel (the first run, and each timed repeat,
     // then with timestamps at the compute pass's start and end where the device has them).
-    let passes = |stamps: Option<&wgpu::QuerySet>| {
+    let passes = |clock: Option<&crate::gpu::pass_clock::PassClock>| {
         let mut encoder =
             device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(label) });
         {
-            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                label: Some(label),
-                timestamp_writes: stamps.map(|query_set| wgpu::ComputePassTimestampWrites {
-                    query_set,
-                    beginning_of_pass_write_index: Some(0),
-                    end_of_pass_write_index: Some(1),
-                }),
-            });
+            let mut pass = crate::gpu::pass_clock::PassClock::pass(clock, &mut encoder);
             pass.set_pipeline(pipeline);
             for bg in &bind_groups {
                 pass.set_bind_group(0, bg, &[]);
@@ -238,20 +231,7 @@ pub fn run_passes(
                 .map(|_| ())
                 .map_err(|e| GpuError::Device(e.to_string()))
         };
-        let stamps = ctx.has_timestamps.then(|| {
-            let set = device.create_query_set(&wgpu::QuerySetDescriptor {
-                label: Some(label),
-                ty: wgpu::QueryType::Timestamp,
-                count: 2,
-            });
-            let resolved = device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some(label),
-                size: 16,
-                usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
-                mapped_at_creation: false,
-            });
-            (set, resolved)
-        });
+        let clock = crate::gpu::pass_clock::PassClock::new(ctx, label);
         let mut seconds = Vec::with_capacity(repeats);
         let mut device_seconds = Vec::new();
         for _ in 0..repeats {
@@ -264,19 +244,17 @@ pub fn run_passes(
                 ctx.queue.submit([e.finish()]);
                 wait()?;
             }
-            let e = passes(stamps.as_ref().map(|s| &s.0));
-            let clock = std::time::Instant::now();
+            let e = passes(clock.as_ref());
+            let started = std::time::Instant::now();
             ctx.queue.submit([e.finish()]);
             wait()?;
-            seconds.push(clock.elapsed().as_secs_f64());
-            if let Some((set, resolved)) = &stamps {
+            seconds.push(started.elapsed().as_secs_f64());
+            if let Some(clock) = &clock {
                 let mut e = device
                     .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(label) });
-                e.resolve_query_set(set, 0..2, resolved, 0);
-                let got = crate::gpu::readback::submit_and_read(ctx, e, &[(resolved, 16)])?;
-                let ticks: Vec<u64> = crate::gpu::readback::values(&got[0]);
-                let period_ns = f64::from(ctx.queue.get_timestamp_period());
-                device_seconds.push(ticks[1].saturating_sub(ticks[0]) as f64 * period_ns * 1e-9);
+                let read = clock.resolve(&mut e);
+                let got = crate::gpu::readback::submit_and_read(ctx, e, &[read])?;
+                device_seconds.push(clock.seconds(&got[0]));
             }
         }
         let timing = KernelTiming {

@@ -1,6 +1,6 @@
-//! The device's own time of a resident batch's compute passes: timestamps at a pass's start
-//! and end, resolved and read back with the pass's other results (no round trip of its
-//! own), added to [`crate::tally`]. Where the adapter has no `TIMESTAMP_QUERY` there is no
+//! The device's own time of a compute pass: timestamps at its start and end, resolved and
+//! read back — for a resident batch with the pass's other results (no round trip of its
+//! own), added to [`crate::tally`]; for `bench kernels` by [`crate::gpu::dispatch::timed`]. Where the adapter has no `TIMESTAMP_QUERY` there is no
 //! clock and nothing is recorded.
 
 use crate::gpu::GpuContext;
@@ -56,13 +56,19 @@ impl PassClock {
         (&self.resolved, BYTES)
     }
 
+    /// The pass's device time (s), from the stamps' bytes read back.
+    pub fn seconds(&self, bytes: &[u8]) -> f64 {
+        let ticks: Vec<u64> = crate::gpu::readback::values(bytes);
+        match ticks[..] {
+            [start, end, ..] => end.saturating_sub(start) as f64 * self.period_ns * 1e-9,
+            _ => 0.0,
+        }
+    }
+
     /// Adds the pass's device time, from the stamps' bytes read back, to the tally
     /// (`trial`: a line-search trial's pass).
     pub fn record(&self, bytes: &[u8], trial: bool) {
-        let ticks: Vec<u64> = crate::gpu::readback::values(bytes);
-        if let [start, end] = ticks[..] {
-            let ns = end.saturating_sub(start) as f64 * self.period_ns;
-            crate::tally::add_device(std::time::Duration::from_nanos(ns as u64), trial);
-        }
+        let took = std::time::Duration::from_secs_f64(self.seconds(bytes));
+        crate::tally::add_device(took, trial);
     }
 }
