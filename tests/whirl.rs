@@ -483,6 +483,67 @@ fn the_shipped_whirl_map() {
     }
 }
 
+/// A friction drawn per variant (a value each, as a Monte Carlo draw or a user's variants
+/// file gives) is mapped in at most `WHIRL_MAP_FACETS` ranges, not one map per value: 9
+/// variants of the shipped whirl map, shortened to 20 ms, with 9 distinct frictions give 6
+/// maps named by their ranges, and every variant lies in exactly one of them.
+#[test]
+fn a_drawn_friction_is_mapped_in_ranges() {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let dir = std::env::temp_dir().join(format!("holewall-whirl-drawn-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let text = std::fs::read_to_string(root.join("cases/whirl_map.toml"))
+        .unwrap()
+        .replace("duration = \"4 s\"", "duration = \"20 ms\"");
+    std::fs::write(dir.join("case.toml"), text).unwrap();
+    let mut csv = String::from("rpm,wob,mu\n");
+    let mus = [0.11, 0.15, 0.19, 0.23, 0.27, 0.31, 0.35, 0.39, 0.43];
+    for (i, mu) in mus.iter().enumerate() {
+        csv.push_str(&format!("{} rpm,{} kN,{mu}\n", 60 + 20 * i, 10 + 3 * i));
+    }
+    std::fs::write(dir.join("variants.csv"), csv).unwrap();
+    let out = dir.join("out");
+    let s = holewall::ensemble::job::run(
+        &dir.join("case.toml"),
+        Some(&dir.join("variants.csv")),
+        holewall::backend::BackendChoice::Cpu,
+        holewall::backend::Precision::F64,
+        &out,
+        false,
+        &Default::default(),
+    )
+    .unwrap();
+    assert_eq!((s.variants, s.failed), (9, 0));
+    let mut maps: Vec<String> = std::fs::read_dir(&out)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|n| n.starts_with("whirl_map_"))
+        .collect();
+    maps.sort();
+    assert_eq!(
+        maps.len(),
+        holewall::ensemble::job::WHIRL_MAP_FACETS,
+        "{maps:?}"
+    );
+    let ranges = holewall::ensemble::job::facets(&mus, holewall::ensemble::job::WHIRL_MAP_FACETS);
+    for mu in mus {
+        assert_eq!(
+            ranges
+                .iter()
+                .filter(|(lo, hi)| (*lo..=*hi).contains(&mu))
+                .count(),
+            1,
+            "{mu}: {ranges:?}"
+        );
+    }
+    assert!(
+        maps.contains(&"whirl_map_stab1_mu0.11-0.15.png".to_string()),
+        "{maps:?}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 /// The GPU dynamic engine starts from the case's initial offset and kick as the CPU
 /// integrator does (`Case::dynamic_start` on each variant's static equilibrium): the short
 /// spin-up let go 2 mm off the axis with a 0.02 m/s kick, two speeds, 0.3 s, f64 engine

@@ -549,39 +549,40 @@ fn whirl_maps(
         return Ok(written);
     };
     let (sx, _) = Unit::of_key(kx).display();
-    // A third varied key (friction, say): one map per value, so no point hides another.
-    let groups: Vec<Option<f64>> = match keys.get(2) {
+    // A third varied key (friction, say): one map per value of a grid, so no point hides
+    // another; a drawn key (a value per variant) in at most `WHIRL_MAP_FACETS` ranges.
+    let groups: Vec<Option<(f64, f64)>> = match keys.get(2) {
         None => vec![None],
         Some(kz) => {
-            let mut vals: Vec<f64> = variants.iter().map(|v| value(v, kz)).collect();
-            vals.sort_by(|a, b| a.total_cmp(b));
-            vals.dedup();
-            vals.into_iter().map(Some).collect()
+            let vals: Vec<f64> = variants.iter().map(|v| value(v, kz)).collect();
+            facets(&vals, WHIRL_MAP_FACETS)
+                .into_iter()
+                .map(Some)
+                .collect()
         }
     };
     for k in 0..stabs {
         for group in &groups {
             let (file, suffix) = match (group, keys.get(2)) {
-                (Some(z), Some(kz)) => {
+                (Some((lo, hi)), Some(kz)) => {
                     let (sz, unit) = Unit::of_key(kz).display();
-                    (
-                        format!(
-                            "whirl_map_stab{}_{}{}.png",
-                            k + 1,
-                            kz.name,
-                            crate::units::show(sz * z)
-                        ),
-                        format!(
-                            ", {} = {}{}",
-                            kz.name,
-                            crate::units::show(sz * z),
-                            if unit == "–" {
-                                String::new()
-                            } else {
-                                format!(" {unit}")
-                            }
-                        ),
-                    )
+                    let unit = if unit == "–" {
+                        String::new()
+                    } else {
+                        format!(" {unit}")
+                    };
+                    let (lo, hi) = (crate::units::show(sz * lo), crate::units::show(sz * hi));
+                    if lo == hi {
+                        (
+                            format!("whirl_map_stab{}_{}{lo}.png", k + 1, kz.name),
+                            format!(", {} = {lo}{unit}", kz.name),
+                        )
+                    } else {
+                        (
+                            format!("whirl_map_stab{}_{}{lo}-{hi}.png", k + 1, kz.name),
+                            format!(", {} from {lo} to {hi}{unit}", kz.name),
+                        )
+                    }
                 }
                 _ => (format!("whirl_map_stab{}.png", k + 1), String::new()),
             };
@@ -589,7 +590,7 @@ fn whirl_maps(
                 .iter()
                 .zip(results)
                 .filter(|(v, _)| match (group, keys.get(2)) {
-                    (Some(z), Some(kz)) => value(v, kz) == *z,
+                    (Some((lo, hi)), Some(kz)) => (*lo..=*hi).contains(&value(v, kz)),
                     _ => true,
                 })
                 .filter_map(|(v, r)| {
@@ -617,4 +618,74 @@ fn whirl_maps(
         }
     }
     Ok(written)
+}
+
+/// At most this many whirl maps per stabilizer over a third varied key
+/// ([`facets`]): a grid's few values each get their own; a key drawn per variant (a
+/// Monte Carlo friction) got one map per distinct value before — 370 PNGs of a few points
+/// each for 1,024 variants of `cases/whirl_map.toml` with μ drawn to three digits.
+pub const WHIRL_MAP_FACETS: usize = 6;
+
+/// The ranges (inclusive, from the smallest value to the largest) a third varied key's
+/// values fall into, in order: one per distinct value where there are at most `max`, else
+/// at most `max` ranges holding about as many variants each (edges at values, a value never
+/// split between two). Values that are not finite (a variant without the key) fall in none.
+pub fn facets(values: &[f64], max: usize) -> Vec<(f64, f64)> {
+    let mut sorted: Vec<f64> = values.iter().copied().filter(|x| x.is_finite()).collect();
+    sorted.sort_by(f64::total_cmp);
+    let mut distinct = sorted.clone();
+    distinct.dedup();
+    if distinct.len() <= max.max(1) {
+        return distinct.into_iter().map(|x| (x, x)).collect();
+    }
+    let n = sorted.len();
+    let mut ranges: Vec<(f64, f64)> = Vec::new();
+    let mut start = 0;
+    for b in 1..=max {
+        // The upper edge of range b: the value at its share of the variants, with every
+        // equal value after it.
+        let mut end = (b * n).div_ceil(max).max(start + 1).min(n);
+        while end < n && sorted[end] == sorted[end - 1] {
+            end += 1;
+        }
+        if start < end {
+            ranges.push((sorted[start], sorted[end - 1]));
+        }
+        start = end;
+        if start >= n {
+            break;
+        }
+    }
+    ranges
+}
+
+#[cfg(test)]
+mod tests {
+    use super::facets;
+
+    #[test]
+    fn a_grid_keeps_one_facet_per_value_and_a_draw_gets_ranges() {
+        // A grid: three values, each its own map.
+        let grid = [0.1, 0.3, 0.5, 0.1, 0.3, 0.5, 0.5];
+        assert_eq!(facets(&grid, 6), vec![(0.1, 0.1), (0.3, 0.3), (0.5, 0.5)]);
+        // A draw: 1,000 distinct values in six ranges of about equal counts, covering
+        // every value once, in order, none split.
+        let drawn: Vec<f64> = (0..1000)
+            .map(|i| ((i * 7919) % 1000) as f64 / 1000.0)
+            .collect();
+        let r = facets(&drawn, 6);
+        assert_eq!(r.len(), 6);
+        assert_eq!((r[0].0, r[5].1), (0.0, 0.999));
+        for w in r.windows(2) {
+            assert!(w[0].1 < w[1].0, "{r:?}");
+        }
+        for (lo, hi) in &r {
+            let count = drawn.iter().filter(|x| (*lo..=*hi).contains(*x)).count();
+            assert!((166..=167).contains(&count), "{r:?}: {count}");
+        }
+        // Repeated values stay together; values not set fall in none.
+        let tied = [1.0, 1.0, 1.0, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, f64::NAN];
+        let r = facets(&tied, 3);
+        assert_eq!(r, vec![(1.0, 1.0), (2.0, 4.0), (5.0, 7.0)]);
+    }
 }
