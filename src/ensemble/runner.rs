@@ -157,12 +157,17 @@ pub fn run_dynamic_gpu<T: crate::gpu::contact::GpuReal>(
         .map(|m| DynamicObserver::new(m, settings.duration))
         .collect();
     let mut last: Vec<Option<DynamicState>> = vec![None; gpu_models.len()];
-    for (j, (d, (q, vel))) in cpu.iter_mut().zip(&starts).enumerate() {
-        if let Ok(s) = d.initial_state_with(q.clone(), vel.clone()) {
-            observers[j].observe(&gpu_models[j], d, &s);
-            last[j] = Some(s);
-        }
-    }
+    // Each variant's initial state and first observation, in parallel (each its own).
+    cpu.par_iter_mut()
+        .zip(starts.par_iter())
+        .zip(observers.par_iter_mut().zip(last.par_iter_mut()))
+        .zip(gpu_models.par_iter())
+        .for_each(|(((d, (q, vel)), (observer, last)), m)| {
+            if let Ok(s) = d.initial_state_with(q.clone(), vel.clone()) {
+                observer.observe(m, d, &s);
+                *last = Some(s);
+            }
+        });
     // None left for the engine: every variant runs on the CPU below.
     let dynamics_clock = std::time::Instant::now();
     let results = if gpu_models.is_empty() {
@@ -179,33 +184,39 @@ pub fn run_dynamic_gpu<T: crate::gpu::contact::GpuReal>(
             &mut |first, t, batch| {
                 let observing = std::time::Instant::now();
                 let (v, n) = (batch.num_variants, batch.num_nodes);
-                for j in 0..v {
-                    let g = first + j;
-                    let Some(state) = last[g].as_mut() else {
-                        continue;
-                    };
-                    let m = &gpu_models[g];
-                    state.t = t;
-                    for i in 0..n {
-                        for k in 0..3 {
-                            state.q.x[i][k] = m.nodes[i].position[k]
-                                + batch.u[(3 * i + k) * v + j].to_f64_lossy();
-                        }
-                        for r in 0..3 {
-                            for c in 0..3 {
-                                state.q.rot[i][r][c] =
-                                    batch.rot[(9 * i + 3 * r + c) * v + j].to_f64_lossy();
+                // Every variant of the batch observed in parallel: each reads its own
+                // column of the variant-fastest state and writes its own observer.
+                let range = first..first + v;
+                last[range.clone()]
+                    .par_iter_mut()
+                    .zip(observers[range.clone()].par_iter_mut())
+                    .zip(gpu_models[range.clone()].par_iter().zip(&cpu[range]))
+                    .enumerate()
+                    .for_each(|(j, ((state, observer), (m, d)))| {
+                        let Some(state) = state.as_mut() else {
+                            return;
+                        };
+                        state.t = t;
+                        for i in 0..n {
+                            for k in 0..3 {
+                                state.q.x[i][k] = m.nodes[i].position[k]
+                                    + batch.u[(3 * i + k) * v + j].to_f64_lossy();
+                            }
+                            for r in 0..3 {
+                                for c in 0..3 {
+                                    state.q.rot[i][r][c] =
+                                        batch.rot[(9 * i + 3 * r + c) * v + j].to_f64_lossy();
+                                }
+                            }
+                            for k in 0..6 {
+                                let idx = (6 * i + k) * v + j;
+                                state.v[6 * i + k] = batch.vel[idx].to_f64_lossy();
+                                state.a[6 * i + k] = batch.acc[idx].to_f64_lossy();
+                                state.vdot[6 * i + k] = batch.vdot[idx].to_f64_lossy();
                             }
                         }
-                        for k in 0..6 {
-                            let idx = (6 * i + k) * v + j;
-                            state.v[6 * i + k] = batch.vel[idx].to_f64_lossy();
-                            state.a[6 * i + k] = batch.acc[idx].to_f64_lossy();
-                            state.vdot[6 * i + k] = batch.vdot[idx].to_f64_lossy();
-                        }
-                    }
-                    observers[g].observe(m, &cpu[g], state);
-                }
+                        observer.observe(m, d, state);
+                    });
                 bar.set_position(((t / settings.duration) * variants.len() as f64) as u64);
                 crate::tally::add_phase(crate::tally::Phase::Observing, observing.elapsed());
             },
