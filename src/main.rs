@@ -660,6 +660,20 @@ fn main() -> ExitCode {
                 Ok(_) => ExitCode::SUCCESS,
                 Err(e) => fail(&[e]),
             },
+            BenchCommand::Job {
+                case,
+                samples,
+                seed,
+                repeats,
+                out,
+                quiet,
+            } => match cli::bench_job::run(&case, samples, seed, repeats, &out, !quiet) {
+                Ok(b) => {
+                    print!("{}", cli::bench_job::markdown(&b));
+                    ExitCode::SUCCESS
+                }
+                Err(e) => fail(&[e]),
+            },
             BenchCommand::Element {
                 states,
                 repeats,

@@ -409,3 +409,70 @@ fn sixty_four_variant_static_ensemble_on_the_gpu_matches_the_cpu_runs() {
     );
     assert!(worst32.iter().all(|&w| w <= 1.2e-3), "{worst32:?}");
 }
+
+/// `holewall bench job` (issue 27): a user's Monte Carlo job (`cases/whirl_job.toml`, 4
+/// variants) timed whole on every path at hand, twice each — every variant solved where the
+/// path says (the engine on the GPU paths, the CPU on the CPU path), the engine's phases
+/// given where it ran and within the job's time, the tables and the last job's outputs
+/// written; `--samples 0` is an input error (exit 2).
+#[test]
+fn the_job_bench_times_a_users_job_on_every_path() {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let case = root.join("cases/whirl_job.toml");
+    let out = common::scratch_dir("ensemble", "bench_job");
+    let args = |samples: &str| {
+        vec![
+            "bench".to_string(),
+            "job".into(),
+            case.to_str().unwrap().into(),
+            "--samples".into(),
+            samples.into(),
+            "--repeats".into(),
+            "2".into(),
+            "--out".into(),
+            out.to_str().unwrap().into(),
+            "--quiet".into(),
+        ]
+    };
+    let run = |samples: &str| {
+        let a = args(samples);
+        common::holewall(&a.iter().map(String::as_str).collect::<Vec<_>>())
+    };
+    let (code, stdout, stderr) = run("4");
+    assert_eq!(code, 0, "{stderr}");
+    assert!(stdout.contains("| CPU f64 | 2 |"), "{stdout}");
+    let r: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("job.json")).unwrap()).unwrap();
+    let paths = match common::gpu() {
+        Some(ctx) if ctx.has_f64 => 3,
+        Some(_) => 2,
+        None => 1,
+    };
+    let runs = r["runs"].as_array().unwrap();
+    assert_eq!(runs.len(), 2 * paths, "{r}");
+    for run in runs {
+        let wall = run["wall_s"].as_f64().unwrap();
+        let inside = run["variant_runs_s"].as_f64().unwrap();
+        assert!(wall >= inside && inside > 0.0, "{run}");
+        assert_eq!(run["failed"], 0, "{run}");
+        if run["path"] == "CPU f64" {
+            assert_eq!(run["solved_by_cpu"], 4, "{run}");
+            assert!(run["engine_seconds"].is_null(), "{run}");
+        } else {
+            assert_eq!(run["solved_by_engine"], 4, "{run}");
+            let e = &run["engine_seconds"];
+            let dynamics = e["dynamics"].as_f64().unwrap();
+            assert!(dynamics > 0.0 && dynamics <= inside, "{run}");
+            assert!(e["observing"].as_f64().unwrap() <= dynamics, "{run}");
+        }
+    }
+    assert_eq!(r["medians"].as_array().unwrap().len(), paths, "{r}");
+    assert!(out.join("job.md").is_file());
+    assert!(out.join("runs/cpu_f64/variants.csv").is_file());
+    let (code, _, stderr) = run("0");
+    assert_eq!(code, 2, "{stderr}");
+    assert!(
+        stderr.contains("--samples") && stderr.contains("at least 1"),
+        "{stderr}"
+    );
+}

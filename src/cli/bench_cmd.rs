@@ -39,6 +39,30 @@ pub enum BenchCommand {
         #[arg(long)]
         json: Option<PathBuf>,
     },
+    /// A user's Monte Carlo ensemble job timed whole (`holewall ensemble CASE --samples N
+    /// --seed S`: static starts, dynamics, observations, statistics, plots, report) on the
+    /// CPU backend and on the GPU engine in f64 and f32, each `--repeats` times in one
+    /// process (run 1 of a GPU path compiles its kernels); job.md and job.json.
+    Job {
+        /// The case (a dynamic ensemble with `[ensemble.uncertain]`).
+        #[arg(default_value = "cases/whirl_job.toml")]
+        case: PathBuf,
+        /// Variants drawn.
+        #[arg(long, default_value_t = 1024)]
+        samples: usize,
+        /// Seed of the draw.
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+        /// Jobs per path.
+        #[arg(long, default_value_t = 2)]
+        repeats: usize,
+        /// Output folder (job.md, job.json; runs/ holds each path's last job).
+        #[arg(long)]
+        out: PathBuf,
+        /// No progress bar.
+        #[arg(long)]
+        quiet: bool,
+    },
     /// Variant-steps per second of dynamic ensembles (V variants × n nodes): CPU f64
     /// integrator, GPU engine f64 and f32; bytes and FLOPs per Newton iteration; a
     /// work-precision table.

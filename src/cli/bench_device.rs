@@ -2,8 +2,8 @@
 //! command (issue 27) — for a user with a GPU to run and send back. It runs, in order, the
 //! contact evaluations (`bench contact`), the beam element (`bench element`), the roofline
 //! per kernel (`bench kernels`), the static ensembles on the shipped stress and
-//! build-and-hold cases (`bench statics`) and the dynamic ensembles (`bench ensemble`), each
-//! against the CPU path in the same run, and gathers their JSON into `device.json` and their
+//! build-and-hold cases (`bench statics`), the dynamic ensembles (`bench ensemble`) and a
+//! user's Monte Carlo job timed whole (`bench job`), each against the CPU path in the same run, and gathers their JSON into `device.json` and their
 //! tables into `device.md`. Nothing here measures anything itself: each part is the
 //! benchmark of its own command.
 
@@ -59,7 +59,7 @@ pub fn run(out: &Path, cases: &Path, options: DeviceOptions) -> Result<(), Error
     let build_and_hold = cases.join("ensemble_build_and_hold.toml");
     let bar = crate::output::progress_bar(
         options.show_progress,
-        6,
+        7,
         "{bar:30} {pos}/{len} parts, {elapsed} elapsed: {msg}",
     );
     let mut parts = Vec::new();
@@ -123,6 +123,17 @@ pub fn run(out: &Path, cases: &Path, options: DeviceOptions) -> Result<(), Error
         ),
         out.join("ensemble.json"),
         &mut |f| super::bench_ensemble::run(&nodes, &variants, 5, 3, 120.0, true, 100, Some(f)),
+    );
+    let job_dir = out.join("job");
+    let job_case = cases.join("whirl_job.toml");
+    let job_samples = if q { 256 } else { 4096 };
+    part(
+        "a user's job",
+        format!(
+            "holewall bench job cases/whirl_job.toml --samples {job_samples} --repeats 2 --out DIR"
+        ),
+        job_dir.join("job.json"),
+        &mut |_| super::bench_job::run(&job_case, job_samples, 1, 2, &job_dir, false).map(|_| ()),
     );
     bar.finish_and_clear();
     let device = crate::gpu::GpuContext::shared()
