@@ -48,9 +48,19 @@ pub struct JobBench {
     pub cpu_threads: usize,
     /// Every job, in order.
     pub runs: Vec<JobRun>,
-    /// Per path: the median wall time of its runs after the first (the first where it ran
-    /// once), and the CPU's median over it.
-    pub medians: Vec<(String, f64, f64)>,
+    /// Per path, its warm job time and speed against the CPU path.
+    pub medians: Vec<JobMedian>,
+}
+
+/// A path's warm job time ([`JobBench::medians`]).
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct JobMedian {
+    /// `CPU f64`, `GPU f64` or `GPU f32`.
+    pub path: String,
+    /// The median wall time of its runs after the first (the first where it ran once), s.
+    pub job_s: f64,
+    /// The CPU path's over it (above 1: faster than the CPU).
+    pub speed_vs_cpu: f64,
 }
 
 fn median(mut x: Vec<f64>) -> f64 {
@@ -151,9 +161,13 @@ pub fn run(
         }
     };
     let cpu = warm("CPU f64");
-    let medians: Vec<(String, f64, f64)> = paths
+    let medians: Vec<JobMedian> = paths
         .iter()
-        .map(|(n, _, _)| (n.to_string(), warm(n), cpu / warm(n)))
+        .map(|(n, _, _)| JobMedian {
+            path: n.to_string(),
+            job_s: warm(n),
+            speed_vs_cpu: cpu / warm(n),
+        })
         .collect();
     let bench = JobBench {
         case: case.display().to_string(),
@@ -202,8 +216,11 @@ pub fn markdown(b: &JobBench) -> String {
         ));
     }
     md.push_str("\n| path | job, median of the runs after the first (s) | speed vs CPU f64 (its job time ÷ this one's) |\n|---|---|---|\n");
-    for (n, t, ratio) in &b.medians {
-        md.push_str(&format!("| {n} | {t:.3} | {ratio:.2} |\n"));
+    for m in &b.medians {
+        md.push_str(&format!(
+            "| {} | {:.3} | {:.2} |\n",
+            m.path, m.job_s, m.speed_vs_cpu
+        ));
     }
     md
 }
