@@ -470,7 +470,10 @@ fn the_job_bench_times_a_users_job_on_every_path() {
     assert_eq!(medians.len(), paths, "{r}");
     assert_eq!(medians[0]["path"], "CPU f64", "{r}");
     assert_eq!(medians[0]["speed_vs_cpu"], 1.0, "{r}");
-    assert!(medians.iter().all(|m| m["job_s"].as_f64().unwrap() > 0.0), "{r}");
+    assert!(
+        medians.iter().all(|m| m["job_s"].as_f64().unwrap() > 0.0),
+        "{r}"
+    );
     assert!(out.join("job.md").is_file());
     assert!(out.join("runs/cpu_f64/variants.csv").is_file());
     let (code, _, stderr) = run("0");

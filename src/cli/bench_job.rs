@@ -63,13 +63,10 @@ pub struct JobMedian {
     pub speed_vs_cpu: f64,
 }
 
+/// The median (NaN of none), by the statistics' one percentile.
 fn median(mut x: Vec<f64>) -> f64 {
     x.sort_by(f64::total_cmp);
-    match x.len() {
-        0 => f64::NAN,
-        n if n % 2 == 1 => x[n / 2],
-        n => 0.5 * (x[n / 2 - 1] + x[n / 2]),
-    }
+    crate::uq::stats::percentile(&x, 50.0)
 }
 
 /// Runs the job `repeats` times per path into `out/runs/` (each run's folder replaced by
