@@ -550,15 +550,17 @@ fn whirl_maps(
     };
     let (sx, _) = Unit::of_key(kx).display();
     // A third varied key (friction, say): one map per value of a grid, so no point hides
-    // another; a drawn key (a value per variant) in at most `WHIRL_MAP_FACETS` ranges.
+    // another; a drawn key (a value per variant) in at most `WHIRL_MAP_FACETS` ranges
+    // (`whirl_map_groups`).
     let groups: Vec<Option<(f64, f64)>> = match keys.get(2) {
         None => vec![None],
         Some(kz) => {
-            let vals: Vec<f64> = variants.iter().map(|v| value(v, kz)).collect();
-            facets(&vals, WHIRL_MAP_FACETS)
-                .into_iter()
-                .map(Some)
-                .collect()
+            let ky = keys.get(1);
+            let points: Vec<[f64; 3]> = variants
+                .iter()
+                .map(|v| [value(v, kx), ky.map_or(0.0, |k| value(v, k)), value(v, kz)])
+                .collect();
+            whirl_map_groups(&points).into_iter().map(Some).collect()
         }
     };
     for k in 0..stabs {
@@ -620,11 +622,34 @@ fn whirl_maps(
     Ok(written)
 }
 
-/// At most this many whirl maps per stabilizer over a third varied key
-/// ([`facets`]): a grid's few values each get their own; a key drawn per variant (a
-/// Monte Carlo friction) got one map per distinct value before — 370 PNGs of a few points
-/// each for 1,024 variants of `cases/whirl_map.toml` with μ drawn to three digits.
+/// At most this many whirl maps per stabilizer over a third varied key drawn per variant
+/// ([`whirl_map_groups`]): one map per distinct value gave 370 PNGs of a few points each for
+/// 1,024 variants of `cases/whirl_map.toml` with μ drawn to three digits.
 pub const WHIRL_MAP_FACETS: usize = 6;
+
+/// A grid's third key keeps one map per value up to this many values (a grid repeats its
+/// (x, y) points for every value, and a map of two values would hide one under the other).
+pub const WHIRL_MAP_GRID_VALUES: usize = 24;
+
+/// The whirl maps' ranges of the third varied key from each variant's `[x, y, z]` (its
+/// first, second and third varied keys): one map per value where there are at most
+/// [`WHIRL_MAP_FACETS`] values, or where some (x, y) point recurs with two values of z (a
+/// grid) and there are at most [`WHIRL_MAP_GRID_VALUES`]; else at most [`WHIRL_MAP_FACETS`]
+/// ranges ([`facets`]).
+pub fn whirl_map_groups(points: &[[f64; 3]]) -> Vec<(f64, f64)> {
+    let z: Vec<f64> = points.iter().map(|p| p[2]).collect();
+    let exact = facets(&z, usize::MAX);
+    let mut seen: std::collections::HashMap<(u64, u64), u64> = std::collections::HashMap::new();
+    let recurs = points.iter().any(|p| {
+        let z = p[2].to_bits();
+        *seen.entry((p[0].to_bits(), p[1].to_bits())).or_insert(z) != z
+    });
+    if exact.len() <= WHIRL_MAP_FACETS || (recurs && exact.len() <= WHIRL_MAP_GRID_VALUES) {
+        exact
+    } else {
+        facets(&z, WHIRL_MAP_FACETS)
+    }
+}
 
 /// The ranges (inclusive, from the smallest value to the largest) a third varied key's
 /// values fall into, in order: one per distinct value where there are at most `max`, else
@@ -662,6 +687,32 @@ pub fn facets(values: &[f64], max: usize) -> Vec<(f64, f64)> {
 #[cfg(test)]
 mod tests {
     use super::facets;
+
+    #[test]
+    fn a_grid_of_many_values_keeps_its_maps_and_a_draw_is_binned() {
+        use super::{whirl_map_groups, WHIRL_MAP_FACETS};
+        // A grid: 4 × 2 (x, y) points at each of 9 frictions: one map each (two frictions
+        // in one map would hide every point under another).
+        let mut grid = Vec::new();
+        for z in 0..9 {
+            for x in 0..4 {
+                for y in 0..2 {
+                    grid.push([x as f64, y as f64, 0.1 + 0.05 * z as f64]);
+                }
+            }
+        }
+        assert_eq!(whirl_map_groups(&grid).len(), 9);
+        // The same 72 variants drawn (no (x, y) point twice): six ranges.
+        let drawn: Vec<[f64; 3]> = grid
+            .iter()
+            .enumerate()
+            .map(|(i, p)| [i as f64, 0.5 * i as f64, p[2]])
+            .collect();
+        assert_eq!(whirl_map_groups(&drawn).len(), WHIRL_MAP_FACETS);
+        // A grid of more values than a page of maps is read in ranges too.
+        let wide: Vec<[f64; 3]> = (0..50).map(|i| [0.0, 0.0, i as f64]).collect();
+        assert_eq!(whirl_map_groups(&wide).len(), WHIRL_MAP_FACETS);
+    }
 
     #[test]
     fn a_grid_keeps_one_facet_per_value_and_a_draw_gets_ranges() {
