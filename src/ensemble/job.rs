@@ -623,8 +623,8 @@ fn whirl_maps(
 }
 
 /// At most this many whirl maps per stabilizer over a third varied key drawn per variant
-/// ([`whirl_map_groups`]): one map per distinct value gave 370 PNGs of a few points each for
-/// 1,024 variants of `cases/whirl_map.toml` with μ drawn to three digits.
+/// ([`whirl_map_groups`]): one map per distinct value gave 378 PNGs of a few points each for
+/// 1,024 variants of `cases/whirl_job.toml` with μ drawn to three digits.
 pub const WHIRL_MAP_FACETS: usize = 6;
 
 /// A grid's third key keeps one map per value up to this many values (a grid repeats its
