@@ -19,7 +19,7 @@ pub fn write_csv_rows<T: serde::Serialize>(
     write_atomic(path, &bytes)
 }
 
-pub use crate::atomic_file::write_atomic;
+pub use crate::atomic_file::{write_atomic, write_json_atomic};
 
 /// Serde for an `f64` that may be NaN: JSON has no NaN, so it is written as `null` (as
 /// serde_json does anyway) and `null` is read back as NaN; every finite value round-trips

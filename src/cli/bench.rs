@@ -118,8 +118,7 @@ pub fn contact(
             adapter,
             rows,
         };
-        let text = serde_json::to_string_pretty(&report)?;
-        write_atomic(path, text.as_bytes())?;
+        crate::output::write_json_atomic(path, &report)?;
     }
     Ok(())
 }

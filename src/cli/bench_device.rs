@@ -161,12 +161,7 @@ pub fn run(out: &Path, cases: &Path, options: DeviceOptions) -> Result<(), Error
         }
     }
     crate::output::write_atomic(&out.join("device.md"), md.as_bytes())?;
-    crate::output::write_atomic(
-        &out.join("device.json"),
-        serde_json::to_string_pretty(&serde_json::Value::Object(all))
-            .unwrap_or_default()
-            .as_bytes(),
-    )?;
+    crate::output::write_json_atomic(&out.join("device.json"), &serde_json::Value::Object(all))?;
     let failed: Vec<&str> = parts
         .iter()
         .filter(|p| p.json.is_err())

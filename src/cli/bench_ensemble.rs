@@ -17,7 +17,6 @@ use crate::error::Error;
 use crate::gpu::contact::GpuReal;
 use crate::gpu::GpuContext;
 use crate::model::Model;
-use crate::output::write_atomic;
 use crate::solve::dynamics::{DynamicOptions, Dynamics};
 use crate::solve::statics::{solve_static, StaticOptions, StaticState};
 
@@ -572,8 +571,7 @@ pub fn run(
             cells,
             work_precision,
         };
-        let text = serde_json::to_string_pretty(&report)?;
-        write_atomic(p, text.as_bytes())?;
+        crate::output::write_json_atomic(p, &report)?;
     }
     Ok(())
 }

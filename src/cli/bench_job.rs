@@ -175,12 +175,7 @@ pub fn run(
         runs,
         medians,
     };
-    crate::output::write_atomic(
-        &out.join("job.json"),
-        serde_json::to_string_pretty(&bench)
-            .unwrap_or_default()
-            .as_bytes(),
-    )?;
+    crate::output::write_json_atomic(&out.join("job.json"), &bench)?;
     crate::output::write_atomic(&out.join("job.md"), markdown(&bench).as_bytes())?;
     Ok(bench)
 }

@@ -401,12 +401,7 @@ pub fn run(
     };
     let md = markdown(&report);
     crate::output::write_atomic(&out.join("kernels.md"), md.as_bytes())?;
-    crate::output::write_atomic(
-        &out.join("kernels.json"),
-        serde_json::to_string_pretty(&report)
-            .unwrap_or_default()
-            .as_bytes(),
-    )?;
+    crate::output::write_json_atomic(&out.join("kernels.json"), &report)?;
     roofline(&out.join("roofline.png"), &report)?;
     println!("{md}");
     Ok(report)

@@ -7,7 +7,6 @@ use crate::error::Error;
 use crate::gpu::contact::{GpuContactRun, GpuReal};
 use crate::gpu::GpuContext;
 use crate::kernels::contact::{contact as contact_twin, ContactBatch, ContactOutputs};
-use crate::output::write_atomic;
 use crate::physics::contact::{ContactMode, ContactTerms, FrictionModel};
 use crate::selfcheck::{median_seconds, random_batch};
 use serde::Serialize;
@@ -133,8 +132,7 @@ pub fn specialisation(pairs: usize, repeats: usize, json: Option<&Path>) -> Resu
         );
     }
     if let Some(path) = json {
-        let text = serde_json::to_string_pretty(&rows)?;
-        write_atomic(path, text.as_bytes())?;
+        crate::output::write_json_atomic(path, &rows)?;
     }
     Ok(())
 }

@@ -384,12 +384,7 @@ pub fn run(
         uncertainty,
         outputs,
     };
-    write_atomic(
-        &out.join("summary.json"),
-        serde_json::to_string_pretty(&summary)
-            .unwrap_or_default()
-            .as_bytes(),
-    )?;
+    crate::output::write_json_atomic(&out.join("summary.json"), &summary)?;
     // `--units field`: variants.csv, the statistics' CSVs and summary.json translated (the
     // chunks and run.json, the run's own state, stay SI).
     crate::display_units::convert_folder(out)?;
