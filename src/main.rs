@@ -664,10 +664,19 @@ fn main() -> ExitCode {
                 case,
                 samples,
                 seed,
+                variants,
                 repeats,
                 out,
                 quiet,
-            } => match cli::bench_job::run(&case, samples, seed, repeats, &out, !quiet) {
+            } => match cli::bench_job::run(
+                &case,
+                variants.as_deref(),
+                samples,
+                seed,
+                repeats,
+                &out,
+                !quiet,
+            ) {
                 Ok(b) => {
                     print!("{}", cli::bench_job::markdown(&b));
                     ExitCode::SUCCESS

@@ -411,7 +411,8 @@ fn sixty_four_variant_static_ensemble_on_the_gpu_matches_the_cpu_runs() {
 }
 
 /// `holewall bench job` (issue 27): a user's Monte Carlo job (`cases/whirl_job.toml`, 4
-/// variants) timed whole on every path at hand, twice each — every variant solved where the
+/// variants, twice each), then the job of a variants file (2 variants, once), timed whole on
+/// every path at hand — every variant solved where the
 /// path says (the engine on the GPU paths, the CPU on the CPU path), the engine's phases
 /// given where it ran and within the job's time, the tables and the last job's outputs
 /// written; `--samples 0` is an input error (exit 2).
@@ -482,4 +483,41 @@ fn the_job_bench_times_a_users_job_on_every_path() {
         stderr.contains("--samples") && stderr.contains("at least 1"),
         "{stderr}"
     );
+    // The job of a variants file (its whirl maps, not the statistics), once per path.
+    let file = out.join("v.csv");
+    std::fs::write(&file, "rpm,wob,mu\n80 rpm,12 kN,0.15\n200 rpm,30 kN,0.4\n").unwrap();
+    let with_file = |extra: &[&str]| {
+        let mut a = vec![
+            "bench",
+            "job",
+            case.to_str().unwrap(),
+            "--variants",
+            file.to_str().unwrap(),
+            "--repeats",
+            "1",
+            "--out",
+            out.to_str().unwrap(),
+            "--quiet",
+        ];
+        a.extend_from_slice(extra);
+        common::holewall(&a)
+    };
+    let (code, stdout, stderr) = with_file(&[]);
+    assert_eq!(code, 0, "{stderr}");
+    assert!(stdout.contains("--variants"), "{stdout}");
+    let r: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("job.json")).unwrap()).unwrap();
+    assert!(
+        r["variants_file"].as_str().unwrap().ends_with("v.csv"),
+        "{r}"
+    );
+    let runs = r["runs"].as_array().unwrap();
+    assert_eq!(runs.len(), paths, "{r}");
+    assert!(runs.iter().all(|run| run["failed"] == 0), "{r}");
+    assert!(out
+        .join("runs/cpu_f64/whirl_map_stab1_mu0.15.png")
+        .is_file());
+    // A file and a draw at once: a usage error (exit 2).
+    let (code, _, stderr) = with_file(&["--samples", "8"]);
+    assert_eq!(code, 2, "{stderr}");
 }

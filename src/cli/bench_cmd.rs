@@ -39,8 +39,8 @@ pub enum BenchCommand {
         #[arg(long)]
         json: Option<PathBuf>,
     },
-    /// A user's Monte Carlo ensemble job timed whole (`holewall ensemble CASE --samples N
-    /// --seed S`: static starts, dynamics, observations, statistics, plots, report) on the
+    /// A user's ensemble job timed whole (`holewall ensemble CASE --samples N --seed S`, or
+    /// `--variants FILE`: static starts, dynamics, observations, statistics, plots, report) on the
     /// CPU backend and on the GPU engine in f64 and f32, each `--repeats` times in one
     /// process (run 1 of a GPU path compiles its kernels); job.md and job.json.
     Job {
@@ -50,6 +50,10 @@ pub enum BenchCommand {
         /// Variants drawn.
         #[arg(long, default_value_t = 1024)]
         samples: usize,
+        /// The job's variants from this file instead (`holewall ensemble CASE --variants
+        /// FILE`: its whirl maps and plots over the inputs rather than the statistics).
+        #[arg(long, conflicts_with_all = ["samples", "seed"])]
+        variants: Option<PathBuf>,
         /// Seed of the draw.
         #[arg(long, default_value_t = 1)]
         seed: u64,

@@ -133,7 +133,9 @@ pub fn run(out: &Path, cases: &Path, options: DeviceOptions) -> Result<(), Error
             "holewall bench job cases/whirl_job.toml --samples {job_samples} --repeats 2 --out DIR"
         ),
         job_dir.join("job.json"),
-        &mut |_| super::bench_job::run(&job_case, job_samples, 1, 2, &job_dir, false).map(|_| ()),
+        &mut |_| {
+            super::bench_job::run(&job_case, None, job_samples, 1, 2, &job_dir, false).map(|_| ())
+        },
     );
     bar.finish_and_clear();
     let device = crate::gpu::GpuContext::shared()

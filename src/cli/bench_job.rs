@@ -1,6 +1,6 @@
-//! `holewall bench job`: a user's Monte Carlo ensemble job timed whole (issue 27) — the
-//! static starts, the dynamic runs, the observations, the statistics, the plots and the
-//! report, as `holewall ensemble CASE --samples N --seed S` runs them — on the CPU backend
+//! `holewall bench job`: a user's ensemble job timed whole (issue 27) — the static starts,
+//! the dynamic runs, the observations, the statistics, the plots and the report, as
+//! `holewall ensemble CASE --samples N --seed S` (or `--variants FILE`) runs them — on the CPU backend
 //! and on the GPU engine in f64 and f32, each run `repeats` times in one process (the first
 //! GPU run compiles the kernels; the later ones are what a user's next job costs). Stop 49
 //! found on an H100 that the engine's own steps ran 8–9× the CPU's while the user's job ran
@@ -38,7 +38,9 @@ pub struct JobRun {
 pub struct JobBench {
     /// The case file.
     pub case: String,
-    /// Variants drawn.
+    /// The variants file, where the job ran one (else `samples` were drawn).
+    pub variants_file: Option<String>,
+    /// Variants drawn (without a variants file).
     pub samples: usize,
     /// Seed of the draw.
     pub seed: u64,
@@ -73,6 +75,7 @@ fn median(mut x: Vec<f64>) -> f64 {
 /// the next; the last stays for a look) and writes `job.json` and `job.md` into `out`.
 pub fn run(
     case: &Path,
+    variants_file: Option<&Path>,
     samples: usize,
     seed: u64,
     repeats: usize,
@@ -104,14 +107,16 @@ pub fn run(
         paths.push(("GPU f32", BackendChoice::Gpu, Precision::F32));
     }
     let options = crate::ensemble::store::EnsembleOptions {
-        monte_carlo: Some(crate::uq::report::MonteCarlo {
-            samples,
-            seed,
-            sampling: crate::uq::Sampling::Random,
-            percentiles: Vec::new(),
-            thresholds: Vec::new(),
-            sobol_indices: false,
-        }),
+        monte_carlo: variants_file
+            .is_none()
+            .then(|| crate::uq::report::MonteCarlo {
+                samples,
+                seed,
+                sampling: crate::uq::Sampling::Random,
+                percentiles: Vec::new(),
+                thresholds: Vec::new(),
+                sobol_indices: false,
+            }),
         ..Default::default()
     };
     let bar = crate::output::progress_bar(
@@ -128,8 +133,15 @@ pub fn run(
                 std::fs::remove_dir_all(&dir)?;
             }
             let clock = Instant::now();
-            let s =
-                crate::ensemble::job::run(case, None, *backend, *precision, &dir, false, &options)?;
+            let s = crate::ensemble::job::run(
+                case,
+                variants_file,
+                *backend,
+                *precision,
+                &dir,
+                false,
+                &options,
+            )?;
             runs.push(JobRun {
                 path: name.to_string(),
                 repeat,
@@ -168,6 +180,7 @@ pub fn run(
         .collect();
     let bench = JobBench {
         case: case.display().to_string(),
+        variants_file: variants_file.map(|p| p.display().to_string()),
         samples,
         seed,
         device,
@@ -182,12 +195,16 @@ pub fn run(
 
 /// The tables of `job.md`.
 pub fn markdown(b: &JobBench) -> String {
+    let inputs = match &b.variants_file {
+        Some(f) => format!("--variants {f}"),
+        None => format!("--samples {} --seed {}", b.samples, b.seed),
+    };
     let mut md = format!(
-        "# A user's job: `holewall ensemble {} --samples {} --seed {}`\n\n{}; CPU threads: {}. \
+        "# A user's job: `holewall ensemble {} {inputs}`\n\n{}; CPU threads: {}. \
          Each job timed whole; run 1 of a GPU path compiles its kernels.\n\n\
          | path | run | job (s) | variants' runs (s) | outside them (s) | engine: static starts (s) | engine: dynamics (s) | of it, observing (s) | engine / CPU / failed |\n\
          |---|---|---|---|---|---|---|---|---|\n",
-        b.case, b.samples, b.seed, b.device, b.cpu_threads
+        b.case, b.device, b.cpu_threads
     );
     let f = |x: Option<f64>| x.map_or("–".to_string(), |x| format!("{x:.3}"));
     for r in &b.runs {
