@@ -3,8 +3,8 @@
 //! contact evaluations (`bench contact`), the beam element (`bench element`), the roofline
 //! per kernel (`bench kernels`), the static ensembles on the shipped stress and
 //! build-and-hold cases (`bench statics`), the dynamic ensembles (`bench ensemble`) and a
-//! user's Monte Carlo job timed whole (`bench job`), each against the CPU path in the same run, and gathers their JSON into `device.json` and their
-//! tables into `device.md`. Nothing here measures anything itself: each part is the
+//! user's Monte Carlo job timed whole (`bench job`), each against the CPU path in the same
+//! run, and gathers their JSON into `device.json` and their tables into `device.md`. Nothing here measures anything itself: each part is the
 //! benchmark of its own command.
 
 use std::path::{Path, PathBuf};

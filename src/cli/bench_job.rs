@@ -1,8 +1,9 @@
 //! `holewall bench job`: a user's ensemble job timed whole (issue 27) — the static starts,
 //! the dynamic runs, the observations, the statistics, the plots and the report, as
-//! `holewall ensemble CASE --samples N --seed S` (or `--variants FILE`) runs them — on the CPU backend
-//! and on the GPU engine in f64 and f32, each run `repeats` times in one process (the first
-//! GPU run compiles the kernels; the later ones are what a user's next job costs). Stop 49
+//! `holewall ensemble CASE --samples N --seed S` (or `--variants FILE`) runs them — on the
+//! CPU backend and on the GPU engine in f64 and f32, each run `repeats` times in one
+//! process (the first GPU run compiles the kernels; the later ones are what a user's next
+//! job costs). Stop 49
 //! found on an H100 that the engine's own steps ran 8–9× the CPU's while the user's job ran
 //! 1.3×: what lies around the engine only a benchmark of the whole job shows.
 

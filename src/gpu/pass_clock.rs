@@ -1,7 +1,7 @@
 //! The device's own time of a compute pass: timestamps at its start and end, resolved and
 //! read back — for a resident batch with the pass's other results (no round trip of its
-//! own), added to [`crate::tally`]; for `bench kernels` by [`crate::gpu::dispatch::timed`]. Where the adapter has no `TIMESTAMP_QUERY` there is no
-//! clock and nothing is recorded.
+//! own), added to [`crate::tally`]; for `bench kernels` by [`crate::gpu::dispatch::timed`].
+//! Where the adapter has no `TIMESTAMP_QUERY` there is no clock and nothing is recorded.
 
 use crate::gpu::GpuContext;
 
