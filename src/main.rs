@@ -603,9 +603,10 @@ fn main() -> ExitCode {
                 cpu_only,
                 precision_nodes,
                 lu_form,
+                trial_round,
                 json,
             } => {
-                cli::bench_cmd::LuFormArg::apply(lu_form);
+                cli::bench_cmd::apply_forms(lu_form, trial_round);
                 let r = cli::bench_ensemble::run(
                     &nodes,
                     &variants,

@@ -56,7 +56,7 @@ pub struct Tally {
     pub device_s: f64,
     /// Of `device_s`, the line-search trials' passes.
     pub trial_device_s: f64,
-    /// Line-search trial passes stamped.
+    /// Line-search trials stamped (each trial of a round formed in one pass counts).
     pub trials: u64,
     /// Seconds of [`Phase::StaticStarts`].
     pub static_starts_s: f64,
@@ -119,13 +119,13 @@ pub fn add_setup(took: std::time::Duration, opening: std::time::Duration) {
     OPEN_NANOS.fetch_add(nanos(opening), Ordering::Relaxed);
 }
 
-/// Counts `took` of the device's own work in a stamped pass (`trial`: a line-search
-/// trial's).
-pub fn add_device(took: std::time::Duration, trial: bool) {
+/// Counts `took` of the device's own work in stamped passes: those of `trials` line-search
+/// trials (0: not trials).
+pub fn add_device(took: std::time::Duration, trials: u64) {
     DEVICE_NANOS.fetch_add(nanos(took), Ordering::Relaxed);
-    if trial {
+    if trials > 0 {
         TRIAL_NANOS.fetch_add(nanos(took), Ordering::Relaxed);
-        TRIALS.fetch_add(1, Ordering::Relaxed);
+        TRIALS.fetch_add(trials, Ordering::Relaxed);
     }
 }
 
@@ -152,7 +152,7 @@ mod tests {
             std::time::Duration::from_millis(5),
             std::time::Duration::from_millis(1),
         );
-        add_device(std::time::Duration::from_millis(2), true);
+        add_device(std::time::Duration::from_millis(2), 1);
         add_phase(Phase::Observing, std::time::Duration::from_millis(3));
         let d = Tally::now().since(&before);
         // Other tests may read back at the same time: at least what was added here.

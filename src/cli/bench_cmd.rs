@@ -96,6 +96,11 @@ pub enum BenchCommand {
         /// (serial: one invocation per variant; lanes: eight), to compare them on a device.
         #[arg(long, value_enum)]
         lu_form: Option<LuFormArg>,
+        /// Line-search trials the GPU engine forms in one submission at most: the adapter's
+        /// choice (default: 8 on a GPU, 1 on a CPU-type adapter), or this (1–8), to compare
+        /// them on a device.
+        #[arg(long, value_parser = clap::value_parser!(u16).range(1..=8))]
+        trial_round: Option<u16>,
         /// Also write the results as JSON here.
         #[arg(long)]
         json: Option<PathBuf>,
@@ -302,6 +307,13 @@ pub enum LuFormArg {
     Serial,
     /// Eight invocations per variant, a row per lane.
     Lanes,
+}
+
+/// Forces the GPU engine's block-solve form and trials per submission for the rest of the
+/// process (`None`: the adapter's choice).
+pub fn apply_forms(form: Option<LuFormArg>, trial_round: Option<u16>) {
+    LuFormArg::apply(form);
+    crate::gpu::batch::force_trials_per_round(trial_round.map(usize::from));
 }
 
 impl LuFormArg {

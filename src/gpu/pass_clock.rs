@@ -8,7 +8,11 @@ use crate::gpu::GpuContext;
 /// Bytes of a resolved pair of timestamps.
 pub const BYTES: u64 = 16;
 
-/// A pair of timestamps and the buffer they are resolved into.
+/// Spans a clock stamps: a submission may time two parts of its passes apart (a dynamic
+/// iteration and the line-search trial formed with it).
+const SPANS: u32 = 2;
+
+/// Pairs of timestamps (one pair per span) and the buffer they are resolved into.
 pub struct PassClock {
     set: wgpu::QuerySet,
     resolved: wgpu::Buffer,
@@ -22,11 +26,11 @@ impl PassClock {
             set: ctx.device.create_query_set(&wgpu::QuerySetDescriptor {
                 label: Some(label),
                 ty: wgpu::QueryType::Timestamp,
-                count: 2,
+                count: 2 * SPANS,
             }),
             resolved: ctx.device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some(label),
-                size: BYTES,
+                size: BYTES * u64::from(SPANS),
                 usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
                 mapped_at_creation: false,
             }),
@@ -39,12 +43,27 @@ impl PassClock {
         clock: Option<&PassClock>,
         encoder: &'e mut wgpu::CommandEncoder,
     ) -> wgpu::ComputePass<'e> {
+        Self::span_pass(clock, encoder, 0, true, true)
+    }
+
+    /// A compute pass that starts span `span` (`begin`) and/or ends it (`end`): a span of
+    /// several passes (with copies between them) is timed from its first pass's start to
+    /// its last one's end.
+    pub fn span_pass<'e>(
+        clock: Option<&PassClock>,
+        encoder: &'e mut wgpu::CommandEncoder,
+        span: u32,
+        begin: bool,
+        end: bool,
+    ) -> wgpu::ComputePass<'e> {
         encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
             label: None,
-            timestamp_writes: clock.map(|c| wgpu::ComputePassTimestampWrites {
-                query_set: &c.set,
-                beginning_of_pass_write_index: Some(0),
-                end_of_pass_write_index: Some(1),
+            timestamp_writes: clock.filter(|_| begin || end).map(|c| {
+                wgpu::ComputePassTimestampWrites {
+                    query_set: &c.set,
+                    beginning_of_pass_write_index: begin.then_some(2 * span),
+                    end_of_pass_write_index: end.then_some(2 * span + 1),
+                }
             }),
         })
     }
@@ -52,15 +71,31 @@ impl PassClock {
     /// Resolves the pass's stamps (after the pass) and names the buffer to read with the
     /// pass's results.
     pub fn resolve(&self, encoder: &mut wgpu::CommandEncoder) -> (&wgpu::Buffer, u64) {
-        encoder.resolve_query_set(&self.set, 0..2, &self.resolved, 0);
-        (&self.resolved, BYTES)
+        self.resolve_spans(encoder, 1)
+    }
+
+    /// Resolves the stamps of the first `spans` spans (each begun and ended in this
+    /// submission) and names the buffer to read.
+    pub fn resolve_spans(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        spans: u32,
+    ) -> (&wgpu::Buffer, u64) {
+        let spans = spans.clamp(1, SPANS);
+        encoder.resolve_query_set(&self.set, 0..2 * spans, &self.resolved, 0);
+        (&self.resolved, BYTES * u64::from(spans))
     }
 
     /// The pass's device time (s), from the stamps' bytes read back.
     pub fn seconds(&self, bytes: &[u8]) -> f64 {
+        self.span_seconds(bytes, 0)
+    }
+
+    /// Span `span`'s device time (s), from the stamps' bytes read back.
+    pub fn span_seconds(&self, bytes: &[u8], span: usize) -> f64 {
         let ticks: Vec<u64> = crate::gpu::readback::values(bytes);
-        match ticks[..] {
-            [start, end, ..] => end.saturating_sub(start) as f64 * self.period_ns * 1e-9,
+        match ticks.get(2 * span..2 * span + 2) {
+            Some(&[start, end]) => end.saturating_sub(start) as f64 * self.period_ns * 1e-9,
             _ => 0.0,
         }
     }
@@ -68,7 +103,13 @@ impl PassClock {
     /// Adds the pass's device time, from the stamps' bytes read back, to the tally
     /// (`trial`: a line-search trial's pass).
     pub fn record(&self, bytes: &[u8], trial: bool) {
-        let took = std::time::Duration::from_secs_f64(self.seconds(bytes));
-        crate::tally::add_device(took, trial);
+        self.record_span(bytes, 0, u64::from(trial));
+    }
+
+    /// Adds span `span`'s device time to the tally, as that of `trials` line-search trials
+    /// (0: an iteration's).
+    pub fn record_span(&self, bytes: &[u8], span: usize, trials: u64) {
+        let took = std::time::Duration::from_secs_f64(self.span_seconds(bytes, span));
+        crate::tally::add_device(took, trials);
     }
 }

@@ -70,6 +70,11 @@ pub struct Iteration<T> {
     pub status: Vec<u32>,
     /// The inertial force scale `max_i m_i |v̇_u,i|`.
     pub inertial: Vec<T>,
+    /// Where the path forms it with the iteration (no round trip of its own): the first
+    /// line-search trial, at α = 1 for the variants iterating and 0 for the others, as
+    /// [`ResidentDynamic::trial`] with `first` would form it — its norms, read for those
+    /// iterating.
+    pub full_step: Option<Norms<T>>,
 }
 
 /// A batch of variants held by a kernel path for a dynamic run: the state at `t_n`, the
@@ -98,6 +103,25 @@ pub trait ResidentDynamic<T> {
         search: &[bool],
         first: bool,
     ) -> Result<Norms<T>, crate::error::SystemError>;
+    /// Trials the path forms in one round trip ([`ResidentDynamic::trials`]).
+    fn trials_per_round(&self) -> usize {
+        1
+    }
+    /// The trials at `alphas[0]`, `alphas[1]`, … in order, each as
+    /// [`ResidentDynamic::trial`] (`first` for the first of them), for the same variants
+    /// `search`; the candidate left is the last one's. The default forms them one at a time.
+    fn trials(
+        &mut self,
+        alphas: &[Vec<T>],
+        search: &[bool],
+        first: bool,
+    ) -> Result<Vec<Norms<T>>, crate::error::SystemError> {
+        alphas
+            .iter()
+            .enumerate()
+            .map(|(k, a)| self.trial(a, search, first && k == 0))
+            .collect()
+    }
     /// The unknown `+= α Δ`.
     fn correct(&mut self, alpha: &[T]) -> Result<(), crate::error::SystemError>;
     /// The unknown becomes the last trial's candidate (a trial forms its residual only:
@@ -623,6 +647,7 @@ fn solve_step<T: Real + Send + Sync, P: KernelPath<T>>(
             f_ref: members.iter().map(|&j| batch.f_ref[j]).collect(),
             hhb,
             running: vec![true; m],
+            full_step: None,
         };
         while newton.any_running() {
             sys.running = (0..m).map(|i| newton.is_running(i)).collect();
@@ -702,6 +727,9 @@ struct DynamicStep<'e, T> {
     hhb: f64,
     /// The variants Newton is iterating on (set before each iteration).
     running: Vec<bool>,
+    /// The first trial formed with the last iteration ([`Iteration::full_step`]), until a
+    /// line search takes it or the next iteration.
+    full_step: Option<Norms<T>>,
 }
 
 impl<T: Real> NewtonSystem for DynamicStep<'_, T> {
@@ -713,7 +741,9 @@ impl<T: Real> NewtonSystem for DynamicStep<'_, T> {
             norms,
             status,
             inertial,
+            full_step,
         } = self.ensemble.iterate(&self.running)?;
+        self.full_step = full_step;
         let f = |x: &T| x.to_f64_lossy();
         Ok(Probe {
             // Scale: the loads, or the inertial forces if larger (a whirling string).
@@ -732,8 +762,34 @@ impl<T: Real> NewtonSystem for DynamicStep<'_, T> {
         search: &[bool],
         first: bool,
     ) -> Result<TrialProbe, crate::error::SystemError> {
+        // The first trial formed with the iteration, where it is this one: α = 1 for the
+        // variants iterating, 0 for the others, read for a subset of them.
+        if let Some(r) = self.full_step.take() {
+            let same = first
+                && (0..alpha.len()).all(|j| {
+                    let want = if self.running[j] { 1.0 } else { 0.0 };
+                    alpha[j] == want && (!search[j] || self.running[j])
+                });
+            if same {
+                return Ok(trial_probe(&r));
+            }
+        }
         let r = self.ensemble.trial(&negated::<T>(alpha), search, first)?;
         Ok(trial_probe(&r))
+    }
+    fn trials_per_round(&self) -> usize {
+        self.ensemble.trials_per_round()
+    }
+    fn trials(
+        &mut self,
+        alphas: &[Vec<f64>],
+        search: &[bool],
+        first: bool,
+    ) -> Result<Vec<TrialProbe>, crate::error::SystemError> {
+        self.full_step = None;
+        let alphas: Vec<Vec<T>> = alphas.iter().map(|a| negated::<T>(a)).collect();
+        let r = self.ensemble.trials(&alphas, search, first)?;
+        Ok(r.iter().map(trial_probe).collect())
     }
     fn accept(
         &mut self,

@@ -107,6 +107,7 @@ impl ResidentDynamic<f64> for TwinDynamic<'_> {
             norms,
             status,
             inertial,
+            full_step: None,
         })
     }
     fn trial(

@@ -25,6 +25,8 @@ pub struct GpuDynamic<T: GpuReal> {
     c: Common,
     /// Invocations per variant of the block solve ([`LuForm`]).
     lu_lanes: usize,
+    /// Line-search trials formed in one submission at most ([`super::trials_per_round`]).
+    round: usize,
     /// The device's time of the passes read back ([`crate::tally`]), where it has stamps.
     clock: Option<crate::gpu::pass_clock::PassClock>,
     _keep: Vec<wgpu::Buffer>,
@@ -128,6 +130,12 @@ struct DynamicBuffers {
     rot_1: wgpu::Buffer,
     vel_1: wgpu::Buffer,
     acc_1: wgpu::Buffer,
+    /// The iteration's norms, kept while the trial formed with it writes its own.
+    iterate_norms: wgpu::Buffer,
+    /// A round's `α` per trial (`round · V`), copied into the trials' `α` in turn.
+    alphas: wgpu::Buffer,
+    /// A round's norms per trial (`round · 4 V`).
+    round_norms: wgpu::Buffer,
 }
 
 impl DynamicBuffers {
@@ -206,6 +214,7 @@ impl<T: GpuReal> GpuDynamic<T> {
             (!dynamic.unbalance.is_empty()).then(|| storage(ctx, "unbalance", &dynamic.unbalance));
         let [diag, upper, lower, rhs] = system_buffers(ctx, v, n, size);
         let st = &dynamic.start;
+        let round = super::trials_per_round(ctx);
         let b = DynamicBuffers {
             coef: empty(ctx, "coef", 5 * size),
             flags: empty(ctx, "step_flags", 4),
@@ -223,6 +232,9 @@ impl<T: GpuReal> GpuDynamic<T> {
             rot_1: empty(ctx, "rot_1", st.rot.len() * size),
             vel_1: empty(ctx, "vel_1", st.vel.len() * size),
             acc_1: empty(ctx, "acc_1", st.acc.len() * size),
+            iterate_norms: empty(ctx, "iterate_norms", 4 * v * size),
+            alphas: empty(ctx, "alphas", round * v * size),
+            round_norms: empty(ctx, "round_norms", round * 4 * v * size),
         };
         // The unknown, the candidate and the trial state start as the state: uploaded once,
         // copied on the device (at V = 4096 the uploads were a large part of the setup).
@@ -385,6 +397,7 @@ impl<T: GpuReal> GpuDynamic<T> {
             a0: T::from_f64_lossy(dynamic.a0),
             c,
             lu_lanes: LuForm::for_adapter(ctx).lanes(),
+            round,
             clock: crate::gpu::pass_clock::PassClock::new(ctx, "dynamic pass"),
             _keep: [mass, inertia0, diag, upper, lower, rhs]
                 .into_iter()
@@ -428,6 +441,26 @@ impl<T: GpuReal> GpuDynamic<T> {
         });
     }
 
+    /// Records a line-search trial at the `α` in `c.alpha`: the candidate of every variant
+    /// (`first`: the search's first trial) or of the `count` listed in `c.active`, and the
+    /// residual and norms of the listed ones.
+    fn record_trial(&self, pass: &mut wgpu::ComputePass, first: bool, count: usize) {
+        let n = self.num_nodes;
+        if first {
+            dispatch(
+                pass,
+                &self.p.accelerate,
+                &self.g.accelerate,
+                n * self.num_variants,
+            );
+        } else {
+            let (p, g) = (&self.p.trial.accelerate, &self.g.trial.accelerate);
+            dispatch(pass, p, g, n * count);
+        }
+        self.record_evaluate(pass, Evaluation::Trial(count));
+        dispatch(pass, &self.p.trial.norms, &self.g.trial.norms, count);
+    }
+
     fn copy_all(encoder: &mut wgpu::CommandEncoder, pairs: &[(&wgpu::Buffer, &wgpu::Buffer)]) {
         for (from, to) in pairs {
             encoder.copy_buffer_to_buffer(from, 0, to, 0, from.size());
@@ -462,59 +495,77 @@ impl<T: GpuReal> crate::engine::dynamic::ResidentDynamic<T> for GpuDynamic<T> {
         running: &[bool],
     ) -> Result<crate::engine::dynamic::Iteration<T>, crate::error::SystemError> {
         let v = self.num_variants;
+        let q = &self.ctx.queue;
         let mut e = encoder(self.ctx, "iterate");
         // Every variant iterating: the kernels over all of them. Else only the listed ones
         // (built `MASKED`): the block solve skips a variant whose status starts at
         // SINGULAR, so the others start there and the listed ones at RUNNING.
-        let listed = (!running.iter().all(|&r| r)).then(|| {
-            let list = super::search_list(running);
-            let q = &self.ctx.queue;
-            q.write_buffer(&self.c.active, 0, bytemuck::cast_slice(&list));
+        let all = running.iter().all(|&r| r);
+        // The list serves the trial formed with the iteration too.
+        let list = super::search_list(running);
+        let count = list.len() - 1;
+        q.write_buffer(&self.c.active, 0, bytemuck::cast_slice(&list));
+        if all {
+            self.c.reset_status(&mut e, v);
+        } else {
             let start: Vec<u32> = running
                 .iter()
                 .map(|&r| if r { RUNNING } else { SINGULAR })
                 .collect();
             q.write_buffer(&self.c.status, 0, bytemuck::cast_slice(&start));
-            list.len() - 1
-        });
-        if listed.is_none() {
-            self.c.reset_status(&mut e, v);
         }
+        // The line search's first trial, formed in the same submission: α = 1 for the
+        // variants iterating, 0 for the others (as `trial` with `first` sets them).
+        let full: Vec<f64> = running.iter().map(|&r| f64::from(u8::from(r))).collect();
+        q.write_buffer(
+            &self.c.alpha,
+            0,
+            bytemuck::cast_slice(&crate::engine::negated::<T>(&full)),
+        );
+        let clock = self.clock.as_ref();
         {
-            let mut pass = PassClock::pass(self.clock.as_ref(), &mut e);
+            let mut pass = PassClock::span_pass(clock, &mut e, 0, true, true);
             let (g, p) = (&self.g, &self.p);
-            match listed {
-                None => self.record_evaluate(&mut pass, Evaluation::All),
-                Some(a) => self.record_evaluate(&mut pass, Evaluation::Listed(a)),
+            match all {
+                true => self.record_evaluate(&mut pass, Evaluation::All),
+                false => self.record_evaluate(&mut pass, Evaluation::Listed(count)),
             }
             for group in &g.lu {
                 dispatch(&mut pass, &p.block_lu, group, self.lu_lanes * v);
             }
-            match listed {
-                None => {
+            match all {
+                true => {
                     dispatch(&mut pass, &p.norms, &g.norms_iterate, v);
                     dispatch(&mut pass, &p.scale, &g.scale, v);
                 }
-                Some(a) => {
-                    dispatch(&mut pass, &p.trial.norms, &g.listed.norms, a);
-                    dispatch(&mut pass, &p.scale_masked, &g.listed.scale, a);
+                false => {
+                    dispatch(&mut pass, &p.trial.norms, &g.listed.norms, count);
+                    dispatch(&mut pass, &p.scale_masked, &g.listed.scale, count);
                 }
             }
         }
         let size = std::mem::size_of::<T>() as u64;
+        let norms_bytes = 4 * v as u64 * size;
+        e.copy_buffer_to_buffer(&self.c.norms, 0, &self.b.iterate_norms, 0, norms_bytes);
+        {
+            let mut pass = PassClock::span_pass(clock, &mut e, 1, true, true);
+            self.record_trial(&mut pass, true, count);
+        }
         let mut reads = vec![
-            (&self.c.norms, 4 * v as u64 * size),
+            (&self.b.iterate_norms, norms_bytes),
             (&self.c.status, 4 * v as u64),
             (&self.b.scale, v as u64 * size),
+            (&self.c.norms, norms_bytes),
         ];
-        reads.extend(self.clock.as_ref().map(|c| c.resolve(&mut e)));
+        reads.extend(clock.map(|c| c.resolve_spans(&mut e, 2)));
         let out = self
             .c
             .staging
             .read(self.ctx, e, &reads)
             .map_err(crate::error::SystemError::from)?;
-        if let (Some(c), Some(stamps)) = (&self.clock, out.get(3)) {
-            c.record(stamps, false);
+        if let (Some(c), Some(stamps)) = (clock, out.get(4)) {
+            c.record_span(stamps, 0, 0);
+            c.record_span(stamps, 1, 1);
         }
         let status: Vec<u32> = values(&out[1]);
         if status.contains(&RUNNING) {
@@ -526,6 +577,7 @@ impl<T: GpuReal> crate::engine::dynamic::ResidentDynamic<T> for GpuDynamic<T> {
             norms: norms_from_bytes(&out[0]),
             status,
             inertial: values(&out[2]),
+            full_step: Some(norms_from_bytes(&out[3])),
         })
     }
 
@@ -535,40 +587,62 @@ impl<T: GpuReal> crate::engine::dynamic::ResidentDynamic<T> for GpuDynamic<T> {
         search: &[bool],
         first: bool,
     ) -> Result<Norms<T>, crate::error::SystemError> {
-        let v = self.num_variants;
+        let mut r = self.trials(&[alpha.to_vec()], search, first)?;
+        r.pop()
+            .ok_or(crate::error::SystemError::Order("no trial formed"))
+    }
+
+    fn trials_per_round(&self) -> usize {
+        self.round
+    }
+
+    fn trials(
+        &mut self,
+        alphas: &[Vec<T>],
+        search: &[bool],
+        first: bool,
+    ) -> Result<Vec<Norms<T>>, crate::error::SystemError> {
+        let (v, k) = (self.num_variants, alphas.len());
+        if k == 0 || k > self.round {
+            return Err(crate::error::SystemError::Order(
+                "a round of trials beyond the batch's buffers",
+            ));
+        }
         let q = &self.ctx.queue;
-        q.write_buffer(&self.c.alpha, 0, bytemuck::cast_slice(alpha));
+        let size = std::mem::size_of::<T>() as u64;
+        let (row, norms_bytes) = (v as u64 * size, 4 * v as u64 * size);
+        // Every trial's α, copied into the kernels' `α` before its passes.
+        let flat: Vec<T> = alphas.iter().flatten().copied().collect();
+        q.write_buffer(&self.b.alphas, 0, bytemuck::cast_slice(&flat));
         // The variants still searching, compacted: [A, v_0, …, v_{A−1}].
         let list = super::search_list(search);
         let count = list.len() - 1;
         q.write_buffer(&self.c.active, 0, bytemuck::cast_slice(&list));
-        let mut e = encoder(self.ctx, "trial");
-        {
-            // The candidate of every variant on a search's first trial (α = 0: the
-            // unknown), of the searching ones after; the residual of the searching ones.
-            let mut pass = PassClock::pass(self.clock.as_ref(), &mut e);
-            let n = self.num_nodes;
-            if first {
-                dispatch(&mut pass, &self.p.accelerate, &self.g.accelerate, n * v);
-            } else {
-                let (p, g) = (&self.p.trial.accelerate, &self.g.trial.accelerate);
-                dispatch(&mut pass, p, g, n * count);
+        let mut e = encoder(self.ctx, "trials");
+        let clock = self.clock.as_ref();
+        for i in 0..k {
+            e.copy_buffer_to_buffer(&self.b.alphas, i as u64 * row, &self.c.alpha, 0, row);
+            {
+                let mut pass = PassClock::span_pass(clock, &mut e, 0, i == 0, i + 1 == k);
+                self.record_trial(&mut pass, first && i == 0, count);
             }
-            self.record_evaluate(&mut pass, Evaluation::Trial(count));
-            dispatch(&mut pass, &self.p.trial.norms, &self.g.trial.norms, count);
+            let at = i as u64 * norms_bytes;
+            e.copy_buffer_to_buffer(&self.c.norms, 0, &self.b.round_norms, at, norms_bytes);
         }
-        let size = std::mem::size_of::<T>() as u64;
-        let mut reads = vec![(&self.c.norms, 4 * v as u64 * size)];
-        reads.extend(self.clock.as_ref().map(|c| c.resolve(&mut e)));
+        let mut reads = vec![(&self.b.round_norms, k as u64 * norms_bytes)];
+        reads.extend(clock.map(|c| c.resolve(&mut e)));
         let out = self
             .c
             .staging
             .read(self.ctx, e, &reads)
             .map_err(crate::error::SystemError::from)?;
-        if let (Some(c), Some(stamps)) = (&self.clock, out.get(1)) {
-            c.record(stamps, true);
+        if let (Some(c), Some(stamps)) = (clock, out.get(1)) {
+            c.record_span(stamps, 0, k as u64);
         }
-        Ok(norms_from_bytes(&out[0]))
+        Ok(out[0]
+            .chunks_exact(norms_bytes as usize)
+            .map(norms_from_bytes)
+            .collect())
     }
 
     fn correct(&mut self, alpha: &[T]) -> Result<(), crate::error::SystemError> {

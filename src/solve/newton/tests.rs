@@ -182,3 +182,180 @@ fn a_failing_variant_stops_alone() {
     assert!(matches!(ended[0].1, Event::Converged(_)));
     assert_eq!(ended[1].1, Event::Failed("residual is not finite".into()));
 }
+
+/// Independent problems `r_j(x) = atan(x − b_j) + 10⁻⁴ x` (one per variant): from a start
+/// far from the root the full Newton step overshoots and the line search halves.
+struct Atan {
+    x: Vec<f64>,
+    b: Vec<f64>,
+    delta: Vec<f64>,
+}
+
+impl Atan {
+    fn r(&self, j: usize, x: f64) -> f64 {
+        (x - self.b[j]).atan() + x * 1e-4
+    }
+}
+
+impl NewtonSystem for Atan {
+    fn variants(&self) -> usize {
+        self.x.len()
+    }
+    fn solve(&mut self) -> Result<Probe, crate::error::SystemError> {
+        let mut p = Probe::default();
+        self.delta.clear();
+        for j in 0..self.x.len() {
+            let x = self.x[j];
+            let r = self.r(j, x);
+            let d = -r / (1.0 / (1.0 + (x - self.b[j]).powi(2)) + 1e-4);
+            self.delta.push(d);
+            p.measure.push(r.abs());
+            p.step.push(d.abs());
+            p.slope.push(d * r);
+            p.norm.push(r.abs());
+            p.solved.push(true);
+        }
+        Ok(p)
+    }
+    fn trial(
+        &mut self,
+        alpha: &[f64],
+        _: &[bool],
+        _: bool,
+    ) -> Result<TrialProbe, crate::error::SystemError> {
+        let mut t = TrialProbe::default();
+        for j in 0..self.x.len() {
+            let r = self.r(j, self.x[j] + alpha[j] * self.delta[j]);
+            t.slope.push(self.delta[j] * r);
+            t.norm.push(r.abs());
+        }
+        Ok(t)
+    }
+    fn accept(&mut self, alpha: &[f64], _: bool) -> Result<(), crate::error::SystemError> {
+        for j in 0..self.x.len() {
+            self.x[j] += alpha[j] * self.delta[j];
+        }
+        Ok(())
+    }
+}
+
+/// A system evaluated through [`NewtonSystem::trials`] in rounds of `per_round`, counting its
+/// round trips (a solve, a trial, a round of trials each count one).
+struct Rounds<S> {
+    inner: S,
+    per_round: usize,
+    round_trips: usize,
+    /// The α of every trial evaluated, in order.
+    evaluated: Vec<Vec<f64>>,
+}
+
+impl<S: NewtonSystem> NewtonSystem for Rounds<S> {
+    fn variants(&self) -> usize {
+        self.inner.variants()
+    }
+    fn solve(&mut self) -> Result<Probe, crate::error::SystemError> {
+        self.round_trips += 1;
+        self.inner.solve()
+    }
+    fn trial(
+        &mut self,
+        alpha: &[f64],
+        search: &[bool],
+        first: bool,
+    ) -> Result<TrialProbe, crate::error::SystemError> {
+        self.round_trips += 1;
+        self.evaluated.push(alpha.to_vec());
+        self.inner.trial(alpha, search, first)
+    }
+    fn trials_per_round(&self) -> usize {
+        self.per_round
+    }
+    fn trials(
+        &mut self,
+        alphas: &[Vec<f64>],
+        search: &[bool],
+        first: bool,
+    ) -> Result<Vec<TrialProbe>, crate::error::SystemError> {
+        self.round_trips += 1;
+        self.evaluated.extend(alphas.iter().cloned());
+        alphas
+            .iter()
+            .enumerate()
+            .map(|(k, a)| self.inner.trial(a, search, first && k == 0))
+            .collect()
+    }
+    fn accept(
+        &mut self,
+        alpha: &[f64],
+        trial_matches: bool,
+    ) -> Result<(), crate::error::SystemError> {
+        self.inner.accept(alpha, trial_matches)
+    }
+}
+
+/// The roots, the events, the updates, the round trips and the trials evaluated.
+type RoundsRun = (Vec<f64>, Vec<(usize, Event)>, Vec<usize>, usize, usize);
+
+/// Solves the [`Atan`] problems from `x0` with `settings`, trials in rounds of `per_round`:
+/// the roots, the events, the updates, the round trips and the trials evaluated.
+fn atans_in_rounds(
+    settings: NewtonSettings,
+    x0: &[f64],
+    b: &[f64],
+    per_round: usize,
+) -> RoundsRun {
+    let v = x0.len();
+    let mut sys = Rounds {
+        inner: Atan {
+            x: x0.to_vec(),
+            b: b.to_vec(),
+            delta: vec![],
+        },
+        per_round,
+        round_trips: 0,
+        evaluated: Vec::new(),
+    };
+    let mut newton = Newton::new(settings, v);
+    for j in 0..v {
+        newton.start(j, 1e-12, false);
+    }
+    let mut ended = Vec::new();
+    while newton.any_running() {
+        ended.extend(newton.iterate(&mut sys).unwrap());
+    }
+    let updates = (0..v).map(|j| newton.state(j).0.updates).collect();
+    (
+        sys.inner.x,
+        ended,
+        updates,
+        sys.round_trips,
+        sys.evaluated.len(),
+    )
+}
+
+#[test]
+fn trials_in_rounds_decide_as_trials_one_at_a_time() {
+    // Starts far from the roots: Newton's full steps overshoot and the searches halve
+    // several times (up to the dynamics' 24, the statics' 5 with its fallback).
+    let x0 = [40.0, -30.0, 0.5, 1e3, 7.0, 3.0];
+    let b = [2.0, 10.0, -5.0, 1.0, 0.1, 3.5];
+    for settings in [
+        NewtonSettings::dynamics(60, 1e-12, 8),
+        NewtonSettings::statics(60, 1e-12, 8),
+        NewtonSettings::statics_for_law(60, 1e-12, 8, true),
+    ] {
+        let (x1, e1, u1, trips1, trials1) = atans_in_rounds(settings, &x0, &b, 1);
+        assert!(trials1 > 2 * u1.iter().max().unwrap(), "the searches halve");
+        for per_round in [2, 4, 8, 30] {
+            let (x, e, u, trips, trials) = atans_in_rounds(settings, &x0, &b, per_round);
+            // The same path to the bit: every decision as one trial at a time.
+            let bits = |x: &[f64]| x.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+            assert_eq!(bits(&x), bits(&x1), "{per_round}");
+            assert_eq!(e, e1, "{per_round}");
+            assert_eq!(u, u1, "{per_round}");
+            // Fewer round trips, paid for with speculative trials.
+            assert!(trips < trips1, "{per_round}: {trips} ≥ {trips1}");
+            assert!(trials >= trials1, "{per_round}");
+        }
+    }
+}
