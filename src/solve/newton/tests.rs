@@ -298,12 +298,7 @@ type RoundsRun = (Vec<f64>, Vec<(usize, Event)>, Vec<usize>, usize, usize);
 
 /// Solves the [`Atan`] problems from `x0` with `settings`, trials in rounds of `per_round`:
 /// the roots, the events, the updates, the round trips and the trials evaluated.
-fn atans_in_rounds(
-    settings: NewtonSettings,
-    x0: &[f64],
-    b: &[f64],
-    per_round: usize,
-) -> RoundsRun {
+fn atans_in_rounds(settings: NewtonSettings, x0: &[f64], b: &[f64], per_round: usize) -> RoundsRun {
     let v = x0.len();
     let mut sys = Rounds {
         inner: Atan {
