@@ -627,9 +627,10 @@ fn main() -> ExitCode {
                 variants,
                 repeats,
                 lu_form,
+                trial_round,
                 json,
             } => {
-                cli::bench_cmd::LuFormArg::apply(lu_form);
+                cli::bench_cmd::apply_forms(lu_form, trial_round);
                 match cli::bench::statics(&case, variants.as_deref(), repeats, json.as_deref()) {
                     Ok(()) => ExitCode::SUCCESS,
                     Err(e) => fail(&[e]),

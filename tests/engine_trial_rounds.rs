@@ -1,7 +1,8 @@
-//! The dynamic engine's line-search trials formed several to a submission (issue 27, item
-//! 3: `gpu::batch::trials_per_round`, 8 on a GPU, 1 on lavapipe), forced on whatever
-//! adapter there is, against one trial at a time: the same run to the bit, with fewer
-//! read-backs. Its own test binary, as the forced round holds for the whole process.
+//! The engines' line-search trials formed several to a submission (issue 27, item 3:
+//! `gpu::batch::trials_per_round`, 8 on a GPU, 1 on lavapipe), forced on whatever adapter
+//! there is, against one trial at a time: the same dynamic run and the same static solve
+//! to the bit, with fewer read-backs. Its own test binary, as the forced round holds for
+//! the whole process.
 
 mod common;
 
@@ -13,6 +14,9 @@ use holewall::kernels::dynamics::DynamicBatch;
 use holewall::model::Model;
 use holewall::solve::statics::{solve_static, StaticOptions};
 use holewall::tally::Tally;
+
+/// The forced round and the read-back counts are the process's: one test at a time.
+static SERIAL: std::sync::Mutex<()> = std::sync::Mutex::new(());
 
 /// Every variant's state at every output step, bit for bit, and what the run cost.
 type Run = (Vec<Vec<u64>>, Vec<DynamicStatus>, Tally);
@@ -56,6 +60,7 @@ fn run<T: holewall::physics::Real + holewall::gpu::contact::GpuReal>(
 
 #[test]
 fn trials_formed_in_rounds_give_the_run_of_trials_one_at_a_time() {
+    let _one = SERIAL.lock().unwrap_or_else(|e| e.into_inner());
     let Some(ctx) = common::gpu() else { return };
     let case = common::bed_case("1");
     // Stiff walls and high speeds: searches that halve (a variant's full Newton step
@@ -118,6 +123,54 @@ fn trials_formed_in_rounds_give_the_run_of_trials_one_at_a_time() {
                 assert!(t.trials > t1.trials);
             }
         }
+    }
+    force_trials_per_round(None);
+}
+
+#[test]
+fn static_trials_formed_in_rounds_give_the_solve_of_trials_one_at_a_time() {
+    use holewall::engine::{solve_static_ensemble, EngineStatus};
+    let _one = SERIAL.lock().unwrap_or_else(|e| e.into_inner());
+    let Some(ctx) = common::gpu() else { return };
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("cases");
+    let case = holewall::case::load_case(&dir.join("stress_two_stabilizers.toml")).unwrap();
+    let list =
+        holewall::ensemble::case_variants(&case, Some(&dir.join("stress_two_stabilizers.csv")))
+            .unwrap()
+            .unwrap();
+    let models: Vec<Model> = list.iter().map(|v| apply(&case, v).unwrap()).collect();
+    let options = StaticOptions::default();
+    let precisions: &[bool] = if ctx.has_f64 {
+        &[true, false]
+    } else {
+        &[false]
+    };
+    for &f64_path in precisions {
+        let go = |round| {
+            force_trials_per_round(Some(round));
+            let before = Tally::now();
+            let out: Vec<(EngineStatus, Vec<u64>, Vec<usize>)> = if f64_path {
+                solve_static_ensemble::<f64, _>(&models, &GpuPath(ctx), &options)
+            } else {
+                solve_static_ensemble::<f32, _>(&models, &GpuPath(ctx), &options)
+            }
+            .unwrap()
+            .into_iter()
+            .map(|r| {
+                let bits = r.state.x.iter().flatten().map(|x| x.to_bits()).collect();
+                (r.status, bits, r.iterations)
+            })
+            .collect();
+            (out, Tally::now().since(&before).readbacks)
+        };
+        let (one, readbacks_one) = go(1);
+        assert!(one.iter().all(|r| r.0 == EngineStatus::Converged));
+        let (eight, readbacks_eight) = go(8);
+        eprintln!(
+            "static, f64 {f64_path}: read-backs {readbacks_one} (one trial a submission) → {readbacks_eight} (rounds up to 8)"
+        );
+        assert!(eight == one, "f64 {f64_path}: the rounds changed the solve");
+        assert!(readbacks_eight < readbacks_one);
     }
     force_trials_per_round(None);
 }

@@ -237,6 +237,8 @@ struct StaticsRow {
     newton_iterations_per_load_step_mean: f64,
     newton_iterations_per_load_step_median: usize,
     step_cuts: usize,
+    /// Read-backs of device buffers (host round trips that wait on the device) per run.
+    readbacks_per_run: f64,
 }
 
 #[derive(Serialize)]
@@ -291,8 +293,14 @@ pub fn statics(
         )
     };
     type Figures = (usize, f64, usize, usize, usize);
-    let mut rows: Vec<(String, f64, Figures)> = Vec::new();
+    let mut rows: Vec<(String, f64, Figures, f64)> = Vec::new();
     let mut figures = None;
+    let tally = crate::tally::Tally::now;
+    // Read-backs per run since `before` (the mean over the warm-up and the repeats).
+    let per_run = |before: &crate::tally::Tally| {
+        tally().since(before).readbacks as f64 / (repeats.max(1) + 1) as f64
+    };
+    let before = tally();
     let t = median_seconds::<Error>(repeats, || {
         let out: Vec<_> = models
             .par_iter()
@@ -312,6 +320,7 @@ pub fn statics(
         "cpu backend (solve_static per variant, f64)".into(),
         t,
         figures.take().unwrap_or_default(),
+        per_run(&before),
     ));
     let engine_figures = |r: &[EngineResult]| {
         let cuts = r
@@ -328,6 +337,7 @@ pub fn statics(
             solved,
         )
     };
+    let before = tally();
     let t = median_seconds::<Error>(repeats, || {
         let r = solve_static_ensemble(&models, &TwinPath, &options)?;
         figures = Some(engine_figures(&r));
@@ -337,6 +347,7 @@ pub fn statics(
         "engine, CPU twins (f64)".into(),
         t,
         figures.take().unwrap_or_default(),
+        per_run(&before),
     ));
     let mut adapter = "none".to_string();
     if let Ok(ctx) = GpuContext::shared() {
@@ -346,6 +357,7 @@ pub fn statics(
             crate::gpu::block_lu::LuForm::for_adapter(ctx)
         );
         if ctx.has_f64 {
+            let before = tally();
             let t = median_seconds::<Error>(repeats, || {
                 let r = solve_static_ensemble::<f64, _>(&models, &GpuPath(ctx), &options)?;
                 figures = Some(engine_figures(&r));
@@ -355,8 +367,10 @@ pub fn statics(
                 "engine, GPU f64".into(),
                 t,
                 figures.take().unwrap_or_default(),
+                per_run(&before),
             ));
         }
+        let before = tally();
         let t = median_seconds::<Error>(repeats, || {
             let r = solve_static_ensemble::<f32, _>(&models, &GpuPath(ctx), &options)?;
             figures = Some(engine_figures(&r));
@@ -366,6 +380,7 @@ pub fn statics(
             "engine, GPU f32".into(),
             t,
             figures.take().unwrap_or_default(),
+            per_run(&before),
         ));
     }
     let cpu = rows[0].1;
@@ -380,7 +395,7 @@ pub fn statics(
         rows: rows
             .into_iter()
             .map(
-                |(path, t, (steps, mean, median, cuts, solved))| StaticsRow {
+                |(path, t, (steps, mean, median, cuts, solved), readbacks)| StaticsRow {
                     path,
                     median_s: t,
                     ratio_to_cpu_backend: cpu / t,
@@ -389,6 +404,7 @@ pub fn statics(
                     newton_iterations_per_load_step_mean: mean,
                     newton_iterations_per_load_step_median: median,
                     step_cuts: cuts,
+                    readbacks_per_run: readbacks,
                 },
             )
             .collect(),

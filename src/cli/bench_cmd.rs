@@ -120,6 +120,10 @@ pub enum BenchCommand {
         /// (serial: one invocation per variant; lanes: eight), to compare them on a device.
         #[arg(long, value_enum)]
         lu_form: Option<LuFormArg>,
+        /// Line-search trials the GPU engine forms in one submission at most (as `bench
+        /// ensemble --trial-round`).
+        #[arg(long, value_parser = clap::value_parser!(u16).range(1..=8))]
+        trial_round: Option<u16>,
         /// Also write the results as JSON here.
         #[arg(long)]
         json: Option<PathBuf>,

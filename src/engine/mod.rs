@@ -104,6 +104,10 @@ impl<T: Real> BatchTables<T> {
     }
 }
 
+/// A solve's norms and statuses ([`ResidentStatic::solve`]) and, where the path forms it
+/// with the solve, the first trial's norms ([`ResidentStatic::solve_with_trial`]).
+pub type SolvedWithTrial<T> = (Norms<T>, Vec<u32>, Option<Norms<T>>);
+
 /// A batch of variants held by a kernel path: a current configuration with its assembled
 /// system, a step `Δ`, and one trial configuration.
 pub trait ResidentStatic<T> {
@@ -121,6 +125,31 @@ pub trait ResidentStatic<T> {
     /// Solves the current system for `Δ`; the norms of its residual and `Δ` (α = 1) and
     /// the solve's status per variant.
     fn solve(&mut self) -> Result<(Norms<T>, Vec<u32>), crate::error::SystemError>;
+    /// [`ResidentStatic::solve`], and where the path forms it in the same round trip, the
+    /// first line-search trial at `α = 1` for every variant ([`ResidentStatic::trial`] with
+    /// `first` and every variant searching): its norms.
+    fn solve_with_trial(&mut self) -> Result<SolvedWithTrial<T>, crate::error::SystemError> {
+        self.solve().map(|(norms, status)| (norms, status, None))
+    }
+    /// Trials the path forms in one round trip ([`ResidentStatic::trials`]).
+    fn trials_per_round(&self) -> usize {
+        1
+    }
+    /// The trials at `alphas[0]`, `alphas[1]`, … in order, each as
+    /// [`ResidentStatic::trial`] (`first` for the first of them), for the same variants
+    /// `search`; the trial left is the last one's. The default forms them one at a time.
+    fn trials(
+        &mut self,
+        alphas: &[Vec<T>],
+        search: &[bool],
+        first: bool,
+    ) -> Result<Vec<Norms<T>>, crate::error::SystemError> {
+        alphas
+            .iter()
+            .enumerate()
+            .map(|(k, a)| self.trial(a, search, first && k == 0))
+            .collect()
+    }
     /// Trial = current + `α Δ`, its residual evaluated (not its tangent: a rejected
     /// trial's tangent would be wasted, and the tangent is most of an evaluation); the norms of the
     /// trial's residual with `Δ`, `α`. Masked as [`NewtonSystem::trial`]: the variants in

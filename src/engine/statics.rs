@@ -34,6 +34,15 @@ pub(super) struct EngineStatic<'a, T> {
     /// Each variant's residual measure without its shift at the current states (kept
     /// until a state changes).
     unshifted: Option<Vec<f64>>,
+    /// The first trial (α = 1, every variant) formed with the last solve
+    /// ([`ResidentStatic::solve_with_trial`]), until a line search takes it or a change
+    /// of every variant's state (a rebase, a shift) makes it stale.
+    full_step: Option<Norms<T>>,
+    /// Variants restored or given new loads since that solve: their trials are stale.
+    touched: Vec<bool>,
+    /// Some variant's trial is not at its α (the first trial was taken from the solve's):
+    /// an accepted step is committed, not taken from the trial.
+    candidate_stale: bool,
 }
 
 impl<'a, T: Real> EngineStatic<'a, T> {
@@ -83,6 +92,9 @@ impl<'a, T: Real> EngineStatic<'a, T> {
             to_save: Vec::new(),
             to_restore: Vec::new(),
             to_rebase: false,
+            full_step: None,
+            touched: vec![false; v],
+            candidate_stale: false,
         }
     }
 
@@ -126,6 +138,7 @@ impl<'a, T: Real> EngineStatic<'a, T> {
                 }
                 self.tables.set_base(self.models[0], moved);
                 self.ensemble.rebase(&self.tables)?;
+                self.full_step = None;
                 self.evaluated = false;
                 self.unshifted = None;
                 // The anchors are held as displacements from the base.
@@ -143,6 +156,7 @@ impl<'a, T: Real> EngineStatic<'a, T> {
         }
         if std::mem::take(&mut self.shift_changed) {
             self.upload_shift()?;
+            self.full_step = None;
         }
         if self.loads_changed {
             self.ensemble
@@ -189,6 +203,8 @@ impl<T: Real> EngineStatic<'_, T> {
             self.shift_changed = true;
             self.evaluated = false;
         }
+        self.full_step = None;
+        self.candidate_stale = false;
         let r = self
             .ensemble
             .trial(&vec![T::zero(); v], &vec![true; v], true)?;
@@ -210,7 +226,9 @@ impl<T: Real> NewtonSystem for EngineStatic<'_, T> {
             self.ensemble.evaluate()?;
             self.evaluated = true;
         }
-        let (now, status) = self.ensemble.solve()?;
+        let (now, status, full_step) = self.ensemble.solve_with_trial()?;
+        self.full_step = full_step;
+        self.touched.iter_mut().for_each(|t| *t = false);
         let f = |x: &T| x.to_f64_lossy();
         Ok(Probe {
             measure: now
@@ -232,8 +250,39 @@ impl<T: Real> NewtonSystem for EngineStatic<'_, T> {
         first: bool,
     ) -> Result<TrialProbe, crate::error::SystemError> {
         self.flush()?;
+        // The first trial formed with the solve, where it is this one for every variant
+        // searching (α = 1, not restored or reloaded since: the kernels read each
+        // variant's own columns alone, so the others' changes leave its trial as it was).
+        if let Some(r) = self.full_step.take() {
+            let fits = |j: usize| alpha[j] == 1.0 && !self.touched[j];
+            if first && (0..alpha.len()).all(|j| !search[j] || fits(j)) {
+                self.candidate_stale = (0..alpha.len()).any(|j| !fits(j));
+                return Ok(trial_probe(&r));
+            }
+        }
+        if first {
+            self.candidate_stale = false;
+        }
         let r = self.ensemble.trial(&negated::<T>(alpha), search, first)?;
         Ok(trial_probe(&r))
+    }
+    fn trials_per_round(&self) -> usize {
+        self.ensemble.trials_per_round()
+    }
+    fn trials(
+        &mut self,
+        alphas: &[Vec<f64>],
+        search: &[bool],
+        first: bool,
+    ) -> Result<Vec<TrialProbe>, crate::error::SystemError> {
+        self.flush()?;
+        self.full_step = None;
+        if first {
+            self.candidate_stale = false;
+        }
+        let alphas: Vec<Vec<T>> = alphas.iter().map(|a| negated::<T>(a)).collect();
+        let r = self.ensemble.trials(&alphas, search, first)?;
+        Ok(r.iter().map(trial_probe).collect())
     }
     fn accept(
         &mut self,
@@ -242,7 +291,9 @@ impl<T: Real> NewtonSystem for EngineStatic<'_, T> {
     ) -> Result<(), crate::error::SystemError> {
         self.flush()?;
         self.unshifted = None;
-        if trial_matches {
+        self.full_step = None;
+        let stale = std::mem::take(&mut self.candidate_stale);
+        if trial_matches && !stale {
             // The trial's residual only: its tangent is formed when the next solve needs it.
             self.ensemble.accept_trial();
             self.evaluated = false;
@@ -283,6 +334,7 @@ impl<T: Real> StaticSystem for EngineStatic<'_, T> {
             );
         }
         self.loads_changed = true;
+        self.touched[j] = true;
         Ok(())
     }
     fn save(&mut self, j: usize) -> Result<(), crate::error::SystemError> {
@@ -291,6 +343,7 @@ impl<T: Real> StaticSystem for EngineStatic<'_, T> {
     }
     fn restore(&mut self, j: usize) -> Result<(), crate::error::SystemError> {
         self.to_restore.push(j);
+        self.touched[j] = true;
         Ok(())
     }
     fn step_floor(&mut self, j: usize) -> Result<f64, crate::error::SystemError> {

@@ -78,46 +78,131 @@ impl<T: GpuReal> ResidentStatic<T> for GpuStatic<T> {
         Ok((norms, status))
     }
 
+    fn solve_with_trial(
+        &mut self,
+    ) -> Result<crate::engine::SolvedWithTrial<T>, crate::error::SystemError> {
+        if !self.formed[self.current] {
+            return Err(crate::error::SystemError::Order(
+                "tangent not formed (a trial's residual only)",
+            ));
+        }
+        let v = self.num_variants;
+        let q = &self.ctx.queue;
+        // The line search's first trial, formed in the same submission: α = 1 and every
+        // variant searching.
+        q.write_buffer(
+            &self.c.alpha,
+            0,
+            bytemuck::cast_slice(&crate::engine::negated::<T>(&vec![1.0; v])),
+        );
+        q.write_buffer(
+            &self.c.active,
+            0,
+            bytemuck::cast_slice(&super::search_list(&vec![true; v])),
+        );
+        let s = &self.slots[self.current];
+        let mut encoder = self.encoder("solve");
+        self.c.reset_status(&mut encoder, v);
+        {
+            let mut pass = encoder.begin_compute_pass(&Default::default());
+            for group in &s.lu {
+                dispatch(&mut pass, &self.p.block_lu, group, self.lu_lanes * v);
+            }
+            dispatch(&mut pass, &self.p.norms, &s.norms_solve, v);
+        }
+        let norm_bytes = (4 * v * std::mem::size_of::<T>()) as u64;
+        encoder.copy_buffer_to_buffer(&self.c.norms, 0, &self.solve_norms, 0, norm_bytes);
+        {
+            let mut pass = encoder.begin_compute_pass(&Default::default());
+            self.record_trial(&mut pass, true, v);
+        }
+        self.formed[1 - self.current] = false;
+        let out = self
+            .c
+            .staging
+            .read(
+                self.ctx,
+                encoder,
+                &[
+                    (&self.solve_norms, norm_bytes),
+                    (&self.c.status, 4 * v as u64),
+                    (&self.c.norms, norm_bytes),
+                ],
+            )
+            .map_err(crate::error::SystemError::from)?;
+        let status: Vec<u32> = values(&out[1]);
+        if status.contains(&RUNNING) {
+            return Err(crate::error::SystemError::BlockSolve(
+                "a dispatch did not complete (status left at running)".into(),
+            ));
+        }
+        Ok((
+            norms_from_bytes(&out[0]),
+            status,
+            Some(norms_from_bytes(&out[2])),
+        ))
+    }
+
     fn trial(
         &mut self,
         alpha: &[T],
         search: &[bool],
         first: bool,
     ) -> Result<Norms<T>, crate::error::SystemError> {
-        let v = self.num_variants;
-        let other = 1 - self.current;
+        let mut r = self.trials(&[alpha.to_vec()], search, first)?;
+        r.pop()
+            .ok_or(crate::error::SystemError::Order("no trial formed"))
+    }
+
+    fn trials_per_round(&self) -> usize {
+        self.round
+    }
+
+    fn trials(
+        &mut self,
+        alphas: &[Vec<T>],
+        search: &[bool],
+        first: bool,
+    ) -> Result<Vec<Norms<T>>, crate::error::SystemError> {
+        let (v, k) = (self.num_variants, alphas.len());
+        if k == 0 || k > self.round {
+            return Err(crate::error::SystemError::Order(
+                "a round of trials beyond the batch's buffers",
+            ));
+        }
         let q = &self.ctx.queue;
-        q.write_buffer(&self.c.alpha, 0, bytemuck::cast_slice(alpha));
+        let size = std::mem::size_of::<T>() as u64;
+        let (row, norm_bytes) = (v as u64 * size, 4 * v as u64 * size);
+        let flat: Vec<T> = alphas.iter().flatten().copied().collect();
+        q.write_buffer(&self.alphas, 0, bytemuck::cast_slice(&flat));
         // The variants still searching, compacted: [A, v_0, …, v_{A−1}].
         let list = super::search_list(search);
         let count = list.len() - 1;
         q.write_buffer(&self.c.active, 0, bytemuck::cast_slice(&list));
-        let mut encoder = self.encoder("trial");
-        let b = &self.slots[other];
-        {
-            // The update moves from the current slot into the trial's (every variant on a
-            // search's first trial, the searching ones after); the kernels built `MASKED`
-            // run one invocation per item and searching variant (issue 27: only the
-            // variants still searching pay for a trial).
-            let mut pass = encoder.begin_compute_pass(&Default::default());
-            let (update, moved) = if first {
-                (&b.update_trial_all, v)
-            } else {
-                (&b.update_trial, count)
-            };
-            dispatch(
-                &mut pass,
-                &self.p.update_trial,
-                update,
-                self.num_nodes * moved,
-            );
-            self.record_evaluate(&mut pass, other, Some(count));
-            dispatch(&mut pass, &self.p.norms_trial, &b.norms_trial, count);
+        let mut encoder = self.encoder("trials");
+        for i in 0..k {
+            encoder.copy_buffer_to_buffer(&self.alphas, i as u64 * row, &self.c.alpha, 0, row);
+            {
+                let mut pass = encoder.begin_compute_pass(&Default::default());
+                self.record_trial(&mut pass, first && i == 0, count);
+            }
+            let at = i as u64 * norm_bytes;
+            encoder.copy_buffer_to_buffer(&self.c.norms, 0, &self.round_norms, at, norm_bytes);
         }
-        self.formed[other] = false;
-        self.finish_with_norms(encoder)
-            .map(|(n, _)| n)
-            .map_err(crate::error::SystemError::from)
+        self.formed[1 - self.current] = false;
+        let out = self
+            .c
+            .staging
+            .read(
+                self.ctx,
+                encoder,
+                &[(&self.round_norms, k as u64 * norm_bytes)],
+            )
+            .map_err(crate::error::SystemError::from)?;
+        Ok(out[0]
+            .chunks_exact(norm_bytes as usize)
+            .map(norms_from_bytes)
+            .collect())
     }
 
     fn accept_trial(&mut self) {

@@ -153,6 +153,13 @@ pub struct GpuStatic<T: GpuReal> {
     /// A relaxation's shift (made at the first); `shifted`: the assembly runs with it.
     shift: Option<ShiftParts>,
     shifted: bool,
+    /// Line-search trials formed in one submission at most ([`trials_per_round`]), with
+    /// their buffers: the solve's norms kept while the trial formed with it writes its own,
+    /// a round's `α` (`round · V`) and norms (`round · 4 V`).
+    round: usize,
+    solve_norms: wgpu::Buffer,
+    alphas: wgpu::Buffer,
+    round_norms: wgpu::Buffer,
     _real: PhantomData<T>,
 }
 
@@ -383,7 +390,12 @@ impl<T: GpuReal> GpuStatic<T> {
             }
         };
         let slots = [make_slot(0), make_slot(1)];
+        let round = trials_per_round(ctx);
         Ok(GpuStatic {
+            round,
+            solve_norms: empty(ctx, "solve_norms", 4 * v * size),
+            alphas: empty(ctx, "alphas", round * v * size),
+            round_norms: empty(ctx, "round_norms", round * 4 * v * size),
             ctx,
             p: pipelines,
             slots,
@@ -471,6 +483,24 @@ impl<T: GpuReal> GpuStatic<T> {
                 (_, _, false) => Some((&*p.assemble_force, &s.assemble_force)),
             },
         });
+    }
+
+    /// Records a line-search trial at the `α` in `c.alpha` into the other slot: the update
+    /// of every variant (`first`: the search's first trial) or of the `count` listed in
+    /// `c.active`, and the residual and norms of the listed ones (the kernels built
+    /// `MASKED`, one invocation per item and listed variant: issue 27, only the variants
+    /// still searching pay for a trial).
+    fn record_trial(&self, pass: &mut wgpu::ComputePass, first: bool, count: usize) {
+        let other = 1 - self.current;
+        let b = &self.slots[other];
+        let (update, moved) = if first {
+            (&b.update_trial_all, self.num_variants)
+        } else {
+            (&b.update_trial, count)
+        };
+        dispatch(pass, &self.p.update_trial, update, self.num_nodes * moved);
+        self.record_evaluate(pass, other, Some(count));
+        dispatch(pass, &self.p.norms_trial, &b.norms_trial, count);
     }
 
     fn encoder(&self, label: &str) -> wgpu::CommandEncoder {
