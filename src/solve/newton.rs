@@ -25,6 +25,10 @@
 //!   residual norm is rounding noise there, which halving cannot lower) — but not one that
 //!   leaves the noise band: a full step along a soft direction (a pinned stabilizer with
 //!   μ = 1 on a 1e10 N/m wall) can jump from 4e-4 of the force scale to 150.
+//!   A system whose trials wait on a device ([`NewtonSystem::trials_per_round`] > 1: the
+//!   GPU engines) is asked for the halvings after the first trial in rounds of 2, 4, 8, …
+//!   at once; the decisions are taken over them in order, so every variant's steps are
+//!   those of one trial at a time (issue 27, item 3: fewer round trips).
 //! - **Failure** per variant: a non-finite residual, a singular tangent, or no convergence
 //!   within `max_iterations` updates, or (statics) a residual that has not halved in
 //!   [`STATIC_STALL_ITERATIONS`]. The failing variant stops; the others go on.
