@@ -535,6 +535,78 @@ pub(crate) fn trial_probe<T: Real>(r: &Norms<T>) -> TrialProbe {
     }
 }
 
+/// The line search's first trial formed with a solve (issue 27, item 3: no round trip of
+/// its own), kept by a batch's Newton system — the static engine's and the dynamic
+/// engine's, one policy — until a search takes it, and whether the candidates the path
+/// holds are at the α Newton accepts.
+pub(crate) struct KeptTrial<T> {
+    /// The trial's norms and the α each variant's candidate was formed at.
+    kept: Option<(Norms<T>, Vec<f64>)>,
+    /// Some variant's candidate is not at its α (the search's first trial was taken from
+    /// the kept one): an accepted step is committed, not taken from the trial.
+    stale: bool,
+}
+
+impl<T: Real> KeptTrial<T> {
+    pub(crate) fn new() -> Self {
+        KeptTrial {
+            kept: None,
+            stale: false,
+        }
+    }
+
+    /// Keeps the trial a solve formed at `alpha` per variant (`None`: none formed).
+    pub(crate) fn keep(&mut self, norms: Option<Norms<T>>, alpha: Vec<f64>) {
+        self.kept = norms.map(|n| (n, alpha));
+    }
+
+    /// Drops the kept trial (the states it was formed from changed for every variant).
+    pub(crate) fn drop_kept(&mut self) {
+        self.kept = None;
+    }
+
+    /// The trial at `alpha` for the variants `search` (`first`: a search's first trial),
+    /// where the kept one is that trial for every one of them (formed at its α, and
+    /// `changed(j)` false: not restored or reloaded since; the kernels read each variant's
+    /// own columns alone, so the others' changes leave its trial as it was). The kept trial
+    /// is gone after this call.
+    pub(crate) fn take(
+        &mut self,
+        alpha: &[f64],
+        search: &[bool],
+        first: bool,
+        changed: &dyn Fn(usize) -> bool,
+    ) -> Option<TrialProbe> {
+        let (norms, formed) = self.kept.take()?;
+        let fits = |j: usize| alpha[j] == formed[j] && !changed(j);
+        if first && (0..alpha.len()).all(|j| !search[j] || fits(j)) {
+            self.stale = (0..alpha.len()).any(|j| !fits(j));
+            return Some(trial_probe(&norms));
+        }
+        None
+    }
+
+    /// A trial the path forms now (`first`: it sets every variant's candidate).
+    pub(crate) fn forming(&mut self, first: bool) {
+        self.kept = None;
+        if first {
+            self.stale = false;
+        }
+    }
+
+    /// At an accepted step: whether the path's trial may be taken as it stands (Newton's
+    /// `trial_matches`, and no candidate stale). Ends the search.
+    pub(crate) fn take_trial(&mut self, trial_matches: bool) -> bool {
+        self.kept = None;
+        trial_matches && !std::mem::take(&mut self.stale)
+    }
+}
+
+/// Rounds of trials' `α` for a kernel path (negated: the kernels take `x − α Δ`).
+pub(crate) fn negated_rounds<T: Real>(alphas: &[Vec<f64>]) -> Vec<Vec<T>> {
+    alphas.iter().map(|a| negated::<T>(a)).collect()
+}
+
 /// A kernel path with batches of at most `max` variants (to test batch boundaries, or to
 /// bound the memory a run takes).
 pub struct Batched<P> {

@@ -36,13 +36,10 @@ pub(super) struct EngineStatic<'a, T> {
     unshifted: Option<Vec<f64>>,
     /// The first trial (α = 1, every variant) formed with the last solve
     /// ([`ResidentStatic::solve_with_trial`]), until a line search takes it or a change
-    /// of every variant's state (a rebase, a shift) makes it stale.
-    full_step: Option<Norms<T>>,
+    /// of every variant's state (a rebase, a shift) drops it.
+    full_step: KeptTrial<T>,
     /// Variants restored or given new loads since that solve: their trials are stale.
     touched: Vec<bool>,
-    /// Some variant's trial is not at its α (the first trial was taken from the solve's):
-    /// an accepted step is committed, not taken from the trial.
-    candidate_stale: bool,
 }
 
 impl<'a, T: Real> EngineStatic<'a, T> {
@@ -92,9 +89,8 @@ impl<'a, T: Real> EngineStatic<'a, T> {
             to_save: Vec::new(),
             to_restore: Vec::new(),
             to_rebase: false,
-            full_step: None,
+            full_step: KeptTrial::new(),
             touched: vec![false; v],
-            candidate_stale: false,
         }
     }
 
@@ -138,7 +134,7 @@ impl<'a, T: Real> EngineStatic<'a, T> {
                 }
                 self.tables.set_base(self.models[0], moved);
                 self.ensemble.rebase(&self.tables)?;
-                self.full_step = None;
+                self.full_step.drop_kept();
                 self.evaluated = false;
                 self.unshifted = None;
                 // The anchors are held as displacements from the base.
@@ -156,7 +152,7 @@ impl<'a, T: Real> EngineStatic<'a, T> {
         }
         if std::mem::take(&mut self.shift_changed) {
             self.upload_shift()?;
-            self.full_step = None;
+            self.full_step.drop_kept();
         }
         if self.loads_changed {
             self.ensemble
@@ -203,8 +199,7 @@ impl<T: Real> EngineStatic<'_, T> {
             self.shift_changed = true;
             self.evaluated = false;
         }
-        self.full_step = None;
-        self.candidate_stale = false;
+        self.full_step.forming(true);
         let r = self
             .ensemble
             .trial(&vec![T::zero(); v], &vec![true; v], true)?;
@@ -227,7 +222,8 @@ impl<T: Real> NewtonSystem for EngineStatic<'_, T> {
             self.evaluated = true;
         }
         let (now, status, full_step) = self.ensemble.solve_with_trial()?;
-        self.full_step = full_step;
+        self.full_step
+            .keep(full_step, vec![1.0; self.tables.num_variants]);
         self.touched.iter_mut().for_each(|t| *t = false);
         let f = |x: &T| x.to_f64_lossy();
         Ok(Probe {
@@ -250,19 +246,11 @@ impl<T: Real> NewtonSystem for EngineStatic<'_, T> {
         first: bool,
     ) -> Result<TrialProbe, crate::error::SystemError> {
         self.flush()?;
-        // The first trial formed with the solve, where it is this one for every variant
-        // searching (α = 1, not restored or reloaded since: the kernels read each
-        // variant's own columns alone, so the others' changes leave its trial as it was).
-        if let Some(r) = self.full_step.take() {
-            let fits = |j: usize| alpha[j] == 1.0 && !self.touched[j];
-            if first && (0..alpha.len()).all(|j| !search[j] || fits(j)) {
-                self.candidate_stale = (0..alpha.len()).any(|j| !fits(j));
-                return Ok(trial_probe(&r));
-            }
+        let touched = &self.touched;
+        if let Some(r) = self.full_step.take(alpha, search, first, &|j| touched[j]) {
+            return Ok(r);
         }
-        if first {
-            self.candidate_stale = false;
-        }
+        self.full_step.forming(first);
         let r = self.ensemble.trial(&negated::<T>(alpha), search, first)?;
         Ok(trial_probe(&r))
     }
@@ -276,12 +264,10 @@ impl<T: Real> NewtonSystem for EngineStatic<'_, T> {
         first: bool,
     ) -> Result<Vec<TrialProbe>, crate::error::SystemError> {
         self.flush()?;
-        self.full_step = None;
-        if first {
-            self.candidate_stale = false;
-        }
-        let alphas: Vec<Vec<T>> = alphas.iter().map(|a| negated::<T>(a)).collect();
-        let r = self.ensemble.trials(&alphas, search, first)?;
+        self.full_step.forming(first);
+        let r = self
+            .ensemble
+            .trials(&negated_rounds::<T>(alphas), search, first)?;
         Ok(r.iter().map(trial_probe).collect())
     }
     fn accept(
@@ -291,9 +277,7 @@ impl<T: Real> NewtonSystem for EngineStatic<'_, T> {
     ) -> Result<(), crate::error::SystemError> {
         self.flush()?;
         self.unshifted = None;
-        self.full_step = None;
-        let stale = std::mem::take(&mut self.candidate_stale);
-        if trial_matches && !stale {
+        if self.full_step.take_trial(trial_matches) {
             // The trial's residual only: its tangent is formed when the next solve needs it.
             self.ensemble.accept_trial();
             self.evaluated = false;

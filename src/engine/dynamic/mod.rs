@@ -646,7 +646,7 @@ fn solve_step<T: Real + Send + Sync, P: KernelPath<T>>(
             f_ref: members.iter().map(|&j| batch.f_ref[j]).collect(),
             hhb,
             running: vec![true; m],
-            full_step: None,
+            full_step: crate::engine::KeptTrial::new(),
         };
         while newton.any_running() {
             sys.running = (0..m).map(|i| newton.is_running(i)).collect();

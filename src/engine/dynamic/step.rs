@@ -2,9 +2,8 @@
 //! split from `engine/dynamic/mod.rs` (issue 24: no file over 800 lines).
 
 use super::{Iteration, ResidentDynamic};
-use crate::engine::{negated, trial_probe};
+use crate::engine::{negated, negated_rounds, trial_probe, KeptTrial};
 use crate::kernels::block_lu::SOLVED;
-use crate::kernels::update::Norms;
 use crate::physics::Real;
 use crate::solve::newton::{NewtonSystem, Probe, TrialProbe};
 
@@ -15,9 +14,10 @@ pub(super) struct DynamicStep<'e, T> {
     pub(super) hhb: f64,
     /// The variants Newton is iterating on (set before each iteration).
     pub(super) running: Vec<bool>,
-    /// The first trial formed with the last iteration ([`Iteration::full_step`]), until a
-    /// line search takes it or the next iteration.
-    pub(super) full_step: Option<Norms<T>>,
+    /// The first trial formed with the last iteration ([`Iteration::full_step`]: α = 1 for
+    /// the variants iterating, 0 for the others), until a line search takes it or the next
+    /// iteration.
+    pub(super) full_step: KeptTrial<T>,
 }
 
 impl<T: Real> NewtonSystem for DynamicStep<'_, T> {
@@ -31,7 +31,12 @@ impl<T: Real> NewtonSystem for DynamicStep<'_, T> {
             inertial,
             full_step,
         } = self.ensemble.iterate(&self.running)?;
-        self.full_step = full_step;
+        let formed = self
+            .running
+            .iter()
+            .map(|&r| f64::from(u8::from(r)))
+            .collect();
+        self.full_step.keep(full_step, formed);
         let f = |x: &T| x.to_f64_lossy();
         Ok(Probe {
             // Scale: the loads, or the inertial forces if larger (a whirling string).
@@ -50,18 +55,10 @@ impl<T: Real> NewtonSystem for DynamicStep<'_, T> {
         search: &[bool],
         first: bool,
     ) -> Result<TrialProbe, crate::error::SystemError> {
-        // The first trial formed with the iteration, where it is this one: α = 1 for the
-        // variants iterating, 0 for the others, read for a subset of them.
-        if let Some(r) = self.full_step.take() {
-            let same = first
-                && (0..alpha.len()).all(|j| {
-                    let want = if self.running[j] { 1.0 } else { 0.0 };
-                    alpha[j] == want && (!search[j] || self.running[j])
-                });
-            if same {
-                return Ok(trial_probe(&r));
-            }
+        if let Some(r) = self.full_step.take(alpha, search, first, &|_| false) {
+            return Ok(r);
         }
+        self.full_step.forming(first);
         let r = self.ensemble.trial(&negated::<T>(alpha), search, first)?;
         Ok(trial_probe(&r))
     }
@@ -74,9 +71,10 @@ impl<T: Real> NewtonSystem for DynamicStep<'_, T> {
         search: &[bool],
         first: bool,
     ) -> Result<Vec<TrialProbe>, crate::error::SystemError> {
-        self.full_step = None;
-        let alphas: Vec<Vec<T>> = alphas.iter().map(|a| negated::<T>(a)).collect();
-        let r = self.ensemble.trials(&alphas, search, first)?;
+        self.full_step.forming(first);
+        let r = self
+            .ensemble
+            .trials(&negated_rounds::<T>(alphas), search, first)?;
         Ok(r.iter().map(trial_probe).collect())
     }
     fn accept(
@@ -84,7 +82,7 @@ impl<T: Real> NewtonSystem for DynamicStep<'_, T> {
         alpha: &[f64],
         trial_matches: bool,
     ) -> Result<(), crate::error::SystemError> {
-        if trial_matches {
+        if self.full_step.take_trial(trial_matches) {
             // The trial at these α is the new unknown.
             self.ensemble.accept_trial()?;
         } else if alpha.iter().any(|&a| a != 0.0) {
