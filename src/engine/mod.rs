@@ -104,13 +104,50 @@ impl<T: Real> BatchTables<T> {
     }
 }
 
+/// A batch's line-search trials on a kernel path ([`ResidentStatic`]'s and
+/// [`dynamic::ResidentDynamic`]'s). A trial is the current point `+ α Δ` (the static
+/// configuration, or the dynamic step's unknown `v̇`) with its residual alone evaluated (not
+/// its tangent: a rejected trial's tangent would be wasted, and the tangent is most of an
+/// evaluation), and the norms of that residual with `Δ`, `α`.
+pub trait ResidentTrials<T> {
+    /// One trial. Masked as [`NewtonSystem::trial`]: the variants in `search` are moved and
+    /// evaluated (their norms are read); on the `first` trial of a search every variant's
+    /// trial is set (α = 0: the current point), later ones keep the others' trials as they
+    /// are, and a path may evaluate only the searching ones.
+    fn trial(
+        &mut self,
+        alpha: &[T],
+        search: &[bool],
+        first: bool,
+    ) -> Result<Norms<T>, crate::error::SystemError>;
+    /// Trials the path forms in one round trip ([`ResidentTrials::trials`]).
+    fn trials_per_round(&self) -> usize {
+        1
+    }
+    /// The trials at `alphas[0]`, `alphas[1]`, … in order, each as
+    /// [`ResidentTrials::trial`] (`first` for the first of them), for the same variants
+    /// `search`; the trial left is the last one's. The default forms them one at a time.
+    fn trials(
+        &mut self,
+        alphas: &[Vec<T>],
+        search: &[bool],
+        first: bool,
+    ) -> Result<Vec<Norms<T>>, crate::error::SystemError> {
+        alphas
+            .iter()
+            .enumerate()
+            .map(|(k, a)| self.trial(a, search, first && k == 0))
+            .collect()
+    }
+}
+
 /// A solve's norms and statuses ([`ResidentStatic::solve`]) and, where the path forms it
 /// with the solve, the first trial's norms ([`ResidentStatic::solve_with_trial`]).
 pub type SolvedWithTrial<T> = (Norms<T>, Vec<u32>, Option<Norms<T>>);
 
 /// A batch of variants held by a kernel path: a current configuration with its assembled
 /// system, a step `Δ`, and one trial configuration.
-pub trait ResidentStatic<T> {
+pub trait ResidentStatic<T>: ResidentTrials<T> {
     /// Sets the external loads (`6 n V`), the pairs' law parameters (`PARAMS_LEN · P`,
     /// field-major) and the elements' unstrained rotations (`6 (n − 1) V`, empty without a
     /// kink) of a load step.
@@ -131,36 +168,6 @@ pub trait ResidentStatic<T> {
     fn solve_with_trial(&mut self) -> Result<SolvedWithTrial<T>, crate::error::SystemError> {
         self.solve().map(|(norms, status)| (norms, status, None))
     }
-    /// Trials the path forms in one round trip ([`ResidentStatic::trials`]).
-    fn trials_per_round(&self) -> usize {
-        1
-    }
-    /// The trials at `alphas[0]`, `alphas[1]`, … in order, each as
-    /// [`ResidentStatic::trial`] (`first` for the first of them), for the same variants
-    /// `search`; the trial left is the last one's. The default forms them one at a time.
-    fn trials(
-        &mut self,
-        alphas: &[Vec<T>],
-        search: &[bool],
-        first: bool,
-    ) -> Result<Vec<Norms<T>>, crate::error::SystemError> {
-        alphas
-            .iter()
-            .enumerate()
-            .map(|(k, a)| self.trial(a, search, first && k == 0))
-            .collect()
-    }
-    /// Trial = current + `α Δ`, its residual evaluated (not its tangent: a rejected
-    /// trial's tangent would be wasted, and the tangent is most of an evaluation); the norms of the
-    /// trial's residual with `Δ`, `α`. Masked as [`NewtonSystem::trial`]: the variants in
-    /// `search` are moved and evaluated (their norms are read); on the `first` trial of a
-    /// search every variant's trial is set, later ones keep the others' trials as they are.
-    fn trial(
-        &mut self,
-        alpha: &[T],
-        search: &[bool],
-        first: bool,
-    ) -> Result<Norms<T>, crate::error::SystemError>;
     /// Makes the last trial (configuration and residual) the current one; its tangent is
     /// formed by the next [`ResidentStatic::evaluate`].
     fn accept_trial(&mut self);
@@ -605,6 +612,36 @@ impl<T: Real> KeptTrial<T> {
 /// Rounds of trials' `α` for a kernel path (negated: the kernels take `x − α Δ`).
 pub(crate) fn negated_rounds<T: Real>(alphas: &[Vec<f64>]) -> Vec<Vec<T>> {
     alphas.iter().map(|a| negated::<T>(a)).collect()
+}
+
+/// A batch's Newton system's trial ([`NewtonSystem::trial`]) on `path`: the kept first
+/// trial where it is this one ([`KeptTrial::take`]), else formed on the path.
+pub(crate) fn trial_on<T: Real>(
+    path: &mut dyn ResidentTrials<T>,
+    kept: &mut KeptTrial<T>,
+    (alpha, search, first): (&[f64], &[bool], bool),
+    changed: &dyn Fn(usize) -> bool,
+) -> Result<TrialProbe, crate::error::SystemError> {
+    if let Some(r) = kept.take(alpha, search, first, changed) {
+        return Ok(r);
+    }
+    kept.forming(first);
+    Ok(trial_probe(&path.trial(
+        &negated::<T>(alpha),
+        search,
+        first,
+    )?))
+}
+
+/// A batch's Newton system's round of trials ([`NewtonSystem::trials`]) on `path`.
+pub(crate) fn trials_on<T: Real>(
+    path: &mut dyn ResidentTrials<T>,
+    kept: &mut KeptTrial<T>,
+    (alphas, search, first): (&[Vec<f64>], &[bool], bool),
+) -> Result<Vec<TrialProbe>, crate::error::SystemError> {
+    kept.forming(first);
+    let r = path.trials(&negated_rounds::<T>(alphas), search, first)?;
+    Ok(r.iter().map(trial_probe).collect())
 }
 
 /// A kernel path with batches of at most `max` variants (to test batch boundaries, or to

@@ -247,12 +247,10 @@ impl<T: Real> NewtonSystem for EngineStatic<'_, T> {
     ) -> Result<TrialProbe, crate::error::SystemError> {
         self.flush()?;
         let touched = &self.touched;
-        if let Some(r) = self.full_step.take(alpha, search, first, &|j| touched[j]) {
-            return Ok(r);
-        }
-        self.full_step.forming(first);
-        let r = self.ensemble.trial(&negated::<T>(alpha), search, first)?;
-        Ok(trial_probe(&r))
+        let request = (alpha, search, first);
+        trial_on(self.ensemble.as_mut(), &mut self.full_step, request, &|j| {
+            touched[j]
+        })
     }
     fn trials_per_round(&self) -> usize {
         self.ensemble.trials_per_round()
@@ -264,11 +262,8 @@ impl<T: Real> NewtonSystem for EngineStatic<'_, T> {
         first: bool,
     ) -> Result<Vec<TrialProbe>, crate::error::SystemError> {
         self.flush()?;
-        self.full_step.forming(first);
-        let r = self
-            .ensemble
-            .trials(&negated_rounds::<T>(alphas), search, first)?;
-        Ok(r.iter().map(trial_probe).collect())
+        let request = (alphas, search, first);
+        trials_on(self.ensemble.as_mut(), &mut self.full_step, request)
     }
     fn accept(
         &mut self,

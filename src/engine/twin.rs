@@ -214,6 +214,44 @@ impl ResidentStatic<f64> for TwinStatic<'_> {
         );
         Ok((n, status))
     }
+    fn accept_trial(&mut self) {
+        self.current = 1 - self.current;
+    }
+    fn commit(&mut self, alpha: &[f64]) -> Result<(), crate::error::SystemError> {
+        update(
+            &mut self.config[self.current],
+            &self.walls,
+            &self.delta,
+            alpha,
+        );
+        self.system[self.current] = None;
+        Ok(())
+    }
+    fn config(&mut self) -> Result<ConfigBatch<f64>, crate::error::SystemError> {
+        Ok(self.config[self.current].clone())
+    }
+    fn set_config(&mut self, config: &ConfigBatch<f64>) -> Result<(), crate::error::SystemError> {
+        let c = &mut self.config[self.current];
+        c.x.copy_from_slice(&config.x);
+        c.rot.copy_from_slice(&config.rot);
+        self.system[self.current] = None;
+        Ok(())
+    }
+    fn set_shift(&mut self, shift: Option<&Shift<f64>>) -> Result<(), crate::error::SystemError> {
+        self.shift = shift.cloned();
+        self.system = [None, None];
+        Ok(())
+    }
+    fn rebase(&mut self, tables: &BatchTables<f64>) -> Result<(), crate::error::SystemError> {
+        self.tables = tables.clone();
+        self.refresh_walls();
+        self.config[self.current].x.fill(0.0);
+        self.system[self.current] = None;
+        Ok(())
+    }
+}
+
+impl ResidentTrials<f64> for TwinStatic<'_> {
     fn trial(
         &mut self,
         alpha: &[f64],
@@ -249,41 +287,6 @@ impl ResidentStatic<f64> for TwinStatic<'_> {
             self.tables.num_nodes,
             self.tables.num_variants,
         ))
-    }
-    fn accept_trial(&mut self) {
-        self.current = 1 - self.current;
-    }
-    fn commit(&mut self, alpha: &[f64]) -> Result<(), crate::error::SystemError> {
-        update(
-            &mut self.config[self.current],
-            &self.walls,
-            &self.delta,
-            alpha,
-        );
-        self.system[self.current] = None;
-        Ok(())
-    }
-    fn config(&mut self) -> Result<ConfigBatch<f64>, crate::error::SystemError> {
-        Ok(self.config[self.current].clone())
-    }
-    fn set_config(&mut self, config: &ConfigBatch<f64>) -> Result<(), crate::error::SystemError> {
-        let c = &mut self.config[self.current];
-        c.x.copy_from_slice(&config.x);
-        c.rot.copy_from_slice(&config.rot);
-        self.system[self.current] = None;
-        Ok(())
-    }
-    fn set_shift(&mut self, shift: Option<&Shift<f64>>) -> Result<(), crate::error::SystemError> {
-        self.shift = shift.cloned();
-        self.system = [None, None];
-        Ok(())
-    }
-    fn rebase(&mut self, tables: &BatchTables<f64>) -> Result<(), crate::error::SystemError> {
-        self.tables = tables.clone();
-        self.refresh_walls();
-        self.config[self.current].x.fill(0.0);
-        self.system[self.current] = None;
-        Ok(())
     }
 }
 

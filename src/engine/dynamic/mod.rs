@@ -78,7 +78,7 @@ pub struct Iteration<T> {
 
 /// A batch of variants held by a kernel path for a dynamic run: the state at `t_n`, the
 /// Newton unknown `v̇_{n+1}`, a trial state and its system.
-pub trait ResidentDynamic<T> {
+pub trait ResidentDynamic<T>: crate::engine::ResidentTrials<T> {
     /// Starts a step: its coefficients and the top's kinematics per variant
     /// (`TOP_LEN · V`); the unknown starts at `v̇_n`.
     fn begin_step(
@@ -91,36 +91,6 @@ pub trait ResidentDynamic<T> {
     /// read for the variants `running` (a path may work on those alone: the others have
     /// converged or failed, and their unknowns stay as they are).
     fn iterate(&mut self, running: &[bool]) -> Result<Iteration<T>, crate::error::SystemError>;
-    /// The residual at `v̇ + α Δ` (line search; the residual alone): its norms with `Δ`,
-    /// `α`, read for the variants in `search`. `first`: the search's first trial — every
-    /// variant's candidate is set (α = 0: the unknown); after it only the searching
-    /// variants' candidates move, every other keeps its own (as
-    /// [`crate::solve::newton::NewtonSystem::trial`]), and a path may evaluate only those.
-    fn trial(
-        &mut self,
-        alpha: &[T],
-        search: &[bool],
-        first: bool,
-    ) -> Result<Norms<T>, crate::error::SystemError>;
-    /// Trials the path forms in one round trip ([`ResidentDynamic::trials`]).
-    fn trials_per_round(&self) -> usize {
-        1
-    }
-    /// The trials at `alphas[0]`, `alphas[1]`, … in order, each as
-    /// [`ResidentDynamic::trial`] (`first` for the first of them), for the same variants
-    /// `search`; the candidate left is the last one's. The default forms them one at a time.
-    fn trials(
-        &mut self,
-        alphas: &[Vec<T>],
-        search: &[bool],
-        first: bool,
-    ) -> Result<Vec<Norms<T>>, crate::error::SystemError> {
-        alphas
-            .iter()
-            .enumerate()
-            .map(|(k, a)| self.trial(a, search, first && k == 0))
-            .collect()
-    }
     /// The unknown `+= α Δ`.
     fn correct(&mut self, alpha: &[T]) -> Result<(), crate::error::SystemError>;
     /// The unknown becomes the last trial's candidate (a trial forms its residual only:

@@ -2,7 +2,7 @@
 //! split from `engine/dynamic/mod.rs` (issue 24: no file over 800 lines).
 
 use super::{Iteration, ResidentDynamic};
-use crate::engine::{negated, negated_rounds, trial_probe, KeptTrial};
+use crate::engine::{negated, trial_on, trials_on, KeptTrial};
 use crate::kernels::block_lu::SOLVED;
 use crate::physics::Real;
 use crate::solve::newton::{NewtonSystem, Probe, TrialProbe};
@@ -55,12 +55,8 @@ impl<T: Real> NewtonSystem for DynamicStep<'_, T> {
         search: &[bool],
         first: bool,
     ) -> Result<TrialProbe, crate::error::SystemError> {
-        if let Some(r) = self.full_step.take(alpha, search, first, &|_| false) {
-            return Ok(r);
-        }
-        self.full_step.forming(first);
-        let r = self.ensemble.trial(&negated::<T>(alpha), search, first)?;
-        Ok(trial_probe(&r))
+        let request = (alpha, search, first);
+        trial_on(self.ensemble, &mut self.full_step, request, &|_| false)
     }
     fn trials_per_round(&self) -> usize {
         self.ensemble.trials_per_round()
@@ -71,11 +67,7 @@ impl<T: Real> NewtonSystem for DynamicStep<'_, T> {
         search: &[bool],
         first: bool,
     ) -> Result<Vec<TrialProbe>, crate::error::SystemError> {
-        self.full_step.forming(first);
-        let r = self
-            .ensemble
-            .trials(&negated_rounds::<T>(alphas), search, first)?;
-        Ok(r.iter().map(trial_probe).collect())
+        trials_on(self.ensemble, &mut self.full_step, (alphas, search, first))
     }
     fn accept(
         &mut self,

@@ -110,20 +110,6 @@ impl ResidentDynamic<f64> for TwinDynamic<'_> {
             full_step: None,
         })
     }
-    fn trial(
-        &mut self,
-        alpha: &[f64],
-        _: &[bool],
-        _: bool,
-    ) -> Result<Norms<f64>, crate::error::SystemError> {
-        // Every variant is moved and evaluated: the searching ones' residuals are those the
-        // GPU forms for them alone, the others' trial points those it keeps (each at its
-        // accepted α).
-        let (v, n) = (self.tables.num_variants, self.tables.num_nodes);
-        let cand = accelerate(&self.tables.basis, &self.unknown, &self.delta, alpha, n, v);
-        let sys = self.evaluate_at(cand, false)?;
-        Ok(norms(&sys.rhs, &self.delta, alpha, n, v))
-    }
     fn correct(&mut self, alpha: &[f64]) -> Result<(), crate::error::SystemError> {
         let (v, n) = (self.tables.num_variants, self.tables.num_nodes);
         self.unknown = accelerate(&self.tables.basis, &self.unknown, &self.delta, alpha, n, v);
@@ -151,6 +137,23 @@ impl ResidentDynamic<f64> for TwinDynamic<'_> {
     fn set_state(&mut self, state: &DynamicBatch<f64>) -> Result<(), crate::error::SystemError> {
         self.state = state.clone();
         Ok(())
+    }
+}
+
+impl crate::engine::ResidentTrials<f64> for TwinDynamic<'_> {
+    fn trial(
+        &mut self,
+        alpha: &[f64],
+        _: &[bool],
+        _: bool,
+    ) -> Result<Norms<f64>, crate::error::SystemError> {
+        // Every variant is moved and evaluated: the searching ones' residuals are those the
+        // GPU forms for them alone, the others' trial points those it keeps (each at its
+        // accepted α).
+        let (v, n) = (self.tables.num_variants, self.tables.num_nodes);
+        let cand = accelerate(&self.tables.basis, &self.unknown, &self.delta, alpha, n, v);
+        let sys = self.evaluate_at(cand, false)?;
+        Ok(norms(&sys.rhs, &self.delta, alpha, n, v))
     }
 }
 

@@ -581,70 +581,6 @@ impl<T: GpuReal> crate::engine::dynamic::ResidentDynamic<T> for GpuDynamic<T> {
         })
     }
 
-    fn trial(
-        &mut self,
-        alpha: &[T],
-        search: &[bool],
-        first: bool,
-    ) -> Result<Norms<T>, crate::error::SystemError> {
-        let mut r = self.trials(&[alpha.to_vec()], search, first)?;
-        r.pop()
-            .ok_or(crate::error::SystemError::Order("no trial formed"))
-    }
-
-    fn trials_per_round(&self) -> usize {
-        self.round
-    }
-
-    fn trials(
-        &mut self,
-        alphas: &[Vec<T>],
-        search: &[bool],
-        first: bool,
-    ) -> Result<Vec<Norms<T>>, crate::error::SystemError> {
-        let (v, k) = (self.num_variants, alphas.len());
-        if k == 0 || k > self.round {
-            return Err(crate::error::SystemError::Order(
-                "a round of trials beyond the batch's buffers",
-            ));
-        }
-        let q = &self.ctx.queue;
-        let size = std::mem::size_of::<T>() as u64;
-        let (row, norms_bytes) = (v as u64 * size, 4 * v as u64 * size);
-        // Every trial's α, copied into the kernels' `α` before its passes.
-        let flat: Vec<T> = alphas.iter().flatten().copied().collect();
-        q.write_buffer(&self.b.alphas, 0, bytemuck::cast_slice(&flat));
-        // The variants still searching, compacted: [A, v_0, …, v_{A−1}].
-        let list = super::search_list(search);
-        let count = list.len() - 1;
-        q.write_buffer(&self.c.active, 0, bytemuck::cast_slice(&list));
-        let mut e = encoder(self.ctx, "trials");
-        let clock = self.clock.as_ref();
-        for i in 0..k {
-            e.copy_buffer_to_buffer(&self.b.alphas, i as u64 * row, &self.c.alpha, 0, row);
-            {
-                let mut pass = PassClock::span_pass(clock, &mut e, 0, i == 0, i + 1 == k);
-                self.record_trial(&mut pass, first && i == 0, count);
-            }
-            let at = i as u64 * norms_bytes;
-            e.copy_buffer_to_buffer(&self.c.norms, 0, &self.b.round_norms, at, norms_bytes);
-        }
-        let mut reads = vec![(&self.b.round_norms, k as u64 * norms_bytes)];
-        reads.extend(clock.map(|c| c.resolve(&mut e)));
-        let out = self
-            .c
-            .staging
-            .read(self.ctx, e, &reads)
-            .map_err(crate::error::SystemError::from)?;
-        if let (Some(c), Some(stamps)) = (clock, out.get(1)) {
-            c.record_span(stamps, 0, k as u64);
-        }
-        Ok(out[0]
-            .chunks_exact(norms_bytes as usize)
-            .map(norms_from_bytes)
-            .collect())
-    }
-
     fn correct(&mut self, alpha: &[T]) -> Result<(), crate::error::SystemError> {
         self.ctx
             .queue
@@ -740,5 +676,71 @@ impl<T: GpuReal> crate::engine::dynamic::ResidentDynamic<T> for GpuDynamic<T> {
             acc: cast(&out[3]),
             vdot: cast(&out[4]),
         })
+    }
+}
+
+impl<T: GpuReal> crate::engine::ResidentTrials<T> for GpuDynamic<T> {
+    fn trial(
+        &mut self,
+        alpha: &[T],
+        search: &[bool],
+        first: bool,
+    ) -> Result<Norms<T>, crate::error::SystemError> {
+        let mut r = self.trials(&[alpha.to_vec()], search, first)?;
+        r.pop()
+            .ok_or(crate::error::SystemError::Order("no trial formed"))
+    }
+
+    fn trials_per_round(&self) -> usize {
+        self.round
+    }
+
+    fn trials(
+        &mut self,
+        alphas: &[Vec<T>],
+        search: &[bool],
+        first: bool,
+    ) -> Result<Vec<Norms<T>>, crate::error::SystemError> {
+        let (v, k) = (self.num_variants, alphas.len());
+        if k == 0 || k > self.round {
+            return Err(crate::error::SystemError::Order(
+                "a round of trials beyond the batch's buffers",
+            ));
+        }
+        let q = &self.ctx.queue;
+        let size = std::mem::size_of::<T>() as u64;
+        let (row, norms_bytes) = (v as u64 * size, 4 * v as u64 * size);
+        // Every trial's α, copied into the kernels' `α` before its passes.
+        let flat: Vec<T> = alphas.iter().flatten().copied().collect();
+        q.write_buffer(&self.b.alphas, 0, bytemuck::cast_slice(&flat));
+        // The variants still searching, compacted: [A, v_0, …, v_{A−1}].
+        let list = super::search_list(search);
+        let count = list.len() - 1;
+        q.write_buffer(&self.c.active, 0, bytemuck::cast_slice(&list));
+        let mut e = encoder(self.ctx, "trials");
+        let clock = self.clock.as_ref();
+        for i in 0..k {
+            e.copy_buffer_to_buffer(&self.b.alphas, i as u64 * row, &self.c.alpha, 0, row);
+            {
+                let mut pass = PassClock::span_pass(clock, &mut e, 0, i == 0, i + 1 == k);
+                self.record_trial(&mut pass, first && i == 0, count);
+            }
+            let at = i as u64 * norms_bytes;
+            e.copy_buffer_to_buffer(&self.c.norms, 0, &self.b.round_norms, at, norms_bytes);
+        }
+        let mut reads = vec![(&self.b.round_norms, k as u64 * norms_bytes)];
+        reads.extend(clock.map(|c| c.resolve(&mut e)));
+        let out = self
+            .c
+            .staging
+            .read(self.ctx, e, &reads)
+            .map_err(crate::error::SystemError::from)?;
+        if let (Some(c), Some(stamps)) = (clock, out.get(1)) {
+            c.record_span(stamps, 0, k as u64);
+        }
+        Ok(out[0]
+            .chunks_exact(norms_bytes as usize)
+            .map(norms_from_bytes)
+            .collect())
     }
 }
