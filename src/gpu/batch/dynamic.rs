@@ -25,8 +25,8 @@ pub struct GpuDynamic<T: GpuReal> {
     c: Common,
     /// Invocations per variant of the block solve ([`LuForm`]).
     lu_lanes: usize,
-    /// Line-search trials formed in one submission at most ([`super::trials_per_round`]).
-    round: usize,
+    /// Line-search trials formed in one submission ([`super::Rounds`]).
+    rounds: super::Rounds,
     /// The device's time of the passes read back ([`crate::tally`]), where it has stamps.
     clock: Option<crate::gpu::pass_clock::PassClock>,
     _keep: Vec<wgpu::Buffer>,
@@ -132,10 +132,6 @@ struct DynamicBuffers {
     acc_1: wgpu::Buffer,
     /// The iteration's norms, kept while the trial formed with it writes its own.
     iterate_norms: wgpu::Buffer,
-    /// A round's `α` per trial (`round · V`), copied into the trials' `α` in turn.
-    alphas: wgpu::Buffer,
-    /// A round's norms per trial (`round · 4 V`).
-    round_norms: wgpu::Buffer,
 }
 
 impl DynamicBuffers {
@@ -214,7 +210,6 @@ impl<T: GpuReal> GpuDynamic<T> {
             (!dynamic.unbalance.is_empty()).then(|| storage(ctx, "unbalance", &dynamic.unbalance));
         let [diag, upper, lower, rhs] = system_buffers(ctx, v, n, size);
         let st = &dynamic.start;
-        let round = super::trials_per_round(ctx);
         let b = DynamicBuffers {
             coef: empty(ctx, "coef", 5 * size),
             flags: empty(ctx, "step_flags", 4),
@@ -233,8 +228,6 @@ impl<T: GpuReal> GpuDynamic<T> {
             vel_1: empty(ctx, "vel_1", st.vel.len() * size),
             acc_1: empty(ctx, "acc_1", st.acc.len() * size),
             iterate_norms: empty(ctx, "iterate_norms", 4 * v * size),
-            alphas: empty(ctx, "alphas", round * v * size),
-            round_norms: empty(ctx, "round_norms", round * 4 * v * size),
         };
         // The unknown, the candidate and the trial state start as the state: uploaded once,
         // copied on the device (at V = 4096 the uploads were a large part of the setup).
@@ -397,7 +390,7 @@ impl<T: GpuReal> GpuDynamic<T> {
             a0: T::from_f64_lossy(dynamic.a0),
             c,
             lu_lanes: LuForm::for_adapter(ctx).lanes(),
-            round,
+            rounds: super::Rounds::new(ctx, v, size),
             clock: crate::gpu::pass_clock::PassClock::new(ctx, "dynamic pass"),
             _keep: [mass, inertia0, diag, upper, lower, rhs]
                 .into_iter()
@@ -692,7 +685,7 @@ impl<T: GpuReal> crate::engine::ResidentTrials<T> for GpuDynamic<T> {
     }
 
     fn trials_per_round(&self) -> usize {
-        self.round
+        self.rounds.round
     }
 
     fn trials(
@@ -701,46 +694,11 @@ impl<T: GpuReal> crate::engine::ResidentTrials<T> for GpuDynamic<T> {
         search: &[bool],
         first: bool,
     ) -> Result<Vec<Norms<T>>, crate::error::SystemError> {
-        let (v, k) = (self.num_variants, alphas.len());
-        if k == 0 || k > self.round {
-            return Err(crate::error::SystemError::Order(
-                "a round of trials beyond the batch's buffers",
-            ));
-        }
-        let q = &self.ctx.queue;
-        let size = std::mem::size_of::<T>() as u64;
-        let (row, norms_bytes) = (v as u64 * size, 4 * v as u64 * size);
-        // Every trial's α, copied into the kernels' `α` before its passes.
-        let flat: Vec<T> = alphas.iter().flatten().copied().collect();
-        q.write_buffer(&self.b.alphas, 0, bytemuck::cast_slice(&flat));
-        // The variants still searching, compacted: [A, v_0, …, v_{A−1}].
-        let list = super::search_list(search);
-        let count = list.len() - 1;
-        q.write_buffer(&self.c.active, 0, bytemuck::cast_slice(&list));
-        let mut e = encoder(self.ctx, "trials");
+        let record = |pass: &mut wgpu::ComputePass, first: bool, listed: usize| {
+            self.record_trial(pass, first, listed)
+        };
         let clock = self.clock.as_ref();
-        for i in 0..k {
-            e.copy_buffer_to_buffer(&self.b.alphas, i as u64 * row, &self.c.alpha, 0, row);
-            {
-                let mut pass = PassClock::span_pass(clock, &mut e, 0, i == 0, i + 1 == k);
-                self.record_trial(&mut pass, first && i == 0, count);
-            }
-            let at = i as u64 * norms_bytes;
-            e.copy_buffer_to_buffer(&self.c.norms, 0, &self.b.round_norms, at, norms_bytes);
-        }
-        let mut reads = vec![(&self.b.round_norms, k as u64 * norms_bytes)];
-        reads.extend(clock.map(|c| c.resolve(&mut e)));
-        let out = self
-            .c
-            .staging
-            .read(self.ctx, e, &reads)
-            .map_err(crate::error::SystemError::from)?;
-        if let (Some(c), Some(stamps)) = (clock, out.get(1)) {
-            c.record_span(stamps, 0, k as u64);
-        }
-        Ok(out[0]
-            .chunks_exact(norms_bytes as usize)
-            .map(norms_from_bytes)
-            .collect())
+        self.rounds
+            .form(self.ctx, &self.c, clock, (alphas, search, first), &record)
     }
 }

@@ -251,7 +251,7 @@ impl<T: GpuReal> crate::engine::ResidentTrials<T> for GpuStatic<T> {
     }
 
     fn trials_per_round(&self) -> usize {
-        self.round
+        self.rounds.round
     }
 
     fn trials(
@@ -260,44 +260,13 @@ impl<T: GpuReal> crate::engine::ResidentTrials<T> for GpuStatic<T> {
         search: &[bool],
         first: bool,
     ) -> Result<Vec<Norms<T>>, crate::error::SystemError> {
-        let (v, k) = (self.num_variants, alphas.len());
-        if k == 0 || k > self.round {
-            return Err(crate::error::SystemError::Order(
-                "a round of trials beyond the batch's buffers",
-            ));
-        }
-        let q = &self.ctx.queue;
-        let size = std::mem::size_of::<T>() as u64;
-        let (row, norm_bytes) = (v as u64 * size, 4 * v as u64 * size);
-        let flat: Vec<T> = alphas.iter().flatten().copied().collect();
-        q.write_buffer(&self.alphas, 0, bytemuck::cast_slice(&flat));
-        // The variants still searching, compacted: [A, v_0, …, v_{A−1}].
-        let list = super::search_list(search);
-        let count = list.len() - 1;
-        q.write_buffer(&self.c.active, 0, bytemuck::cast_slice(&list));
-        let mut encoder = self.encoder("trials");
-        for i in 0..k {
-            encoder.copy_buffer_to_buffer(&self.alphas, i as u64 * row, &self.c.alpha, 0, row);
-            {
-                let mut pass = encoder.begin_compute_pass(&Default::default());
-                self.record_trial(&mut pass, first && i == 0, count);
-            }
-            let at = i as u64 * norm_bytes;
-            encoder.copy_buffer_to_buffer(&self.c.norms, 0, &self.round_norms, at, norm_bytes);
-        }
+        let record = |pass: &mut wgpu::ComputePass, first: bool, listed: usize| {
+            self.record_trial(pass, first, listed)
+        };
+        let r = self
+            .rounds
+            .form(self.ctx, &self.c, None, (alphas, search, first), &record);
         self.formed[1 - self.current] = false;
-        let out = self
-            .c
-            .staging
-            .read(
-                self.ctx,
-                encoder,
-                &[(&self.round_norms, k as u64 * norm_bytes)],
-            )
-            .map_err(crate::error::SystemError::from)?;
-        Ok(out[0]
-            .chunks_exact(norm_bytes as usize)
-            .map(norms_from_bytes)
-            .collect())
+        r
     }
 }

@@ -153,13 +153,10 @@ pub struct GpuStatic<T: GpuReal> {
     /// A relaxation's shift (made at the first); `shifted`: the assembly runs with it.
     shift: Option<ShiftParts>,
     shifted: bool,
-    /// Line-search trials formed in one submission at most ([`trials_per_round`]), with
-    /// their buffers: the solve's norms kept while the trial formed with it writes its own,
-    /// a round's `α` (`round · V`) and norms (`round · 4 V`).
-    round: usize,
+    /// The solve's norms, kept while the trial formed with it writes its own.
     solve_norms: wgpu::Buffer,
-    alphas: wgpu::Buffer,
-    round_norms: wgpu::Buffer,
+    /// Line-search trials formed in one submission ([`Rounds`]).
+    rounds: Rounds,
     _real: PhantomData<T>,
 }
 
@@ -390,12 +387,9 @@ impl<T: GpuReal> GpuStatic<T> {
             }
         };
         let slots = [make_slot(0), make_slot(1)];
-        let round = trials_per_round(ctx);
         Ok(GpuStatic {
-            round,
             solve_norms: empty(ctx, "solve_norms", 4 * v * size),
-            alphas: empty(ctx, "alphas", round * v * size),
-            round_norms: empty(ctx, "round_norms", round * 4 * v * size),
+            rounds: Rounds::new(ctx, v, size),
             ctx,
             p: pipelines,
             slots,
@@ -573,6 +567,86 @@ pub fn trials_per_round(ctx: &GpuContext) -> usize {
 pub fn force_trials_per_round(round: Option<usize>) {
     let k = round.map_or(0, |k| k.clamp(1, MAX_TRIALS_PER_ROUND));
     FORCED_ROUND.store(k, std::sync::atomic::Ordering::Relaxed);
+}
+
+/// A resident batch's line-search trials formed several to a submission: how many at most
+/// ([`trials_per_round`]) and their buffers, a round's `α` (`round · V`) and norms
+/// (`round · 4 V`).
+struct Rounds {
+    round: usize,
+    alphas: wgpu::Buffer,
+    norms: wgpu::Buffer,
+}
+
+impl Rounds {
+    fn new(ctx: &GpuContext, v: usize, size: usize) -> Self {
+        let round = trials_per_round(ctx);
+        Rounds {
+            round,
+            alphas: empty(ctx, "round_alphas", round * v * size),
+            norms: empty(ctx, "round_norms", round * 4 * v * size),
+        }
+    }
+
+    /// Forms the trials at `alphas` in one submission for the variants `search` (the
+    /// search's `first` for the first of them): each trial's `α` copied into `c.alpha`, its
+    /// passes recorded by `record(pass, first, listed)` (stamped by `clock` as one span,
+    /// from the first trial's start to the last one's end), its norms copied out; the norms
+    /// of each, read back.
+    fn form<T: GpuReal>(
+        &self,
+        ctx: &GpuContext,
+        c: &Common,
+        clock: Option<&crate::gpu::pass_clock::PassClock>,
+        (alphas, search, first): (&[Vec<T>], &[bool], bool),
+        record: &dyn Fn(&mut wgpu::ComputePass, bool, usize),
+    ) -> Result<Vec<Norms<T>>, crate::error::SystemError> {
+        let (v, k) = (search.len(), alphas.len());
+        if k == 0 || k > self.round {
+            return Err(crate::error::SystemError::Order(
+                "a round of trials beyond the batch's buffers",
+            ));
+        }
+        let size = std::mem::size_of::<T>() as u64;
+        let (row, norm_bytes) = (v as u64 * size, 4 * v as u64 * size);
+        let flat: Vec<T> = alphas.iter().flatten().copied().collect();
+        ctx.queue
+            .write_buffer(&self.alphas, 0, bytemuck::cast_slice(&flat));
+        // The variants still searching, compacted: [A, v_0, …, v_{A−1}].
+        let list = search_list(search);
+        let count = list.len() - 1;
+        ctx.queue
+            .write_buffer(&c.active, 0, bytemuck::cast_slice(&list));
+        let mut e = encoder(ctx, "trials");
+        for i in 0..k {
+            e.copy_buffer_to_buffer(&self.alphas, i as u64 * row, &c.alpha, 0, row);
+            {
+                let mut pass = crate::gpu::pass_clock::PassClock::span_pass(
+                    clock,
+                    &mut e,
+                    0,
+                    i == 0,
+                    i + 1 == k,
+                );
+                record(&mut pass, first && i == 0, count);
+            }
+            let at = i as u64 * norm_bytes;
+            e.copy_buffer_to_buffer(&c.norms, 0, &self.norms, at, norm_bytes);
+        }
+        let mut reads = vec![(&self.norms, k as u64 * norm_bytes)];
+        reads.extend(clock.map(|c| c.resolve(&mut e)));
+        let out = c
+            .staging
+            .read(ctx, e, &reads)
+            .map_err(crate::error::SystemError::from)?;
+        if let (Some(clock), Some(stamps)) = (clock, out.get(1)) {
+            clock.record_span(stamps, 0, k as u64);
+        }
+        Ok(out[0]
+            .chunks_exact(norm_bytes as usize)
+            .map(norms_from_bytes)
+            .collect())
+    }
 }
 
 /// The variants still searching (`search[j]`), compacted as the kernels built `MASKED`
