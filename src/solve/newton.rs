@@ -576,10 +576,10 @@ impl Newton {
             // from its solve), then the next halvings of the variants still searching in
             // rounds of 2, 4, 8, … up to the system's size: each variant's trials and
             // decisions are those of a search one trial at a time, the later ones of a round
-            // speculative. (Measured on a dynamic ensemble, V = 256: of the searches, 67 %
+            // speculative. (Traced on a dynamic ensemble, V = 256: of the searches, 67 %
             // take the full step, 21 % the first halving, 5 % the second, 7 % the third to
-            // sixth; rounds of 2 then 4 cost 24 % more trials than one at a time, a round of
-            // 8 at once 140 %.)
+            // sixth; by that count rounds of 2 then 4 cost 24 % more trials than one at a
+            // time, a round of 8 at once 140 %.)
             let round = if trial == 0 {
                 1
             } else {

@@ -542,18 +542,18 @@ fn record_chain<'b>(
 /// Line-search trials a resident batch forms at most in one submission on a GPU (after the
 /// first, which it forms with the iteration): the next halvings of the variants still
 /// searching, speculatively, in rounds of 2, 4 and 8 ([`crate::solve::newton`]; issue 27,
-/// item 3). One read-back per iteration where no variant searches past the full step, about
-/// three where some search to the sixth halving (measured on lavapipe, V = 256: 23 read-backs
-/// a step against 54 one trial at a time), for 24 % more trial work.
+/// item 3). Measured on lavapipe (V = 256, dynamic): 25.6–28.4 read-backs a step against
+/// 48.4–53.6 one trial at a time, for a third more trial passes.
 pub const MAX_TRIALS_PER_ROUND: usize = 8;
 
 static FORCED_ROUND: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
 
 /// Trials per submission for `ctx`'s adapter: [`MAX_TRIALS_PER_ROUND`] on a GPU, where a
 /// round trip costs more than the trials a variant may not need; 1 on a CPU-type adapter
-/// (lavapipe), whose kernels run on the same cores as the host and whose round trips cost
-/// little — there the speculative trials slowed a dynamic ensemble 1.5–2× (V = 16, 256).
-/// [`force_trials_per_round`] overrides it for a process (tests run rounds on lavapipe).
+/// (lavapipe), whose kernels run on the host's cores: there a trial costs its work and a
+/// round trip little (rounds forced there, `bench ensemble --trial-round 8`, ran up to 1.3×
+/// slower at V = 256). [`force_trials_per_round`] overrides it for a process (tests run
+/// rounds on lavapipe).
 pub fn trials_per_round(ctx: &GpuContext) -> usize {
     match FORCED_ROUND.load(std::sync::atomic::Ordering::Relaxed) {
         0 if ctx.info.device_type == wgpu::DeviceType::Cpu => 1,
