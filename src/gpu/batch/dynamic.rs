@@ -679,9 +679,7 @@ impl<T: GpuReal> crate::engine::ResidentTrials<T> for GpuDynamic<T> {
         search: &[bool],
         first: bool,
     ) -> Result<Norms<T>, crate::error::SystemError> {
-        let mut r = self.trials(&[alpha.to_vec()], search, first)?;
-        r.pop()
-            .ok_or(crate::error::SystemError::Order("no trial formed"))
+        super::single(self.trials(&[alpha.to_vec()], search, first))
     }
 
     fn trials_per_round(&self) -> usize {

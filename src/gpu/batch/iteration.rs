@@ -51,22 +51,7 @@ impl<T: GpuReal> ResidentStatic<T> for GpuStatic<T> {
     }
 
     fn solve(&mut self) -> Result<(Norms<T>, Vec<u32>), crate::error::SystemError> {
-        if !self.formed[self.current] {
-            return Err(crate::error::SystemError::Order(
-                "tangent not formed (a trial's residual only)",
-            ));
-        }
-        let v = self.num_variants;
-        let s = &self.slots[self.current];
-        let mut encoder = self.encoder("solve");
-        self.c.reset_status(&mut encoder, v);
-        {
-            let mut pass = encoder.begin_compute_pass(&Default::default());
-            for group in &s.lu {
-                dispatch(&mut pass, &self.p.block_lu, group, self.lu_lanes * v);
-            }
-            dispatch(&mut pass, &self.p.norms, &s.norms_solve, v);
-        }
+        let encoder = self.record_solve()?;
         let (norms, status) = self
             .finish_with_norms(encoder)
             .map_err(crate::error::SystemError::from)?;
@@ -81,11 +66,6 @@ impl<T: GpuReal> ResidentStatic<T> for GpuStatic<T> {
     fn solve_with_trial(
         &mut self,
     ) -> Result<crate::engine::SolvedWithTrial<T>, crate::error::SystemError> {
-        if !self.formed[self.current] {
-            return Err(crate::error::SystemError::Order(
-                "tangent not formed (a trial's residual only)",
-            ));
-        }
         let v = self.num_variants;
         let q = &self.ctx.queue;
         // The line search's first trial, formed in the same submission: α = 1 and every
@@ -95,21 +75,9 @@ impl<T: GpuReal> ResidentStatic<T> for GpuStatic<T> {
             0,
             bytemuck::cast_slice(&crate::engine::negated::<T>(&vec![1.0; v])),
         );
-        q.write_buffer(
-            &self.c.active,
-            0,
-            bytemuck::cast_slice(&super::search_list(&vec![true; v])),
-        );
-        let s = &self.slots[self.current];
-        let mut encoder = self.encoder("solve");
-        self.c.reset_status(&mut encoder, v);
-        {
-            let mut pass = encoder.begin_compute_pass(&Default::default());
-            for group in &s.lu {
-                dispatch(&mut pass, &self.p.block_lu, group, self.lu_lanes * v);
-            }
-            dispatch(&mut pass, &self.p.norms, &s.norms_solve, v);
-        }
+        let mut encoder = self.record_solve()?;
+        let list_bytes = 4 * (v as u64 + 1);
+        encoder.copy_buffer_to_buffer(&self.c.all_active, 0, &self.c.active, 0, list_bytes);
         let norm_bytes = (4 * v * std::mem::size_of::<T>()) as u64;
         encoder.copy_buffer_to_buffer(&self.c.norms, 0, &self.solve_norms, 0, norm_bytes);
         {
@@ -245,9 +213,7 @@ impl<T: GpuReal> crate::engine::ResidentTrials<T> for GpuStatic<T> {
         search: &[bool],
         first: bool,
     ) -> Result<Norms<T>, crate::error::SystemError> {
-        let mut r = self.trials(&[alpha.to_vec()], search, first)?;
-        r.pop()
-            .ok_or(crate::error::SystemError::Order("no trial formed"))
+        super::single(self.trials(&[alpha.to_vec()], search, first))
     }
 
     fn trials_per_round(&self) -> usize {

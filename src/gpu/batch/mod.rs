@@ -501,6 +501,29 @@ impl<T: GpuReal> GpuStatic<T> {
         encoder(self.ctx, label)
     }
 
+    /// An encoder with the current system's block solve and its norms recorded (the
+    /// statuses reset first); an error where the current slot holds a trial's residual
+    /// alone.
+    fn record_solve(&self) -> Result<wgpu::CommandEncoder, crate::error::SystemError> {
+        if !self.formed[self.current] {
+            return Err(crate::error::SystemError::Order(
+                "tangent not formed (a trial's residual only)",
+            ));
+        }
+        let v = self.num_variants;
+        let s = &self.slots[self.current];
+        let mut encoder = self.encoder("solve");
+        self.c.reset_status(&mut encoder, v);
+        {
+            let mut pass = encoder.begin_compute_pass(&Default::default());
+            for group in &s.lu {
+                dispatch(&mut pass, &self.p.block_lu, group, self.lu_lanes * v);
+            }
+            dispatch(&mut pass, &self.p.norms, &s.norms_solve, v);
+        }
+        Ok(encoder)
+    }
+
     /// Submits `encoder` after copying the norms and statuses out; reads them back.
     fn finish_with_norms(
         &self,
@@ -609,9 +632,10 @@ impl Rounds {
         }
         let size = std::mem::size_of::<T>() as u64;
         let (row, norm_bytes) = (v as u64 * size, 4 * v as u64 * size);
-        let flat: Vec<T> = alphas.iter().flatten().copied().collect();
-        ctx.queue
-            .write_buffer(&self.alphas, 0, bytemuck::cast_slice(&flat));
+        for (i, a) in alphas.iter().enumerate() {
+            ctx.queue
+                .write_buffer(&self.alphas, i as u64 * row, bytemuck::cast_slice(a));
+        }
         // The variants still searching, compacted: [A, v_0, …, v_{A−1}].
         let list = search_list(search);
         let count = list.len() - 1;
@@ -647,6 +671,16 @@ impl Rounds {
             .map(norms_from_bytes)
             .collect())
     }
+}
+
+/// The one trial of a round of one ([`crate::engine::ResidentTrials::trial`] on a batch
+/// that forms its trials in rounds).
+fn single<T>(
+    round: Result<Vec<Norms<T>>, crate::error::SystemError>,
+) -> Result<Norms<T>, crate::error::SystemError> {
+    round?
+        .pop()
+        .ok_or(crate::error::SystemError::Order("no trial formed"))
 }
 
 /// The variants still searching (`search[j]`), compacted as the kernels built `MASKED`
