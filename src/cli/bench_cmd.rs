@@ -96,9 +96,9 @@ pub enum BenchCommand {
         /// (serial: one invocation per variant; lanes: eight), to compare them on a device.
         #[arg(long, value_enum)]
         lu_form: Option<LuFormArg>,
-        /// Line-search trials the GPU engine forms in one submission at most: the adapter's
-        /// choice (default: 8 on a GPU, 1 on a CPU-type adapter), or this (1–8), to compare
-        /// them on a device.
+        /// Line-search trials the GPU engine forms in one submission at most: 1 by default
+        /// (`crate::gpu::batch::trials_per_round`), or this (1–8), to compare them on a
+        /// device.
         #[arg(long, value_parser = clap::value_parser!(u16).range(1..=8))]
         trial_round: Option<u16>,
         /// Also write the results as JSON here.

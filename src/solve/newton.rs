@@ -26,7 +26,8 @@
 //!   leaves the noise band: a full step along a soft direction (a pinned stabilizer with
 //!   μ = 1 on a 1e10 N/m wall) can jump from 4e-4 of the force scale to 150.
 //!   A system whose trials wait on a device ([`NewtonSystem::trials_per_round`] > 1: the
-//!   GPU engines) is asked for the halvings after the first trial in rounds of 2, 4, 8, …
+//!   GPU engines when `--trial-round` asks; one trial a submission is their default, see
+//!   `crate::gpu::batch::trials_per_round`) is asked for the halvings after the first trial in rounds of 2, 4, 8, …
 //!   at once; the decisions are taken over them in order, so every variant's steps are
 //!   those of one trial at a time (issue 27, item 3: fewer round trips).
 //! - **Failure** per variant: a non-finite residual, a singular tangent, or no convergence

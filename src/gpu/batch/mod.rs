@@ -571,16 +571,20 @@ pub const MAX_TRIALS_PER_ROUND: usize = 8;
 
 static FORCED_ROUND: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
 
-/// Trials per submission for `ctx`'s adapter: [`MAX_TRIALS_PER_ROUND`] on a GPU, where a
-/// round trip costs more than the trials a variant may not need; 1 on a CPU-type adapter
-/// (lavapipe), whose kernels run on the host's cores: there a trial costs its work and a
-/// round trip little (rounds forced there, `bench ensemble --trial-round 8`, ran up to 1.3×
-/// slower at V = 256). [`force_trials_per_round`] overrides it for a process (tests run
-/// rounds on lavapipe).
-pub fn trials_per_round(ctx: &GpuContext) -> usize {
+/// Trials per submission for `ctx`'s adapter: 1 on every adapter, unless forced
+/// ([`force_trials_per_round`]; `bench ensemble --trial-round`, tests). Rounds cut the
+/// read-backs but not the time on either device measured, because a speculative trial's
+/// passes cost the device about what the round trip they save costs the host:
+/// - lavapipe (V = 256, dynamic): up to 1.3× slower with rounds of 8;
+/// - NVIDIA H100 (stop 52, `bench ensemble --nodes 100 --variants 16,256 --steps 5
+///   --repeats 5 --trial-round 1|8`, alternated, four runs each): the median run 2–8 %
+///   slower with rounds (V = 16 f64: 0.093 → 0.099 s; V = 256 f64: 0.150 → 0.156 s);
+///   read-backs per step 29.2 → 23.2 at V = 16, while the trials' device time rose
+///   16 → 24 ms and the waiting outside the passes stayed at 32 ms. The static engines likewise (stress, f64:
+///   0.121–0.126 s with 1, 0.122–0.123 s with 8).
+pub fn trials_per_round() -> usize {
     match FORCED_ROUND.load(std::sync::atomic::Ordering::Relaxed) {
-        0 if ctx.info.device_type == wgpu::DeviceType::Cpu => 1,
-        0 => MAX_TRIALS_PER_ROUND,
+        0 => 1,
         k => k.min(MAX_TRIALS_PER_ROUND),
     }
 }
@@ -603,7 +607,7 @@ struct Rounds {
 
 impl Rounds {
     fn new(ctx: &GpuContext, v: usize, size: usize) -> Self {
-        let round = trials_per_round(ctx);
+        let round = trials_per_round();
         Rounds {
             round,
             alphas: empty(ctx, "round_alphas", round * v * size),
