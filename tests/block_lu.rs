@@ -5,6 +5,7 @@
 mod common;
 
 use holewall::gpu::block_lu::{block_lu_gpu, block_lu_gpu_chunked, block_lu_gpu_form, LuForm};
+use holewall::kernels::block_cr::block_cr;
 use holewall::kernels::block_lu::{block_lu, ChainBatch, SINGULAR, SOLVED};
 use holewall::solve::chain::{BlockTridiagonal, ChainSolver};
 use rand::{Rng, SeedableRng};
@@ -299,4 +300,148 @@ fn gpu_matches_the_twin_and_a_singular_variant_fails_alone() {
             "GPU variant {j}"
         );
     }
+}
+
+/// The cyclic reduction's twin against faer and the chain walk: the paper tangents, random
+/// systems spanning six decades, and every chain length around the powers of two (the
+/// levels' edge cases: a node without a right neighbour, node 0 alone).
+#[test]
+fn cyclic_reduction_twin_matches_faer_at_every_length() {
+    let mut rng = rand::rngs::StdRng::seed_from_u64(17);
+    let mut systems: Vec<(String, BlockTridiagonal, Vec<f64>)> = paper_tangents()
+        .into_iter()
+        .map(|(name, a)| {
+            let b = (0..6 * a.nodes())
+                .map(|_| rng.random_range(-1e4..1e4))
+                .collect();
+            (name, a, b)
+        })
+        .collect();
+    for n in [1, 2, 3, 4, 5, 7, 8, 9, 15, 16, 17, 31, 33, 64, 65, 100, 129] {
+        let (a, b) = random_system(&mut rng, n, 3);
+        systems.push((format!("random, {n} nodes"), a, b));
+    }
+    for (name, a, b) in &systems {
+        let reference = ChainSolver::new().solve_sparse(a, b).unwrap();
+        let batch = ChainBatch::<f64>::from_systems(&[(a, b.as_slice())]);
+        let (x, status) = block_cr(&batch);
+        assert_eq!(status, vec![SOLVED], "{name}");
+        let (walk, _) = block_lu(&batch);
+        let res = relative_residual(a, &x, b);
+        let err = relative_error(&x, &reference);
+        let err_walk = relative_error(&walk, &reference);
+        eprintln!(
+            "{name}: cyclic residual {res:.2e}, from faer {err:.2e} (the walk {err_walk:.2e})"
+        );
+        assert!(res <= 1e-10, "{name}: residual {res:e}");
+        assert!(err <= 1e-8, "{name}: differs from faer by {err:e}");
+    }
+}
+
+/// The cyclic form on the GPU against its twin (f64: to rounding; f32: the twin's bits, or
+/// within 8·u·κ of the f64 solution where the driver fuses), chunked, on the paper tangents
+/// (247 and 255 nodes: eight levels), and a singular or NaN variant failing alone.
+#[test]
+fn cyclic_reduction_on_the_gpu_matches_its_twin_and_a_singular_variant_fails_alone() {
+    let Some(ctx) = common::gpu() else { return };
+    let mut rng = rand::rngs::StdRng::seed_from_u64(23);
+    for n in [1, 2, 3, 6, 30, 33] {
+        let sys: Vec<(BlockTridiagonal, Vec<f64>)> =
+            (0..64).map(|_| random_system(&mut rng, n, 0)).collect();
+        let refs: Vec<(&BlockTridiagonal, &[f64])> =
+            sys.iter().map(|(a, b)| (a, b.as_slice())).collect();
+        let b64 = ChainBatch::<f64>::from_systems(&refs);
+        let (twin, st) = block_cr(&b64);
+        assert!(st.iter().all(|&s| s == SOLVED));
+        if ctx.has_f64 {
+            let (x, s) = block_lu_gpu_form(ctx, &b64, usize::MAX, LuForm::Cyclic).unwrap();
+            assert_eq!(s, st, "{n} nodes");
+            common::assert_same(
+                ctx,
+                &x,
+                &twin,
+                relative_error,
+                1e-12,
+                &format!("f64, {n} nodes"),
+            );
+            let (xc, _) = block_lu_gpu_form(ctx, &b64, 5, LuForm::Cyclic).unwrap();
+            assert_eq!(xc, x, "f64, {n} nodes, in chunks of 5");
+        }
+        let b32 = ChainBatch::<f32>::from_systems(&refs);
+        let (twin32, _) = block_cr(&b32);
+        let (x32, s32) = block_lu_gpu_form(ctx, &b32, usize::MAX, LuForm::Cyclic).unwrap();
+        assert!(s32.iter().all(|&s| s == SOLVED), "f32, {n} nodes");
+        if common::fuses(ctx) {
+            for (j, (a, _)) in sys.iter().enumerate() {
+                let dense = a.to_dense();
+                let kappa = dense.norm() * dense.clone().try_inverse().unwrap().norm();
+                let bound = 8.0 * f32::EPSILON as f64 * kappa;
+                let g: Vec<f64> = b32.unpack(&x32, j).iter().map(|&y| y as f64).collect();
+                let e = relative_error(&g, &b64.unpack(&twin, j));
+                assert!(e <= bound, "f32, {n} nodes, variant {j}: {e:e} > {bound:e}");
+            }
+        } else {
+            assert_eq!(x32, twin32, "f32, {n} nodes");
+        }
+    }
+    if ctx.has_f64 {
+        for (name, a) in paper_tangents() {
+            let b: Vec<f64> = (0..6 * a.nodes())
+                .map(|k| (k as f64 * 0.37).sin() * 1e4)
+                .collect();
+            let batch = ChainBatch::<f64>::from_systems(&[(&a, b.as_slice()), (&a, b.as_slice())]);
+            let (twin, _) = block_cr(&batch);
+            let (gpu, st) = block_lu_gpu_form(ctx, &batch, usize::MAX, LuForm::Cyclic).unwrap();
+            assert_eq!(st, vec![SOLVED; 2]);
+            let err = relative_error(&batch.unpack(&gpu, 1), &batch.unpack(&twin, 1));
+            eprintln!("{name}: cyclic GPU f64 vs its twin {err:.2e}");
+            assert!(err <= 1e-12, "{name}: {err:e}");
+        }
+    }
+    // A zero block row at node 3 (odd: eliminated at the first level) and a NaN at node 0
+    // (solved last): those two variants fail, with a zero solution; the others keep their bits.
+    let n = 30;
+    let sys: Vec<(BlockTridiagonal, Vec<f64>)> =
+        (0..16).map(|_| random_system(&mut rng, n, 0)).collect();
+    let mut bad = sys.clone();
+    bad[5].0.diag[3] = [[0.0; 6]; 6];
+    bad[5].0.upper[3] = [[0.0; 6]; 6];
+    bad[5].0.lower[2] = [[0.0; 6]; 6];
+    bad[9].0.diag[0][0][0] = f64::NAN;
+    let refs: Vec<(&BlockTridiagonal, &[f64])> =
+        sys.iter().map(|(a, b)| (a, b.as_slice())).collect();
+    let refs_bad: Vec<(&BlockTridiagonal, &[f64])> =
+        bad.iter().map(|(a, b)| (a, b.as_slice())).collect();
+    fn check<T: holewall::gpu::contact::GpuReal + holewall::physics::Real>(
+        ctx: &'static holewall::gpu::GpuContext,
+        good: &ChainBatch<T>,
+        bad: &ChainBatch<T>,
+    ) {
+        let (twin, _) = block_cr(bad);
+        let (x, st) = block_lu_gpu_form(ctx, bad, usize::MAX, LuForm::Cyclic).unwrap();
+        let (xg, _) = block_lu_gpu_form(ctx, good, usize::MAX, LuForm::Cyclic).unwrap();
+        assert_eq!(block_cr(bad).1, st, "the twin flags the same variants");
+        for (j, &sj) in st.iter().enumerate() {
+            if j == 5 || j == 9 {
+                assert_eq!(sj, SINGULAR, "variant {j}");
+                assert!(bad.unpack(&x, j).iter().all(|&y| y == T::zero()));
+                assert!(bad.unpack(&twin, j).iter().all(|&y| y == T::zero()));
+            } else {
+                assert_eq!(sj, SOLVED, "variant {j}");
+                assert_eq!(bad.unpack(&x, j), good.unpack(&xg, j), "variant {j}");
+            }
+        }
+    }
+    if ctx.has_f64 {
+        check(
+            ctx,
+            &ChainBatch::<f64>::from_systems(&refs),
+            &ChainBatch::<f64>::from_systems(&refs_bad),
+        );
+    }
+    check(
+        ctx,
+        &ChainBatch::<f32>::from_systems(&refs),
+        &ChainBatch::<f32>::from_systems(&refs_bad),
+    );
 }

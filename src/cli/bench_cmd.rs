@@ -93,7 +93,7 @@ pub enum BenchCommand {
         #[arg(long, default_value_t = 100)]
         precision_nodes: usize,
         /// The block solve's form on the GPU: the adapter's choice (default), or one forced
-        /// (serial: one invocation per variant; lanes: eight), to compare them on a device.
+        /// (serial: one invocation per variant; lanes: eight; cyclic: cyclic reduction, an invocation per node), to compare them on a device.
         #[arg(long, value_enum)]
         lu_form: Option<LuFormArg>,
         /// Line-search trials the GPU engine forms in one submission at most: 1 by default
@@ -117,7 +117,7 @@ pub enum BenchCommand {
         #[arg(long, default_value_t = 3)]
         repeats: usize,
         /// The block solve's form on the GPU: the adapter's choice (default), or one forced
-        /// (serial: one invocation per variant; lanes: eight), to compare them on a device.
+        /// (serial: one invocation per variant; lanes: eight; cyclic: cyclic reduction, an invocation per node), to compare them on a device.
         #[arg(long, value_enum)]
         lu_form: Option<LuFormArg>,
         /// Line-search trials the GPU engine forms in one submission at most (as `bench
@@ -311,6 +311,8 @@ pub enum LuFormArg {
     Serial,
     /// Eight invocations per variant, a row per lane.
     Lanes,
+    /// Block cyclic reduction: an invocation per node and variant, log₂ n levels.
+    Cyclic,
 }
 
 /// Forces the GPU engine's block-solve form and trials per submission for the rest of the
@@ -327,6 +329,7 @@ impl LuFormArg {
         force_lu_form(form.map(|f| match f {
             LuFormArg::Serial => LuForm::Serial,
             LuFormArg::Lanes => LuForm::Lanes,
+            LuFormArg::Cyclic => LuForm::Cyclic,
         }));
     }
 }

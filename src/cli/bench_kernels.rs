@@ -156,6 +156,7 @@ struct Counts {
     beam_per_element: f64,
     assemble: f64,
     block_lu: f64,
+    block_cr: f64,
 }
 
 fn counts(n: usize) -> Counts {
@@ -173,12 +174,14 @@ fn counts(n: usize) -> Counts {
     let assemble = counted(|| crate::kernels::assemble::assemble(&a));
     let b = cast_chain(&chain_batch(n, 1), Counted);
     let block_lu = counted(|| crate::kernels::block_lu::block_lu(&b));
+    let block_cr = counted(|| crate::kernels::block_cr::block_cr(&b));
     Counts {
         contact_per_pair: contact,
         // The kernel's form: the closed form one dual direction at a time (9 passes).
         beam_per_element: super::bench::element_flops().by_direction as f64,
         assemble,
         block_lu,
+        block_cr,
     }
 }
 
@@ -290,19 +293,20 @@ fn run_size<T: GpuReal>(
         c.assemble * v as f64,
         r.map_err(|e| e.to_string()).and_then(|_| of(t)),
     ));
-    // The block-tridiagonal solve, in both forms (the engine runs the adapter's:
-    // `LuForm::for_adapter`); the names say which.
+    // The block-tridiagonal solve, in every form (the engine runs the adapter's:
+    // `LuForm::for_adapter`); the names say which. The cyclic form's FLOPs are its twin's.
     let b = cast_chain(&chain_batch(n, v), to_t);
-    for (form, name) in [
-        (LuForm::Serial, "block solve (serial)"),
-        (LuForm::Lanes, "block solve (lanes)"),
+    for (form, name, flops) in [
+        (LuForm::Serial, "block solve (serial)", c.block_lu),
+        (LuForm::Lanes, "block solve (lanes)", c.block_lu),
+        (LuForm::Cyclic, "block solve (cyclic)", c.block_cr),
     ] {
         let (r, t) = crate::gpu::dispatch::timed(repeats, || {
             crate::gpu::block_lu::block_lu_gpu_form::<T>(ctx, &b, usize::MAX, form)
         });
         rows.push((
             name.into(),
-            c.block_lu * v as f64,
+            flops * v as f64,
             r.map_err(|e| e.to_string()).and_then(|_| of(t)),
         ));
     }

@@ -32,6 +32,9 @@ pub enum LuForm {
     Serial,
     /// [`LANES`] invocations per variant.
     Lanes,
+    /// Block cyclic reduction (`shaders/block_cr.wgsl`, [`crate::gpu::block_cr`]): an
+    /// invocation per (node, variant) of each level, `2⌈log₂ n⌉ + 1` dispatches.
+    Cyclic,
 }
 
 impl LuForm {
@@ -40,16 +43,26 @@ impl LuForm {
         match FORCED.load(std::sync::atomic::Ordering::Relaxed) {
             1 => LuForm::Serial,
             2 => LuForm::Lanes,
+            3 => LuForm::Cyclic,
             _ if ctx.info.device_type == wgpu::DeviceType::Cpu => LuForm::Serial,
             _ => LuForm::Lanes,
         }
     }
 
-    /// Invocations per variant.
-    pub fn lanes(self) -> usize {
+    /// Invocations per variant of its widest dispatch on an `n`-node chain.
+    pub fn widest(self, n: usize) -> usize {
         match self {
             LuForm::Serial => 1,
             LuForm::Lanes => LANES,
+            LuForm::Cyclic => n,
+        }
+    }
+
+    /// Entries per variant of the workspace buffers `(work_x, work_z)` on an `n`-node chain.
+    pub fn workspace(self, n: usize) -> (usize, usize) {
+        match self {
+            LuForm::Serial | LuForm::Lanes => (36 * n.saturating_sub(1).max(1), 6 * n),
+            LuForm::Cyclic => crate::gpu::block_cr::workspace(n),
         }
     }
 }
@@ -64,6 +77,7 @@ pub fn force_lu_form(form: Option<LuForm>) {
         None => 0,
         Some(LuForm::Serial) => 1,
         Some(LuForm::Lanes) => 2,
+        Some(LuForm::Cyclic) => 3,
     };
     FORCED.store(code, std::sync::atomic::Ordering::Relaxed);
 }
@@ -79,6 +93,10 @@ pub fn block_lu_wgsl(f64: bool, form: LuForm) -> Result<String, GpuError> {
     }
     if form == LuForm::Serial {
         flags.insert("SERIAL");
+    }
+    if form == LuForm::Cyclic {
+        let text = compose("block_cr.wgsl", &flags, f64)?;
+        return Ok(crate::gpu::block_cr::expand(&text));
     }
     let text = compose("block_lu.wgsl", &flags, f64)?;
     // The written-out walk is the same text every time: made once per process.
@@ -411,21 +429,31 @@ pub fn passes(n: usize) -> Vec<(usize, usize, u32)> {
     passes
 }
 
-/// The parameter block of every pass of [`passes`] for `v` variants.
-pub fn pass_dims(n: usize, v: usize) -> Vec<LuDims> {
-    passes(n)
-        .into_iter()
-        .map(|(begin, end, phase)| LuDims {
-            num_variants: v as u32,
-            num_nodes: n as u32,
-            begin: begin as u32,
-            end: end as u32,
-            phase,
-            _pad0: 0,
-            _pad1: 0,
-            _pad2: 0,
-        })
-        .collect()
+/// Every dispatch of the block solve of an `n`-node chain in `form` for `v` variants: its
+/// parameter block and its invocations ([`passes`]; the cyclic form's
+/// [`crate::gpu::block_cr::passes`], whose `begin` is the level's stride and `end` the
+/// nodes of the dispatch).
+pub fn plan(form: LuForm, n: usize, v: usize) -> Vec<(LuDims, usize)> {
+    let dims = |begin: usize, end: usize, phase: u32| LuDims {
+        num_variants: v as u32,
+        num_nodes: n as u32,
+        begin: begin as u32,
+        end: end as u32,
+        phase,
+        _pad0: 0,
+        _pad1: 0,
+        _pad2: 0,
+    };
+    match form {
+        LuForm::Cyclic => crate::gpu::block_cr::passes(n)
+            .into_iter()
+            .map(|(stride, nodes, phase)| (dims(stride, nodes, phase), nodes * v))
+            .collect(),
+        _ => passes(n)
+            .into_iter()
+            .map(|(begin, end, phase)| (dims(begin, end, phase), form.widest(n) * v))
+            .collect(),
+    }
 }
 
 /// Solves every variant of `batch` on the GPU. Returns the field-major solution and a
@@ -454,16 +482,19 @@ pub fn block_lu_gpu_form<T: GpuReal>(
     form: LuForm,
 ) -> Result<(Vec<T>, Vec<u32>), GpuError> {
     crate::gpu::contact::require_precision::<T>(ctx)?;
-    let lanes = form.lanes();
     let wgsl = block_lu_wgsl(T::IS_F64, form)?;
     let pipeline = ctx.pipeline("block_lu", &wgsl)?;
     let size = std::mem::size_of::<T>();
     let (n, v) = (batch.num_nodes, batch.num_variants);
     let m = n.saturating_sub(1);
     let max_binding = ctx.max_binding_bytes() as usize;
-    // The largest array per variant is a 36-float block field over n nodes.
-    let cap = (max_binding / (36 * n.max(1) * size))
-        .min(ctx.limits.max_compute_workgroups_per_dimension as usize * WORKGROUP / lanes)
+    // The largest array per variant: a 36-float block field over n nodes, or the workspace.
+    let (work_x, work_z) = form.workspace(n);
+    let cap = (max_binding / ((36 * n).max(work_x).max(1) * size))
+        .min(
+            ctx.limits.max_compute_workgroups_per_dimension as usize * WORKGROUP
+                / form.widest(n).max(1),
+        )
         .min(max_chunk)
         .max(1);
     let mut x = vec![T::zero(); 6 * n * v];
@@ -481,8 +512,9 @@ pub fn block_lu_gpu_form<T: GpuReal>(
             }
             out
         };
-        let params = pass_dims(n, len);
-        let param_bytes: Vec<&[u8]> = params.iter().map(bytemuck::bytes_of).collect();
+        let params = plan(form, n, len);
+        let param_bytes: Vec<&[u8]> = params.iter().map(|(d, _)| bytemuck::bytes_of(d)).collect();
+        let invocations: Vec<usize> = params.iter().map(|&(_, k)| k).collect();
         let (diag, upper, lower, rhs) = (
             gather(&batch.diag, 36 * n),
             gather(&batch.upper, 36 * m),
@@ -503,12 +535,12 @@ pub fn block_lu_gpu_form<T: GpuReal>(
                 bytemuck::cast_slice(&rhs),
             ],
             &[
-                Out::Empty(36 * m.max(1) * len * size),
-                Out::Empty(6 * n * len * size),
+                Out::Empty(work_x * len * size),
+                Out::Empty(work_z * len * size),
                 Out::Empty(x_bytes),
                 Out::From(bytemuck::cast_slice(&running)),
             ],
-            lanes * len,
+            &invocations,
         )?;
         let xs: Vec<T> = crate::gpu::readback::values(&out[2]);
         let st: Vec<u32> = crate::gpu::readback::values(&out[3]);

@@ -17,6 +17,7 @@ use crate::error::GpuError;
 pub const SHADERS: &[(&str, &str)] = &[
     ("contact.wgsl", include_str!("../../shaders/contact.wgsl")),
     ("block_lu.wgsl", include_str!("../../shaders/block_lu.wgsl")),
+    ("block_cr.wgsl", include_str!("../../shaders/block_cr.wgsl")),
     ("assemble.wgsl", include_str!("../../shaders/assemble.wgsl")),
     ("update.wgsl", include_str!("../../shaders/update.wgsl")),
     ("beam.wgsl", include_str!("../../shaders/beam.wgsl")),

@@ -48,7 +48,7 @@ pub struct KernelTiming {
     pub bytes_in: u64,
     /// Bytes of its outputs.
     pub bytes_out: u64,
-    /// Invocations per pass.
+    /// Invocations of all its passes together.
     pub invocations: usize,
     /// Passes (dispatches) per run.
     pub passes: usize,
@@ -98,12 +98,13 @@ pub fn run_once(
         &[params],
         inputs,
         outputs,
-        invocations,
+        &[invocations],
     )
 }
 
 /// Runs `pipeline` once per parameter block, in order, on the same storage buffers (each dispatch
-/// sees the previous one's writes); returns the bytes of each output after the last.
+/// sees the previous one's writes), with `invocations[k]` invocations for block `k`; returns
+/// the bytes of each output after the last.
 pub fn run_passes(
     ctx: &GpuContext,
     pipeline: &wgpu::ComputePipeline,
@@ -111,8 +112,13 @@ pub fn run_passes(
     params: &[&[u8]],
     inputs: &[&[u8]],
     outputs: &[Out],
-    invocations: usize,
+    invocations: &[usize],
 ) -> Result<Vec<Vec<u8>>, GpuError> {
+    assert_eq!(
+        invocations.len(),
+        params.len(),
+        "one invocation count per pass"
+    );
     let output_bytes: Vec<usize> = outputs.iter().map(Out::bytes).collect();
     let input_bytes: usize = inputs.iter().map(|b| b.len()).sum();
     // The outputs' initial contents (for a timed run's restore).
@@ -195,9 +201,9 @@ pub fn run_passes(
         {
             let mut pass = crate::gpu::pass_clock::PassClock::pass(clock, &mut encoder);
             pass.set_pipeline(pipeline);
-            for bg in &bind_groups {
+            for (bg, k) in bind_groups.iter().zip(invocations) {
                 pass.set_bind_group(0, bg, &[]);
-                pass.dispatch_workgroups(invocations.div_ceil(WORKGROUP) as u32, 1, 1);
+                pass.dispatch_workgroups(k.div_ceil(WORKGROUP) as u32, 1, 1);
             }
         }
         encoder
@@ -263,7 +269,7 @@ pub fn run_passes(
             device_seconds,
             bytes_in: (params.iter().map(|p| p.len()).sum::<usize>() + input_bytes) as u64,
             bytes_out: output_bytes.iter().sum::<usize>() as u64,
-            invocations,
+            invocations: invocations.iter().sum(),
             passes: params.len(),
         };
         TIMING.with(|t| {

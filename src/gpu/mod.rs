@@ -3,6 +3,7 @@
 pub mod assemble;
 pub mod batch;
 pub mod beam;
+pub mod block_cr;
 pub mod block_lu;
 pub mod ceilings;
 pub mod compose;

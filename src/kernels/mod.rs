@@ -6,6 +6,7 @@
 //! |---|---|
 //! | `shaders/contact.wgsl` | [`contact`] |
 //! | `shaders/block_lu.wgsl` | [`block_lu`] |
+//! | `shaders/block_cr.wgsl` | [`block_cr`] |
 //! | `shaders/assemble.wgsl` | [`assemble`] |
 //! | `shaders/update.wgsl` | [`update`] |
 //! | `shaders/beam.wgsl` | [`beam`] |
@@ -16,6 +17,7 @@
 
 pub mod assemble;
 pub mod beam;
+pub mod block_cr;
 pub mod block_lu;
 pub mod contact;
 pub mod dynamics;
@@ -27,6 +29,7 @@ pub mod update;
 pub const TWINS: &[(&str, &str)] = &[
     ("contact.wgsl", "src/kernels/contact.rs"),
     ("block_lu.wgsl", "src/kernels/block_lu.rs"),
+    ("block_cr.wgsl", "src/kernels/block_cr.rs"),
     ("assemble.wgsl", "src/kernels/assemble.rs"),
     ("update.wgsl", "src/kernels/update.rs"),
     ("beam.wgsl", "src/kernels/beam.rs"),

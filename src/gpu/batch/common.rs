@@ -48,6 +48,8 @@ pub(super) struct Common {
     pub(super) contact_trial_dims: wgpu::Buffer,
     pub(super) assemble_dims: wgpu::Buffer,
     pub(super) lu_dims: Vec<wgpu::Buffer>,
+    /// Invocations of each pass of the block solve (`lu_dims`), in its form.
+    pub(super) lu_invocations: Vec<usize>,
 }
 
 impl Common {
@@ -127,6 +129,18 @@ impl Common {
         all
     }
 
+    /// Records the block solve's passes (`groups`, from [`Common::lu_groups`]) into `pass`.
+    pub(super) fn record_lu(
+        &self,
+        pass: &mut wgpu::ComputePass,
+        pipeline: &wgpu::ComputePipeline,
+        groups: &[wgpu::BindGroup],
+    ) {
+        for (group, &k) in groups.iter().zip(&self.lu_invocations) {
+            super::dispatch(pass, pipeline, group, k);
+        }
+    }
+
     /// One bind group per pass of the block solve of `system` (diag, upper, lower, rhs).
     pub(super) fn lu_groups(
         &self,
@@ -193,7 +207,8 @@ impl Common {
         let (v, n, s) = (tables.num_variants, tables.num_nodes, tables.num_sites);
         let (m, p) = (n.saturating_sub(1), tables.pair_node.len());
         let size = std::mem::size_of::<T>();
-        if largest_binding_per_variant(n, s, size) * v > ctx.max_binding_bytes() as usize {
+        let lu_form = crate::gpu::block_lu::LuForm::for_adapter(ctx);
+        if largest_binding_per_variant(n, s, size, lu_form) * v > ctx.max_binding_bytes() as usize {
             return Err(GpuError::Unsupported(format!(
                 "{v} variants of {n} nodes exceed one binding of {} bytes; split the variants",
                 ctx.max_binding_bytes()
@@ -207,6 +222,8 @@ impl Common {
         }
         let cast = |x: Vec<f64>| -> Vec<T> { x.into_iter().map(T::from_f64_lossy).collect() };
         let table = |label: &str, x: Vec<f64>| storage(ctx, label, &cast(x));
+        let (lu_x, lu_z) = lu_form.workspace(n);
+        let lu_plan = crate::gpu::block_lu::plan(lu_form, n, v);
         let given = |label: &str, x: Option<&[T]>, len: usize| match x {
             Some(x) => storage(ctx, label, x),
             None => empty(ctx, label, len * size),
@@ -234,8 +251,8 @@ impl Common {
                 crate::kernels::contact::output_fields(&tables.terms) * p * size,
             ),
             flags: empty(ctx, "contact_flags", 4 * p),
-            work_x: empty(ctx, "lu_work", 36 * m.max(1) * v * size),
-            work_z: empty(ctx, "lu_work_z", 6 * n * v * size),
+            work_x: empty(ctx, "lu_work", lu_x * v * size),
+            work_z: empty(ctx, "lu_work_z", lu_z * v * size),
             delta: empty(ctx, "delta", 6 * n * v * size),
             status: empty(ctx, "status", 4 * v),
             running: storage(ctx, "status_running", &vec![RUNNING; v]),
@@ -311,10 +328,11 @@ impl Common {
                     _pad: 0,
                 },
             ),
-            lu_dims: crate::gpu::block_lu::pass_dims(n, v)
+            lu_dims: lu_plan
                 .iter()
-                .map(|d| param_block(ctx, "lu_dims", d))
+                .map(|(d, _)| param_block(ctx, "lu_dims", d))
                 .collect(),
+            lu_invocations: lu_plan.iter().map(|&(_, k)| k).collect(),
         })
     }
 }

@@ -23,8 +23,6 @@ pub struct GpuDynamic<T: GpuReal> {
     num_pairs: usize,
     a0: T,
     c: Common,
-    /// Invocations per variant of the block solve ([`LuForm`]).
-    lu_lanes: usize,
     /// Line-search trials formed in one submission ([`super::Rounds`]).
     rounds: super::Rounds,
     /// The device's time of the passes read back ([`crate::tally`]), where it has stamps.
@@ -389,7 +387,6 @@ impl<T: GpuReal> GpuDynamic<T> {
             num_pairs: p,
             a0: T::from_f64_lossy(dynamic.a0),
             c,
-            lu_lanes: LuForm::for_adapter(ctx).lanes(),
             rounds: super::Rounds::new(ctx, v, size),
             clock: crate::gpu::pass_clock::PassClock::new(ctx, "dynamic pass"),
             _keep: [mass, inertia0, diag, upper, lower, rhs]
@@ -523,9 +520,7 @@ impl<T: GpuReal> crate::engine::dynamic::ResidentDynamic<T> for GpuDynamic<T> {
                 true => self.record_evaluate(&mut pass, Evaluation::All),
                 false => self.record_evaluate(&mut pass, Evaluation::Listed(count)),
             }
-            for group in &g.lu {
-                dispatch(&mut pass, &p.block_lu, group, self.lu_lanes * v);
-            }
+            self.c.record_lu(&mut pass, &p.block_lu, &g.lu);
             match all {
                 true => {
                     dispatch(&mut pass, &p.norms, &g.norms_iterate, v);

@@ -60,9 +60,12 @@ pub fn bytes_per_variant(n: usize, s: usize, size: usize) -> usize {
 }
 
 /// The largest per-variant array of one binding, in bytes: the element tangents.
-fn largest_binding_per_variant(n: usize, s: usize, size: usize) -> usize {
+fn largest_binding_per_variant(n: usize, s: usize, size: usize, form: LuForm) -> usize {
     let m = n.saturating_sub(1);
-    size * (144 * m).max(36 * n).max(OUTPUT_LEN * s)
+    size * (144 * m)
+        .max(36 * n)
+        .max(OUTPUT_LEN * s)
+        .max(form.workspace(n).0)
 }
 
 /// The most variants of `model` one batch may hold on `ctx`: every binding within the
@@ -70,8 +73,10 @@ fn largest_binding_per_variant(n: usize, s: usize, size: usize) -> usize {
 pub fn max_variants(ctx: &GpuContext, model: &Model, size: usize) -> usize {
     let n = model.nodes.len();
     let s = model.sites.len();
-    let by_binding = ctx.max_binding_bytes() as usize / largest_binding_per_variant(n, s, size);
-    let widest = n.max(s).max(LuForm::for_adapter(ctx).lanes());
+    let form = LuForm::for_adapter(ctx);
+    let by_binding =
+        ctx.max_binding_bytes() as usize / largest_binding_per_variant(n, s, size, form);
+    let widest = n.max(s).max(form.widest(n));
     let by_groups = ctx.limits.max_compute_workgroups_per_dimension as usize * WORKGROUP / widest;
     by_binding.min(by_groups).max(1)
 }
@@ -141,8 +146,6 @@ pub struct GpuStatic<T: GpuReal> {
     slots: [Slot; 2],
     /// Whether each slot's assembled system has its tangent (a trial's has its residual only).
     formed: [bool; 2],
-    /// Invocations per variant of the block solve ([`LuForm`]).
-    lu_lanes: usize,
     current: usize,
     contact: wgpu::BindGroup,
     contact_force: wgpu::BindGroup,
@@ -394,7 +397,6 @@ impl<T: GpuReal> GpuStatic<T> {
             p: pipelines,
             slots,
             formed: [false; 2],
-            lu_lanes: LuForm::for_adapter(ctx).lanes(),
             current: 0,
             contact,
             contact_force,
@@ -516,9 +518,7 @@ impl<T: GpuReal> GpuStatic<T> {
         self.c.reset_status(&mut encoder, v);
         {
             let mut pass = encoder.begin_compute_pass(&Default::default());
-            for group in &s.lu {
-                dispatch(&mut pass, &self.p.block_lu, group, self.lu_lanes * v);
-            }
+            self.c.record_lu(&mut pass, &self.p.block_lu, &s.lu);
             dispatch(&mut pass, &self.p.norms, &s.norms_solve, v);
         }
         Ok(encoder)
