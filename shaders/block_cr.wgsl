@@ -5,10 +5,11 @@
 // chain walk of shaders/block_lu.wgsl takes n dependent node steps; here the levels
 // s = 1, 2, 4, … (dims.begin) each take one dispatch whose nodes are independent:
 //
-//   phase 2 (s = 1, every node): load the node; the odd ones factored (P, Q, r), the even
-//            ones copied to the workspace; a chain of one node solved at once.
+//   phase 2 (level 1's odd nodes): each factored (P, Q, r) into the workspace; a chain of
+//            one node solved at once.
 //   phase 3 (level s, the multiples of 2s): the even update by both odd neighbours, then
-//            the node factored if odd at level 2s, or solved if node 0 is alone.
+//            the node factored if odd at level 2s, or solved if node 0 is alone. At s = 1
+//            the node and its couplings are read from the inputs (nothing was copied).
 //   phase 4 (level s, coarsest first, the odd nodes of the level): back substitution
 //            x_j = r_j − P_j x_{j−s} − Q_j x_{j+s}; the last (s = 1, node 1) marks the
 //            variant solved.
@@ -83,10 +84,11 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         }
         return;
     }
-    var i = k;
-    if (phase == 3u) {
-        i = 2u * s * k;
+    var i = 2u * s * k;
+    if (phase == 2u) {
+        i = select(2u * k + 1u, 0u, n == 1u);
     }
+    let from_inputs = phase == 2u || s == 1u;
     //@LOAD
     if (phase == 3u) {
         //@UPDATE
@@ -96,7 +98,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     var alone = false;
     var has_right = false;
     if (phase == 2u) {
-        factor_it = i % 2u == 1u;
+        factor_it = n > 1u;
         alone = n == 1u;
         has_right = i + 1u < n;
     } else {

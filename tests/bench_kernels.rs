@@ -54,8 +54,8 @@ fn the_roofline_bench_measures_every_kernel_under_its_ceilings() {
         // Bytes are the bindings' sizes: at least the outputs the kernel writes.
         assert!(f("gbytes_per_s") > 0.0 && f("intensity") > 0.0, "{k}");
     }
-    // The block solve's counted FLOPs grow linearly in V at fixed n, in both forms.
-    for form in ["serial", "lanes"] {
+    // The block solve's counted FLOPs grow linearly in V at fixed n, in every form.
+    for form in ["serial", "lanes", "cyclic"] {
         let lu: Vec<f64> = rows
             .iter()
             .filter(|k| {

@@ -352,9 +352,9 @@ pub fn statics(
     let mut adapter = "none".to_string();
     if let Ok(ctx) = GpuContext::shared() {
         adapter = format!(
-            "{}; block solve: {:?}",
+            "{}; block solve: {}",
             ctx.describe(),
-            crate::gpu::block_lu::LuForm::for_adapter(ctx)
+            crate::gpu::block_lu::LuForm::describe(ctx)
         );
         if ctx.has_f64 {
             let before = tally();

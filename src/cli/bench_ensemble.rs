@@ -343,9 +343,9 @@ pub fn run(
     let adapter = ctx
         .map(|c| {
             format!(
-                "{}; block solve: {:?}",
+                "{}; block solve: {}",
                 c.describe(),
-                crate::gpu::block_lu::LuForm::for_adapter(c)
+                crate::gpu::block_lu::LuForm::describe(c)
             )
         })
         .unwrap_or_else(|| "none".into());

@@ -294,7 +294,7 @@ fn run_size<T: GpuReal>(
         r.map_err(|e| e.to_string()).and_then(|_| of(t)),
     ));
     // The block-tridiagonal solve, in every form (the engine runs the adapter's:
-    // `LuForm::for_adapter`); the names say which. The cyclic form's FLOPs are its twin's.
+    // `LuForm::for_batch`); the names say which. The cyclic form's FLOPs are its twin's.
     let b = cast_chain(&chain_batch(n, v), to_t);
     for (form, name, flops) in [
         (LuForm::Serial, "block solve (serial)", c.block_lu),

@@ -7,7 +7,7 @@ use std::fmt::Write;
 
 use crate::kernels::block_cr::levels;
 
-/// Phase of the first pass (level 1: every node loaded, the odd ones factored).
+/// Phase of the first pass (level 1's odd nodes factored; node 0 solved if alone).
 const LOAD: u32 = 2;
 /// Phase of a level's even update (and the factoring of the next level's odd nodes).
 const REDUCE: u32 = 3;
@@ -18,7 +18,7 @@ const BACK: u32 = 4;
 /// reduction per level, then the back substitution from the coarsest level.
 pub fn passes(n: usize) -> Vec<(usize, usize, u32)> {
     let levels = levels(n);
-    let mut out = vec![(1, n, LOAD)];
+    let mut out = vec![(1, if n == 1 { 1 } else { n / 2 }, LOAD)];
     out.extend(levels.iter().map(|&s| (s, (n - 1) / (2 * s) + 1, REDUCE)));
     out.extend(
         levels
@@ -64,7 +64,7 @@ fn load() -> String {
         }
         let _ = writeln!(w, "    var y{r}: real;");
     }
-    let _ = writeln!(w, "    if (phase == 2u) {{");
+    let _ = writeln!(w, "    if (from_inputs) {{");
     for r in 0..6 {
         for c in 0..6 {
             let _ = writeln!(w, "        d{r}_{c} = diag[blk(i, {}u, v)];", 6 * r + c);
@@ -149,16 +149,39 @@ fn neg_product(w: &mut String, indent: &str, b_field: u32, out_field: u32) {
     }
 }
 
+/// `A` = the coupling `field` of node `i` (1: `WL`, at level 1 the input `lower` block of
+/// row `i`; 2: `WU`, at level 1 `upper`).
 fn load_coupling(w: &mut String, field: u32) {
+    let input = match field {
+        1 => "lower[blk(i - 1u",
+        _ => "upper[blk(i",
+    };
+    for r in 0..6 {
+        for k in 0..6 {
+            let _ = writeln!(w, "            var a{r}_{k}: real;");
+        }
+    }
+    let _ = writeln!(w, "            if (s == 1u) {{");
     for r in 0..6 {
         for k in 0..6 {
             let _ = writeln!(
                 w,
-                "            let a{r}_{k} = work_x[wk({field}u, i, {}u, v)];",
+                "                a{r}_{k} = {input}, {}u, v)];",
                 6 * r + k
             );
         }
     }
+    let _ = writeln!(w, "            }} else {{");
+    for r in 0..6 {
+        for k in 0..6 {
+            let _ = writeln!(
+                w,
+                "                a{r}_{k} = work_x[wk({field}u, i, {}u, v)];",
+                6 * r + k
+            );
+        }
+    }
+    let _ = writeln!(w, "            }}");
 }
 
 fn update() -> String {
@@ -188,21 +211,6 @@ fn update() -> String {
 fn store() -> String {
     let mut s = String::new();
     let w = &mut s;
-    let _ = writeln!(w, "        if (phase == 2u) {{");
-    let _ = writeln!(
-        w,
-        "            for (var rc = 0u; rc < 36u; rc = rc + 1u) {{"
-    );
-    let _ = writeln!(
-        w,
-        "                if (i > 0u) {{ work_x[wk(1u, i, rc, v)] = lower[blk(i - 1u, rc, v)]; }}"
-    );
-    let _ = writeln!(
-        w,
-        "                if (i + 1u < n) {{ work_x[wk(2u, i, rc, v)] = upper[blk(i, rc, v)]; }}"
-    );
-    let _ = writeln!(w, "            }}");
-    let _ = writeln!(w, "        }}");
     for r in 0..6 {
         for c in 0..6 {
             let _ = writeln!(

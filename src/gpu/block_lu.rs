@@ -38,7 +38,9 @@ pub enum LuForm {
 }
 
 impl LuForm {
-    /// The form for `ctx`'s adapter (or the override).
+    /// The form for `ctx`'s adapter (or the override), for a batch of any size: the chain
+    /// walk (serial on a CPU-type adapter, lanes on a GPU). [`LuForm::for_batch`] is the
+    /// engine's choice.
     pub fn for_adapter(ctx: &GpuContext) -> LuForm {
         match FORCED.load(std::sync::atomic::Ordering::Relaxed) {
             1 => LuForm::Serial,
@@ -46,6 +48,38 @@ impl LuForm {
             3 => LuForm::Cyclic,
             _ if ctx.info.device_type == wgpu::DeviceType::Cpu => LuForm::Serial,
             _ => LuForm::Lanes,
+        }
+    }
+
+    /// The form for a batch of `v` variants of an `n`-node chain on `ctx`'s adapter (or the
+    /// override): on a GPU, cyclic reduction while the batch is small enough that the
+    /// walk's `n` dependent steps leave the device idle (`n · v ≤` [`CYCLIC_MAX_NODE_VARIANTS`]),
+    /// the lane walk above it, where the reduction's larger traffic costs more than the
+    /// latency it saves; the serial walk on a CPU-type adapter (lavapipe: variants are its
+    /// parallelism, and the reduction's extra work and dispatches cost it 2×).
+    pub fn for_batch(ctx: &GpuContext, n: usize, v: usize) -> LuForm {
+        match Self::for_adapter(ctx) {
+            LuForm::Lanes
+                if FORCED.load(std::sync::atomic::Ordering::Relaxed) == 0
+                    && n.saturating_mul(v) <= CYCLIC_MAX_NODE_VARIANTS =>
+            {
+                LuForm::Cyclic
+            }
+            form => form,
+        }
+    }
+
+    /// The choice [`LuForm::for_batch`] makes on `ctx`, in words (the benchmarks' headers).
+    pub fn describe(ctx: &GpuContext) -> String {
+        match (
+            FORCED.load(std::sync::atomic::Ordering::Relaxed),
+            Self::for_adapter(ctx),
+        ) {
+            (0, LuForm::Lanes) => {
+                format!("Cyclic up to n·V = {CYCLIC_MAX_NODE_VARIANTS}, Lanes above")
+            }
+            (0, form) => format!("{form:?}"),
+            (_, form) => format!("{form:?} (forced)"),
         }
     }
 
@@ -67,7 +101,13 @@ impl LuForm {
     }
 }
 
-/// The forced form: 0 none, 1 serial, 2 lanes.
+/// Nodes × variants up to which a GPU batch solves by cyclic reduction
+/// ([`LuForm::for_batch`]). Measured on an H100 (stop 52, `bench ensemble --nodes 100,400
+/// --variants … --lu-form lanes|cyclic`): the reduction ahead at n · V = 1,632 (n = 102,
+/// V = 16), 26,112 and 102,912 (n = 402, V = 256), behind at 417,792 (n = 102, V = 4096).
+pub const CYCLIC_MAX_NODE_VARIANTS: usize = 200_000;
+
+/// The forced form: 0 none, 1 serial, 2 lanes, 3 cyclic.
 static FORCED: std::sync::atomic::AtomicU8 = std::sync::atomic::AtomicU8::new(0);
 
 /// Makes every block solve of this process (kernels built from now on) use `form`, or the
@@ -471,7 +511,8 @@ pub fn block_lu_gpu_chunked<T: GpuReal>(
     batch: &ChainBatch<T>,
     max_chunk: usize,
 ) -> Result<(Vec<T>, Vec<u32>), GpuError> {
-    block_lu_gpu_form(ctx, batch, max_chunk, LuForm::for_adapter(ctx))
+    let form = LuForm::for_batch(ctx, batch.num_nodes, batch.num_variants.min(max_chunk));
+    block_lu_gpu_form(ctx, batch, max_chunk, form)
 }
 
 /// As [`block_lu_gpu_chunked`] in a given form (tests: both forms on any adapter).

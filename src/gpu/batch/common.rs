@@ -48,6 +48,8 @@ pub(super) struct Common {
     pub(super) contact_trial_dims: wgpu::Buffer,
     pub(super) assemble_dims: wgpu::Buffer,
     pub(super) lu_dims: Vec<wgpu::Buffer>,
+    /// The block solve's form for this batch ([`crate::gpu::block_lu::LuForm::for_batch`]).
+    pub(super) lu_form: crate::gpu::block_lu::LuForm,
     /// Invocations of each pass of the block solve (`lu_dims`), in its form.
     pub(super) lu_invocations: Vec<usize>,
 }
@@ -207,8 +209,8 @@ impl Common {
         let (v, n, s) = (tables.num_variants, tables.num_nodes, tables.num_sites);
         let (m, p) = (n.saturating_sub(1), tables.pair_node.len());
         let size = std::mem::size_of::<T>();
-        let lu_form = crate::gpu::block_lu::LuForm::for_adapter(ctx);
-        if largest_binding_per_variant(n, s, size, lu_form) * v > ctx.max_binding_bytes() as usize {
+        let lu_form = crate::gpu::block_lu::LuForm::for_batch(ctx, n, v);
+        if largest_binding_per_variant(n, s, size) * v > ctx.max_binding_bytes() as usize {
             return Err(GpuError::Unsupported(format!(
                 "{v} variants of {n} nodes exceed one binding of {} bytes; split the variants",
                 ctx.max_binding_bytes()
@@ -333,6 +335,7 @@ impl Common {
                 .map(|(d, _)| param_block(ctx, "lu_dims", d))
                 .collect(),
             lu_invocations: lu_plan.iter().map(|&(_, k)| k).collect(),
+            lu_form,
         })
     }
 }

@@ -181,7 +181,7 @@ impl<T: GpuReal> GpuDynamic<T> {
                 dynamic: true,
                 unbalance: !dynamic.unbalance.is_empty(),
             })?,
-            block_lu: k(Kernel::BlockLu(LuForm::for_adapter(ctx)))?,
+            block_lu: k(Kernel::BlockLu(c.lu_form))?,
             norms: k(Kernel::Norms { trial: false })?,
             trial: TrialPipelines {
                 accelerate: k(Kernel::DynamicsMasked(DynamicsKernel::Accelerate))?,

@@ -60,12 +60,13 @@ pub fn bytes_per_variant(n: usize, s: usize, size: usize) -> usize {
 }
 
 /// The largest per-variant array of one binding, in bytes: the element tangents.
-fn largest_binding_per_variant(n: usize, s: usize, size: usize, form: LuForm) -> usize {
+/// (The block solve's workspace in its largest form: the form depends on the batch's size.)
+fn largest_binding_per_variant(n: usize, s: usize, size: usize) -> usize {
     let m = n.saturating_sub(1);
     size * (144 * m)
         .max(36 * n)
         .max(OUTPUT_LEN * s)
-        .max(form.workspace(n).0)
+        .max(LuForm::Cyclic.workspace(n).0)
 }
 
 /// The most variants of `model` one batch may hold on `ctx`: every binding within the
@@ -73,10 +74,9 @@ fn largest_binding_per_variant(n: usize, s: usize, size: usize, form: LuForm) ->
 pub fn max_variants(ctx: &GpuContext, model: &Model, size: usize) -> usize {
     let n = model.nodes.len();
     let s = model.sites.len();
-    let form = LuForm::for_adapter(ctx);
-    let by_binding =
-        ctx.max_binding_bytes() as usize / largest_binding_per_variant(n, s, size, form);
-    let widest = n.max(s).max(form.widest(n));
+    let by_binding = ctx.max_binding_bytes() as usize / largest_binding_per_variant(n, s, size);
+    // Every form's widest dispatch is at most n invocations a variant.
+    let widest = n.max(s).max(LuForm::Lanes.widest(n));
     let by_groups = ctx.limits.max_compute_workgroups_per_dimension as usize * WORKGROUP / widest;
     by_binding.min(by_groups).max(1)
 }
@@ -290,7 +290,7 @@ impl<T: GpuReal> GpuStatic<T> {
                 dynamic: false,
                 unbalance: false,
             })?,
-            block_lu: k(Kernel::BlockLu(LuForm::for_adapter(ctx)))?,
+            block_lu: k(Kernel::BlockLu(c.lu_form))?,
             norms: k(Kernel::Norms { trial: false })?,
             norms_trial: k(Kernel::Norms { trial: true })?,
             update: k(Kernel::Update { trial: false })?,
