@@ -40,8 +40,8 @@ fn the_roofline_bench_measures_every_kernel_under_its_ceilings() {
     let precisions = if ctx.has_f64 { 2 } else { 1 };
     assert_eq!(
         rows.len(),
-        5 * 2 * precisions,
-        "4 kernels (the block solve in 2 forms) × 2 sizes × precisions"
+        6 * 2 * precisions,
+        "4 kernels (the block solve in 3 forms) × 2 sizes × precisions"
     );
     for k in rows {
         let f = |key: &str| k[key].as_f64().unwrap_or(f64::NAN);
