@@ -1,7 +1,8 @@
-//! The engines with the lane form of the block solve (`shaders/block_lu.wgsl`, six lanes
-//! per variant: what real GPUs run) forced on whatever adapter there is — lavapipe runs the
-//! serial form by default — against the twin path: the static and the dynamic ensemble.
-//! Its own test binary, as the forced form holds for the whole process.
+//! The engines with the GPU forms of the block solve — the lane walk (`shaders/block_lu.wgsl`,
+//! six lanes per variant) and cyclic reduction (`shaders/block_cr.wgsl`, an invocation per
+//! node), what real GPUs run (`LuForm::for_batch`) — forced on whatever adapter there is
+//! (lavapipe runs the serial walk by default), against the twin path: the static and the
+//! dynamic ensemble. Its own test binary, as the forced form holds for the whole process.
 
 mod common;
 
@@ -14,10 +15,16 @@ use holewall::kernels::dynamics::DynamicBatch;
 use holewall::solve::statics::{solve_static, StaticOptions};
 
 #[test]
-fn engines_with_the_lane_form_match_the_twin_path() {
-    force_lu_form(Some(LuForm::Lanes));
+fn engines_with_the_gpu_forms_of_the_block_solve_match_the_twin_path() {
     let Some(ctx) = common::gpu() else { return };
-    assert_eq!(LuForm::for_adapter(ctx), LuForm::Lanes);
+    for form in [LuForm::Lanes, LuForm::Cyclic] {
+        force_lu_form(Some(form));
+        engines_match_the_twin_path(ctx, form);
+    }
+    force_lu_form(None);
+}
+
+fn engines_match_the_twin_path(ctx: &'static holewall::gpu::GpuContext, form: LuForm) {
     let case = common::bed_case("1");
     let variants = variants_from_csv_text(
         "v.csv",
@@ -25,6 +32,7 @@ fn engines_with_the_lane_form_match_the_twin_path() {
     )
     .unwrap();
     let models: Vec<_> = variants.iter().map(|v| apply(&case, v).unwrap()).collect();
+    assert_eq!(LuForm::for_batch(ctx, models[0].nodes.len(), 3), form);
     let options = StaticOptions::default();
     let twin = solve_static_ensemble(&models, &TwinPath, &options).unwrap();
     let precisions: &[bool] = if ctx.has_f64 {
@@ -55,7 +63,7 @@ fn engines_with_the_lane_form_match_the_twin_path() {
                 }
             }
         }
-        eprintln!("static, lane form, f64 {f64_path}: largest position difference from the twin path {diff:.2e} m");
+        eprintln!("static, {form:?} form, f64 {f64_path}: largest position difference from the twin path {diff:.2e} m");
         // f32: 3.7e-7 m measured on lavapipe (sag of metres in f32).
         assert!(diff <= if f64_path { 1e-9 } else { 1e-5 }, "{diff:e}");
     }
@@ -112,7 +120,7 @@ fn engines_with_the_lane_form_match_the_twin_path() {
             .flat_map(|(a, b)| a.u.iter().zip(&b.u))
             .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()));
         eprintln!(
-            "dynamic, lane form, f64: displacements {:.2e} of their largest",
+            "dynamic, {form:?} form, f64: displacements {:.2e} of their largest",
             diff / scale
         );
         assert!(diff <= 1e-9 * scale, "{diff:e}");
