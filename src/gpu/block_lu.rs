@@ -52,16 +52,15 @@ impl LuForm {
     }
 
     /// The form for a batch of `v` variants of an `n`-node chain on `ctx`'s adapter (or the
-    /// override): on a GPU, cyclic reduction while the batch is small enough that the
-    /// walk's `n` dependent steps leave the device idle (`n · v ≤` [`CYCLIC_MAX_NODE_VARIANTS`]),
-    /// the lane walk above it, where the reduction's larger traffic costs more than the
-    /// latency it saves; the serial walk on a CPU-type adapter (lavapipe: variants are its
-    /// parallelism, and the reduction's extra work and dispatches cost it 2×).
+    /// override): on a GPU, cyclic reduction where the walk's `n` dependent steps leave the
+    /// device idle ([`cyclic_pays`]), the lane walk where the reduction's larger traffic
+    /// costs more than the latency it saves; the serial walk on a CPU-type adapter
+    /// (lavapipe: variants are its parallelism, and the reduction's extra work and
+    /// dispatches cost it 2×).
     pub fn for_batch(ctx: &GpuContext, n: usize, v: usize) -> LuForm {
         match Self::for_adapter(ctx) {
             LuForm::Lanes
-                if FORCED.load(std::sync::atomic::Ordering::Relaxed) == 0
-                    && n.saturating_mul(v) <= CYCLIC_MAX_NODE_VARIANTS =>
+                if FORCED.load(std::sync::atomic::Ordering::Relaxed) == 0 && cyclic_pays(n, v) =>
             {
                 LuForm::Cyclic
             }
@@ -76,7 +75,7 @@ impl LuForm {
             Self::for_adapter(ctx),
         ) {
             (0, LuForm::Lanes) => {
-                format!("Cyclic up to n·V = {CYCLIC_MAX_NODE_VARIANTS}, Lanes above")
+                "Cyclic up to 2048 variants (4096 from 400 nodes), Lanes above".into()
             }
             (0, form) => format!("{form:?}"),
             (_, form) => format!("{form:?} (forced)"),
@@ -101,11 +100,22 @@ impl LuForm {
     }
 }
 
-/// Nodes × variants up to which a GPU batch solves by cyclic reduction
-/// ([`LuForm::for_batch`]). Measured on an H100 (stop 52, `bench ensemble --nodes 100,400
-/// --variants … --lu-form lanes|cyclic`): the reduction ahead at n · V = 1,632 (n = 102,
-/// V = 16), 26,112 and 102,912 (n = 402, V = 256), behind at 417,792 (n = 102, V = 4096).
-pub const CYCLIC_MAX_NODE_VARIANTS: usize = 200_000;
+/// Whether a GPU batch of `v` variants of an `n`-node chain solves by cyclic reduction
+/// ([`LuForm::for_batch`]) rather than by the lane walk. The walk takes `n` dependent node
+/// steps of 16–27 µs on an H100 whatever `v` is; the reduction takes `2⌈log₂ n⌉ + 1`
+/// dispatches of 35–55 µs plus about 3× the walk's memory traffic, which grows with `n · v`.
+/// Measured there (stop 52; `bench ensemble --lu-form lanes|cyclic`, the median run, and
+/// `bench kernels --nodes 101|401`, the block solve alone):
+/// - n = 102: the reduction ahead at V = 16 (run 0.076 s against 0.085 s, f64), 256, 1024
+///   and 2048 (f32 0.203–0.209 s against 0.219–0.230 s); behind at V = 4096 (f64 0.763 s
+///   against 0.677–0.685 s; the solve alone 2.38 ms against 2.05 ms, f32);
+/// - n = 402: ahead at V = 256 (f32 0.255 s against 0.331 s) and 1024 (0.436 s against
+///   0.548 s); the solve alone at V = 4096 4.97 ms against 8.04 ms (f32).
+///
+/// Beyond what was measured (V > 4096, or V > 2048 on short chains) the walk is kept.
+pub fn cyclic_pays(n: usize, v: usize) -> bool {
+    v <= 2048 || (n >= 400 && v <= 4096)
+}
 
 /// The forced form: 0 none, 1 serial, 2 lanes, 3 cyclic.
 static FORCED: std::sync::atomic::AtomicU8 = std::sync::atomic::AtomicU8::new(0);
