@@ -1,6 +1,9 @@
-//! Runs `shaders/block_lu.wgsl` (twin: `src/kernels/block_lu.rs`): every variant's
-//! block-tridiagonal system solved by [`LANES`] invocations (a row of the 6 × 13 block per
-//! lane), variants split into chunks that fit the adapter's binding limits.
+//! Runs the block solve of every variant's block-tridiagonal system, variants split into
+//! chunks that fit the adapter's binding limits, in one of three forms ([`LuForm`]): the
+//! chain walk of `shaders/block_lu.wgsl` (twin `src/kernels/block_lu.rs`), one invocation
+//! or [`LANES`] per variant, or cyclic reduction (`shaders/block_cr.wgsl`, twin
+//! `src/kernels/block_cr.rs`, code in [`crate::gpu::block_cr`]). [`LuForm::for_batch`] is
+//! the one choice between them.
 
 use std::collections::BTreeSet;
 
@@ -20,12 +23,12 @@ pub const NODES_PER_PASS: usize = 32;
 /// idle lanes, eight variants per workgroup of 64).
 pub const LANES: usize = 8;
 
-/// Which form of the block solve an adapter runs: the serial form (one invocation per
-/// variant) on CPU-type adapters (lavapipe: its workgroup is one core's SIMD lanes, and
-/// barriers cost more than the rows they split — 2× the time measured there), the lane
-/// form on GPUs (a chain's node costs six lanes a sixth of the time; 8 V invocations keep
-/// an H100's SMs busy where V alone would not). [`force_lu_form`] overrides it for a
-/// process (tests run both forms on lavapipe).
+/// The forms of the block solve: the serial walk (one invocation per variant) on CPU-type
+/// adapters (lavapipe: its workgroup is one core's SIMD lanes, and barriers cost more than
+/// the rows they split — 2× the time measured there); on GPUs the lane walk (a chain's node
+/// costs six lanes a sixth of the time; 8 V invocations keep an H100's SMs busier than V) or
+/// cyclic reduction (log₂ n levels instead of n steps), as [`LuForm::for_batch`] chooses.
+/// [`force_lu_form`] overrides it for a process (tests run every form on lavapipe).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum LuForm {
     /// One invocation per variant.
@@ -103,10 +106,11 @@ impl LuForm {
 /// Whether a GPU batch of `v` variants of an `n`-node chain solves by cyclic reduction
 /// ([`LuForm::for_batch`]) rather than by the lane walk. The walk takes `n` dependent node
 /// steps of 16–27 µs on an H100 whatever `v` is; the reduction takes `2⌈log₂ n⌉ + 1`
-/// dispatches of 35–55 µs plus about 3× the walk's memory traffic, which grows with `n · v`.
+/// dispatches of 35–55 µs plus work that grows with `n · v` (2.3× the walk's FLOPs, and its workspace
+/// read and written at every level).
 /// Measured there (stop 52; `bench ensemble --lu-form lanes|cyclic`, the median run, and
 /// `bench kernels --nodes 101|401`, the block solve alone):
-/// - n = 102: the reduction ahead at V = 16 (run 0.076 s against 0.085 s, f64), 256, 1024
+/// - n = 102: the reduction ahead at V = 16 (runs 0.068–0.083 s against 0.085–0.088 s, f64), 256, 1024
 ///   and 2048 (f32 0.203–0.209 s against 0.219–0.230 s); behind at V = 4096 (f64 0.763 s
 ///   against 0.677–0.685 s; the solve alone 2.38 ms against 2.05 ms, f32);
 /// - n = 402: ahead at V = 256 (f32 0.255 s against 0.331 s) and 1024 (0.436 s against
@@ -525,7 +529,7 @@ pub fn block_lu_gpu_chunked<T: GpuReal>(
     block_lu_gpu_form(ctx, batch, max_chunk, form)
 }
 
-/// As [`block_lu_gpu_chunked`] in a given form (tests: both forms on any adapter).
+/// As [`block_lu_gpu_chunked`] in a given form (tests: every form on any adapter).
 pub fn block_lu_gpu_form<T: GpuReal>(
     ctx: &'static GpuContext,
     batch: &ChainBatch<T>,
