@@ -163,7 +163,7 @@ pub trait ResidentStatic<T>: ResidentTrials<T> {
     /// the solve's status per variant.
     fn solve(&mut self) -> Result<(Norms<T>, Vec<u32>), crate::error::SystemError>;
     /// [`ResidentStatic::solve`], and where the path forms it in the same round trip, the
-    /// first line-search trial at `α = 1` for every variant ([`ResidentStatic::trial`] with
+    /// first line-search trial at `α = 1` for every variant ([`ResidentTrials::trial`] with
     /// `first` and every variant searching): its norms.
     fn solve_with_trial(&mut self) -> Result<SolvedWithTrial<T>, crate::error::SystemError> {
         self.solve().map(|(norms, status)| (norms, status, None))

@@ -71,7 +71,7 @@ pub struct Iteration<T> {
     pub inertial: Vec<T>,
     /// Where the path forms it with the iteration (no round trip of its own): the first
     /// line-search trial, at α = 1 for the variants iterating and 0 for the others, as
-    /// [`ResidentDynamic::trial`] with `first` would form it — its norms, read for those
+    /// [`crate::engine::ResidentTrials::trial`] with `first` would form it — its norms, read for those
     /// iterating.
     pub full_step: Option<Norms<T>>,
 }
