@@ -27,35 +27,10 @@
 // [(36 (f n + i) + rc) V + v] in work_x; y (then r) of node i at [(6 i + r) V + v] in work_z.
 #include "shared/layout.wgsl"
 
-@group(0) @binding(0) var<storage, read> dims: LuDims;
-@group(0) @binding(1) var<storage, read> diag: array<real>;
-@group(0) @binding(2) var<storage, read> upper: array<real>;
-@group(0) @binding(3) var<storage, read> lower: array<real>;
-@group(0) @binding(4) var<storage, read> rhs: array<real>;
-@group(0) @binding(5) var<storage, read_write> work_x: array<real>;
-@group(0) @binding(6) var<storage, read_write> work_z: array<real>;
-@group(0) @binding(7) var<storage, read_write> x: array<real>;
-@group(0) @binding(8) var<storage, read_write> status: array<u32>;
-
-fn blk(i: u32, rc: u32, v: u32) -> u32 {
-    return (36u * i + rc) * dims.num_variants + v;
-}
-
-fn vec_at(i: u32, r: u32, v: u32) -> u32 {
-    return (6u * i + r) * dims.num_variants + v;
-}
+#include "shared/chain_solve.wgsl"
 
 fn wk(f: u32, i: u32, rc: u32, v: u32) -> u32 {
     return (36u * (f * dims.num_nodes + i) + rc) * dims.num_variants + v;
-}
-
-// Zero, infinite or NaN, by bits (as shaders/block_lu.wgsl).
-fn bad_pivot(p: real) -> bool {
-#if F64
-    return (bitcast<u32>(f32(p)) & 0x7f800000u) == 0x7f800000u || p == real(0.0);
-#else
-    return (bitcast<u32>(p) & 0x7f800000u) == 0x7f800000u || p == real(0.0);
-#endif
 }
 
 @compute @workgroup_size(64)

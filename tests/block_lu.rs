@@ -105,10 +105,9 @@ fn paper_tangents() -> Vec<(String, BlockTridiagonal)> {
         .collect()
 }
 
-#[test]
-fn twin_matches_faer_on_paper_tangents_and_random_systems() {
-    let mut rng = rand::rngs::StdRng::seed_from_u64(7);
-    let mut systems: Vec<(String, BlockTridiagonal, Vec<f64>)> = paper_tangents()
+/// The paper tangents, each with a random right-hand side.
+fn paper_systems(rng: &mut rand::rngs::StdRng) -> Vec<(String, BlockTridiagonal, Vec<f64>)> {
+    paper_tangents()
         .into_iter()
         .map(|(name, a)| {
             let b = (0..6 * a.nodes())
@@ -116,7 +115,13 @@ fn twin_matches_faer_on_paper_tangents_and_random_systems() {
                 .collect();
             (name, a, b)
         })
-        .collect();
+        .collect()
+}
+
+#[test]
+fn twin_matches_faer_on_paper_tangents_and_random_systems() {
+    let mut rng = rand::rngs::StdRng::seed_from_u64(7);
+    let mut systems = paper_systems(&mut rng);
     for k in 0..8 {
         let (a, b) = random_system(&mut rng, 40, 3);
         systems.push((format!("random {k}"), a, b));
@@ -308,15 +313,7 @@ fn gpu_matches_the_twin_and_a_singular_variant_fails_alone() {
 #[test]
 fn cyclic_reduction_twin_matches_faer_at_every_length() {
     let mut rng = rand::rngs::StdRng::seed_from_u64(17);
-    let mut systems: Vec<(String, BlockTridiagonal, Vec<f64>)> = paper_tangents()
-        .into_iter()
-        .map(|(name, a)| {
-            let b = (0..6 * a.nodes())
-                .map(|_| rng.random_range(-1e4..1e4))
-                .collect();
-            (name, a, b)
-        })
-        .collect();
+    let mut systems = paper_systems(&mut rng);
     for n in [1, 2, 3, 4, 5, 7, 8, 9, 15, 16, 17, 31, 33, 64, 65, 100, 129] {
         let (a, b) = random_system(&mut rng, n, 3);
         systems.push((format!("random, {n} nodes"), a, b));

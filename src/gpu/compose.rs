@@ -36,6 +36,10 @@ pub const SHADERS: &[(&str, &str)] = &[
         include_str!("../../shaders/shared/rotation_exp.wgsl"),
     ),
     (
+        "shared/chain_solve.wgsl",
+        include_str!("../../shaders/shared/chain_solve.wgsl"),
+    ),
+    (
         "shared/listed.wgsl",
         include_str!("../../shaders/shared/listed.wgsl"),
     ),

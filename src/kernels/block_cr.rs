@@ -37,8 +37,6 @@
 
 // Index loops mirror the WGSL kernel line for line.
 #![allow(clippy::needless_range_loop)]
-use rayon::prelude::*;
-
 use crate::kernels::block_lu::{ChainBatch, SINGULAR, SOLVED};
 use crate::physics::Real;
 
@@ -258,15 +256,5 @@ fn solve_one<T: Real>(b: &ChainBatch<T>, j: usize) -> (Vec<T>, u32) {
 /// field-major solution (`6 n V`) and a status per variant, as
 /// [`crate::kernels::block_lu::block_lu`] (a singular variant: zero, alone).
 pub fn block_cr<T: Real + Send + Sync>(b: &ChainBatch<T>) -> (Vec<T>, Vec<u32>) {
-    let v = b.num_variants;
-    let per: Vec<(Vec<T>, u32)> = (0..v).into_par_iter().map(|j| solve_one(b, j)).collect();
-    let mut x = vec![T::zero(); 6 * b.num_nodes * v];
-    let mut status = vec![SOLVED; v];
-    for (j, (xj, s)) in per.into_iter().enumerate() {
-        status[j] = s;
-        for (k, val) in xj.into_iter().enumerate() {
-            x[k * v + j] = val;
-        }
-    }
-    (x, status)
+    crate::kernels::block_lu::per_variant(b, solve_one)
 }

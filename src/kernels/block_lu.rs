@@ -179,8 +179,17 @@ fn solve_one<T: Real>(b: &ChainBatch<T>, j: usize) -> (Vec<T>, u32) {
 /// (`6 n V`) and a status per variant ([`SOLVED`] or [`SINGULAR`]; a singular variant's
 /// solution is zero and no other variant is affected).
 pub fn block_lu<T: Real + Send + Sync>(b: &ChainBatch<T>) -> (Vec<T>, Vec<u32>) {
+    per_variant(b, solve_one)
+}
+
+/// Solves every variant with `solve` (rayon over variants; `solve(b, j)` gives variant `j`'s
+/// solution, node-major, and status) into the field-major solution and the statuses.
+pub fn per_variant<T: Real + Send + Sync>(
+    b: &ChainBatch<T>,
+    solve: impl Fn(&ChainBatch<T>, usize) -> (Vec<T>, u32) + Sync,
+) -> (Vec<T>, Vec<u32>) {
     let v = b.num_variants;
-    let per: Vec<(Vec<T>, u32)> = (0..v).into_par_iter().map(|j| solve_one(b, j)).collect();
+    let per: Vec<(Vec<T>, u32)> = (0..v).into_par_iter().map(|j| solve(b, j)).collect();
     let mut x = vec![T::zero(); 6 * b.num_nodes * v];
     let mut status = vec![SOLVED; v];
     for (j, (xj, s)) in per.into_iter().enumerate() {
