@@ -78,7 +78,8 @@ impl LuForm {
             Self::for_adapter(ctx),
         ) {
             (0, LuForm::Lanes) => {
-                "Cyclic up to 2048 variants (4096 from 400 nodes), Lanes above".into()
+                "Cyclic from 32 nodes up to 2048 variants (4096 from 400 nodes), Lanes otherwise"
+                    .into()
             }
             (0, form) => format!("{form:?}"),
             (_, form) => format!("{form:?} (forced)"),
@@ -116,9 +117,13 @@ impl LuForm {
 /// - n = 402: ahead at V = 256 (f32 0.255 s against 0.331 s) and 1024 (0.436 s against
 ///   0.548 s); the solve alone at V = 4096 4.97 ms against 8.04 ms (f32).
 ///
+/// - n = 21 (`bench device --quick`'s kernels part): behind at V = 16 and 256 (the solve
+///   alone 0.44–0.45 ms against 0.34 ms, f32): 11 dispatches cost more than 21 node steps.
+///   By the two costs above the walk is ahead below about 32 nodes.
+///
 /// Beyond what was measured (V > 4096, or V > 2048 on short chains) the walk is kept.
 pub fn cyclic_pays(n: usize, v: usize) -> bool {
-    v <= 2048 || (n >= 400 && v <= 4096)
+    n >= 32 && (v <= 2048 || (n >= 400 && v <= 4096))
 }
 
 /// The forced form: 0 none, 1 serial, 2 lanes, 3 cyclic.
