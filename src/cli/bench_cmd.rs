@@ -92,8 +92,10 @@ pub enum BenchCommand {
         /// Nodes of the work-precision runs (0: none).
         #[arg(long, default_value_t = 100)]
         precision_nodes: usize,
-        /// The block solve's form on the GPU: the adapter's choice (default), or one forced
-        /// (serial: one invocation per variant; lanes: eight; cyclic: cyclic reduction, an invocation per node), to compare them on a device.
+        /// The block solve's form on the GPU: the batch's choice (default:
+        /// `gpu::block_lu::LuForm::for_batch`), or one forced (serial: one invocation per
+        /// variant; lanes: eight; cyclic: cyclic reduction, an invocation per node), to
+        /// compare them on a device.
         #[arg(long, value_enum)]
         lu_form: Option<LuFormArg>,
         /// Line-search trials the GPU engine forms in one submission at most: 1 by default
@@ -116,8 +118,10 @@ pub enum BenchCommand {
         /// Timed repeats per path (the median is reported).
         #[arg(long, default_value_t = 3)]
         repeats: usize,
-        /// The block solve's form on the GPU: the adapter's choice (default), or one forced
-        /// (serial: one invocation per variant; lanes: eight; cyclic: cyclic reduction, an invocation per node), to compare them on a device.
+        /// The block solve's form on the GPU: the batch's choice (default:
+        /// `gpu::block_lu::LuForm::for_batch`), or one forced (serial: one invocation per
+        /// variant; lanes: eight; cyclic: cyclic reduction, an invocation per node), to
+        /// compare them on a device.
         #[arg(long, value_enum)]
         lu_form: Option<LuFormArg>,
         /// Line-search trials the GPU engine forms in one submission at most (as `bench

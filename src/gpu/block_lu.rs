@@ -107,16 +107,15 @@ impl LuForm {
 /// Whether a GPU batch of `v` variants of an `n`-node chain solves by cyclic reduction
 /// ([`LuForm::for_batch`]) rather than by the lane walk. The walk takes `n` dependent node
 /// steps of 16–27 µs on an H100 whatever `v` is; the reduction takes `2⌈log₂ n⌉ + 1`
-/// dispatches of 35–55 µs plus work that grows with `n · v` (2.3× the walk's FLOPs, and its workspace
-/// read and written at every level).
-/// Measured there (stop 52; `bench ensemble --lu-form lanes|cyclic`, the median run, and
-/// `bench kernels --nodes 101|401`, the block solve alone):
-/// - n = 102: the reduction ahead at V = 16 (runs 0.068–0.083 s against 0.085–0.088 s, f64), 256, 1024
-///   and 2048 (f32 0.203–0.209 s against 0.219–0.230 s); behind at V = 4096 (f64 0.763 s
-///   against 0.677–0.685 s; the solve alone 2.38 ms against 2.05 ms, f32);
+/// dispatches of 35–55 µs plus work that grows with `n · v` (2.3× the walk's FLOPs, and its
+/// workspace read and written at every level). Measured there (stop 52; `bench ensemble
+/// --lu-form lanes|cyclic`, the median run, and `bench kernels`, the block solve alone):
+/// - n = 102: the reduction ahead at V = 16 (runs 0.068–0.083 s against 0.085–0.088 s,
+///   f64), 256, 1024 and 2048 (f32 0.203–0.209 s against 0.219–0.230 s); behind at
+///   V = 4096 (f64 0.763 s against 0.677–0.685 s; the solve alone 2.38 ms against 2.05 ms,
+///   f32);
 /// - n = 402: ahead at V = 256 (f32 0.255 s against 0.331 s) and 1024 (0.436 s against
-///   0.548 s); the solve alone at V = 4096 4.97 ms against 8.04 ms (f32).
-///
+///   0.548 s); the solve alone at V = 4096 4.97 ms against 8.04 ms (f32);
 /// - n = 21 (`bench device --quick`'s kernels part): behind at V = 16 and 256 (the solve
 ///   alone 0.44–0.45 ms against 0.34 ms, f32): 11 dispatches cost more than 21 node steps.
 ///   By the two costs above the walk is ahead below about 32 nodes.
