@@ -404,3 +404,69 @@ fn back() -> String {
     }
     s
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The passes, read as `shaders/block_cr.wgsl` reads them (node from the invocation's
+    /// `k`, factored or solved where the shader decides), eliminate every node exactly once
+    /// (node 0 last, alone) and give every other node exactly one back substitution, at
+    /// every chain length up to 600.
+    #[test]
+    fn the_passes_eliminate_and_substitute_every_node_once() {
+        for n in 1..=600usize {
+            let mut factored = vec![0u32; n];
+            let mut substituted = vec![0u32; n];
+            let mut solved_alone = 0;
+            for (s, nodes, phase) in passes(n) {
+                for k in 0..nodes {
+                    match phase {
+                        LOAD => {
+                            let i = if n == 1 { 0 } else { 2 * k + 1 };
+                            assert!(i < n, "n {n}: load node {i}");
+                            if n == 1 {
+                                solved_alone += 1;
+                            } else {
+                                factored[i] += 1;
+                            }
+                        }
+                        REDUCE => {
+                            let i = 2 * s * k;
+                            assert!(i < n, "n {n}: reduce node {i} at {s}");
+                            // Its odd neighbours were factored before this pass.
+                            for j in [i.checked_sub(s), Some(i + s).filter(|&j| j < n)]
+                                .into_iter()
+                                .flatten()
+                            {
+                                assert_eq!(factored[j], 1, "n {n}: node {i} at {s} reads {j}");
+                            }
+                            assert_eq!(factored[i], 0, "n {n}: node {i} updated after its factor");
+                            if i % (4 * s) == 2 * s {
+                                factored[i] += 1;
+                            } else if i == 0 && 2 * s >= n {
+                                solved_alone += 1;
+                            }
+                        }
+                        BACK => {
+                            let j = s + 2 * s * k;
+                            assert!(j < n && j % (2 * s) == s, "n {n}: back node {j} at {s}");
+                            substituted[j] += 1;
+                        }
+                        _ => unreachable!(),
+                    }
+                }
+            }
+            assert_eq!(solved_alone, 1, "n {n}: node 0 solved once");
+            assert_eq!(factored[0], 0, "n {n}");
+            assert!(factored[1..].iter().all(|&c| c == 1), "n {n}: {factored:?}");
+            assert!(
+                substituted[1..].iter().all(|&c| c == 1),
+                "n {n}: {substituted:?}"
+            );
+            assert_eq!(substituted[0], 0);
+            // The widest pass fits the batch's dispatch bound (n invocations a variant).
+            assert!(passes(n).iter().all(|p| p.1 <= n));
+        }
+    }
+}
