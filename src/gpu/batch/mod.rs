@@ -616,7 +616,8 @@ impl Rounds {
     }
 
     /// Forms the trials at `alphas` in one submission for the variants `search` (the
-    /// search's `first` for the first of them): each trial's `α` copied into `c.alpha`, its
+    /// search's `first` for the first of them): each trial's `α` copied into `c.alpha` (a
+    /// round of one writes it there), its
     /// passes recorded by `record(pass, first, listed)` (stamped by `clock` as one span,
     /// from the first trial's start to the last one's end), its norms copied out; the norms
     /// of each, read back.
@@ -636,9 +637,15 @@ impl Rounds {
         }
         let size = std::mem::size_of::<T>() as u64;
         let (row, norm_bytes) = (v as u64 * size, 4 * v as u64 * size);
+        // A round of one (the default) writes its α straight into the kernels' buffer and
+        // reads its norms where the kernels leave them: no copies through the round's.
+        let single = k == 1;
         for (i, a) in alphas.iter().enumerate() {
-            ctx.queue
-                .write_buffer(&self.alphas, i as u64 * row, bytemuck::cast_slice(a));
+            let (to, at) = match single {
+                true => (&c.alpha, 0),
+                false => (&self.alphas, i as u64 * row),
+            };
+            ctx.queue.write_buffer(to, at, bytemuck::cast_slice(a));
         }
         // The variants still searching, compacted: [A, v_0, …, v_{A−1}].
         let list = search_list(search);
@@ -647,7 +654,9 @@ impl Rounds {
             .write_buffer(&c.active, 0, bytemuck::cast_slice(&list));
         let mut e = encoder(ctx, "trials");
         for i in 0..k {
-            e.copy_buffer_to_buffer(&self.alphas, i as u64 * row, &c.alpha, 0, row);
+            if !single {
+                e.copy_buffer_to_buffer(&self.alphas, i as u64 * row, &c.alpha, 0, row);
+            }
             {
                 let mut pass = crate::gpu::pass_clock::PassClock::span_pass(
                     clock,
@@ -658,10 +667,15 @@ impl Rounds {
                 );
                 record(&mut pass, first && i == 0, count);
             }
-            let at = i as u64 * norm_bytes;
-            e.copy_buffer_to_buffer(&c.norms, 0, &self.norms, at, norm_bytes);
+            if !single {
+                let at = i as u64 * norm_bytes;
+                e.copy_buffer_to_buffer(&c.norms, 0, &self.norms, at, norm_bytes);
+            }
         }
-        let mut reads = vec![(&self.norms, k as u64 * norm_bytes)];
+        let mut reads = vec![match single {
+            true => (&c.norms, norm_bytes),
+            false => (&self.norms, k as u64 * norm_bytes),
+        }];
         reads.extend(clock.map(|c| c.resolve(&mut e)));
         let out = c
             .staging
