@@ -14,7 +14,9 @@
 //!   below `tolerance` with a step below `step_tolerance`, or when the step is down at the
 //!   variant's rounding floor (`1e-12` of its largest coordinate in f64; `100 ε₃₂` of its
 //!   displacements in f32) with the residual below `small_residual` (1e-6 in f64, `1e4 ε₃₂`
-//!   in f32). Statics test the step just taken ([`StepTest::Taken`]), dynamics the
+//!   in f32), or, for a solve started with [`SolveLimits::relative`] (a relaxation's
+//!   inexact sub-solve), once an update has brought the measure to that fraction of its
+//!   value at the start. Statics test the step just taken ([`StepTest::Taken`]), dynamics the
 //!   correction about to be taken ([`StepTest::Next`], applied on convergence).
 //! - **Line search** per variant ([`LineSearch`]): the full step unless it fails the test,
 //!   then halved. Statics accept a step whose energy slope `|Δ·r(α)|` does not exceed
@@ -307,6 +309,9 @@ struct Track {
     /// [`NewtonSettings::fold_level`] stalls (a load step's solve at a fold), where shorter
     /// than the settings' `stall_iterations`.
     fold_stall: Option<usize>,
+    relative: Option<f64>,
+    /// The residual measure at the solve's start (NaN before its first test).
+    start_measure: f64,
 }
 
 /// What limits one solve beside the settings ([`Newton::start_limited`]).
@@ -318,6 +323,9 @@ pub struct SolveLimits {
     /// Updates without the residual halving after which a solve whose residual is already
     /// below [`NewtonSettings::fold_level`] stalls (a load step: [`FOLD_STALL_ITERATIONS`]).
     pub fold_stall: Option<usize>,
+    /// Converged once an update has brought the residual measure to this fraction of its
+    /// value at the solve's start (an inexact sub-solve of a relaxation).
+    pub relative: Option<f64>,
 }
 
 /// One variant's Newton state ([`Newton::state`]).
@@ -382,6 +390,8 @@ impl Newton {
             best: f64::INFINITY,
             best_at: 0,
             fold_stall: limits.fold_stall,
+            relative: limits.relative,
+            start_measure: f64::NAN,
         };
         if let Some(a) = self.round.alpha.get_mut(j) {
             *a = 0.0;
@@ -479,8 +489,14 @@ impl Newton {
                 StepTest::Taken => track.last_step,
                 StepTest::Next => probe.step[j],
             };
+            if track.updates == 0 {
+                track.start_measure = measure;
+            }
             let converged = (measure <= s.tolerance && step <= s.step_tolerance)
-                || (step <= track.floor && measure <= s.small_residual);
+                || (step <= track.floor && measure <= s.small_residual)
+                || track
+                    .relative
+                    .is_some_and(|eta| track.updates > 0 && measure <= eta * track.start_measure);
             if converged && s.step_test == StepTest::Taken && !track.polish {
                 track.running = false;
                 events.push((j, Event::Converged(track.updates)));

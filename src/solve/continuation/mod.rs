@@ -18,7 +18,9 @@
 //!    ([`StaticSystem::relax_scale`]), the variant **relaxes** to the full loads by
 //!    proximal points ([`Stage::Relax`]): sub-solves of `r(x) + s (x − a) = 0` for the
 //!    translations, each from and anchored at the last one's answer `a`, `s` lowered as
-//!    they get easy (to [`RELAX_FLOOR`] × its start) and raised where one fails, until an
+//!    they get easy (to [`RELAX_FLOOR`] × its start) and raised where one fails (not
+//!    lowered again to a shift that failed lately), each solved inexactly (to
+//!    [`RELAX_SUB_REDUCTION`] of its residual at the anchor), until an
 //!    answer is an equilibrium without the shift ([`LoadPath::shift_settled`]). The shift keeps each sub-solve's tangent positive where the string's own
 //!    is not, and accepts a step whose plain residual grows: the path crosses the fold as
 //!    an overdamped string would. The same follows a gravity stage that failed.
@@ -107,6 +109,16 @@ struct Relax {
     best_at: usize,
     /// Settled on a stall: the unshifted measure it stalled at.
     stalled: Option<f64>,
+    /// The shift of the last sub-solve that failed, halved at each one that converges
+    /// since (0: none): the shift is not lowered below twice it, so the next try at that
+    /// shift comes after two sub-solves that converge, not one, and from a failure on
+    /// easy sub-solves halve the shift rather than quarter it. Without it the shift
+    /// ping-ponged (quartered after an easy sub-solve, the next failing after its 30
+    /// iterations, raised fourfold, …): corpus well 525 (horizontal, sliding, 10 m
+    /// elements) ran 81 failed sub-solves, 2,430 of its relaxation's 3,602 Newton
+    /// iterations, and 32 with it (2,811 Newton iterations in all against 4,583); the 11
+    /// slow wells of [`RELAX_SUB_REDUCTION`] 30,450 → 24,854 Newton iterations.
+    failed_at: f64,
     /// The failure that started it (and its stage, for the message if it fails too).
     reason: String,
     gravity: bool,
@@ -134,6 +146,16 @@ const RELAX_MAX_BUDGET: usize = 100;
 /// Newton iterations of a shifted sub-solve before it fails (and the shift is raised): the
 /// shift makes each a well-posed problem that converges in a few, or does not at all.
 const RELAX_SUB_ITERATIONS: usize = 30;
+/// A shifted sub-solve ends once an update has brought its residual measure to this
+/// fraction of its value at the anchor (or below the tolerance): the proximal points are
+/// solved inexactly, as pseudo-transient continuation takes a Newton step or two per
+/// pseudo-time step, since only the last one, the equilibrium, needs to be exact (its
+/// unshifted measure is tested against the tolerance, [`LoadPath::shift_settled`]).
+/// Measured on the 11 slow relaxed wells at 10 m elements (corpus seeds 525, 283, 134,
+/// 221, 312, 206, 28, 294, 226, 17, 0; `holewall bench corpus --wells 1 --first-seed S`),
+/// with the shift's memory ([`Relax::failed_at`]): 24,854 Newton iterations solved to the
+/// tolerance, 20,198 at 0.5, 21,150 at 0.9; 0.1 without the memory 29,112 against 30,450.
+const RELAX_SUB_REDUCTION: f64 = 0.5;
 /// A relaxation settles where its unshifted measure has not improved by 1 % in this many
 /// sub-solves and is below [`RELAX_STALL_FACTOR`] × the tolerance (f64; f32: below its own
 /// tolerance). Measured on corpus well 0 (horizontal, sliding, 532 nodes): the measure fell
@@ -361,6 +383,7 @@ impl LoadPath {
             iterations: self.iteration_limit(),
             fold_stall: (self.stage == Stage::Load && self.load_failures > 0)
                 .then_some(FOLD_STALL_ITERATIONS),
+            relative: (self.shift() > 0.0).then_some(RELAX_SUB_REDUCTION),
         }
     }
 
@@ -484,6 +507,9 @@ impl LoadPath {
                     // the rate `s / (s + k)` per sub-solve along a stiffness `k`); a shift
                     // taken to 0 would leave a plain Newton solve, which two-cycles at a
                     // contact onset near the fold as the load step did.
+                    // Not back below a shift that failed lately ([`Relax::failed_at`]).
+                    r.s = r.s.max(2.0 * r.failed_at);
+                    r.failed_at /= 2.0;
                     r.s = r.s.max(RELAX_FLOOR * r.s0);
                 }
             }
@@ -517,6 +543,7 @@ impl LoadPath {
             best: f64::INFINITY,
             best_at: 0,
             stalled: None,
+            failed_at: 0.0,
             reason,
             gravity,
             step: self.step,
@@ -662,6 +689,7 @@ impl LoadPath {
                 let r = self.relax.as_mut().expect("a relaxation");
                 r.subs += 1;
                 r.iterations += RELAX_SUB_ITERATIONS.min(self.max_iterations);
+                r.failed_at = r.s;
                 r.s *= 4.0;
                 if r.s > RELAX_CEILING * r.s0
                     || r.subs >= RELAX_MAX_SUBS

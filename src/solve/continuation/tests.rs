@@ -34,7 +34,8 @@ fn a_load_path_that_has_met_a_fold_stalls_sooner_in_its_load_steps() {
         p.limits(),
         SolveLimits {
             iterations: Some(RELAX_SUB_ITERATIONS),
-            fold_stall: None
+            fold_stall: None,
+            relative: Some(RELAX_SUB_REDUCTION),
         }
     );
 }
@@ -112,9 +113,17 @@ fn a_relaxation_lowers_its_shift_until_its_answer_is_an_equilibrium() {
     assert_eq!(p.shift(), 1.25e5);
     p.converged(25);
     assert_eq!(p.shift(), 1.25e5);
-    // A failed sub-solve raises it fourfold.
+    // A failed sub-solve raises it fourfold…
     assert_eq!(p.failed("no".into()), Next::Step);
     assert_eq!(p.shift(), 5e5);
+    // …and the shift that failed (1.25e5) is tried again only after two easy sub-solves
+    // (2.5e5, then 1.25e5), not one; from then on easy sub-solves halve it.
+    p.converged(3);
+    assert_eq!(p.shift(), 2.5e5);
+    p.converged(3);
+    assert_eq!(p.shift(), 1.25e5);
+    p.converged(3);
+    assert_eq!(p.shift(), 6.25e4);
     // It stays at or above RELAX_FLOOR s0 while the answers are not equilibria…
     for _ in 0..20 {
         p.shift_settled(1e-6);

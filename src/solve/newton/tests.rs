@@ -139,8 +139,8 @@ fn kink(c: f64, size: usize, limits: SolveLimits) -> (String, usize) {
 #[test]
 fn a_solve_stalled_near_a_kink_ends_sooner_where_its_path_has_met_a_fold() {
     let fold = SolveLimits {
-        iterations: None,
         fold_stall: Some(FOLD_STALL_ITERATIONS),
+        ..SolveLimits::default()
     };
     // Below FOLD_LEVEL: the fold's stall.
     let (why, updates) = kink(1e-6, 8, fold);
@@ -162,6 +162,46 @@ fn a_solve_stalled_near_a_kink_ends_sooner_where_its_path_has_met_a_fold() {
         );
         assert!(updates >= STATIC_STALL_ITERATIONS, "{updates}");
     }
+}
+
+#[test]
+fn a_solve_with_a_relative_limit_ends_once_its_residual_has_fallen_that_far() {
+    // x³ + x = 1e3 from x = 10 (residual 10 of the scale 1e3 → 1e-2): Newton's quadratic
+    // convergence takes it below 1e-12 in a few updates; with `relative` 0.5 it ends after
+    // the first update that halves the starting measure, there and not before.
+    let solve = |limits: SolveLimits| {
+        let mut sys = Cubic {
+            x: vec![10.0],
+            b: vec![1e3],
+            delta: vec![],
+        };
+        let mut newton = Newton::new(NewtonSettings::statics(40, 1e-12, 8), 1);
+        newton.start_limited(0, 1e-12, false, limits);
+        let mut measures = Vec::new();
+        let mut ended = Vec::new();
+        while newton.any_running() {
+            let x = sys.x[0];
+            measures.push((x * x * x + x - 1e3).abs() / 1e3);
+            ended.extend(newton.iterate(&mut sys).unwrap());
+        }
+        let updates = match &ended[..] {
+            [(0, Event::Converged(u))] => *u,
+            other => panic!("{other:?}"),
+        };
+        (updates, measures)
+    };
+    let (full, m) = solve(SolveLimits::default());
+    assert!(m[full] < 1e-12, "{m:?}");
+    let relative = SolveLimits {
+        relative: Some(0.5),
+        ..SolveLimits::default()
+    };
+    let (inexact, m) = solve(relative);
+    assert!(inexact >= 1 && inexact < full, "{inexact} {full}");
+    // Ended at the first measure at or below half the start's, which is above tolerance.
+    let first = m.iter().position(|&x| x <= 0.5 * m[0]).unwrap();
+    assert_eq!(first, inexact, "{m:?}");
+    assert!(m[inexact] > 1e-12, "{m:?}");
 }
 
 #[test]
