@@ -117,7 +117,7 @@ struct Relax {
     /// iterations, raised fourfold, …): corpus well 525 (horizontal, sliding, 10 m
     /// elements) ran 81 failed sub-solves, 2,430 of its relaxation's 3,602 Newton
     /// iterations, and 32 with it (2,811 Newton iterations in all against 4,583); the 11
-    /// slow wells of [`RELAX_SUB_REDUCTION`] 30,450 → 24,854 Newton iterations.
+    /// slow wells named at [`RELAX_SUB_REDUCTION`]: 30,450 → 24,854 Newton iterations.
     failed_at: f64,
     /// The failure that started it (and its stage, for the message if it fails too).
     reason: String,
