@@ -309,6 +309,7 @@ struct Track {
     /// [`NewtonSettings::fold_level`] stalls (a load step's solve at a fold), where shorter
     /// than the settings' `stall_iterations`.
     fold_stall: Option<usize>,
+    /// Converged at this fraction of `start_measure` ([`SolveLimits::relative`]).
     relative: Option<f64>,
     /// The residual measure at the solve's start (NaN before its first test).
     start_measure: f64,

@@ -641,9 +641,10 @@ impl Rounds {
         // reads its norms where the kernels leave them: no copies through the round's.
         let single = k == 1;
         for (i, a) in alphas.iter().enumerate() {
-            let (to, at) = match single {
-                true => (&c.alpha, 0),
-                false => (&self.alphas, i as u64 * row),
+            let (to, at) = if single {
+                (&c.alpha, 0)
+            } else {
+                (&self.alphas, i as u64 * row)
             };
             ctx.queue.write_buffer(to, at, bytemuck::cast_slice(a));
         }
@@ -672,9 +673,10 @@ impl Rounds {
                 e.copy_buffer_to_buffer(&c.norms, 0, &self.norms, at, norm_bytes);
             }
         }
-        let mut reads = vec![match single {
-            true => (&c.norms, norm_bytes),
-            false => (&self.norms, k as u64 * norm_bytes),
+        let mut reads = vec![if single {
+            (&c.norms, norm_bytes)
+        } else {
+            (&self.norms, k as u64 * norm_bytes)
         }];
         reads.extend(clock.map(|c| c.resolve(&mut e)));
         let out = c
