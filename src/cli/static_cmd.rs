@@ -118,11 +118,20 @@ pub fn run(
     let mut bit = None;
     let mut tendency = None;
     let mut through_wall = None;
+    let mut span_sag = None;
     let (rows, hook, torque, its) = match which {
         StaticModel::Fe => {
             let sol = fe.ok_or(Error::failed("no FE solution"))?;
             let (rows, hook, torque, w) = fe_rows(model, &sol);
             through_wall = crate::diagnose::through_wall_warning(&case, model, &sol.state.x);
+            let element_axial: Vec<f64> = sol.section_forces.iter().map(|f| f.axial).collect();
+            span_sag = crate::diagnose::span_through_wall_warning(
+                &case,
+                model,
+                &sol.state.x,
+                &sol.state.rot,
+                &element_axial,
+            );
             wob = w;
             solver_log = sol.log.clone();
             bit = Some(crate::bha::bit_loads_of(model, &sol));
@@ -233,7 +242,7 @@ pub fn run(
             eprintln!("holewall: warning: {w}");
             warnings.push(w);
         }
-        if let Some(w) = through_wall {
+        for w in [through_wall, span_sag].into_iter().flatten() {
             eprintln!("holewall: warning: {w}");
             warnings.push(w);
         }

@@ -594,6 +594,10 @@ pub struct WellResult {
     /// Solved: how far the FE string lies outside the hole where no contact site holds it
     /// (mm; 0 inside it: [`crate::diagnose::through_wall`]). NaN when not solved.
     pub through_wall_mm: f64,
+    /// Solved: how far the pipe's middle sags beyond the wall between the nodes that hold
+    /// it (mm; 0 where every span stays in the hole: [`crate::diagnose::span_through_wall`]).
+    /// NaN when not solved.
+    pub span_sag_mm: f64,
     /// Pipe-body contact sites the solve kept where the string lies on the wall (its guards
     /// in contact: [`crate::profile::solve_in_hole`]; 0 with contact at every node).
     pub wall_sites: usize,
@@ -658,6 +662,7 @@ pub fn run_well(
         lock_up_fraction: crate::diagnose::lock_up_fraction(&case).unwrap_or(f64::NAN),
         fe_reached: 0.0,
         through_wall_mm: f64::NAN,
+        span_sag_mm: f64::NAN,
         wall_sites,
         hook_load_ratio: f64::NAN,
         fe_torque_nm: f64::NAN,
@@ -675,6 +680,15 @@ pub fn run_well(
             r.fe_reached = 1.0;
             r.through_wall_mm = crate::diagnose::through_wall(&case, model, &sol.state.x)
                 .map_or(0.0, |t| 1e3 * t.excess_m);
+            let axial: Vec<f64> = sol.section_forces.iter().map(|f| f.axial).collect();
+            r.span_sag_mm = crate::diagnose::span_through_wall(
+                &case,
+                model,
+                &sol.state.x,
+                &sol.state.rot,
+                &axial,
+            )
+            .map_or(0.0, |t| 1e3 * t.excess_m);
             r.load_steps = sol.iterations.len();
             r.step_cuts = sol
                 .log

@@ -390,6 +390,184 @@ pub fn through_wall_warning(
     ))
 }
 
+/// The fraction of its clearance by which a span's middle sags beyond the wall before
+/// `holewall static` warns ([`span_through_wall_warning`]; `corpus.csv` reports every sag
+/// past [`THROUGH_WALL_TOLERANCE`]). Corpus well 622 (4 in pipe in a 6¼ in casing,
+/// horizontal, turning 2.2°/30 m, rotating; 29 mm clearance): 10 mm beyond the wall at 10 m
+/// elements (surface torque +28 % on the converged one), 2 mm at 5 m (+7 %); the shipped
+/// build-and-hold cases, 5 in pipe in 8½ in hole at 10 m elements, 4–5 mm of 44 mm in a
+/// hole that builds without turning (where the spans' weight does not twist the string).
+pub const SPAN_SAG_WARNING: f64 = 0.25;
+
+/// Where a solved string's pipe sags through the wall between its nodes
+/// ([`span_through_wall`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SpanSag {
+    /// MD of the middle of the element that sags furthest (m).
+    pub md: f64,
+    /// How far its middle lies beyond the wall (m).
+    pub excess_m: f64,
+    /// Elements beyond the wall by more than [`THROUGH_WALL_TOLERANCE`].
+    pub elements: usize,
+    /// MD of the middle of the shallowest and the deepest of them (m).
+    pub first_md: f64,
+    /// See `first_md`.
+    pub last_md: f64,
+    /// Length of the element that sags furthest (m).
+    pub element_m: f64,
+    /// The pipe body's radial clearance at its middle (m).
+    pub clearance_m: f64,
+    /// The length at which that element's own weight would bend it
+    /// [`THROUGH_WALL_TOLERANCE`] between clamped ends (m): `(384 EI · tol / q)^¼`.
+    pub suggested_m: f64,
+}
+
+/// Mid-span deflection (m) of a span of length `l` clamped at both ends under a uniform
+/// lateral load `q` (N/m), bending stiffness `ei`, axial tension `t` (N; compression and
+/// zero: the bending beam's `q l⁴ / 384 EI`, which compression would only raise):
+/// `EI w⁗ − T w″ = q` gives `q l / (2 T λ) (z − tanh z)`, `λ = √(T/EI)`, `z = λ l / 4`.
+pub fn clamped_span_sag(q: f64, l: f64, ei: f64, t: f64) -> f64 {
+    let bending = q * l.powi(4) / (384.0 * ei);
+    if t <= 0.0 {
+        return bending;
+    }
+    let lambda = (t / ei).sqrt();
+    let z = 0.25 * lambda * l;
+    if z < 0.05 {
+        // z − tanh z = z³/3 − 2z⁵/15 + 17z⁷/315 − …
+        bending * (1.0 - 0.4 * z * z + 17.0 / 105.0 * z.powi(4))
+    } else {
+        q * l / (2.0 * t * lambda) * (z - z.tanh())
+    }
+}
+
+/// The elements of a solved configuration (`x`, nodal rotations `rot`; `axial` each
+/// element's axial force, tension positive) of `model` whose pipe passes through the wall
+/// of `case`'s hole between the nodes. The FE holds the string at its nodes only; between
+/// them the pipe's shape is the element's cubic (from the nodes' positions and tangents)
+/// plus the sag of its own weight across the span ([`clamped_span_sag`] of the weight's
+/// part across the hole). Each element's middle is measured as [`through_wall`] measures
+/// a node, against the hole's axis at its MD (the cubic through the nodes' axis points and
+/// tangents) and the pipe body's clearance, or the nodes' own offsets where a soft wall lets
+/// them further. Where elements are long for their pipe, the
+/// middle of a span laid on the wall sags through it: the wall's support is lumped at the
+/// nodes, and where the hole turns the consistent end moments of a span's weight no longer
+/// cancel at the node and twist the string (a horizontally curved girder's torsion), so the
+/// FE's torque moves with the element's length, up or down as the turn's and the rotation's
+/// senses meet. `None` where no element's middle is beyond
+/// the wall by more than [`THROUGH_WALL_TOLERANCE`].
+pub fn span_through_wall(
+    case: &Case,
+    model: &Model,
+    x: &[crate::physics::vec3::Vec3<f64>],
+    rot: &[crate::physics::rotation::Mat3<f64>],
+    axial: &[f64],
+) -> Option<SpanSag> {
+    use crate::physics::vec3::{add, dot, scale, sub};
+    let turn = |r: &crate::physics::rotation::Mat3<f64>, v: &[f64; 3]| -> [f64; 3] {
+        std::array::from_fn(|i| (0..3).map(|k| r[i][k] * v[k]).sum())
+    };
+    // The cubic's middle from end points and unit tangents over a length `l`.
+    let middle = |a: &[f64; 3], b: &[f64; 3], ta: &[f64; 3], tb: &[f64; 3], l: f64| {
+        add(&scale(&add(a, b), 0.5), &scale(&sub(ta, tb), l / 8.0))
+    };
+    let mut out: Option<SpanSag> = None;
+    for (i, e) in model.elements.iter().enumerate() {
+        let (na, nb) = (&model.nodes[i], &model.nodes[i + 1]);
+        let l = e.length0;
+        let axis_mid = middle(&na.position, &nb.position, &na.hole_axis, &nb.hole_axis, l);
+        let ta = turn(&rot[i], &na.hole_axis);
+        let tb = turn(&rot[i + 1], &nb.hole_axis);
+        let pipe_mid = middle(&x[i], &x[i + 1], &ta, &tb, l);
+        let sum = add(&na.hole_axis, &nb.hole_axis);
+        let t = scale(&sum, 1.0 / dot(&sum, &sum).sqrt());
+        let across = |v: &[f64; 3]| sub(v, &scale(&t, dot(v, &t)));
+        // The weight's part across the hole (gravity along +z) sags the span.
+        let g_across = across(&[0.0, 0.0, 1.0]);
+        let s = dot(&g_across, &g_across).sqrt();
+        let q = e.buoyed_weight_per_length.max(0.0) * s;
+        let ei = e.section.bending_stiffness();
+        let sag = if s > 0.0 {
+            let tension = axial.get(i).copied().unwrap_or(0.0);
+            scale(&g_across, clamped_span_sag(q, l, ei, tension) / s)
+        } else {
+            [0.0; 3]
+        };
+        let d = across(&add(&sub(&pipe_mid, &axis_mid), &sag));
+        let md = 0.5 * (na.md + nb.md);
+        // Beyond the wall, or beyond the nodes where their springs let them into it: the
+        // span's own sag, not the wall's give.
+        let node_offset = |k: usize| {
+            let n = &model.nodes[k];
+            let d = sub(&x[k], &n.position);
+            let d = sub(&d, &scale(&n.hole_axis, dot(&d, &n.hole_axis)));
+            dot(&d, &d).sqrt()
+        };
+        let clearance = 0.5 * (case.hole_at(md).diameter - e.outer_diameter);
+        let allowed = clearance.max(node_offset(i)).max(node_offset(i + 1));
+        let excess = dot(&d, &d).sqrt() - allowed;
+        if excess <= THROUGH_WALL_TOLERANCE {
+            continue;
+        }
+        let suggested = if q > 0.0 {
+            (384.0 * ei * THROUGH_WALL_TOLERANCE / q).powf(0.25)
+        } else {
+            l
+        };
+        let w = out.get_or_insert(SpanSag {
+            md,
+            excess_m: excess,
+            elements: 0,
+            first_md: md,
+            last_md: md,
+            element_m: l,
+            clearance_m: clearance,
+            suggested_m: suggested,
+        });
+        w.elements += 1;
+        w.last_md = md;
+        if excess > w.excess_m {
+            w.excess_m = excess;
+            w.md = md;
+            w.element_m = l;
+            w.clearance_m = clearance;
+            w.suggested_m = suggested;
+        }
+    }
+    out
+}
+
+/// [`span_through_wall`]'s warning for a solved FE profile where a span sags beyond the
+/// wall by more than [`SPAN_SAG_WARNING`] of its clearance, `None` elsewhere.
+pub fn span_through_wall_warning(
+    case: &Case,
+    model: &Model,
+    x: &[crate::physics::vec3::Vec3<f64>],
+    rot: &[crate::physics::rotation::Mat3<f64>],
+    axial: &[f64],
+) -> Option<String> {
+    let w = span_through_wall(case, model, x, rot, axial)?;
+    if w.excess_m <= SPAN_SAG_WARNING * w.clearance_m {
+        return None;
+    }
+    Some(format!(
+        "between the nodes that hold it the pipe sags through the wall in {} elements \
+         (MD {:.0}–{:.0} m), up to {:.0} mm at MD {:.0} m (its {:.1} m element): the wall's \
+         support is lumped at the nodes, and where the hole turns the spans' own weight \
+         twists the string, so the torque depends on the element length (a horizontal well \
+         turning 2.2°/30 m: twice the converged surface torque at 20 m elements, +28 % at \
+         10 m, +7 % at 5 m); elements of {:.1} m or less there keep the sag within {:.0} mm",
+        w.elements,
+        w.first_md,
+        w.last_md,
+        1e3 * w.excess_m,
+        w.md,
+        w.element_m,
+        w.suggested_m,
+        1e3 * THROUGH_WALL_TOLERANCE,
+    ))
+}
+
 /// A failed static solve's message with the likely reason, from the case's soft-string
 /// profile at full load: compression beyond the helical buckling load (the string winds
 /// into a helix the mesh may not resolve), or the load factor it stopped at.

@@ -471,3 +471,180 @@ fn unsupported_collars_past_lubinskis_load_are_named() {
     assert!(unsupported_buckling(&walled, &walled.soft_string().tension).is_none());
     assert!(!static_failure(&walled, &error).contains("Lubinski"));
 }
+
+/// The clamped span's sag ([`clamped_span_sag`]) against a finite-difference solution of
+/// `EI w⁗ − T w″ = q` with clamped ends, from no tension to a cable's, and continuous where
+/// it changes from the series to the closed form.
+#[test]
+fn a_clamped_span_sags_as_the_beam_column_equation_says() {
+    let (q, l, ei) = (180.0, 12.0, 1.2e6);
+    let n = 400usize;
+    let h = l / n as f64;
+    for t in [0.0, 1e3, 5e4, 1e6] {
+        // w_1 … w_{n−1}; w_0 = w_n = 0 and zero slopes (ghosts w_{−1} = w_1, w_{n+1} = w_{n−1}).
+        let m = n - 1;
+        let mut a = nalgebra::DMatrix::<f64>::zeros(m, m);
+        let b = nalgebra::DVector::<f64>::from_element(m, q);
+        let (c4, c2) = (ei / h.powi(4), t / (h * h));
+        for i in 0..m {
+            let j = i as isize + 1;
+            for (off, w4, w2) in [
+                (-2isize, 1.0, 0.0),
+                (-1, -4.0, 1.0),
+                (0, 6.0, -2.0),
+                (1, -4.0, 1.0),
+                (2, 1.0, 0.0),
+            ] {
+                let mut k = j + off;
+                if k < 0 {
+                    k = -k;
+                }
+                if k > n as isize {
+                    k = 2 * n as isize - k;
+                }
+                if k == 0 || k == n as isize {
+                    continue;
+                }
+                a[(i, (k - 1) as usize)] += c4 * w4 - c2 * w2;
+            }
+        }
+        let w = a.lu().solve(&b).expect("a regular system");
+        let (fd, closed) = (w[n / 2 - 1], clamped_span_sag(q, l, ei, t));
+        eprintln!("T = {t:.0} N: sag {closed:.6e} m, finite differences {fd:.6e} m");
+        assert!(
+            (fd - closed).abs() <= 1e-3 * closed,
+            "T = {t}: {closed} against {fd}"
+        );
+    }
+    assert_eq!(
+        clamped_span_sag(q, l, ei, -5e4),
+        q * l.powi(4) / (384.0 * ei)
+    );
+    // The series below z = λl/4 = 0.05 meets the closed form above it.
+    let t = ei * (0.2 / l).powi(2);
+    let (below, above) = (
+        clamped_span_sag(q, l, ei, t * (1.0 - 1e-9)),
+        clamped_span_sag(q, l, ei, t * (1.0 + 1e-9)),
+    );
+    assert!(
+        (below - above).abs() <= 1e-8 * below,
+        "{below} against {above}"
+    );
+}
+
+/// A string laid on the low side of a straight horizontal hole, its nodes at the wall:
+/// between them each span's own weight carries its middle through the wall by the clamped
+/// span's sag, reported with 20 m elements and not with 2 m ones.
+#[test]
+fn a_long_span_laid_on_the_wall_sags_through_it_by_its_weight() {
+    let case_for = |element_m: f64| {
+        with_survey(
+            "md, inclination, azimuth\n0, 90, 0\n500, 90, 0\n",
+            &format!(
+                "[well]\nprofile = \"survey\"\nsurvey = \"survey.csv\"\ntotal_md = \"400 m\"\n\
+                 [[hole]]\nbottom_md = \"400 m\"\ndiameter = \"8.5 in\"\nfriction = 0.25\n\
+                 [mud]\ndensity = \"1.2 sg\"\n\
+                 [[string]]\nkind = \"drill_pipe\"\nlength = \"400 m\"\nod = \"5 in\"\nid = \"4.276 in\"\n\
+                 [operation]\nmode = \"rotating\"\nrpm = \"60 rpm\"\n\
+                 [mesh]\nelement_length = \"{element_m} m\"\n"
+            ),
+        )
+    };
+    for (element_m, flagged) in [(20.0, true), (2.0, false)] {
+        let case = case_for(element_m);
+        let model = &case.model;
+        let e = &model.elements[1];
+        let clearance = 0.5 * (case.hole_at(model.nodes[1].md).diameter - e.outer_diameter);
+        let x: Vec<_> = model
+            .nodes
+            .iter()
+            .map(|n| [n.position[0], n.position[1], n.position[2] + clearance])
+            .collect();
+        let identity = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+        let rot = vec![identity; model.nodes.len()];
+        let axial = vec![0.0; model.elements.len()];
+        let found = span_through_wall(&case, model, &x, &rot, &axial);
+        let sag = e.buoyed_weight_per_length * e.length0.powi(4)
+            / (384.0 * e.section.bending_stiffness());
+        eprintln!("{element_m} m elements: sag {sag:.3e} m, found {found:?}");
+        assert_eq!(found.is_some(), flagged, "{element_m} m: {found:?}");
+        let warning = span_through_wall_warning(&case, model, &x, &rot, &axial);
+        assert_eq!(warning.is_some(), flagged, "{warning:?}");
+        if let Some(w) = found {
+            assert!(
+                (w.excess_m - sag).abs() <= 1e-9 + 1e-6 * sag,
+                "{} against {sag}",
+                w.excess_m
+            );
+            assert_eq!(
+                w.elements,
+                model
+                    .elements
+                    .iter()
+                    .filter(|e| (e.length0 - element_m).abs() < 1e-6)
+                    .count()
+            );
+            let at = (384.0 * e.section.bending_stiffness() * THROUGH_WALL_TOLERANCE
+                / e.buoyed_weight_per_length)
+                .powf(0.25);
+            assert!((w.suggested_m - at).abs() <= 1e-9 * at);
+        }
+    }
+}
+
+/// Rotating off bottom in a horizontal hole that turns 1°/30 m: with 2 m elements the
+/// surface torque is the closed form's `μ w cos(atan μ) r L` (the string on the low side,
+/// climbed up the wall by the friction angle, no tension)
+/// and the spans stay in the hole; with 20 m elements the spans sag through the wall, the
+/// check says so, and the torque is far from it (the spans' weight twists the string at
+/// every turning node, here against the friction's torque).
+#[test]
+fn long_spans_in_a_turning_hole_misstate_the_torque_and_are_reported() {
+    let case_for = |element_m: f64| {
+        with_survey(
+            "md, inclination, azimuth\n0, 90, 0\n600, 90, 20\n",
+            &format!(
+                "[well]\nprofile = \"survey\"\nsurvey = \"survey.csv\"\ntotal_md = \"600 m\"\n\
+                 [[hole]]\nbottom_md = \"600 m\"\ndiameter = \"8.5 in\"\nfriction = 0.25\n\
+                 [mud]\ndensity = \"1.2 sg\"\n\
+                 [[string]]\nkind = \"drill_pipe\"\nlength = \"600 m\"\nod = \"5 in\"\nid = \"4.276 in\"\n\
+                 [operation]\nmode = \"rotating\"\nrpm = \"60 rpm\"\n\
+                 [mesh]\nelement_length = \"{element_m} m\"\n"
+            ),
+        )
+    };
+    let solve = |element_m: f64| {
+        let mut case = case_for(element_m);
+        let statics = case.settings().statics();
+        let sol = crate::profile::solve_with_progress(&mut case, statics, false).expect("solved");
+        let model = &case.model;
+        let (_, _, torque, _) = crate::profile::fe_rows(model, &sol);
+        let axial: Vec<f64> = sol.section_forces.iter().map(|f| f.axial).collect();
+        let span = span_through_wall(&case, model, &sol.state.x, &sol.state.rot, &axial);
+        let e = &model.elements[1];
+        // The rotating pipe climbs the wall by the friction angle: N = w cos(atan μ).
+        let mu: f64 = 0.25;
+        let closed =
+            mu * e.buoyed_weight_per_length * mu.atan().cos() * 600.0 * 0.5 * e.contact_diameter;
+        (torque.abs(), span, closed)
+    };
+    let (coarse, coarse_span, closed) = solve(20.0);
+    let (fine, fine_span, _) = solve(2.0);
+    eprintln!(
+        "surface torque {coarse:.0} N·m at 20 m elements ({coarse_span:?}), {fine:.0} N·m at 2 m \
+         ({fine_span:?}); μ w r L = {closed:.0} N·m"
+    );
+    assert!(
+        (fine - closed).abs() <= 0.05 * closed,
+        "{fine} against {closed}"
+    );
+    assert_eq!(fine_span, None);
+    assert!(
+        (coarse - fine).abs() > 0.3 * fine,
+        "{coarse} against {fine}"
+    );
+    assert!(
+        coarse_span.is_some_and(|w| w.excess_m > 0.02),
+        "{coarse_span:?}"
+    );
+}
