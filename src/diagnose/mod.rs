@@ -349,7 +349,6 @@ pub fn beyond_wall(
     model: &Model,
     x: &[crate::physics::vec3::Vec3<f64>],
 ) -> Vec<(usize, f64)> {
-    use crate::physics::vec3::{dot, scale, sub};
     let mut held = vec![false; model.nodes.len()];
     for site in &model.sites {
         held[site.node] = true;
@@ -359,15 +358,23 @@ pub fn beyond_wall(
         if held[i] {
             continue;
         }
-        let d = sub(&x[i], &node.position);
-        let d_t = sub(&d, &scale(&node.hole_axis, dot(&d, &node.hole_axis)));
-        let offset = dot(&d_t, &d_t).sqrt();
-        let excess = offset - (0.5 * case.hole_at(node.md).diameter - model.pipe_radius_at(i));
+        let excess = lateral_offset(model, x, i)
+            - (0.5 * case.hole_at(node.md).diameter - model.pipe_radius_at(i));
         if excess > 0.0 {
             out.push((i, excess));
         }
     }
     out
+}
+
+/// Node `i`'s lateral offset in `x` (m): its displacement from its hole axis with the part
+/// along the axis removed, as a contact site measures it.
+fn lateral_offset(model: &Model, x: &[crate::physics::vec3::Vec3<f64>], i: usize) -> f64 {
+    use crate::physics::vec3::{dot, scale, sub};
+    let node = &model.nodes[i];
+    let d = sub(&x[i], &node.position);
+    let d_t = sub(&d, &scale(&node.hole_axis, dot(&d, &node.hole_axis)));
+    dot(&d_t, &d_t).sqrt()
 }
 
 /// [`through_wall`]'s warning for a solved FE profile, `None` where the string is in the
@@ -497,14 +504,10 @@ pub fn span_through_wall(
         let md = 0.5 * (na.md + nb.md);
         // Beyond the wall, or beyond the nodes where their springs let them into it: the
         // span's own sag, not the wall's give.
-        let node_offset = |k: usize| {
-            let n = &model.nodes[k];
-            let d = sub(&x[k], &n.position);
-            let d = sub(&d, &scale(&n.hole_axis, dot(&d, &n.hole_axis)));
-            dot(&d, &d).sqrt()
-        };
         let clearance = 0.5 * (case.hole_at(md).diameter - e.outer_diameter);
-        let allowed = clearance.max(node_offset(i)).max(node_offset(i + 1));
+        let allowed = clearance
+            .max(lateral_offset(model, x, i))
+            .max(lateral_offset(model, x, i + 1));
         let excess = dot(&d, &d).sqrt() - allowed;
         if excess <= THROUGH_WALL_TOLERANCE {
             continue;
