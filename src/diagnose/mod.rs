@@ -456,13 +456,12 @@ pub fn clamped_span_sag(q: f64, l: f64, ei: f64, t: f64) -> f64 {
 /// part across the hole). Each element's middle is measured as [`through_wall`] measures
 /// a node, against the hole's axis at its MD (the cubic through the nodes' axis points and
 /// tangents) and the pipe body's clearance, or the nodes' own offsets where a soft wall lets
-/// them further. Where elements are long for their pipe, the
-/// middle of a span laid on the wall sags through it: the wall's support is lumped at the
-/// nodes, and where the hole turns the consistent end moments of a span's weight no longer
-/// cancel at the node and twist the string (a horizontally curved girder's torsion), so the
-/// FE's torque moves with the element's length, up or down as the turn's and the rotation's
-/// senses meet. `None` where no element's middle is beyond
-/// the wall by more than [`THROUGH_WALL_TOLERANCE`].
+/// them further. Where elements are long for their pipe, the middle of a span laid on the
+/// wall sags through it: the wall's support is lumped at the nodes, and where the hole turns
+/// the consistent end moments of a span's weight no longer cancel at the node and twist the
+/// string (a horizontally curved girder's torsion), so the FE's torque moves with the
+/// element's length, up or down as the turn's and the rotation's senses meet. `None` where
+/// no element's middle is beyond the wall by more than [`THROUGH_WALL_TOLERANCE`].
 pub fn span_through_wall(
     case: &Case,
     model: &Model,
