@@ -472,6 +472,22 @@ fn unsupported_collars_past_lubinskis_load_are_named() {
     assert!(!static_failure(&walled, &error).contains("Lubinski"));
 }
 
+/// 5 in drill pipe, `md` metres of it, rotating off bottom at 60 rpm in an 8½ in hole
+/// along `survey` (μ 0.25, 1.2 sg), meshed at `element_m`.
+fn rotating_pipe(survey: &str, md: f64, element_m: f64) -> Case {
+    with_survey(
+        survey,
+        &format!(
+            "[well]\nprofile = \"survey\"\nsurvey = \"survey.csv\"\ntotal_md = \"{md} m\"\n\
+             [[hole]]\nbottom_md = \"{md} m\"\ndiameter = \"8.5 in\"\nfriction = 0.25\n\
+             [mud]\ndensity = \"1.2 sg\"\n\
+             [[string]]\nkind = \"drill_pipe\"\nlength = \"{md} m\"\nod = \"5 in\"\nid = \"4.276 in\"\n\
+             [operation]\nmode = \"rotating\"\nrpm = \"60 rpm\"\n\
+             [mesh]\nelement_length = \"{element_m} m\"\n"
+        ),
+    )
+}
+
 /// The clamped span's sag ([`clamped_span_sag`]) against a finite-difference solution of
 /// `EI w⁗ − T w″ = q` with clamped ends, from no tension to a cable's, and continuous where
 /// it changes from the series to the closed form.
@@ -538,16 +554,10 @@ fn a_clamped_span_sags_as_the_beam_column_equation_says() {
 #[test]
 fn a_long_span_laid_on_the_wall_sags_through_it_by_its_weight() {
     let case_for = |element_m: f64| {
-        with_survey(
+        rotating_pipe(
             "md, inclination, azimuth\n0, 90, 0\n500, 90, 0\n",
-            &format!(
-                "[well]\nprofile = \"survey\"\nsurvey = \"survey.csv\"\ntotal_md = \"400 m\"\n\
-                 [[hole]]\nbottom_md = \"400 m\"\ndiameter = \"8.5 in\"\nfriction = 0.25\n\
-                 [mud]\ndensity = \"1.2 sg\"\n\
-                 [[string]]\nkind = \"drill_pipe\"\nlength = \"400 m\"\nod = \"5 in\"\nid = \"4.276 in\"\n\
-                 [operation]\nmode = \"rotating\"\nrpm = \"60 rpm\"\n\
-                 [mesh]\nelement_length = \"{element_m} m\"\n"
-            ),
+            400.0,
+            element_m,
         )
     };
     for (element_m, flagged) in [(20.0, true), (2.0, false)] {
@@ -601,16 +611,10 @@ fn a_long_span_laid_on_the_wall_sags_through_it_by_its_weight() {
 #[test]
 fn long_spans_in_a_turning_hole_misstate_the_torque_and_are_reported() {
     let case_for = |element_m: f64| {
-        with_survey(
+        rotating_pipe(
             "md, inclination, azimuth\n0, 90, 0\n600, 90, 20\n",
-            &format!(
-                "[well]\nprofile = \"survey\"\nsurvey = \"survey.csv\"\ntotal_md = \"600 m\"\n\
-                 [[hole]]\nbottom_md = \"600 m\"\ndiameter = \"8.5 in\"\nfriction = 0.25\n\
-                 [mud]\ndensity = \"1.2 sg\"\n\
-                 [[string]]\nkind = \"drill_pipe\"\nlength = \"600 m\"\nod = \"5 in\"\nid = \"4.276 in\"\n\
-                 [operation]\nmode = \"rotating\"\nrpm = \"60 rpm\"\n\
-                 [mesh]\nelement_length = \"{element_m} m\"\n"
-            ),
+            600.0,
+            element_m,
         )
     };
     let solve = |element_m: f64| {
