@@ -399,11 +399,7 @@ pub fn through_wall_warning(
 
 /// The fraction of its clearance by which a span's middle sags beyond the wall before
 /// `holewall static` warns ([`span_through_wall_warning`]; `corpus.csv` reports every sag
-/// past [`THROUGH_WALL_TOLERANCE`]). Corpus well 622 (4 in pipe in a 6¼ in casing,
-/// horizontal, turning 2.2°/30 m, rotating; 29 mm clearance): 10 mm beyond the wall at 10 m
-/// elements (surface torque +28 % on the converged one), 2 mm at 5 m (+7 %); the shipped
-/// build-and-hold cases, 5 in pipe in 8½ in hole at 10 m elements, 4–5 mm of 44 mm in a
-/// hole that builds without turning (where the spans' weight does not twist the string).
+/// past [`THROUGH_WALL_TOLERANCE`]).
 pub const SPAN_SAG_WARNING: f64 = 0.25;
 
 /// Where a solved string's pipe sags through the wall between its nodes
@@ -450,18 +446,17 @@ pub fn clamped_span_sag(q: f64, l: f64, ei: f64, t: f64) -> f64 {
 
 /// The elements of a solved configuration (`x`, nodal rotations `rot`; `axial` each
 /// element's axial force, tension positive) of `model` whose pipe passes through the wall
-/// of `case`'s hole between the nodes. The FE holds the string at its nodes only; between
-/// them the pipe's shape is the element's cubic (from the nodes' positions and tangents)
-/// plus the sag of its own weight across the span ([`clamped_span_sag`] of the weight's
-/// part across the hole). Each element's middle is measured as [`through_wall`] measures
-/// a node, against the hole's axis at its MD (the cubic through the nodes' axis points and
-/// tangents) and the pipe body's clearance, or the nodes' own offsets where a soft wall lets
-/// them further. Where elements are long for their pipe, the middle of a span laid on the
-/// wall sags through it: the wall's support is lumped at the nodes, and where the hole turns
-/// the consistent end moments of a span's weight no longer cancel at the node and twist the
-/// string (a horizontally curved girder's torsion), so the FE's torque moves with the
-/// element's length, up or down as the turn's and the rotation's senses meet. `None` where
-/// no element's middle is beyond the wall by more than [`THROUGH_WALL_TOLERANCE`].
+/// of `case`'s hole between the nodes, where nothing holds it there. An element whose two
+/// nodes are contact sites is not checked: its span's wall support is integrated at the
+/// nodes, as its weight is ([`crate::solve::statics::external_loads`]), so a span that
+/// would sag onto the wall between them is one the wall carries. Between nodes without a
+/// site on both ends the FE's pipe is the element's cubic (from the nodes' positions and
+/// tangents) plus the sag of its own weight across the span ([`clamped_span_sag`] of the
+/// weight's part across the hole), and the wall is not there for it. Each element's middle
+/// is measured as [`through_wall`] measures a node, against the hole's axis at its MD (the
+/// cubic through the nodes' axis points and tangents) and the pipe body's clearance, or
+/// the nodes' own offsets where a soft wall lets them further. `None` where no such
+/// element's middle is beyond the wall by more than [`THROUGH_WALL_TOLERANCE`].
 pub fn span_through_wall(
     case: &Case,
     model: &Model,
@@ -478,7 +473,14 @@ pub fn span_through_wall(
         add(&scale(&add(a, b), 0.5), &scale(&sub(ta, tb), l / 8.0))
     };
     let mut out: Option<SpanSag> = None;
+    let mut site = vec![false; model.nodes.len()];
+    for s in &model.sites {
+        site[s.node] = true;
+    }
     for (i, e) in model.elements.iter().enumerate() {
+        if site[i] && site[i + 1] {
+            continue;
+        }
         let (na, nb) = (&model.nodes[i], &model.nodes[i + 1]);
         let l = e.length0;
         let axis_mid = middle(&na.position, &nb.position, &na.hole_axis, &nb.hole_axis, l);
@@ -553,12 +555,12 @@ pub fn span_through_wall_warning(
         return None;
     }
     Some(format!(
-        "between the nodes that hold it the pipe sags through the wall in {} elements \
-         (MD {:.0}–{:.0} m), up to {:.0} mm at MD {:.0} m (its {:.1} m element): the wall's \
-         support is lumped at the nodes, and where the hole turns the spans' own weight \
-         twists the string, so the torque depends on the element length (a horizontal well \
-         turning 2.2°/30 m: twice the converged surface torque at 20 m elements, +28 % at \
-         10 m, +7 % at 5 m); elements of {:.1} m or less there keep the sag within {:.0} mm",
+        "between its nodes, where no contact site holds it, the pipe sags through the wall \
+         in {} elements (MD {:.0}–{:.0} m), up to {:.0} mm at MD {:.0} m (its {:.1} m \
+         element): the FE does not see that contact, so the side forces and the drag there \
+         are missing; contact at every node (`contact.sites = \"all_nodes\"`) would hold it, or \
+         elements of {:.1} m or less there (a sag within {:.0} mm) put a node where it meets \
+         the wall",
         w.elements,
         w.first_md,
         w.last_md,
