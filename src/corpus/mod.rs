@@ -594,9 +594,9 @@ pub struct WellResult {
     /// Solved: how far the FE string lies outside the hole where no contact site holds it
     /// (mm; 0 inside it: [`crate::diagnose::through_wall`]). NaN when not solved.
     pub through_wall_mm: f64,
-    /// Solved: how far the pipe's middle sags beyond the wall between the nodes that hold
-    /// it (mm; 0 where every span stays in the hole: [`crate::diagnose::span_through_wall`]).
-    /// NaN when not solved.
+    /// Solved: how far the pipe's middle sags beyond the wall between two nodes not both
+    /// contact sites (mm; 0 where every such span stays in the hole:
+    /// [`crate::diagnose::span_through_wall`]). NaN when not solved.
     pub span_sag_mm: f64,
     /// Pipe-body contact sites the solve kept where the string lies on the wall (its guards
     /// in contact: [`crate::profile::solve_in_hole`]; 0 with contact at every node).
