@@ -6,7 +6,8 @@
 //! Boundary conditions: top clamped (all six DOFs); bit held laterally (the two
 //! translations perpendicular to the hole axis), loaded by the weight on bit `−WOB·t` and
 //! the torque on bit `−TOB·t` (`t` the down-hole axis); buoyed self-weight as nodal forces,
-//! half an element's weight at each of its nodes ([`external_loads`]). All external loads are scaled by the load factor `λ ∈ [0, 1]`.
+//! half an element's weight at each of its nodes ([`external_loads`]). All external loads
+//! are scaled by the load factor `λ ∈ [0, 1]`.
 
 use crate::model::{Model, TopBoundary};
 use crate::physics::beam::{
