@@ -495,20 +495,19 @@ fn a_dynamic_corpus_case_through_the_engine_matches_the_cpu() {
         return;
     }
     let dir = tempdir::Dir::new("dynamic_corpus_engine");
-    let case = dynamic_sample(dir.path(), 40, 80)
+    let (case, cpu) = dynamic_sample(dir.path(), 40, 80)
         .into_iter()
         .filter(|c| c.spec.mass == "lumped")
-        .find(|c| {
-            let cpu = holewall::corpus::dynamic::run_case_dynamic(c).unwrap();
+        .find_map(|c| {
+            let cpu = holewall::corpus::dynamic::run_case_dynamic(&c).unwrap();
             eprintln!(
                 "dynamic seed {}: {} CPU step cuts",
                 c.spec.seed, cpu.step_cuts
             );
-            cpu.solved && cpu.step_cuts == 0
+            (cpu.solved && cpu.step_cuts == 0).then_some((c, cpu))
         })
         .unwrap();
-    let (cpu, rows) = cpu_and_engine(&case);
-    for (f32, e) in rows {
+    for (f32, e) in engine_rows(&case, &cpu) {
         eprintln!(
             "dynamic seed {} {}: by engine {}, {} cuts ({} on the CPU), hook load {:.1e}, torque {:.1e}, stab1 force {:.1e} off the CPU's, same whirl {}, {:.1} s; {}",
             e.seed,
@@ -535,14 +534,25 @@ fn cpu_and_engine(
     holewall::corpus::dynamic::DynamicRow,
     Vec<(bool, holewall::corpus::dynamic::DynamicEngineRow)>,
 ) {
-    use holewall::corpus::dynamic::{run_case_dynamic, run_case_engine};
-    let cpu = run_case_dynamic(case).unwrap();
+    let cpu = holewall::corpus::dynamic::run_case_dynamic(case).unwrap();
     assert!(cpu.solved, "{}", cpu.reason);
-    let rows = [false, true]
-        .into_iter()
-        .map(|f32| (f32, run_case_engine(case, &cpu, f32).unwrap()))
-        .collect();
+    let rows = engine_rows(case, &cpu);
     (cpu, rows)
+}
+
+/// A dynamic corpus case through the engine in f64 and in f32, against its CPU row: each
+/// engine row with its `f32` flag.
+fn engine_rows(
+    case: &holewall::corpus::dynamic::DynamicCase,
+    cpu: &holewall::corpus::dynamic::DynamicRow,
+) -> Vec<(bool, holewall::corpus::dynamic::DynamicEngineRow)> {
+    [false, true]
+        .into_iter()
+        .map(|f32| {
+            let row = holewall::corpus::dynamic::run_case_engine(case, cpu, f32).unwrap();
+            (f32, row)
+        })
+        .collect()
 }
 
 /// A dynamic corpus case's engine row against its CPU run: run by the engine itself, hook
