@@ -423,6 +423,15 @@ pub fn stabilizer_name(number: usize) -> String {
 }
 
 impl Model {
+    /// Per node, whether a contact site holds it.
+    pub fn site_nodes(&self) -> Vec<bool> {
+        let mut held = vec![false; self.nodes.len()];
+        for s in &self.sites {
+            held[s.node] = true;
+        }
+        held
+    }
+
     /// The stabilizer sites (indices into `sites`), **nearest the bit first**: stabilizer
     /// number `k` (1-based, as in [`stabilizer_name`]) is entry `k − 1`. The one numbering
     /// every output uses.

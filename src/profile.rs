@@ -223,10 +223,7 @@ pub(crate) type StaticSolve<'s> = dyn FnMut(
 /// The nodes of `model` without a contact site, the clamped top (node 0) aside: where
 /// [`solve_in_hole`] puts its guards.
 pub(crate) fn unheld_nodes(model: &Model) -> Vec<usize> {
-    let mut held = vec![false; model.nodes.len()];
-    for s in &model.sites {
-        held[s.node] = true;
-    }
+    let held = model.site_nodes();
     (1..model.nodes.len()).filter(|&i| !held[i]).collect()
 }
 

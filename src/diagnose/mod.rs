@@ -349,10 +349,7 @@ pub fn beyond_wall(
     model: &Model,
     x: &[crate::physics::vec3::Vec3<f64>],
 ) -> Vec<(usize, f64)> {
-    let mut held = vec![false; model.nodes.len()];
-    for site in &model.sites {
-        held[site.node] = true;
-    }
+    let held = model.site_nodes();
     let mut out = Vec::new();
     for (i, node) in model.nodes.iter().enumerate() {
         if held[i] {
@@ -473,10 +470,7 @@ pub fn span_through_wall(
         add(&scale(&add(a, b), 0.5), &scale(&sub(ta, tb), l / 8.0))
     };
     let mut out: Option<SpanSag> = None;
-    let mut site = vec![false; model.nodes.len()];
-    for s in &model.sites {
-        site[s.node] = true;
-    }
+    let site = model.site_nodes();
     for (i, e) in model.elements.iter().enumerate() {
         if site[i] && site[i + 1] {
             continue;
