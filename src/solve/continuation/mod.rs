@@ -10,19 +10,24 @@
 //!    steps); with linear laws, by relaxation (below) where the system can relax, else by
 //!    continuation in gravity γ from the laid start (steps of 1/4 grown after easy steps,
 //!    cut down to 1/64). Without sites every load ramps with λ.
-//! 2. λ → 1 in steps (bit loads, point loads and friction scaled by λ): a step that fails
-//!    is cut in half from the last converged state; a step taken in at most 6 iterations
-//!    grows the next by 1.5. Where a step fails even at `min_step` (a fold of the
+//! 2. λ → 1 in steps (bit loads, point loads and friction scaled by λ): a step taken in at
+//!    most 6 iterations grows the next by 1.5. Where a step fails (a fold of the
 //!    equilibrium path: a compressed string that snaps into a buckled shape, a contact
 //!    onset each side of which has its root on the other) and the system can relax
-//!    ([`StaticSystem::relax_scale`]), the variant **relaxes** to the full loads by
-//!    proximal points ([`Stage::Relax`]): sub-solves of `r(x) + s (x − a) = 0` for the
+//!    ([`StaticSystem::relax_scale`]: the CPU solve and the engine), the variant
+//!    **relaxes** from the last equilibrium at once; a system that cannot relax cuts the
+//!    step in half from the last converged state, down to `min_step`, and fails there.
+//!    Cutting first, down to `min_step`, cost corpus wells 0, 17 and 28 (horizontal,
+//!    10 m elements) 12–13 failed steps of 20–80 iterations each and only found the fold
+//!    more closely; relaxing at the first failure took them 1,085 / 1,509 / 1,058 → 683 /
+//!    1,059 / 598 Newton iterations (docs/validation.md, stop 56). The relaxation goes to
+//!    the full loads by proximal points ([`Stage::Relax`]): sub-solves of `r(x) + s (x − a) = 0` for the
 //!    translations, each from and anchored at the last one's answer `a`, `s` lowered as
 //!    they get easy (to [`RELAX_FLOOR`] × its start) and raised where one fails (not
 //!    lowered again to a shift that failed lately), each solved inexactly (to
 //!    [`RELAX_SUB_REDUCTION`] of its residual at the anchor), until an
-//!    answer is an equilibrium without the shift ([`LoadPath::shift_settled`]). The shift keeps each sub-solve's tangent positive where the string's own
-//!    is not, and accepts a step whose plain residual grows: the path crosses the fold as
+//!    answer is an equilibrium without the shift ([`LoadPath::shift_settled`]). The shift
+//!    keeps each sub-solve's tangent positive where the string's own is not, and accepts a step whose plain residual grows: the path crosses the fold as
 //!    an overdamped string would. The same follows a gravity stage that failed.
 //! 3. At λ = 1 one more full Newton step polishes the answer to rounding level (so it does
 //!    not depend on the load path). In f32 the full load is solved a second time from its
@@ -169,9 +174,9 @@ const RELAX_STALL_FACTOR: f64 = 100.0;
 /// The smallest shift, `s0 ×` this: the proximal points converge at the rate `s / (s + k)`
 /// per sub-solve along a stiffness `k`, and a buckled string's lateral modes are soft (a
 /// span's `EI / L³` less its compression's share), so a high floor costs hundreds of
-/// sub-solves. Measured (`holewall bench corpus --wells 500`): 1e-5 instead of 1e-3, with
-/// the relaxation started at the first step that fails at `min_step` (the two jumps to the
-/// rest of the load that came before it dropped) — 486 / 500 solved against 478, every
+/// sub-solves. Measured (`holewall bench corpus --wells 500`) when the relaxation started
+/// at the first step that failed at `min_step` (the two jumps to the rest of the load that
+/// came before it dropped; it starts at the first failed step now): 1e-5 instead of 1e-3 — 486 / 500 solved against 478, every
 /// gravity-stage failure gone, Newton iterations 285,931 → 175,519; on the slow wells at
 /// 10 m elements (0, 17, 221, 226, 294, 312) sub-solves 367–682 → 59–119. 1e-7 measured the
 /// same as 1e-5 on those wells.
@@ -658,23 +663,25 @@ impl LoadPath {
             }
             Stage::Load => {
                 self.load_failures += 1;
+                if let Some(s0) = relax {
+                    // The first load step that fails starts the relaxation, from the last
+                    // equilibrium to the full loads at once: the sub-solves follow the
+                    // string past the fold as far as it goes (measured on corpus well 17:
+                    // relaxing to each failed step's loads instead took 18 relaxations
+                    // and 3.3× the time). Cutting the step down to `min_step` first
+                    // only found where the fold is.
+                    let why = format!(
+                        "load step λ {:.6} → {:.6} failed ({reason})",
+                        self.lambda, self.target.lambda
+                    );
+                    let target = LoadTarget {
+                        lambda: 1.0,
+                        friction: 1.0,
+                        ..self.target
+                    };
+                    return self.relax_after(target, s0, why, false);
+                }
                 if self.step / 2.0 < self.min_step {
-                    if let Some(s0) = relax {
-                        // To the full loads at once: the sub-solves follow the string
-                        // past the fold as far as it goes (measured on corpus well 17:
-                        // relaxing to each failed step's loads instead took 18 relaxations
-                        // and 3.3× the time).
-                        let why = format!(
-                            "load step λ {:.6} → {:.6} failed at the smallest step ({reason})",
-                            self.lambda, self.target.lambda
-                        );
-                        let target = LoadTarget {
-                            lambda: 1.0,
-                            friction: 1.0,
-                            ..self.target
-                        };
-                        return self.relax_after(target, s0, why, false);
-                    }
                     return fail(self, self.step, reason);
                 }
                 self.log.push(format!(

@@ -2,7 +2,8 @@
 
 use super::*;
 
-/// A path past its gravity stage, its load step failing until it is below `min_step`.
+/// A path past its gravity stage, its first load step failing until it relaxes (`relax`:
+/// the system's shift scale) or, where the system cannot relax, is below `min_step`.
 fn stuck(relax: Option<f64>) -> (LoadPath, Next) {
     let mut p = LoadPath::new(&StaticOptions::default(), true, true, false);
     assert_eq!(p.converged(10), Next::Step);
@@ -14,22 +15,28 @@ fn stuck(relax: Option<f64>) -> (LoadPath, Next) {
 }
 
 #[test]
-fn a_load_path_that_has_met_a_fold_stalls_sooner_in_its_load_steps() {
-    let mut p = LoadPath::new(&StaticOptions::default(), true, true, false);
-    // Gravity, and the load steps before one has failed: the plain stall.
-    assert_eq!(p.limits(), SolveLimits::default());
-    assert_eq!(p.converged(10), Next::Step);
-    assert_eq!(p.stage, Stage::Load);
-    assert_eq!(p.limits().fold_stall, None);
-    assert_eq!(p.converged(10), Next::Step);
-    assert_eq!(p.limits().fold_stall, None);
-    // A failed load step: every later one stalls sooner, the relaxation's sub-solves not.
+fn a_failed_load_step_relaxes_at_once_where_the_system_can_and_else_stalls_sooner() {
+    let start = || {
+        let mut p = LoadPath::new(&StaticOptions::default(), true, true, false);
+        // Gravity, and the load steps before one has failed: the plain stall.
+        assert_eq!(p.limits(), SolveLimits::default());
+        assert_eq!(p.converged(10), Next::Step);
+        assert_eq!(p.stage, Stage::Load);
+        assert_eq!(p.limits().fold_stall, None);
+        assert_eq!(p.converged(10), Next::Step);
+        assert_eq!(p.limits().fold_stall, None);
+        assert_eq!(p.lambda, 0.25);
+        p
+    };
+    // Where the system can relax, the first failed load step relaxes from its start to the
+    // full loads, not cut first.
+    let mut p = start();
     assert_eq!(p.failed_at("no".into(), None, Some(1e6)), Next::Step);
-    assert_eq!(p.limits().fold_stall, Some(FOLD_STALL_ITERATIONS));
-    assert_eq!(p.converged(3), Next::Step);
-    assert_eq!(p.limits().fold_stall, Some(FOLD_STALL_ITERATIONS));
-    let (p, _) = stuck(Some(1e6));
     assert_eq!(p.stage, Stage::Relax);
+    assert_eq!(p.lambda, 0.25);
+    let t = p.target();
+    assert_eq!((t.gravity, t.lambda, t.friction), (1.0, 1.0, 1.0));
+    assert_eq!(p.shift(), 1e6);
     assert_eq!(
         p.limits(),
         SolveLimits {
@@ -38,6 +45,14 @@ fn a_load_path_that_has_met_a_fold_stalls_sooner_in_its_load_steps() {
             relative: Some(RELAX_SUB_REDUCTION),
         }
     );
+    // Where it cannot, the step is cut and every later load step stalls sooner.
+    let mut p = start();
+    assert_eq!(p.failed_at("no".into(), None, None), Next::Step);
+    assert_eq!(p.stage, Stage::Load);
+    assert!(p.target().lambda < 0.5 && p.target().lambda > 0.25);
+    assert_eq!(p.limits().fold_stall, Some(FOLD_STALL_ITERATIONS));
+    assert_eq!(p.converged(3), Next::Step);
+    assert_eq!(p.limits().fold_stall, Some(FOLD_STALL_ITERATIONS));
 }
 
 #[test]
