@@ -21,14 +21,15 @@
 //!    10 m elements) 12–13 failed steps of 20–80 iterations each and only found the fold
 //!    more closely; relaxing at the first failure took them 1,085 / 1,509 / 1,058 → 683 /
 //!    1,059 / 598 Newton iterations (docs/validation.md, stop 56). The relaxation goes to
-//!    the full loads by proximal points ([`Stage::Relax`]): sub-solves of `r(x) + s (x − a) = 0` for the
-//!    translations, each from and anchored at the last one's answer `a`, `s` lowered as
-//!    they get easy (to [`RELAX_FLOOR`] × its start) and raised where one fails (not
-//!    lowered again to a shift that failed lately), each solved inexactly (to
-//!    [`RELAX_SUB_REDUCTION`] of its residual at the anchor), until an
+//!    the full loads by proximal points ([`Stage::Relax`]): sub-solves of
+//!    `r(x) + s (x − a) = 0` for the translations, each from and anchored at the last
+//!    one's answer `a`, `s` lowered as they get easy (to [`RELAX_FLOOR`] × its start) and
+//!    raised where one fails (not lowered again to a shift that failed lately), each
+//!    solved inexactly (to [`RELAX_SUB_REDUCTION`] of its residual at the anchor), until an
 //!    answer is an equilibrium without the shift ([`LoadPath::shift_settled`]). The shift
-//!    keeps each sub-solve's tangent positive where the string's own is not, and accepts a step whose plain residual grows: the path crosses the fold as
-//!    an overdamped string would. The same follows a gravity stage that failed.
+//!    keeps each sub-solve's tangent positive where the string's own is not, and accepts a
+//!    step whose plain residual grows: the path crosses the fold as an overdamped string
+//!    would. The same follows a gravity stage that failed.
 //! 3. At λ = 1 one more full Newton step polishes the answer to rounding level (so it does
 //!    not depend on the load path). In f32 the full load is solved a second time from its
 //!    own converged state as base ([`LoadPath::new`]'s `refine`).
@@ -180,10 +181,10 @@ const RELAX_STALL_FACTOR: f64 = 100.0;
 /// span's `EI / L³` less its compression's share), so a high floor costs hundreds of
 /// sub-solves. Measured (`holewall bench corpus --wells 500`) when the relaxation started
 /// at the first step that failed at `min_step` (the two jumps to the rest of the load that
-/// came before it dropped; it starts at the first failed step now): 1e-5 instead of 1e-3 — 486 / 500 solved against 478, every
-/// gravity-stage failure gone, Newton iterations 285,931 → 175,519; on the slow wells at
-/// 10 m elements (0, 17, 221, 226, 294, 312) sub-solves 367–682 → 59–119. 1e-7 measured the
-/// same as 1e-5 on those wells.
+/// came before it dropped; it starts at the first failed step now): 1e-5 instead of 1e-3
+/// — 486 / 500 solved against 478, every gravity-stage failure gone, Newton iterations
+/// 285,931 → 175,519; on the slow wells at 10 m elements (0, 17, 221, 226, 294, 312)
+/// sub-solves 367–682 → 59–119. 1e-7 measured the same as 1e-5 on those wells.
 const RELAX_FLOOR: f64 = 1e-5;
 /// A shift above `s0 ×` this ends a relaxation that cannot make progress.
 const RELAX_CEILING: f64 = 1e6;
