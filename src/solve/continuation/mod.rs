@@ -566,7 +566,9 @@ impl LoadPath {
     /// As [`LoadPath::failed`], with where the residual force was largest (MD, m) and,
     /// where the system can relax, its shift scale `relax` ([`StaticSystem::relax_scale`]).
     pub fn failed_at(&mut self, reason: String, at_md: Option<f64>, relax: Option<f64>) -> Next {
-        let fail = |p: &mut LoadPath, step: f64, reason: String| {
+        // `at_smallest`: the step failed at `min_step` (the message names it), not after a
+        // relaxation from it.
+        let fail = |p: &mut LoadPath, step: f64, at_smallest: bool, reason: String| {
             let gravity = matches!(
                 p.stage,
                 Stage::Gravity | Stage::GravityRamp | Stage::Exponent { .. }
@@ -586,7 +588,7 @@ impl LoadPath {
             p.error = Some(StaticError::LoadStep {
                 stage,
                 from: p.lambda,
-                step: if gravity { 0.0 } else { step },
+                step: if gravity || !at_smallest { 0.0 } else { step },
                 min: p.min_step,
                 reason,
                 at_md,
@@ -602,7 +604,7 @@ impl LoadPath {
                 return p.relax_after(GRAVITY_ONLY, s0, why, true);
             }
             let step = p.step;
-            fail(p, step, why)
+            fail(p, step, false, why)
         };
         match self.stage {
             Stage::Gravity => {
@@ -687,7 +689,7 @@ impl LoadPath {
                     return self.relax_after(target, s0, why, false);
                 }
                 if self.step / 2.0 < self.min_step {
-                    return fail(self, self.step, reason);
+                    return fail(self, self.step, true, reason);
                 }
                 self.log.push(format!(
                     "load step λ {:.6} → {:.6} failed ({reason}); step cut to {:.3e}",
@@ -722,7 +724,7 @@ impl LoadPath {
                         "{}; relaxation by proximal points found no equilibrium past it either ({} sub-solves, {} Newton iterations; last: {reason})",
                         r.reason, r.subs, r.iterations
                     );
-                    return fail(self, r.step, why);
+                    return fail(self, r.step, false, why);
                 }
             }
             Stage::Done | Stage::Failed => return Next::Failed,

@@ -60,6 +60,12 @@ fn without_a_shift_scale_a_step_below_the_smallest_fails() {
     let (p, next) = stuck(None);
     assert_eq!(next, Next::Failed);
     assert!(matches!(p.error, Some(StaticError::LoadStep { .. })));
+    assert!(p
+        .error
+        .as_ref()
+        .unwrap()
+        .to_string()
+        .contains("smallest allowed"));
     // In the load steps, not the gravity stage.
     assert!(!p.error.unwrap().in_gravity_stage());
 }
@@ -168,6 +174,8 @@ fn a_relaxation_that_cannot_settle_fails_saying_so() {
     let e = p.error.unwrap().to_string();
     assert!(e.contains("found no equilibrium past it either"), "{e}");
     assert!(e.contains("applying the bit loads"), "{e}");
+    // The step was not cut to the smallest: the message does not say it was.
+    assert!(!e.contains("smallest allowed"), "{e}");
 }
 
 #[test]
