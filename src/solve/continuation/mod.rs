@@ -32,7 +32,9 @@
 //!    would. The same follows a gravity stage that failed.
 //! 3. At λ = 1 one more full Newton step polishes the answer to rounding level (so it does
 //!    not depend on the load path). In f32 the full load is solved a second time from its
-//!    own converged state as base ([`LoadPath::new`]'s `refine`).
+//!    own converged state as base ([`LoadPath::new`]'s `refine`), and so is a relaxation's
+//!    answer at the full loads, in f32 and f64 ([`Stage::Refine`]; where that solve fails,
+//!    the first answer stands).
 //!
 //! [`solve_loads`] runs the paths of every variant of a [`StaticSystem`] through one
 //! [`Newton`], all variants advancing in the same evaluations: a variant that completes a
@@ -487,12 +489,14 @@ impl LoadPath {
                     self.relax = None;
                     self.doubtful = true;
                     self.lambda = target.lambda;
+                    // At the full loads the answer is solved once more without the shift
+                    // and polished ([`Stage::Refine`]): a relaxation settles within the
+                    // tolerance, which leaves a buckled string's soft modes µm apart
+                    // between paths (the engine's twin and the CPU solve on a bent string,
+                    // `tests/bend.rs`: 4.5e-6 m), where a polished answer is the same to
+                    // rounding whatever path reached it.
                     self.stage = if self.lambda >= 1.0 {
-                        if self.refine {
-                            Stage::Refine
-                        } else {
-                            Stage::Done
-                        }
+                        Stage::Refine
                     } else {
                         Stage::Load
                     };
@@ -660,9 +664,10 @@ impl LoadPath {
                 ));
             }
             Stage::Refine => {
-                // f32's second solve at full load did not converge: the first one stands.
+                // The second solve at full load (f32's, or after a relaxation) did not
+                // converge: the first answer stands.
                 self.log.push(format!(
-                    "full load solved again from its own state as base failed ({reason}); the first solution kept"
+                    "full load solved again from its own state failed ({reason}); the first solution kept"
                 ));
                 self.doubtful = true;
                 self.stage = Stage::Done;
