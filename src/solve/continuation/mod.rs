@@ -15,8 +15,9 @@
 //!    equilibrium path: a compressed string that snaps into a buckled shape, a contact
 //!    onset each side of which has its root on the other) and the system can relax
 //!    ([`StaticSystem::relax_scale`]: the CPU solve and the engine), the variant
-//!    **relaxes** from the last equilibrium at once; a system that cannot relax cuts the
-//!    step in half from the last converged state, down to `min_step`, and fails there.
+//!    **relaxes** from the last equilibrium — at once where every spring law is linear; a
+//!    soft or hard law first cuts the step in half from the last converged state, down to
+//!    `min_step`, as does a system that cannot relax, which fails there.
 //!    Cutting first, down to `min_step`, cost corpus wells 0, 17 and 28 (horizontal,
 //!    10 m elements) 12–13 failed steps of 20–80 iterations each and only found the fold
 //!    more closely; relaxing at the first failure took them 1,085 / 1,509 / 1,058 → 683 /
