@@ -99,10 +99,10 @@ pub const STATIC_STALL_ITERATIONS: usize = 80;
 /// step's equations have no root near the last equilibrium: Newton falls to 1e-5–1e-7 of
 /// the force scale in a few iterations and then cycles between the sides of a contact
 /// onset (corpus well 312 at 10 m elements: 52 failed tries, every one a stall, 20 of
-/// them ending below this level), each try spending [`STATIC_STALL_ITERATIONS`]. Since a
-/// system that can relax (the CPU solve and the engine both can) relaxes at its first
-/// failed load step (`crate::solve::continuation`), no load step follows a failure there:
-/// this stall is that of a system that cannot relax and cuts its steps instead.
+/// them ending below this level), each try spending [`STATIC_STALL_ITERATIONS`]. Since stop 56
+/// a path with linear spring laws relaxes at its first failed load step
+/// (`crate::solve::continuation`), so this stall applies where the steps are still cut: a
+/// soft or hard law, or a system that cannot relax.
 pub const FOLD_LEVEL: f64 = 1e-4;
 
 /// See [`FOLD_LEVEL`]. Measured (`holewall bench corpus`): on seeds 0–49, 49 / 50 solved
