@@ -573,7 +573,9 @@ pub fn static_failure(case: &Case, error: &StaticError) -> String {
     let mut msg = format!("the static solve failed: {error}");
     let from = error.reached();
     let model = &case.model;
-    let gravity = matches!(error, StaticError::LoadStep { step, .. } if *step == 0.0);
+    // The stage, by its name: a load step whose relaxation failed has no smallest step to
+    // name either (`step` 0, since stop 56), and was read as the gravity stage here.
+    let gravity = error.in_gravity_stage();
     if gravity {
         msg.push_str(
             "\n  the string found no equilibrium under its own weight: the bit loads and \

@@ -395,6 +395,42 @@ fn a_failure_that_locks_up_says_so() {
     assert!(weak.contains("must be pushed from the surface"), "{weak}");
 }
 
+/// A failure names its stage by the stage's name: a load step whose relaxation failed (no
+/// smallest step, `step` 0) says how far the loads got, not that the string found no
+/// equilibrium under its own weight (what corpus well 419's message said at stop 56).
+#[test]
+fn a_failed_load_step_is_not_reported_as_the_gravity_stage() {
+    let case = horizontal(0.3, 250.0);
+    let relaxed = StaticError::LoadStep {
+        stage: "applying the bit loads and friction (stage 2), the step λ 0.2500 → 0.5000".into(),
+        from: 0.25,
+        step: 0.0,
+        min: 1e-4,
+        reason: "relaxation by proximal points found no equilibrium past it either".into(),
+        at_md: Some(306.0),
+    };
+    let msg = static_failure(&case, &relaxed);
+    assert!(!msg.contains("under its own weight"), "{msg}");
+    assert!(msg.contains("it reached 25.0 % of the"), "{msg}");
+    let gravity = StaticError::LoadStep {
+        stage: format!(
+            "{} (stage 1 of the load path)",
+            crate::solve::static_options::GRAVITY_STAGE
+        ),
+        from: 0.0,
+        step: 0.0,
+        min: 1e-4,
+        reason: "Newton stalled".into(),
+        at_md: Some(306.0),
+    };
+    let msg = static_failure(&case, &gravity);
+    assert!(
+        msg.contains("found no equilibrium under its own weight"),
+        "{msg}"
+    );
+    assert!(!msg.contains("it reached"), "{msg}");
+}
+
 /// A vertical 6⅛ in hole drilled at `wob_kn` on a near-bit stabilizer and 5 × 2¼ in
 /// collars (corpus well 439's BHA), contact at `sites`.
 fn vertical_bha(wob_kn: f64, sites: &str) -> Case {

@@ -128,8 +128,11 @@ struct Relax {
     /// iterations, and 32 with it (2,811 Newton iterations in all against 4,583); the 11
     /// slow wells named at [`RELAX_SUB_REDUCTION`]: 30,450 → 24,854 Newton iterations.
     failed_at: f64,
-    /// The failure that started it (and its stage, for the message if it fails too).
+    /// The failure that started it, with its stage (for the log).
     reason: String,
+    /// That failure's cause alone: the message if the relaxation fails too, whose stage
+    /// ([`StaticError::LoadStep`]'s) already names the step.
+    cause: String,
     gravity: bool,
     step: f64,
 }
@@ -547,7 +550,13 @@ impl LoadPath {
 
     /// Starts a relaxation to the loads `target` after a failure there (`s0`: the
     /// system's shift scale), or goes on with the one running.
-    fn relax_after(&mut self, target: LoadTarget, s0: f64, reason: String, gravity: bool) -> Next {
+    fn relax_after(
+        &mut self,
+        target: LoadTarget,
+        s0: f64,
+        (reason, cause): (String, String),
+        gravity: bool,
+    ) -> Next {
         self.relax = Some(Relax {
             target,
             s: s0,
@@ -560,6 +569,7 @@ impl LoadPath {
             stalled: None,
             failed_at: 0.0,
             reason,
+            cause,
             gravity,
             step: self.step,
         });
@@ -605,8 +615,8 @@ impl LoadPath {
         let give_up_gravity = |p: &mut LoadPath| -> Next {
             let why = std::mem::take(&mut p.gravity_reason);
             if let Some(s0) = relax {
-                let why = format!("the gravity stage failed ({why})");
-                return p.relax_after(GRAVITY_ONLY, s0, why, true);
+                let reason = format!("the gravity stage failed ({why})");
+                return p.relax_after(GRAVITY_ONLY, s0, (reason, why), true);
             }
             let step = p.step;
             fail(p, step, false, why)
@@ -621,7 +631,7 @@ impl LoadPath {
                         // way, every hook load the same to 1e-6) and cost 8,486 Newton
                         // iterations more (13 wells; 321: 1,747 → 742).
                         let why = format!("the gravity stage failed ({reason})");
-                        return self.relax_after(GRAVITY_ONLY, s0, why, true);
+                        return self.relax_after(GRAVITY_ONLY, s0, (why, reason), true);
                     }
                     // A system that cannot relax: continuation in gravity from the laid
                     // start.
@@ -698,7 +708,7 @@ impl LoadPath {
                         friction: 1.0,
                         ..self.target
                     };
-                    return self.relax_after(target, s0, why, false);
+                    return self.relax_after(target, s0, (why, reason), false);
                 }
                 if self.step / 2.0 < self.min_step {
                     return fail(self, self.step, true, reason);
@@ -734,7 +744,7 @@ impl LoadPath {
                     self.step = r.step;
                     let why = format!(
                         "{}; relaxation by proximal points found no equilibrium past it either ({} sub-solves, {} Newton iterations; last: {reason})",
-                        r.reason, r.subs, r.iterations
+                        r.cause, r.subs, r.iterations
                     );
                     return fail(self, r.step, false, why);
                 }

@@ -201,6 +201,11 @@ fn a_relaxation_that_cannot_settle_fails_saying_so() {
     assert!(e.contains("applying the bit loads"), "{e}");
     // The step was not cut to the smallest: the message does not say it was.
     assert!(!e.contains("smallest allowed"), "{e}");
+    // The stage names the step once; the cause follows it without naming it again.
+    assert!(
+        e.contains("the step λ") && !e.contains("load step λ"),
+        "{e}"
+    );
 }
 
 #[test]
