@@ -548,15 +548,17 @@ impl LoadPath {
         self.failed_at(reason, None, None)
     }
 
-    /// Starts a relaxation to the loads `target` after a failure there (`s0`: the
-    /// system's shift scale), or goes on with the one running.
-    fn relax_after(
-        &mut self,
-        target: LoadTarget,
-        s0: f64,
-        (reason, cause): (String, String),
-        gravity: bool,
-    ) -> Next {
+    /// Starts a relaxation to the loads `target` after a failure (`cause`) of the gravity
+    /// stage (`gravity`) or of the load step being solved (`s0`: the system's shift scale).
+    fn relax_after(&mut self, target: LoadTarget, s0: f64, cause: String, gravity: bool) -> Next {
+        let reason = if gravity {
+            format!("the gravity stage failed ({cause})")
+        } else {
+            format!(
+                "load step λ {:.6} → {:.6} failed ({cause})",
+                self.lambda, self.target.lambda
+            )
+        };
         self.relax = Some(Relax {
             target,
             s: s0,
@@ -615,8 +617,7 @@ impl LoadPath {
         let give_up_gravity = |p: &mut LoadPath| -> Next {
             let why = std::mem::take(&mut p.gravity_reason);
             if let Some(s0) = relax {
-                let reason = format!("the gravity stage failed ({why})");
-                return p.relax_after(GRAVITY_ONLY, s0, (reason, why), true);
+                return p.relax_after(GRAVITY_ONLY, s0, why, true);
             }
             let step = p.step;
             fail(p, step, false, why)
@@ -630,8 +631,7 @@ impl LoadPath {
                         // first solved no well the relaxation did not (486 / 500 either
                         // way, every hook load the same to 1e-6) and cost 8,486 Newton
                         // iterations more (13 wells; 321: 1,747 → 742).
-                        let why = format!("the gravity stage failed ({reason})");
-                        return self.relax_after(GRAVITY_ONLY, s0, (why, reason), true);
+                        return self.relax_after(GRAVITY_ONLY, s0, reason, true);
                     }
                     // A system that cannot relax: continuation in gravity from the laid
                     // start.
@@ -699,16 +699,12 @@ impl LoadPath {
                     // goes (measured on corpus well 17: relaxing to each failed step's
                     // loads instead took 18 relaxations and 3.3× the time). Cutting the
                     // step down to `min_step` first only found where the fold is.
-                    let why = format!(
-                        "load step λ {:.6} → {:.6} failed ({reason})",
-                        self.lambda, self.target.lambda
-                    );
                     let target = LoadTarget {
                         lambda: 1.0,
                         friction: 1.0,
                         ..self.target
                     };
-                    return self.relax_after(target, s0, (why, reason), false);
+                    return self.relax_after(target, s0, reason, false);
                 }
                 if self.step / 2.0 < self.min_step {
                     return fail(self, self.step, true, reason);
