@@ -36,6 +36,26 @@ fn the_roofline_bench_measures_every_kernel_under_its_ceilings() {
     let fma32 = c["fma_gflops_f32"].as_f64().unwrap();
     let copy = c["copy_gbytes_per_s"].as_f64().unwrap();
     assert!(fma32 > 0.1 && copy > 0.1, "{c}");
+    // The copy at every footprint from 1 MB to 256 MB, the headline its largest.
+    let curve = c["copy_curve"].as_array().unwrap();
+    let footprints: Vec<u64> = curve
+        .iter()
+        .map(|p| p["footprint_bytes"].as_u64().unwrap())
+        .collect();
+    assert_eq!(footprints, (20..=28).map(|k| 1u64 << k).collect::<Vec<_>>());
+    assert!(curve
+        .iter()
+        .all(|p| p["gbytes_per_s"].as_f64().unwrap() > 0.1));
+    assert_eq!(curve[8]["gbytes_per_s"].as_f64().unwrap(), copy);
+    // A kernel's bandwidth ceiling: the best copy at a footprint from the nearest to its
+    // bytes (on a log scale) up.
+    let ceiling = |bytes: f64| {
+        curve
+            .iter()
+            .filter(|p| p["footprint_bytes"].as_f64().unwrap() >= bytes / 2f64.sqrt())
+            .map(|p| p["gbytes_per_s"].as_f64().unwrap())
+            .fold(copy, f64::max)
+    };
     let rows = r["rows"].as_array().unwrap();
     let precisions = if ctx.has_f64 { 2 } else { 1 };
     assert_eq!(
@@ -53,6 +73,10 @@ fn the_roofline_bench_measures_every_kernel_under_its_ceilings() {
         assert!(f("fraction_of_fma") < 1.2, "{k}");
         // Bytes are the bindings' sizes: at least the outputs the kernel writes.
         assert!(f("gbytes_per_s") > 0.0 && f("intensity") > 0.0, "{k}");
+        // Set against the copy at its footprint or larger.
+        let against = f("gbytes_per_s") / f("fraction_of_bandwidth");
+        let expected = ceiling(f("bytes"));
+        assert!((against - expected).abs() <= 1e-9 * expected, "{k} {c}");
     }
     // The block solve's counted FLOPs grow linearly in V at fixed n, in every form.
     for form in ["serial", "lanes", "cyclic"] {

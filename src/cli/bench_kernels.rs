@@ -389,8 +389,8 @@ pub fn run(
                     gbytes_per_s: bytes / seconds / 1e9,
                     intensity,
                     fraction_of_fma: gflops / fma,
-                    fraction_of_bandwidth: bytes / seconds / 1e9 / ceilings.copy_gbytes_per_s,
-                    roof_gflops: fma.min(ceilings.copy_gbytes_per_s * intensity),
+                    fraction_of_bandwidth: bytes / seconds / 1e9 / ceilings.copy_at(bytes),
+                    roof_gflops: fma.min(ceilings.copy_at(bytes) * intensity),
                     note,
                 });
             }
@@ -426,7 +426,7 @@ fn roofline(path: &Path, r: &KernelsReport) -> std::io::Result<()> {
     };
     let mut roofs = vec![(
         format!(
-            "f32 roof: FMA {:.1} GFLOP/s, copy {:.1} GB/s",
+            "f32 roof: FMA {:.1} GFLOP/s, copy {:.1} GB/s (its largest footprint)",
             c.fma_gflops_f32, c.copy_gbytes_per_s
         ),
         roof(c.fma_gflops_f32),
@@ -480,22 +480,37 @@ pub fn h100_estimate_seconds(k: &KernelRow) -> f64 {
 /// The table as markdown.
 pub fn markdown(r: &KernelsReport) -> String {
     let c = &r.ceilings;
+    let curve = c
+        .copy_curve
+        .iter()
+        .map(|p| {
+            format!(
+                "{} MB {:.1} ({})",
+                p.footprint_bytes >> 20,
+                p.gbytes_per_s,
+                p.form
+            )
+        })
+        .collect::<Vec<_>>()
+        .join(", ");
     let mut s = format!(
-        "Device: {}\n\nCeilings measured here: FMA f32 {:.1} GFLOP/s, FMA f64 {}, copy {:.1} GB/s \
-         (read + write). \"median\": the kernel's time, by the device's timestamps at the compute \
-         pass's start and end where \"timed by\" says device, else by the host's clock; \"host\": \
-         from submission to the end of the wait (kernel and round trip).\n\n\
-         | kernel | precision | V | nodes | median (ms) | timed by | host (ms) | GFLOP/s | of FMA | GB/s | of copy | FLOP/B | roof (GFLOP/s) | note |\n\
-         |---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
+        "Device: {}\n\nCeilings measured here: FMA f32 {:.1} GFLOP/s, FMA f64 {}; copy (GB/s, read + \
+         write, at each footprint of bytes read plus written; the faster of a `vec4<f32>` and an \
+         `f32` an invocation): {curve}. \"of copy\" sets a kernel's bandwidth against the copy's at \
+         the footprint nearest its bytes (\"copy there\"), so a kernel whose data fits a cache is \
+         held to the cache's bandwidth. \"median\": the kernel's time, by the device's timestamps \
+         at the compute pass's start and end where \"timed by\" says device, else by the host's \
+         clock; \"host\": from submission to the end of the wait (kernel and round trip).\n\n\
+         | kernel | precision | V | nodes | median (ms) | timed by | host (ms) | GFLOP/s | of FMA | GB/s | copy there (GB/s) | of copy | FLOP/B | roof (GFLOP/s) | note |\n\
+         |---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
         r.device,
         c.fma_gflops_f32,
         c.fma_gflops_f64
             .map_or("—".to_string(), |x| format!("{x:.1} GFLOP/s")),
-        c.copy_gbytes_per_s
     );
     for k in &r.rows {
         s.push_str(&format!(
-            "| {} | {} | {} | {} | {:.3} | {} | {:.3} | {:.2} | {:.0} % | {:.2} | {:.0} % | {:.2} | {:.1} | {} |\n",
+            "| {} | {} | {} | {} | {:.3} | {} | {:.3} | {:.2} | {:.0} % | {:.2} | {:.1} | {:.0} % | {:.2} | {:.1} | {} |\n",
             k.kernel,
             k.precision,
             k.variants,
@@ -506,6 +521,7 @@ pub fn markdown(r: &KernelsReport) -> String {
             k.gflops,
             100.0 * k.fraction_of_fma,
             k.gbytes_per_s,
+            c.copy_at(k.bytes),
             100.0 * k.fraction_of_bandwidth,
             k.intensity,
             k.roof_gflops,
