@@ -41,18 +41,29 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
     let n = dims.num_nodes;
     if (dims.phase == 1u) {
-        // Back substitution over [begin, end), downwards: x_i = z_i − X_i x_{i+1}.
+        // Back substitution over [begin, end), downwards: x_i = z_i − X_i x_{i+1}, with
+        // x_{i+1} carried in registers from node to node (read once, where the dispatch
+        // starts below the chain's end), not read back from memory 36 times a node.
+        var below = array<real, 6>();
+        if (dims.end < n) {
+            for (var c = 0u; c < 6u; c = c + 1u) {
+                below[c] = x[vec_at(dims.end, c, v)];
+            }
+        }
         for (var step = dims.begin; step < dims.end; step = step + 1u) {
             let i = dims.end - 1u - (step - dims.begin);
+            var here = array<real, 6>();
             for (var r = 0u; r < 6u; r = r + 1u) {
                 var s = work_z[vec_at(i, r, v)];
                 if (i + 1u < n) {
                     for (var c = 0u; c < 6u; c = c + 1u) {
-                        s = s - work_x[blk(i, 6u * r + c, v)] * x[vec_at(i + 1u, c, v)];
+                        s = s - work_x[blk(i, 6u * r + c, v)] * below[c];
                     }
                 }
+                here[r] = s;
                 x[vec_at(i, r, v)] = s;
             }
+            below = here;
         }
         if (dims.begin == 0u) {
             status[v] = 0u;
