@@ -264,23 +264,32 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     if (s != NO_SITE) {
         let p = s * nv + v;
         if (contact_flag[p] != 0u) {
+            // Each input read once (a read is a loop over the lanes on lavapipe).
+            let normal = vec3<real>(pair_normals[3u * p], pair_normals[3u * p + 1u], pair_normals[3u * p + 2u]);
             for (var k = 0u; k < 6u; k = k + 1u) {
+                let c_omega = contact[(OUT_C_OMEGA + k) * pairs + p];
                 for (var c = 0u; c < 3u; c = c + 1u) {
                     d[6u * k + c] = d[6u * k + c] + hg * contact[(OUT_C + 3u * k + c) * pairs + p];
-                    d[6u * k + 3u + c] = d[6u * k + 3u + c]
-                        + hg * contact[(OUT_C_OMEGA + k) * pairs + p] * pair_normals[3u * p + c];
+                    d[6u * k + 3u + c] = d[6u * k + 3u + c] + hg * c_omega * normal[c];
                 }
             }
         }
     }
 #endif
+    // The node's rotation, read once: R[a][k] = rot[(9 i + 3 a + k) V + v].
+    var rm: array<array<real, 3>, 3>;
+    for (var a = 0u; a < 3u; a = a + 1u) {
+        for (var k = 0u; k < 3u; k = k + 1u) {
+            rm[a][k] = rot[(9u * i + 3u * a + k) * nv + v];
+        }
+    }
     // J = R J0 Rᵀ.
     var rj: array<array<real, 3>, 3>;
     for (var a = 0u; a < 3u; a = a + 1u) {
         for (var c = 0u; c < 3u; c = c + 1u) {
             var acc_rj = real(0.0);
             for (var k = 0u; k < 3u; k = k + 1u) {
-                acc_rj = acc_rj + rot[(9u * i + 3u * a + k) * nv + v] * inertia0[9u * i + 3u * k + c];
+                acc_rj = acc_rj + rm[a][k] * inertia0[9u * i + 3u * k + c];
             }
             rj[a][c] = acc_rj;
         }
@@ -290,13 +299,14 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         for (var c = 0u; c < 3u; c = c + 1u) {
             var acc_j = real(0.0);
             for (var k = 0u; k < 3u; k = k + 1u) {
-                acc_j = acc_j + rj[a][k] * rot[(9u * i + 3u * c + k) * nv + v];
+                acc_j = acc_j + rj[a][k] * rm[c][k];
             }
             jm[a][c] = acc_j;
         }
     }
     let m = node_mass[i];
     let w = vec3<real>(vel[(6u * i + 3u) * nv + v], vel[(6u * i + 4u) * nv + v], vel[(6u * i + 5u) * nv + v]);
+    let wdot = vec3<real>(vdot[(6u * i + 3u) * nv + v], vdot[(6u * i + 4u) * nv + v], vdot[(6u * i + 5u) * nv + v]);
     var jw = vec3<real>(real(0.0), real(0.0), real(0.0));
     var jwd = vec3<real>(real(0.0), real(0.0), real(0.0));
     for (var a = 0u; a < 3u; a = a + 1u) {
@@ -304,7 +314,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         var s2 = real(0.0);
         for (var k = 0u; k < 3u; k = k + 1u) {
             s1 = s1 + jm[a][k] * w[k];
-            s2 = s2 + jm[a][k] * vdot[(6u * i + 3u + k) * nv + v];
+            s2 = s2 + jm[a][k] * wdot[k];
         }
         jw[a] = s1;
         jwd[a] = s2;
@@ -346,12 +356,11 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     if (m > real(0.0) && (u0.x != real(0.0) || u0.y != real(0.0) || u0.z != real(0.0))) {
         var uu = vec3<real>(real(0.0), real(0.0), real(0.0));
         for (var a = 0u; a < 3u; a = a + 1u) {
-            uu[a] = rot[(9u * i + 3u * a) * nv + v] * u0.x + rot[(9u * i + 3u * a + 1u) * nv + v] * u0.y
-                + rot[(9u * i + 3u * a + 2u) * nv + v] * u0.z;
+            uu[a] = rm[a][0] * u0.x + rm[a][1] * u0.y + rm[a][2] * u0.z;
         }
         let dd = uu / m;
         let xdd = vec3<real>(vdot[(6u * i) * nv + v], vdot[(6u * i + 1u) * nv + v], vdot[(6u * i + 2u) * nv + v]);
-        let wd = vec3<real>(vdot[(6u * i + 3u) * nv + v], vdot[(6u * i + 4u) * nv + v], vdot[(6u * i + 5u) * nv + v]);
+        let wd = wdot;
         let wxd = cross(w, dd);
         let a_rel = cross(wd, dd) + cross(w, wxd);
         let moment = cross(uu, xdd + a_rel);

@@ -330,13 +330,18 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     for (var node = 0u; node < 2u; node = node + 1u) {
         let i = e + node;
         w[node] = vec3<real>(x[(3u * i) * nv + v], x[(3u * i + 1u) * nv + v], x[(3u * i + 2u) * nv + v]);
-        // triad = R_i · frame0_i, by columns.
+        // triad = R_i · frame0_i, by columns; R_i read once (a read is a loop over the
+        // lanes on lavapipe, which does not merge repeated ones).
+        var rm: array<real, 9>;
+        for (var k = 0u; k < 9u; k = k + 1u) {
+            rm[k] = rot[(9u * i + k) * nv + v];
+        }
         var cols: array<vec3<real>, 3>;
         for (var c = 0u; c < 3u; c = c + 1u) {
             for (var r = 0u; r < 3u; r = r + 1u) {
                 var s = real(0.0);
                 for (var m = 0u; m < 3u; m = m + 1u) {
-                    s = s + rot[(9u * i + 3u * r + m) * nv + v] * frame0[9u * i + 3u * m + c];
+                    s = s + rm[3u * r + m] * frame0[9u * i + 3u * m + c];
                 }
                 cols[c][r] = s;
             }
