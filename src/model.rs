@@ -534,8 +534,10 @@ impl Model {
     pub fn element_stiffness(&self, i: usize) -> crate::physics::beam::ElementStiffness<f64> {
         let e = &self.elements[i];
         let k = crate::physics::beam::ElementStiffness::of(&e.section, e.length0);
-        match self.kinks(1.0).into_iter().find(|(el, _)| *el == i) {
-            Some((_, rest)) => k.with_rest(rest),
+        // The first bend at this element, as `kinks(1.0)` lists them (called per element
+        // and evaluation: the others' rest rotations are not formed).
+        match self.bends.iter().find(|b| b.node - 1 == i) {
+            Some(b) => k.with_rest(self.kink(b, 1.0).1),
             None => k,
         }
     }
@@ -544,18 +546,18 @@ impl Model {
     /// `scale` (the static load factor; 1: in full): the one place a [`Bend`] becomes an
     /// element's rest state, for the CPU solvers and the kernels' `rest` table alike.
     pub fn kinks(&self, scale: f64) -> Vec<(usize, [[f64; 3]; 2])> {
-        self.bends
-            .iter()
-            .map(|b| {
-                let e = b.node - 1;
-                let rest = crate::physics::beam::kink_rest_rotation(
-                    scale * b.angle,
-                    b.toolface,
-                    self.elements[e].length0,
-                );
-                (e, rest)
-            })
-            .collect()
+        self.bends.iter().map(|b| self.kink(b, scale)).collect()
+    }
+
+    /// The kinked element of bend `b` and its unstrained rotations at `scale`.
+    fn kink(&self, b: &Bend, scale: f64) -> (usize, [[f64; 3]; 2]) {
+        let e = b.node - 1;
+        let rest = crate::physics::beam::kink_rest_rotation(
+            scale * b.angle,
+            b.toolface,
+            self.elements[e].length0,
+        );
+        (e, rest)
     }
 
     /// The unstrained nodal rotations of element `i` (zero but at a kink).
