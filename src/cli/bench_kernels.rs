@@ -485,10 +485,11 @@ pub fn markdown(r: &KernelsReport) -> String {
         .iter()
         .map(|p| {
             format!(
-                "{} MB {:.1} ({})",
+                "{} MB {:.1} (vec4 {:.1}, f32 {:.1})",
                 p.footprint_bytes >> 20,
                 p.gbytes_per_s,
-                p.form
+                p.by_form[0],
+                p.by_form[1]
             )
         })
         .collect::<Vec<_>>()
@@ -496,7 +497,7 @@ pub fn markdown(r: &KernelsReport) -> String {
     let mut s = format!(
         "Device: {}\n\nCeilings measured here: FMA f32 {:.1} GFLOP/s, FMA f64 {}; copy (GB/s, read + \
          write, at each footprint of bytes read plus written; the faster of a `vec4<f32>` and an \
-         `f32` an invocation): {curve}. \"of copy\" sets a kernel's bandwidth against the copy's at \
+         `f32` an invocation, each given): {curve}. \"of copy\" sets a kernel's bandwidth against the copy's at \
          the footprint nearest its bytes (\"copy there\"), so a kernel whose data fits a cache is \
          held to the cache's bandwidth. \"median\": the kernel's time, by the device's timestamps \
          at the compute pass's start and end where \"timed by\" says device, else by the host's \

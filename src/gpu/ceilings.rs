@@ -95,6 +95,10 @@ pub struct CopyPoint {
     pub gbytes_per_s: f64,
     /// The faster form's element (`vec4<f32>` or `f32`).
     pub form: &'static str,
+    /// Each form's bandwidth (GB/s), in [`COPY_FORMS`]' order: on lavapipe a storage
+    /// access is a loop over the SIMD lanes (Mesa's `emit_load_mem`), which a `vec4` pays
+    /// once for four elements.
+    pub by_form: [f64; 2],
 }
 
 /// The measured ceilings: each the fastest of its repeats (a ceiling is the best the device
@@ -182,7 +186,8 @@ pub fn measure(ctx: &GpuContext, repeats: usize) -> Result<Ceilings, GpuError> {
         let bytes = footprint / 2;
         let src = vec![1u8; bytes];
         let mut best: Option<CopyPoint> = None;
-        for (element, size) in COPY_FORMS {
+        let mut by_form = [f64::NAN; 2];
+        for (slot, (element, size)) in COPY_FORMS.into_iter().enumerate() {
             let label = format!("ceiling_copy_{size}");
             let pipeline = ctx.pipeline(&label, &copy_wgsl(element))?;
             let words = bytes / size;
@@ -210,15 +215,17 @@ pub fn measure(ctx: &GpuContext, repeats: usize) -> Result<Ceilings, GpuError> {
                 passes *= 2;
             };
             let gbytes_per_s = footprint as f64 / seconds / 1e9;
+            by_form[slot] = gbytes_per_s;
             if best.is_none_or(|b| gbytes_per_s > b.gbytes_per_s) {
                 best = Some(CopyPoint {
                     footprint_bytes: footprint,
                     gbytes_per_s,
                     form: element,
+                    by_form: [f64::NAN; 2],
                 });
             }
         }
-        copy_curve.extend(best);
+        copy_curve.extend(best.map(|b| CopyPoint { by_form, ..b }));
     }
     Ok(Ceilings {
         fma_gflops_f32,
@@ -238,6 +245,7 @@ mod tests {
             footprint_bytes: mb << 20,
             gbytes_per_s: g,
             form: "f32",
+            by_form: [g, g],
         };
         let c = Ceilings {
             fma_gflops_f32: 1.0,
