@@ -497,9 +497,9 @@ pub fn markdown(r: &KernelsReport) -> String {
     let mut s = format!(
         "Device: {}\n\nCeilings measured here: FMA f32 {:.1} GFLOP/s, FMA f64 {}; copy (GB/s, read + \
          write, at each footprint of bytes read plus written; the faster of a `vec4<f32>` and an \
-         `f32` an invocation, each given): {curve}. \"of copy\" sets a kernel's bandwidth against the copy's at \
-         the footprint nearest its bytes (\"copy there\"), so a kernel whose data fits a cache is \
-         held to the cache's bandwidth. \"median\": the kernel's time, by the device's timestamps \
+         `f32` an invocation, each given): {curve}. \"of copy\" sets a kernel's bandwidth against the best \
+         copy at a footprint from the one nearest its bytes up (\"copy there\"), so a kernel whose data \
+         fits a cache is held to the cache's bandwidth. \"median\": the kernel's time, by the device's timestamps \
          at the compute pass's start and end where \"timed by\" says device, else by the host's \
          clock; \"host\": from submission to the end of the wait (kernel and round trip).\n\n\
          | kernel | precision | V | nodes | median (ms) | timed by | host (ms) | GFLOP/s | of FMA | GB/s | copy there (GB/s) | of copy | FLOP/B | roof (GFLOP/s) | note |\n\
