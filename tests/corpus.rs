@@ -523,6 +523,23 @@ fn a_dynamic_corpus_case_through_the_engine_matches_the_cpu() {
             e.reason
         );
         assert_engine_matches_cpu(&e, f32);
+        // The CPU's own spread (its start changed by 1e-8): the change reached the run, and
+        // this uncut run is not sensitive to its start (its end values are a test of the
+        // engine, as above).
+        eprintln!(
+            "dynamic seed {}: the CPU's own spread, hook load {:.1e}, torque {:.1e}",
+            e.seed, e.cpu_spread_hook_rel, e.cpu_spread_torque_rel
+        );
+        assert!(
+            e.cpu_spread_hook_rel > 0.0 || e.cpu_spread_torque_rel > 0.0,
+            "the perturbed start changed nothing"
+        );
+        assert!(
+            e.cpu_spread_hook_rel <= 1e-4 && e.cpu_spread_torque_rel <= 1e-4,
+            "{} {}",
+            e.cpu_spread_hook_rel,
+            e.cpu_spread_torque_rel
+        );
     }
 }
 
@@ -546,10 +563,11 @@ fn engine_rows(
     case: &holewall::corpus::dynamic::DynamicCase,
     cpu: &holewall::corpus::dynamic::DynamicRow,
 ) -> Vec<(bool, holewall::corpus::dynamic::DynamicEngineRow)> {
+    let again = holewall::corpus::dynamic::run_case_perturbed(case).unwrap();
     [false, true]
         .into_iter()
         .map(|f32| {
-            let row = holewall::corpus::dynamic::run_case_engine(case, cpu, f32).unwrap();
+            let row = holewall::corpus::dynamic::run_case_engine(case, cpu, &again, f32).unwrap();
             (f32, row)
         })
         .collect()

@@ -13,7 +13,8 @@ use serde::Serialize;
 
 use super::bench_corpus::{spread, Spread};
 use crate::corpus::dynamic::{
-    run_case_dynamic, run_case_engine, write_dynamic_case, DynamicEngineRow, DynamicRow,
+    run_case_dynamic, run_case_engine, run_case_perturbed, write_dynamic_case, DynamicEngineRow,
+    DynamicRow,
 };
 use crate::error::Error;
 
@@ -53,6 +54,13 @@ pub struct EnginePathSummary {
     pub stab1_force_rel: Spread,
     /// Cases whose stab1 whirls in the CPU's class.
     pub same_whirl: usize,
+    /// The CPU's own sensitivity of the hook load to a 1e-8 change of its start, over the
+    /// same cases ([`crate::corpus::dynamic::run_case_perturbed`]).
+    pub cpu_spread_hook_rel: Spread,
+    /// Cases the engine solved whose hook load lies within the CPU's own spread (its
+    /// difference from the CPU at most the two CPU runs' difference): there the engine's
+    /// difference says nothing about the engine; elsewhere it does.
+    pub hook_within_cpu_spread: usize,
     /// Wall time per case (s).
     pub seconds: Spread,
 }
@@ -133,9 +141,14 @@ pub fn run(out: &Path, options: &DynamicCorpusOptions) -> Result<DynamicCorpusSu
         .filter(|(c, r)| r.solved && r.nodes <= options.engine_max_nodes && c.spec.mass == "lumped")
         .take(options.engine_sample)
         .collect();
+    // The CPU's own sensitivity to its start, for each sampled case (in parallel).
+    let perturbed: Vec<DynamicRow> = sample
+        .par_iter()
+        .map(|(case, _)| run_case_perturbed(case))
+        .collect::<Result<_, _>>()?;
     for f32 in [false, true] {
-        for (case, cpu) in &sample {
-            match run_case_engine(case, cpu, f32) {
+        for ((case, cpu), again) in sample.iter().zip(&perturbed) {
+            match run_case_engine(case, cpu, again, f32) {
                 Ok(r) => engine_rows.push(r),
                 Err(e) => {
                     unavailable.push(format!("{}: {e}", if f32 { "gpu_f32" } else { "gpu_f64" }));
@@ -179,6 +192,16 @@ pub fn run(out: &Path, options: &DynamicCorpusOptions) -> Result<DynamicCorpusSu
                         .collect::<Vec<_>>(),
                 ),
                 same_whirl: e.iter().filter(|r| r.by_engine && r.same_whirl).count(),
+                cpu_spread_hook_rel: spread(
+                    &e.iter()
+                        .filter(|r| r.by_engine)
+                        .map(|r| (r.seed, r.cpu_spread_hook_rel))
+                        .collect::<Vec<_>>(),
+                ),
+                hook_within_cpu_spread: e
+                    .iter()
+                    .filter(|r| r.by_engine && r.hook_load_rel <= r.cpu_spread_hook_rel)
+                    .count(),
                 seconds: spread(&e.iter().map(|r| (r.seed, r.seconds)).collect::<Vec<_>>()),
             })
         })

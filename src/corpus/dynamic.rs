@@ -468,6 +468,32 @@ pub fn run_case_dynamic(case: &DynamicCase) -> Result<DynamicRow, Error> {
     Ok(row_of(&case.spec, &loaded.model, &r, growth, seconds))
 }
 
+/// The relative change of the start that [`run_case_perturbed`] makes: far above rounding
+/// (1e-16 in f64), far below anything a user sets.
+pub const START_PERTURBATION: f64 = 1e-8;
+
+/// [`run_case_dynamic`] with the start changed by [`START_PERTURBATION`]: the BHA's kick
+/// (`initial_lateral_velocity`) scaled by `1 + 1e-8`, or without a kick a kick of 1e-8 m/s
+/// (not the initial offset: an offset that would start a node beyond its wall is scaled to
+/// land on it, which takes any change of it away — dynamic corpus seed 266). Two CPU runs
+/// this close differ by the case's own sensitivity to its start: the yardstick for an
+/// engine's difference from the CPU (a chaotic run's end values cannot agree between two
+/// solvers that differ at rounding).
+pub fn run_case_perturbed(case: &DynamicCase) -> Result<DynamicRow, Error> {
+    let mut loaded = crate::case::load_case(&case.case_path)?;
+    if let Some(d) = loaded.dynamics.as_mut() {
+        d.initial_lateral_velocity = if d.initial_lateral_velocity != 0.0 {
+            d.initial_lateral_velocity * (1.0 + START_PERTURBATION)
+        } else {
+            START_PERTURBATION
+        };
+    }
+    let clock = std::time::Instant::now();
+    let (r, growth) = dynamic_variant_tracked(&loaded, "cpu", &loaded.model, true);
+    let seconds = clock.elapsed().as_secs_f64();
+    Ok(row_of(&case.spec, &loaded.model, &r, growth, seconds))
+}
+
 /// One dynamic case through the GPU engine (a one-variant dynamic ensemble, as `holewall
 /// ensemble --backend gpu` runs it), against the CPU run.
 #[derive(Clone, Debug, Serialize)]
@@ -495,6 +521,13 @@ pub struct DynamicEngineRow {
     pub stab1_force_rel: f64,
     /// The same whirl class as the CPU's at stab1.
     pub same_whirl: bool,
+    /// The CPU's own sensitivity: |Δ hook load| / CPU's between the CPU run and the CPU run
+    /// with its start changed by [`START_PERTURBATION`] ([`run_case_perturbed`]).
+    pub cpu_spread_hook_rel: f64,
+    /// The same for the largest surface torque.
+    pub cpu_spread_torque_rel: f64,
+    /// The same for stab1's largest side force (NaN without stabilizers).
+    pub cpu_spread_stab1_rel: f64,
     /// Why the engine did not solve it itself.
     pub reason: String,
 }
@@ -508,11 +541,13 @@ fn rel(a: f64, b: f64) -> f64 {
 }
 
 /// Runs `case` through the GPU engine in f64 (`f32 = false`) or f32 and compares it with the
-/// CPU row `cpu`. `Err` where the path cannot run here (no adapter, no f64) or the case
-/// needs what only the CPU integrator has (consistent mass).
+/// CPU row `cpu`, beside the CPU's own spread (`perturbed`: [`run_case_perturbed`]). `Err`
+/// where the path cannot run here (no adapter, no f64) or the case needs what only the CPU
+/// integrator has (consistent mass).
 pub fn run_case_engine(
     case: &DynamicCase,
     cpu: &DynamicRow,
+    perturbed: &DynamicRow,
     f32: bool,
 ) -> Result<DynamicEngineRow, Error> {
     use crate::ensemble::runner::run_dynamic_gpu;
@@ -555,6 +590,9 @@ pub fn run_case_engine(
         torque_rel: rel(e.max_surface_torque_nm, cpu.max_surface_torque_nm),
         stab1_force_rel: rel(e.stab1_max_side_force_n, cpu.stab1_max_side_force_n),
         same_whirl: e.stab1_whirl == cpu.stab1_whirl,
+        cpu_spread_hook_rel: rel(perturbed.hook_load_n, cpu.hook_load_n),
+        cpu_spread_torque_rel: rel(perturbed.max_surface_torque_nm, cpu.max_surface_torque_nm),
+        cpu_spread_stab1_rel: rel(perturbed.stab1_max_side_force_n, cpu.stab1_max_side_force_n),
         reason: if r.solved_by == crate::ensemble::qoi::SolvedBy::Engine {
             e.reason
         } else {
