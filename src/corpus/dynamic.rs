@@ -461,7 +461,16 @@ fn row_of(
 /// Runs a drawn case on the CPU integrator as `holewall run` runs it (the static start held
 /// in the hole, [`crate::profile::solve_in_hole`]; then generalised-α with step control).
 pub fn run_case_dynamic(case: &DynamicCase) -> Result<DynamicRow, Error> {
-    let loaded = crate::case::load_case(&case.case_path)?;
+    run_case_cpu(case, |_| {})
+}
+
+/// A drawn case on the CPU integrator, its loaded case changed by `change` first.
+fn run_case_cpu(
+    case: &DynamicCase,
+    change: impl FnOnce(&mut crate::case::Case),
+) -> Result<DynamicRow, Error> {
+    let mut loaded = crate::case::load_case(&case.case_path)?;
+    change(&mut loaded);
     let clock = std::time::Instant::now();
     let (r, growth) = dynamic_variant_tracked(&loaded, "cpu", &loaded.model, true);
     let seconds = clock.elapsed().as_secs_f64();
@@ -480,18 +489,15 @@ pub const START_PERTURBATION: f64 = 1e-8;
 /// engine's difference from the CPU (a chaotic run's end values cannot agree between two
 /// solvers that differ at rounding).
 pub fn run_case_perturbed(case: &DynamicCase) -> Result<DynamicRow, Error> {
-    let mut loaded = crate::case::load_case(&case.case_path)?;
-    if let Some(d) = loaded.dynamics.as_mut() {
-        d.initial_lateral_velocity = if d.initial_lateral_velocity != 0.0 {
-            d.initial_lateral_velocity * (1.0 + START_PERTURBATION)
-        } else {
-            START_PERTURBATION
-        };
-    }
-    let clock = std::time::Instant::now();
-    let (r, growth) = dynamic_variant_tracked(&loaded, "cpu", &loaded.model, true);
-    let seconds = clock.elapsed().as_secs_f64();
-    Ok(row_of(&case.spec, &loaded.model, &r, growth, seconds))
+    run_case_cpu(case, |loaded| {
+        if let Some(d) = loaded.dynamics.as_mut() {
+            d.initial_lateral_velocity = if d.initial_lateral_velocity != 0.0 {
+                d.initial_lateral_velocity * (1.0 + START_PERTURBATION)
+            } else {
+                START_PERTURBATION
+            };
+        }
+    })
 }
 
 /// One dynamic case through the GPU engine (a one-variant dynamic ensemble, as `holewall

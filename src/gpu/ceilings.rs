@@ -181,15 +181,23 @@ pub fn measure(ctx: &GpuContext, repeats: usize) -> Result<Ceilings, GpuError> {
     let fma_gflops_f32 = fma(false)?;
     let fma_gflops_f64 = if ctx.has_f64 { Some(fma(true)?) } else { None };
     let largest = (ctx.max_binding_bytes() as usize).min(1 << 30) / 16 * 16;
+    // Each form's kernel, made once for every footprint.
+    let forms = COPY_FORMS
+        .iter()
+        .map(|&(element, size)| {
+            let label = format!("ceiling_copy_{size}");
+            let pipeline = ctx.pipeline(&label, &copy_wgsl(element))?;
+            Ok((element, size, label, pipeline))
+        })
+        .collect::<Result<Vec<_>, GpuError>>()?;
     let mut copy_curve = Vec::new();
     for footprint in copy_footprints().filter(|&f| f / 2 <= largest) {
         let bytes = footprint / 2;
         let src = vec![1u8; bytes];
         let mut best: Option<CopyPoint> = None;
         let mut by_form = [f64::NAN; 2];
-        for (slot, (element, size)) in COPY_FORMS.into_iter().enumerate() {
-            let label = format!("ceiling_copy_{size}");
-            let pipeline = ctx.pipeline(&label, &copy_wgsl(element))?;
+        for (slot, (element, size, label, pipeline)) in forms.iter().enumerate() {
+            let (element, size) = (*element, *size);
             let words = bytes / size;
             // Grid-stride: a GPU's one-dimensional dispatch holds 65,535 workgroups.
             let threads = words.min(65_535 * 64);
@@ -199,8 +207,8 @@ pub fn measure(ctx: &GpuContext, repeats: usize) -> Result<Ceilings, GpuError> {
                 let (r, t) = timed(repeats, || {
                     run_once(
                         ctx,
-                        &pipeline,
-                        &label,
+                        pipeline,
+                        label,
                         bytemuck::cast_slice(&params),
                         &[&src],
                         &[Out::Empty(bytes)],
