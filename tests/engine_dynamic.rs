@@ -947,3 +947,92 @@ fn a_site_held_for_another_variant_adds_nothing() {
         );
     }
 }
+
+/// A run that cuts its step to a quarter and regrows it inside a 10 ms step (ε = 1e-6 m/s,
+/// μ = 1 at 30 rpm, near stick-slip) takes the same steps on the engine as on the CPU
+/// integrator — both step by `solve::dynamics::control` — and ends where it ends, to
+/// rounding as the run amplifies it (twin and GPU f64). Before the two shared that module,
+/// the integrator took a regrown step at once, off the engine's grid: 24 cuts on the CPU
+/// against 18 on the twin, the end displacements 8.8e-3 of the largest apart.
+#[test]
+fn a_run_that_cuts_and_regrows_takes_the_cpu_integrators_steps_in_the_engine() {
+    let text = common::bed_text("1.0", "8.25 in", "6e7", "1", "1e-6")
+        .replace("time_step = \"2 ms\"", "time_step = \"10 ms\"")
+        .replace("rpm = \"120 rpm\"", "rpm = \"30 rpm\"");
+    let case = holewall::case::parse_case(std::path::Path::new("bed.toml"), &text).unwrap();
+    // The second variant, ε changed by 1e-13, measures the run's own sensitivity.
+    let (models, starts) = with_starts(&case, "eps\n1e-6\n1.0000000000001e-6\n");
+    let options = case.dynamics.as_ref().unwrap().integrator_options();
+    let density = case.element_density.clone();
+    let t_end = 0.15;
+    let m = &models[0];
+    let end_of = |j: usize| {
+        let mut d = Dynamics::new(&models[j], options, &|e| density[e]);
+        let mut s = d.initial_state(starts[j].clone()).unwrap();
+        d.run(&mut s, t_end, &mut |_, _| {}).unwrap();
+        (d.log.clone(), s)
+    };
+    let (log, s) = end_of(0);
+    let (_, perturbed) = end_of(1);
+    let cuts = |log: &[String]| log.iter().filter(|l| l.contains("cut to")).count();
+    let quarter = log.iter().any(|l| l.contains("cut to 2.500e-3"));
+    let regrown = log.iter().filter(|l| l.contains("regrown")).count();
+    eprintln!(
+        "CPU integrator: {} cuts, {regrown} regrowths, to a quarter: {quarter}",
+        cuts(&log)
+    );
+    assert!(
+        quarter && regrown > 0,
+        "the case no longer cuts to a quarter and regrows"
+    );
+    let n = m.nodes.len();
+    let cpu_u: Vec<f64> = (0..n)
+        .flat_map(|i| (0..3).map(move |k| (i, k)))
+        .map(|(i, k)| s.q.x[i][k] - m.nodes[i].position[k])
+        .collect();
+    let scale = cpu_u.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    let spread = (0..3 * n).fold(0.0f64, |m, k| {
+        let (i, c) = (k / 3, k % 3);
+        m.max((perturbed.q.x[i][c] - s.q.x[i][c]).abs())
+    });
+    eprintln!(
+        "CPU integrator alone, ε changed by 1e-13: ends {:.2e} of the largest apart",
+        spread / scale
+    );
+    // Rounding apart, amplified as the run's own sensitivity amplifies a 1e-13 change (the
+    // policy of before: 1.4e-2 of the largest, with 33 cuts on the CPU against 31).
+    let bound = (10.0 * spread).max(1e-10 * scale).min(1e-6 * scale);
+    let check = |label: &str, path: &dyn holewall::engine::KernelPath<f64>| {
+        let mut last = None;
+        let r = run_dynamic_ensemble(
+            &models,
+            &at_rest(&starts),
+            &density,
+            &common::Counting::new(path),
+            &options,
+            t_end,
+            1,
+            &mut |_, _, b: &DynamicBatch<f64>| last = Some(b.clone()),
+        )
+        .unwrap();
+        assert_eq!(r[0].status, DynamicStatus::Finished, "{label}");
+        let b = last.unwrap();
+        let v = b.num_variants;
+        let diff = (0..3 * n).fold(0.0f64, |m, k| m.max((b.u[k * v] - cpu_u[k]).abs()));
+        eprintln!(
+            "{label}: {} cuts; end displacement vs the CPU integrator {:.2e} of the largest ({scale:.2e} m)",
+            cuts(&r[0].log),
+            diff / scale
+        );
+        assert_eq!(cuts(&r[0].log), cuts(&log), "{label}: cuts");
+        assert!(
+            diff <= bound,
+            "{label}: {diff:e} of {scale:e} (bound {bound:e})"
+        );
+    };
+    check("twin", &TwinPath);
+    let Some(ctx) = common::gpu() else { return };
+    if ctx.has_f64 {
+        check("GPU f64", &GpuPath(ctx));
+    }
+}

@@ -48,6 +48,9 @@ pub struct EnginePathSummary {
     pub fallbacks: Vec<(u64, String)>,
     /// |Δ hook load| / CPU's.
     pub hook_load_rel: Spread,
+    /// |Δ hook load| / the run's force scale
+    /// ([`crate::corpus::dynamic::DynamicEngineRow::hook_load_of_force_scale`]).
+    pub hook_load_of_force_scale: Spread,
     /// |Δ largest surface torque| / CPU's.
     pub torque_rel: Spread,
     /// |Δ stab1's largest side force| / CPU's.
@@ -183,6 +186,12 @@ pub fn run(out: &Path, options: &DynamicCorpusOptions) -> Result<DynamicCorpusSu
                     &e.iter()
                         .filter(|r| r.by_engine)
                         .map(|r| (r.seed, r.hook_load_rel))
+                        .collect::<Vec<_>>(),
+                ),
+                hook_load_of_force_scale: spread(
+                    &e.iter()
+                        .filter(|r| r.by_engine)
+                        .map(|r| (r.seed, r.hook_load_of_force_scale))
                         .collect::<Vec<_>>(),
                 ),
                 torque_rel: spread(

@@ -521,6 +521,10 @@ pub struct DynamicEngineRow {
     pub seconds: f64,
     /// |Δ hook load| / |CPU hook load|.
     pub hook_load_rel: f64,
+    /// |Δ hook load| / the run's force scale (the string's buoyed weight and the bit loads,
+    /// [`crate::solve::statics::reference_force`]): the precision's measure, which a hook
+    /// load near zero (a horizontal section's) does not inflate as it does `hook_load_rel`.
+    pub hook_load_of_force_scale: f64,
     /// |Δ largest surface torque| / CPU's.
     pub torque_rel: f64,
     /// |Δ stab1's largest side force| / CPU's (NaN without stabilizers).
@@ -593,6 +597,8 @@ pub fn run_case_engine(
         step_cuts: e.step_cuts,
         seconds,
         hook_load_rel: rel(e.hook_load_n, cpu.hook_load_n),
+        hook_load_of_force_scale: (e.hook_load_n - cpu.hook_load_n).abs()
+            / crate::solve::statics::reference_force(&loaded.model),
         torque_rel: rel(e.max_surface_torque_nm, cpu.max_surface_torque_nm),
         stab1_force_rel: rel(e.stab1_max_side_force_n, cpu.stab1_max_side_force_n),
         same_whirl: e.stab1_whirl == cpu.stab1_whirl,

@@ -27,7 +27,7 @@ use crate::model::Model;
 use crate::physics::contact::{ContactMode, PARAMS_LEN};
 use crate::physics::mass::MassKind;
 use crate::physics::Real;
-use crate::solve::dynamics::{DynamicOptions, Dynamics};
+use crate::solve::dynamics::{control, DynamicOptions, Dynamics};
 use crate::solve::statics::StaticState;
 
 use super::{columns, ensemble_tables_from, variant_fastest, BatchTables, KernelPath, TwinPath};
@@ -468,9 +468,7 @@ fn run_span<T: Real + Send + Sync, P: KernelPath<T>>(
     let settings = NewtonSettings::dynamics(options.max_iterations, options.tolerance, size);
     let mut time = t0;
     let mut step = 0usize;
-    while time < t_end - 1e-12 * t_end.abs().max(1.0) {
-        let hh = h.min(t_end - time);
-        let t1 = time + hh;
+    while let Some((hh, t1)) = control::next_step(time, t_end, h) {
         let coefficients = StepCoefficients {
             h: t(hh),
             alpha_m: t(p.alpha_m),
@@ -511,7 +509,7 @@ fn run_span<T: Real + Send + Sync, P: KernelPath<T>>(
         let deferred: Vec<usize> = (0..m)
             .filter(|&i| {
                 let j = members[i];
-                batch.status[j] == DynamicStatus::Finished && batch.step[j] < hh * (1.0 - 1e-9)
+                batch.status[j] == DynamicStatus::Finished && control::defers(batch.step[j], hh)
             })
             .collect();
         let at_n = if deferred.is_empty() {
@@ -532,10 +530,9 @@ fn run_span<T: Real + Send + Sync, P: KernelPath<T>>(
             .iter()
             .map(|&i| (i, batch.step[members[i]]))
             .collect();
-        let cut = hh / 2.0;
         for (i, reason) in failed {
             let j = members[i];
-            if cut < options.min_dt {
+            let Some(cut) = control::cut(hh, options.min_dt) else {
                 batch.status[j] = DynamicStatus::Failed(
                     t1,
                     format!(
@@ -543,13 +540,13 @@ fn run_span<T: Real + Send + Sync, P: KernelPath<T>>(
                         options.min_dt
                     ),
                 );
-            } else {
-                batch.log[j].push(format!(
-                    "t = {time:.6} s: step {hh:.3e} s failed ({reason}); cut to {cut:.3e} s"
-                ));
-                batch.step[j] = cut;
-                retry.push((i, cut));
-            }
+                continue;
+            };
+            batch.log[j].push(format!(
+                "t = {time:.6} s: step {hh:.3e} s failed ({reason}); cut to {cut:.3e} s"
+            ));
+            batch.step[j] = cut;
+            retry.push((i, cut));
         }
         if !retry.is_empty() {
             let at_n = before.or(at_n).ok_or(crate::error::SystemError::Order(
@@ -626,9 +623,9 @@ fn solve_step<T: Real + Send + Sync, P: KernelPath<T>>(
                         let j = members[i];
                         batch.iterations[j].push(its);
                         // As the CPU integrator: a cut step doubles after an easy one.
-                        if its <= 4 && batch.step[j] < batch.options.dt {
-                            batch.step[j] = (2.0 * batch.step[j]).min(batch.options.dt);
-                            batch.log[j].push(format!("step regrown to {:.3e} s", batch.step[j]));
+                        if let Some(h) = control::regrown(batch.step[j], its, batch.options.dt) {
+                            batch.step[j] = h;
+                            batch.log[j].push(format!("step regrown to {h:.3e} s"));
                         }
                     }
                     Event::Failed(reason) => failed.push((i, reason)),

@@ -33,6 +33,7 @@ use crate::solve::statics::{
     reference_force, to_global, StaticState,
 };
 
+pub mod control;
 mod step;
 use step::CpuStep;
 
@@ -233,6 +234,8 @@ pub struct Dynamics<'a> {
     pub log: Vec<String>,
     /// Newton iterations of every completed step.
     pub iterations: Vec<usize>,
+    /// The run's own step ([`control`]): `dt`, or cut and not yet regrown.
+    own_step: f64,
 }
 
 impl<'a> Dynamics<'a> {
@@ -252,6 +255,7 @@ impl<'a> Dynamics<'a> {
             inertia0,
             f_ext: external_loads(model),
             f_ref: reference_force(model),
+            own_step: options.dt,
             options,
             solver: ChainSolver::new(),
             k0: None,
@@ -689,47 +693,6 @@ impl<'a> Dynamics<'a> {
                 };
             }
         }
-    }
-
-    /// Integrates to `t_end`, calling `observe` after every step; cuts the step on failure
-    /// (logged) and regrows it after easy steps.
-    pub fn run(
-        &mut self,
-        s: &mut DynamicState,
-        t_end: f64,
-        observe: &mut dyn FnMut(&Dynamics, &DynamicState),
-    ) -> Result<(), DynamicError> {
-        let mut h = self.options.dt;
-        while s.t < t_end - 1e-12 {
-            let step = h.min(t_end - s.t);
-            match self.step(s, step) {
-                Ok(its) => {
-                    self.iterations.push(its);
-                    observe(self, s);
-                    if its <= 4 && h < self.options.dt {
-                        h = (2.0 * h).min(self.options.dt);
-                        self.log
-                            .push(format!("t = {:.6} s: step regrown to {h:.3e} s", s.t));
-                    }
-                }
-                Err(reason) => {
-                    if step / 2.0 < self.options.min_dt {
-                        return Err(DynamicError::Stalled {
-                            t: s.t,
-                            step,
-                            min_dt: self.options.min_dt,
-                            reason: reason.to_string(),
-                        });
-                    }
-                    h = step / 2.0;
-                    self.log.push(format!(
-                        "t = {:.6} s: step {step:.3e} s failed ({reason}); cut to {h:.3e} s",
-                        s.t
-                    ));
-                }
-            }
-        }
-        Ok(())
     }
 }
 
