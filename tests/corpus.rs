@@ -485,10 +485,7 @@ fn dynamic_corpus_sample_runs_to_the_end() {
 /// The smallest of the dynamic corpus through the GPU engine, f64 and f32, against the CPU
 /// integrator (the first seed of at most 80 nodes with lumped mass, which the engine runs,
 /// that the CPU runs without a step cut): solved by the engine itself, hook load and largest
-/// surface torque to solver tolerance in f64. A cut step puts the two on different time
-/// grids (the CPU regrows its step from where the cut left it, the engine takes the batch's
-/// step in sub-steps), so a cut run is compared by `holewall bench dynamic-corpus`, not to
-/// the solver's tolerance.
+/// surface torque to solver tolerance in f64. A run that cuts is the next test's.
 #[test]
 fn a_dynamic_corpus_case_through_the_engine_matches_the_cpu() {
     if common::gpu().is_none() {
@@ -541,6 +538,47 @@ fn a_dynamic_corpus_case_through_the_engine_matches_the_cpu() {
             e.cpu_spread_torque_rel
         );
     }
+}
+
+/// The first dynamic corpus case of at most 80 nodes (lumped mass) that the CPU integrator
+/// runs with step cuts, through the GPU engine in f64: both cut and regrow by one policy
+/// (`solve::dynamics::control`), so the engine cuts as often as the CPU and its hook load and
+/// largest surface torque lie within ten times the CPU's own spread (the CPU run again with
+/// its kick changed by 1e-8) or 1e-6, whichever is larger. Before the policy was shared the
+/// CPU regrew a cut step in the middle of the engine's step: seed 5's hook loads parted by
+/// 5.2e-2.
+#[test]
+fn a_dynamic_corpus_case_that_cuts_takes_the_cpus_steps_in_the_engine() {
+    if common::gpu().is_none_or(|c| !c.has_f64) {
+        return;
+    }
+    let dir = tempdir::Dir::new("dynamic_corpus_engine_cut");
+    let (case, cpu) = dynamic_sample(dir.path(), 40, 80)
+        .into_iter()
+        .filter(|c| c.spec.mass == "lumped")
+        .find_map(|c| {
+            let cpu = holewall::corpus::dynamic::run_case_dynamic(&c).unwrap();
+            (cpu.solved && cpu.step_cuts > 0).then_some((c, cpu))
+        })
+        .unwrap();
+    let again = holewall::corpus::dynamic::run_case_perturbed(&case).unwrap();
+    let e = holewall::corpus::dynamic::run_case_engine(&case, &cpu, &again, false).unwrap();
+    eprintln!(
+        "dynamic seed {} gpu_f64: {} cuts ({} on the CPU), hook load {:.1e} (CPU spread {:.1e}), torque {:.1e} (spread {:.1e}), same whirl {}",
+        e.seed,
+        e.step_cuts,
+        cpu.step_cuts,
+        e.hook_load_rel,
+        e.cpu_spread_hook_rel,
+        e.torque_rel,
+        e.cpu_spread_torque_rel,
+        e.same_whirl
+    );
+    assert!(e.solved && e.by_engine, "{}", e.reason);
+    assert_eq!(e.step_cuts, cpu.step_cuts, "cuts");
+    let bound = |spread: f64| (10.0 * spread).max(1e-6);
+    assert!(e.hook_load_rel <= bound(e.cpu_spread_hook_rel), "hook load");
+    assert!(e.torque_rel <= bound(e.cpu_spread_torque_rel), "torque");
 }
 
 /// A dynamic corpus case run on the CPU (which must solve it), then through the engine in
