@@ -254,7 +254,12 @@ pub fn run_case(case: &Case, out: &Path, run_options: RunOptions) -> Result<RunS
                     ));
                     break;
                 }
-                let until = (s.t + settings.output_interval).min(settings.duration);
+                // A whole number of steps (the output interval's, at least one), so that a
+                // chunk ends on the steps' grid and the run takes the steps it takes
+                // unbounded (`solve::dynamics::control`).
+                let dt = settings.time_step;
+                let steps = (settings.output_interval / dt).round().max(1.0);
+                let until = (s.t + steps * dt).min(settings.duration);
                 dynamics
                     .run(&mut s, until, &mut observe)
                     .map_err(Error::failed)?;

@@ -651,6 +651,56 @@ fn output_folder_is_checked_first_and_replaced_whole() {
     assert_eq!(std::fs::read(out.join("summary.json")).unwrap(), before);
 }
 
+/// A bounded run (`run --max-seconds`, an output interval at a time) takes the steps the
+/// unbounded run takes, cuts included: the extreme-contact bed near stick-slip (ε = 1e-6
+/// m/s, μ = 1, 30 rpm, 10 ms steps, 0.15 s), which cuts and regrows, writes the same time
+/// series bit for bit either way. Before, each chunk began with a full step (18 cuts
+/// unbounded, 24 bounded) and its end, computed as the start plus the interval, left a
+/// step an ulp short of the time step (the series parted at t = 0.03 s by 1e-12, then by
+/// the cuts).
+#[test]
+fn a_bounded_run_takes_the_steps_of_the_unbounded_one() {
+    let text = common::bed_text("1.0", "8.25 in", "6e7", "1", "1e-6")
+        .replace("time_step = \"2 ms\"", "time_step = \"10 ms\"")
+        .replace("rpm = \"120 rpm\"", "rpm = \"30 rpm\"")
+        .replace("duration = \"0.1 s\"", "duration = \"0.15 s\"");
+    let out = scratch("bounded-steps");
+    let case = out.join("bed.toml");
+    std::fs::create_dir_all(&out).unwrap();
+    std::fs::write(&case, text).unwrap();
+    let series = |name: &str, bounded: bool| {
+        let dir = out.join(name);
+        let mut args = vec![
+            "run",
+            case.to_str().unwrap(),
+            "--out",
+            dir.to_str().unwrap(),
+            "--quiet",
+        ];
+        if bounded {
+            args.extend(["--max-seconds", "1000"]);
+        }
+        let (code, stdout, stderr) = holewall(&args);
+        assert_eq!(code, 0, "{stderr}");
+        let summary: serde_json::Value = serde_json::from_str(&stdout).unwrap();
+        let cuts = summary["log"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .filter(|l| l.as_str().unwrap().contains("cut to"))
+            .count();
+        (
+            std::fs::read_to_string(dir.join("timeseries.csv")).unwrap(),
+            cuts,
+        )
+    };
+    let (free, free_cuts) = series("free", false);
+    let (bounded, bounded_cuts) = series("bounded", true);
+    assert!(free_cuts > 0, "the case no longer cuts");
+    assert_eq!(bounded_cuts, free_cuts);
+    assert_eq!(bounded, free);
+}
+
 /// Long runs can be bounded (issue 15, part 2): `run --max-seconds` stops at an output
 /// instant, writes the outputs of the time simulated and says so; the static FE solve stops
 /// with how far it got.

@@ -22,11 +22,23 @@ use super::{DynamicError, DynamicState, Dynamics};
 pub const EASY_ITERATIONS: usize = 4;
 
 /// A span's next step from `time` at level `h` towards `t_end`: `(step, end)`, the step
-/// shortened to end on `t_end`; `None` once the span is done.
+/// shortened to end on `t_end`; `None` once the span is done. Where what is left is `h`
+/// to rounding (1e-9 of it), the step is `h` itself and ends on `t_end`: a span's end
+/// computed another way (a sub-span's, a bounded run's chunk) does not leave a step an ulp
+/// off `h` — which a run near stick-slip carries to other cuts.
 pub fn next_step(time: f64, t_end: f64, h: f64) -> Option<(f64, f64)> {
     if time < t_end - 1e-12 * t_end.abs().max(1.0) {
-        let step = h.min(t_end - time);
-        Some((step, time + step))
+        let rest = t_end - time;
+        if rest <= h * (1.0 + 1e-9) {
+            let step = if (rest - h).abs() <= 1e-9 * h {
+                h
+            } else {
+                rest
+            };
+            Some((step, t_end))
+        } else {
+            Some((h, time + h))
+        }
     } else {
         None
     }
@@ -128,6 +140,9 @@ mod tests {
         assert_eq!(steps.len(), 3);
         assert!((steps[2] - 0.005).abs() < 1e-15);
         assert_eq!(t, 0.025);
+        // 0.03 − 0.02 is 0.01 less an ulp: the step is 0.01 itself, ending on 0.03.
+        assert_ne!(0.03 - 0.02, 0.01);
+        assert_eq!(next_step(0.02, 0.03, 0.01), Some((0.01, 0.03)));
         assert_eq!(cut(0.01, 1e-7), Some(0.005));
         assert_eq!(cut(1.5e-7, 1e-7), None);
         assert_eq!(regrown(0.0025, 4, 0.01), Some(0.005));
