@@ -660,10 +660,8 @@ fn output_folder_is_checked_first_and_replaced_whole() {
 /// the cuts).
 #[test]
 fn a_bounded_run_takes_the_steps_of_the_unbounded_one() {
-    let text = common::bed_text("1.0", "8.25 in", "6e7", "1", "1e-6")
-        .replace("time_step = \"2 ms\"", "time_step = \"10 ms\"")
-        .replace("rpm = \"120 rpm\"", "rpm = \"30 rpm\"")
-        .replace("duration = \"0.1 s\"", "duration = \"0.15 s\"");
+    let text =
+        common::stick_slip_bed_text().replace("duration = \"0.1 s\"", "duration = \"0.15 s\"");
     let out = scratch("bounded-steps");
     let case = out.join("bed.toml");
     std::fs::create_dir_all(&out).unwrap();

@@ -492,18 +492,7 @@ fn a_dynamic_corpus_case_through_the_engine_matches_the_cpu() {
         return;
     }
     let dir = tempdir::Dir::new("dynamic_corpus_engine");
-    let (case, cpu) = dynamic_sample(dir.path(), 40, 80)
-        .into_iter()
-        .filter(|c| c.spec.mass == "lumped")
-        .find_map(|c| {
-            let cpu = holewall::corpus::dynamic::run_case_dynamic(&c).unwrap();
-            eprintln!(
-                "dynamic seed {}: {} CPU step cuts",
-                c.spec.seed, cpu.step_cuts
-            );
-            (cpu.solved && cpu.step_cuts == 0).then_some((c, cpu))
-        })
-        .unwrap();
+    let (case, cpu) = first_small_lumped(dir.path(), |cpu| cpu.step_cuts == 0);
     for (f32, e) in engine_rows(&case, &cpu) {
         eprintln!(
             "dynamic seed {} {}: by engine {}, {} cuts ({} on the CPU), hook load {:.1e}, torque {:.1e}, stab1 force {:.1e} off the CPU's, same whirl {}, {:.1} s; {}",
@@ -553,14 +542,7 @@ fn a_dynamic_corpus_case_that_cuts_takes_the_cpus_steps_in_the_engine() {
         return;
     }
     let dir = tempdir::Dir::new("dynamic_corpus_engine_cut");
-    let (case, cpu) = dynamic_sample(dir.path(), 40, 80)
-        .into_iter()
-        .filter(|c| c.spec.mass == "lumped")
-        .find_map(|c| {
-            let cpu = holewall::corpus::dynamic::run_case_dynamic(&c).unwrap();
-            (cpu.solved && cpu.step_cuts > 0).then_some((c, cpu))
-        })
-        .unwrap();
+    let (case, cpu) = first_small_lumped(dir.path(), |cpu| cpu.step_cuts > 0);
     let again = holewall::corpus::dynamic::run_case_perturbed(&case).unwrap();
     let e = holewall::corpus::dynamic::run_case_engine(&case, &cpu, &again, false).unwrap();
     eprintln!(
@@ -579,6 +561,29 @@ fn a_dynamic_corpus_case_that_cuts_takes_the_cpus_steps_in_the_engine() {
     let bound = |spread: f64| (10.0 * spread).max(1e-6);
     assert!(e.hook_load_rel <= bound(e.cpu_spread_hook_rel), "hook load");
     assert!(e.torque_rel <= bound(e.cpu_spread_torque_rel), "torque");
+}
+
+/// The first dynamic corpus case of at most 80 nodes with lumped mass (which the engine
+/// runs) that the CPU solves and whose CPU row passes `want`: the case and that row.
+fn first_small_lumped(
+    dir: &std::path::Path,
+    want: impl Fn(&holewall::corpus::dynamic::DynamicRow) -> bool,
+) -> (
+    holewall::corpus::dynamic::DynamicCase,
+    holewall::corpus::dynamic::DynamicRow,
+) {
+    dynamic_sample(dir, 40, 80)
+        .into_iter()
+        .filter(|c| c.spec.mass == "lumped")
+        .find_map(|c| {
+            let cpu = holewall::corpus::dynamic::run_case_dynamic(&c).unwrap();
+            eprintln!(
+                "dynamic seed {}: {} CPU step cuts",
+                c.spec.seed, cpu.step_cuts
+            );
+            (cpu.solved && want(&cpu)).then_some((c, cpu))
+        })
+        .unwrap()
 }
 
 /// A dynamic corpus case run on the CPU (which must solve it), then through the engine in

@@ -754,10 +754,8 @@ fn a_variant_whose_step_fails_is_cut_on_its_own_in_the_engine() {
     let t_end = 0.05;
     // The CPU integrator on the variant that needs cuts.
     let m = &models[1];
-    let mut d = Dynamics::new(m, options, &|e| density[e]);
-    let mut s = d.initial_state(starts[1].clone()).unwrap();
-    d.run(&mut s, t_end, &mut |_, _| {}).unwrap();
-    assert!(!d.log.is_empty(), "the CPU integrator did not cut");
+    let (log, s) = cpu_to_end(&models, &starts, &density, 1, &options, t_end);
+    assert!(!log.is_empty(), "the CPU integrator did not cut");
     let n = m.nodes.len();
     let cpu_u: Vec<f64> = (0..n)
         .flat_map(|i| (0..3).map(move |k| (i, k)))
@@ -772,7 +770,7 @@ fn a_variant_whose_step_fails_is_cut_on_its_own_in_the_engine() {
         }
         eprintln!(
             "{label}: variant 1 cuts: {:?}; CPU integrator: {:?}",
-            results[1].log, d.log
+            results[1].log, log
         );
         assert!(
             !results[1].log.is_empty(),
@@ -945,9 +943,7 @@ fn a_site_held_for_another_variant_adds_nothing() {
 /// against 18 on the twin, the end displacements 8.8e-3 of the largest apart.
 #[test]
 fn a_run_that_cuts_and_regrows_takes_the_cpu_integrators_steps_in_the_engine() {
-    let text = common::bed_text("1.0", "8.25 in", "6e7", "1", "1e-6")
-        .replace("time_step = \"2 ms\"", "time_step = \"10 ms\"")
-        .replace("rpm = \"120 rpm\"", "rpm = \"30 rpm\"");
+    let text = common::stick_slip_bed_text();
     let case = holewall::case::parse_case(std::path::Path::new("bed.toml"), &text).unwrap();
     // The second variant, ε changed by 1e-13, measures the run's own sensitivity.
     let (models, starts) = with_starts(&case, "eps\n1e-6\n1.0000000000001e-6\n");
@@ -955,14 +951,8 @@ fn a_run_that_cuts_and_regrows_takes_the_cpu_integrators_steps_in_the_engine() {
     let density = case.element_density.clone();
     let t_end = 0.15;
     let m = &models[0];
-    let end_of = |j: usize| {
-        let mut d = Dynamics::new(&models[j], options, &|e| density[e]);
-        let mut s = d.initial_state(starts[j].clone()).unwrap();
-        d.run(&mut s, t_end, &mut |_, _| {}).unwrap();
-        (d.log.clone(), s)
-    };
-    let (log, s) = end_of(0);
-    let (_, perturbed) = end_of(1);
+    let (log, s) = cpu_to_end(&models, &starts, &density, 0, &options, t_end);
+    let (_, perturbed) = cpu_to_end(&models, &starts, &density, 1, &options, t_end);
     let cuts = |log: &[String]| log.iter().filter(|l| l.contains("cut to")).count();
     let quarter = log.iter().any(|l| l.contains("cut to 2.500e-3"));
     let regrown = log.iter().filter(|l| l.contains("regrown")).count();
@@ -1040,4 +1030,20 @@ fn run_to_end(
     )
     .unwrap();
     (r, last.unwrap())
+}
+
+/// The CPU integrator's run of variant `j` from rest at its start to `t_end`: its log and
+/// its last state.
+fn cpu_to_end(
+    models: &[Model],
+    starts: &[StaticState],
+    density: &[f64],
+    j: usize,
+    options: &holewall::solve::dynamics::DynamicOptions,
+    t_end: f64,
+) -> (Vec<String>, holewall::solve::dynamics::DynamicState) {
+    let mut d = Dynamics::new(&models[j], *options, &|e| density[e]);
+    let mut s = d.initial_state(starts[j].clone()).unwrap();
+    d.run(&mut s, t_end, &mut |_, _| {}).unwrap();
+    (d.log, s)
 }

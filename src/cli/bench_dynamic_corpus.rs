@@ -173,6 +173,15 @@ pub fn run(out: &Path, options: &DynamicCorpusOptions) -> Result<DynamicCorpusSu
         .iter()
         .filter_map(|&path| {
             let e: Vec<&DynamicEngineRow> = engine_rows.iter().filter(|r| r.path == path).collect();
+            // A measure's spread over the cases the engine solved itself.
+            let solved = |f: fn(&DynamicEngineRow) -> f64| {
+                spread(
+                    &e.iter()
+                        .filter(|r| r.by_engine)
+                        .map(|r| (r.seed, f(r)))
+                        .collect::<Vec<_>>(),
+                )
+            };
             (!e.is_empty()).then(|| EnginePathSummary {
                 path: path.into(),
                 cases: e.len(),
@@ -182,37 +191,12 @@ pub fn run(out: &Path, options: &DynamicCorpusOptions) -> Result<DynamicCorpusSu
                     .filter(|r| !r.by_engine)
                     .map(|r| (r.seed, r.reason.chars().take(300).collect()))
                     .collect(),
-                hook_load_rel: spread(
-                    &e.iter()
-                        .filter(|r| r.by_engine)
-                        .map(|r| (r.seed, r.hook_load_rel))
-                        .collect::<Vec<_>>(),
-                ),
-                hook_load_of_force_scale: spread(
-                    &e.iter()
-                        .filter(|r| r.by_engine)
-                        .map(|r| (r.seed, r.hook_load_of_force_scale))
-                        .collect::<Vec<_>>(),
-                ),
-                torque_rel: spread(
-                    &e.iter()
-                        .filter(|r| r.by_engine)
-                        .map(|r| (r.seed, r.torque_rel))
-                        .collect::<Vec<_>>(),
-                ),
-                stab1_force_rel: spread(
-                    &e.iter()
-                        .filter(|r| r.by_engine)
-                        .map(|r| (r.seed, r.stab1_force_rel))
-                        .collect::<Vec<_>>(),
-                ),
+                hook_load_rel: solved(|r| r.hook_load_rel),
+                hook_load_of_force_scale: solved(|r| r.hook_load_of_force_scale),
+                torque_rel: solved(|r| r.torque_rel),
+                stab1_force_rel: solved(|r| r.stab1_force_rel),
                 same_whirl: e.iter().filter(|r| r.by_engine && r.same_whirl).count(),
-                cpu_spread_hook_rel: spread(
-                    &e.iter()
-                        .filter(|r| r.by_engine)
-                        .map(|r| (r.seed, r.cpu_spread_hook_rel))
-                        .collect::<Vec<_>>(),
-                ),
+                cpu_spread_hook_rel: solved(|r| r.cpu_spread_hook_rel),
                 hook_within_cpu_spread: e
                     .iter()
                     .filter(|r| {

@@ -194,10 +194,9 @@ pub fn measure(ctx: &GpuContext, repeats: usize) -> Result<Ceilings, GpuError> {
     for footprint in copy_footprints().filter(|&f| f / 2 <= largest) {
         let bytes = footprint / 2;
         let src = vec![1u8; bytes];
-        let mut best: Option<CopyPoint> = None;
         let mut by_form = [f64::NAN; 2];
-        for (slot, (element, size, label, pipeline)) in forms.iter().enumerate() {
-            let (element, size) = (*element, *size);
+        for (slot, (_, size, label, pipeline)) in forms.iter().enumerate() {
+            let size = *size;
             let words = bytes / size;
             // Grid-stride: a GPU's one-dimensional dispatch holds 65,535 workgroups.
             let threads = words.min(65_535 * 64);
@@ -224,16 +223,15 @@ pub fn measure(ctx: &GpuContext, repeats: usize) -> Result<Ceilings, GpuError> {
             };
             let gbytes_per_s = footprint as f64 / seconds / 1e9;
             by_form[slot] = gbytes_per_s;
-            if best.is_none_or(|b| gbytes_per_s > b.gbytes_per_s) {
-                best = Some(CopyPoint {
-                    footprint_bytes: footprint,
-                    gbytes_per_s,
-                    form: element,
-                    by_form: [f64::NAN; 2],
-                });
-            }
         }
-        copy_curve.extend(best.map(|b| CopyPoint { by_form, ..b }));
+        // The faster form (the first where they tie).
+        let best = (0..forms.len()).fold(0, |b, k| if by_form[k] > by_form[b] { k } else { b });
+        copy_curve.push(CopyPoint {
+            footprint_bytes: footprint,
+            gbytes_per_s: by_form[best],
+            form: forms[best].0,
+            by_form,
+        });
     }
     Ok(Ceilings {
         fma_gflops_f32,

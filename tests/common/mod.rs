@@ -68,6 +68,15 @@ pub fn bed_text(mu: &str, blade: &str, k_e: &str, m: &str, eps: &str) -> String 
     .replace("EPS", eps)
 }
 
+/// [`bed_text`] near stick-slip (μ = 1, ε = 1e-6 m/s, 30 rpm, 10 ms steps): a run that
+/// cuts its step to a quarter and regrows it, for the tests of the step control
+/// (`solve::dynamics::control`).
+pub fn stick_slip_bed_text() -> String {
+    bed_text("1.0", "8.25 in", "6e7", "1", "1e-6")
+        .replace("time_step = \"2 ms\"", "time_step = \"10 ms\"")
+        .replace("rpm = \"120 rpm\"", "rpm = \"30 rpm\"")
+}
+
 /// [`bed_text`] parsed, with Table 1 values except the spring exponent `m`.
 pub fn bed_case(m: &str) -> holewall::case::Case {
     holewall::case::parse_case(
