@@ -22,7 +22,11 @@
 //!   then halved. Statics accept a step whose energy slope `|Δ·r(α)|` does not exceed
 //!   `|Δ·r(0)|` or that lowers `‖r‖₂` by `1e-4 α`, halving at most 5 times and taking the
 //!   last (α = 1/32); dynamics accept only a lower `‖r‖₂`, halving up to 24 times and
-//!   taking the full step when nothing shorter helps. In f32 a variant whose residual is at
+//!   taking the full step when nothing shorter helps. A static search whose full step
+//!   fails goes on from one halving above the last update's step ([`LineSearch::memory`]):
+//!   down from there as before where that fails, up by bisection toward the full step
+//!   where it passes, so it takes the longest passing step of the halvings as the plain
+//!   search does wherever the steps that pass are the short ones. In f32 a variant whose residual is at
 //!   the precision's floor accepts a trial that keeps `‖r‖₂` within twice its value (its
 //!   residual norm is rounding noise there, which halving cannot lower) — but not one that
 //!   leaves the noise band: a full step along a soft direction (a pinned stabilizer with
@@ -57,6 +61,16 @@ pub struct LineSearch {
     pub take_smallest: bool,
     /// The step taken when no trial passes and `take_smallest`.
     pub fallback_halvings: usize,
+    /// After the full step fails, go on from one halving above the last update's: down
+    /// from there where it fails, up by bisection between the full step (failed) and it
+    /// where it passes. A solve that crawls toward a soft wall (the Newton direction
+    /// carries a node off the wall far through it, and the search takes the halving that
+    /// stops short of it) halves its step at about every update, and searched from the full
+    /// step each time it paid for all those halvings again: corpus well 221 (soft law,
+    /// 10 m elements), 14,305 trials in 1,835 iterations, 8,183 with the memory on the same
+    /// iterations and answer (`holewall static`, docs/performance.md, stop 60). Statics;
+    /// a time step's few iterations do not crawl.
+    pub memory: bool,
 }
 
 /// Newton settings: iterations, tolerances, line search.
@@ -139,6 +153,7 @@ impl NewtonSettings {
                 max_halvings: 5,
                 take_smallest: true,
                 fallback_halvings: 5,
+                memory: true,
             },
             noise_band_at_floor: size == 4,
             stall_iterations: STATIC_STALL_ITERATIONS,
@@ -191,6 +206,7 @@ impl NewtonSettings {
                 max_halvings: 24,
                 take_smallest: false,
                 fallback_halvings: 24,
+                memory: false,
             },
             noise_band_at_floor: size == 4,
             stall_iterations: usize::MAX,
@@ -302,6 +318,8 @@ struct Track {
     finishing: bool,
     updates: usize,
     last_step: f64,
+    /// Halvings of the last update's step (0: the full step).
+    last_halvings: usize,
     floor: f64,
     /// Updates before this solve fails (`max_iterations` unless started with a limit).
     limit: usize,
@@ -387,6 +405,7 @@ impl Newton {
             finishing: false,
             updates: 0,
             last_step: f64::INFINITY,
+            last_halvings: 0,
             floor,
             limit: limits.iterations.map_or(self.settings.max_iterations, |l| {
                 l.min(self.settings.max_iterations)
@@ -590,31 +609,48 @@ impl Newton {
         // kept where every candidate is at its variant's final α.
         let mut candidate: Vec<Option<f64>> = vec![None; v];
         let last_trial = s.line_search.max_halvings;
+        // Each variant's search: the halvings of its next trial, and whether it goes up (to
+        // longer steps, from a short one that passed: [`LineSearch::memory`]) by bisection
+        // between the longest step that failed and the shortest that passed (halvings).
+        let mut depth = vec![0usize; v];
+        let mut up = vec![false; v];
+        let mut bracket = vec![(0usize, 0usize); v];
+        let mut jumped_to: Vec<Option<usize>> = vec![None; v];
         let mut trial = 0;
         let mut rounds = 0u32;
-        while trial <= last_trial && pending.iter().any(|&p| p) {
+        while pending.iter().any(|&p| p) {
             // The first trial alone (most variants take the full step; a system may have it
-            // from its solve), then the next halvings of the variants still searching in
+            // from its solve), then the next trials of the variants still searching in
             // rounds of 2, 4, 8, … up to the system's size: each variant's trials and
             // decisions are those of a search one trial at a time, the later ones of a round
-            // speculative. (Traced on a dynamic ensemble, V = 256: of the searches, 67 %
-            // take the full step, 21 % the first halving, 5 % the second, 7 % the third to
-            // sixth; by that count rounds of 2 then 4 cost 24 % more trials than one at a
-            // time, a round of 8 at once 140 %.)
+            // speculative (a variant whose search turns within a round leaves the rest of
+            // the round's trials unread). (Traced on a dynamic ensemble, V = 256: of the
+            // searches, 67 % take the full step, 21 % the first halving, 5 % the second, 7 %
+            // the third to sixth; by that count rounds of 2 then 4 cost 24 % more trials than
+            // one at a time, a round of 8 at once 140 %.)
+            let left = (0..v)
+                .filter(|&j| pending[j])
+                .map(|j| if up[j] { 1 } else { last_trial + 1 - depth[j] })
+                .max()
+                .unwrap_or(1);
             let round = if trial == 0 {
                 1
             } else {
                 let grown = 1usize << rounds.min(16);
-                grown
-                    .min(sys.trials_per_round())
-                    .clamp(1, last_trial + 1 - trial)
+                grown.min(sys.trials_per_round()).clamp(1, left)
             };
             rounds += 1;
             let alphas: Vec<Vec<f64>> = (0..round)
                 .map(|k| {
-                    let h = 0.5f64.powi(k as i32);
                     (0..v)
-                        .map(|j| if pending[j] { alpha[j] * h } else { alpha[j] })
+                        .map(|j| {
+                            // A bisection up has one trial a round (its next depends on it).
+                            if pending[j] && !up[j] {
+                                halved((depth[j] + k).min(last_trial))
+                            } else {
+                                alpha[j]
+                            }
+                        })
                         .collect()
                 })
                 .collect();
@@ -637,35 +673,78 @@ impl Newton {
                 }
             }
             for (k, r) in probes.iter().enumerate() {
-                let t = trial + k;
-                let last = t == last_trial;
                 for j in 0..v {
-                    if !pending[j] {
+                    if !pending[j] || alphas[k][j] != alpha[j] {
                         continue;
                     }
+                    let t = depth[j];
+                    let last = t == last_trial;
                     let a = alpha[j];
                     let finite = r.slope[j].is_finite() && r.norm[j].is_finite();
-                    last_finite[j] = finite;
-                    if t == s.line_search.fallback_halvings {
-                        fallback_finite[j] = finite;
-                    }
                     let slope_ok =
                         s.line_search.slope_test && r.slope[j].abs() <= probe.slope[j].abs();
                     let norm_ok = r.norm[j] <= (1.0 - 1e-4 * a) * probe.norm[j];
                     let band_ok = at_floor[j] && r.norm[j] <= 2.0 * probe.norm[j];
-                    if finite && (slope_ok || norm_ok || band_ok) {
-                        pending[j] = false;
+                    let pass = finite && (slope_ok || norm_ok || band_ok);
+                    if up[j] {
+                        // Up from a step that passed: the longest that passes, by bisection.
+                        let (failed, passed) = &mut bracket[j];
+                        if pass {
+                            *passed = t;
+                        } else {
+                            *failed = t;
+                        }
+                        if *passed - *failed > 1 {
+                            depth[j] = (*failed + *passed) / 2;
+                        } else {
+                            pending[j] = false;
+                            depth[j] = *passed;
+                        }
+                        alpha[j] = halved(depth[j]);
+                        continue;
+                    }
+                    last_finite[j] = finite;
+                    if t == s.line_search.fallback_halvings {
+                        fallback_finite[j] = finite;
+                    }
+                    if pass {
+                        if jumped_to[j] == Some(t) && t > 1 {
+                            // The first step tried after the jump passed: a longer one may.
+                            up[j] = true;
+                            bracket[j] = (0, t);
+                            depth[j] = t / 2;
+                            alpha[j] = halved(depth[j]);
+                        } else {
+                            pending[j] = false;
+                        }
                     } else if last {
                         pending[j] = false;
+                        let skipped =
+                            jumped_to[j].is_some_and(|d| d > s.line_search.fallback_halvings);
                         if !s.line_search.take_smallest {
                             alpha[j] = 1.0;
-                        } else if fallback_finite[j] && t != s.line_search.fallback_halvings {
-                            // The fallback step (its residual was finite); else the smallest.
-                            alpha[j] = 0.5f64.powi(s.line_search.fallback_halvings as i32);
+                        } else if (fallback_finite[j] || skipped)
+                            && t != s.line_search.fallback_halvings
+                        {
+                            // The fallback step (its residual was finite, or it was jumped
+                            // over: taken untried, a residual it makes non-finite fails the
+                            // next test); else the smallest.
+                            alpha[j] = halved(s.line_search.fallback_halvings);
                             last_finite[j] = true;
                         }
                     } else {
-                        alpha[j] *= 0.5;
+                        depth[j] = if t == 0 && s.line_search.memory {
+                            // From one halving above the last update's.
+                            let d = self.tracks[j]
+                                .last_halvings
+                                .saturating_sub(1)
+                                .clamp(1, last_trial);
+                            jumped_to[j] = Some(d);
+                            d
+                        } else {
+                            t + 1
+                        };
+                        alpha[j] = halved(depth[j]);
                     }
                 }
             }
@@ -690,6 +769,7 @@ impl Newton {
                 track.updates += 1;
             }
             track.last_step = probe.step[j] * alpha[j];
+            track.last_halvings = (-alpha[j].log2()).round().max(0.0) as usize;
             if ends[j] {
                 track.running = false;
                 events.push((j, Event::Converged(track.updates)));
@@ -697,6 +777,11 @@ impl Newton {
         }
         Ok(events)
     }
+}
+
+/// `2^−d`: the step after `d` halvings.
+fn halved(d: usize) -> f64 {
+    0.5f64.powi(d as i32)
 }
 
 #[cfg(test)]
