@@ -26,16 +26,17 @@
 //!   fails goes on from one halving above the last update's step ([`LineSearch::memory`]):
 //!   down from there as before where that fails, up by bisection toward the full step
 //!   where it passes, so it takes the longest passing step of the halvings as the plain
-//!   search does wherever the steps that pass are the short ones. In f32 a variant whose residual is at
-//!   the precision's floor accepts a trial that keeps `‖r‖₂` within twice its value (its
-//!   residual norm is rounding noise there, which halving cannot lower) — but not one that
-//!   leaves the noise band: a full step along a soft direction (a pinned stabilizer with
-//!   μ = 1 on a 1e10 N/m wall) can jump from 4e-4 of the force scale to 150.
+//!   search does wherever the steps that pass are the short ones. In f32 a variant whose
+//!   residual is at the precision's floor accepts a trial that keeps `‖r‖₂` within twice
+//!   its value (its residual norm is rounding noise there, which halving cannot lower) —
+//!   but not one that leaves the noise band: a full step along a soft direction (a pinned
+//!   stabilizer with μ = 1 on a 1e10 N/m wall) can jump from 4e-4 of the force scale to 150.
 //!   A system whose trials wait on a device ([`NewtonSystem::trials_per_round`] > 1: the
 //!   GPU engines when `--trial-round` asks; one trial a submission is their default, see
-//!   `crate::gpu::batch::trials_per_round`) is asked for the halvings after the first trial in rounds of 2, 4, 8, …
-//!   at once; the decisions are taken over them in order, so every variant's steps are
-//!   those of one trial at a time (issue 27, item 3: fewer round trips).
+//!   `crate::gpu::batch::trials_per_round`) is asked for the trials after the first in
+//!   rounds of 2, 4, 8, … at once (a bisection up, one at a time); the decisions are taken
+//!   over them in order, so every variant's steps are those of one trial at a time (issue
+//!   27, item 3: fewer round trips).
 //! - **Failure** per variant: a non-finite residual, a singular tangent, or no convergence
 //!   within `max_iterations` updates, or (statics) a residual that has not halved in
 //!   [`STATIC_STALL_ITERATIONS`]. The failing variant stops; the others go on.
