@@ -223,33 +223,35 @@ fn a_failing_variant_stops_alone() {
     assert_eq!(ended[1].1, Event::Failed("residual is not finite".into()));
 }
 
-/// Independent problems `r_j(x) = atan(x − b_j) + 10⁻⁴ x` (one per variant): from a start
-/// far from the root the full Newton step overshoots and the line search halves.
-struct Atan {
-    x: Vec<f64>,
-    b: Vec<f64>,
-    delta: Vec<f64>,
-}
-
-impl Atan {
-    fn r(&self, j: usize, x: f64) -> f64 {
-        (x - self.b[j]).atan() + x * 1e-4
+/// Independent scalar problems, one per variant: the residual `r(j, x)`, its derivative, and
+/// the scale its measure is taken against.
+trait Scalar {
+    fn r(&self, j: usize, x: f64) -> f64;
+    fn dr(&self, j: usize, x: f64) -> f64;
+    fn scale(&self, _j: usize) -> f64 {
+        1.0
     }
 }
 
-impl NewtonSystem for Atan {
+/// A [`Scalar`] problem at the points `x` as a [`NewtonSystem`].
+struct Scalars<P> {
+    p: P,
+    x: Vec<f64>,
+    delta: Vec<f64>,
+}
+
+impl<P: Scalar> NewtonSystem for Scalars<P> {
     fn variants(&self) -> usize {
         self.x.len()
     }
     fn solve(&mut self) -> Result<Probe, crate::error::SystemError> {
         let mut p = Probe::default();
         self.delta.clear();
-        for j in 0..self.x.len() {
-            let x = self.x[j];
-            let r = self.r(j, x);
-            let d = -r / (1.0 / (1.0 + (x - self.b[j]).powi(2)) + 1e-4);
+        for (j, &x) in self.x.iter().enumerate() {
+            let r = self.p.r(j, x);
+            let d = -r / self.p.dr(j, x);
             self.delta.push(d);
-            p.measure.push(r.abs());
+            p.measure.push(r.abs() / self.p.scale(j));
             p.step.push(d.abs());
             p.slope.push(d * r);
             p.norm.push(r.abs());
@@ -265,7 +267,7 @@ impl NewtonSystem for Atan {
     ) -> Result<TrialProbe, crate::error::SystemError> {
         let mut t = TrialProbe::default();
         for j in 0..self.x.len() {
-            let r = self.r(j, self.x[j] + alpha[j] * self.delta[j]);
+            let r = self.p.r(j, self.x[j] + alpha[j] * self.delta[j]);
             t.slope.push(self.delta[j] * r);
             t.norm.push(r.abs());
         }
@@ -276,6 +278,21 @@ impl NewtonSystem for Atan {
             self.x[j] += alpha[j] * self.delta[j];
         }
         Ok(())
+    }
+}
+
+/// `r_j(x) = atan(x − b_j) + 10⁻⁴ x`: from a start far from the root the full Newton step
+/// overshoots and the line search halves.
+struct Atan {
+    b: Vec<f64>,
+}
+
+impl Scalar for Atan {
+    fn r(&self, j: usize, x: f64) -> f64 {
+        (x - self.b[j]).atan() + x * 1e-4
+    }
+    fn dr(&self, j: usize, x: f64) -> f64 {
+        1.0 / (1.0 + (x - self.b[j]).powi(2)) + 1e-4
     }
 }
 
@@ -336,14 +353,14 @@ impl<S: NewtonSystem> NewtonSystem for Rounds<S> {
 /// The roots, the events, the updates, the round trips and the trials evaluated.
 type RoundsRun = (Vec<f64>, Vec<(usize, Event)>, Vec<usize>, usize, usize);
 
-/// Solves the [`Atan`] problems from `x0` with `settings`, trials in rounds of `per_round`:
-/// the roots, the events, the updates, the round trips and the trials evaluated.
-fn atans_in_rounds(settings: NewtonSettings, x0: &[f64], b: &[f64], per_round: usize) -> RoundsRun {
+/// Solves the problems `p` from `x0` with `settings`, trials in rounds of `per_round`: the
+/// roots, the events, the updates, the round trips and the trials evaluated.
+fn in_rounds<P: Scalar>(settings: NewtonSettings, p: P, x0: &[f64], per_round: usize) -> RoundsRun {
     let v = x0.len();
     let mut sys = Rounds {
-        inner: Atan {
+        inner: Scalars {
+            p,
             x: x0.to_vec(),
-            b: b.to_vec(),
             delta: vec![],
         },
         per_round,
@@ -379,10 +396,11 @@ fn trials_in_rounds_decide_as_trials_one_at_a_time() {
         NewtonSettings::statics(60, 1e-12, 8),
         NewtonSettings::statics_for_law(60, 1e-12, 8, true),
     ] {
-        let (x1, e1, u1, trips1, trials1) = atans_in_rounds(settings, &x0, &b, 1);
+        let atan = || Atan { b: b.to_vec() };
+        let (x1, e1, u1, trips1, trials1) = in_rounds(settings, atan(), &x0, 1);
         assert!(trials1 > 2 * u1.iter().max().unwrap(), "the searches halve");
         for per_round in [2, 4, 8, 30] {
-            let (x, e, u, trips, trials) = atans_in_rounds(settings, &x0, &b, per_round);
+            let (x, e, u, trips, trials) = in_rounds(settings, atan(), &x0, per_round);
             // The same path to the bit: every decision as one trial at a time.
             let bits = |x: &[f64]| x.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
             assert_eq!(bits(&x), bits(&x1), "{per_round}");
@@ -395,99 +413,32 @@ fn trials_in_rounds_decide_as_trials_one_at_a_time() {
     }
 }
 
-/// Independent problems `r_j(x) = s x − F_j + K max(0, x − w)²` (one per variant): a soft
-/// spring pushed onto a stiff wall at `w`. From `x = 0` (off the wall) the full Newton step
-/// lands far inside the wall; the search takes the longest step that stays near it, and
-/// the next update's direction is as long again: the solve crawls toward the wall, halving
-/// its step at each update (a soft-law contact's onset in a static solve, issue 22).
+/// `r_j(x) = s x − F_j + K max(0, x − w)²`: a soft spring pushed onto a stiff wall at `w`.
+/// From `x = 0` (off the wall) the full Newton step lands far inside the wall; the search
+/// takes the longest step that stays near it, and the next update's direction is as long
+/// again: the solve crawls toward the wall, halving its step at each update (a soft-law
+/// contact's onset in a static solve, issue 22).
 struct Wall {
-    x: Vec<f64>,
     f: Vec<f64>,
-    delta: Vec<f64>,
 }
 
 impl Wall {
     const S: f64 = 1.0;
     const K: f64 = 1e8;
     const W: f64 = 1.0;
+}
+
+impl Scalar for Wall {
     fn r(&self, j: usize, x: f64) -> f64 {
         let pen = (x - Self::W).max(0.0);
         Self::S * x - self.f[j] + Self::K * pen * pen
     }
-}
-
-impl NewtonSystem for Wall {
-    fn variants(&self) -> usize {
-        self.x.len()
+    fn dr(&self, _j: usize, x: f64) -> f64 {
+        Self::S + 2.0 * Self::K * (x - Self::W).max(0.0)
     }
-    fn solve(&mut self) -> Result<Probe, crate::error::SystemError> {
-        let mut p = Probe::default();
-        self.delta.clear();
-        for j in 0..self.x.len() {
-            let x = self.x[j];
-            let r = self.r(j, x);
-            let d = -r / (Self::S + 2.0 * Self::K * (x - Self::W).max(0.0));
-            self.delta.push(d);
-            p.measure.push(r.abs() / self.f[j]);
-            p.step.push(d.abs());
-            p.slope.push(d * r);
-            p.norm.push(r.abs());
-            p.solved.push(true);
-        }
-        Ok(p)
+    fn scale(&self, j: usize) -> f64 {
+        self.f[j]
     }
-    fn trial(
-        &mut self,
-        alpha: &[f64],
-        _: &[bool],
-        _: bool,
-    ) -> Result<TrialProbe, crate::error::SystemError> {
-        let mut t = TrialProbe::default();
-        for j in 0..self.x.len() {
-            let r = self.r(j, self.x[j] + alpha[j] * self.delta[j]);
-            t.slope.push(self.delta[j] * r);
-            t.norm.push(r.abs());
-        }
-        Ok(t)
-    }
-    fn accept(&mut self, alpha: &[f64], _: bool) -> Result<(), crate::error::SystemError> {
-        for j in 0..self.x.len() {
-            self.x[j] += alpha[j] * self.delta[j];
-        }
-        Ok(())
-    }
-}
-
-/// Solves the [`Wall`] problems with `settings`, trials in rounds of `per_round`: the
-/// roots, the events, the updates, the round trips and the trials evaluated.
-fn walls_in_rounds(settings: NewtonSettings, f: &[f64], per_round: usize) -> RoundsRun {
-    let v = f.len();
-    let mut sys = Rounds {
-        inner: Wall {
-            x: vec![0.0; v],
-            f: f.to_vec(),
-            delta: vec![],
-        },
-        per_round,
-        round_trips: 0,
-        evaluated: Vec::new(),
-    };
-    let mut newton = Newton::new(settings, v);
-    for j in 0..v {
-        newton.start(j, 1e-12, false);
-    }
-    let mut ended = Vec::new();
-    while newton.any_running() {
-        ended.extend(newton.iterate(&mut sys).unwrap());
-    }
-    let updates = (0..v).map(|j| newton.state(j).0.updates).collect();
-    (
-        sys.inner.x,
-        ended,
-        updates,
-        sys.round_trips,
-        sys.evaluated.len(),
-    )
 }
 
 #[test]
@@ -498,8 +449,10 @@ fn a_search_that_remembers_its_last_step_crawls_to_a_wall_on_fewer_trials() {
     plain.line_search.memory = false;
     let mut memory = plain;
     memory.line_search.memory = true;
-    let (x0, e0, u0, _, trials0) = walls_in_rounds(plain, &f, 1);
-    let (x1, e1, u1, _, trials1) = walls_in_rounds(memory, &f, 1);
+    let wall = || Wall { f: f.to_vec() };
+    let start = [0.0; 3];
+    let (x0, e0, u0, _, trials0) = in_rounds(plain, wall(), &start, 1);
+    let (x1, e1, u1, _, trials1) = in_rounds(memory, wall(), &start, 1);
     for (j, f) in f.iter().enumerate() {
         // The root: s x + K (x − w)² = F.
         let pen = (-Wall::S + (Wall::S * Wall::S + 4.0 * Wall::K * (f - Wall::S * Wall::W)).sqrt())
@@ -533,7 +486,7 @@ fn a_search_that_remembers_its_last_step_crawls_to_a_wall_on_fewer_trials() {
     assert!(3 * trials1 < 2 * trials0, "{trials1} against {trials0}");
     // In rounds, the same decisions.
     for per_round in [2, 4, 8] {
-        let (x, e, u, _, _) = walls_in_rounds(memory, &f, per_round);
+        let (x, e, u, _, _) = in_rounds(memory, wall(), &start, per_round);
         assert_eq!(bits(&x), bits(&x1), "{per_round}");
         assert_eq!((e, u), (e1.clone(), u1.clone()), "{per_round}");
     }
