@@ -63,15 +63,11 @@ pub struct LineSearch {
     /// The step taken when no trial passes and `take_smallest`.
     pub fallback_halvings: usize,
     /// After the full step fails, go on from one halving above the last update's: down
-    /// from there where it fails, up by bisection between the full step (failed) and it
-    /// where it passes. A solve that crawls toward a soft wall (the Newton direction
-    /// carries a node off the wall far through it, and the search takes the halving that
-    /// stops short of it) halves its step at about every update, and searched from the full
-    /// step each time it paid for all those halvings again: corpus well 221 (soft law,
-    /// 10 m elements), 14,305 trials in 1,835 iterations, 8,183 with the memory on the same
-    /// iterations and answer (`holewall static`, docs/performance.md, stop 60). Time
-    /// steps too: the dynamic corpus's seeds 0–99 took 148.4 → 133.6 s of solve time
-    /// (case 64, 201 cuts, 27.1 → 20.0 s), 98 of 100 with identical figures.
+    /// from there where it fails, up by bisection toward the full step where it passes. A
+    /// solve crawling toward a soft wall halves its step at about every update and paid
+    /// for every halving again: well 221 (soft law, 10 m), 14,305 → 8,183 trials on the
+    /// same 1,835 iterations; dynamic corpus 0–99 148.4 → 133.6 s, 98 of 100 identical
+    /// (docs/performance.md, stop 60).
     pub memory: bool,
 }
 
@@ -611,13 +607,7 @@ impl Newton {
         // kept where every candidate is at its variant's final α.
         let mut candidate: Vec<Option<f64>> = vec![None; v];
         let last_trial = s.line_search.max_halvings;
-        // Each variant's search: the halvings of its next trial, and whether it goes up (to
-        // longer steps, from a short one that passed: [`LineSearch::memory`]) by bisection
-        // between the longest step that failed and the shortest that passed (halvings).
-        let mut depth = vec![0usize; v];
-        let mut up = vec![false; v];
-        let mut bracket = vec![(0usize, 0usize); v];
-        let mut jumped_to: Vec<Option<usize>> = vec![None; v];
+        let mut search = vec![Search::default(); v];
         let mut trial = 0;
         let mut rounds = 0u32;
         while pending.iter().any(|&p| p) {
@@ -632,7 +622,10 @@ impl Newton {
             // one at a time, a round of 8 at once 140 %.)
             let left = (0..v)
                 .filter(|&j| pending[j])
-                .map(|j| if up[j] { 1 } else { last_trial + 1 - depth[j] })
+                .map(|j| match search[j].up {
+                    Some(_) => 1,
+                    None => last_trial + 1 - search[j].depth,
+                })
                 .max()
                 .unwrap_or(1);
             let round = if trial == 0 {
@@ -647,8 +640,8 @@ impl Newton {
                     (0..v)
                         .map(|j| {
                             // A bisection up has one trial a round (its next depends on it).
-                            if pending[j] && !up[j] {
-                                halved((depth[j] + k).min(last_trial))
+                            if pending[j] && search[j].up.is_none() {
+                                halved((search[j].depth + k).min(last_trial))
                             } else {
                                 alpha[j]
                             }
@@ -679,7 +672,7 @@ impl Newton {
                     if !pending[j] || alphas[k][j] != alpha[j] {
                         continue;
                     }
-                    let t = depth[j];
+                    let t = search[j].depth;
                     let last = t == last_trial;
                     let a = alpha[j];
                     let finite = r.slope[j].is_finite() && r.norm[j].is_finite();
@@ -688,21 +681,21 @@ impl Newton {
                     let norm_ok = r.norm[j] <= (1.0 - 1e-4 * a) * probe.norm[j];
                     let band_ok = at_floor[j] && r.norm[j] <= 2.0 * probe.norm[j];
                     let pass = finite && (slope_ok || norm_ok || band_ok);
-                    if up[j] {
+                    let sj = &mut search[j];
+                    if let Some((failed, passed)) = &mut sj.up {
                         // Up from a step that passed: the longest that passes, by bisection.
-                        let (failed, passed) = &mut bracket[j];
                         if pass {
                             *passed = t;
                         } else {
                             *failed = t;
                         }
                         if *passed - *failed > 1 {
-                            depth[j] = (*failed + *passed) / 2;
+                            sj.depth = (*failed + *passed) / 2;
                         } else {
                             pending[j] = false;
-                            depth[j] = *passed;
+                            sj.depth = *passed;
                         }
-                        alpha[j] = halved(depth[j]);
+                        alpha[j] = halved(sj.depth);
                         continue;
                     }
                     last_finite[j] = finite;
@@ -710,19 +703,19 @@ impl Newton {
                         fallback_finite[j] = finite;
                     }
                     if pass {
-                        if jumped_to[j] == Some(t) && t > 1 {
+                        if sj.jumped_to == Some(t) && t > 1 {
                             // The first step tried after the jump passed: a longer one may.
-                            up[j] = true;
-                            bracket[j] = (0, t);
-                            depth[j] = t / 2;
-                            alpha[j] = halved(depth[j]);
+                            sj.up = Some((0, t));
+                            sj.depth = t / 2;
+                            alpha[j] = halved(sj.depth);
                         } else {
                             pending[j] = false;
                         }
                     } else if last {
                         pending[j] = false;
-                        let skipped =
-                            jumped_to[j].is_some_and(|d| d > s.line_search.fallback_halvings);
+                        let skipped = sj
+                            .jumped_to
+                            .is_some_and(|d| d > s.line_search.fallback_halvings);
                         if !s.line_search.take_smallest {
                             alpha[j] = 1.0;
                         } else if (fallback_finite[j] || skipped)
@@ -735,18 +728,18 @@ impl Newton {
                             last_finite[j] = true;
                         }
                     } else {
-                        depth[j] = if t == 0 && s.line_search.memory {
+                        sj.depth = if t == 0 && s.line_search.memory {
                             // From one halving above the last update's.
                             let d = self.tracks[j]
                                 .last_halvings
                                 .saturating_sub(1)
                                 .clamp(1, last_trial);
-                            jumped_to[j] = Some(d);
+                            sj.jumped_to = Some(d);
                             d
                         } else {
                             t + 1
                         };
-                        alpha[j] = halved(depth[j]);
+                        alpha[j] = halved(sj.depth);
                     }
                 }
             }
@@ -779,6 +772,19 @@ impl Newton {
         }
         Ok(events)
     }
+}
+
+/// One variant's line search in [`Newton::advance`].
+#[derive(Clone, Copy, Debug, Default)]
+struct Search {
+    /// Halvings of its next trial.
+    depth: usize,
+    /// Going up (to longer steps, from a short one that passed: [`LineSearch::memory`]) by
+    /// bisection between the longest step that failed and the shortest that passed
+    /// (halvings).
+    up: Option<(usize, usize)>,
+    /// The halvings it jumped to after the full step failed.
+    jumped_to: Option<usize>,
 }
 
 /// `2^−d`: the step after `d` halvings.
