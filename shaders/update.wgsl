@@ -35,10 +35,15 @@
 @group(0) @binding(9) var<storage, read> rot_from: array<real>;
 @group(0) @binding(10) var<storage, read_write> x: array<real>;
 @group(0) @binding(11) var<storage, read_write> rot: array<real>;
+// Per (node, variant) the landing epoch in which the node last landed on its wall, moved
+// from and to; per variant the current epoch (twin: ConfigBatch::landed, UpdateWalls::epoch).
+@group(0) @binding(12) var<storage, read> landed_from: array<u32>;
+@group(0) @binding(13) var<storage, read_write> landed: array<u32>;
+@group(0) @binding(14) var<storage, read> epoch: array<u32>;
 #if MASKED
 // Built MASKED: the variants to move, compacted: [A, v_0, …, v_{A−1}]; the others' trial
 // configurations are left as they were.
-@group(0) @binding(12) var<storage, read> searching: array<u32>;
+@group(0) @binding(15) var<storage, read> searching: array<u32>;
 #endif
 
 fn x_at(k: u32) -> real {
@@ -48,9 +53,15 @@ fn x_at(k: u32) -> real {
 fn rot_at(k: u32) -> real {
     return rot_from[k];
 }
+
+fn landed_at(k: u32) -> u32 {
+    return landed_from[k];
+}
 #else
 @group(0) @binding(8) var<storage, read_write> x: array<real>;
 @group(0) @binding(9) var<storage, read_write> rot: array<real>;
+@group(0) @binding(10) var<storage, read_write> landed: array<u32>;
+@group(0) @binding(11) var<storage, read> epoch: array<u32>;
 
 fn x_at(k: u32) -> real {
     return x[k];
@@ -59,6 +70,10 @@ fn x_at(k: u32) -> real {
 fn rot_at(k: u32) -> real {
     return rot[k];
 }
+
+fn landed_at(k: u32) -> u32 {
+    return landed[k];
+}
 #endif
 #endif
 
@@ -66,6 +81,8 @@ fn rot_at(k: u32) -> real {
 #include "shared/rotation_exp.wgsl"
 
 const NO_SITE: u32 = 0xffffffffu;
+// physics::contact::LANDING_DEPTH (as a fraction of the clearance).
+const LANDING_DEPTH = 1e-6;
 
 // Twin: physics::contact::wall_following_step. The step `du` of a node at offset `d` from
 // its hole axis point (axis `t`), its lateral part split into radial and circumferential
@@ -85,6 +102,25 @@ fn wall_following_step(d: vec3<real>, t: vec3<real>, du: vec3<real>, min_radius:
     let phi = ds / r;
     let scale = (r + dr) / (r * sqrt(real(1.0) + phi * phi));
     return da * t + scale * (d_perp + ds * e_t) - d_perp;
+}
+
+// Twin: physics::contact::landing_step. A step of a node off its wall (offset `d`, axis
+// `t`) that would end inside it, its lateral part shortened to land the node LANDING_DEPTH
+// of its clearance inside; `du` itself otherwise.
+fn landing_step(d: vec3<real>, t: vec3<real>, du: vec3<real>, clearance: real) -> vec3<real> {
+    let d0 = d - dot(d, t) * t;
+    if (sqrt(dot(d0, d0)) > clearance) {
+        return du;
+    }
+    let e = d + du;
+    let d1 = e - dot(e, t) * t;
+    let r1 = sqrt(dot(d1, d1));
+    let land = clearance * (real(1.0) + real(LANDING_DEPTH));
+    if (!(r1 > land)) {
+        return du;
+    }
+    let s = land / r1;
+    return s * d1 + (e - d1) - d;
 }
 
 @compute @workgroup_size(64)
@@ -110,6 +146,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         step[r] = dot(brow, du);
     }
     let x_old = vec3<real>(x_at((3u * i) * nv + v), x_at((3u * i + 1u) * nv + v), x_at((3u * i + 2u) * nv + v));
+    var mark = landed_at(i * nv + v);
     let site = node_site[i * nv + v];
     if (site != NO_SITE) {
         let pair = site * nv + v;
@@ -117,7 +154,16 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         let t = vec3<real>(pair_normals[3u * pair], pair_normals[3u * pair + 1u], pair_normals[3u * pair + 2u]);
         // physics::contact::wall_following_radius: half the clearance.
         step = wall_following_step(d, t, step, real(0.5) * pair_params[pair]);
+        // Once an epoch, a node off its wall whose step ends inside it lands on it.
+        if (mark != epoch[v]) {
+            let l = landing_step(d, t, step, pair_params[pair]);
+            if (any(l != step)) {
+                step = l;
+                mark = epoch[v];
+            }
+        }
     }
+    landed[i * nv + v] = mark;
     for (var r = 0u; r < 3u; r = r + 1u) {
         x[(3u * i + r) * nv + v] = x_old[r] + step[r];
     }

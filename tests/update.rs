@@ -23,6 +23,7 @@ fn batch(
             .collect(),
         rot: vec![0.0; 9 * n * v],
         basis: vec![0.0; 9 * n],
+        landed: Vec::new(),
     };
     for i in 0..n {
         // A rotated basis at the last node (the bit held in the hole frame), identity elsewhere.
@@ -137,6 +138,7 @@ fn update_matches_rodrigues_and_gpu_matches_twin() {
         x: cast(&b0.x),
         rot: cast(&b0.rot),
         basis: cast(&b0.basis),
+        landed: Vec::new(),
     };
     update_gpu(
         ctx,
@@ -216,6 +218,7 @@ fn contact_nodes_step_along_their_wall_on_both_paths() {
         pair_base: vec![0.0; 3 * p],
         pair_normals: vec![0.0; 3 * p],
         pair_params: vec![0.0; holewall::physics::contact::PARAMS_LEN * p],
+        epoch: Vec::new(),
     };
     for (k, &node) in sites.iter().enumerate() {
         for j in 0..v {
@@ -250,4 +253,146 @@ fn contact_nodes_step_along_their_wall_on_both_paths() {
         eprintln!("wall-following update, GPU f64 vs twin: {diff:.2e} m ({moved} coordinates moved off the straight step)");
         assert!(diff <= 1e-15);
     }
+}
+
+/// A node off its wall whose step would end inside it lands on it, LANDING_DEPTH of its
+/// clearance inside, with its axial step kept; a node on its wall, or one whose step stays
+/// off it, keeps its step. In a batch a node lands once an epoch: the twin marks it, does not
+/// land it again in the same epoch, and does in the next; the GPU moves and marks as the twin.
+#[test]
+fn a_node_stepping_through_its_wall_lands_on_it_once_an_epoch() {
+    use holewall::physics::contact::{landing_step, LANDING_DEPTH};
+    let t = [0.0, 0.0, 1.0];
+    let c = 0.05;
+    let land = c * (1.0 + LANDING_DEPTH);
+    // 0.3 mm off the wall, a step 3.2 mm out and 1 mm along the axis (corpus well 221's).
+    let d = [c - 3e-4, 0.0, 7.0];
+    let du = [3.2e-3, 1e-4, 1e-3];
+    let l = landing_step(&d, &t, &du, c);
+    let e: Vec<f64> = (0..3).map(|k| d[k] + l[k]).collect();
+    let r = (e[0] * e[0] + e[1] * e[1]).sqrt();
+    assert!((r - land).abs() <= 1e-15, "landed at {r} for {land}");
+    // The axial step kept, to the rounding of the node's 7 m axial offset.
+    assert!((l[2] - du[2]).abs() <= 2.0 * f64::EPSILON * 7.0, "{}", l[2]);
+    // The landing point lies on the straight step's lateral direction.
+    let ex = d[0] + du[0];
+    assert!((e[1] / e[0] - du[1] / ex).abs() <= 1e-12);
+    // On the wall already, or staying off it: the step itself.
+    assert_eq!(landing_step(&[c + 1e-5, 0.0, 0.0], &t, &du, c), du);
+    assert_eq!(
+        landing_step(&[c - 3e-3, 0.0, 0.0], &t, &[1e-3, 0.0, 0.0], c),
+        [1e-3, 0.0, 0.0]
+    );
+
+    // A batch: every other node a site 0.5 mm off a 5 cm clearance, stepped 2 mm out.
+    let (v, n) = (8, 12);
+    let mut rng = rand::rngs::StdRng::seed_from_u64(29);
+    let (mut b0, _, _) = batch(v, n, &mut rng);
+    let mut delta = vec![0.0; 6 * n * v];
+    let sites: Vec<usize> = (0..n).step_by(2).collect();
+    let p = sites.len() * v;
+    let mut walls = UpdateWalls {
+        node_site: vec![holewall::kernels::assemble::NO_SITE; n * v],
+        pair_base: vec![0.0; 3 * p],
+        pair_normals: vec![0.0; 3 * p],
+        pair_params: vec![0.0; holewall::physics::contact::PARAMS_LEN * p],
+        epoch: vec![1; v],
+    };
+    b0.x.iter_mut().for_each(|x| *x = 0.0);
+    for (k, &node) in sites.iter().enumerate() {
+        for j in 0..v {
+            let i = k * v + j;
+            walls.node_site[node * v + j] = k as u32;
+            let phi: f64 = rng.random_range(0.0..std::f64::consts::TAU);
+            let (cs, sn) = (phi.cos(), phi.sin());
+            walls.pair_normals[3 * i + 2] = 1.0;
+            walls.pair_base[3 * i] = (c - 5e-4) * cs;
+            walls.pair_base[3 * i + 1] = (c - 5e-4) * sn;
+            walls.pair_params[i] = c;
+            delta[(6 * node) * v + j] = 2e-3 * cs;
+            delta[(6 * node + 1) * v + j] = 2e-3 * sn;
+            delta[(6 * node + 2) * v + j] = 1e-3;
+        }
+    }
+    b0.landed = vec![0; n * v];
+    let alpha = vec![1.0; v];
+    let radius = |b: &ConfigBatch<f64>, node: usize, j: usize| -> f64 {
+        let i = (node / 2) * v + j;
+        let x: Vec<f64> = (0..2)
+            .map(|a| walls.pair_base[3 * i + a] + b.x[(3 * node + a) * v + j])
+            .collect();
+        (x[0] * x[0] + x[1] * x[1]).sqrt()
+    };
+    let mut twin = b0.clone();
+    update(&mut twin, &walls, &delta, &alpha);
+    for &node in &sites {
+        for j in 0..v {
+            assert!((radius(&twin, node, j) - land).abs() <= 1e-15);
+            assert_eq!(twin.landed[node * v + j], 1, "marked with the epoch");
+        }
+    }
+    // The same epoch: the same step from the start does not land a marked node.
+    let mut again = b0.clone();
+    again.landed = twin.landed.clone();
+    update(&mut again, &walls, &delta, &alpha);
+    assert!(
+        (radius(&again, 0, 0) - (c + 1.5e-3)).abs() <= 1e-12,
+        "landed twice in one epoch"
+    );
+    // The next epoch of variant 0 only: its nodes land again, the others' do not.
+    let mut next = walls.clone();
+    next.epoch[0] = 2;
+    let mut third = b0.clone();
+    third.landed = twin.landed.clone();
+    update(&mut third, &next, &delta, &alpha);
+    assert!((radius(&third, 0, 0) - land).abs() <= 1e-15);
+    assert!((radius(&third, 0, 1) - (c + 1.5e-3)).abs() <= 1e-12);
+    let Some(ctx) = common::gpu() else { return };
+    let cast = |x: &[f64]| -> Vec<f32> { x.iter().map(|&x| x as f32).collect() };
+    if ctx.has_f64 {
+        for (w, landed) in [(&walls, &b0.landed), (&next, &twin.landed)] {
+            let mut gpu = b0.clone();
+            gpu.landed = landed.clone();
+            let mut cpu = gpu.clone();
+            update(&mut cpu, w, &delta, &alpha);
+            update_gpu(ctx, &mut gpu, w, &delta, &alpha).unwrap();
+            let diff = gpu
+                .x
+                .iter()
+                .zip(&cpu.x)
+                .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+            eprintln!("landing update, GPU f64 vs twin: {diff:.2e} m");
+            assert!(diff <= 1e-16);
+            assert_eq!(gpu.landed, cpu.landed);
+        }
+    }
+    // f32: the same marks, the landing radius to f32 rounding.
+    let w32 = UpdateWalls {
+        node_site: walls.node_site.clone(),
+        pair_base: cast(&walls.pair_base),
+        pair_normals: cast(&walls.pair_normals),
+        pair_params: cast(&walls.pair_params),
+        epoch: walls.epoch.clone(),
+    };
+    let b32 = ConfigBatch {
+        num_variants: v,
+        num_nodes: n,
+        x: cast(&b0.x),
+        rot: cast(&b0.rot),
+        basis: cast(&b0.basis),
+        landed: b0.landed.clone(),
+    };
+    let mut cpu = b32.clone();
+    update(&mut cpu, &w32, &cast(&delta), &cast(&alpha));
+    let mut gpu = b32.clone();
+    update_gpu(ctx, &mut gpu, &w32, &cast(&delta), &cast(&alpha)).unwrap();
+    assert_eq!(gpu.landed, cpu.landed);
+    assert_eq!(cpu.landed, twin.landed);
+    let diff = gpu
+        .x
+        .iter()
+        .zip(&cpu.x)
+        .fold(0.0f32, |m, (a, b)| m.max((a - b).abs()));
+    eprintln!("landing update, GPU f32 vs twin: {diff:.2e} m");
+    assert!(diff <= 4.0 * f32::EPSILON * 0.05);
 }

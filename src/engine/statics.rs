@@ -22,6 +22,8 @@ pub(super) struct EngineStatic<'a, T> {
     pub(super) saved: Vec<(Vec<f64>, Vec<f64>)>,
     to_save: Vec<usize>,
     to_restore: Vec<usize>,
+    /// Variants whose nodes may land on their walls once more (a new target or a restart).
+    to_land: Vec<usize>,
     to_rebase: bool,
     /// Per variant: a relaxation's shift (0: none) and its anchor (displacements from the
     /// reference, `3 n`; empty without a shift).
@@ -88,6 +90,7 @@ impl<'a, T: Real> EngineStatic<'a, T> {
             saved,
             to_save: Vec::new(),
             to_restore: Vec::new(),
+            to_land: Vec::new(),
             to_rebase: false,
             full_step: KeptTrial::new(),
             touched: vec![false; v],
@@ -153,6 +156,13 @@ impl<'a, T: Real> EngineStatic<'a, T> {
         if std::mem::take(&mut self.shift_changed) {
             self.upload_shift()?;
             self.full_step.drop_kept();
+        }
+        if !self.to_land.is_empty() {
+            let mut land = vec![false; v];
+            for j in std::mem::take(&mut self.to_land) {
+                land[j] = true;
+            }
+            self.ensemble.allow_landing(&land)?;
         }
         if self.loads_changed {
             self.ensemble
@@ -314,6 +324,7 @@ impl<T: Real> StaticSystem for EngineStatic<'_, T> {
         }
         self.loads_changed = true;
         self.touched[j] = true;
+        self.to_land.push(j);
         Ok(())
     }
     fn save(&mut self, j: usize) -> Result<(), crate::error::SystemError> {
@@ -323,6 +334,7 @@ impl<T: Real> StaticSystem for EngineStatic<'_, T> {
     fn restore(&mut self, j: usize) -> Result<(), crate::error::SystemError> {
         self.to_restore.push(j);
         self.touched[j] = true;
+        self.to_land.push(j);
         Ok(())
     }
     fn step_floor(&mut self, j: usize) -> Result<f64, crate::error::SystemError> {

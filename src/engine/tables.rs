@@ -112,6 +112,7 @@ pub fn ensemble_tables_from<T: Real>(
         x,
         rot,
         basis: basis.iter().map(|&b| t(b)).collect(),
+        landed: vec![0; n * v],
     };
     let p = s_count * v;
     let mut node_site = vec![NO_SITE; n * v];

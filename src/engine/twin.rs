@@ -163,6 +163,7 @@ impl TwinStatic<'_> {
             pair_base: t.pair_base.clone(),
             pair_normals: t.pair_normals.clone(),
             pair_params: self.contact.pair_params.clone(),
+            epoch: std::mem::take(&mut self.walls.epoch),
         };
     }
 
@@ -242,6 +243,14 @@ impl ResidentStatic<f64> for TwinStatic<'_> {
         self.system = [None, None];
         Ok(())
     }
+    fn allow_landing(&mut self, variants: &[bool]) -> Result<(), crate::error::SystemError> {
+        for (e, &on) in self.walls.epoch.iter_mut().zip(variants) {
+            if on {
+                *e = e.wrapping_add(1);
+            }
+        }
+        Ok(())
+    }
     fn rebase(&mut self, tables: &BatchTables<f64>) -> Result<(), crate::error::SystemError> {
         self.tables = tables.clone();
         self.refresh_walls();
@@ -276,6 +285,11 @@ impl ResidentTrials<f64> for TwinStatic<'_> {
             for (k, r) in moved.rot.iter().enumerate() {
                 if search[k % v] {
                     to.rot[k] = *r;
+                }
+            }
+            for (k, m) in moved.landed.iter().enumerate() {
+                if search[k % v] {
+                    to.landed[k] = *m;
                 }
             }
         }
@@ -316,6 +330,7 @@ impl KernelPath<f64> for TwinPath {
             shift: None,
         };
         twin.refresh_walls();
+        twin.walls.epoch = vec![1; tables.num_variants];
         Ok(Box::new(twin))
     }
     fn open_dynamic<'a>(

@@ -3,7 +3,9 @@
 //!
 //! `update`: one invocation per (node, variant): `x_i += α B_i Δu_i` (`B_i` the node's
 //! translation basis, identity but at a bit held in the hole frame; at a contact site near
-//! its wall the step follows the wall, `physics::contact::wall_following_step`) and
+//! its wall the step follows the wall, `physics::contact::wall_following_step`, and one off
+//! it whose step would end inside it lands on it, once a landing epoch,
+//! `physics::contact::landing_step`) and
 //! `R_i ← exp([α Δθ_i]×) R_i`. The exponential is written with series, the same in both
 //! (no f64 trigonometry on Vulkan): with `φ = |θ|` reduced to `[0, π]` (a rotation by
 //! `φ > π` is one by `φ − 2π·round(φ/2π)` about the same axis) and `h = φ/2`,
@@ -100,6 +102,9 @@ pub struct ConfigBatch<T> {
     pub rot: Vec<T>,
     /// Translation basis per node, `9 n` (identity where the node has none).
     pub basis: Vec<T>,
+    /// Per (node, variant), `n V`: the landing epoch in which the node last landed on its
+    /// wall ([`UpdateWalls::epoch`]); empty: no node lands.
+    pub landed: Vec<u32>,
 }
 
 /// The contact sites the update makes follow the wall
@@ -115,6 +120,13 @@ pub struct UpdateWalls<T> {
     pub pair_normals: Vec<T>,
     /// Law parameters per pair, `PARAMS_LEN · P`, field-major (clearance first).
     pub pair_params: Vec<T>,
+    /// Landing epoch per variant, `V` (empty: no node lands): a contact node off its wall
+    /// whose step would end in it lands on it
+    /// ([`crate::physics::contact::landing_step`]) if it has not landed in this epoch
+    /// ([`ConfigBatch::landed`]); the static engine starts a new epoch for a variant at each
+    /// load target and each restart, so a node lands once per load step, as in
+    /// `solve_static`.
+    pub epoch: Vec<u32>,
 }
 
 /// The update of node `i`, variant `v`: new position and rotation.
@@ -125,7 +137,7 @@ fn update_node<T: Real>(
     alpha: &[T],
     i: usize,
     v: usize,
-) -> ([T; 3], [T; 9]) {
+) -> ([T; 3], [T; 9], Option<u32>) {
     let nv = b.num_variants;
     let al = alpha[v];
     let du: [T; 3] = std::array::from_fn(|k| al * delta[(6 * i + k) * nv + v]);
@@ -138,6 +150,7 @@ fn update_node<T: Real>(
         step[r] = s;
     }
     let old: [T; 3] = std::array::from_fn(|k| b.x[(3 * i + k) * nv + v]);
+    let mut landed = b.landed.get(i * nv + v).copied();
     let site = walls
         .node_site
         .get(i * nv + v)
@@ -155,6 +168,16 @@ fn update_node<T: Real>(
         ));
         debug_assert!(pair < p);
         step = crate::physics::contact::wall_following_step(&d, &t, &step, min_radius);
+        if let (Some(m), Some(&e)) = (landed.as_mut(), walls.epoch.get(v)) {
+            if *m != e {
+                let l =
+                    crate::physics::contact::landing_step(&d, &t, &step, walls.pair_params[pair]);
+                if l != step {
+                    step = l;
+                    *m = e;
+                }
+            }
+        }
     }
     let x: [T; 3] = std::array::from_fn(|k| old[k] + step[k]);
     let dth: [T; 3] = std::array::from_fn(|k| al * delta[(6 * i + 3 + k) * nv + v]);
@@ -169,11 +192,11 @@ fn update_node<T: Real>(
             rot[3 * r + c] = s;
         }
     }
-    (x, rot)
+    (x, rot, landed)
 }
 
 /// Applies `α_v Δ_v` to every variant (rayon over nodes × variants), contact nodes near
-/// their wall moving along it.
+/// their wall moving along it and, once an epoch, landing on it ([`UpdateWalls::epoch`]).
 pub fn update<T: Real + Send + Sync>(
     b: &mut ConfigBatch<T>,
     walls: &UpdateWalls<T>,
@@ -185,8 +208,11 @@ pub fn update<T: Real + Send + Sync>(
         .into_par_iter()
         .map(|idx| update_node(b, walls, delta, alpha, idx / nv, idx % nv))
         .collect();
-    for (idx, (x, rot)) in new.into_iter().enumerate() {
+    for (idx, (x, rot, landed)) in new.into_iter().enumerate() {
         let (i, v) = (idx / nv, idx % nv);
+        if let Some(m) = landed {
+            b.landed[idx] = m;
+        }
         for k in 0..3 {
             b.x[(3 * i + k) * nv + v] = x[k];
         }

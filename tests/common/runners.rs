@@ -149,6 +149,16 @@ pub fn update_gpu<T: GpuReal>(
     } else {
         walls.node_site.clone()
     };
+    // No landing state or epoch: every node's mark equals its variant's epoch (no landing),
+    // as the twin's empty `landed` or `epoch`.
+    let (landed, epoch) = if b.landed.is_empty() || walls.epoch.is_empty() {
+        (
+            vec![0u32; b.num_nodes * b.num_variants],
+            vec![0u32; b.num_variants],
+        )
+    } else {
+        (b.landed.clone(), walls.epoch.clone())
+    };
     // Bindings must not be empty.
     let pad = |v: &[T]| -> Vec<T> {
         if v.is_empty() {
@@ -174,11 +184,16 @@ pub fn update_gpu<T: GpuReal>(
         &[
             Out::From(bytemuck::cast_slice(&b.x)),
             Out::From(bytemuck::cast_slice(&b.rot)),
+            Out::From(bytemuck::cast_slice(&landed)),
+            Out::From(bytemuck::cast_slice(&epoch)),
         ],
         b.num_nodes * b.num_variants,
     )?;
     b.x = values(&out[0]);
     b.rot = values(&out[1]);
+    if !b.landed.is_empty() {
+        b.landed = values(&out[2]);
+    }
     Ok(())
 }
 

@@ -155,6 +155,7 @@ impl<T: GpuReal> ResidentStatic<T> for GpuStatic<T> {
             x: values(&out[0]),
             rot: values(&out[1]),
             basis: Vec::new(),
+            landed: Vec::new(),
         })
     }
 
@@ -185,6 +186,18 @@ impl<T: GpuReal> ResidentStatic<T> for GpuStatic<T> {
             }
         }
         self.formed = [false; 2];
+        Ok(())
+    }
+
+    fn allow_landing(&mut self, variants: &[bool]) -> Result<(), crate::error::SystemError> {
+        for (e, &on) in self.epoch_host.iter_mut().zip(variants) {
+            if on {
+                *e = e.wrapping_add(1);
+            }
+        }
+        self.ctx
+            .queue
+            .write_buffer(&self.epoch, 0, bytemuck::cast_slice(&self.epoch_host));
         Ok(())
     }
 

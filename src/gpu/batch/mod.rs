@@ -160,6 +160,10 @@ pub struct GpuStatic<T: GpuReal> {
     solve_norms: wgpu::Buffer,
     /// Line-search trials formed in one submission ([`Rounds`]).
     rounds: Rounds,
+    /// Each variant's landing epoch ([`crate::kernels::update::UpdateWalls::epoch`]), and
+    /// its copy on the host.
+    epoch: wgpu::Buffer,
+    epoch_host: Vec<u32>,
     _real: PhantomData<T>,
 }
 
@@ -302,11 +306,14 @@ impl<T: GpuReal> GpuStatic<T> {
             (
                 storage(ctx, label, &tables.start.x),
                 storage(ctx, label, &tables.start.rot),
+                storage(ctx, label, &vec![0u32; n * v]),
             )
         });
+        let epoch_host = vec![1u32; v];
+        let epoch = storage(ctx, "epoch", &epoch_host);
         let make_slot = |k: usize| -> Slot {
-            let (x, rot) = configs[k].clone();
-            let (x_from, rot_from) = &configs[1 - k];
+            let (x, rot, landed) = configs[k].clone();
+            let (x_from, rot_from, landed_from) = &configs[1 - k];
             let [diag, upper, lower, rhs] = system_buffers(ctx, v, n, size);
             let beam = c.beam_group(ctx, &pipelines.beam, &x, &rot, false, false);
             let beam_force = c.beam_group(ctx, &pipelines.beam_force, &x, &rot, true, true);
@@ -359,14 +366,27 @@ impl<T: GpuReal> GpuStatic<T> {
                 ctx,
                 &pipelines.update,
                 "update",
-                &[&walls[..], &[&x, &rot]].concat(),
+                &[&walls[..], &[&x, &rot, &landed, &epoch]].concat(),
             );
             let trial_update = |mask: &wgpu::Buffer| {
                 bind(
                     ctx,
                     &pipelines.update_trial,
                     "update_trial",
-                    &[&walls[..], &[x_from, rot_from, &x, &rot, mask]].concat(),
+                    &[
+                        &walls[..],
+                        &[
+                            x_from,
+                            rot_from,
+                            &x,
+                            &rot,
+                            landed_from,
+                            &landed,
+                            &epoch,
+                            mask,
+                        ],
+                    ]
+                    .concat(),
                 )
             };
             let update_trial_all = trial_update(&c.all_active);
@@ -391,6 +411,8 @@ impl<T: GpuReal> GpuStatic<T> {
         };
         let slots = [make_slot(0), make_slot(1)];
         Ok(GpuStatic {
+            epoch,
+            epoch_host,
             solve_norms: empty(ctx, "solve_norms", 4 * v * size),
             rounds: Rounds::new(ctx, v, size),
             ctx,

@@ -358,6 +358,8 @@ fn update(
     state: &StaticState,
     delta: &[f64],
     alpha: f64,
+    may_land: &[bool],
+    landed: &mut Vec<usize>,
 ) -> StaticState {
     let mut s = state.clone();
     for i in 0..s.x.len() {
@@ -368,6 +370,13 @@ fn update(
         if let Some(w) = &walls[i] {
             let d = sub(&s.x[i], &w.origin);
             du = crate::physics::contact::wall_following_step(&d, &w.axis, &du, w.min_radius);
+            if may_land.get(i).copied().unwrap_or(false) {
+                let l = crate::physics::contact::landing_step(&d, &w.axis, &du, w.clearance);
+                if l != du {
+                    landed.push(i);
+                    du = l;
+                }
+            }
         }
         for (x, d) in s.x[i].iter_mut().zip(du) {
             *x += d;
@@ -385,6 +394,7 @@ pub(crate) struct Wall {
     origin: Vec3<f64>,
     axis: Vec3<f64>,
     min_radius: f64,
+    clearance: f64,
 }
 
 /// Per node, the hole its contact site sits in (none where no site).
@@ -396,6 +406,7 @@ pub(crate) fn walls(model: &Model) -> Vec<Option<Wall>> {
             origin: node.position,
             axis: node.hole_axis,
             min_radius: crate::physics::contact::wall_following_radius(site.params.clearance),
+            clearance: site.params.clearance,
         });
     }
     w

@@ -23,7 +23,9 @@ pub(super) struct CpuStatic<'a> {
     tangent: BlockTridiagonal,
     trial: Vec<f64>,
     delta: Vec<f64>,
-    trial_state: Option<(f64, StaticState)>,
+    trial_state: Option<(f64, StaticState, Vec<usize>)>,
+    /// Per node: may still land on the wall in this target's solve.
+    may_land: Vec<bool>,
     evaluated: bool,
     /// Proximal shift (N/m) and its anchor ([`crate::solve::continuation`]'s relaxation).
     shift: f64,
@@ -73,10 +75,12 @@ impl<'a> CpuStatic<'a> {
     pub(super) fn new(model: &'a Model, start: StaticState) -> Self {
         let (f_gravity, f_other) = split_loads(model);
         let n = model.nodes.len();
+        let walls = walls(model);
         CpuStatic {
+            may_land: walls.iter().map(Option::is_some).collect(),
             model,
             c: constraints(model),
-            walls: walls(model),
+            walls,
             f_ref: reference_force(model),
             f_step: vec![0.0; 6 * n],
             f_gravity,
@@ -94,6 +98,30 @@ impl<'a> CpuStatic<'a> {
             shift: 0.0,
             anchor: Vec::new(),
         }
+    }
+}
+
+impl CpuStatic<'_> {
+    /// Every contact node may land on its wall once more
+    /// ([`crate::physics::contact::landing_step`]): at a new target, and at a step's
+    /// restart.
+    fn reset_landing(&mut self) {
+        self.may_land = self.walls.iter().map(Option::is_some).collect();
+    }
+
+    /// The state moved by `α Δ`, and the nodes that landed on their wall in it.
+    fn moved(&self, alpha: f64) -> (StaticState, Vec<usize>) {
+        let mut landed = Vec::new();
+        let s = update(
+            &self.c,
+            &self.walls,
+            &self.state,
+            &self.delta,
+            alpha,
+            &self.may_land,
+            &mut landed,
+        );
+        (s, landed)
     }
 }
 
@@ -146,11 +174,11 @@ impl crate::solve::newton::NewtonSystem for CpuStatic<'_> {
         _: &[bool],
         _: bool,
     ) -> Result<crate::solve::newton::TrialProbe, crate::error::SystemError> {
-        let s = update(&self.c, &self.walls, &self.state, &self.delta, alpha[0]);
+        let (s, landed) = self.moved(alpha[0]);
         assemble(&self.loaded, &s, 1.0, &self.f_step, &mut self.trial, None);
         add_shift(self.shift, &s.x, &self.anchor, &mut self.trial, None);
         constrain_residual(&self.c, &mut self.trial);
-        self.trial_state = Some((alpha[0], s));
+        self.trial_state = Some((alpha[0], s, landed));
         Ok(crate::solve::newton::TrialProbe {
             slope: vec![dot_n(&self.delta, &self.trial)],
             norm: vec![dot_n(&self.trial, &self.trial).sqrt()],
@@ -164,10 +192,14 @@ impl crate::solve::newton::NewtonSystem for CpuStatic<'_> {
         if alpha[0] == 0.0 {
             return Ok(());
         }
-        self.state = match self.trial_state.take() {
-            Some((a, s)) if trial_matches && a == alpha[0] => s,
-            _ => update(&self.c, &self.walls, &self.state, &self.delta, alpha[0]),
+        let (state, landed) = match self.trial_state.take() {
+            Some((a, s, l)) if trial_matches && a == alpha[0] => (s, l),
+            _ => self.moved(alpha[0]),
         };
+        self.state = state;
+        for i in landed {
+            self.may_land[i] = false;
+        }
         self.evaluated = false;
         Ok(())
     }
@@ -180,6 +212,7 @@ impl crate::solve::continuation::StaticSystem for CpuStatic<'_> {
         target: &crate::solve::continuation::LoadTarget,
     ) -> Result<(), crate::error::SystemError> {
         self.loaded = loaded_model(self.model, target);
+        self.reset_landing();
         for (f, (g, o)) in self
             .f_step
             .iter_mut()
@@ -197,6 +230,7 @@ impl crate::solve::continuation::StaticSystem for CpuStatic<'_> {
     fn restore(&mut self, _j: usize) -> Result<(), crate::error::SystemError> {
         self.state = self.saved.clone();
         self.evaluated = false;
+        self.reset_landing();
         Ok(())
     }
     fn worst_residual_md(&mut self, _j: usize) -> Option<f64> {
