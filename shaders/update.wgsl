@@ -154,8 +154,9 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         let t = vec3<real>(pair_normals[3u * pair], pair_normals[3u * pair + 1u], pair_normals[3u * pair + 2u]);
         // physics::contact::wall_following_radius: half the clearance.
         step = wall_following_step(d, t, step, real(0.5) * pair_params[pair]);
-        // Once an epoch, a node off its wall whose step ends inside it lands on it.
-        if (mark != epoch[v]) {
+        // Once an epoch (none in epoch 0), a node off its wall whose step ends inside it
+        // lands on it.
+        if (epoch[v] != 0u && mark != epoch[v]) {
             let l = landing_step(d, t, step, pair_params[pair]);
             if (any(l != step)) {
                 step = l;

@@ -182,10 +182,9 @@ pub trait ResidentStatic<T>: ResidentTrials<T> {
     /// now on adds `s_v (u − a_v)` to each node's translations' residual and `s_v I` to their
     /// diagonal block (the systems must be evaluated again).
     fn set_shift(&mut self, shift: Option<&Shift<T>>) -> Result<(), crate::error::SystemError>;
-    /// Starts a new landing epoch for the variants in `variants` (`V`): each of their
-    /// contact nodes may land on its wall once more ([`crate::kernels::update::UpdateWalls::epoch`];
-    /// the static engine's at a load target and at a restart, as `solve_static`).
-    fn allow_landing(&mut self, variants: &[bool]) -> Result<(), crate::error::SystemError>;
+    /// Sets each variant's landing epoch (`V`; [`crate::kernels::update::UpdateWalls::epoch`]:
+    /// a contact node lands on its wall once an epoch, none in epoch 0).
+    fn set_landing_epochs(&mut self, epochs: &[u32]) -> Result<(), crate::error::SystemError>;
     /// Moves the base to the current configuration, given as `tables` after
     /// [`BatchTables::set_base`] with the host's sum of the old base and the current
     /// displacements: the displacements from it are set to zero, the rotations kept (the

@@ -22,8 +22,10 @@ pub(super) struct EngineStatic<'a, T> {
     pub(super) saved: Vec<(Vec<f64>, Vec<f64>)>,
     to_save: Vec<usize>,
     to_restore: Vec<usize>,
-    /// Variants whose nodes may land on their walls once more (a new target or a restart).
-    to_land: Vec<usize>,
+    /// Per variant the landing epoch counter (one more at each target and restart), and
+    /// whether the epochs the ensemble holds are stale.
+    land_epoch: Vec<u32>,
+    epochs_changed: bool,
     to_rebase: bool,
     /// Per variant: a relaxation's shift (0: none) and its anchor (displacements from the
     /// reference, `3 n`; empty without a shift).
@@ -90,7 +92,8 @@ impl<'a, T: Real> EngineStatic<'a, T> {
             saved,
             to_save: Vec::new(),
             to_restore: Vec::new(),
-            to_land: Vec::new(),
+            land_epoch: vec![1; v],
+            epochs_changed: true,
             to_rebase: false,
             full_step: KeptTrial::new(),
             touched: vec![false; v],
@@ -157,12 +160,15 @@ impl<'a, T: Real> EngineStatic<'a, T> {
             self.upload_shift()?;
             self.full_step.drop_kept();
         }
-        if !self.to_land.is_empty() {
-            let mut land = vec![false; v];
-            for j in std::mem::take(&mut self.to_land) {
-                land[j] = true;
-            }
-            self.ensemble.allow_landing(&land)?;
+        if std::mem::take(&mut self.epochs_changed) {
+            // As `solve_static`: a node lands once a load step, not in a relaxation.
+            let epochs: Vec<u32> = self
+                .land_epoch
+                .iter()
+                .zip(&self.shifts)
+                .map(|(&e, s)| if s.0 != 0.0 { 0 } else { e })
+                .collect();
+            self.ensemble.set_landing_epochs(&epochs)?;
         }
         if self.loads_changed {
             self.ensemble
@@ -324,7 +330,8 @@ impl<T: Real> StaticSystem for EngineStatic<'_, T> {
         }
         self.loads_changed = true;
         self.touched[j] = true;
-        self.to_land.push(j);
+        self.land_epoch[j] = self.land_epoch[j].wrapping_add(1).max(1);
+        self.epochs_changed = true;
         Ok(())
     }
     fn save(&mut self, j: usize) -> Result<(), crate::error::SystemError> {
@@ -334,7 +341,8 @@ impl<T: Real> StaticSystem for EngineStatic<'_, T> {
     fn restore(&mut self, j: usize) -> Result<(), crate::error::SystemError> {
         self.to_restore.push(j);
         self.touched[j] = true;
-        self.to_land.push(j);
+        self.land_epoch[j] = self.land_epoch[j].wrapping_add(1).max(1);
+        self.epochs_changed = true;
         Ok(())
     }
     fn step_floor(&mut self, j: usize) -> Result<f64, crate::error::SystemError> {
@@ -372,6 +380,7 @@ impl<T: Real> StaticSystem for EngineStatic<'_, T> {
         }
         self.shifts[j].0 = s;
         self.to_anchor.push(j);
+        self.epochs_changed = true;
         Ok(())
     }
 }

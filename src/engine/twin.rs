@@ -243,12 +243,8 @@ impl ResidentStatic<f64> for TwinStatic<'_> {
         self.system = [None, None];
         Ok(())
     }
-    fn allow_landing(&mut self, variants: &[bool]) -> Result<(), crate::error::SystemError> {
-        for (e, &on) in self.walls.epoch.iter_mut().zip(variants) {
-            if on {
-                *e = e.wrapping_add(1);
-            }
-        }
+    fn set_landing_epochs(&mut self, epochs: &[u32]) -> Result<(), crate::error::SystemError> {
+        self.walls.epoch = epochs.to_vec();
         Ok(())
     }
     fn rebase(&mut self, tables: &BatchTables<f64>) -> Result<(), crate::error::SystemError> {
@@ -330,7 +326,6 @@ impl KernelPath<f64> for TwinPath {
             shift: None,
         };
         twin.refresh_walls();
-        twin.walls.epoch = vec![1; tables.num_variants];
         Ok(Box::new(twin))
     }
     fn open_dynamic<'a>(

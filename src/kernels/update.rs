@@ -120,12 +120,12 @@ pub struct UpdateWalls<T> {
     pub pair_normals: Vec<T>,
     /// Law parameters per pair, `PARAMS_LEN · P`, field-major (clearance first).
     pub pair_params: Vec<T>,
-    /// Landing epoch per variant, `V` (empty: no node lands): a contact node off its wall
-    /// whose step would end in it lands on it
+    /// Landing epoch per variant, `V` (empty, or 0 for a variant: no node lands): a contact
+    /// node off its wall whose step would end in it lands on it
     /// ([`crate::physics::contact::landing_step`]) if it has not landed in this epoch
     /// ([`ConfigBatch::landed`]); the static engine starts a new epoch for a variant at each
-    /// load target and each restart, so a node lands once per load step, as in
-    /// `solve_static`.
+    /// load target and each restart, and sets 0 while it relaxes, so a node lands once per
+    /// load step and not in a relaxation, as in `solve_static`.
     pub epoch: Vec<u32>,
 }
 
@@ -169,7 +169,7 @@ fn update_node<T: Real>(
         debug_assert!(pair < p);
         step = crate::physics::contact::wall_following_step(&d, &t, &step, min_radius);
         if let (Some(m), Some(&e)) = (landed.as_mut(), walls.epoch.get(v)) {
-            if *m != e {
+            if e != 0 && *m != e {
                 let l =
                     crate::physics::contact::landing_step(&d, &t, &step, walls.pair_params[pair]);
                 if l != step {

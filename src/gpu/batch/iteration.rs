@@ -189,15 +189,10 @@ impl<T: GpuReal> ResidentStatic<T> for GpuStatic<T> {
         Ok(())
     }
 
-    fn allow_landing(&mut self, variants: &[bool]) -> Result<(), crate::error::SystemError> {
-        for (e, &on) in self.epoch_host.iter_mut().zip(variants) {
-            if on {
-                *e = e.wrapping_add(1);
-            }
-        }
+    fn set_landing_epochs(&mut self, epochs: &[u32]) -> Result<(), crate::error::SystemError> {
         self.ctx
             .queue
-            .write_buffer(&self.epoch, 0, bytemuck::cast_slice(&self.epoch_host));
+            .write_buffer(&self.epoch, 0, bytemuck::cast_slice(epochs));
         Ok(())
     }
 

@@ -160,10 +160,8 @@ pub struct GpuStatic<T: GpuReal> {
     solve_norms: wgpu::Buffer,
     /// Line-search trials formed in one submission ([`Rounds`]).
     rounds: Rounds,
-    /// Each variant's landing epoch ([`crate::kernels::update::UpdateWalls::epoch`]), and
-    /// its copy on the host.
+    /// Each variant's landing epoch ([`crate::kernels::update::UpdateWalls::epoch`]).
     epoch: wgpu::Buffer,
-    epoch_host: Vec<u32>,
     _real: PhantomData<T>,
 }
 
@@ -309,8 +307,8 @@ impl<T: GpuReal> GpuStatic<T> {
                 storage(ctx, label, &vec![0u32; n * v]),
             )
         });
-        let epoch_host = vec![1u32; v];
-        let epoch = storage(ctx, "epoch", &epoch_host);
+        // No landing until the engine sets the epochs (`set_landing_epochs`).
+        let epoch = storage(ctx, "epoch", &vec![0u32; v]);
         let make_slot = |k: usize| -> Slot {
             let (x, rot, landed) = configs[k].clone();
             let (x_from, rot_from, landed_from) = &configs[1 - k];
@@ -412,7 +410,6 @@ impl<T: GpuReal> GpuStatic<T> {
         let slots = [make_slot(0), make_slot(1)];
         Ok(GpuStatic {
             epoch,
-            epoch_host,
             solve_norms: empty(ctx, "solve_norms", 4 * v * size),
             rounds: Rounds::new(ctx, v, size),
             ctx,
