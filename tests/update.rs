@@ -10,6 +10,25 @@ use holewall::kernels::update::{norms, update, ConfigBatch, UpdateWalls};
 use holewall::physics::beam::rotation_exp;
 use rand::{Rng, SeedableRng};
 
+/// Contact sites at every other node of `n`, for `v` variants, their tables zero (to be
+/// filled), with the landing `epoch`.
+fn sites_at_every_other_node(
+    v: usize,
+    n: usize,
+    epoch: Vec<u32>,
+) -> (Vec<usize>, UpdateWalls<f64>) {
+    let sites: Vec<usize> = (0..n).step_by(2).collect();
+    let p = sites.len() * v;
+    let walls = UpdateWalls {
+        node_site: vec![holewall::kernels::assemble::NO_SITE; n * v],
+        pair_base: vec![0.0; 3 * p],
+        pair_normals: vec![0.0; 3 * p],
+        pair_params: vec![0.0; holewall::physics::contact::PARAMS_LEN * p],
+        epoch,
+    };
+    (sites, walls)
+}
+
 fn batch(
     v: usize,
     n: usize,
@@ -211,15 +230,7 @@ fn contact_nodes_step_along_their_wall_on_both_paths() {
     let mut rng = rand::rngs::StdRng::seed_from_u64(11);
     let (v, n) = (8, 12);
     let (mut b0, delta, alpha) = batch(v, n, &mut rng);
-    let sites: Vec<usize> = (0..n).step_by(2).collect();
-    let p = sites.len() * v;
-    let mut walls = UpdateWalls {
-        node_site: vec![holewall::kernels::assemble::NO_SITE; n * v],
-        pair_base: vec![0.0; 3 * p],
-        pair_normals: vec![0.0; 3 * p],
-        pair_params: vec![0.0; holewall::physics::contact::PARAMS_LEN * p],
-        epoch: Vec::new(),
-    };
+    let (sites, mut walls) = sites_at_every_other_node(v, n, Vec::new());
     for (k, &node) in sites.iter().enumerate() {
         for j in 0..v {
             let i = k * v + j;
@@ -289,15 +300,7 @@ fn a_node_stepping_through_its_wall_lands_on_it_once_an_epoch() {
     let mut rng = rand::rngs::StdRng::seed_from_u64(29);
     let (mut b0, _, _) = batch(v, n, &mut rng);
     let mut delta = vec![0.0; 6 * n * v];
-    let sites: Vec<usize> = (0..n).step_by(2).collect();
-    let p = sites.len() * v;
-    let mut walls = UpdateWalls {
-        node_site: vec![holewall::kernels::assemble::NO_SITE; n * v],
-        pair_base: vec![0.0; 3 * p],
-        pair_normals: vec![0.0; 3 * p],
-        pair_params: vec![0.0; holewall::physics::contact::PARAMS_LEN * p],
-        epoch: vec![1; v],
-    };
+    let (sites, mut walls) = sites_at_every_other_node(v, n, vec![1; v]);
     b0.x.iter_mut().for_each(|x| *x = 0.0);
     for (k, &node) in sites.iter().enumerate() {
         for j in 0..v {
