@@ -469,10 +469,12 @@ pub const LANDING_DEPTH: f64 = 1e-6;
 /// a node 0.3 mm off moved 3.2 mm out). The line search can only shorten the whole step:
 /// it halves until the node stops short of the wall, and the next iteration does the same
 /// from halfway closer — the solve crawls toward the wall and stalls there with the node's
-/// residual unresolved. The static solves land a node this way once per load step
-/// (`crate::solve::statics`, the engine's update kernel): shortening one node's step breaks
-/// the step's consistency with its neighbours' rotations, and a node landed again and
-/// again can cycle with them (corpus wells 27 and 110 did).
+/// residual unresolved. The static solves land a node this way once per load step and not
+/// in a relaxation's shifted sub-solves (`crate::solve::statics`, the engine's update
+/// kernel): shortening one node's step breaks the step's consistency with its neighbours'
+/// rotations, and a node landed again and again can cycle with them (corpus wells 27 and
+/// 110 did); a relaxation follows an overdamped string's path across a fold, which a jump
+/// to the wall leaves (corpus well 90 failed its relaxation with it).
 pub fn landing_step<T: Real>(d: &Vec3<T>, t: &Vec3<T>, du: &Vec3<T>, clearance: T) -> Vec3<T> {
     let perp = |v: &Vec3<T>| -> Vec3<T> {
         let a = dot(v, t);
