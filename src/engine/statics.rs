@@ -161,12 +161,20 @@ impl<'a, T: Real> EngineStatic<'a, T> {
             self.full_step.drop_kept();
         }
         if std::mem::take(&mut self.epochs_changed) {
-            // As `solve_static`: a node lands once a load step, not in a relaxation.
+            // As `solve_static`: a node lands once a load step, not in a relaxation, and
+            // only in double precision.
             let epochs: Vec<u32> = self
                 .land_epoch
                 .iter()
                 .zip(&self.shifts)
-                .map(|(&e, s)| if s.0 != 0.0 { 0 } else { e })
+                .map(|(&e, s)| {
+                    let lands = crate::physics::contact::lands_in(std::mem::size_of::<T>());
+                    if s.0 != 0.0 || !lands {
+                        0
+                    } else {
+                        e
+                    }
+                })
                 .collect();
             self.ensemble.set_landing_epochs(&epochs)?;
         }

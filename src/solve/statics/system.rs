@@ -3,6 +3,7 @@
 //! [`super::polish_static`] step through the load path.
 
 use super::*;
+use crate::physics::contact::lands_in;
 
 /// One model's static Newton system on the CPU (faer), for [`solve_static_from`].
 pub(super) struct CpuStatic<'a> {
@@ -77,7 +78,7 @@ impl<'a> CpuStatic<'a> {
         let n = model.nodes.len();
         let walls = walls(model);
         CpuStatic {
-            may_land: walls.iter().map(Option::is_some).collect(),
+            may_land: walls.iter().map(|w| w.is_some() && lands_in(8)).collect(),
             model,
             c: constraints(model),
             walls,
@@ -106,7 +107,11 @@ impl CpuStatic<'_> {
     /// ([`crate::physics::contact::landing_step`]): at a new target, and at a step's
     /// restart.
     fn reset_landing(&mut self) {
-        self.may_land = self.walls.iter().map(Option::is_some).collect();
+        self.may_land = self
+            .walls
+            .iter()
+            .map(|w| w.is_some() && lands_in(8))
+            .collect();
     }
 
     /// The state moved by `α Δ`, and the nodes that landed on their wall in it.
