@@ -163,18 +163,12 @@ impl<'a, T: Real> EngineStatic<'a, T> {
         if std::mem::take(&mut self.epochs_changed) {
             // As `solve_static`: a node lands once a load step, not in a relaxation, and
             // only in double precision.
+            let lands = crate::physics::contact::lands_in(std::mem::size_of::<T>());
             let epochs: Vec<u32> = self
                 .land_epoch
                 .iter()
                 .zip(&self.shifts)
-                .map(|(&e, s)| {
-                    let lands = crate::physics::contact::lands_in(std::mem::size_of::<T>());
-                    if s.0 != 0.0 || !lands {
-                        0
-                    } else {
-                        e
-                    }
-                })
+                .map(|(&e, s)| if lands && s.0 == 0.0 { e } else { 0 })
                 .collect();
             self.ensemble.set_landing_epochs(&epochs)?;
         }

@@ -78,7 +78,7 @@ impl<'a> CpuStatic<'a> {
         let n = model.nodes.len();
         let walls = walls(model);
         CpuStatic {
-            may_land: walls.iter().map(|w| w.is_some() && lands_in(8)).collect(),
+            may_land: landing_flags(&walls),
             model,
             c: constraints(model),
             walls,
@@ -102,16 +102,18 @@ impl<'a> CpuStatic<'a> {
     }
 }
 
+/// Per node: may land on its wall ([`crate::physics::contact::landing_step`]; every contact
+/// node, this solve being f64).
+fn landing_flags(walls: &[Option<Wall>]) -> Vec<bool> {
+    walls.iter().map(|w| w.is_some() && lands_in(8)).collect()
+}
+
 impl CpuStatic<'_> {
     /// Every contact node may land on its wall once more
     /// ([`crate::physics::contact::landing_step`]): at a new target, and at a step's
     /// restart.
     fn reset_landing(&mut self) {
-        self.may_land = self
-            .walls
-            .iter()
-            .map(|w| w.is_some() && lands_in(8))
-            .collect();
+        self.may_land = landing_flags(&self.walls);
     }
 
     /// The state moved by `α Δ`, and the nodes that landed on their wall in it.
