@@ -123,6 +123,34 @@ fn landing_step(d: vec3<real>, t: vec3<real>, du: vec3<real>, clearance: real) -
     return s * d1 + (e - d1) - d;
 }
 
+#if F64
+// physics::contact::DEEPENING_FACTOR.
+const DEEPENING_FACTOR = 4.0;
+
+// Twin: physics::contact::deepening_step (f64 only, soft laws: physics::contact::deepens).
+// A step of a node that would take its depth from δ₀ beyond max(DEEPENING_FACTOR δ₀,
+// LANDING_DEPTH · clearance), its lateral part shortened to end there; `du` otherwise.
+fn deepening_step(d: vec3<real>, t: vec3<real>, du: vec3<real>, clearance: real) -> vec3<real> {
+    let floor = clearance * real(LANDING_DEPTH);
+    let d0 = d - dot(d, t) * t;
+    let depth0 = sqrt(dot(d0, d0)) - clearance;
+    let e = d + du;
+    let d1 = e - dot(e, t) * t;
+    let r1 = sqrt(dot(d1, d1));
+    let deeper = real(DEEPENING_FACTOR) * depth0;
+    var cap = floor;
+    if (deeper > floor) {
+        cap = deeper;
+    }
+    let limit = clearance + cap;
+    if (!(r1 > limit)) {
+        return du;
+    }
+    let s = limit / r1;
+    return s * d1 + (e - d1) - d;
+}
+#endif
+
 @compute @workgroup_size(64)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let nv = dims.num_variants;
@@ -163,6 +191,14 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
                 mark = epoch[v];
             }
         }
+#if F64
+        // A soft-law node (spring exponent, field 3 of the pair's parameters, below 1)
+        // goes no deeper than its bound.
+        let pairs = arrayLength(&pair_normals) / 3u;
+        if (pair_params[3u * pairs + pair] < real(1.0)) {
+            step = deepening_step(d, t, step, pair_params[pair]);
+        }
+#endif
     }
     landed[i * nv + v] = mark;
     for (var r = 0u; r < 3u; r = r + 1u) {

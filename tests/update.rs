@@ -19,11 +19,14 @@ fn sites_at_every_other_node(
 ) -> (Vec<usize>, UpdateWalls<f64>) {
     let sites: Vec<usize> = (0..n).step_by(2).collect();
     let p = sites.len() * v;
+    let mut pair_params = vec![0.0; holewall::physics::contact::PARAMS_LEN * p];
+    // A linear law (spring exponent, field 3, 1): no depth bound.
+    pair_params[3 * p..4 * p].fill(1.0);
     let walls = UpdateWalls {
         node_site: vec![holewall::kernels::assemble::NO_SITE; n * v],
         pair_base: vec![0.0; 3 * p],
         pair_normals: vec![0.0; 3 * p],
-        pair_params: vec![0.0; holewall::physics::contact::PARAMS_LEN * p],
+        pair_params,
         epoch,
     };
     (sites, walls)
@@ -397,5 +400,135 @@ fn a_node_stepping_through_its_wall_lands_on_it_once_an_epoch() {
         .zip(&cpu.x)
         .fold(0.0f32, |m, (a, b)| m.max((a - b).abs()));
     eprintln!("landing update, GPU f32 vs twin: {diff:.2e} m");
+    assert!(diff <= 4.0 * f32::EPSILON * 0.05);
+}
+
+/// A soft-law node (spring exponent below 1) whose step would take it more than
+/// DEEPENING_FACTOR times deeper — or, from off its wall or at its onset, deeper than
+/// LANDING_DEPTH of its clearance — stops at that depth on the step's lateral direction,
+/// with its axial step kept; a shallower step, or any step on a linear law, is unchanged.
+/// In a batch the twin bounds soft-law nodes in f64 only, and the GPU moves them as the
+/// twin, to the bit in f64 (and, unbounded, in f32).
+#[test]
+fn a_soft_law_node_goes_no_deeper_than_its_bound_in_f64() {
+    use holewall::physics::contact::{deepening_step, deepens, DEEPENING_FACTOR, LANDING_DEPTH};
+    assert!(deepens(2.0 / 3.0, 8) && !deepens(2.0 / 3.0, 4));
+    assert!(!deepens(1.0, 8) && !deepens(1.5, 8));
+    let t = [0.0, 0.0, 1.0];
+    let c = 0.05;
+    let depth = |d: &[f64; 3], du: &[f64; 3]| -> f64 {
+        let e: Vec<f64> = (0..3).map(|k| d[k] + du[k]).collect();
+        (e[0] * e[0] + e[1] * e[1]).sqrt() - c
+    };
+    // 10 µm in, a step 3 mm in and 1 mm along the axis: it ends 40 µm in.
+    let d = [c + 1e-5, 0.0, 7.0];
+    let du = [3e-3, 2e-4, 1e-3];
+    let l = deepening_step(&d, &t, &du, c);
+    assert!(
+        (depth(&d, &l) - DEEPENING_FACTOR * 1e-5).abs() <= 1e-15,
+        "{}",
+        depth(&d, &l)
+    );
+    assert!((l[2] - du[2]).abs() <= 2.0 * f64::EPSILON * 7.0);
+    let e: Vec<f64> = (0..3).map(|k| d[k] + l[k]).collect();
+    assert!((e[1] / e[0] - du[1] / (d[0] + du[0])).abs() <= 1e-12);
+    // From off the wall: to the landing depth.
+    let off = [c - 3e-4, 0.0, 0.0];
+    let l = deepening_step(&off, &t, &du, c);
+    assert!((depth(&off, &l) - LANDING_DEPTH * c).abs() <= 1e-15);
+    // Within the bound, or outward: the step itself.
+    assert_eq!(
+        deepening_step(&d, &t, &[2e-5, 0.0, 0.0], c),
+        [2e-5, 0.0, 0.0]
+    );
+    assert_eq!(
+        deepening_step(&d, &t, &[-1e-3, 0.0, 0.0], c),
+        [-1e-3, 0.0, 0.0]
+    );
+
+    // A batch: every other node a site 10 µm in a 5 cm clearance, stepped 3 mm in; the
+    // even variants on a soft law (m = 2/3), the odd on a linear one.
+    let (v, n) = (8, 12);
+    let mut rng = rand::rngs::StdRng::seed_from_u64(31);
+    let (mut b0, _, _) = batch(v, n, &mut rng);
+    b0.x.iter_mut().for_each(|x| *x = 0.0);
+    let mut delta = vec![0.0; 6 * n * v];
+    let (sites, mut walls) = sites_at_every_other_node(v, n, Vec::new());
+    let p = sites.len() * v;
+    for (k, &node) in sites.iter().enumerate() {
+        for j in 0..v {
+            let i = k * v + j;
+            walls.node_site[node * v + j] = k as u32;
+            let phi: f64 = rng.random_range(0.0..std::f64::consts::TAU);
+            let (cs, sn) = (phi.cos(), phi.sin());
+            walls.pair_normals[3 * i + 2] = 1.0;
+            walls.pair_base[3 * i] = (c + 1e-5) * cs;
+            walls.pair_base[3 * i + 1] = (c + 1e-5) * sn;
+            walls.pair_params[i] = c;
+            walls.pair_params[3 * p + i] = if j % 2 == 0 { 2.0 / 3.0 } else { 1.0 };
+            delta[(6 * node) * v + j] = 3e-3 * cs;
+            delta[(6 * node + 1) * v + j] = 3e-3 * sn;
+            delta[(6 * node + 2) * v + j] = 1e-3;
+        }
+    }
+    let alpha = vec![1.0; v];
+    let radius = |x: &[f64], node: usize, j: usize| -> f64 {
+        let i = (node / 2) * v + j;
+        let e: Vec<f64> = (0..2)
+            .map(|a| walls.pair_base[3 * i + a] + x[(3 * node + a) * v + j])
+            .collect();
+        (e[0] * e[0] + e[1] * e[1]).sqrt()
+    };
+    let mut twin = b0.clone();
+    update(&mut twin, &walls, &delta, &alpha);
+    for &node in &sites {
+        for j in 0..v {
+            let want = if j % 2 == 0 {
+                c + DEEPENING_FACTOR * 1e-5
+            } else {
+                c + 1e-5 + 3e-3
+            };
+            assert!(
+                (radius(&twin.x, node, j) - want).abs() <= 1e-15,
+                "node {node} variant {j}: {} for {want}",
+                radius(&twin.x, node, j)
+            );
+        }
+    }
+    let cast = |x: &[f64]| -> Vec<f32> { x.iter().map(|&x| x as f32).collect() };
+    let w32 = UpdateWalls {
+        node_site: walls.node_site.clone(),
+        pair_base: cast(&walls.pair_base),
+        pair_normals: cast(&walls.pair_normals),
+        pair_params: cast(&walls.pair_params),
+        epoch: Vec::new(),
+    };
+    let b32 = ConfigBatch {
+        num_variants: v,
+        num_nodes: n,
+        x: cast(&b0.x),
+        rot: cast(&b0.rot),
+        basis: cast(&b0.basis),
+        landed: Vec::new(),
+    };
+    let mut cpu32 = b32.clone();
+    update(&mut cpu32, &w32, &cast(&delta), &cast(&alpha));
+    // f32: no bound, every node its full step.
+    let x64: Vec<f64> = cpu32.x.iter().map(|&x| x as f64).collect();
+    assert!((radius(&x64, 0, 0) - (c + 1e-5 + 3e-3)).abs() <= 1e-7);
+    let Some(ctx) = common::gpu() else { return };
+    if ctx.has_f64 {
+        let mut gpu = b0.clone();
+        update_gpu(ctx, &mut gpu, &walls, &delta, &alpha).unwrap();
+        assert_eq!(gpu.x, twin.x, "GPU f64 against the twin");
+    }
+    let mut gpu32 = b32.clone();
+    update_gpu(ctx, &mut gpu32, &w32, &cast(&delta), &cast(&alpha)).unwrap();
+    let diff = gpu32
+        .x
+        .iter()
+        .zip(&cpu32.x)
+        .fold(0.0f32, |m, (a, b)| m.max((a - b).abs()));
+    eprintln!("soft-law update, GPU f32 vs twin: {diff:.2e} m");
     assert!(diff <= 4.0 * f32::EPSILON * 0.05);
 }

@@ -5,7 +5,8 @@
 //! translation basis, identity but at a bit held in the hole frame; at a contact site near
 //! its wall the step follows the wall, `physics::contact::wall_following_step`, and one off
 //! it whose step would end inside it lands on it, once a landing epoch,
-//! `physics::contact::landing_step`) and
+//! `physics::contact::landing_step`), and one on a soft-law wall goes no deeper than its
+//! bound in f64, `physics::contact::deepening_step`) and
 //! `R_i ← exp([α Δθ_i]×) R_i`. The exponential is written with series, the same in both
 //! (no f64 trigonometry on Vulkan): with `φ = |θ|` reduced to `[0, π]` (a rotation by
 //! `φ > π` is one by `φ − 2π·round(φ/2π)` about the same axis) and `h = φ/2`,
@@ -177,6 +178,10 @@ fn update_node<T: Real>(
                     *m = e;
                 }
             }
+        }
+        let exponent = walls.pair_params[3 * p + pair].to_f64_lossy();
+        if crate::physics::contact::deepens(exponent, std::mem::size_of::<T>()) {
+            step = crate::physics::contact::deepening_step(&d, &t, &step, walls.pair_params[pair]);
         }
     }
     let x: [T; 3] = std::array::from_fn(|k| old[k] + step[k]);

@@ -351,7 +351,9 @@ pub(crate) fn to_global(c: &Constraints, delta: &mut [f64]) {
 }
 
 /// Applies `α·Δ` (constrained coordinates) to a state; contact nodes near the wall move
-/// along it ([`crate::physics::contact::wall_following_step`]).
+/// along it ([`crate::physics::contact::wall_following_step`]), those off it that may land
+/// land on it ([`crate::physics::contact::landing_step`]), and soft-law ones go no deeper
+/// than their bound ([`crate::physics::contact::deepening_step`]).
 fn update(
     c: &Constraints,
     walls: &[Option<Wall>],
@@ -377,6 +379,9 @@ fn update(
                     du = l;
                 }
             }
+            if w.deepens {
+                du = crate::physics::contact::deepening_step(&d, &w.axis, &du, w.clearance);
+            }
         }
         for (x, d) in s.x[i].iter_mut().zip(du) {
             *x += d;
@@ -395,6 +400,8 @@ pub(crate) struct Wall {
     axis: Vec3<f64>,
     min_radius: f64,
     clearance: f64,
+    /// Its steps are bounded in depth ([`crate::physics::contact::deepens`]).
+    deepens: bool,
 }
 
 /// Per node, the hole its contact site sits in (none where no site).
@@ -407,6 +414,7 @@ pub(crate) fn walls(model: &Model) -> Vec<Option<Wall>> {
             axis: node.hole_axis,
             min_radius: crate::physics::contact::wall_following_radius(site.params.clearance),
             clearance: site.params.clearance,
+            deepens: crate::physics::contact::deepens(site.params.spring_exponent, 8),
         });
     }
     w
