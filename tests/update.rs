@@ -32,6 +32,74 @@ fn sites_at_every_other_node(
     (sites, walls)
 }
 
+/// A batch of V = 8 variants on n = 12 nodes at zero offset, every other node a site on a
+/// vertical hole axis of clearance `c`, `base` from the axis in a random direction per
+/// variant (rng `seed`), stepped `step` radially outward and 1 mm along the axis.
+fn radial_steps(
+    seed: u64,
+    c: f64,
+    base: f64,
+    step: f64,
+    epoch: Vec<u32>,
+) -> (Vec<usize>, UpdateWalls<f64>, ConfigBatch<f64>, Vec<f64>) {
+    let (v, n) = (8, 12);
+    let mut rng = rand::rngs::StdRng::seed_from_u64(seed);
+    let (mut b0, _, _) = batch(v, n, &mut rng);
+    b0.x.iter_mut().for_each(|x| *x = 0.0);
+    let mut delta = vec![0.0; 6 * n * v];
+    let (sites, mut walls) = sites_at_every_other_node(v, n, epoch);
+    for (k, &node) in sites.iter().enumerate() {
+        for j in 0..v {
+            let i = k * v + j;
+            walls.node_site[node * v + j] = k as u32;
+            let phi: f64 = rng.random_range(0.0..std::f64::consts::TAU);
+            let (cs, sn) = (phi.cos(), phi.sin());
+            walls.pair_normals[3 * i + 2] = 1.0;
+            walls.pair_base[3 * i] = base * cs;
+            walls.pair_base[3 * i + 1] = base * sn;
+            walls.pair_params[i] = c;
+            delta[(6 * node) * v + j] = step * cs;
+            delta[(6 * node + 1) * v + j] = step * sn;
+            delta[(6 * node + 2) * v + j] = 1e-3;
+        }
+    }
+    (sites, walls, b0, delta)
+}
+
+/// The lateral offset from its hole axis of `node` (a site of [`radial_steps`]), variant `j`,
+/// at positions `x`.
+fn radius_of(walls: &UpdateWalls<f64>, x: &[f64], v: usize, node: usize, j: usize) -> f64 {
+    let i = (node / 2) * v + j;
+    let e: Vec<f64> = (0..2)
+        .map(|a| walls.pair_base[3 * i + a] + x[(3 * node + a) * v + j])
+        .collect();
+    (e[0] * e[0] + e[1] * e[1]).sqrt()
+}
+
+fn cast(x: &[f64]) -> Vec<f32> {
+    x.iter().map(|&x| x as f32).collect()
+}
+
+/// `walls` and `b` in f32.
+fn in_f32(walls: &UpdateWalls<f64>, b: &ConfigBatch<f64>) -> (UpdateWalls<f32>, ConfigBatch<f32>) {
+    let w = UpdateWalls {
+        node_site: walls.node_site.clone(),
+        pair_base: cast(&walls.pair_base),
+        pair_normals: cast(&walls.pair_normals),
+        pair_params: cast(&walls.pair_params),
+        epoch: walls.epoch.clone(),
+    };
+    let b = ConfigBatch {
+        num_variants: b.num_variants,
+        num_nodes: b.num_nodes,
+        x: cast(&b.x),
+        rot: cast(&b.rot),
+        basis: cast(&b.basis),
+        landed: b.landed.clone(),
+    };
+    (w, b)
+}
+
 fn batch(
     v: usize,
     n: usize,
@@ -299,36 +367,11 @@ fn a_node_stepping_through_its_wall_lands_on_it_once_an_epoch() {
     );
 
     // A batch: every other node a site 0.5 mm off a 5 cm clearance, stepped 2 mm out.
-    let (v, n) = (8, 12);
-    let mut rng = rand::rngs::StdRng::seed_from_u64(29);
-    let (mut b0, _, _) = batch(v, n, &mut rng);
-    let mut delta = vec![0.0; 6 * n * v];
-    let (sites, mut walls) = sites_at_every_other_node(v, n, vec![1; v]);
-    b0.x.iter_mut().for_each(|x| *x = 0.0);
-    for (k, &node) in sites.iter().enumerate() {
-        for j in 0..v {
-            let i = k * v + j;
-            walls.node_site[node * v + j] = k as u32;
-            let phi: f64 = rng.random_range(0.0..std::f64::consts::TAU);
-            let (cs, sn) = (phi.cos(), phi.sin());
-            walls.pair_normals[3 * i + 2] = 1.0;
-            walls.pair_base[3 * i] = (c - 5e-4) * cs;
-            walls.pair_base[3 * i + 1] = (c - 5e-4) * sn;
-            walls.pair_params[i] = c;
-            delta[(6 * node) * v + j] = 2e-3 * cs;
-            delta[(6 * node + 1) * v + j] = 2e-3 * sn;
-            delta[(6 * node + 2) * v + j] = 1e-3;
-        }
-    }
+    let (sites, walls, mut b0, delta) = radial_steps(29, c, c - 5e-4, 2e-3, vec![1; 8]);
+    let (v, n) = (b0.num_variants, b0.num_nodes);
     b0.landed = vec![0; n * v];
     let alpha = vec![1.0; v];
-    let radius = |b: &ConfigBatch<f64>, node: usize, j: usize| -> f64 {
-        let i = (node / 2) * v + j;
-        let x: Vec<f64> = (0..2)
-            .map(|a| walls.pair_base[3 * i + a] + b.x[(3 * node + a) * v + j])
-            .collect();
-        (x[0] * x[0] + x[1] * x[1]).sqrt()
-    };
+    let radius = |b: &ConfigBatch<f64>, node: usize, j: usize| radius_of(&walls, &b.x, v, node, j);
     let mut twin = b0.clone();
     update(&mut twin, &walls, &delta, &alpha);
     for &node in &sites {
@@ -354,7 +397,6 @@ fn a_node_stepping_through_its_wall_lands_on_it_once_an_epoch() {
     assert!((radius(&third, 0, 0) - land).abs() <= 1e-15);
     assert!((radius(&third, 0, 1) - (c + 1.5e-3)).abs() <= 1e-12);
     let Some(ctx) = common::gpu() else { return };
-    let cast = |x: &[f64]| -> Vec<f32> { x.iter().map(|&x| x as f32).collect() };
     if ctx.has_f64 {
         for (w, landed) in [(&walls, &b0.landed), (&next, &twin.landed)] {
             let mut gpu = b0.clone();
@@ -373,21 +415,7 @@ fn a_node_stepping_through_its_wall_lands_on_it_once_an_epoch() {
         }
     }
     // f32: the same marks, the landing radius to f32 rounding.
-    let w32 = UpdateWalls {
-        node_site: walls.node_site.clone(),
-        pair_base: cast(&walls.pair_base),
-        pair_normals: cast(&walls.pair_normals),
-        pair_params: cast(&walls.pair_params),
-        epoch: walls.epoch.clone(),
-    };
-    let b32 = ConfigBatch {
-        num_variants: v,
-        num_nodes: n,
-        x: cast(&b0.x),
-        rot: cast(&b0.rot),
-        basis: cast(&b0.basis),
-        landed: b0.landed.clone(),
-    };
+    let (w32, b32) = in_f32(&walls, &b0);
     let mut cpu = b32.clone();
     update(&mut cpu, &w32, &cast(&delta), &cast(&alpha));
     let mut gpu = b32.clone();
@@ -448,37 +476,14 @@ fn a_soft_law_node_goes_no_deeper_than_its_bound_in_f64() {
 
     // A batch: every other node a site 10 µm in a 5 cm clearance, stepped 3 mm in; the
     // even variants on a soft law (m = 2/3), the odd on a linear one.
-    let (v, n) = (8, 12);
-    let mut rng = rand::rngs::StdRng::seed_from_u64(31);
-    let (mut b0, _, _) = batch(v, n, &mut rng);
-    b0.x.iter_mut().for_each(|x| *x = 0.0);
-    let mut delta = vec![0.0; 6 * n * v];
-    let (sites, mut walls) = sites_at_every_other_node(v, n, Vec::new());
+    let (sites, mut walls, b0, delta) = radial_steps(31, c, c + 1e-5, 3e-3, Vec::new());
+    let v = b0.num_variants;
     let p = sites.len() * v;
-    for (k, &node) in sites.iter().enumerate() {
-        for j in 0..v {
-            let i = k * v + j;
-            walls.node_site[node * v + j] = k as u32;
-            let phi: f64 = rng.random_range(0.0..std::f64::consts::TAU);
-            let (cs, sn) = (phi.cos(), phi.sin());
-            walls.pair_normals[3 * i + 2] = 1.0;
-            walls.pair_base[3 * i] = (c + 1e-5) * cs;
-            walls.pair_base[3 * i + 1] = (c + 1e-5) * sn;
-            walls.pair_params[i] = c;
-            walls.pair_params[3 * p + i] = if j % 2 == 0 { 2.0 / 3.0 } else { 1.0 };
-            delta[(6 * node) * v + j] = 3e-3 * cs;
-            delta[(6 * node + 1) * v + j] = 3e-3 * sn;
-            delta[(6 * node + 2) * v + j] = 1e-3;
-        }
+    for i in 0..p {
+        walls.pair_params[3 * p + i] = if i % v % 2 == 0 { 2.0 / 3.0 } else { 1.0 };
     }
     let alpha = vec![1.0; v];
-    let radius = |x: &[f64], node: usize, j: usize| -> f64 {
-        let i = (node / 2) * v + j;
-        let e: Vec<f64> = (0..2)
-            .map(|a| walls.pair_base[3 * i + a] + x[(3 * node + a) * v + j])
-            .collect();
-        (e[0] * e[0] + e[1] * e[1]).sqrt()
-    };
+    let radius = |x: &[f64], node: usize, j: usize| radius_of(&walls, x, v, node, j);
     let mut twin = b0.clone();
     update(&mut twin, &walls, &delta, &alpha);
     for &node in &sites {
@@ -495,22 +500,7 @@ fn a_soft_law_node_goes_no_deeper_than_its_bound_in_f64() {
             );
         }
     }
-    let cast = |x: &[f64]| -> Vec<f32> { x.iter().map(|&x| x as f32).collect() };
-    let w32 = UpdateWalls {
-        node_site: walls.node_site.clone(),
-        pair_base: cast(&walls.pair_base),
-        pair_normals: cast(&walls.pair_normals),
-        pair_params: cast(&walls.pair_params),
-        epoch: Vec::new(),
-    };
-    let b32 = ConfigBatch {
-        num_variants: v,
-        num_nodes: n,
-        x: cast(&b0.x),
-        rot: cast(&b0.rot),
-        basis: cast(&b0.basis),
-        landed: Vec::new(),
-    };
+    let (w32, b32) = in_f32(&walls, &b0);
     let mut cpu32 = b32.clone();
     update(&mut cpu32, &w32, &cast(&delta), &cast(&alpha));
     // f32: no bound, every node its full step.
