@@ -80,26 +80,6 @@ fn cast(x: &[f64]) -> Vec<f32> {
     x.iter().map(|&x| x as f32).collect()
 }
 
-/// `walls` and `b` in f32.
-fn in_f32(walls: &UpdateWalls<f64>, b: &ConfigBatch<f64>) -> (UpdateWalls<f32>, ConfigBatch<f32>) {
-    let w = UpdateWalls {
-        node_site: walls.node_site.clone(),
-        pair_base: cast(&walls.pair_base),
-        pair_normals: cast(&walls.pair_normals),
-        pair_params: cast(&walls.pair_params),
-        epoch: walls.epoch.clone(),
-    };
-    let b = ConfigBatch {
-        num_variants: b.num_variants,
-        num_nodes: b.num_nodes,
-        x: cast(&b.x),
-        rot: cast(&b.rot),
-        basis: cast(&b.basis),
-        landed: b.landed.clone(),
-    };
-    (w, b)
-}
-
 fn batch(
     v: usize,
     n: usize,
@@ -221,15 +201,7 @@ fn update_matches_rodrigues_and_gpu_matches_twin() {
         }
     }
     // f32: against the f64 twin.
-    let cast = |x: &[f64]| x.iter().map(|&y| y as f32).collect::<Vec<f32>>();
-    let mut b32 = ConfigBatch {
-        num_variants: v,
-        num_nodes: n,
-        x: cast(&b0.x),
-        rot: cast(&b0.rot),
-        basis: cast(&b0.basis),
-        landed: Vec::new(),
-    };
+    let mut b32 = b0.map(|x| x as f32);
     update_gpu(
         ctx,
         &mut b32,
@@ -415,7 +387,7 @@ fn a_node_stepping_through_its_wall_lands_on_it_once_an_epoch() {
         }
     }
     // f32: the same marks, the landing radius to f32 rounding.
-    let (w32, b32) = in_f32(&walls, &b0);
+    let (w32, b32) = (walls.map(|x| x as f32), b0.map(|x| x as f32));
     let mut cpu = b32.clone();
     update(&mut cpu, &w32, &cast(&delta), &cast(&alpha));
     let mut gpu = b32.clone();
@@ -500,7 +472,7 @@ fn a_soft_law_node_goes_no_deeper_than_its_bound_in_f64() {
             );
         }
     }
-    let (w32, b32) = in_f32(&walls, &b0);
+    let (w32, b32) = (walls.map(|x| x as f32), b0.map(|x| x as f32));
     let mut cpu32 = b32.clone();
     update(&mut cpu32, &w32, &cast(&delta), &cast(&alpha));
     // f32: no bound, every node its full step.

@@ -130,6 +130,36 @@ pub struct UpdateWalls<T> {
     pub epoch: Vec<u32>,
 }
 
+impl ConfigBatch<f64> {
+    /// The batch with every real mapped by `f` (to f32, as
+    /// [`crate::kernels::assemble::AssemblyInputs::map_static`]).
+    pub fn map<U>(&self, f: impl Fn(f64) -> U) -> ConfigBatch<U> {
+        let c = |x: &[f64]| x.iter().map(|&y| f(y)).collect::<Vec<U>>();
+        ConfigBatch {
+            num_variants: self.num_variants,
+            num_nodes: self.num_nodes,
+            x: c(&self.x),
+            rot: c(&self.rot),
+            basis: c(&self.basis),
+            landed: self.landed.clone(),
+        }
+    }
+}
+
+impl UpdateWalls<f64> {
+    /// The walls with every real mapped by `f` (as [`ConfigBatch::map`]).
+    pub fn map<U>(&self, f: impl Fn(f64) -> U) -> UpdateWalls<U> {
+        let c = |x: &[f64]| x.iter().map(|&y| f(y)).collect::<Vec<U>>();
+        UpdateWalls {
+            node_site: self.node_site.clone(),
+            pair_base: c(&self.pair_base),
+            pair_normals: c(&self.pair_normals),
+            pair_params: c(&self.pair_params),
+            epoch: self.epoch.clone(),
+        }
+    }
+}
+
 /// The update of node `i`, variant `v`: new position and rotation.
 fn update_node<T: Real>(
     b: &ConfigBatch<T>,
