@@ -112,14 +112,19 @@ fn landing_step(d: vec3<real>, t: vec3<real>, du: vec3<real>, clearance: real) -
     if (sqrt(dot(d0, d0)) > clearance) {
         return du;
     }
+    return within_radius(d, t, du, clearance * (real(1.0) + real(LANDING_DEPTH)));
+}
+
+// Twin: physics::contact::within_radius. The step `du` of a node at offset `d` (axis `t`),
+// its lateral part shortened to end `limit` from the axis where it would end farther.
+fn within_radius(d: vec3<real>, t: vec3<real>, du: vec3<real>, limit: real) -> vec3<real> {
     let e = d + du;
     let d1 = e - dot(e, t) * t;
     let r1 = sqrt(dot(d1, d1));
-    let land = clearance * (real(1.0) + real(LANDING_DEPTH));
-    if (!(r1 > land)) {
+    if (!(r1 > limit)) {
         return du;
     }
-    let s = land / r1;
+    let s = limit / r1;
     return s * d1 + (e - d1) - d;
 }
 
@@ -134,20 +139,12 @@ fn deepening_step(d: vec3<real>, t: vec3<real>, du: vec3<real>, clearance: real)
     let floor = clearance * real(LANDING_DEPTH);
     let d0 = d - dot(d, t) * t;
     let depth0 = sqrt(dot(d0, d0)) - clearance;
-    let e = d + du;
-    let d1 = e - dot(e, t) * t;
-    let r1 = sqrt(dot(d1, d1));
     let deeper = real(DEEPENING_FACTOR) * depth0;
     var cap = floor;
     if (deeper > floor) {
         cap = deeper;
     }
-    let limit = clearance + cap;
-    if (!(r1 > limit)) {
-        return du;
-    }
-    let s = limit / r1;
-    return s * d1 + (e - d1) - d;
+    return within_radius(d, t, du, clearance + cap);
 }
 #endif
 

@@ -486,23 +486,33 @@ pub fn lands_in(size: usize) -> bool {
 /// 110 did); a relaxation follows an overdamped string's path across a fold, which a jump
 /// to the wall leaves (corpus well 90 failed its relaxation with it).
 pub fn landing_step<T: Real>(d: &Vec3<T>, t: &Vec3<T>, du: &Vec3<T>, clearance: T) -> Vec3<T> {
-    let perp = |v: &Vec3<T>| -> Vec3<T> {
-        let a = dot(v, t);
-        std::array::from_fn(|k| v[k] - a * t[k])
-    };
-    let d0 = perp(d);
+    let d0 = perp(d, t);
     if dot(&d0, &d0).sqrt().to_f64_lossy() > clearance.to_f64_lossy() {
         return *du;
     }
-    let e: Vec3<T> = std::array::from_fn(|k| d[k] + du[k]);
-    let d1 = perp(&e);
-    let r1 = dot(&d1, &d1).sqrt();
     let land = clearance * (T::one() + T::from_f64_lossy(LANDING_DEPTH));
+    within_radius(d, t, du, land)
+}
+
+/// `v` less its part along the unit axis `t`.
+fn perp<T: Real>(v: &Vec3<T>, t: &Vec3<T>) -> Vec3<T> {
+    let a = dot(v, t);
+    std::array::from_fn(|k| v[k] - a * t[k])
+}
+
+/// The step `du` of a node at offset `d` from its point on the hole axis `t`, its lateral
+/// part shortened where it would end farther than `limit` from the axis: to end at `limit`,
+/// along the same direction across the axis, the axial part unchanged ([`landing_step`],
+/// [`deepening_step`]).
+fn within_radius<T: Real>(d: &Vec3<T>, t: &Vec3<T>, du: &Vec3<T>, limit: T) -> Vec3<T> {
+    let e: Vec3<T> = std::array::from_fn(|k| d[k] + du[k]);
+    let d1 = perp(&e, t);
+    let r1 = dot(&d1, &d1).sqrt();
     let r1_f = r1.to_f64_lossy();
-    if r1_f.is_nan() || r1_f <= land.to_f64_lossy() {
+    if r1_f.is_nan() || r1_f <= limit.to_f64_lossy() {
         return *du;
     }
-    let s = land / r1;
+    let s = limit / r1;
     std::array::from_fn(|k| s * d1[k] + (e[k] - d1[k]) - d[k])
 }
 
@@ -542,28 +552,15 @@ pub fn deepens(m: f64, size: usize) -> bool {
 /// inside the wall (the floor alone, every step) well 27's load steps cycled and were cut.
 pub fn deepening_step<T: Real>(d: &Vec3<T>, t: &Vec3<T>, du: &Vec3<T>, clearance: T) -> Vec3<T> {
     let floor = clearance * T::from_f64_lossy(LANDING_DEPTH);
-    let perp = |v: &Vec3<T>| -> Vec3<T> {
-        let a = dot(v, t);
-        std::array::from_fn(|k| v[k] - a * t[k])
-    };
-    let d0 = perp(d);
+    let d0 = perp(d, t);
     let depth0 = dot(&d0, &d0).sqrt() - clearance;
-    let e: Vec3<T> = std::array::from_fn(|k| d[k] + du[k]);
-    let d1 = perp(&e);
-    let r1 = dot(&d1, &d1).sqrt();
     let deeper = T::from_f64_lossy(DEEPENING_FACTOR) * depth0;
     let cap = if deeper.to_f64_lossy() > floor.to_f64_lossy() {
         deeper
     } else {
         floor
     };
-    let limit = clearance + cap;
-    let r1_f = r1.to_f64_lossy();
-    if r1_f.is_nan() || r1_f <= limit.to_f64_lossy() {
-        return *du;
-    }
-    let s = limit / r1;
-    std::array::from_fn(|k| s * d1[k] + (e[k] - d1[k]) - d[k])
+    within_radius(d, t, du, clearance + cap)
 }
 
 /// A Newton step `du` of a node at offset `d` from its point on the hole axis `t`, taken
@@ -580,8 +577,7 @@ pub fn wall_following_step<T: Real>(
     du: &Vec3<T>,
     min_radius: T,
 ) -> Vec3<T> {
-    let along = dot(d, t);
-    let d_perp: Vec3<T> = std::array::from_fn(|k| d[k] - along * t[k]);
+    let d_perp = perp(d, t);
     let r = dot(&d_perp, &d_perp).sqrt();
     if r.to_f64_lossy() < min_radius.to_f64_lossy() || r.to_f64_lossy() == 0.0 {
         return *du;
