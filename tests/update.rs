@@ -76,6 +76,13 @@ fn radius_of(walls: &UpdateWalls<f64>, x: &[f64], v: usize, node: usize, j: usiz
     (e[0] * e[0] + e[1] * e[1]).sqrt()
 }
 
+/// The largest |a − b| over two position vectors (in f64).
+fn max_diff<T: Copy + Into<f64>>(a: &[T], b: &[T]) -> f64 {
+    a.iter()
+        .zip(b)
+        .fold(0.0f64, |m, (&x, &y)| m.max((x.into() - y.into()).abs()))
+}
+
 fn cast(x: &[f64]) -> Vec<f32> {
     x.iter().map(|&x| x as f32).collect()
 }
@@ -299,11 +306,7 @@ fn contact_nodes_step_along_their_wall_on_both_paths() {
     if ctx.has_f64 {
         let mut gpu = b0.clone();
         update_gpu(ctx, &mut gpu, &walls, &delta, &alpha).unwrap();
-        let diff = gpu
-            .x
-            .iter()
-            .zip(&twin.x)
-            .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+        let diff = max_diff(&gpu.x, &twin.x);
         eprintln!("wall-following update, GPU f64 vs twin: {diff:.2e} m ({moved} coordinates moved off the straight step)");
         assert!(diff <= 1e-15);
     }
@@ -376,11 +379,7 @@ fn a_node_stepping_through_its_wall_lands_on_it_once_an_epoch() {
             let mut cpu = gpu.clone();
             update(&mut cpu, w, &delta, &alpha);
             update_gpu(ctx, &mut gpu, w, &delta, &alpha).unwrap();
-            let diff = gpu
-                .x
-                .iter()
-                .zip(&cpu.x)
-                .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+            let diff = max_diff(&gpu.x, &cpu.x);
             eprintln!("landing update, GPU f64 vs twin: {diff:.2e} m");
             assert!(diff <= 1e-16);
             assert_eq!(gpu.landed, cpu.landed);
@@ -394,13 +393,9 @@ fn a_node_stepping_through_its_wall_lands_on_it_once_an_epoch() {
     update_gpu(ctx, &mut gpu, &w32, &cast(&delta), &cast(&alpha)).unwrap();
     assert_eq!(gpu.landed, cpu.landed);
     assert_eq!(cpu.landed, twin.landed);
-    let diff = gpu
-        .x
-        .iter()
-        .zip(&cpu.x)
-        .fold(0.0f32, |m, (a, b)| m.max((a - b).abs()));
+    let diff = max_diff(&gpu.x, &cpu.x);
     eprintln!("landing update, GPU f32 vs twin: {diff:.2e} m");
-    assert!(diff <= 4.0 * f32::EPSILON * 0.05);
+    assert!(diff <= f64::from(4.0 * f32::EPSILON * 0.05));
 }
 
 /// A soft-law node (spring exponent below 1) whose step would take it more than
@@ -486,11 +481,7 @@ fn a_soft_law_node_goes_no_deeper_than_its_bound_in_f64() {
     }
     let mut gpu32 = b32.clone();
     update_gpu(ctx, &mut gpu32, &w32, &cast(&delta), &cast(&alpha)).unwrap();
-    let diff = gpu32
-        .x
-        .iter()
-        .zip(&cpu32.x)
-        .fold(0.0f32, |m, (a, b)| m.max((a - b).abs()));
+    let diff = max_diff(&gpu32.x, &cpu32.x);
     eprintln!("soft-law update, GPU f32 vs twin: {diff:.2e} m");
-    assert!(diff <= 4.0 * f32::EPSILON * 0.05);
+    assert!(diff <= f64::from(4.0 * f32::EPSILON * 0.05));
 }
