@@ -17,7 +17,8 @@
 //!    ([`StaticSystem::relax_scale`]: the CPU solve and the engine), the variant
 //!    **relaxes** from the last equilibrium — at once where every spring law is linear; a
 //!    soft or hard law first cuts the step in half from the last converged state, down to
-//!    `min_step`, as does a system that cannot relax, which fails there.
+//!    [`RELAX_AFTER_STEP`]; a system that cannot relax cuts down to `min_step` and fails
+//!    there.
 //!    Cutting first, down to `min_step`, cost corpus wells 0, 17 and 28 (horizontal,
 //!    10 m elements) 12–13 failed steps of 20–80 iterations each and only found the fold
 //!    more closely; relaxing at the first failure took them 1,085 / 1,509 / 1,058 → 683 /
@@ -192,6 +193,22 @@ const RELAX_STALL_FACTOR: f64 = 100.0;
 /// 285,931 → 175,519; on the slow wells at 10 m elements (0, 17, 221, 226, 294, 312)
 /// sub-solves 367–682 → 59–119. 1e-7 measured the same as 1e-5 on those wells.
 const RELAX_FLOOR: f64 = 1e-5;
+/// With a soft or hard spring law, a failed load step is cut in half down to this size
+/// before the path relaxes (linear laws relax at the first failure). A soft law's onset
+/// needs small steps: `tests/case_files.rs`
+/// `soft_spring_laws_solve_a_two_stabilizer_deviated_well` (m = 0.1) solves by cuts down to
+/// a step of 0.026, and relaxing where a step of 0.053 failed (or at the first failure)
+/// runs its relaxation out (5,001 sub-solves, no equilibrium). Cutting on down to
+/// `min_step` (1e-4, before stop 63) only located the fold where there is one: on the 46
+/// soft-law (m = 2/3) wells of the 500-well corpus (`holewall bench corpus --wells 1
+/// --first-seed S`) 15,888 → 16,144 Newton iterations, 30.3 → 30.0 s, all 46 solved; well
+/// 221 (10 m elements, relaxed past a fold) 1,428 → 994 iterations, 2.3 → 1.5 s, well 134
+/// 1,454 → 1,249, 376 1,539 → 1,198, the lock-up 283 6,994 → 8,104; the 51 hard-law (m =
+/// 3/2) wells 4,635 → 4,478, 13.6 → 13.4 s. The same wells with m = 0.3 (stiffness scaled
+/// to the same force at 1 mm) all solve either way (221 584 → 432 iterations of converged
+/// steps). At 1 (relax at the first failure) the m = 2/3 wells took 14,143 iterations, but
+/// the m = 0.1 case fails; at 1/16 13,736, and it fails.
+const RELAX_AFTER_STEP: f64 = 1.0 / 64.0;
 /// A shift above `s0 ×` this ends a relaxation that cannot make progress.
 const RELAX_CEILING: f64 = 1e6;
 
@@ -687,12 +704,10 @@ impl LoadPath {
             Stage::Load => {
                 self.load_failures += 1;
                 // With linear spring laws the first load step that fails relaxes; with a
-                // soft or hard law the step is cut down to `min_step` first, as a soft
-                // law's onset needs small steps (`tests/case_files.rs`
-                // `soft_spring_laws_solve_a_two_stabilizer_deviated_well`, m = 0.1: cut,
-                // it solves; relaxed at the first failure, 5,001 sub-solves found no
-                // equilibrium).
-                let relax = relax.filter(|_| self.linear_law || self.step / 2.0 < self.min_step);
+                // soft or hard law the step is cut down to [`RELAX_AFTER_STEP`] first.
+                let relax = relax.filter(|_| {
+                    self.linear_law || self.step / 2.0 < RELAX_AFTER_STEP.max(self.min_step)
+                });
                 if let Some(s0) = relax {
                     // The relaxation goes from the last equilibrium to the full loads at
                     // once: the sub-solves follow the string past the fold as far as it
