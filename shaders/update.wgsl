@@ -128,11 +128,10 @@ fn within_radius(d: vec3<real>, t: vec3<real>, du: vec3<real>, limit: real) -> v
     return s * d1 + (e - d1) - d;
 }
 
-#if F64
 // physics::contact::DEEPENING_FACTOR.
 const DEEPENING_FACTOR = 4.0;
 
-// Twin: physics::contact::deepening_step (f64 only, soft laws: physics::contact::deepens).
+// Twin: physics::contact::deepening_step (soft laws, every precision: physics::contact::deepens).
 // A step of a node that would take its depth from δ₀ beyond max(DEEPENING_FACTOR δ₀,
 // LANDING_DEPTH · clearance), its lateral part shortened to end there; `du` otherwise.
 fn deepening_step(d: vec3<real>, t: vec3<real>, du: vec3<real>, clearance: real) -> vec3<real> {
@@ -146,7 +145,6 @@ fn deepening_step(d: vec3<real>, t: vec3<real>, du: vec3<real>, clearance: real)
     }
     return within_radius(d, t, du, clearance + cap);
 }
-#endif
 
 @compute @workgroup_size(64)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
@@ -188,14 +186,12 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
                 mark = epoch[v];
             }
         }
-#if F64
         // A soft-law node (spring exponent, field 3 of the pair's parameters, below 1)
         // goes no deeper than its bound.
         let pairs = arrayLength(&pair_normals) / 3u;
         if (pair_params[3u * pairs + pair] < real(1.0)) {
             step = deepening_step(d, t, step, pair_params[pair]);
         }
-#endif
     }
     landed[i * nv + v] = mark;
     for (var r = 0u; r < 3u; r = r + 1u) {

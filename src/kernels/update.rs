@@ -6,7 +6,7 @@
 //! its wall the step follows the wall, `physics::contact::wall_following_step`, and one off
 //! it whose step would end inside it lands on it, once a landing epoch,
 //! `physics::contact::landing_step`), and one on a soft-law wall goes no deeper than its
-//! bound in f64, `physics::contact::deepening_step`) and
+//! bound, `physics::contact::deepening_step`) and
 //! `R_i ← exp([α Δθ_i]×) R_i`. The exponential is written with series, the same in both
 //! (no f64 trigonometry on Vulkan): with `φ = |θ|` reduced to `[0, π]` (a rotation by
 //! `φ > π` is one by `φ − 2π·round(φ/2π)` about the same axis) and `h = φ/2`,
@@ -210,7 +210,7 @@ fn update_node<T: Real>(
             }
         }
         let exponent = walls.pair_params[3 * p + pair].to_f64_lossy();
-        if crate::physics::contact::deepens(exponent, std::mem::size_of::<T>()) {
+        if crate::physics::contact::deepens(exponent) {
             step = crate::physics::contact::deepening_step(&d, &t, &step, walls.pair_params[pair]);
         }
     }

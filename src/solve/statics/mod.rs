@@ -414,7 +414,7 @@ pub(crate) fn walls(model: &Model) -> Vec<Option<Wall>> {
             axis: node.hole_axis,
             min_radius: crate::physics::contact::wall_following_radius(site.params.clearance),
             clearance: site.params.clearance,
-            deepens: crate::physics::contact::deepens(site.params.spring_exponent, 8),
+            deepens: crate::physics::contact::deepens(site.params.spring_exponent),
         });
     }
     w
