@@ -535,10 +535,9 @@ pub const DEEPENING_FACTOR: f64 = 4.0;
 /// few ulps of an f32 offset, but the bound's work is the factor on the depth a node has.
 /// The 38 soft-law wells of at most 1,000 nodes through the engine's GPU f32 path
 /// (`holewall bench corpus --wells 1 --first-seed S --engine-sample 1`): 5,118 → 4,226
-/// Newton iterations, 68 → 47 step cuts, 136 → 86 s on lavapipe, all solved either way;
-/// wells 5 and 88 no longer fail their guarded solve (8 and 13 cuts → none) and answer on
-/// the CPU's model; the hook load of every well that does not relax within 9.6e-6 of the
-/// CPU's f64 either way. The soft-law dynamic corpus cases of at most 400 nodes (8, 27, 48,
+/// Newton iterations, 68 → 47 step cuts, 136 → 86 s on lavapipe, all solved either way
+/// (wells 5 and 88: 8 and 13 cuts → none); the hook load of every well that does not relax
+/// within 9.6e-6 of the CPU's f64 either way. The soft-law dynamic corpus cases of at most 400 nodes (8, 27, 48,
 /// 56, 72, 85) through the engine in f32: the same cuts and whirl class, the hook load as
 /// far from the CPU's as before (within 2e-5).
 pub fn deepens(m: f64) -> bool {
