@@ -537,9 +537,11 @@ pub const DEEPENING_FACTOR: f64 = 4.0;
 /// (`holewall bench corpus --wells 1 --first-seed S --engine-sample 1`): 5,118 → 4,226
 /// Newton iterations, 68 → 47 step cuts, 136 → 86 s on lavapipe, all solved either way
 /// (wells 5 and 88: 8 and 13 cuts → none); the hook load of every well that does not relax
-/// within 9.6e-6 of the CPU's f64 either way. The soft-law dynamic corpus cases of at most 400 nodes (8, 27, 48,
-/// 56, 72, 85) through the engine in f32: the same cuts and whirl class, the hook load as
-/// far from the CPU's as before (within 2e-5).
+/// within 9.6e-6 of the CPU's f64 either way. Not every well gains: the unseen 775 (5 m
+/// elements) 153 → 462 iterations, 4 → 13 cuts (docs/performance.md, stop 63). The
+/// soft-law dynamic corpus cases of at most 400 nodes (8, 27, 48, 56, 72, 85) through the
+/// engine in f32: the same cuts and whirl class, the hook load as far from the CPU's as
+/// before (within 2e-5).
 pub fn deepens(m: f64) -> bool {
     m < 1.0
 }
