@@ -138,18 +138,6 @@ fn assembly_inputs(n: usize, v: usize) -> AssemblyInputs<f64> {
     }
 }
 
-fn cast_chain<U>(b: &ChainBatch<f64>, f: impl Fn(f64) -> U) -> ChainBatch<U> {
-    let c = |x: &[f64]| x.iter().map(|&y| f(y)).collect::<Vec<U>>();
-    ChainBatch {
-        num_variants: b.num_variants,
-        num_nodes: b.num_nodes,
-        diag: c(&b.diag),
-        upper: c(&b.upper),
-        lower: c(&b.lower),
-        rhs: c(&b.rhs),
-    }
-}
-
 /// FLOPs per variant of each kernel on an `n`-node string (counted on the twins).
 struct Counts {
     contact_per_pair: f64,
@@ -172,7 +160,7 @@ fn counts(n: usize) -> Counts {
     }) / pairs as f64;
     let a = assembly_inputs(n, 1).map_static(Counted);
     let assemble = counted(|| crate::kernels::assemble::assemble(&a));
-    let b = cast_chain(&chain_batch(n, 1), Counted);
+    let b = chain_batch(n, 1).map(Counted);
     let block_lu = counted(|| crate::kernels::block_lu::block_lu(&b));
     let block_cr = counted(|| crate::kernels::block_cr::block_cr(&b));
     Counts {
@@ -295,7 +283,7 @@ fn run_size<T: GpuReal>(
     ));
     // The block-tridiagonal solve, in every form (the engine runs the adapter's:
     // `LuForm::for_batch`); the names say which. The cyclic form's FLOPs are its twin's.
-    let b = cast_chain(&chain_batch(n, v), to_t);
+    let b = chain_batch(n, v).map(to_t);
     for (form, name, flops) in [
         (LuForm::Serial, "block solve (serial)", c.block_lu),
         (LuForm::Lanes, "block solve (lanes)", c.block_lu),

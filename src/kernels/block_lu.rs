@@ -46,6 +46,22 @@ pub struct ChainBatch<T> {
     pub rhs: Vec<T>,
 }
 
+impl ChainBatch<f64> {
+    /// The batch with every real mapped by `f` (to f32 or a FLOP counter, as
+    /// [`crate::kernels::update::ConfigBatch::map`]).
+    pub fn map<U>(&self, f: impl Fn(f64) -> U) -> ChainBatch<U> {
+        let c = |x: &[f64]| x.iter().map(|&y| f(y)).collect::<Vec<U>>();
+        ChainBatch {
+            num_variants: self.num_variants,
+            num_nodes: self.num_nodes,
+            diag: c(&self.diag),
+            upper: c(&self.upper),
+            lower: c(&self.lower),
+            rhs: c(&self.rhs),
+        }
+    }
+}
+
 impl<T: Real> ChainBatch<T> {
     /// Packs one system per variant.
     pub fn from_systems(systems: &[(&BlockTridiagonal, &[f64])]) -> Self {
