@@ -412,6 +412,10 @@ fn a_failed_load_step_is_not_reported_as_the_gravity_stage() {
     let msg = static_failure(&case, &relaxed);
     assert!(!msg.contains("under its own weight"), "{msg}");
     assert!(msg.contains("it reached 25.0 % of the"), "{msg}");
+    assert!(
+        msg.contains("the last equilibrium on this load path"),
+        "{msg}"
+    );
     let gravity = StaticError::LoadStep {
         stage: format!(
             "{} (stage 1 of the load path)",
@@ -429,6 +433,10 @@ fn a_failed_load_step_is_not_reported_as_the_gravity_stage() {
         "{msg}"
     );
     assert!(!msg.contains("it reached"), "{msg}");
+    assert!(
+        !msg.contains("the last equilibrium on this load path"),
+        "{msg}"
+    );
 }
 
 /// A vertical 6⅛ in hole drilled at `wob_kn` on a near-bit stabilizer and 5 × 2¼ in

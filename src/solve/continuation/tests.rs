@@ -230,14 +230,57 @@ fn a_relaxation_stops_when_its_iteration_budget_is_spent() {
         )),
         "{e}"
     );
-    // Easy sub-solves at the smallest shift that never settle: the sub-solve count.
+    // Easy sub-solves at the smallest shift that never settle, their unshifted measure
+    // still falling (halving every 400 sub-solves, far above the tolerance): the sub-solve
+    // count.
     let (mut p, _) = stuck(Some(1e6));
     let mut subs = 0;
-    while p.converged(2) == Next::Step {
+    loop {
+        p.shift_settled(1e-2 * 0.5f64.powf(subs as f64 / 400.0));
+        if p.converged(2) != Next::Step {
+            break;
+        }
         subs += 1;
     }
     assert_eq!(subs + 1, RELAX_MAX_SUBS);
-    assert!(p.error.is_some());
+    let e = p.error.unwrap().to_string();
+    assert!(e.contains("sub-solves ran out"), "{e}");
+}
+
+/// A relaxation whose unshifted measure stops falling fails after [`RELAX_STAGNANT_SUBS`]
+/// sub-solves without a 1 % gain, counted from its best, failed sub-solves included.
+#[test]
+fn a_relaxation_whose_residual_stops_falling_fails_saying_so() {
+    let (mut p, _) = stuck(Some(1e6));
+    let mut subs = 0;
+    let mut next = Next::Step;
+    while next == Next::Step {
+        // Falling by 10 % a sub-solve for 40 sub-solves, then within 1 % of its best
+        // (a failed sub-solve every tenth, at the shift's raised value).
+        let measure = if subs < 40 {
+            0.9f64.powi(subs as i32)
+        } else {
+            0.9f64.powi(39) * (1.0 - 0.005 * (subs % 2) as f64)
+        };
+        next = if subs >= 40 && subs % 10 == 0 {
+            p.failed("no".into())
+        } else {
+            p.shift_settled(measure);
+            p.converged(3)
+        };
+        subs += 1;
+    }
+    assert_eq!(next, Next::Failed);
+    // Its best came at sub-solve 39; the 500th after it ends the relaxation.
+    assert_eq!(subs, 39 + RELAX_STAGNANT_SUBS);
+    let e = p.error.unwrap().to_string();
+    assert!(
+        e.contains(&format!(
+            "has not fallen by 1 % in {RELAX_STAGNANT_SUBS} sub-solves"
+        )),
+        "{e}"
+    );
+    assert!(e.contains("found no equilibrium past it either"), "{e}");
 }
 
 #[test]
