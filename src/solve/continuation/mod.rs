@@ -179,12 +179,14 @@ const RELAX_MAX_SUBS: usize = 5000;
 /// within the old budget takes the same path.
 const RELAX_MAX_BUDGET: usize = 100;
 /// A relaxation fails once its unshifted measure ([`LoadPath::shift_settled`]) has not
-/// improved by 1 % in this many sub-solves: on the lock-up failures of the corpus the measure
-/// stops falling after a few hundred sub-solves and the relaxation then spent the rest of
-/// [`RELAX_MAX_BUDGET`] (corpus well 419, horizontal, tripping in, 2 m elements: its best
-/// at sub-solve 243, no 1 % gain in the ~1,100 sub-solves after it, 133 s). The longest
-/// run without a 1 % gain in a relaxation that settled, over the 61 relaxed wells of seeds
-/// 0–499 (`holewall bench corpus --wells 500`): 359 sub-solves (well 44), then 98 (283).
+/// improved by 1 % in this many sub-solves. On the lock-up failures of the corpus the
+/// measure stops falling within a few hundred sub-solves and the relaxation then spent the
+/// rest of [`RELAX_MAX_BUDGET`]: corpus well 419 (horizontal, tripping in, 2 m elements)
+/// had its best (6.5e-6 of the force scale) at sub-solve 244 and ran on to 1,364 sub-solves
+/// and 20,031 Newton iterations; with this bound 11,884. The longest run without a 1 % gain
+/// in a relaxation that settled, over the 54 of the relaxed wells of seeds 0–499 and the
+/// unseen 754 (`holewall bench corpus --wells 1 --first-seed S`): 359 sub-solves (well 44),
+/// then 98 (283) and 75 (90); their paths are unchanged (docs/performance.md, stop 64).
 const RELAX_STAGNANT_SUBS: usize = 500;
 /// Newton iterations of a shifted sub-solve before it fails (and the shift is raised): the
 /// shift makes each a well-posed problem that converges in a few, or does not at all.
