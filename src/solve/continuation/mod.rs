@@ -768,7 +768,13 @@ impl LoadPath {
                 r.iterations += RELAX_SUB_ITERATIONS.min(self.max_iterations);
                 r.failed_at = r.s;
                 r.s *= 4.0;
-                if r.s > RELAX_CEILING * r.s0 || r.exhausted(self.max_iterations).is_some() {
+                let ends = r.exhausted(self.max_iterations);
+                if r.s > RELAX_CEILING * r.s0 || ends.is_some() {
+                    // A sub-solve that failed as the relaxation ran out says both.
+                    let reason = match ends {
+                        Some(e) if !reason.contains(&e) => format!("{reason}; {e}"),
+                        _ => reason,
+                    };
                     let r = self.relax.take().expect("a relaxation");
                     self.log.push(format!(
                         "relaxation after \"{}\" stopped after {} sub-solves ({} Newton iterations): {reason}",
