@@ -1,0 +1,83 @@
+//! The relaxation's constants ([`super::Stage::Relax`]): its budget, its sub-solves, when it
+//! settles, stops or starts. A relaxation's state and its policy are in [`super`].
+
+/// Sub-solves a relaxation may take before the variant fails (a run of one- or
+/// two-iteration sub-solves at the smallest shift that never settles would otherwise spend
+/// the iteration budget many times over). Corpus well 126 (horizontal, sliding, 5 m
+/// elements) settles after 499 (1,492 Newton iterations); at 400 it failed. Raised from
+/// 1,000 with [`RELAX_MAX_BUDGET`].
+pub(super) const RELAX_MAX_SUBS: usize = 5000;
+/// Newton iterations a relaxation may take before the variant fails, in units of a step's
+/// `max_iterations` (a failed sub-solve counted in full). 15 (3,000 iterations) ended
+/// every relaxation of the 14 corpus wells that failed (`holewall bench corpus --wells
+/// 500`); at 100 (20,000) five of them settle at the full load, after 4,581–13,689 Newton
+/// iterations (wells 173, 263, 381, 44 and 195; 18–156 s): a buckled string's soft lateral
+/// modes converge at `s / (s + k)` per sub-solve. The cost falls on wells that fail anyway:
+/// 200–620 s instead of 30–160 s (bounded by `--max-seconds`). A relaxation that settles
+/// within the old budget takes the same path.
+pub(super) const RELAX_MAX_BUDGET: usize = 100;
+/// A relaxation fails once its unshifted measure ([`super::LoadPath::shift_settled`]) has not
+/// improved by 1 % in this many sub-solves. On the lock-up failures of the corpus the
+/// measure stops falling within a few hundred sub-solves and the relaxation then spent the
+/// rest of [`RELAX_MAX_BUDGET`]: corpus well 419 (horizontal, tripping in, 2 m elements)
+/// had its best (6.5e-6 of the force scale) at sub-solve 244 and ran on to 1,364 sub-solves
+/// and 20,031 Newton iterations; with this bound 11,884. The longest run without a 1 % gain
+/// in a relaxation that settled, over the 54 of the relaxed wells of seeds 0–499 and the
+/// unseen 754 (`holewall bench corpus --wells 1 --first-seed S`): 359 sub-solves (well 44),
+/// then 98 (283) and 75 (90); their paths are unchanged (docs/performance.md, stop 64).
+pub(super) const RELAX_STAGNANT_SUBS: usize = 500;
+/// Newton iterations of a shifted sub-solve before it fails (and the shift is raised): the
+/// shift makes each a well-posed problem that converges in a few, or does not at all.
+pub(super) const RELAX_SUB_ITERATIONS: usize = 30;
+/// A shifted sub-solve ends once an update has brought its residual measure to this
+/// fraction of its value at the anchor (or below the tolerance): the proximal points are
+/// solved inexactly, as pseudo-transient continuation takes a Newton step or two per
+/// pseudo-time step, since only the last one, the equilibrium, needs to be exact (its
+/// unshifted measure is tested against the tolerance, [`super::LoadPath::shift_settled`]).
+/// Measured on the 11 slow relaxed wells at 10 m elements (corpus seeds 525, 283, 134,
+/// 221, 312, 206, 28, 294, 226, 17, 0; `holewall bench corpus --wells 1 --first-seed S`),
+/// with the shift's memory ([`super::Relax`]`::failed_at`): 24,854 Newton iterations solved to the
+/// tolerance, 20,198 at 0.5, 21,150 at 0.9; 0.1 without the memory 29,112 against 30,450.
+pub(super) const RELAX_SUB_REDUCTION: f64 = 0.5;
+/// A relaxation settles where its unshifted measure has not improved by 1 % in this many
+/// sub-solves and is below [`RELAX_STALL_FACTOR`] × the tolerance (f64; f32: below its own
+/// tolerance). Measured on corpus well 0 (horizontal, sliding, 532 nodes): the measure fell
+/// to 1.7e-9 of the force scale in 156 sub-solves and stayed at 1.98e-9 (2 mN of a 1 MN
+/// force scale) for the next 840 until the sub-solve bound ended it — the smallest residual
+/// sits at a contact onset's kink, as the load step's two-cycle did; on well 126, which
+/// settles, the measure stalled near 1e-6 for 130 sub-solves before falling on to 1e-9.
+/// 20, not 50 (stop 56): the same paths and answers (hook loads within 0.1 N), 60 Newton
+/// iterations fewer on each of corpus wells 0, 17, 28 and 68 at 10 m elements (683 → 623,
+/// 1,059 → 999, 598 → 538, 580 → 520) — 5–10 % of them once the failed load steps before
+/// a relaxation were gone (stop 50 measured 2.4 % with them).
+pub(super) const RELAX_STALL_SUBS: usize = 20;
+/// See [`RELAX_STALL_SUBS`].
+pub(super) const RELAX_STALL_FACTOR: f64 = 100.0;
+/// The smallest shift, `s0 ×` this: the proximal points converge at the rate `s / (s + k)`
+/// per sub-solve along a stiffness `k`, and a buckled string's lateral modes are soft (a
+/// span's `EI / L³` less its compression's share), so a high floor costs hundreds of
+/// sub-solves. Measured (`holewall bench corpus --wells 500`) when the relaxation started
+/// at the first step that failed at `min_step` (the two jumps to the rest of the load that
+/// came before it dropped; it starts at the first failed step now): 1e-5 instead of 1e-3
+/// — 486 / 500 solved against 478, every gravity-stage failure gone, Newton iterations
+/// 285,931 → 175,519; on the slow wells at 10 m elements (0, 17, 221, 226, 294, 312)
+/// sub-solves 367–682 → 59–119. 1e-7 measured the same as 1e-5 on those wells.
+pub(super) const RELAX_FLOOR: f64 = 1e-5;
+/// With a soft or hard spring law, a failed load step is cut in half down to this size
+/// before the path relaxes (linear laws relax at the first failure). A soft law's onset
+/// needs small steps: `tests/case_files.rs`
+/// `soft_spring_laws_solve_a_two_stabilizer_deviated_well` (m = 0.1) solves by cuts down to
+/// a step of 0.026, and relaxing where a step of 0.053 failed (or at the first failure)
+/// runs its relaxation out (5,001 sub-solves, no equilibrium). Cutting on down to
+/// `min_step` (1e-4, before stop 63) only located the fold where there is one: on the 46
+/// soft-law (m = 2/3) wells of the 500-well corpus (`holewall bench corpus --wells 1
+/// --first-seed S`) 15,888 → 16,144 Newton iterations, 30.3 → 30.0 s, all 46 solved; well
+/// 221 (10 m elements, relaxed past a fold) 1,428 → 994 iterations, 2.3 → 1.5 s, well 134
+/// 1,454 → 1,249, 376 1,539 → 1,198, the lock-up 283 6,994 → 8,104; the 51 hard-law (m =
+/// 3/2) wells 4,635 → 4,478, 13.6 → 13.4 s. The same wells with m = 0.3 (stiffness scaled
+/// to the same force at 1 mm) all solve either way (221 584 → 432 iterations of converged
+/// steps). At 1 (relax at the first failure) the m = 2/3 wells took 14,143 iterations, but
+/// the m = 0.1 case fails; at 1/16 13,736, and it fails.
+pub(super) const RELAX_AFTER_STEP: f64 = 1.0 / 64.0;
+/// A shift above `s0 ×` this ends a relaxation that cannot make progress.
+pub(super) const RELAX_CEILING: f64 = 1e6;
