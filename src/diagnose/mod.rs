@@ -570,6 +570,7 @@ pub fn span_through_wall_warning(
 /// profile at full load: compression beyond the helical buckling load (the string winds
 /// into a helix the mesh may not resolve), or the load factor it stopped at.
 pub fn static_failure(case: &Case, error: &StaticError) -> String {
+    use crate::solve::continuation::LOCK_FOUND;
     let mut msg = format!("the static solve failed: {error}");
     let from = error.reached();
     let model = &case.model;
@@ -594,14 +595,25 @@ pub fn static_failure(case: &Case, error: &StaticError) -> String {
             100.0 * from
         ));
     }
-    if !gravity && matches!(error, StaticError::LoadStep { .. }) {
-        // Corpus well 419 (tripping in, 2 m elements) fails past 25 % of its loads, yet
-        // the case with its friction scaled to 0.4–0.7 solves from its own load path.
-        msg.push_str(
-            "\n  that is the last equilibrium on this load path, not where the string stops: \
-             equilibria at larger loads may exist (the case with its hole friction scaled \
-             down solves on a path of its own and shows how far the string runs in)",
-        );
+    match error {
+        StaticError::LoadStep { reason, .. } if reason.contains(LOCK_FOUND) => {
+            msg.push_str(
+                "\n  that is where the string stops on this model, to within the loads named \
+                 above: an equilibrium there, none found at the larger one",
+            );
+        }
+        StaticError::LoadStep { .. } if !gravity => {
+            // Corpus well 419 (tripping in, 2 m elements) failed past 25 % of its loads
+            // before its path bracketed, yet the case with its friction scaled to 0.4–0.7
+            // solves from its own load path.
+            msg.push_str(
+                "\n  that is the last equilibrium on this load path, not where the string \
+                 stops: equilibria at larger loads may exist (the case with its hole \
+                 friction scaled down solves on a path of its own and shows how far the \
+                 string runs in)",
+            );
+        }
+        _ => {}
     }
     if matches!(error, StaticError::LoadStep { .. }) {
         let top_element = model

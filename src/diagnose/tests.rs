@@ -416,6 +416,28 @@ fn a_failed_load_step_is_not_reported_as_the_gravity_stage() {
         msg.contains("the last equilibrium on this load path"),
         "{msg}"
     );
+    // A path that bracketed where the string stops says that instead.
+    let bracketed = StaticError::LoadStep {
+        stage: "applying the bit loads and friction (stage 2)".into(),
+        from: 0.625,
+        step: 0.0,
+        min: 1e-4,
+        reason: format!(
+            "load step λ 0 → 0.25 failed (no); {} λ = 0.6250 and none at λ = 0.7500",
+            crate::solve::continuation::LOCK_FOUND
+        ),
+        at_md: None,
+    };
+    let msg = static_failure(&case, &bracketed);
+    assert!(msg.contains("it reached 62.5 % of the"), "{msg}");
+    assert!(
+        msg.contains("where the string stops on this model"),
+        "{msg}"
+    );
+    assert!(
+        !msg.contains("the last equilibrium on this load path"),
+        "{msg}"
+    );
     let gravity = StaticError::LoadStep {
         stage: format!(
             "{} (stage 1 of the load path)",

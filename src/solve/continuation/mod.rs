@@ -49,6 +49,7 @@ mod driver;
 mod relax;
 
 pub use driver::{solve_loads, solve_loads_from, StaticSystem};
+pub use relax::LOCK_FOUND;
 use relax::*;
 
 use super::newton::{NewtonSettings, SolveLimits, FOLD_STALL_ITERATIONS};
@@ -101,69 +102,6 @@ enum Stage {
     Failed,
 }
 
-/// A relaxation's state ([`Stage::Relax`]).
-#[derive(Clone, Debug)]
-struct Relax {
-    /// The loads relaxed to (the failed step's).
-    target: LoadTarget,
-    /// Shift now (N/m; never below [`RELAX_FLOOR`] × `s0`).
-    s: f64,
-    /// The starting shift (the system's scale).
-    s0: f64,
-    /// Sub-solves so far.
-    subs: usize,
-    /// Newton iterations so far.
-    iterations: usize,
-    /// The last sub-solve's answer is an equilibrium without the shift
-    /// ([`LoadPath::shift_settled`]).
-    settled: bool,
-    /// The smallest unshifted measure so far (improved by at least 1 %) and the sub-solve
-    /// it came at.
-    best: f64,
-    best_at: usize,
-    /// Settled on a stall: the unshifted measure it stalled at.
-    stalled: Option<f64>,
-    /// The shift of the last sub-solve that failed, halved at each one that converges
-    /// since (0: none): the shift is not lowered below twice it, so the next try at that
-    /// shift comes after two sub-solves that converge, not one, and from a failure on
-    /// easy sub-solves halve the shift rather than quarter it. Without it the shift
-    /// ping-ponged (quartered after an easy sub-solve, the next failing after its 30
-    /// iterations, raised fourfold, …): corpus well 525 (horizontal, sliding, 10 m
-    /// elements) ran 81 failed sub-solves, 2,430 of its relaxation's 3,602 Newton
-    /// iterations, and 32 with it (2,811 Newton iterations in all against 4,583); the 11
-    /// slow wells named at [`RELAX_SUB_REDUCTION`]: 30,450 → 24,854 Newton iterations.
-    failed_at: f64,
-    /// The failure that started it, with its stage (for the log).
-    reason: String,
-    /// That failure's cause alone: the message if the relaxation fails too, whose stage
-    /// ([`StaticError::LoadStep`]'s) already names the step.
-    cause: String,
-    gravity: bool,
-    step: f64,
-}
-
-impl Relax {
-    /// Why the relaxation stops without an equilibrium, where it does: its budget
-    /// ([`RELAX_MAX_BUDGET`], [`RELAX_MAX_SUBS`]) ran out, or its unshifted measure has not
-    /// improved by 1 % in [`RELAX_STAGNANT_SUBS`] sub-solves.
-    fn exhausted(&self, max_iterations: usize) -> Option<String> {
-        if self.iterations >= RELAX_MAX_BUDGET * max_iterations || self.subs >= RELAX_MAX_SUBS {
-            Some(format!(
-                "the relaxation's budget of {} Newton iterations or {RELAX_MAX_SUBS} sub-solves ran out",
-                RELAX_MAX_BUDGET * max_iterations
-            ))
-        } else if self.subs >= self.best_at + RELAX_STAGNANT_SUBS {
-            Some(format!(
-                "its residual without the shift has not fallen by 1 % in {RELAX_STAGNANT_SUBS} \
-                 sub-solves (at best {:.1e} of the force scale, {} sub-solves in)",
-                self.best, self.best_at
-            ))
-        } else {
-            None
-        }
-    }
-}
-
 /// The words a relaxation's log line carries (the corpus counts the wells it solved).
 pub const RELAXED: &str = "relaxed by proximal points";
 
@@ -197,6 +135,9 @@ pub struct LoadPath {
     pub error: Option<StaticError>,
     /// Load steps that failed so far (a load path that has met a fold).
     load_failures: usize,
+    /// After the relaxation to the full loads failed: where the string stops, bracketed
+    /// ([`LoadPath::bracket`]).
+    lock: Option<Lock>,
     /// The answer came by relaxation past a fold, or f32's second solve at full load
     /// failed from it: a small residual says less there (near a fold the tangent is nearly
     /// singular), so the f32 engine confirms such an answer in f64 (`engine::verify_f32`).
@@ -260,6 +201,7 @@ impl LoadPath {
             log: Vec::new(),
             error: None,
             doubtful: false,
+            lock: None,
             load_failures: 0,
         };
         p.set_target();
@@ -465,6 +407,10 @@ impl LoadPath {
                     self.relax = None;
                     self.doubtful = true;
                     self.lambda = target.lambda;
+                    if let Some(mut lock) = self.lock.take() {
+                        lock.lo = self.lambda;
+                        return self.bracket(lock);
+                    }
                     // At the full loads the answer is solved once more without the shift
                     // and polished ([`Stage::Refine`]): a relaxation settles within the
                     // tolerance, which leaves a buckled string's soft modes µm apart
@@ -507,6 +453,49 @@ impl LoadPath {
         } else {
             Next::Step
         }
+    }
+
+    /// After the relaxation to the full loads failed (the string may stop on its way in):
+    /// relaxations to loads between the largest with an equilibrium (`lock.lo`) and the
+    /// smallest without (`lock.hi`), each from where the last one ended, halve that
+    /// interval down to [`LOCK_BRACKET`]; then the path fails, its message saying where
+    /// between the two the string stops. Corpus well 419 (tripping in, 2 m elements) fails
+    /// at its first step, yet the case with its friction scaled to 0.4–0.7 solves on a
+    /// path of its own (docs/performance.md, stop 64).
+    fn bracket(&mut self, lock: Lock) -> Next {
+        if lock.hi - lock.lo <= LOCK_BRACKET * (1.0 + 1e-9) {
+            self.log.push(format!(
+                "where the string stops: an equilibrium at λ = {:.4}, none found at λ = {:.4}",
+                lock.lo, lock.hi
+            ));
+            self.error = Some(StaticError::LoadStep {
+                stage: "applying the bit loads and friction (stage 2)".into(),
+                from: lock.lo,
+                step: 0.0,
+                min: self.min_step,
+                reason: format!(
+                    "{}; {LOCK_FOUND} λ = {:.4} and none at λ = {:.4}",
+                    lock.why, lock.lo, lock.hi
+                ),
+                at_md: None,
+            });
+            self.stage = Stage::Failed;
+            return Next::Failed;
+        }
+        let mid = 0.5 * (lock.lo + lock.hi);
+        let target = LoadTarget {
+            lambda: mid,
+            friction: mid,
+            ..self.target
+        };
+        let (s0, from) = (lock.s0, lock.lo);
+        self.lock = Some(lock);
+        let next = self.relax_after(target, s0, String::new(), false);
+        if let Some(r) = self.relax.as_mut() {
+            r.reason = format!("where the string stops: relaxation from λ = {from:.4} to {mid:.4}");
+            r.cause = r.reason.clone();
+        }
+        next
     }
 
     /// The step failed (`reason`): what follows, from the last converged state
@@ -711,6 +700,28 @@ impl LoadPath {
                         "{}; relaxation by proximal points found no equilibrium past it either ({} sub-solves, {} Newton iterations; last: {reason})",
                         r.cause, r.subs, r.iterations
                     );
+                    if !r.gravity {
+                        let lock = match self.lock.take() {
+                            Some(lock) => Lock {
+                                hi: r.target.lambda,
+                                ..lock
+                            },
+                            None => Lock {
+                                lo: self.lambda,
+                                hi: r.target.lambda,
+                                // The step that failed, named (the stage's words name
+                                // the bracket instead).
+                                why: format!(
+                                    "{}; relaxation by proximal points found no equilibrium \
+                                     at the full loads either ({} sub-solves, {} Newton \
+                                     iterations; last: {reason})",
+                                    r.reason, r.subs, r.iterations
+                                ),
+                                s0: r.s0,
+                            },
+                        };
+                        return self.bracket(lock);
+                    }
                     return fail(self, r.step, false, why);
                 }
             }

@@ -1,5 +1,8 @@
-//! The relaxation's constants ([`super::Stage::Relax`]): its budget, its sub-solves, when it
-//! settles, stops or starts. A relaxation's state and its policy are in [`super`].
+//! The relaxation's state and constants ([`super::Stage::Relax`]): its budget, its
+//! sub-solves, when it settles, stops or starts, and the bracket of where the string stops
+//! after it failed. The policy that drives them is [`super::LoadPath`]'s.
+
+use super::LoadTarget;
 
 /// Sub-solves a relaxation may take before the variant fails (a run of one- or
 /// two-iteration sub-solves at the smallest shift that never settles would otherwise spend
@@ -36,7 +39,7 @@ pub(super) const RELAX_SUB_ITERATIONS: usize = 30;
 /// unshifted measure is tested against the tolerance, [`super::LoadPath::shift_settled`]).
 /// Measured on the 11 slow relaxed wells at 10 m elements (corpus seeds 525, 283, 134,
 /// 221, 312, 206, 28, 294, 226, 17, 0; `holewall bench corpus --wells 1 --first-seed S`),
-/// with the shift's memory ([`super::Relax`]`::failed_at`): 24,854 Newton iterations solved to the
+/// with the shift's memory ([`Relax::failed_at`]): 24,854 Newton iterations solved to the
 /// tolerance, 20,198 at 0.5, 21,150 at 0.9; 0.1 without the memory 29,112 against 30,450.
 pub(super) const RELAX_SUB_REDUCTION: f64 = 0.5;
 /// A relaxation settles where its unshifted measure has not improved by 1 % in this many
@@ -81,3 +84,86 @@ pub(super) const RELAX_FLOOR: f64 = 1e-5;
 pub(super) const RELAX_AFTER_STEP: f64 = 1.0 / 64.0;
 /// A shift above `s0 ×` this ends a relaxation that cannot make progress.
 pub(super) const RELAX_CEILING: f64 = 1e6;
+/// Where the relaxation to the full loads failed, relaxations to smaller loads bracket
+/// the largest load with an equilibrium to this width of the load factor (at most three
+/// from a failure at the first step).
+pub(super) const LOCK_BRACKET: f64 = 0.125;
+/// The words of a failure whose load path bracketed where the string stops
+/// ([`super::LoadPath::bracket`]); `crate::diagnose::static_failure` reads them.
+pub const LOCK_FOUND: &str = "relaxations to smaller loads found an equilibrium at";
+
+/// A relaxation's state ([`super::Stage::Relax`]).
+#[derive(Clone, Debug)]
+pub(super) struct Relax {
+    /// The loads relaxed to (the failed step's).
+    pub(super) target: LoadTarget,
+    /// Shift now (N/m; never below [`RELAX_FLOOR`] × `s0`).
+    pub(super) s: f64,
+    /// The starting shift (the system's scale).
+    pub(super) s0: f64,
+    /// Sub-solves so far.
+    pub(super) subs: usize,
+    /// Newton iterations so far.
+    pub(super) iterations: usize,
+    /// The last sub-solve's answer is an equilibrium without the shift
+    /// ([`super::LoadPath::shift_settled`]).
+    pub(super) settled: bool,
+    /// The smallest unshifted measure so far (improved by at least 1 %) and the sub-solve
+    /// it came at.
+    pub(super) best: f64,
+    pub(super) best_at: usize,
+    /// Settled on a stall: the unshifted measure it stalled at.
+    pub(super) stalled: Option<f64>,
+    /// The shift of the last sub-solve that failed, halved at each one that converges
+    /// since (0: none): the shift is not lowered below twice it, so the next try at that
+    /// shift comes after two sub-solves that converge, not one, and from a failure on
+    /// easy sub-solves halve the shift rather than quarter it. Without it the shift
+    /// ping-ponged (quartered after an easy sub-solve, the next failing after its 30
+    /// iterations, raised fourfold, …): corpus well 525 (horizontal, sliding, 10 m
+    /// elements) ran 81 failed sub-solves, 2,430 of its relaxation's 3,602 Newton
+    /// iterations, and 32 with it (2,811 Newton iterations in all against 4,583); the 11
+    /// slow wells named at [`RELAX_SUB_REDUCTION`]: 30,450 → 24,854 Newton iterations.
+    pub(super) failed_at: f64,
+    /// The failure that started it, with its stage (for the log).
+    pub(super) reason: String,
+    /// That failure's cause alone: the message if the relaxation fails too, whose stage
+    /// ([`StaticError::LoadStep`]'s) already names the step.
+    pub(super) cause: String,
+    pub(super) gravity: bool,
+    pub(super) step: f64,
+}
+
+impl Relax {
+    /// Why the relaxation stops without an equilibrium, where it does: its budget
+    /// ([`RELAX_MAX_BUDGET`], [`RELAX_MAX_SUBS`]) ran out, or its unshifted measure has not
+    /// improved by 1 % in [`RELAX_STAGNANT_SUBS`] sub-solves.
+    pub(super) fn exhausted(&self, max_iterations: usize) -> Option<String> {
+        if self.iterations >= RELAX_MAX_BUDGET * max_iterations || self.subs >= RELAX_MAX_SUBS {
+            Some(format!(
+                "the relaxation's budget of {} Newton iterations or {RELAX_MAX_SUBS} sub-solves ran out",
+                RELAX_MAX_BUDGET * max_iterations
+            ))
+        } else if self.subs >= self.best_at + RELAX_STAGNANT_SUBS {
+            Some(format!(
+                "its residual without the shift has not fallen by 1 % in {RELAX_STAGNANT_SUBS} \
+                 sub-solves (at best {:.1e} of the force scale, {} sub-solves in)",
+                self.best, self.best_at
+            ))
+        } else {
+            None
+        }
+    }
+}
+
+/// Where a path whose relaxation to the full loads failed stops ([`super::LoadPath::bracket`]).
+#[derive(Clone, Debug)]
+pub(super) struct Lock {
+    /// The largest load factor at which the path has an equilibrium.
+    pub(super) lo: f64,
+    /// The smallest at which a relaxation found none.
+    pub(super) hi: f64,
+    /// The full-load relaxation's failure, for the message.
+    pub(super) why: String,
+    /// The shift scale the relaxations start from.
+    pub(super) s0: f64,
+}

@@ -199,28 +199,44 @@ fn a_relaxation_that_cannot_settle_fails_saying_so() {
     }
     assert_eq!(next, Next::Failed);
     let e = p.error.unwrap().to_string();
-    assert!(e.contains("found no equilibrium past it either"), "{e}");
-    assert!(e.contains("applying the bit loads"), "{e}");
-    // The step was not cut to the smallest: the message does not say it was.
-    assert!(!e.contains("smallest allowed"), "{e}");
-    // The stage names the step once; the cause follows it without naming it again.
     assert!(
-        e.contains("the step λ") && !e.contains("load step λ"),
+        e.contains("found no equilibrium at the full loads either"),
         "{e}"
     );
+    assert!(e.contains("applying the bit loads"), "{e}");
+    // Every relaxation to smaller loads failed too: no equilibrium past the start.
+    assert!(
+        e.contains(&format!("{LOCK_FOUND} λ = 0.0000 and none at λ = 0.1250")),
+        "{e}"
+    );
+    // The step was not cut to the smallest: the message does not say it was.
+    assert!(!e.contains("smallest allowed"), "{e}");
+    // The failed step is named once.
+    assert_eq!(e.matches("step λ").count(), 1, "{e}");
+}
+
+/// Drives `p`'s relaxations with `sub` (the sub-solve's outcome, given how many the
+/// relaxation to the full loads has had) until the path ends; returns how many sub-solves
+/// that first relaxation had (the ones after it bracket where the string stops).
+fn relax_to_the_end(p: &mut LoadPath, mut sub: impl FnMut(&mut LoadPath, usize) -> Next) -> usize {
+    let mut first = 0;
+    let mut next = Next::Step;
+    while next == Next::Step {
+        let at_full = p.target().lambda == 1.0;
+        next = sub(p, first);
+        if at_full {
+            first += 1;
+        }
+    }
+    assert_eq!(next, Next::Failed);
+    first
 }
 
 #[test]
 fn a_relaxation_stops_when_its_iteration_budget_is_spent() {
+    // Hard sub-solves: the shift stays, the iterations add up.
     let (mut p, _) = stuck(Some(1e6));
-    let mut next = Next::Step;
-    let mut subs = 0;
-    while next == Next::Step {
-        // Hard sub-solves: the shift stays, the iterations add up.
-        next = p.converged(150);
-        subs += 1;
-    }
-    assert_eq!(next, Next::Failed);
+    let subs = relax_to_the_end(&mut p, |p, _| p.converged(150));
     assert_eq!(subs, (RELAX_MAX_BUDGET * 200).div_ceil(150));
     let e = p.error.unwrap().to_string();
     assert!(
@@ -234,15 +250,13 @@ fn a_relaxation_stops_when_its_iteration_budget_is_spent() {
     // still falling (halving every 400 sub-solves, far above the tolerance): the sub-solve
     // count.
     let (mut p, _) = stuck(Some(1e6));
-    let mut subs = 0;
-    loop {
-        p.shift_settled(1e-2 * 0.5f64.powf(subs as f64 / 400.0));
-        if p.converged(2) != Next::Step {
-            break;
-        }
-        subs += 1;
-    }
-    assert_eq!(subs + 1, RELAX_MAX_SUBS);
+    let mut all = 0;
+    let subs = relax_to_the_end(&mut p, |p, _| {
+        p.shift_settled(1e-2 * 0.5f64.powf(all as f64 / 400.0));
+        all += 1;
+        p.converged(2)
+    });
+    assert_eq!(subs, RELAX_MAX_SUBS);
     let e = p.error.unwrap().to_string();
     assert!(e.contains("sub-solves ran out"), "{e}");
 }
@@ -253,40 +267,45 @@ fn a_relaxation_stops_when_its_iteration_budget_is_spent() {
 #[test]
 fn a_relaxation_whose_residual_stops_falling_fails_saying_so() {
     // `falls`: sub-solves in which the measure falls by 10 % each (the best comes at the
-    // last of them), then it stays within 1 % of its best, a failed sub-solve every tenth.
-    let run = |falls: usize| {
+    // last of them), then it stays within 1 % of its best, a failed sub-solve every tenth
+    // (counted within each relaxation).
+    for falls in [40, 42] {
         let (mut p, _) = stuck(Some(1e6));
-        let mut subs = 0;
-        let mut next = Next::Step;
         let mut last_failed = false;
-        while next == Next::Step {
-            let measure = 0.9f64.powi(subs.min(falls - 1) as i32)
-                * if subs < falls {
+        let (mut k, mut target) = (0, 1.0);
+        let subs = relax_to_the_end(&mut p, |p, _| {
+            if p.target().lambda != target {
+                (k, target) = (0, p.target().lambda);
+            }
+            let measure = 0.9f64.powi(k.min(falls - 1) as i32)
+                * if k < falls {
                     1.0
                 } else {
-                    1.0 - 0.005 * (subs % 2) as f64
+                    1.0 - 0.005 * (k % 2) as f64
                 };
-            last_failed = subs >= falls && subs % 10 == 0;
-            next = if last_failed {
+            let failed = k >= falls && k % 10 == 0;
+            if target == 1.0 {
+                last_failed = failed;
+            }
+            k += 1;
+            if failed {
                 p.failed("no".into())
             } else {
                 p.shift_settled(measure);
                 p.converged(3)
-            };
-            subs += 1;
-        }
-        assert_eq!(next, Next::Failed);
-        (subs, last_failed, p.error.unwrap().to_string())
-    };
-    for falls in [40, 42] {
-        let (subs, last_failed, e) = run(falls);
+            }
+        });
         // The best at sub-solve `falls − 1`; the 500th after it ends the relaxation (a
         // converged sub-solve for 40, a failed one for 42).
         assert_eq!(subs, falls - 1 + RELAX_STAGNANT_SUBS);
         assert_eq!(last_failed, falls == 42);
+        let e = p.error.unwrap().to_string();
         let said = format!("has not fallen by 1 % in {RELAX_STAGNANT_SUBS} sub-solves");
         assert!(e.contains(&said), "{e}");
-        assert!(e.contains("found no equilibrium past it either"), "{e}");
+        assert!(
+            e.contains("found no equilibrium at the full loads either"),
+            "{e}"
+        );
     }
 }
 
@@ -321,4 +340,81 @@ fn a_failed_gravity_step_relaxes_at_once_where_the_system_can_and_ramps_where_it
     assert_eq!(p.failed_at("no".into(), None, None), Next::Step);
     assert_eq!(p.stage, Stage::GravityRamp);
     assert!(p.target().gravity < 1.0);
+}
+
+/// Where the relaxation to the full loads fails, relaxations to smaller loads bracket where
+/// the string stops to [`LOCK_BRACKET`]: each from where the last ended, lower after one
+/// that fails, higher after one that settles; the message names the bracket and the
+/// failure's load factor is its lower end.
+#[test]
+fn a_failed_full_load_relaxation_brackets_where_the_string_stops() {
+    let (mut p, next) = stuck(Some(1e6));
+    assert_eq!(next, Next::Step);
+    assert_eq!(
+        (p.stage, p.lambda, p.target().lambda),
+        (Stage::Relax, 0.0, 1.0)
+    );
+    // Ends a relaxation without an equilibrium (its shift raised past the ceiling).
+    let fail_relaxation = |p: &mut LoadPath| {
+        let mut next = Next::Step;
+        let target = p.target().lambda;
+        while p.stage == Stage::Relax && p.target().lambda == target {
+            next = p.failed("no".into());
+        }
+        next
+    };
+    // Settles a relaxation at once.
+    let settle = |p: &mut LoadPath| {
+        p.shift_settled(1e-12);
+        p.converged(3)
+    };
+    // The full loads fail: a relaxation to 0.5 from where it ended.
+    assert_eq!(fail_relaxation(&mut p), Next::Step);
+    assert_eq!((p.stage, p.lambda), (Stage::Relax, 0.0));
+    let t = p.target();
+    assert_eq!((t.lambda, t.friction, t.gravity), (0.5, 0.5, 1.0));
+    // 0.5 settles: on to 0.75.
+    assert_eq!(settle(&mut p), Next::Step);
+    assert_eq!(
+        (p.stage, p.lambda, p.target().lambda),
+        (Stage::Relax, 0.5, 0.75)
+    );
+    // 0.75 fails: back to 0.625.
+    assert_eq!(fail_relaxation(&mut p), Next::Step);
+    assert_eq!(
+        (p.stage, p.lambda, p.target().lambda),
+        (Stage::Relax, 0.5, 0.625)
+    );
+    // 0.625 settles: the bracket [0.625, 0.75] is narrow enough; the path fails there.
+    assert_eq!(settle(&mut p), Next::Failed);
+    let e = p.error.clone().unwrap();
+    assert_eq!(e.reached(), 0.625);
+    let e = e.to_string();
+    // The step that failed is named once, the bracket after it.
+    assert!(
+        e.contains("load step λ 0.000000 → 0.250000 failed (no)"),
+        "{e}"
+    );
+    assert!(
+        e.contains(&format!("{LOCK_FOUND} λ = 0.6250 and none at λ = 0.7500")),
+        "{e}"
+    );
+    assert!(
+        e.contains("found no equilibrium at the full loads either"),
+        "{e}"
+    );
+    assert!(p.log.last().unwrap().contains("where the string stops"));
+    // From a failed step at λ 0.75: one relaxation, to 0.875, which fails there too.
+    let mut q = LoadPath::new(&StaticOptions::default(), true, true, false);
+    assert_eq!(q.converged(10), Next::Step);
+    while q.lambda < 0.75 {
+        assert_eq!(q.converged(10), Next::Step);
+    }
+    assert_eq!(q.failed_at("no".into(), None, Some(1e6)), Next::Step);
+    assert_eq!(fail_relaxation(&mut q), Next::Step);
+    assert_eq!(q.target().lambda, 0.875);
+    assert_eq!(fail_relaxation(&mut q), Next::Failed);
+    let e = q.error.unwrap();
+    assert_eq!(e.reached(), 0.75);
+    assert!(e.to_string().contains("none at λ = 0.8750"), "{e}");
 }
