@@ -696,10 +696,6 @@ impl LoadPath {
                         Stage::Load
                     };
                     self.step = r.step;
-                    let why = format!(
-                        "{}; relaxation by proximal points found no equilibrium past it either ({} sub-solves, {} Newton iterations; last: {reason})",
-                        r.cause, r.subs, r.iterations
-                    );
                     if !r.gravity {
                         let lock = match self.lock.take() {
                             Some(lock) => Lock {
@@ -722,6 +718,10 @@ impl LoadPath {
                         };
                         return self.bracket(lock);
                     }
+                    let why = format!(
+                        "{}; relaxation by proximal points found no equilibrium past it either ({} sub-solves, {} Newton iterations; last: {reason})",
+                        r.cause, r.subs, r.iterations
+                    );
                     return fail(self, r.step, false, why);
                 }
             }
