@@ -35,11 +35,11 @@ pub(super) const RELAX_STAGNANT_SUBS: usize = 500;
 /// the failed ones cost more than those that converge (traced at 30 on the relaxed wells of
 /// corpus seeds 0–499: 419, 12,720 Newton iterations in 424 failed sub-solves against
 /// 7,281 in the rest; 44, 4,260 against 3,447), while 96 % of those that converge take 20
-/// or fewer. Measured on the 62 relaxed wells of seeds 0–499 and the unseen 754 (`holewall
+/// or fewer. Measured on the 61 relaxed wells of seeds 0–499 and the unseen 754 (`holewall
 /// bench corpus --wells 1 --first-seed S`; stop 65): at 30, 73,135 Newton iterations; at
 /// 25, 74,248; at 20, 66,359 (all 62 solved; 754 797 → 701, 283 8,104 → 5,669, 44 8,713
 /// → 5,442, 173 3,620 → 1,645; 195 5,631 → 7,374); at 15, 53,313 on the 59 it solves, but
-/// wells 90 and 263 fail. The lock-ups fail at the same brackets with fewer (795 24,341 →
+/// wells 90, 195 and 263 fail. The lock-ups fail at the same brackets with fewer (795 24,341 →
 /// 18,865, 214 32,587 → 25,093).
 pub(super) const RELAX_SUB_ITERATIONS: usize = 20;
 /// A shifted sub-solve ends once an update has brought its residual measure to this
