@@ -98,6 +98,10 @@ pub enum StaticError {
 /// `stage`).
 pub const GRAVITY_STAGE: &str = "laying the string in the hole under its own weight";
 
+/// How a failure in the load path's second stage names it (followed by the failed step,
+/// where one is named).
+pub const LOAD_STAGE: &str = "applying the bit loads and friction (stage 2)";
+
 impl StaticError {
     /// Whether the solve failed laying the string in the hole under gravity (the load
     /// path's first stage), before any bit load.

@@ -53,7 +53,7 @@ pub use relax::LOCK_FOUND;
 use relax::*;
 
 use super::newton::{NewtonSettings, SolveLimits, FOLD_STALL_ITERATIONS};
-use super::static_options::{StaticError, StaticOptions, GRAVITY_STAGE};
+use super::static_options::{StaticError, StaticOptions, GRAVITY_STAGE, LOAD_STAGE};
 
 /// The loads a variant is solved for: each a factor of the full value.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -469,7 +469,7 @@ impl LoadPath {
                 lock.lo, lock.hi
             ));
             self.error = Some(StaticError::LoadStep {
-                stage: "applying the bit loads and friction (stage 2)".into(),
+                stage: LOAD_STAGE.into(),
                 from: lock.lo,
                 step: 0.0,
                 min: self.min_step,
@@ -553,7 +553,7 @@ impl LoadPath {
                 )
             } else {
                 format!(
-                    "applying the bit loads and friction (stage 2), the step λ {:.4} → {:.4}",
+                    "{LOAD_STAGE}, the step λ {:.4} → {:.4}",
                     p.lambda,
                     (p.lambda + step).min(1.0)
                 )
