@@ -296,7 +296,17 @@ pub(crate) fn hold_in_hole(
             *model = kept;
             return Ok(sol);
         }
-        Err(e) => e,
+        Err(mut e) => {
+            // Where the string stops, with the sites kept as for an answer.
+            if let crate::solve::statics::StaticError::LoadStep {
+                stopped: Some(st), ..
+            } = &mut e
+            {
+                let sol = crate::solve::statics::stopped_solution(st);
+                st.model = keep_touching(model, st.model.clone(), sol).0;
+            }
+            e
+        }
     };
     if matches!(failed, crate::solve::statics::StaticError::Budget { .. }) {
         return Err(failed);
@@ -350,6 +360,23 @@ pub fn solve_with_progress(
     options: crate::solve::statics::StaticOptions,
     show_progress: bool,
 ) -> Result<crate::solve::statics::StaticSolution, crate::error::Error> {
+    solve_or_stop(case, options, show_progress).map_err(|(e, _)| e)
+}
+
+/// As [`solve_with_progress`]; a failure also gives where the string stands if its load path
+/// bracketed where it stops ([`crate::solve::statics::Stopped`], with the model's sites as
+/// [`solve_in_hole`] keeps them).
+pub fn solve_or_stop(
+    case: &mut Case,
+    options: crate::solve::statics::StaticOptions,
+    show_progress: bool,
+) -> Result<
+    crate::solve::statics::StaticSolution,
+    (
+        crate::error::Error,
+        Option<Box<crate::solve::statics::Stopped>>,
+    ),
+> {
     let bar = crate::output::progress_bar(
         show_progress,
         1000,
@@ -365,5 +392,14 @@ pub fn solve_with_progress(
     );
     bar.finish_and_clear();
     case.model = model;
-    solved.map_err(|e| crate::error::Error::Failed(crate::diagnose::static_failure(case, &e)))
+    solved.map_err(|mut e| {
+        let stopped = match &mut e {
+            crate::solve::statics::StaticError::LoadStep { stopped, .. } => stopped.take(),
+            _ => None,
+        };
+        (
+            crate::error::Error::Failed(crate::diagnose::static_failure(case, &e)),
+            stopped,
+        )
+    })
 }

@@ -90,6 +90,10 @@ pub struct CorpusSummary {
     /// the buckled soft string locks up, [`crate::diagnose::lock_up_fraction`]). Where
     /// the two agree, the FE's fold is the lock-up the physics predicts.
     pub lock_up_factors: Vec<(u64, f64, f64)>,
+    /// Failed wells whose load path bracketed where the string stops and gave the string
+    /// where it stands there (`corpus.csv`'s `stopped_hook_load_n`): (seed, that load
+    /// factor, the FE hook load there, N).
+    pub failed_stopped: Vec<(u64, f64, f64)>,
     /// Solved wells whose FE string lies outside the hole where no contact site holds it
     /// (`contact.sites = "stabilizers"`: [`crate::diagnose::through_wall`]), with how far
     /// (mm): an equilibrium of a string in no hole, counted in `solved` but not an answer.
@@ -254,6 +258,11 @@ pub fn run(out: &Path, options: &CorpusOptions) -> Result<CorpusSummary, Error> 
             .iter()
             .filter(|r| !r.solved && r.lock_up_fraction.is_finite())
             .map(|r| (r.spec.seed, r.fe_reached, r.lock_up_fraction))
+            .collect(),
+        failed_stopped: results
+            .iter()
+            .filter(|r| !r.solved && r.stopped_hook_load_n.is_finite())
+            .map(|r| (r.spec.seed, r.fe_reached, r.stopped_hook_load_n))
             .collect(),
         solved_through_wall: solved
             .iter()

@@ -10,7 +10,7 @@ use crate::error::Error;
 use crate::model::Model;
 use crate::output::RunFolder;
 
-use crate::profile::{buckling, fe_rows, neutral_point, solve_with_progress, ProfileRow};
+use crate::profile::{buckling, fe_rows, neutral_point, solve_or_stop, ProfileRow};
 
 /// Which model computes the profile.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
@@ -73,6 +73,23 @@ pub struct Summary {
     /// What the case holds that is allowed but unusual ([`crate::case::Case::warnings`]).
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub warnings: Vec<String>,
+    /// Where the FE load path found that the string stops on its way (a lock-up): every
+    /// figure above is then the string where it stands, at the fraction `load_factor` of
+    /// the operation's friction and bit loads; absent where the loads were reached.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub stopped: Option<StoppedSummary>,
+}
+
+/// `summary.json`'s `stopped` ([`crate::solve::statics::Stopped`]).
+#[derive(Clone, Debug, Serialize)]
+pub struct StoppedSummary {
+    /// The largest fraction of the friction coefficients and bit loads (and a bent sub's
+    /// bend) at which the string has an equilibrium: where it stands.
+    pub load_factor: f64,
+    /// The smallest fraction at which the load path found none.
+    pub none_at: f64,
+    /// Why the loads were not reached (the solve's failure, as the command prints it).
+    pub failure: String,
 }
 
 /// Options of `holewall static`.
@@ -97,19 +114,41 @@ pub fn run(
     let folder = RunFolder::prepare(out)?.with_report("static", case_path);
     // The FE solve first: it gives the case's model contact sites wherever the string meets
     // the wall (`profile::solve_in_hole`), and every output below reads that model.
+    // Where the string stops on its way (a lock-up): the outputs are written for the string
+    // where it stands, then the command fails with the solve's message.
+    let mut stopped: Option<(StoppedSummary, Error)> = None;
     let fe = match which {
         StaticModel::Fe => {
             let statics = case
                 .settings()
                 .with_max_seconds(options.max_seconds)
                 .statics();
-            Some(
-                solve_with_progress(&mut case, statics, options.show_progress)
-                    .map_err(Error::failed)?,
-            )
+            match solve_or_stop(&mut case, statics, options.show_progress) {
+                Ok(sol) => Some(sol),
+                Err((e, Some(st))) => {
+                    let solution = crate::solve::statics::stopped_solution(&st);
+                    let st = *st;
+                    case.model = st.model;
+                    case.title = format!(
+                        "{} — where it stops: friction and bit loads × {:.3}, none found at × {:.3}",
+                        case.title, st.lambda, st.none_at
+                    );
+                    stopped = Some((
+                        StoppedSummary {
+                            load_factor: st.lambda,
+                            none_at: st.none_at,
+                            failure: e.to_string(),
+                        },
+                        e,
+                    ));
+                    Some(solution)
+                }
+                Err((e, None)) => return Err(e),
+            }
         }
         StaticModel::SoftString => None,
     };
+    let load_factor = stopped.as_ref().map_or(1.0, |(s, _)| s.load_factor);
     let case = case;
     let model = &case.model;
     let n = model.nodes.len();
@@ -238,7 +277,10 @@ pub fn run(
             eprintln!("holewall: warning: {w}");
             warnings.push(w);
         }
-        if let Some(w) = crate::diagnose::locked_up_warning(&case, hook) {
+        // (Not for the string where it stops: that equilibrium is the one it reaches.)
+        if let Some(w) =
+            crate::diagnose::locked_up_warning(&case, hook).filter(|_| stopped.is_none())
+        {
             eprintln!("holewall: warning: {w}");
             warnings.push(w);
         }
@@ -263,7 +305,8 @@ pub fn run(
         max_side_force_md_m: rows[k_max].md_m,
         sinusoidal_buckling: sinusoidal,
         helical_buckling: helical,
-        helical_buckling_drag_n: crate::diagnose::helical_drag(&case, &axial),
+        // Linear in the friction factor, which is the case's × `load_factor` here.
+        helical_buckling_drag_n: load_factor * crate::diagnose::helical_drag(&case, &axial),
         bit,
         tendency,
         strength,
@@ -275,7 +318,13 @@ pub fn run(
         }),
         newton_iterations: its,
         solver_log,
+        stopped: None,
     };
+    let mut summary = summary;
+    let failure = stopped.map(|(note, e)| {
+        summary.stopped = Some(note);
+        e
+    });
     let dir = folder.path();
     crate::output::write_csv_rows(&dir.join("profile.csv"), &rows)?;
     write_plots(&case, which, &rows, np, summary.bit.as_ref(), dir)?;
@@ -284,7 +333,16 @@ pub fn run(
     }
     let json = serde_json::to_vec_pretty(&summary)?;
     folder.finish(&json)?;
-    Ok(summary)
+    match failure {
+        Some(e) => Err(Error::Failed(format!(
+            "{e}\n  written to {}: the string where it stops, at {:.1} % of the friction and \
+             bit loads, the largest fraction with an equilibrium found (summary.json's \
+             `stopped`)",
+            out.display(),
+            100.0 * load_factor
+        ))),
+        None => Ok(summary),
+    }
 }
 
 fn write_plots(

@@ -98,6 +98,7 @@ pub fn run_well_engine(well: &CorpusWell, path: EnginePath) -> Result<EngineOutc
                 min: 0.0,
                 reason,
                 at_md: None,
+                stopped: None,
             };
             match engine(m, options) {
                 Ok(r) => {

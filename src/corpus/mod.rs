@@ -591,6 +591,9 @@ pub struct WellResult {
     /// The load factor the FE solve reached: 1 when solved, where its load path stopped
     /// when not ([`crate::solve::statics::StaticError::reached`]; 0 in the gravity stage).
     pub fe_reached: f64,
+    /// Failed where its load path bracketed where the string stops: the FE hook load (N)
+    /// where it stands, at `fe_reached` ([`crate::solve::statics::Stopped`]); else NaN.
+    pub stopped_hook_load_n: f64,
     /// Solved: how far the FE string lies outside the hole where no contact site holds it
     /// (mm; 0 inside it: [`crate::diagnose::through_wall`]). NaN when not solved.
     pub through_wall_mm: f64,
@@ -661,6 +664,7 @@ pub fn run_well(
         lock_up_md_m: crate::diagnose::lock_up(&case).map_or(f64::NAN, |l| l.md),
         lock_up_fraction: crate::diagnose::lock_up_fraction(&case).unwrap_or(f64::NAN),
         fe_reached: 0.0,
+        stopped_hook_load_n: f64::NAN,
         through_wall_mm: f64::NAN,
         span_sag_mm: f64::NAN,
         wall_sites,
@@ -722,6 +726,10 @@ pub fn run_well(
         }
         Err(e) => {
             r.fe_reached = e.reached();
+            if let Some(st) = e.stopped() {
+                let sol = crate::solve::statics::stopped_solution(st);
+                r.stopped_hook_load_n = crate::profile::fe_rows(&st.model, &sol).1;
+            }
             r.error = crate::diagnose::static_failure(&case, &e);
         }
     }

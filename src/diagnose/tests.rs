@@ -286,6 +286,7 @@ fn a_guarded_solve_that_fails_is_tried_with_the_models_own_sites() {
         min: 0.0,
         reason: why.into(),
         at_md: None,
+        stopped: None,
     };
     let held_everywhere =
         |m: &Model| (1..m.nodes.len()).all(|i| m.sites.iter().any(|s| s.node == i));
@@ -380,6 +381,7 @@ fn a_failure_that_locks_up_says_so() {
         min: 1e-4,
         reason: "Newton did not converge".into(),
         at_md: Some(1200.0),
+        stopped: None,
     };
     let case = horizontal(0.3, 250.0);
     let lu = lock_up(&case).unwrap();
@@ -408,6 +410,7 @@ fn a_failed_load_step_is_not_reported_as_the_gravity_stage() {
         min: 1e-4,
         reason: "relaxation by proximal points found no equilibrium past it either".into(),
         at_md: Some(306.0),
+        stopped: None,
     };
     let msg = static_failure(&case, &relaxed);
     assert!(!msg.contains("under its own weight"), "{msg}");
@@ -427,6 +430,7 @@ fn a_failed_load_step_is_not_reported_as_the_gravity_stage() {
             crate::solve::continuation::LOCK_FOUND
         ),
         at_md: None,
+        stopped: None,
     };
     let msg = static_failure(&case, &bracketed);
     assert!(msg.contains("it reached 62.5 % of the"), "{msg}");
@@ -448,6 +452,7 @@ fn a_failed_load_step_is_not_reported_as_the_gravity_stage() {
         min: 1e-4,
         reason: "Newton stalled".into(),
         at_md: Some(306.0),
+        stopped: None,
     };
     let msg = static_failure(&case, &gravity);
     assert!(
@@ -525,6 +530,7 @@ fn unsupported_collars_past_lubinskis_load_are_named() {
         min: 1e-4,
         reason: "r".into(),
         at_md: None,
+        stopped: None,
     };
     let msg = static_failure(&case, &error);
     assert!(

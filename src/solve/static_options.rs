@@ -83,6 +83,10 @@ pub enum StaticError {
         reason: String,
         /// Where the residual force was largest when it failed (MD, m), where known.
         at_md: Option<f64>,
+        /// Where the string stands where its load path bracketed where it stops: the last
+        /// equilibrium, at the largest load factor that has one (the CPU solve keeps it;
+        /// `None` for every other failure).
+        stopped: Option<Box<Stopped>>,
     },
     /// The wall-clock budget ran out before the full load was reached.
     #[error("stopped after {seconds:.1} s (the --max-seconds budget) at {:.1} % of the loads", 100.0 * reached)]
@@ -92,6 +96,27 @@ pub enum StaticError {
         /// Load factor reached.
         reached: f64,
     },
+}
+
+/// Where a string stands that stops on its way (a lock-up, [`StaticError::LoadStep`]'s
+/// `stopped`): its load path found an equilibrium with the friction and the bit loads at
+/// the fraction `lambda` of the operation's and none at `none_at`
+/// ([`crate::solve::continuation::LoadPath::stopped_between`]).
+#[derive(Clone, Debug)]
+pub struct Stopped {
+    /// The load factor of the equilibrium (friction coefficients, bit and point loads, and
+    /// a bent sub's bend scaled by it; gravity in full).
+    pub lambda: f64,
+    /// The smallest load factor at which the path found no equilibrium.
+    pub none_at: f64,
+    /// The model at those loads (`solve::statics::model_at`).
+    pub model: Model,
+    /// The equilibrium there, the string as it stands when it stops: node positions and
+    /// nodal rotations (`solve::statics::StaticState`'s; its section forces, contact
+    /// and reactions: `solve::statics::stopped_solution`).
+    pub x: Vec<crate::physics::vec3::Vec3<f64>>,
+    /// See `x`.
+    pub rot: Vec<crate::physics::rotation::Mat3<f64>>,
 }
 
 /// How a failure in the load path's first stage names it ([`StaticError::LoadStep`]'s
@@ -107,6 +132,14 @@ impl StaticError {
     /// path's first stage), before any bit load.
     pub fn in_gravity_stage(&self) -> bool {
         matches!(self, StaticError::LoadStep { stage, .. } if stage.starts_with(GRAVITY_STAGE))
+    }
+
+    /// Where the string stands, where the load path bracketed where it stops.
+    pub fn stopped(&self) -> Option<&Stopped> {
+        match self {
+            StaticError::LoadStep { stopped, .. } => stopped.as_deref(),
+            StaticError::Budget { .. } => None,
+        }
     }
 
     /// The load factor reached before the failure.

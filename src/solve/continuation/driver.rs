@@ -35,6 +35,10 @@ pub trait StaticSystem: NewtonSystem {
     fn unshifted_measure(&mut self, _j: usize) -> f64 {
         f64::INFINITY
     }
+    /// Keeps variant `j`'s current state, an equilibrium at the loads `target`
+    /// ([`LoadPath::take_equilibrium`]), as where its string stands should its path fail
+    /// where the string stops. Systems without a use for it keep nothing.
+    fn keep_equilibrium(&mut self, _j: usize, _target: &LoadTarget) {}
     /// Sets variant `j`'s proximal shift `s` (0: none), anchored at its current state:
     /// the residual gains `s (x − a)` on the translations, the tangent `s I`.
     fn set_shift(&mut self, _j: usize, s: f64) -> Result<(), crate::error::SystemError> {
@@ -128,7 +132,11 @@ fn next_steps(
                 if path.shift() > 0.0 {
                     path.shift_settled(sys.unshifted_measure(j));
                 }
-                (path.converged(its), true)
+                let next = path.converged(its);
+                if let Some(target) = path.take_equilibrium() {
+                    sys.keep_equilibrium(j, &target);
+                }
+                (next, true)
             }
             Event::Failed(reason) => {
                 let at = sys.worst_residual_md(j);

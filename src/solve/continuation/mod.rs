@@ -138,6 +138,12 @@ pub struct LoadPath {
     /// After the relaxation to the full loads failed: where the string stops, bracketed
     /// ([`LoadPath::bracket`]).
     lock: Option<Lock>,
+    /// The loads of the step that just converged to an equilibrium (not a relaxation's
+    /// unsettled sub-solve), until [`LoadPath::take_equilibrium`] takes them.
+    equilibrium: Option<LoadTarget>,
+    /// The path failed where its bracket closed: the largest load factor with an
+    /// equilibrium and the smallest without ([`LoadPath::stopped_between`]).
+    stopped: Option<(f64, f64)>,
     /// The answer came by relaxation past a fold, or f32's second solve at full load
     /// failed from it: a small residual says less there (near a fold the tangent is nearly
     /// singular), so the f32 engine confirms such an answer in f64 (`engine::verify_f32`).
@@ -202,6 +208,8 @@ impl LoadPath {
             error: None,
             doubtful: false,
             lock: None,
+            equilibrium: None,
+            stopped: None,
             load_failures: 0,
         };
         p.set_target();
@@ -326,6 +334,22 @@ impl LoadPath {
         }
     }
 
+    /// The loads at which the step that converged last left an equilibrium (a load step,
+    /// a gravity step or a relaxation that settled; `None` after a relaxation's
+    /// unsettled sub-solve), once: the driver keeps that state
+    /// ([`StaticSystem::keep_equilibrium`]), which is where the string stands if the path
+    /// later fails where it stops ([`LoadPath::stopped_between`]).
+    pub fn take_equilibrium(&mut self) -> Option<LoadTarget> {
+        self.equilibrium.take()
+    }
+
+    /// Where a failed path bracketed where the string stops: the largest load factor at
+    /// which it found an equilibrium and the smallest at which it found none (`None` for
+    /// every other end).
+    pub fn stopped_between(&self) -> Option<(f64, f64)> {
+        self.stopped
+    }
+
     /// Whether the path is finished (converged or failed).
     pub fn finished(&self) -> bool {
         matches!(self.stage, Stage::Done | Stage::Failed)
@@ -343,6 +367,11 @@ impl LoadPath {
     /// The step converged in `iterations`: what follows.
     pub fn converged(&mut self, iterations: usize) -> Next {
         self.iterations.push(iterations);
+        self.equilibrium = match (&self.stage, &self.relax) {
+            (Stage::Relax, Some(r)) => r.settled.then_some(r.target),
+            (Stage::Relax | Stage::Done | Stage::Failed, _) => None,
+            _ => Some(self.target),
+        };
         match self.stage {
             Stage::Gravity => self.stage = Stage::Load,
             Stage::GravityRamp => {
@@ -468,6 +497,7 @@ impl LoadPath {
                 "where the string stops: an equilibrium at λ = {:.4}, none found at λ = {:.4}",
                 lock.lo, lock.hi
             ));
+            self.stopped = Some((lock.lo, lock.hi));
             self.error = Some(StaticError::LoadStep {
                 stage: LOAD_STAGE.into(),
                 from: lock.lo,
@@ -478,6 +508,7 @@ impl LoadPath {
                     lock.why, lock.lo, lock.hi
                 ),
                 at_md: None,
+                stopped: None,
             });
             self.stage = Stage::Failed;
             return Next::Failed;
@@ -565,6 +596,7 @@ impl LoadPath {
                 min: p.min_step,
                 reason,
                 at_md,
+                stopped: None,
             });
             p.stage = Stage::Failed;
             Next::Failed

@@ -363,11 +363,20 @@ fn a_failed_full_load_relaxation_brackets_where_the_string_stops() {
         }
         next
     };
-    // Settles a relaxation at once.
+    // Settles a relaxation at once: an equilibrium at its target, to be kept.
     let settle = |p: &mut LoadPath| {
+        let target = p.target();
         p.shift_settled(1e-12);
-        p.converged(3)
+        let next = p.converged(3);
+        assert_eq!(p.take_equilibrium(), Some(target));
+        assert_eq!(p.take_equilibrium(), None, "taken once");
+        next
     };
+    // A sub-solve that converges unsettled leaves no equilibrium to keep.
+    p.shift_settled(1.0);
+    assert_eq!(p.converged(3), Next::Step);
+    assert_eq!(p.take_equilibrium(), None);
+    assert_eq!(p.stopped_between(), None);
     // The full loads fail: a relaxation to 0.5 from where it ended.
     assert_eq!(fail_relaxation(&mut p), Next::Step);
     assert_eq!((p.stage, p.lambda), (Stage::Relax, 0.0));
@@ -386,7 +395,9 @@ fn a_failed_full_load_relaxation_brackets_where_the_string_stops() {
         (Stage::Relax, 0.5, 0.625)
     );
     // 0.625 settles: the bracket [0.625, 0.75] is narrow enough; the path fails there.
+    assert_eq!(p.stopped_between(), None);
     assert_eq!(settle(&mut p), Next::Failed);
+    assert_eq!(p.stopped_between(), Some((0.625, 0.75)));
     let e = p.error.clone().unwrap();
     assert_eq!(e.reached(), 0.625);
     let e = e.to_string();
@@ -407,13 +418,17 @@ fn a_failed_full_load_relaxation_brackets_where_the_string_stops() {
     // From a failed step at λ 0.75: one relaxation, to 0.875, which fails there too.
     let mut q = LoadPath::new(&StaticOptions::default(), true, true, false);
     assert_eq!(q.converged(10), Next::Step);
+    assert_eq!(q.take_equilibrium().map(|t| t.lambda), Some(0.0), "gravity");
     while q.lambda < 0.75 {
+        let target = q.target();
         assert_eq!(q.converged(10), Next::Step);
+        assert_eq!(q.take_equilibrium(), Some(target), "a load step");
     }
     assert_eq!(q.failed_at("no".into(), None, Some(1e6)), Next::Step);
     assert_eq!(fail_relaxation(&mut q), Next::Step);
     assert_eq!(q.target().lambda, 0.875);
     assert_eq!(fail_relaxation(&mut q), Next::Failed);
+    assert_eq!(q.stopped_between(), Some((0.75, 0.875)));
     let e = q.error.unwrap();
     assert_eq!(e.reached(), 0.75);
     assert!(e.to_string().contains("none at λ = 0.8750"), "{e}");

@@ -18,14 +18,14 @@ use crate::physics::contact::{evaluate, ContactMode, ContactResponse, ContactTer
 use crate::physics::vec3::{cross, dot, scale, sub, Vec3};
 use crate::solve::chain::{BlockTridiagonal, ChainSolver};
 
-pub use super::static_options::{StaticError, StaticOptions};
+pub use super::static_options::{StaticError, StaticOptions, Stopped};
 
 mod results;
 mod state;
 mod system;
 pub use results::{
-    element_deformation, element_section_forces, loaded_model, loaded_params, solution_at,
-    split_loads,
+    element_deformation, element_section_forces, loaded_model, loaded_params, model_at,
+    solution_at, split_loads,
 };
 use results::{finish, penetration_for};
 pub use state::StaticState;
@@ -585,10 +585,27 @@ pub fn solve_static_monitored(
             min: options.min_step,
             reason: reason.to_string(),
             at_md: None,
+            stopped: None,
         });
     }
-    let [path] = paths;
-    if let Some(e) = path.error {
+    let [mut path] = paths;
+    let stopped_between = path.stopped_between();
+    if let Some(mut e) = path.error.take() {
+        if let (Some((lambda, none_at)), Some((state, target))) = (stopped_between, sys.kept) {
+            // The string stops on its way: where it stands is the equilibrium kept at the
+            // bracket's lower end (a relaxation's end, or the last load step).
+            if let StaticError::LoadStep { stopped, .. } = &mut e {
+                if target.lambda == lambda && target.gravity == 1.0 && target.exponent == 1.0 {
+                    *stopped = Some(Box::new(Stopped {
+                        lambda,
+                        none_at,
+                        model: model_at(model, &target),
+                        x: state.x,
+                        rot: state.rot,
+                    }));
+                }
+            }
+        }
         return Err(e);
     }
     if !path.finished() {
@@ -598,6 +615,16 @@ pub fn solve_static_monitored(
         });
     }
     Ok(finish(model, sys.state, path.iterations, path.log))
+}
+
+/// The solution (section forces, contact, reactions) of the string where it stops
+/// ([`Stopped`]), in its model at those loads.
+pub fn stopped_solution(stopped: &Stopped) -> StaticSolution {
+    let state = StaticState {
+        x: stopped.x.clone(),
+        rot: stopped.rot.clone(),
+    };
+    solution_at(&stopped.model, state)
 }
 
 /// The largest residual of a configuration at full load over the force scale (the
@@ -628,6 +655,7 @@ pub fn polish_static(
             min: options.min_step,
             reason: reason.to_string(),
             at_md: None,
+            stopped: None,
         }
     })?;
     let [path] = paths;

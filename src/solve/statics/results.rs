@@ -18,6 +18,22 @@ pub fn loaded_model(model: &Model, target: &crate::solve::continuation::LoadTarg
     m
 }
 
+/// The model at a target of its load path with gravity in full: [`loaded_model`]'s
+/// friction, spring exponents and bends, and the bit loads and point loads at the fraction
+/// `target.lambda` (the loads [`crate::solve::continuation`] solves a step for), so that a
+/// state the path reached there is an equilibrium of this model.
+pub fn model_at(model: &Model, target: &crate::solve::continuation::LoadTarget) -> Model {
+    let mut m = loaded_model(model, target);
+    m.weight_on_bit *= target.lambda;
+    m.torque_on_bit *= target.lambda;
+    for (_, load) in &mut m.point_loads {
+        for f in load.iter_mut() {
+            *f *= target.lambda;
+        }
+    }
+    m
+}
+
 /// A site's law parameters at a load target: friction scaled, exponent blended from 1.
 pub fn loaded_params(
     p: &crate::physics::contact::ContactParams<f64>,

@@ -31,6 +31,9 @@ pub(super) struct CpuStatic<'a> {
     /// Proximal shift (N/m) and its anchor ([`crate::solve::continuation`]'s relaxation).
     shift: f64,
     anchor: Vec<Vec3<f64>>,
+    /// The last equilibrium the load path reached, with its loads
+    /// ([`StaticSystem::keep_equilibrium`]).
+    pub(super) kept: Option<(StaticState, crate::solve::continuation::LoadTarget)>,
 }
 
 /// The first proximal shift of a relaxation of `model` (N/m; [`StaticSystem::relax_scale`]
@@ -98,6 +101,7 @@ impl<'a> CpuStatic<'a> {
             evaluated: false,
             shift: 0.0,
             anchor: Vec::new(),
+            kept: None,
         }
     }
 }
@@ -261,6 +265,9 @@ impl crate::solve::continuation::StaticSystem for CpuStatic<'_> {
         assemble(&self.loaded, &self.state, 1.0, &self.f_step, &mut r, None);
         constrain_residual(&self.c, &mut r);
         residual_measure(&r, self.f_ref)
+    }
+    fn keep_equilibrium(&mut self, _j: usize, target: &crate::solve::continuation::LoadTarget) {
+        self.kept = Some((self.state.clone(), *target));
     }
     fn set_shift(&mut self, _j: usize, s: f64) -> Result<(), crate::error::SystemError> {
         self.shift = s;

@@ -1,0 +1,121 @@
+//! A string that stops on its way into the hole (issue 22): corpus well 242 (horizontal,
+//! 2,455 m, 9⅞ in hole, tripping in, friction 0.21 cased / 0.37 open) meshed with 5 m
+//! elements (1 m in the BHA). Its load path finds no equilibrium at the full friction, and
+//! relaxations to smaller loads bracket where the string stops. The solve then gives the
+//! string where it stands — the equilibrium at the bracket's lower end — and `holewall
+//! static` writes its outputs for it before it fails. About 25 s on 2 cores (the two tests
+//! run side by side).
+
+mod common;
+
+use std::path::PathBuf;
+
+/// Corpus well 242 with 5 m elements, in a scratch folder `tag`.
+fn lock_up_case(tag: &str) -> PathBuf {
+    let dir = common::scratch_dir("lock-up", tag);
+    let well = holewall::corpus::write_well(242, &dir).unwrap();
+    let text = std::fs::read_to_string(&well.case_path).unwrap();
+    let text: Vec<&str> = text
+        .lines()
+        .map(|l| {
+            if l.starts_with("element_length") {
+                "element_length = \"5 m\""
+            } else if l.starts_with("bha_element_length") {
+                "bha_element_length = \"1 m\""
+            } else {
+                l
+            }
+        })
+        .collect();
+    std::fs::write(&well.case_path, text.join("\n")).unwrap();
+    well.case_path
+}
+
+#[test]
+fn a_string_that_stops_on_its_way_in_is_given_where_it_stands() {
+    let path = lock_up_case("library");
+    let mut case = holewall::case::load_case(&path).unwrap();
+    let options = case.settings().statics();
+    let (e, stopped) = holewall::profile::solve_or_stop(&mut case, options, false)
+        .expect_err("the string stops on its way in");
+    let st = stopped.expect("where it stands");
+    let solution = holewall::solve::statics::stopped_solution(&st);
+    eprintln!(
+        "stops between λ = {} and {}; hook load {:.1} kN",
+        st.lambda,
+        st.none_at,
+        -solution.top_reaction[2] / 1e3
+    );
+    // The bracket, as the message names it.
+    assert!(st.lambda > 0.5 && st.lambda < 1.0, "{}", st.lambda);
+    assert!(st.none_at > st.lambda && st.none_at - st.lambda <= 0.125 + 1e-12);
+    let message = e.to_string();
+    assert!(
+        message.contains(&format!(
+            "{} λ = {:.4} and none at λ = {:.4}",
+            holewall::solve::continuation::LOCK_FOUND,
+            st.lambda,
+            st.none_at
+        )),
+        "{message}"
+    );
+    // An equilibrium of the model at those loads (a relaxation settles within 100× the
+    // tolerance), and far from one at the operation's full friction.
+    let at = holewall::solve::statics::residual_measure_at(&st.model, &solution.state);
+    assert!(at <= 100.0 * options.tolerance, "{at:e}");
+    let full = holewall::solve::statics::residual_measure_at(&case.model, &solution.state);
+    assert!(
+        full > 1e3 * at.max(options.tolerance),
+        "{full:e} against {at:e}"
+    );
+    // The sites' friction is the case's × λ.
+    for (a, b) in st.model.sites.iter().zip(&case.model.sites) {
+        assert!((a.params.mu_l - st.lambda * b.params.mu_l).abs() <= 1e-12 * b.params.mu_l);
+    }
+    // Pushed from the surface where it stands, and an independent check that this load
+    // locks the string up: the soft string carrying Mitchell's buckled wall force runs away
+    // from a friction factor near the FE's.
+    let hook = solution.top_reaction[2];
+    assert!(hook > 0.0, "pushed: top reaction {hook} N upward is a pull");
+    let soft = holewall::diagnose::lock_up_fraction(&case).expect("the soft string locks up");
+    assert!(
+        (soft - st.lambda).abs() < 0.2,
+        "soft string {soft}, FE {}",
+        st.lambda
+    );
+}
+
+#[test]
+fn the_static_command_writes_the_string_where_it_stops_and_fails() {
+    let path = lock_up_case("command");
+    let out = path.parent().unwrap().join("out");
+    let (code, _, stderr) = common::holewall(&[
+        "static",
+        "--quiet",
+        "--out",
+        out.to_str().unwrap(),
+        path.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 1, "{stderr}");
+    assert!(stderr.contains("the string where it stops"), "{stderr}");
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    let stopped = &summary["stopped"];
+    let lambda = stopped["load_factor"].as_f64().unwrap();
+    assert!(lambda > 0.5 && lambda < 1.0, "{stopped}");
+    assert!(stopped["none_at"].as_f64().unwrap() > lambda);
+    assert!(stopped["failure"]
+        .as_str()
+        .unwrap()
+        .contains(&format!("an equilibrium at λ = {lambda:.4}")));
+    assert!(summary["title"]
+        .as_str()
+        .unwrap()
+        .contains("where it stops"));
+    assert!(summary["hook_load_n"].as_f64().unwrap() < 0.0, "pushed");
+    let profile = std::fs::read_to_string(out.join("profile.csv")).unwrap();
+    assert!(profile.lines().count() > 400, "a row per node");
+    for plot in ["axial_force.png", "side_force.png"] {
+        assert!(out.join(plot).is_file(), "{plot}");
+    }
+}
