@@ -334,6 +334,38 @@ fn a_guarded_solve_that_fails_is_tried_with_the_models_own_sites() {
     });
     assert!(matches!(out, Err(StaticError::LoadStep { ref reason, .. }) if reason == "guarded"));
     assert_eq!(calls, [true, false]);
+    // Both fail, the guarded one where the string stops: where it stands keeps the sites an
+    // answer would (its own and the guards in contact), as the guarded solve's answer did.
+    let (solved_model, _, _) = run(&case, &|_| None);
+    let (_, out, _) = run(&case, &|m| {
+        let sol = crate::solve::statics::solve_static(m, &StaticOptions::default()).unwrap();
+        let stopped = crate::solve::statics::Stopped {
+            lambda: 1.0,
+            none_at: 1.0,
+            model: m.clone(),
+            x: sol.state.x,
+            rot: sol.state.rot,
+        };
+        let mut e = failure("stops");
+        if let StaticError::LoadStep { stopped: s, .. } = &mut e {
+            *s = Some(Box::new(stopped));
+        }
+        Some(e)
+    });
+    let e = out.expect_err("fails");
+    let st = e.stopped().expect("where it stands");
+    assert!(
+        st.model.sites.len() < case.model.nodes.len() - 1,
+        "guards dropped"
+    );
+    assert_eq!(
+        st.model.sites.iter().map(|s| s.node).collect::<Vec<_>>(),
+        solved_model
+            .sites
+            .iter()
+            .map(|s| s.node)
+            .collect::<Vec<_>>()
+    );
     // The own sites' answer lies beyond the wall (the inclined string): the error.
     let inclined = inclined_bha("stabilizers");
     let (model, out, calls) = run(&inclined, &|m| {
