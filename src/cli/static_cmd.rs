@@ -149,6 +149,10 @@ pub fn run(
         StaticModel::SoftString => None,
     };
     let load_factor = stopped.as_ref().map_or(1.0, |(s, _)| s.load_factor);
+    let (stopped, failure) = match stopped {
+        Some((note, e)) => (Some(note), Some(e)),
+        None => (None, None),
+    };
     let case = case;
     let model = &case.model;
     let n = model.nodes.len();
@@ -318,13 +322,8 @@ pub fn run(
         }),
         newton_iterations: its,
         solver_log,
-        stopped: None,
+        stopped,
     };
-    let mut summary = summary;
-    let failure = stopped.map(|(note, e)| {
-        summary.stopped = Some(note);
-        e
-    });
     let dir = folder.path();
     crate::output::write_csv_rows(&dir.join("profile.csv"), &rows)?;
     write_plots(&case, which, &rows, np, summary.bit.as_ref(), dir)?;
