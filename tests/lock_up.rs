@@ -3,8 +3,8 @@
 //! elements (1 m in the BHA). Its load path finds no equilibrium at the full friction, and
 //! relaxations to smaller loads bracket where the string stops. The solve then gives the
 //! string where it stands — the equilibrium at the bracket's lower end — and `holewall
-//! static` writes its outputs for it before it fails. About 25 s on 2 cores (the two tests
-//! run side by side).
+//! static` writes its outputs for it before it fails; an ensemble's variant that stops gives
+//! the load factor. About 45 s on 2 cores (the three tests run side by side).
 
 mod common;
 
@@ -118,4 +118,43 @@ fn the_static_command_writes_the_string_where_it_stops_and_fails() {
     for plot in ["axial_force.png", "side_force.png"] {
         assert!(out.join(plot).is_file(), "{plot}");
     }
+}
+
+#[test]
+fn an_ensemble_variant_that_stops_says_where() {
+    let path = lock_up_case("ensemble");
+    // The case's open-hole friction (0.368) stops the string; 0.2 lets it in.
+    let mut text = std::fs::read_to_string(&path).unwrap();
+    text.push_str(
+        "\n[ensemble]\nanalysis = \"static\"\n[ensemble.grid]\n\"mu.open\" = [0.2, 0.368]\n",
+    );
+    std::fs::write(&path, text).unwrap();
+    let out = path.parent().unwrap().join("out");
+    let s = holewall::ensemble::job::run(
+        &path,
+        None,
+        holewall::backend::BackendChoice::Cpu,
+        holewall::backend::Precision::F64,
+        &out,
+        false,
+        &Default::default(),
+    )
+    .unwrap();
+    assert_eq!((s.variants, s.failed, s.stopped), (2, 1, 1), "{s:?}");
+    assert!(s.notices().iter().any(|n| n.contains("stop on their way")));
+    let mut csv = csv::Reader::from_path(out.join("variants.csv")).unwrap();
+    let headers = csv.headers().unwrap().clone();
+    let col = |name: &str| headers.iter().position(|h| h == name).unwrap();
+    let (status, stopped) = (col("status"), col("stopped_load_factor"));
+    let rows: Vec<(String, String)> = csv
+        .records()
+        .map(|r| {
+            let r = r.unwrap();
+            (r[status].to_string(), r[stopped].to_string())
+        })
+        .collect();
+    assert_eq!(rows[0], ("converged".into(), String::new()), "{rows:?}");
+    assert_eq!(rows[1].0, "failed");
+    let lambda: f64 = rows[1].1.parse().unwrap();
+    assert!(lambda > 0.5 && lambda < 1.0, "{rows:?}");
 }

@@ -270,6 +270,7 @@ pub fn run(
             failed: 0,
             failures: Vec::new(),
             outside_hole: 0,
+            stopped: 0,
             solved_by_engine: 0,
             solved_by_cpu: 0,
             seconds: 0.0,
@@ -370,6 +371,10 @@ pub fn run(
         outside_hole: results
             .iter()
             .filter(|r| r.status != Status::Failed && r.string.outside_hole_m > Some(0.0))
+            .count(),
+        stopped: results
+            .iter()
+            .filter(|r| r.string.stopped_load_factor.is_some())
             .count(),
         solved_by_engine: results
             .iter()

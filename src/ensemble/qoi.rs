@@ -53,6 +53,11 @@ pub struct StringQoi {
     /// stabilizers only, an answer for a string in no hole.
     #[serde(default)]
     pub outside_hole_m: Option<f64>,
+    /// A static variant that failed where its load path bracketed where the string stops
+    /// (a lock-up, [`crate::solve::statics::Stopped`]): the largest fraction of its friction
+    /// and bit loads at which the FE found an equilibrium.
+    #[serde(default)]
+    pub stopped_load_factor: Option<f64>,
 }
 
 /// How a variant ended.
@@ -274,7 +279,11 @@ fn solve_held(
     let (model, solved) = held_start(case, model, add);
     match solved {
         Ok(sol) => static_result(case, name, &model, &sol),
-        Err(e) => failed(name, e.to_string(), model.stabilizer_sites().len()),
+        Err(e) => {
+            let mut r = failed(name, e.to_string(), model.stabilizer_sites().len());
+            r.string.stopped_load_factor = e.stopped().map(|s| s.lambda);
+            r
+        }
     }
 }
 
@@ -319,6 +328,7 @@ pub fn static_result(
         outside_hole_m: Some(
             crate::diagnose::through_wall(case, model, &sol.state.x).map_or(0.0, |t| t.excess_m),
         ),
+        stopped_load_factor: None,
     };
     let travel = crate::rig::Travel::of_axial_speed(model.axial_speed);
     VariantResult {
@@ -591,6 +601,7 @@ impl DynamicObserver {
             helical_buckling: None,
             stick_slip_severity: severity,
             outside_hole_m: None,
+            stopped_load_factor: None,
         };
         finished(
             name,

@@ -44,6 +44,10 @@ pub struct EnsembleSummary {
     /// Solved static variants whose equilibrium lies outside the hole where no contact site
     /// holds it (`variants.csv`: `outside_hole_m`; [`crate::diagnose::through_wall`]).
     pub outside_hole: usize,
+    /// Failed static variants whose load path bracketed where the string stops (a
+    /// lock-up; `variants.csv`: `stopped_load_factor`).
+    #[serde(default)]
+    pub stopped: usize,
     /// Variants the kernel engine solved.
     pub solved_by_engine: usize,
     /// Variants the CPU solved: all of them on the CPU backend; on the GPU backend, the
@@ -105,6 +109,14 @@ impl EnsembleSummary {
                  its contact sites (variants.csv: outside_hole_m): equilibria of a string in no \
                  hole, whose side forces mean nothing; contact.sites = \"all_nodes\" holds it",
                 self.outside_hole, self.variants
+            ));
+        }
+        if self.stopped > 0 {
+            n.push(format!(
+                "{} of {} variants stop on their way (a lock-up): no equilibrium found at their \
+                 loads; variants.csv's stopped_load_factor gives the largest fraction of the \
+                 friction and bit loads at which each has one",
+                self.stopped, self.variants
             ));
         }
         if self.backend == "gpu" && self.solved_by_cpu > 0 {
@@ -203,7 +215,13 @@ pub(crate) fn variants_csv(
         header.push("stick_slip_severity".into());
     } else {
         header.extend(
-            ["sinusoidal_buckling", "helical_buckling", "outside_hole_m"].map(String::from),
+            [
+                "sinusoidal_buckling",
+                "helical_buckling",
+                "outside_hole_m",
+                "stopped_load_factor",
+            ]
+            .map(String::from),
         );
         header.extend(crate::bha::BIT_COLUMNS.map(String::from));
     }
@@ -279,6 +297,7 @@ pub(crate) fn variants_csv(
             row.push(flag(r.string.sinusoidal_buckling));
             row.push(flag(r.string.helical_buckling));
             row.push(opt(r.string.outside_hole_m));
+            row.push(opt(r.string.stopped_load_factor));
             match &r.bit {
                 Some(b) => row.extend(b.columns().map(fmt)),
                 None => row.extend(crate::bha::BIT_COLUMNS.map(|_| String::new())),
