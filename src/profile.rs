@@ -174,6 +174,15 @@ pub fn fe_rows(
 /// The words a solution's log says sites were added with ([`solve_in_hole`]).
 pub const WALL_CONTACT: &str = "contact added where the string met the wall";
 
+/// How often a static solution's load path left plain load steps, by its log: step cuts,
+/// failed steps relaxed past, stage changes, the model's own sites taken where the guarded
+/// solve failed — every line but [`WALL_CONTACT`]'s. The step cuts of `holewall bench
+/// corpus` and of an ensemble's static variants (a variant with any is `step_cut`, not
+/// `converged`).
+pub fn path_events(log: &[String]) -> usize {
+    log.iter().filter(|l| !l.starts_with(WALL_CONTACT)).count()
+}
+
 /// The FE static solution of `model` (the case's, or a variant's of it) with the string
 /// held in the hole wherever it meets the wall. Where the case has contact sites at its
 /// stabilizers only (`contact.sites = "stabilizers"`), a compressed or sagging string

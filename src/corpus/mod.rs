@@ -694,11 +694,7 @@ pub fn run_well(
             )
             .map_or(0.0, |t| 1e3 * t.excess_m);
             r.load_steps = sol.iterations.len();
-            r.step_cuts = sol
-                .log
-                .iter()
-                .filter(|l| !l.starts_with(crate::profile::WALL_CONTACT))
-                .count();
+            r.step_cuts = crate::profile::path_events(&sol.log);
             r.relaxed = sol
                 .log
                 .iter()

@@ -173,11 +173,13 @@ pub(crate) fn failed(name: &str, reason: String, stabs: usize) -> VariantResult 
     }
 }
 
-/// A variant that finished: converged, or with the step cuts its solver log records.
+/// A variant that finished: converged, or with `cuts` step cuts (or other departures from
+/// its plain steps) that its solver log `log` records.
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn finished(
     name: &str,
     log: &[String],
+    cuts: usize,
     iterations: &[usize],
     neutral_point_from_bit_m: Option<f64>,
     hook_load_n: f64,
@@ -185,7 +187,6 @@ pub(crate) fn finished(
     stabilizers: Vec<StabilizerQoi>,
     string: StringQoi,
 ) -> VariantResult {
-    let cuts = log.iter().filter(|l| l.contains("cut")).count();
     VariantResult {
         name: name.to_string(),
         status: if cuts > 0 {
@@ -206,6 +207,11 @@ pub(crate) fn finished(
             / iterations.len().max(1) as f64,
         step_cuts: cuts,
     }
+}
+
+/// The time steps a dynamic run's log says were cut.
+fn dynamic_cuts(log: &[String]) -> usize {
+    log.iter().filter(|l| l.contains("cut to")).count()
 }
 
 /// Static equilibrium of one model of the case (its own, or one made from it), held in the
@@ -340,6 +346,7 @@ pub fn static_result(
         ..finished(
             name,
             &sol.log,
+            crate::profile::path_events(&sol.log),
             &sol.iterations,
             neutral_point(&rows).map(|md| bit_md_of(case, model) - md),
             hook,
@@ -465,7 +472,7 @@ fn dynamic_held(
     observe(&dynamics, &s);
     let result = dynamics.run(&mut s, settings.duration, &mut observe);
     let energy_growth = (mass.is_some() && first > 0.0).then(|| second / first - 1.0);
-    let cuts = dynamics.log.iter().filter(|l| l.contains("cut to")).count();
+    let cuts = dynamic_cuts(&dynamics.log);
     if let Err(reason) = result {
         let mut f = failed(name, reason.to_string(), stabs.len());
         f.step_cuts = cuts;
@@ -606,6 +613,7 @@ impl DynamicObserver {
         finished(
             name,
             log,
+            dynamic_cuts(log),
             iterations,
             np.map(|x| bit_md_of(case, model) - x),
             axial.first().copied().unwrap_or(f64::NAN),
