@@ -307,10 +307,7 @@ pub(crate) fn hold_in_hole(
         }
         Err(mut e) => {
             // Where the string stops, with the sites kept as for an answer.
-            if let crate::solve::statics::StaticError::LoadStep {
-                stopped: Some(st), ..
-            } = &mut e
-            {
+            if let Some(st) = e.stopped_mut() {
                 let sol = crate::solve::statics::stopped_solution(st);
                 st.model = keep_touching(model, st.model.clone(), sol).0;
             }
@@ -402,10 +399,7 @@ pub fn solve_or_stop(
     bar.finish_and_clear();
     case.model = model;
     solved.map_err(|mut e| {
-        let stopped = match &mut e {
-            crate::solve::statics::StaticError::LoadStep { stopped, .. } => stopped.take(),
-            _ => None,
-        };
+        let stopped = e.take_stopped();
         (
             crate::error::Error::Failed(crate::diagnose::static_failure(case, &e)),
             stopped,

@@ -142,6 +142,22 @@ impl StaticError {
         }
     }
 
+    /// [`StaticError::stopped`], to change.
+    pub fn stopped_mut(&mut self) -> Option<&mut Stopped> {
+        match self {
+            StaticError::LoadStep { stopped, .. } => stopped.as_deref_mut(),
+            StaticError::Budget { .. } => None,
+        }
+    }
+
+    /// [`StaticError::stopped`], taken out of the error.
+    pub fn take_stopped(&mut self) -> Option<Box<Stopped>> {
+        match self {
+            StaticError::LoadStep { stopped, .. } => stopped.take(),
+            StaticError::Budget { .. } => None,
+        }
+    }
+
     /// The load factor reached before the failure.
     pub fn reached(&self) -> f64 {
         match self {

@@ -267,7 +267,15 @@ impl crate::solve::continuation::StaticSystem for CpuStatic<'_> {
         residual_measure(&r, self.f_ref)
     }
     fn keep_equilibrium(&mut self, _j: usize, target: &crate::solve::continuation::LoadTarget) {
-        self.kept = Some((self.state.clone(), *target));
+        // Into the buffers of the last one kept: no allocation a converged step.
+        match &mut self.kept {
+            Some((state, t)) => {
+                state.x.clone_from(&self.state.x);
+                state.rot.clone_from(&self.state.rot);
+                *t = *target;
+            }
+            None => self.kept = Some((self.state.clone(), *target)),
+        }
     }
     fn set_shift(&mut self, _j: usize, s: f64) -> Result<(), crate::error::SystemError> {
         self.shift = s;
