@@ -112,11 +112,11 @@ pub fn set_rest_column<T: crate::physics::Real>(
     }
 }
 
-/// Element forces and tangents of V variants (rayon over elements × variants) at
-/// displacements `u` from the base whose chords are `chords` ([`base_chords`]) and
-/// rotations `rot`, with the unstrained rotations `rest` ([`rest_table`]; empty: none);
-/// with `tangent` false the forces alone (the tangents returned are zeros, as the
-/// force-only kernel leaves its tangent binding out).
+/// Element forces and tangents of V variants (rayon over elements, each writing its own
+/// slab of the outputs) at displacements `u` from the base whose chords are `chords`
+/// ([`base_chords`]) and rotations `rot`, with the unstrained rotations `rest`
+/// ([`rest_table`]; empty: none); with `tangent` false the forces alone (the tangents
+/// returned are empty, as the force-only kernel leaves its tangent binding out).
 pub fn beam(
     model: &Model,
     num_variants: usize,
@@ -128,12 +128,25 @@ pub fn beam(
 ) -> (Vec<f64>, Vec<f64>) {
     let nv = num_variants;
     let ne = model.elements.len();
-    let per: Vec<([f64; 12], [[f64; 12]; 12])> = (0..ne * nv)
-        .into_par_iter()
-        .map(|idx| {
-            let (e, v) = (idx / nv, idx % nv);
-            let disp = |i: usize| -> [f64; 3] { std::array::from_fn(|k| u[(3 * i + k) * nv + v]) };
-            let triad = |i: usize| -> Mat3<f64> {
+    let mut force = vec![0.0; 12 * ne * nv];
+    let mut tangent_out = if tangent {
+        vec![0.0; 144 * ne * nv]
+    } else {
+        Vec::new()
+    };
+    // Element e's entries are `[(12 e + j) V + v]` and `[(144 e + 12 j + c) V + v]`: one
+    // contiguous slab of each output per element.
+    let tangent_slabs: Vec<&mut [f64]> = if tangent {
+        tangent_out.chunks_mut((144 * nv).max(1)).collect()
+    } else {
+        (0..ne).map(|_| <&mut [f64]>::default()).collect()
+    };
+    force
+        .par_chunks_mut((12 * nv).max(1))
+        .zip(tangent_slabs)
+        .enumerate()
+        .for_each(|(e, (f_slab, k_slab))| {
+            let triad = |i: usize, v: usize| -> Mat3<f64> {
                 let f = &model.nodes[i].frame0;
                 std::array::from_fn(|r| {
                     std::array::from_fn(|c| {
@@ -143,43 +156,40 @@ pub fn beam(
                     })
                 })
             };
-            // Node 2 at c + w₂: the chord's positions form (the f64 kernel's).
-            let x = [
-                disp(e),
-                std::array::from_fn(|k| {
-                    chords[(CHORD_LEN * e + k) * nv + v] + u[(3 * (e + 1) + k) * nv + v]
-                }),
-            ];
-            let t = [triad(e), triad(e + 1)];
             let el = &model.elements[e];
             let form = Chord::Positions {
                 length0: el.length0,
             };
-            let mut k = ElementStiffness::of(&el.section, el.length0);
-            if !rest.is_empty() {
-                k.rest = std::array::from_fn(|node| {
-                    std::array::from_fn(|c| rest[(REST_LEN * e + 3 * node + c) * nv + v])
-                });
-            }
-            if tangent {
-                force_and_tangent_closed(&x, &t, &form, &k)
-            } else {
-                (element_force(&x, &t, &form, &k), [[0.0; 12]; 12])
-            }
-        })
-        .collect();
-    let mut force = vec![0.0; 12 * ne * nv];
-    let mut tangent_out = vec![0.0; 144 * ne * nv];
-    for (idx, (f, k)) in per.into_iter().enumerate() {
-        let (e, v) = (idx / nv, idx % nv);
-        for j in 0..12 {
-            force[(12 * e + j) * nv + v] = f[j];
-            if tangent {
-                for c in 0..12 {
-                    tangent_out[(144 * e + 12 * j + c) * nv + v] = k[j][c];
+            for v in 0..nv {
+                // Node 2 at c + w₂: the chord's positions form (the f64 kernel's).
+                let x = [
+                    std::array::from_fn(|k| u[(3 * e + k) * nv + v]),
+                    std::array::from_fn(|k| {
+                        chords[(CHORD_LEN * e + k) * nv + v] + u[(3 * (e + 1) + k) * nv + v]
+                    }),
+                ];
+                let t = [triad(e, v), triad(e + 1, v)];
+                let mut k = ElementStiffness::of(&el.section, el.length0);
+                if !rest.is_empty() {
+                    k.rest = std::array::from_fn(|node| {
+                        std::array::from_fn(|c| rest[(REST_LEN * e + 3 * node + c) * nv + v])
+                    });
+                }
+                if tangent {
+                    let (f, kt) = force_and_tangent_closed(&x, &t, &form, &k);
+                    for j in 0..12 {
+                        f_slab[j * nv + v] = f[j];
+                        for c in 0..12 {
+                            k_slab[(12 * j + c) * nv + v] = kt[j][c];
+                        }
+                    }
+                } else {
+                    let f = element_force(&x, &t, &form, &k);
+                    for j in 0..12 {
+                        f_slab[j * nv + v] = f[j];
+                    }
                 }
             }
-        }
-    }
+        });
     (force, tangent_out)
 }

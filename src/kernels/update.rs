@@ -29,6 +29,19 @@ use crate::physics::Real;
 /// Terms of the Taylor series of `sinc` and `cos` on `[0, π/2]` (the last term below 2e-17).
 pub const SERIES_TERMS: usize = 12;
 
+/// `1/(2k+1)!` (sinc) and `1/(2k)!` (cos), `k = 0 … SERIES_TERMS − 1`, formed once at
+/// compile time (the factorials as the same left-to-right products in f64 the series always
+/// used, so every coefficient is the same bit for bit).
+const SERIES_COEFFICIENTS: [[f64; 2]; SERIES_TERMS] = {
+    let mut table = [[0.0; 2]; SERIES_TERMS];
+    let mut k = 0;
+    while k < SERIES_TERMS {
+        table[k] = [1.0 / factorial(2 * k + 1), 1.0 / factorial(2 * k)];
+        k += 1;
+    }
+    table
+};
+
 /// `(sinc h, cos h)` for `0 ≤ h ≤ π/2`, Horner in `h²`.
 pub fn sinc_cos<T: Real>(h: T) -> (T, T) {
     let h2 = h * h;
@@ -36,8 +49,8 @@ pub fn sinc_cos<T: Real>(h: T) -> (T, T) {
     let mut c = T::zero();
     for k in (0..SERIES_TERMS).rev() {
         // sinc: Σ (−1)^k h^{2k}/(2k+1)!, cos: Σ (−1)^k h^{2k}/(2k)!.
-        let sk = T::from_f64_lossy(1.0 / factorial(2 * k + 1));
-        let ck = T::from_f64_lossy(1.0 / factorial(2 * k));
+        let [sk, ck] = SERIES_COEFFICIENTS[k];
+        let (sk, ck) = (T::from_f64_lossy(sk), T::from_f64_lossy(ck));
         let sign = if k % 2 == 0 {
             T::one()
         } else {
@@ -49,8 +62,15 @@ pub fn sinc_cos<T: Real>(h: T) -> (T, T) {
     (s, c)
 }
 
-fn factorial(n: usize) -> f64 {
-    (1..=n).fold(1.0, |p, k| p * k as f64)
+/// `n!` as the product `1 · 1 · 2 · … · n` in f64, left to right.
+const fn factorial(n: usize) -> f64 {
+    let mut p = 1.0;
+    let mut k = 1;
+    while k <= n {
+        p *= k as f64;
+        k += 1;
+    }
+    p
 }
 
 /// `exp([θ]×)` by [`sinc_cos`] (row-major 3×3).
@@ -330,6 +350,42 @@ impl<T: Copy> Norms<T> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_shader_writes_out_the_twins_series_coefficients_bit_for_bit() {
+        // shaders/shared/rotation_exp.wgsl writes each (−1)^k/(2k+1)! and (−1)^k/(2k)! as
+        // a literal on a line ending "// sinc k" or "// cos k": each must parse to the
+        // twin's coefficient exactly (an f64 literal reads back to the value it was printed
+        // from), and every k must be there once.
+        let text = include_str!("../../shaders/shared/rotation_exp.wgsl");
+        let mut seen = [[false; 2]; SERIES_TERMS];
+        for line in text.lines() {
+            let Some((code, tag)) = line.split_once("// ") else {
+                continue;
+            };
+            let (which, k) = match tag.split_once(' ') {
+                Some(("sinc", k)) => (0, k),
+                Some(("cos", k)) => (1, k),
+                _ => continue,
+            };
+            let k: usize = k.trim().parse().expect("k after the tag");
+            let literal = code
+                .split_once("real(")
+                .and_then(|(_, r)| r.split_once(')'))
+                .map(|(l, _)| l)
+                .expect("a real(…) literal on a tagged line");
+            let value: f64 = literal.parse().expect("an f64 literal");
+            let sign = if k.is_multiple_of(2) { 1.0 } else { -1.0 };
+            assert_eq!(
+                value.to_bits(),
+                (sign * SERIES_COEFFICIENTS[k][which]).to_bits(),
+                "{line}"
+            );
+            assert!(!seen[k][which], "{line}: twice");
+            seen[k][which] = true;
+        }
+        assert!(seen.iter().flatten().all(|&s| s), "{seen:?}");
+    }
 
     #[test]
     fn series_exponential_matches_rodrigues_with_std_trig() {
