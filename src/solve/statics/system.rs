@@ -267,11 +267,13 @@ impl crate::solve::continuation::StaticSystem for CpuStatic<'_> {
         residual_measure(&r, self.f_ref)
     }
     fn keep_equilibrium(&mut self, _j: usize, target: &crate::solve::continuation::LoadTarget) {
-        // Into the buffers of the last one kept: no allocation a converged step.
+        // Into the buffers of the last one kept: no allocation a converged step. Every field
+        // by name, so a field added to the state cannot be left out unnoticed.
         match &mut self.kept {
             Some((state, t)) => {
-                state.x.clone_from(&self.state.x);
-                state.rot.clone_from(&self.state.rot);
+                let StaticState { x, rot } = &self.state;
+                state.x.clone_from(x);
+                state.rot.clone_from(rot);
                 *t = *target;
             }
             None => self.kept = Some((self.state.clone(), *target)),
