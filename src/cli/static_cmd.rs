@@ -130,8 +130,15 @@ pub fn run(
                     let st = *st;
                     case.model = st.model;
                     case.title = format!(
-                        "{} — where it stops: friction and bit loads × {:.3}, none found at × {:.3}",
-                        case.title, st.lambda, st.none_at
+                        "{} — {}: friction and bit loads × {:.3}, none found at × {:.3}",
+                        case.title,
+                        if crate::diagnose::stops(&case.model) {
+                            "where it stops"
+                        } else {
+                            "the largest loads with an equilibrium"
+                        },
+                        st.lambda,
+                        st.none_at
                     );
                     stopped = Some((
                         StoppedSummary {
@@ -334,10 +341,15 @@ pub fn run(
     folder.finish(&json)?;
     match failure {
         Some(e) => Err(Error::Failed(format!(
-            "{e}\n  written to {}: the string where it stops, at {:.1} % of the friction and \
-             bit loads, the largest fraction with an equilibrium found (summary.json's \
-             `stopped`)",
+            "{e}\n  written to {}: the string {}at {:.1} % of the friction and bit loads, \
+             the largest fraction with an equilibrium found (summary.json's `stopped`)",
             out.display(),
+            // Not run in or out, a string does not stop (crate::diagnose::static_failure).
+            if crate::diagnose::stops(&case.model) {
+                "where it stops, "
+            } else {
+                ""
+            },
             100.0 * load_factor
         ))),
         None => Ok(summary),

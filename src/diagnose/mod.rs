@@ -11,6 +11,9 @@ use crate::case::Case;
 use crate::model::Model;
 use crate::solve::statics::StaticError;
 
+mod whirl;
+pub use whirl::{rotating_whirl, whirl_reason, Whirl};
+
 /// The sinusoidal and helical buckling loads of element `e` (N of compression) in a hole of
 /// diameter `hole_diameter`.
 pub fn critical_loads(model: &Model, e: usize, hole_diameter: f64) -> (f64, f64) {
@@ -566,6 +569,13 @@ pub fn span_through_wall_warning(
     ))
 }
 
+/// Whether the operation runs the string in or out (tripping, sliding, reaming): only then
+/// has a failed load path's bracket a place where the string stops; a string turning on
+/// or off bottom has an equilibrium up to some load and none found past it.
+pub fn stops(model: &Model) -> bool {
+    model.axial_speed != 0.0
+}
+
 /// A failed static solve's message with the likely reason, from the case's soft-string
 /// profile at full load: compression beyond the helical buckling load (the string winds
 /// into a helix the mesh may not resolve), or the load factor it stopped at.
@@ -596,10 +606,19 @@ pub fn static_failure(case: &Case, error: &StaticError) -> String {
         ));
     }
     match error {
-        StaticError::LoadStep { reason, .. } if reason.contains(LOCK_FOUND) => {
+        StaticError::LoadStep { reason, .. } if reason.contains(LOCK_FOUND) && stops(model) => {
             msg.push_str(
                 "\n  that is where the string stops on this model, to within the loads named \
                  above: an equilibrium there, none found at the larger one",
+            );
+        }
+        StaticError::LoadStep { reason, .. } if reason.contains(LOCK_FOUND) => {
+            // Not run in or out, the string has nowhere to stop: past the bracket this
+            // model has no static answer (probe well 24 of stop 68: drilling, it whirls).
+            msg.push_str(
+                "\n  this model has an equilibrium there and none found at the larger load (to \
+                 within the loads named above); a string not run in or out does not stop, so \
+                 past that load it has no static answer on this model",
             );
         }
         StaticError::LoadStep { .. } if !gravity => {
@@ -676,6 +695,9 @@ pub fn static_failure(case: &Case, error: &StaticError) -> String {
             f / 1e3,
             critical / 1e3
         ));
+    }
+    if let Some(reason) = whirl_reason(case, &profile) {
+        msg.push_str(&reason);
     }
     if let crate::model::TopBoundary::Clamped = model.top {
         if let Some((ratio, md, f, h, pitch, length)) = worst_helical(case, &profile.tension) {
