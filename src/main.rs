@@ -732,6 +732,7 @@ fn main() -> ExitCode {
                 max_seconds,
                 out,
                 quiet,
+                style,
             } => match cli::bench_corpus::run(
                 &out,
                 &cli::bench_corpus::CorpusOptions {
@@ -741,6 +742,7 @@ fn main() -> ExitCode {
                     engine_max_nodes,
                     max_seconds,
                     show_progress: !quiet,
+                    style,
                 },
             ) {
                 Ok(s) => {

@@ -62,8 +62,50 @@ mod tempdir {
 #[test]
 fn corpus_sample_solves_and_agrees_with_the_soft_string() {
     let (_dir, rows) = corpus();
+    let solved = solved_and_agreeing(&rows);
+    eprintln!("corpus sample: {solved} of {WELLS} solved");
+    assert!(
+        solved >= SOLVED_AT_LEAST,
+        "{solved} of {WELLS} corpus wells solved; {SOLVED_AT_LEAST} did when this was written"
+    );
+}
+
+/// Solved of the user-style seeds 0–15 (`holewall bench corpus --style user`; stop 68): all
+/// but seed 0, a horizontal well tripped in that locks up (its soft string runs away at MD
+/// 1,526 m), which fails in 20 s saying so.
+const USER_SOLVED_AT_LEAST: usize = 15;
+const USER_SEEDS: std::ops::RangeInclusive<u64> = 0..=15;
+
+/// The corpus's user style (tool joints, reaming and back-reaming, three hole sections,
+/// tapered pipe, WOB past the buckling limit; src/corpus/user.rs) in CI: a sample solved
+/// and checked as the drawn sample is.
+#[test]
+fn user_style_sample_solves_and_agrees_with_the_soft_string() {
+    let dir = tempdir::Dir::new("corpus_user");
+    let rows: Vec<_> = USER_SEEDS
+        .map(|seed| {
+            let well =
+                holewall::corpus::user::write_user_well(seed, dir.path()).unwrap_or_else(|e| {
+                    panic!("user seed {seed}: the generator wrote a case the parser refuses: {e}")
+                });
+            let r = run_well(&well, &Default::default()).unwrap();
+            (well, r)
+        })
+        .collect();
+    let solved = solved_and_agreeing(&rows);
+    eprintln!("user-style sample: {solved} of {} solved", rows.len());
+    assert!(
+        solved >= USER_SOLVED_AT_LEAST,
+        "{solved} of {} user-style wells solved; {USER_SOLVED_AT_LEAST} did when this was written",
+        rows.len()
+    );
+}
+
+/// Checks every solved well of `rows` against the soft string and every failure's words;
+/// returns the wells solved inside their hole.
+fn solved_and_agreeing(rows: &[(holewall::corpus::CorpusWell, WellResult)]) -> usize {
     let mut solved = 0;
-    for (_, r) in &rows {
+    for (well, r) in rows {
         let s = &r.spec;
         eprintln!(
             "seed {:>3} {:<14} {:<12} {:>5} m, {:>4}/{:<4} m elements, {:>5} nodes: {} in {:.2} s, {} its, {} cuts, hook FE/soft {:.3}, torque {:.3} {}",
@@ -127,21 +169,28 @@ fn corpus_sample_solves_and_agrees_with_the_soft_string() {
         }
         // Torque: in a deviated hole (the pipe on the wall along most of its length) within
         // 40 %; near-vertical holes touch the wall only at survey noise, which a soft string
-        // counts in full and a stiff string spans.
+        // counts in full and a stiff string spans. With tool joints the soft string turns
+        // every contact on the joints' radius, while the stiff string, pulled straight
+        // between its joints through a dogleg, bears on its body there too (stop 68: the
+        // user style's back-reaming wells 0.54–0.85 with joints, 0.76–0.95 without): the
+        // lower bound falls by the body's radius over the joint's.
         if s.max_inclination_deg > 10.0 && r.torque_ratio.is_finite() {
+            let case = holewall::case::load_case(&well.case_path).unwrap();
+            let arm = case
+                .model
+                .elements
+                .iter()
+                .map(|e| e.outer_diameter / e.contact_diameter)
+                .fold(1.0, f64::min);
             assert!(
-                (0.6..=1.4).contains(&r.torque_ratio),
+                (0.6 * arm..=1.4).contains(&r.torque_ratio),
                 "seed {}: FE/soft-string torque {}",
                 s.seed,
                 r.torque_ratio
             );
         }
     }
-    eprintln!("corpus sample: {solved} of {WELLS} solved");
-    assert!(
-        solved >= SOLVED_AT_LEAST,
-        "{solved} of {WELLS} corpus wells solved; {SOLVED_AT_LEAST} did when this was written"
-    );
+    solved
 }
 
 /// The engine paths this machine runs: the twins, and the GPU in f64 (where the adapter has

@@ -208,6 +208,11 @@ pub enum BenchCommand {
         /// No progress bar.
         #[arg(long)]
         quiet: bool,
+        /// How the wells are drawn: `drawn` spans geometry, string, loads and mesh; `user`
+        /// as users write wells (tool joints, reaming, three hole sections, tapered pipe,
+        /// WOB past buckling; src/corpus/user.rs).
+        #[arg(long, value_enum, default_value_t = crate::corpus::CorpusStyle::Drawn)]
+        style: crate::corpus::CorpusStyle,
     },
     /// The dynamic run (`holewall run`, CPU f64) on a corpus of BHA runs drawn from seeds:
     /// solved / total, step cuts, Newton iterations per step, wall time per simulated

@@ -28,6 +28,8 @@ pub struct CorpusOptions {
     pub max_seconds: Option<f64>,
     /// Progress bar.
     pub show_progress: bool,
+    /// How the wells are drawn.
+    pub style: crate::corpus::CorpusStyle,
 }
 
 /// Median and worst of a figure, with the seed of the worst.
@@ -86,6 +88,12 @@ pub struct CorpusSummary {
     /// Solved wells whose load locks up by that soft string (the FE answer, on a mesh that
     /// may not resolve the helix, disagrees with it: read its warning).
     pub solved_locking_up: usize,
+    /// Failed wells, not locking up, whose turning buckled string nothing holds on the
+    /// wall ([`crate::diagnose::rotating_whirl`]: it whirls; a failure, named).
+    pub failed_whirling: usize,
+    /// Solved wells the same rule names (the rule is the soft string's; the FE string
+    /// found a place to stand).
+    pub solved_whirling: usize,
     /// Failed lock-up wells: (seed, the load factor the FE reached, the factor at which
     /// the buckled soft string locks up, [`crate::diagnose::lock_up_fraction`]). Where
     /// the two agree, the FE's fold is the lock-up the physics predicts.
@@ -153,7 +161,7 @@ pub fn run(out: &Path, options: &CorpusOptions) -> Result<CorpusSummary, Error> 
                 return Ok(None);
             }
             let seed = options.first_seed + k as u64;
-            let well = write_well(seed, &wells_dir)?;
+            let well = crate::corpus::write_corpus_well(options.style, seed, &wells_dir)?;
             let r = run_well(&well, &static_options)?;
             if r.solved {
                 done.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
@@ -254,6 +262,11 @@ pub fn run(out: &Path, options: &CorpusOptions) -> Result<CorpusSummary, Error> 
             .filter(|r| !r.solved && r.lock_up_md_m.is_finite())
             .count(),
         solved_locking_up: solved.iter().filter(|r| r.lock_up_md_m.is_finite()).count(),
+        failed_whirling: results
+            .iter()
+            .filter(|r| !r.solved && !r.lock_up_md_m.is_finite() && r.whirl_md_m.is_finite())
+            .count(),
+        solved_whirling: solved.iter().filter(|r| r.whirl_md_m.is_finite()).count(),
         lock_up_factors: results
             .iter()
             .filter(|r| !r.solved && r.lock_up_fraction.is_finite())

@@ -20,6 +20,9 @@
 //! - **wall**: stiffness 1e6–1e9 N/m log-uniform, a linear law (a hard m = 3/2 or soft
 //!   m = 2/3 law in one well in ten each, its stiffness giving the same force at 1 mm).
 //!
+//! That is the `drawn` style; [`user`] draws a second, `user` style as users write wells
+//! (tool joints, reaming, three hole sections, tapered strings, WOB past buckling).
+//!
 //! [`run_well`] solves one well with the FE static solve and the soft string and reports
 //! what a user would see: solved or not (with the message), load steps and cuts, Newton
 //! iterations, time, and the FE/soft-string hook-load and torque ratios.
@@ -31,10 +34,13 @@ use rand_chacha::ChaCha8Rng;
 use serde::Serialize;
 
 use crate::error::Error;
+use draw::{pick, survey, tube, write_survey};
 
+mod draw;
 pub mod dynamic;
 mod engine;
 mod row;
+pub mod user;
 pub use engine::{run_well_engine, EngineOutcome, EnginePath};
 pub use row::WellRow;
 
@@ -108,6 +114,24 @@ pub struct CorpusWell {
     pub case_path: PathBuf,
 }
 
+/// How a corpus draws its wells.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum)]
+pub enum CorpusStyle {
+    /// [`write_well`]: spans geometry, string, loads, mesh and wall (the 500-well corpus).
+    #[default]
+    Drawn,
+    /// [`user::write_user_well`]: as users write wells, with what `drawn` leaves out.
+    User,
+}
+
+/// Draws well `seed` of `style` into `dir`.
+pub fn write_corpus_well(style: CorpusStyle, seed: u64, dir: &Path) -> Result<CorpusWell, Error> {
+    match style {
+        CorpusStyle::Drawn => write_well(seed, dir),
+        CorpusStyle::User => user::write_user_well(seed, dir),
+    }
+}
+
 struct HoleSize {
     hole_in: f64,
     casing_id_in: f64,
@@ -162,111 +186,6 @@ const SIZES: [HoleSize; 6] = [
 ];
 
 const INCH: f64 = 0.0254;
-
-/// Survey stations (md, inclination, azimuth; deg) every 30 m of a trajectory with noise.
-fn survey(rng: &mut ChaCha8Rng, kind: Trajectory, total_md: f64) -> (Vec<[f64; 3]>, bool) {
-    // Piecewise plan: (md where a rate starts, inclination rate °/30 m, target inclination).
-    let azimuth0 = rng.random_range(0.0..360.0);
-    let kop = match kind {
-        Trajectory::Vertical => total_md,
-        Trajectory::Horizontal => rng.random_range(0.15..0.45) * total_md,
-        _ => rng.random_range(0.1..0.5) * total_md,
-    };
-    let build = match kind {
-        Trajectory::Horizontal => rng.random_range(3.0..8.0),
-        _ => rng.random_range(1.0..4.0),
-    };
-    let hold_inc = match kind {
-        Trajectory::Vertical => 0.0,
-        Trajectory::BuildAndHold => rng.random_range(15.0..70.0),
-        Trajectory::SShaped => rng.random_range(20.0..45.0),
-        Trajectory::Horizontal => rng.random_range(86.0..92.0),
-    };
-    let drop_at = kop
-        + 30.0 * hold_inc / build
-        + rng.random_range(0.1..0.4) * (total_md - kop - 30.0 * hold_inc / build).max(0.0);
-    let drop = rng.random_range(1.0..3.0);
-    let final_inc = rng.random_range(0.0..10.0);
-    let turn = kind != Trajectory::Vertical && rng.random_bool(0.4);
-    let (turn_from, turn_to, turn_rate) = if turn {
-        let a = rng.random_range(kop..total_md);
-        let b = rng.random_range(a..total_md);
-        let rate = rng.random_range(0.5..3.0) * if rng.random_bool(0.5) { 1.0 } else { -1.0 };
-        (a, b, rate)
-    } else {
-        (0.0, 0.0, 0.0)
-    };
-    let sigma = rng.random_range(0.05..0.4);
-    let mut out = Vec::new();
-    let (mut inc, mut az) = (0.0f64, azimuth0);
-    let mut md = 0.0;
-    let noise = |rng: &mut ChaCha8Rng| {
-        // Box–Muller: normal noise without another crate.
-        let u1: f64 = rng.random_range(1e-12..1.0);
-        let u2: f64 = rng.random();
-        sigma * (-2.0 * u1.ln()).sqrt() * (std::f64::consts::TAU * u2).cos()
-    };
-    loop {
-        let (ni, na) = (noise(rng), noise(rng));
-        let inc_out = if inc < 1e-9 {
-            ni.abs()
-        } else {
-            (inc + ni).clamp(0.0, 179.0)
-        };
-        let az_noise = na / (inc_out.to_radians().sin()).max(0.1);
-        out.push([md, inc_out, (az + az_noise).rem_euclid(360.0)]);
-        if md >= total_md {
-            break;
-        }
-        let next = (md + 30.0).min(total_md + 30.0);
-        // Inclination plan at the next station.
-        if next > kop {
-            if kind == Trajectory::SShaped && next > drop_at {
-                inc = (inc - drop).max(final_inc);
-            } else {
-                inc = (inc + build).min(hold_inc);
-            }
-        }
-        if turn && next > turn_from && next <= turn_to {
-            az += turn_rate;
-        }
-        md = next;
-    }
-    (out, turn)
-}
-
-fn pick<T: Copy>(rng: &mut ChaCha8Rng, items: &[(T, f64)]) -> T {
-    let total: f64 = items.iter().map(|x| x.1).sum();
-    let mut r = rng.random_range(0.0..total);
-    for &(x, w) in items {
-        if r < w {
-            return x;
-        }
-        r -= w;
-    }
-    items[items.len() - 1].0
-}
-
-/// Writes `stations` (MD, inclination, azimuth; m, deg) as the survey CSV `<name>.csv` in
-/// `dir` (created), as a user's survey is written; returns the file's name.
-fn write_survey(dir: &Path, name: &str, stations: &[[f64; 3]]) -> Result<String, Error> {
-    let csv_name = format!("{name}.csv");
-    let mut csv = String::from("md_m, inclination_deg, azimuth_deg\n");
-    for s in stations {
-        csv.push_str(&format!("{:.2}, {:.4}, {:.4}\n", s[0], s[1], s[2]));
-    }
-    std::fs::create_dir_all(dir)
-        .map_err(|e| std::io::Error::new(e.kind(), format!("{}: {e}", dir.display())))?;
-    std::fs::write(dir.join(&csv_name), csv)?;
-    Ok(csv_name)
-}
-
-/// A `[[string]]` table of a tube `len` m long, `od` × `id` in, with `extra` lines.
-fn tube(kind: &str, len: f64, od: f64, id: f64, extra: &str) -> String {
-    format!(
-        "[[string]]\nkind = \"{kind}\"\nlength = \"{len} m\"\nod = \"{od} in\"\nid = \"{id} in\"\n{extra}"
-    )
-}
 
 /// The bottom of a drawn BHA, from the bit up (both corpora): the bit; a bent motor housing
 /// where `bend` > 0 (its length, 6–9 m, and the bend's height, 1–2.5 m, drawn from `rng`);
@@ -588,6 +507,9 @@ pub struct WellResult {
     /// The load factor (friction and bit loads) at which that soft string starts to lock up
     /// (NaN where it does not: [`crate::diagnose::lock_up_fraction`]).
     pub lock_up_fraction: f64,
+    /// Where a turning buckled string presses the wall harder than anything holds it: the
+    /// MD of its worst element (m; NaN where none: [`crate::diagnose::rotating_whirl`]).
+    pub whirl_md_m: f64,
     /// The load factor the FE solve reached: 1 when solved, where its load path stopped
     /// when not ([`crate::solve::statics::StaticError::reached`]; 0 in the gravity stage).
     pub fe_reached: f64,
@@ -663,6 +585,8 @@ pub fn run_well(
         helical_drag_n: crate::diagnose::helical_drag(&case, &soft.tension),
         lock_up_md_m: crate::diagnose::lock_up(&case).map_or(f64::NAN, |l| l.md),
         lock_up_fraction: crate::diagnose::lock_up_fraction(&case).unwrap_or(f64::NAN),
+        whirl_md_m: crate::diagnose::rotating_whirl(&case, &soft.tension, &soft.side_force)
+            .map_or(f64::NAN, |w| w.md),
         fe_reached: 0.0,
         stopped_hook_load_n: f64::NAN,
         through_wall_mm: f64::NAN,
