@@ -403,36 +403,43 @@ pub fn write_well(seed: u64, dir: &Path) -> Result<CorpusWell, Error> {
         ));
         t
     };
-    let case_path = dir.join(format!("{name}.toml"));
-    let mut wob = 0.0;
-    if on_bottom {
-        let text = case_text(0.0);
-        let case = crate::case::parse_case(&case_path, &text)?;
-        let limit = buckling_limited_wob(&case, mode == "sliding").min(150e3);
-        wob = (wob_fraction * limit / 100.0).round() * 100.0;
+    let spec = WellSpec {
+        seed,
+        trajectory,
+        turn,
+        total_md,
+        max_inclination_deg: max_inc,
+        hole_in: size.hole_in,
+        mode: mode.to_string(),
+        wob_n: 0.0,
+        element_m: element,
+        bha_element_m: bha_element,
+        stabilizers,
+        bend_deg: bend,
+        sites: sites.to_string(),
+        wall_stiffness,
+        exponent,
+    };
+    let wob_of = |limit: f64| (wob_fraction * limit.min(150e3) / 100.0).round() * 100.0;
+    write_at_wob(dir.join(format!("{name}.toml")), spec, &case_text, &wob_of)
+}
+
+/// Writes a drawn well's case (both styles): on bottom (drilling, sliding) at the weight on
+/// bit `wob_of` gives for the buckling-limited WOB ([`buckling_limited_wob`]) of the case
+/// read without one, off bottom at none; `case_text` writes the case at a WOB (N), and
+/// `spec` takes the WOB written.
+fn write_at_wob(
+    case_path: PathBuf,
+    mut spec: WellSpec,
+    case_text: &dyn Fn(f64) -> String,
+    wob_of: &dyn Fn(f64) -> f64,
+) -> Result<CorpusWell, Error> {
+    if matches!(spec.mode.as_str(), "drilling" | "sliding") {
+        let case = crate::case::parse_case(&case_path, &case_text(0.0))?;
+        spec.wob_n = wob_of(buckling_limited_wob(&case, spec.mode == "sliding"));
     }
-    let text = case_text(wob);
-    crate::output::write_atomic(&case_path, text.as_bytes())?;
-    Ok(CorpusWell {
-        spec: WellSpec {
-            seed,
-            trajectory,
-            turn,
-            total_md,
-            max_inclination_deg: max_inc,
-            hole_in: size.hole_in,
-            mode: mode.to_string(),
-            wob_n: wob,
-            element_m: element,
-            bha_element_m: bha_element,
-            stabilizers,
-            bend_deg: bend,
-            sites: sites.to_string(),
-            wall_stiffness,
-            exponent,
-        },
-        case_path,
-    })
+    crate::output::write_atomic(&case_path, case_text(spec.wob_n).as_bytes())?;
+    Ok(CorpusWell { spec, case_path })
 }
 
 /// The largest weight on bit (N) at which the soft-string compression stays below the

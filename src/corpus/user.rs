@@ -9,8 +9,8 @@
 //! own, run by `holewall static`); this is its generator in the product.
 
 use super::{
-    bha_bottom, buckling_limited_wob, pick, survey, tube, write_survey, CorpusWell, Trajectory,
-    WellSpec, SIZES,
+    bha_bottom, pick, survey, tube, write_at_wob, write_survey, CorpusWell, Trajectory, WellSpec,
+    SIZES,
 };
 use crate::error::Error;
 use rand::{Rng, SeedableRng};
@@ -230,34 +230,24 @@ pub fn write_user_well(seed: u64, dir: &Path) -> Result<CorpusWell, Error> {
         ));
         t
     };
-    let case_path = dir.join(format!("{name}.toml"));
-    let mut wob = 0.0;
-    if on_bottom {
-        let case = crate::case::parse_case(&case_path, &case_text(0.0))?;
-        let cap = if size.hole_in < 7.0 { 60e3 } else { 150e3 };
-        let limit = buckling_limited_wob(&case, mode == "sliding");
-        wob = ((wob_fraction * limit).min(cap) / 100.0).round() * 100.0;
-    }
-    let text = case_text(wob);
-    crate::output::write_atomic(&case_path, text.as_bytes())?;
-    Ok(CorpusWell {
-        spec: WellSpec {
-            seed,
-            trajectory,
-            turn,
-            total_md,
-            max_inclination_deg: max_inc,
-            hole_in: size.hole_in,
-            mode: mode.to_string(),
-            wob_n: wob,
-            element_m: element,
-            bha_element_m: bha_element,
-            stabilizers,
-            bend_deg: bend,
-            sites: sites.to_string(),
-            wall_stiffness,
-            exponent,
-        },
-        case_path,
-    })
+    let spec = WellSpec {
+        seed,
+        trajectory,
+        turn,
+        total_md,
+        max_inclination_deg: max_inc,
+        hole_in: size.hole_in,
+        mode: mode.to_string(),
+        wob_n: 0.0,
+        element_m: element,
+        bha_element_m: bha_element,
+        stabilizers,
+        bend_deg: bend,
+        sites: sites.to_string(),
+        wall_stiffness,
+        exponent,
+    };
+    let cap = if size.hole_in < 7.0 { 60e3 } else { 150e3 };
+    let wob_of = |limit: f64| ((wob_fraction * limit).min(cap) / 100.0).round() * 100.0;
+    write_at_wob(dir.join(format!("{name}.toml")), spec, &case_text, &wob_of)
 }
