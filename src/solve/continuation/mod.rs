@@ -494,7 +494,9 @@ impl LoadPath {
     fn bracket(&mut self, lock: Lock) -> Next {
         if lock.hi - lock.lo <= LOCK_BRACKET * (1.0 + 1e-9) {
             self.log.push(format!(
-                "where the string stops: an equilibrium at λ = {:.4}, none found at λ = {:.4}",
+                // "The load path", not "the string": a string that is not run in or out
+                // (turning on or off bottom) does not stop (crate::diagnose::stops).
+                "where the load path stops: an equilibrium at λ = {:.4}, none found at λ = {:.4}",
                 lock.lo, lock.hi
             ));
             self.stopped = Some((lock.lo, lock.hi));
@@ -523,7 +525,8 @@ impl LoadPath {
         self.lock = Some(lock);
         let next = self.relax_after(target, s0, String::new(), false);
         if let Some(r) = self.relax.as_mut() {
-            r.reason = format!("where the string stops: relaxation from λ = {from:.4} to {mid:.4}");
+            r.reason =
+                format!("where the load path stops: relaxation from λ = {from:.4} to {mid:.4}");
             r.cause = r.reason.clone();
         }
         next

@@ -414,7 +414,7 @@ fn a_failed_full_load_relaxation_brackets_where_the_string_stops() {
         e.contains("found no equilibrium at the full loads either"),
         "{e}"
     );
-    assert!(p.log.last().unwrap().contains("where the string stops"));
+    assert!(p.log.last().unwrap().contains("where the load path stops"));
     // From a failed step at λ 0.75: one relaxation, to 0.875, which fails there too.
     let mut q = LoadPath::new(&StaticOptions::default(), true, true, false);
     assert_eq!(q.converged(10), Next::Step);
