@@ -94,6 +94,9 @@ pub struct CorpusSummary {
     /// Solved wells the same rule names (the rule is the soft string's; the FE string
     /// found a place to stand).
     pub solved_whirling: usize,
+    /// Solved wells whose answer stresses the pipe past every API grade's yield
+    /// ([`crate::diagnose::past_yield`]): counted solved, an answer no pipe carries.
+    pub solved_past_yield: Vec<u64>,
     /// Failed lock-up wells: (seed, the load factor the FE reached, the factor at which
     /// the buckled soft string locks up, [`crate::diagnose::lock_up_fraction`]). Where
     /// the two agree, the FE's fold is the lock-up the physics predicts.
@@ -267,6 +270,11 @@ pub fn run(out: &Path, options: &CorpusOptions) -> Result<CorpusSummary, Error> 
             .filter(|r| !r.solved && !r.lock_up_md_m.is_finite() && r.whirl_md_m.is_finite())
             .count(),
         solved_whirling: solved.iter().filter(|r| r.whirl_md_m.is_finite()).count(),
+        solved_past_yield: solved
+            .iter()
+            .filter(|r| r.past_yield)
+            .map(|r| r.spec.seed)
+            .collect(),
         lock_up_factors: results
             .iter()
             .filter(|r| !r.solved && r.lock_up_fraction.is_finite())

@@ -283,6 +283,11 @@ pub fn run(
     let (sinusoidal, helical) = buckling(&case, model, &rows);
     let axial: Vec<f64> = rows.iter().map(|r| r.axial_force_n).collect();
     let mut warnings = case.warnings.clone();
+    // Either model: an answer past every grade's yield is no answer (stop 68).
+    if let Some(w) = crate::diagnose::past_yield_warning(&case, &axial) {
+        eprintln!("holewall: warning: {w}");
+        warnings.push(w);
+    }
     if let StaticModel::Fe = which {
         if let Some(w) = crate::diagnose::unresolved_helix(&case, &axial) {
             eprintln!("holewall: warning: {w}");

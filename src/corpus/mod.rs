@@ -530,6 +530,9 @@ pub struct WellResult {
     /// contact sites (mm; 0 where every such span stays in the hole:
     /// [`crate::diagnose::span_through_wall`]). NaN when not solved.
     pub span_sag_mm: f64,
+    /// Solved: whether its axial stress passes every API grade's yield somewhere
+    /// ([`crate::diagnose::past_yield`]: an answer no pipe carries). False when not solved.
+    pub past_yield: bool,
     /// Pipe-body contact sites the solve kept where the string lies on the wall (its guards
     /// in contact: [`crate::profile::solve_in_hole`]; 0 with contact at every node).
     pub wall_sites: usize,
@@ -599,6 +602,7 @@ pub fn run_well(
         through_wall_mm: f64::NAN,
         span_sag_mm: f64::NAN,
         wall_sites,
+        past_yield: false,
         hook_load_ratio: f64::NAN,
         fe_torque_nm: f64::NAN,
         soft_torque_nm: soft.surface_torque(),
@@ -616,6 +620,7 @@ pub fn run_well(
             r.through_wall_mm = crate::diagnose::through_wall(&case, model, &sol.state.x)
                 .map_or(0.0, |t| 1e3 * t.excess_m);
             let axial: Vec<f64> = sol.section_forces.iter().map(|f| f.axial).collect();
+            r.past_yield = crate::diagnose::past_yield(&case, &axial).is_some();
             r.span_sag_mm = crate::diagnose::span_through_wall(
                 &case,
                 model,

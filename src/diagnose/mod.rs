@@ -11,7 +11,9 @@ use crate::case::Case;
 use crate::model::Model;
 use crate::solve::statics::StaticError;
 
+mod past_yield;
 mod whirl;
+pub use past_yield::{past_yield, past_yield_warning, STRONGEST_API_YIELD_PA};
 pub use whirl::{rotating_whirl, whirl_reason, Whirl};
 
 /// The sinusoidal and helical buckling loads of element `e` (N of compression) in a hole of
