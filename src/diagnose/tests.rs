@@ -3,8 +3,8 @@
 use super::*;
 
 /// The case `text` parsed beside a survey file `survey.csv` holding `survey`, in a folder
-/// of its own (the tests run in parallel and each removes its own).
-fn with_survey(survey: &str, text: &str) -> Case {
+/// of its own (the tests run in parallel and each removes its own); `whirl`'s tests too.
+pub(super) fn with_survey(survey: &str, text: &str) -> Case {
     static CALLS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
     let call = CALLS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
     let dir = std::env::temp_dir().join(format!("holewall_diagnose_{}_{call}", std::process::id()));

@@ -125,12 +125,6 @@ mod tests {
                 format!("{md}, {inc}, 0\n")
             })
             .collect::<String>();
-        let dir = std::env::temp_dir().join(format!(
-            "holewall_whirl_{}_{kickoff}_{mode}_{wob}_{friction}",
-            std::process::id()
-        ));
-        std::fs::create_dir_all(&dir).unwrap();
-        std::fs::write(dir.join("survey.csv"), format!("md, inc, az\n{survey}")).unwrap();
         let rpm = if mode == "rotating" {
             "rpm = \"120 rpm\"\n"
         } else {
@@ -145,9 +139,7 @@ mod tests {
              [operation]\nmode = \"{mode}\"\n{rpm}weight_on_bit = \"{wob} kN\"\n\
              [mesh]\nelement_length = \"10 m\"\n"
         );
-        let case = crate::case::parse_case(&dir.join("case.toml"), &text).unwrap();
-        let _ = std::fs::remove_dir_all(&dir);
-        case
+        crate::diagnose::tests::with_survey(&format!("md, inc, az\n{survey}"), &text)
     }
 
     /// The rule by hand at the element the function names: its numbers are the module's
