@@ -73,6 +73,11 @@ pub struct Site {
     pub params: ContactParams<f64>,
     /// Whether the site is a stabilizer (as opposed to pipe body contact).
     pub stabilizer: bool,
+    /// Static mode only: the turning string whirls here (`crate::diagnose::mark_whirling_sites`),
+    /// and the site's circumferential friction acts as its torque alone — the side force
+    /// `N·mu_t·phi_t·t` it would put on the node turns with the contact round the hole and
+    /// averages to nothing over a whirl (`crate::solve::statics::site_response`).
+    pub whirls: bool,
 }
 
 /// Top boundary condition.
@@ -412,6 +417,7 @@ pub fn add_sites(
                 soft_blend: settings.soft_blend,
             },
             stabilizer,
+            whirls: false,
         });
     }
 }

@@ -292,18 +292,26 @@ pub(crate) fn hold_in_hole(
     options: &crate::solve::statics::StaticOptions,
     solve: &mut StaticSolve<'_>,
 ) -> Result<crate::solve::statics::StaticSolution, crate::solve::statics::StaticError> {
+    let span = crate::diagnose::mark_whirling_sites(case, model);
+    let said = |mut sol: crate::solve::statics::StaticSolution| {
+        if let Some((from, to)) = span {
+            sol.log.push(whirl_note(from, to));
+        }
+        sol
+    };
     let free = unheld_nodes(model);
     if free.is_empty() {
-        return solve(model, options);
+        return solve(model, options).map(said);
     }
     let clock = std::time::Instant::now();
     let mut guarded = model.clone();
     add(&mut guarded, &free);
+    crate::diagnose::mark_whirling_sites(case, &mut guarded);
     let failed = match solve(&guarded, options) {
         Ok(sol) => {
             let (kept, sol) = keep_touching(model, guarded, sol);
             *model = kept;
-            return Ok(sol);
+            return Ok(said(sol));
         }
         Err(mut e) => {
             // Where the string stops, with the sites kept as for an answer.
@@ -323,7 +331,8 @@ pub(crate) fn hold_in_hole(
         .max_seconds
         .map(|s| (s - clock.elapsed().as_secs_f64()).max(0.0));
     match solve(model, &options) {
-        Ok(mut sol) if crate::diagnose::beyond_wall(case, model, &sol.state.x).is_empty() => {
+        Ok(sol) if crate::diagnose::beyond_wall(case, model, &sol.state.x).is_empty() => {
+            let mut sol = said(sol);
             sol.log.push(format!(
                 "the solve with a guard site at every node failed ({}); the string solved at \
                  its own {} sites lies in the hole",
@@ -335,6 +344,20 @@ pub(crate) fn hold_in_hole(
         _ => Err(failed),
     }
 }
+
+/// The solver log's line (and the static command's note) for a turning string that
+/// whirls between MD `from` and `to` (m) ([`crate::diagnose::whirl_span`]).
+pub fn whirl_note(from: f64, to: f64) -> String {
+    format!(
+        "{WHIRL_AVERAGED} between MD {from:.0} and {to:.0} m: no weight holds the turning \
+         string on the wall there, and it rolls round the hole; the circumferential friction \
+         there acts as torque alone (its side force averages to nothing over a whirl; \
+         `holewall run` gives the motion)"
+    )
+}
+
+/// The words that open [`whirl_note`] (the corpus finds the note by them).
+pub const WHIRL_AVERAGED: &str = "the string whirls, taken at the whirl's average,";
 
 /// Pipe-body contact sites at `nodes` of `model` (the case's or a variant's of it), as
 /// [`solve_in_hole`] adds them where the string meets the wall: the case's wall law, the

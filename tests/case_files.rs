@@ -765,10 +765,12 @@ fn runs_can_be_bounded_in_wall_time() {
     );
 }
 
-/// A WOB far beyond helical buckling: the solve fails and says why (issue 15), and gives the
-/// string at the largest WOB with an equilibrium it found.
+/// A WOB far beyond helical buckling (1 MN on 5 in pipe), turning: until stop 69 the solve
+/// failed here and said why (issue 15; stop 68: the buckled string whirls in the vertical
+/// hole above the kick-off). Now it solves at the whirl's average and says so, and says that
+/// its 10 m elements cannot follow the helix, with Mitchell's estimate of the drag missed.
 #[test]
-fn a_failed_static_solve_names_helical_buckling() {
+fn a_turning_string_far_past_helical_buckling_solves_at_the_whirls_average_and_warns() {
     let dir = scratch("wob1mn");
     let text = std::fs::read_to_string(root().join("cases/build_and_hold.toml"))
         .unwrap()
@@ -782,34 +784,24 @@ fn a_failed_static_solve_names_helical_buckling() {
         out.to_str().unwrap(),
         "--quiet",
     ]);
-    assert_eq!(code, 1, "{stdout}");
+    assert_eq!(code, 0, "{stdout}\n{stderr}");
     assert!(
-        stderr.contains("helical buckling load") && stderr.contains("WOB below"),
+        stderr.contains("the string whirls, taken at the whirl's average, between MD 0 and")
+            && stderr.contains("helical buckling load")
+            && stderr.contains("cannot follow"),
         "{stderr}"
     );
-    // Its load path brackets the largest WOB with an equilibrium, and the outputs are the
-    // string there (issue 22): `summary.json` says so, with that WOB.
     let summary: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
-    let lambda = summary["stopped"]["load_factor"].as_f64().unwrap();
-    assert!(lambda > 0.0 && lambda < 1.0, "{summary}");
-    let wob = summary["weight_on_bit_n"].as_f64().unwrap();
-    assert!(
-        (wob - lambda * 1e6).abs() < 1e-6 * 1e6,
-        "WOB {wob} N at λ = {lambda}"
-    );
-    // Turning on bottom, it does not stop (stop 68): the words say what was found, and
-    // that this buckled string, turning in the vertical hole above its kick-off, whirls.
-    assert!(
-        stderr.contains("a string not run in or out does not stop")
-            && !stderr.contains("where it stops")
-            && stderr.contains("whirls"),
-        "{stderr}"
-    );
-    assert!(summary["title"]
-        .as_str()
+    assert!(summary["stopped"].is_null(), "{summary}");
+    assert_eq!(summary["weight_on_bit_n"].as_f64().unwrap(), 1e6);
+    // Pushed from the surface: the hook load is negative.
+    assert!(summary["hook_load_n"].as_f64().unwrap() < 0.0, "{summary}");
+    assert!(summary["warnings"]
+        .as_array()
         .unwrap()
-        .contains("the largest loads with an equilibrium"));
+        .iter()
+        .any(|w| w.as_str().unwrap().contains("whirl's average")));
 }
 
 /// Soft spring laws (m < 1) on an ordinary two-stabilizer deviated well: solved (they cycled

@@ -289,14 +289,24 @@ impl Case {
 
     /// The soft-string profile of the case's operation, with each hole section's friction.
     pub fn soft_string(&self) -> crate::solve::soft_string::SoftStringProfile {
+        self.soft_string_of(&self.model)
+    }
+
+    /// As [`Case::soft_string`], for `model` (the case's, or a variant's of it: its speeds
+    /// and bit loads) in the case's hole.
+    pub fn soft_string_of(&self, model: &Model) -> crate::solve::soft_string::SoftStringProfile {
         let friction_at = |md: f64| self.hole_at(md).friction;
-        crate::solve::soft_string::soft_string_with(&self.model, &self.operation(), &friction_at)
+        crate::solve::soft_string::soft_string_with(model, &self.operation_of(model), &friction_at)
     }
 
     /// The case's operation for the soft string (speeds and bit loads; the friction of the
     /// hole at the surface, each section's where it has one).
     pub fn operation(&self) -> crate::solve::soft_string::Operation {
-        let model = &self.model;
+        self.operation_of(&self.model)
+    }
+
+    /// As [`Case::operation`], with the speeds and bit loads of `model`.
+    pub fn operation_of(&self, model: &Model) -> crate::solve::soft_string::Operation {
         crate::solve::soft_string::Operation {
             axial_speed: model.axial_speed,
             rotation_speed: model.rotation_speed,

@@ -91,8 +91,9 @@ pub struct CorpusSummary {
     /// Failed wells, not locking up, whose turning buckled string nothing holds on the
     /// wall ([`crate::diagnose::rotating_whirl`]: it whirls; a failure, named).
     pub failed_whirling: usize,
-    /// Solved wells the same rule names (the rule is the soft string's; the FE string
-    /// found a place to stand).
+    /// Solved wells the same rule names: since stop 69 solved at the whirl's average over
+    /// the span [`crate::diagnose::whirl_span`] widens it to (the circumferential friction
+    /// there as torque alone; the solver log says so).
     pub solved_whirling: usize,
     /// Solved wells whose answer stresses the pipe past every API grade's yield
     /// ([`crate::diagnose::past_yield`]): counted solved, an answer no pipe carries.

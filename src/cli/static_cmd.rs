@@ -300,7 +300,12 @@ pub fn run(
             eprintln!("holewall: warning: {w}");
             warnings.push(w);
         }
-        for w in [through_wall, span_sag].into_iter().flatten() {
+        // A turning string that whirls, taken at the whirl's average (stop 69).
+        let whirl = solver_log
+            .iter()
+            .find(|l| l.starts_with(crate::profile::WHIRL_AVERAGED))
+            .cloned();
+        for w in [through_wall, span_sag, whirl].into_iter().flatten() {
             eprintln!("holewall: warning: {w}");
             warnings.push(w);
         }

@@ -16,7 +16,72 @@
 //! same case with no friction in that casing, or slid instead of rotated, solves.
 
 use crate::case::Case;
+use crate::model::Model;
 use crate::solve::soft_string::SoftStringProfile;
+
+/// Below this inclination (degrees) the hole is near-vertical for [`whirl_span`]: the
+/// weight's hold there, `w sin 10° = 0.17 w` per length, is less than the circumferential
+/// friction of a string pressed with its own weight at μ ≥ 0.17.
+pub const NEAR_VERTICAL_DEG: f64 = 10.0;
+
+/// The span (MD from, to, m) over which `model`'s turning string (the case's, or a
+/// variant's of it) whirls in static mode, `None` where none does: the span
+/// [`rotating_whirl_of`] names on the model's soft-string profile, widened on either side
+/// through the near-vertical hole next to it (inclination below [`NEAR_VERTICAL_DEG`]).
+///
+/// Widened because the soft string places the span too narrowly for the FE string: the FE
+/// string's compression reaches higher than the soft string's (its buckled drag differs),
+/// and next to a whirling span a near-vertical string has no weight to hold it either.
+/// Measured (docs/performance.md, stop 69): user-style well 73, reaming 3½ in pipe buckled
+/// in a vertical 6¼ in casing, fails with the rule's span alone (1,220–1,586 m), with it
+/// widened to the soft string's neutral point above (1,180 m) or 64 m below, and solves
+/// widened through the near-vertical hole.
+pub fn whirl_span(case: &Case, model: &Model) -> Option<(f64, f64)> {
+    if model.rotation_speed == 0.0 {
+        return None;
+    }
+    let profile = case.soft_string_of(model);
+    let w = rotating_whirl_of(case, model, &profile.tension, &profile.side_force)?;
+    let near_vertical = |i: usize| {
+        let t = model.nodes[i].hole_axis;
+        (t[0] * t[0] + t[1] * t[1])
+            .sqrt()
+            .atan2(t[2])
+            .to_degrees()
+            .abs()
+            < NEAR_VERTICAL_DEG
+    };
+    let n = model.nodes.len();
+    let mut top = model
+        .nodes
+        .iter()
+        .position(|nd| nd.md >= w.md_from)
+        .unwrap_or(0);
+    while top > 0 && near_vertical(top - 1) {
+        top -= 1;
+    }
+    let mut bottom = model
+        .nodes
+        .iter()
+        .rposition(|nd| nd.md <= w.md_to)
+        .unwrap_or(n - 1);
+    while bottom + 1 < n && near_vertical(bottom + 1) {
+        bottom += 1;
+    }
+    Some((model.nodes[top].md, model.nodes[bottom].md))
+}
+
+/// Marks the sites of `model` in its [`whirl_span`] as whirling
+/// ([`crate::model::Site::whirls`]; the others not), and gives the span.
+pub fn mark_whirling_sites(case: &Case, model: &mut Model) -> Option<(f64, f64)> {
+    let span = whirl_span(case, model);
+    let nodes = &model.nodes;
+    for site in &mut model.sites {
+        let md = nodes[site.node].md;
+        site.whirls = span.is_some_and(|(a, b)| md >= a && md <= b);
+    }
+    span
+}
 
 /// A span of the string that whirls at its soft-string profile ([`rotating_whirl`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -42,7 +107,16 @@ pub struct Whirl {
 /// the soft-string profile `axial` (nodal axial forces, tension +) and `side_force`
 /// (per element, N); `None` for a string that does not turn or where no element whirls.
 pub fn rotating_whirl(case: &Case, axial: &[f64], side_force: &[f64]) -> Option<Whirl> {
-    let model = &case.model;
+    rotating_whirl_of(case, &case.model, axial, side_force)
+}
+
+/// As [`rotating_whirl`], for `model` (the case's, or a variant's of it) and its profile.
+pub fn rotating_whirl_of(
+    case: &Case,
+    model: &Model,
+    axial: &[f64],
+    side_force: &[f64],
+) -> Option<Whirl> {
     if model.rotation_speed == 0.0 {
         return None;
     }
@@ -92,15 +166,17 @@ pub fn rotating_whirl(case: &Case, axial: &[f64], side_force: &[f64]) -> Option<
 /// (`case.soft_string()`).
 pub fn whirl_reason(case: &Case, profile: &SoftStringProfile) -> Option<String> {
     let w = rotating_whirl(case, &profile.tension, &profile.side_force)?;
+    let span = whirl_span(case, &case.model).unwrap_or((w.md_from, w.md_to));
     Some(format!(
         "\n  likely reason: turning, the buckled string presses the wall between MD {:.0} and \
          {:.0} m harder than anything holds it there — at MD {:.0} m (inclination {:.1}°, \
          compression {:.1} kN) its circumferential friction is {:.1} N/m against the {:.1} N/m \
          of weight and hole curvature that keep a turning string in place on the wall: it \
-         rolls round the hole (whirls) rather than standing, and this model may have no \
-         static equilibrium there; `--model soft-string` gives this case's torque and drag, \
-         `holewall run` its motion; less WOB (less compression) or a smaller hole there \
-         brings the string back to a place it can stand",
+         rolls round the hole (whirls) rather than standing; the static solve took the \
+         circumferential friction between MD {:.0} and {:.0} m as torque alone (the whirl's \
+         average) and found no equilibrium even so; `--model soft-string` gives this case's \
+         torque and drag, `holewall run` its motion; less WOB (less compression) or a \
+         smaller hole there brings the string back to a place it can stand",
         w.md_from,
         w.md_to,
         w.md,
@@ -108,6 +184,8 @@ pub fn whirl_reason(case: &Case, profile: &SoftStringProfile) -> Option<String> 
         w.compression_n / 1e3,
         w.friction_per_m,
         w.hold_per_m,
+        span.0,
+        span.1,
     ))
 }
 
@@ -193,5 +271,148 @@ mod tests {
         assert_eq!(none(&well(100.0, "rotating", 150.0, 0.25)), None);
         // Frictionless: nothing pushes it round.
         assert_eq!(none(&well(1200.0, "rotating", 150.0, 0.0)), None);
+    }
+
+    /// The span widens from the rule's through the vertical hole above it and down the
+    /// build to 10°; exactly the sites in it are marked.
+    #[test]
+    fn the_whirl_span_widens_through_the_near_vertical_hole_and_marks_its_sites() {
+        let case = well(1200.0, "rotating", 150.0, 0.25);
+        let p = case.soft_string();
+        let rule = rotating_whirl(&case, &p.tension, &p.side_force).unwrap();
+        let (from, to) = whirl_span(&case, &case.model).unwrap();
+        assert!(
+            from == 0.0 && from < rule.md_from && to >= rule.md_to,
+            "{from} {to} {rule:?}"
+        );
+        // Built at 1°/10 m from 1,200 m: 10° at 1,300 m.
+        let inclination = |i: usize| {
+            let t = case.model.nodes[i].hole_axis;
+            (t[0] * t[0] + t[1] * t[1]).sqrt().atan2(t[2]).to_degrees()
+        };
+        let last = case.model.nodes.iter().position(|n| n.md == to).unwrap();
+        assert!(
+            inclination(last) < NEAR_VERTICAL_DEG && inclination(last + 1) >= NEAR_VERTICAL_DEG
+        );
+        assert!((1280.0..1300.0).contains(&to), "{to}");
+        let mut model = case.model.clone();
+        let nodes: Vec<usize> = (1..model.nodes.len()).collect();
+        model.sites.clear();
+        crate::profile::add_wall_sites(&case, &mut model, &nodes);
+        assert_eq!(mark_whirling_sites(&case, &mut model), Some((from, to)));
+        for s in &model.sites {
+            let md = model.nodes[s.node].md;
+            assert_eq!(s.whirls, md <= to, "site at MD {md}");
+        }
+        // Slid, nothing whirls and nothing is marked.
+        let slid = well(1200.0, "sliding", 150.0, 0.25);
+        let mut m = slid.model.clone();
+        m.sites.clear();
+        crate::profile::add_wall_sites(&slid, &mut m, &nodes);
+        m.sites.iter_mut().for_each(|s| s.whirls = true);
+        assert_eq!(mark_whirling_sites(&slid, &mut m), None);
+        assert!(m.sites.iter().all(|s| !s.whirls));
+    }
+
+    /// A whirling site's response: the force rows are the element's without circumferential
+    /// friction, the moment rows the whole element's (its torque `R_d μ N` kept), and its
+    /// `K` is the derivative of that response (central differences).
+    #[test]
+    fn a_whirling_site_keeps_its_torque_drops_its_side_force_and_its_tangent_is_exact() {
+        use crate::solve::statics::{site_response, static_start};
+        let case = well(1200.0, "rotating", 150.0, 0.25);
+        let mut model = case.model.clone();
+        model.sites.clear();
+        crate::profile::add_wall_sites(&case, &mut model, &[50]);
+        let mut state = static_start(&model);
+        let node = model.nodes[50].clone();
+        let site = model.sites[0].clone();
+        // Pressed 2 mm into the wall, off both axes of the hole's frame.
+        let (a, b) = (1.0f64, 0.6f64);
+        let e1 = [a / (a * a + b * b).sqrt(), b / (a * a + b * b).sqrt(), 0.0];
+        let depth = site.params.clearance + 2e-3;
+        state.x[50] = [
+            node.position[0] + depth * e1[0],
+            node.position[1] + depth * e1[1],
+            node.position[2] + 0.1,
+        ];
+        let mut whirling = model.clone();
+        whirling.sites[0].whirls = true;
+        let full = site_response(&model, &state, &model.sites[0]);
+        let avg = site_response(&whirling, &state, &whirling.sites[0]);
+        let mut bare_model = model.clone();
+        bare_model.sites[0].params.mu_t = 0.0;
+        let bare = site_response(&bare_model, &state, &bare_model.sites[0]);
+        assert!(full.contact && avg.contact);
+        assert_eq!(avg.g[..3], bare.g[..3]);
+        assert_eq!(avg.g[3..], full.g[3..]);
+        // The side force it drops is μ N, and the torque about the hole axis is R_d μ N.
+        let normal = (0..3).map(|i| bare.g[i] * e1[i]).sum::<f64>();
+        let side: f64 = (0..3)
+            .map(|i| (full.g[i] - avg.g[i]).powi(2))
+            .sum::<f64>()
+            .sqrt();
+        assert!(
+            (side - 0.25 * normal.abs()).abs() <= 1e-9 * side,
+            "{side} {normal}"
+        );
+        let torque: f64 = (0..3).map(|i| avg.g[3 + i] * node.hole_axis[i]).sum();
+        assert!(
+            (torque.abs() - site.params.disk_radius * side).abs() <= 1e-9 * torque.abs(),
+            "{torque}"
+        );
+        for c in 0..3 {
+            let h = 1e-7;
+            let at = |d: f64| {
+                let mut s2 = state.clone();
+                s2.x[50][c] += d;
+                site_response(&whirling, &s2, &whirling.sites[0]).g
+            };
+            let (gp, gm) = (at(h), at(-h));
+            for r in 0..6 {
+                let fd = (gp[r] - gm[r]) / (2.0 * h);
+                let scale = avg.k.iter().flatten().fold(0.0f64, |m, x| m.max(x.abs()));
+                assert!(
+                    (fd - avg.k[r][c]).abs() <= 1e-6 * scale,
+                    "K[{r}][{c}] {} against {fd}",
+                    avg.k[r][c]
+                );
+            }
+        }
+    }
+
+    /// The buckled string turning in the vertical hole solves at the whirl's average, the
+    /// log says so, and its hook load and surface torque agree with the soft string's (the
+    /// torque within 25 %: the soft string adds Mitchell's buckled contact, the FE its own).
+    /// Before stop 69 it failed at 87.5 % of its loads (`holewall static`, this case).
+    #[test]
+    fn a_turning_string_buckled_in_a_vertical_hole_solves_at_the_whirls_average() {
+        let case = well(1200.0, "rotating", 150.0, 0.25);
+        let mut model = case.model.clone();
+        let sol = crate::profile::solve_in_hole(
+            &case,
+            &mut model,
+            &mut |m, nodes| crate::profile::add_wall_sites(&case, m, nodes),
+            &crate::solve::statics::StaticOptions::default(),
+            &mut |_| {},
+        )
+        .expect("solved at the whirl's average");
+        assert!(
+            sol.log
+                .iter()
+                .any(|l| l.starts_with(crate::profile::WHIRL_AVERAGED)),
+            "{:?}",
+            sol.log
+        );
+        assert!(model.sites.iter().any(|s| s.whirls));
+        let (_, hook, torque, _) = crate::profile::fe_rows(&model, &sol);
+        let soft = case.soft_string();
+        let (soft_hook, soft_torque) = (soft.tension[0], soft.torque[0]);
+        eprintln!("hook {hook} soft {soft_hook}; torque {torque} soft {soft_torque}");
+        assert!((hook / soft_hook - 1.0).abs() < 0.02, "{hook} {soft_hook}");
+        assert!(
+            (torque / soft_torque - 1.0).abs() < 0.25,
+            "{torque} {soft_torque}"
+        );
     }
 }
