@@ -23,7 +23,7 @@ fn pow_pos(x: f32, m: f32) -> f32 {
 @group(0) @binding(0) var<storage, read> dims: ContactDims;
 // Hole axis n per site: [3 · site + k].
 @group(0) @binding(1) var<storage, read> site_normals: array<real>;
-// clearance, disk_radius, k_e, m, c, mu_t, mu_l, eps, soft_blend.
+// clearance, disk_radius, k_e, m, c, mu_t, mu_l, eps, soft_blend, side_friction.
 @group(0) @binding(2) var<storage, read> pair_params: array<real>;
 // d (3) = x − x0, v (3), omega.
 @group(0) @binding(3) var<storage, read> pair_state: array<real>;
@@ -241,12 +241,22 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let fr = friction_factors(s_t, s_l, param(7u, i));
     let a_t = mu_t * fr.phi.x;
     let a_l = mu_l * fr.phi.y;
-    dir_f = u + t * a_t + n * a_l;
+#if DYNAMIC
+    let a_t_f = a_t;
+    let mu_t_f = mu_t * fr.d_dst.x;
+#else
+    // Static: the circumferential friction's share as a side force (0 where the turning
+    // string whirls: its friction as torque alone).
+    let side = param(9u, i);
+    let a_t_f = a_t * side;
+    let mu_t_f = mu_t * fr.d_dst.x * side;
+#endif
+    dir_f = u + t * a_t_f + n * a_l;
     dir_m = (n * a_t - t * a_l) * rd;
     let sigma = -v_u / r;
-    let fric_f = t * (mu_t * fr.d_dst.x) + n * (mu_l * fr.d_dst.y);
+    let fric_f = t * mu_t_f + n * (mu_l * fr.d_dst.y);
     let fric_m = (n * (mu_t * fr.d_dst.x) - t * (mu_l * fr.d_dst.y)) * rd;
-    kf_t = kf_t + (fric_f * sigma - u * (a_t / r)) * normal;
+    kf_t = kf_t + (fric_f * sigma - u * (a_t_f / r)) * normal;
     km_t = (fric_m * sigma + u * (rd * a_l / r)) * normal;
 #if DYNAMIC
 #if !FORCE_ONLY

@@ -73,11 +73,15 @@ pub struct Site {
     pub params: ContactParams<f64>,
     /// Whether the site is a stabilizer (as opposed to pipe body contact).
     pub stabilizer: bool,
-    /// Static mode only: the turning string whirls here (`crate::diagnose::mark_whirling_sites`),
-    /// and the site's circumferential friction acts as its torque alone — the side force
-    /// `N·mu_t·phi_t·t` it would put on the node turns with the contact round the hole and
-    /// averages to nothing over a whirl (`crate::solve::statics::site_response`).
-    pub whirls: bool,
+}
+
+impl Site {
+    /// Whether the turning string whirls here in static mode
+    /// ([`crate::diagnose::mark_whirling_sites`]): its circumferential friction acts as
+    /// torque alone (`params.side_friction` below 1).
+    pub fn whirls(&self) -> bool {
+        self.params.side_friction < 1.0
+    }
 }
 
 /// Top boundary condition.
@@ -415,9 +419,9 @@ pub fn add_sites(
                 mu_l: mu,
                 eps: settings.eps,
                 soft_blend: settings.soft_blend,
+                side_friction: 1.0,
             },
             stabilizer,
-            whirls: false,
         });
     }
 }

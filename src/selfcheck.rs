@@ -234,6 +234,8 @@ pub fn sample(rng: &mut StdRng, n: &Vec3<f64>, friction: FrictionModel) -> Sampl
         mu_l: mu(rng),
         eps,
         soft_blend,
+        // The paper's element: the whirl's average is checked against the twin in tests.
+        side_friction: 1.0,
     };
     Sample {
         d,

@@ -514,3 +514,78 @@ fn force_only_kernel_gives_the_full_kernels_forces() {
     }
     assert_eq!(checked, 16);
 }
+
+/// The whirl's average (`side_friction` 0: a turning string's circumferential friction as
+/// torque alone, static mode) in the kernel: every other pair of a random static batch
+/// takes it; the GPU in f64 matches the twin to its bound, and on the twin those pairs'
+/// force rows are the element's with `mu_t = 0`, their moment rows the whole element's.
+/// Dynamic mode ignores it.
+#[test]
+fn the_whirls_average_in_the_kernel_matches_its_twin() {
+    let ctx = common::gpu();
+    for (k, friction) in [FrictionModel::Split, FrictionModel::Coupled]
+        .into_iter()
+        .enumerate()
+    {
+        let mut batch = batch(friction, 300 + k as u64);
+        let full = batch.clone();
+        let mut bare = batch.clone();
+        for i in 0..batch.num_pairs() {
+            let mut p = batch.params(i);
+            if i % 2 == 0 {
+                p.side_friction = 0.0;
+            }
+            batch.set_params(i, &p);
+            let mut q = full.params(i);
+            q.mu_t = 0.0;
+            bare.set_params(i, &q);
+        }
+        let terms = ContactTerms::all(friction, ContactMode::Static);
+        let eval = |b: &ContactBatch<f64>, terms: &ContactTerms| {
+            let mut out = ContactOutputs::new(b.num_pairs());
+            contact(terms, b, &mut out);
+            out
+        };
+        let (avg, with, without) = (
+            eval(&batch, &terms),
+            eval(&full, &terms),
+            eval(&bare, &terms),
+        );
+        let mut averaged = 0;
+        for i in 0..batch.num_pairs() {
+            let (a, w, b) = (avg.fields(i), with.fields(i), without.fields(i));
+            if i % 2 == 1 {
+                assert_eq!(a, w, "pair {i}: side_friction 1 is the paper's element");
+                continue;
+            }
+            // g rows 0–2 and K rows 0–2 (fields 6–14) from the bare element; the moments
+            // (g rows 3–5, K rows 3–5: fields 3–5, 15–23) from the whole one.
+            for f in (0..3).chain(6..15) {
+                assert_eq!(a[f], b[f], "pair {i} field {f}");
+            }
+            for f in (3..6).chain(15..24) {
+                assert_eq!(a[f], w[f], "pair {i} field {f}");
+            }
+            averaged += usize::from(avg.contact[i] == 1 && a[..3] != w[..3]);
+        }
+        assert!(averaged * 4 >= batch.num_pairs() / 2, "{averaged}");
+        // Dynamic mode: side_friction has no effect.
+        let dynamic = ContactTerms::all(friction, ContactMode::Dynamic);
+        let (d_avg, d_full) = (eval(&batch, &dynamic), eval(&full, &dynamic));
+        for i in 0..batch.num_pairs() {
+            assert_eq!(d_avg.fields(i), d_full.fields(i), "dynamic pair {i}");
+        }
+        let Some(ctx) = ctx else { continue };
+        let gpu = contact_gpu(ctx, &terms, &batch).unwrap();
+        let rep = compare(
+            &batch,
+            &terms,
+            &avg,
+            &|i| (gpu.fields(i), gpu.contact[i]),
+            f64::EPSILON / 2.0,
+            F64_BOUND,
+            "GPU f64, the whirl's average",
+        );
+        assert!(rep.max_normwise_well <= 1e-12, "{}", rep.max_normwise_well);
+    }
+}

@@ -86,8 +86,11 @@ fn precision_study_of_the_short_spin_up() {
     }
 }
 
-/// `holewall study stability` on the deviated well without dynamics: every cell solved but
-/// the WOB far past helical buckling, which the map records as failed (not skipped).
+/// `holewall study stability` on the deviated well without dynamics: a cell that fails is
+/// recorded as failed (not skipped). Since stop 69 the WOB far past helical buckling (534
+/// kN, the string buckled and turning in the vertical hole) solves at the whirl's average;
+/// the one failure left is the soft law (m = 2/3) at k_e = 1e11 N/m^m, which the start of
+/// stop 69 failed as well (stalling at λ 0.22).
 #[test]
 fn stability_map_of_the_build_and_hold_well() {
     let case = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("cases/build_and_hold.toml");
@@ -115,12 +118,16 @@ fn stability_map_of_the_build_and_hold_well() {
         .map(|c| format!("{} {}", c["parameter"], c["value"]))
         .collect();
     eprintln!("failed: {failed:?}; step cuts: {}", s["step_cut"]);
-    assert!(
-        failed
-            .iter()
-            .any(|f| f.contains("wob") && f.contains("534 kN")),
+    assert_eq!(
+        failed,
+        vec!["\"k_e at m = 0.6667\" \"1e11 N/m^m\"".to_string()],
         "{failed:?}"
     );
+    let wob = map
+        .iter()
+        .find(|c| c["parameter"] == "wob" && c["value"] == "534 kN")
+        .unwrap();
+    assert_ne!(wob["status"], "failed", "{wob}");
     assert_eq!(
         s["converged"].as_u64().unwrap()
             + s["step_cut"].as_u64().unwrap()

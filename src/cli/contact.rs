@@ -357,6 +357,7 @@ pub fn parse_line(
             mu_l,
             eps,
             soft_blend,
+            side_friction: 1.0,
         },
         friction,
         mode,

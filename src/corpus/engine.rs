@@ -50,24 +50,6 @@ pub fn run_well_engine(well: &CorpusWell, path: EnginePath) -> Result<EngineOutc
     use crate::gpu::GpuPath;
     use crate::solve::statics::{StaticError, StaticOptions};
     let case = crate::case::load_case(&well.case_path)?;
-    if let Some((from, to)) = crate::diagnose::whirl_span(&case, &case.model) {
-        // The engine does not carry the whirl's average (`engine::refuse_whirling`): a
-        // failure of the engine on this well, said so, not of the path.
-        return Ok(EngineOutcome {
-            seed: well.spec.seed,
-            path,
-            solved: false,
-            iterations: 0,
-            step_cuts: 0,
-            seconds: 0.0,
-            hook_load_n: f64::NAN,
-            wall_sites: 0,
-            error: format!(
-                "not run: the turning string whirls between MD {from:.0} and {to:.0} m, and \
-                 the engine does not take a whirl's average"
-            ),
-        });
-    }
     let ctx = match path {
         EnginePath::Twin => None,
         EnginePath::GpuF64 | EnginePath::GpuF32 => {

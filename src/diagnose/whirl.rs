@@ -71,14 +71,17 @@ pub fn whirl_span(case: &Case, model: &Model) -> Option<(f64, f64)> {
     Some((model.nodes[top].md, model.nodes[bottom].md))
 }
 
-/// Marks the sites of `model` in its [`whirl_span`] as whirling
-/// ([`crate::model::Site::whirls`]; the others not), and gives the span.
+/// Marks the sites of `model` in its [`whirl_span`] as whirling, the others not: their
+/// circumferential friction acts as torque alone in static mode
+/// ([`crate::physics::contact::ContactParams::side_friction`] 0, the others' 1) — on the
+/// CPU and in the engine's contact kernel alike. Gives the span.
 pub fn mark_whirling_sites(case: &Case, model: &mut Model) -> Option<(f64, f64)> {
     let span = whirl_span(case, model);
     let nodes = &model.nodes;
     for site in &mut model.sites {
         let md = nodes[site.node].md;
-        site.whirls = span.is_some_and(|(a, b)| md >= a && md <= b);
+        let whirls = span.is_some_and(|(a, b)| md >= a && md <= b);
+        site.params.side_friction = if whirls { 0.0 } else { 1.0 };
     }
     span
 }
@@ -302,16 +305,18 @@ mod tests {
         assert_eq!(mark_whirling_sites(&case, &mut model), Some((from, to)));
         for s in &model.sites {
             let md = model.nodes[s.node].md;
-            assert_eq!(s.whirls, md <= to, "site at MD {md}");
+            assert_eq!(s.whirls(), md <= to, "site at MD {md}");
         }
         // Slid, nothing whirls and nothing is marked.
         let slid = well(1200.0, "sliding", 150.0, 0.25);
         let mut m = slid.model.clone();
         m.sites.clear();
         crate::profile::add_wall_sites(&slid, &mut m, &nodes);
-        m.sites.iter_mut().for_each(|s| s.whirls = true);
+        m.sites
+            .iter_mut()
+            .for_each(|s| s.params.side_friction = 0.0);
         assert_eq!(mark_whirling_sites(&slid, &mut m), None);
-        assert!(m.sites.iter().all(|s| !s.whirls));
+        assert!(m.sites.iter().all(|s| !s.whirls()));
     }
 
     /// A whirling site's response: the force rows are the element's without circumferential
@@ -337,7 +342,7 @@ mod tests {
             node.position[2] + 0.1,
         ];
         let mut whirling = model.clone();
-        whirling.sites[0].whirls = true;
+        whirling.sites[0].params.side_friction = 0.0;
         let full = site_response(&model, &state, &model.sites[0]);
         let avg = site_response(&whirling, &state, &whirling.sites[0]);
         let mut bare_model = model.clone();
@@ -404,7 +409,7 @@ mod tests {
             "{:?}",
             sol.log
         );
-        assert!(model.sites.iter().any(|s| s.whirls));
+        assert!(model.sites.iter().any(|s| s.whirls()));
         let (_, hook, torque, _) = crate::profile::fe_rows(&model, &sol);
         let soft = case.soft_string();
         let (soft_hook, soft_torque) = (soft.tension[0], soft.torque[0]);

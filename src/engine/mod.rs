@@ -318,20 +318,6 @@ pub fn solve_static_ensemble<T: Real + Send + Sync, P: KernelPath<T>>(
     solve_static_ensemble_with_progress(models, path, options, &mut |_| {})
 }
 
-/// An error where a variant's turning string whirls ([`crate::model::Site::whirls`]): its
-/// sites there take their circumferential friction as torque alone
-/// ([`crate::solve::statics::site_response`]), which the engine's contact kernel does not.
-pub(crate) fn refuse_whirling(models: &[Model]) -> Result<(), crate::error::SystemError> {
-    match models.iter().position(|m| m.sites.iter().any(|s| s.whirls)) {
-        Some(j) => Err(crate::error::SystemError::Unsupported(format!(
-            "variant {j}'s turning string whirls (`holewall static` names the span); the \
-             static solve takes its circumferential friction there as torque alone, which the \
-             engine's contact kernel does not: run it on the CPU (`--backend cpu`)"
-        ))),
-        None => Ok(()),
-    }
-}
-
 /// As [`solve_static_ensemble`], reporting the fraction done (0 … 1) after every iteration
 /// (for a progress bar). Batches of [`KernelPath::max_batch`] variants run one after another.
 pub fn solve_static_ensemble_with_progress<T: Real + Send + Sync, P: KernelPath<T>>(
@@ -341,7 +327,6 @@ pub fn solve_static_ensemble_with_progress<T: Real + Send + Sync, P: KernelPath<
     progress: &mut dyn FnMut(f64),
 ) -> Result<Vec<EngineResult>, crate::error::SystemError> {
     check_same_mesh(models)?;
-    refuse_whirling(models)?;
     let batch = path.max_batch(&models[0]).max(1);
     let total = models.len();
     let mut results = Vec::with_capacity(total);

@@ -305,6 +305,12 @@ fn guarded_models(
         })
         .collect::<Result<_, _>>()
         .map_err(|e| SystemError::Unsupported(format!("variant: {e}")))?;
+    // A turning string that whirls, at the whirl's average, as the CPU solve takes it
+    // (`profile::hold_in_hole`).
+    let mut guarded = guarded;
+    for g in &mut guarded {
+        crate::diagnose::mark_whirling_sites(case, g);
+    }
     crate::engine::check_same_mesh(&guarded)?;
     Ok(guarded)
 }

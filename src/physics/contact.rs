@@ -108,10 +108,17 @@ pub struct ContactParams<T> {
     pub eps: T,
     /// `soft_blend` (m) > 0: depth below which a soft spring is blended; default 1e-5.
     pub soft_blend: T,
+    /// Static mode only: the share of the circumferential friction `N·mu_t·phi_t·t` that acts
+    /// as a side force on the node — 1, the paper's element; 0 where the turning string
+    /// whirls, its circumferential friction then acting as torque alone (the side force
+    /// turns with the contact round the hole and averages to nothing over a whirl;
+    /// `crate::diagnose::whirl_span`). The moments are the whole friction's either way;
+    /// dynamic mode takes 1.
+    pub side_friction: T,
 }
 
 /// Number of scalars in [`ContactParams`] (GPU layout order is the field order).
-pub const PARAMS_LEN: usize = 9;
+pub const PARAMS_LEN: usize = 10;
 
 impl<T: Real> ContactParams<T> {
     /// The fields in layout order.
@@ -126,6 +133,7 @@ impl<T: Real> ContactParams<T> {
             self.mu_l,
             self.eps,
             self.soft_blend,
+            self.side_friction,
         ]
     }
 
@@ -141,6 +149,7 @@ impl<T: Real> ContactParams<T> {
             mu_l: a[6],
             eps: a[7],
             soft_blend: a[8],
+            side_friction: a[9],
         }
     }
 
@@ -353,7 +362,10 @@ pub fn evaluate<T: Real>(
         let (phi, jac) = friction_factors(s_t, s_l, p.eps, model);
         let a_t = p.mu_t * phi[0];
         let a_l = p.mu_l * phi[1];
-        dir_f = add(&add(&u, &scale(&t, a_t)), &scale(n, a_l));
+        // The circumferential friction's share as a side force (static mode; 1 in dynamics).
+        let side = |x: T| if dynamic { x } else { x * p.side_friction };
+        let a_t_f = side(a_t);
+        dir_f = add(&add(&u, &scale(&t, a_t_f)), &scale(n, a_l));
         dir_m = scale(&sub(&scale(n, a_t), &scale(&t, a_l)), rd);
 
         // ∂s_t/∂x = v·∂t/∂x = −(v·u)/r tᵀ =: sigma tᵀ;  ∂s_l/∂x = 0.
@@ -363,7 +375,7 @@ pub fn evaluate<T: Real>(
         let dphi_t_dst = jac[0][0];
         let dphi_l_dst = jac[1][0];
         let fric_f = add(
-            &scale(&t, p.mu_t * dphi_t_dst),
+            &scale(&t, side(p.mu_t * dphi_t_dst)),
             &scale(n, p.mu_l * dphi_l_dst),
         );
         let fric_m = scale(
@@ -375,7 +387,7 @@ pub fn evaluate<T: Real>(
         );
         kf_t = add(
             &kf_t,
-            &scale(&sub(&scale(&fric_f, sigma), &scale(&u, a_t / r)), normal),
+            &scale(&sub(&scale(&fric_f, sigma), &scale(&u, a_t_f / r)), normal),
         );
         km_t = scale(
             &add(&scale(&fric_m, sigma), &scale(&u, rd * a_l / r)),

@@ -180,7 +180,12 @@ fn jacobians_match_central_differences() {
             let terms = ContactTerms::all(friction, mode);
             for _ in 0..1000 {
                 let n = random_unit(&mut rng);
-                let s = sample(&mut rng, &n, friction);
+                let mut s = sample(&mut rng, &n, friction);
+                // Static: every other state at the whirl's average (its circumferential
+                // friction as torque alone, `side_friction` 0).
+                if mode == ContactMode::Static && count % 2 == 0 {
+                    s.params.side_friction = 0.0;
+                }
                 // The analytic Jacobian, in double-double too: the same generic code as the
                 // f64 path, here free of f64 rounding, which near-singular states (clearance 0
                 // with a large axial offset, slip within rounding of eps) would otherwise
@@ -287,6 +292,7 @@ fn params(m: f64) -> ContactParams<f64> {
         mu_l: 0.3,
         eps: 1e-3,
         soft_blend: 1e-5,
+        side_friction: 1.0,
     }
 }
 

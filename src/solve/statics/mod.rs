@@ -140,16 +140,9 @@ pub fn external_loads(model: &Model) -> Vec<f64> {
 }
 
 /// A site's contact response in static mode (friction direction from the operation's
-/// virtual velocities, eqs 2.12–2.23 in static mode).
-///
-/// At a site where the turning string whirls ([`crate::model::Site::whirls`]) the
-/// circumferential friction acts as its torque alone: the force rows (`f`, and their rows
-/// of `K`) are the element's with `mu_t = 0` — the elastic force and the axial friction —
-/// and the moment rows the whole element's (the normal force passes through the node, so
-/// the moment is the friction's alone: the circumferential friction's torque `R_d μ_t N`
-/// and the axial friction's bending moment). The side force `N·mu_t·phi_t·t` turns with
-/// the contact round the hole and averages to nothing over a whirl, where a static solve
-/// that keeps it has no equilibrium (`crate::diagnose::whirl`).
+/// virtual velocities, eqs 2.12–2.23 in static mode). Where the turning string whirls
+/// (`site.params.side_friction` 0: [`crate::diagnose::mark_whirling_sites`]) its
+/// circumferential friction acts as torque alone, the side force `N·mu_t·phi_t·t` left out.
 pub fn site_response(
     model: &Model,
     state: &StaticState,
@@ -164,26 +157,14 @@ pub fn site_response(
     let node = &model.nodes[site.node];
     let d = sub(&state.x[site.node], &node.position);
     let v = scale(&node.hole_axis, model.axial_speed);
-    let at = |params: &crate::physics::contact::ContactParams<f64>| {
-        evaluate(
-            &node.hole_axis,
-            &d,
-            &v,
-            model.rotation_speed,
-            params,
-            &terms,
-        )
-    };
-    let mut out = at(&site.params);
-    if site.whirls && out.contact && model.rotation_speed != 0.0 && site.params.mu_t != 0.0 {
-        let without = at(&crate::physics::contact::ContactParams {
-            mu_t: 0.0,
-            ..site.params
-        });
-        out.g[..3].copy_from_slice(&without.g[..3]);
-        out.k[..3].copy_from_slice(&without.k[..3]);
-    }
-    out
+    evaluate(
+        &node.hole_axis,
+        &d,
+        &v,
+        model.rotation_speed,
+        &site.params,
+        &terms,
+    )
 }
 
 /// Residual `f_int + g_contact − λ f_ext` and (if `tangent` is given) the tangent, before
