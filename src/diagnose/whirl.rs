@@ -10,18 +10,28 @@
 //! (Mitchell: `N_b = r F² / (8 EI)` past the sinusoidal load, `r F² / (4 EI)` past the
 //! helical, `F` the compression, `r` the radial clearance), and in a near-vertical hole
 //! `H` is all but nothing. Where `μ (H + N_b) > H` no place on the wall holds the turning
-//! string: it rolls round the hole (whirls) and a static solve finds no equilibrium.
-//! Measured (docs/performance.md, stop 68): a 3,035 m horizontal well drilled at 107 kN
-//! with 5 in pipe in a 13⅝ in casing above its kick-off fails past 75 % of its loads; the
-//! same case with no friction in that casing, or slid instead of rotated, solves.
+//! string: it rolls round the hole (whirls), and a static solve that keeps the friction's
+//! side force finds no equilibrium. Measured (docs/performance.md, stop 68): a 3,035 m
+//! horizontal well drilled at 107 kN with 5 in pipe in a 13⅝ in casing above its kick-off
+//! failed past 75 % of its loads; the same case with no friction in that casing, or slid
+//! instead of rotated, solved.
+//!
+//! Since stop 69 the static solve takes such a string at the **whirl's average**: over
+//! [`whirl_span`] its contacts' circumferential friction acts as torque alone — the side
+//! force turns with the contact round the hole and averages to nothing over a whirl — by
+//! the contact element's `side_friction` ([`mark_whirling_sites`]; the CPU solve and the
+//! engine's kernels alike). The answer warns with the span; the whirl itself (its kind,
+//! the torque it really costs) is `holewall run`'s.
 
 use crate::case::Case;
 use crate::model::Model;
 use crate::solve::soft_string::SoftStringProfile;
 
 /// Below this inclination (degrees) the hole is near-vertical for [`whirl_span`]: the
-/// weight's hold there, `w sin 10° = 0.17 w` per length, is less than the circumferential
-/// friction of a string pressed with its own weight at μ ≥ 0.17.
+/// weight's hold there, under `w sin 10° = 0.17 w` per length, is less than the
+/// circumferential friction `μ N_b` of a buckled string pressed with its weight's worth
+/// (`N_b ≥ w`) at any μ ≥ 0.17. A choice, checked on user well 73 (docs/performance.md,
+/// stop 69), not fitted.
 pub const NEAR_VERTICAL_DEG: f64 = 10.0;
 
 /// The span (MD from, to, m) over which `model`'s turning string (the case's, or a
