@@ -459,6 +459,12 @@ pub const DOGLEG_WARNING_DEG_PER_30M: f64 = 15.0;
 /// the limit (short-radius wells): more likely a typo in a station than a hole.
 pub const DOGLEG_LIMIT_DEG_PER_30M: f64 = 30.0;
 
+/// A survey that ends above the bit by at most this much (m) is projected to the bit along
+/// its last tangent, with a warning: an MWD survey's last station lies the sensor's offset
+/// (10–25 m) above the bit, and a few metres more may be drilled since. Farther, refused: a
+/// survey of another well, or a total_md in the wrong unit.
+pub const SURVEY_PROJECTION_M: f64 = 30.0;
+
 /// A survey that runs past the deepest MD of its case by more than this factor is refused:
 /// the likeliest reason is MD in feet read as metres (3.28×).
 pub const SURVEY_PAST_CASE_FACTOR: f64 = 1.5;

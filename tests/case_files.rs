@@ -535,6 +535,72 @@ fn survey_messages_name_the_csv_line_and_refuse_a_partial_survey() {
     }
 }
 
+/// A survey that ends a sensor's offset above the bit (20 m of the 300 m `GOOD` well) is
+/// projected to the bit along its last station's inclination and azimuth, with a warning
+/// naming the line and the length; one a unit's rounding short (1 mm) loads without one.
+#[test]
+fn a_survey_ending_a_sensor_offset_above_the_bit_is_projected_to_it() {
+    for (last, warned) in [(280.0, true), (299.999, false)] {
+        let dir = scratch(&format!("survey-projected-{warned}"));
+        std::fs::write(
+            dir.join("survey.csv"),
+            format!("md,inclination,azimuth\n0,0,0\n100,5,10\n{last},8,30\n"),
+        )
+        .unwrap();
+        let text = GOOD.replace(
+            "profile = \"vertical\"",
+            "profile = \"survey\"\nsurvey = \"survey.csv\"",
+        );
+        let case = holewall::case::load_case(&write_case(&dir, &text)).unwrap();
+        let warning = case
+            .warnings
+            .iter()
+            .find(|w| w.contains("projected to the bit"));
+        assert_eq!(warning.is_some(), warned, "{:?}", case.warnings);
+        if warned {
+            let w = warning.unwrap();
+            assert!(
+                w.contains("survey.csv:4:") && w.contains("20 m above the bit"),
+                "{w}"
+            );
+        }
+        // Past the last station the path holds its tangent: the bit's node lies 300 − last
+        // metres along (8°, 30°) from the last station's position.
+        let model = &case.model;
+        let bit = model.nodes.last().unwrap();
+        let stations: Vec<holewall::well::SurveyStation> =
+            [(0.0, 0.0, 0.0), (100.0, 5.0, 10.0), (last, 8.0, 30.0)]
+                .iter()
+                .map(
+                    |&(md, inclination_deg, azimuth_deg)| holewall::well::SurveyStation {
+                        md,
+                        inclination_deg,
+                        azimuth_deg,
+                    },
+                )
+                .collect();
+        let at_last = holewall::well::WellPath::from_survey(&stations, [0.0; 3])
+            .unwrap()
+            .at(last)
+            .0;
+        let (i, a) = (8f64.to_radians(), 30f64.to_radians());
+        let t = [i.sin() * a.cos(), i.sin() * a.sin(), i.cos()];
+        for k in 0..3 {
+            assert!(
+                (bit.hole_axis[k] - t[k]).abs() < 1e-12,
+                "{:?}",
+                bit.hole_axis
+            );
+            let expected = at_last[k] + (bit.md - last) * t[k];
+            assert!(
+                (bit.position[k] - expected).abs() < 1e-9,
+                "{k}: {:?} {expected}",
+                bit.position
+            );
+        }
+    }
+}
+
 /// A hook-load top moves along the vertical: in a well whose top is inclined (a survey
 /// starting at 30°) it is refused with its key, line and what to do, exit code 2; the same
 /// survey with the top clamped (weight on bit) solves.

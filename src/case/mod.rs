@@ -435,6 +435,11 @@ fn build_case(path: &Path, mut source: CaseSource) -> Result<Case, InputError> {
             deepest,
             limit,
         )?);
+        warnings.extend(survey::survey_projection_warning(
+            &survey_path.display().to_string(),
+            read,
+            bit_md,
+        ));
     }
     let mud = ctx.fluid_density(&spec.mud.density, "mud.density", "0 (a dry string)")?;
     let mud_inside = match &spec.mud.inside_density {

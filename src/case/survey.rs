@@ -174,15 +174,23 @@ pub(super) fn read_well(
                 }
             }
             if let Some((last, line)) = read.last() {
-                if read.len() >= 2 && last.md < bit_md - 1e-6 {
+                // A survey ends above the bit (the MWD sensor rides 10–25 m above it): up to
+                // SURVEY_PROJECTION_M it is projected to the bit along its last tangent
+                // (`WellPath` holds the last station's inclination and azimuth past it;
+                // `survey_projection_warning` says so); farther, refused.
+                let short = bit_md - last.md;
+                if read.len() >= 2 && short > crate::units::SURVEY_PROJECTION_M {
                     return Err(survey_err(
                         *line,
                         format!(
-                            "the last station is at MD {} m, above the bit at {b} m \
-                             (well.total_md); a survey must reach the bit: add stations \
-                             down to {b} m",
+                            "the last station is at MD {} m, {} m above the bit at {} m \
+                             (well.total_md); a survey is projected to the bit along its \
+                             last tangent for at most {} m (the sensor's offset): add \
+                             stations down to the bit",
                             crate::units::show(last.md),
-                            b = crate::units::show(bit_md),
+                            crate::units::show(short),
+                            crate::units::show(bit_md),
+                            crate::units::show(crate::units::SURVEY_PROJECTION_M),
                         ),
                     ));
                 }
@@ -199,6 +207,28 @@ pub(super) fn read_well(
         }
     };
     Ok((well, survey_read))
+}
+
+/// The warning for a survey `read` from `source` that ends above the bit at `bit_md` (m)
+/// by more than 0.1 m (less is a unit's rounding), projected to it along its last tangent;
+/// `None` otherwise.
+pub fn survey_projection_warning(
+    source: &str,
+    read: &[(SurveyStation, usize)],
+    bit_md: f64,
+) -> Option<String> {
+    let (last, line) = read.last()?;
+    let short = bit_md - last.md;
+    (read.len() >= 2 && short > 0.1).then(|| {
+        format!(
+            "{source}:{line}: the survey ends at MD {} m, {} m above the bit: projected to \
+             the bit along its last station's inclination and azimuth ({}°, {}°)",
+            crate::units::show(last.md),
+            crate::units::show(short),
+            crate::units::show(last.inclination_deg),
+            crate::units::show(last.azimuth_deg),
+        )
+    })
 }
 
 /// The plausibility of a survey's stations (issue 23), one policy with
