@@ -356,7 +356,7 @@ pub fn whirl_note(from: f64, to: f64) -> String {
     )
 }
 
-/// The words that open [`whirl_note`] (the corpus finds the note by them).
+/// The words that open [`whirl_note`] (`holewall static` finds the note by them to warn).
 pub const WHIRL_AVERAGED: &str = "the string whirls, taken at the whirl's average,";
 
 /// Pipe-body contact sites at `nodes` of `model` (the case's or a variant's of it), as
