@@ -430,4 +430,42 @@ mod tests {
             "{torque} {soft_torque}"
         );
     }
+
+    /// A turning string whose load path brackets an equilibrium has nowhere to stop: its
+    /// failure says so and names the whirl's average taken. (Stop 68 checked these words end
+    /// to end on 1 MN turning in `cases/build_and_hold.toml`, which now solves.) Slid in, the
+    /// same bracket is where the string stops.
+    #[test]
+    fn a_turning_strings_bracketed_failure_says_it_does_not_stop() {
+        use crate::solve::statics::StaticError;
+        let error = StaticError::LoadStep {
+            stage: "applying the bit loads and friction (stage 2)".into(),
+            from: 0.5,
+            step: 0.0,
+            min: 1e-3,
+            reason: format!(
+                "Newton stalled; {} λ = 0.5000 and none at λ = 0.6250",
+                crate::solve::continuation::LOCK_FOUND
+            ),
+            at_md: None,
+            stopped: None,
+        };
+        let turning = well(1200.0, "rotating", 150.0, 0.25);
+        let m = crate::diagnose::static_failure(&turning, &error);
+        assert!(
+            m.contains("a string not run in or out does not stop")
+                && !m.contains("where the string stops")
+                && m.contains("it reached 50.0 % of the bit loads")
+                && m.contains("as torque alone (the whirl's average) and found no equilibrium"),
+            "{m}"
+        );
+        let mut slid = well(1200.0, "rotating", 150.0, 0.25);
+        slid.model.rotation_speed = 0.0;
+        slid.model.axial_speed = 0.3;
+        let m = crate::diagnose::static_failure(&slid, &error);
+        assert!(
+            m.contains("that is where the string stops") && !m.contains("whirl"),
+            "{m}"
+        );
+    }
 }
