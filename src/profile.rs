@@ -306,7 +306,8 @@ pub(crate) fn hold_in_hole(
     let clock = std::time::Instant::now();
     let mut guarded = model.clone();
     add(&mut guarded, &free);
-    crate::diagnose::mark_whirling_sites(case, &mut guarded);
+    // The same string with more sites: the same span (the soft string has no sites).
+    crate::diagnose::mark_span(&mut guarded, span);
     let failed = match solve(&guarded, options) {
         Ok(sol) => {
             let (kept, sol) = keep_touching(model, guarded, sol);

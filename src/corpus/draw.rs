@@ -118,3 +118,17 @@ pub(super) fn tube(kind: &str, len: f64, od: f64, id: f64, extra: &str) -> Strin
         "[[string]]\nkind = \"{kind}\"\nlength = \"{len} m\"\nod = \"{od} in\"\nid = \"{id} in\"\n{extra}"
     )
 }
+
+/// A corpus case's `[contact]` and `[mesh]` tables (both styles write them alike).
+pub(super) fn contact_and_mesh(
+    sites: &str,
+    wall_stiffness: f64,
+    exponent: f64,
+    element: f64,
+    bha_element: f64,
+) -> String {
+    format!(
+        "[contact]\nsites = \"{sites}\"\nwall_stiffness = {wall_stiffness:.6e}\nexponent = {exponent:.6}\n\
+         [mesh]\nelement_length = \"{element} m\"\nbha_element_length = \"{bha_element} m\"\n"
+    )
+}

@@ -34,7 +34,7 @@ use rand_chacha::ChaCha8Rng;
 use serde::Serialize;
 
 use crate::error::Error;
-use draw::{pick, survey, tube, write_survey};
+use draw::{contact_and_mesh, pick, survey, tube, write_survey};
 
 mod draw;
 pub mod dynamic;
@@ -395,11 +395,12 @@ pub fn write_well(seed: u64, dir: &Path) -> Result<CorpusWell, Error> {
                 }
             ));
         }
-        t.push_str(&format!(
-            "[contact]\nsites = \"{sites}\"\nwall_stiffness = {wall_stiffness:.6e}\nexponent = {exponent:.6}\n"
-        ));
-        t.push_str(&format!(
-            "[mesh]\nelement_length = \"{element} m\"\nbha_element_length = \"{bha_element} m\"\n"
+        t.push_str(&contact_and_mesh(
+            sites,
+            wall_stiffness,
+            exponent,
+            element,
+            bha_element,
         ));
         t
     };

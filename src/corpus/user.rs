@@ -9,8 +9,8 @@
 //! own, run by `holewall static`); this is its generator in the product.
 
 use super::{
-    bha_bottom, pick, survey, tube, write_at_wob, write_survey, CorpusWell, Trajectory, WellSpec,
-    SIZES,
+    bha_bottom, contact_and_mesh, pick, survey, tube, write_at_wob, write_survey, CorpusWell,
+    Trajectory, WellSpec, SIZES,
 };
 use crate::error::Error;
 use rand::{Rng, SeedableRng};
@@ -222,11 +222,12 @@ pub fn write_user_well(seed: u64, dir: &Path) -> Result<CorpusWell, Error> {
                 ));
             }
         }
-        t.push_str(&format!(
-            "[contact]\nsites = \"{sites}\"\nwall_stiffness = {wall_stiffness:.6e}\nexponent = {exponent:.6}\n"
-        ));
-        t.push_str(&format!(
-            "[mesh]\nelement_length = \"{element} m\"\nbha_element_length = \"{bha_element} m\"\n"
+        t.push_str(&contact_and_mesh(
+            sites,
+            wall_stiffness,
+            exponent,
+            element,
+            bha_element,
         ));
         t
     };

@@ -52,6 +52,12 @@ pub fn whirl_span(case: &Case, model: &Model) -> Option<(f64, f64)> {
     }
     let profile = case.soft_string_of(model);
     let w = rotating_whirl_of(case, model, &profile.tension, &profile.side_force)?;
+    Some(widened(model, &w))
+}
+
+/// The rule's span `w` on `model`, widened through the near-vertical hole on either side
+/// ([`whirl_span`]).
+fn widened(model: &Model, w: &Whirl) -> (f64, f64) {
     let near_vertical = |i: usize| {
         let t = model.nodes[i].hole_axis;
         (t[0] * t[0] + t[1] * t[1])
@@ -78,7 +84,7 @@ pub fn whirl_span(case: &Case, model: &Model) -> Option<(f64, f64)> {
     while bottom + 1 < n && near_vertical(bottom + 1) {
         bottom += 1;
     }
-    Some((model.nodes[top].md, model.nodes[bottom].md))
+    (model.nodes[top].md, model.nodes[bottom].md)
 }
 
 /// Marks the sites of `model` in its [`whirl_span`] as whirling, the others not: their
@@ -87,13 +93,20 @@ pub fn whirl_span(case: &Case, model: &Model) -> Option<(f64, f64)> {
 /// CPU and in the engine's contact kernel alike. Gives the span.
 pub fn mark_whirling_sites(case: &Case, model: &mut Model) -> Option<(f64, f64)> {
     let span = whirl_span(case, model);
+    mark_span(model, span);
+    span
+}
+
+/// Marks the sites of `model` inside `span` (MD from, to) as whirling, the others not (as
+/// [`mark_whirling_sites`]; for a model whose span is known: the same string with more
+/// sites).
+pub fn mark_span(model: &mut Model, span: Option<(f64, f64)>) {
     let nodes = &model.nodes;
     for site in &mut model.sites {
         let md = nodes[site.node].md;
         let whirls = span.is_some_and(|(a, b)| md >= a && md <= b);
         site.params.side_friction = if whirls { 0.0 } else { 1.0 };
     }
-    span
 }
 
 /// A span of the string that whirls at its soft-string profile ([`rotating_whirl`]).
@@ -179,7 +192,7 @@ pub fn rotating_whirl_of(
 /// (`case.soft_string()`).
 pub fn whirl_reason(case: &Case, profile: &SoftStringProfile) -> Option<String> {
     let w = rotating_whirl(case, &profile.tension, &profile.side_force)?;
-    let span = whirl_span(case, &case.model).unwrap_or((w.md_from, w.md_to));
+    let span = widened(&case.model, &w);
     Some(format!(
         "\n  likely reason: turning, the buckled string presses the wall between MD {:.0} and \
          {:.0} m harder than anything holds it there — at MD {:.0} m (inclination {:.1}°, \
