@@ -115,16 +115,17 @@ pub fn fe_rows(
             };
             let axial = avg(&|e| sol.section_forces[e].axial);
             let area = avg(&|e| model.elements[e].section.area);
-            let d = sub(&sol.state.x[i], &model.nodes[i].position);
+            let d = sol.state.u[i];
+            let p = sol.state.position(model, i);
             let t = model.nodes[i].hole_axis;
             let d_t = sub(&d, &scale(&t, dot(&d, &t)));
             ProfileRow {
                 von_mises_pa: f64::NAN,
                 yield_utilisation: f64::NAN,
                 md_m: model.nodes[i].md,
-                x_m: sol.state.x[i][0],
-                y_m: sol.state.x[i][1],
-                z_m: sol.state.x[i][2],
+                x_m: p[0],
+                y_m: p[1],
+                z_m: p[2],
                 axial_force_n: axial,
                 axial_stress_pa: axial / area,
                 torque_nm: avg(&|e| sol.section_forces[e].torque).abs(),
@@ -332,7 +333,10 @@ pub(crate) fn hold_in_hole(
         .max_seconds
         .map(|s| (s - clock.elapsed().as_secs_f64()).max(0.0));
     match solve(model, &options) {
-        Ok(sol) if crate::diagnose::beyond_wall(case, model, &sol.state.x).is_empty() => {
+        Ok(sol)
+            if crate::diagnose::beyond_wall(case, model, &sol.state.positions(model))
+                .is_empty() =>
+        {
             let mut sol = said(sol);
             sol.log.push(format!(
                 "the solve with a guard site at every node failed ({}); the string solved at \

@@ -90,7 +90,7 @@ fn record(
     let n = model.nodes.len();
     let bit = n - 1;
     let tb = model.nodes[bit].hole_axis;
-    let bit_axial = dot(&sub(&s.q.x[bit], &model.nodes[bit].position), &tb);
+    let bit_axial = dot(&s.q.u[bit], &tb);
     let forces = |i: usize| crate::solve::statics::element_section_forces(model, &s.q, i);
     let torque = forces(0).torque.abs();
     let ke = if want("energy") {
@@ -108,7 +108,7 @@ fn record(
         let contact = dynamics.contact_forces(s);
         for (k, (site, out)) in model.sites.iter().zip(contact).enumerate() {
             let node = &model.nodes[site.node];
-            let d = sub(&s.q.x[site.node], &node.position);
+            let d = s.q.u[site.node];
             let d_t = sub(&d, &scale(&node.hole_axis, dot(&d, &node.hole_axis)));
             let f = &node.frame0;
             let (ex, ey) = ([f[0][1], f[1][1], f[2][1]], [f[0][2], f[1][2], f[2][2]]);

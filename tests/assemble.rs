@@ -53,7 +53,7 @@ fn inputs(
     let states: Vec<StaticState> = (0..v)
         .map(|_| {
             let mut s = base.clone();
-            for x in s.x.iter_mut().skip(1) {
+            for x in s.u.iter_mut().skip(1) {
                 for c in x.iter_mut() {
                     *c += rng.random_range(-2e-3..2e-3);
                 }
@@ -95,7 +95,7 @@ fn inputs(
     for (j, s) in states.iter().enumerate() {
         for (i, el) in model.elements.iter().enumerate() {
             let es = ElementState {
-                x: [s.x[i], s.x[i + 1]],
+                x: [s.position(&model, i), s.position(&model, i + 1)],
                 triad: [
                     mat_mul(&s.rot[i], &model.nodes[i].frame0),
                     mat_mul(&s.rot[i + 1], &model.nodes[i + 1].frame0),

@@ -16,7 +16,7 @@ fn gpu_beam_matches_the_twin() {
     let model = case.model;
     let n = model.nodes.len();
     let v = 8;
-    let base = StaticState::on_low_side(&model);
+    let base = StaticState::on_low_side(&model).positions(&model);
     let mut rng = rand::rngs::StdRng::seed_from_u64(21);
     let mut x = vec![0.0; 3 * n * v];
     // The spun configuration without the small deformations: a base for the states.
@@ -27,12 +27,12 @@ fn gpu_beam_matches_the_twin() {
         // deformations.
         let spin = rotation_exp(&[0.0, 0.0, rng.random_range(-50.0..50.0)]);
         for i in 0..n {
-            let p: [f64; 3] = std::array::from_fn(|k| base.x[i][k] + rng.random_range(-3e-3..3e-3));
+            let p: [f64; 3] = std::array::from_fn(|k| base[i][k] + rng.random_range(-3e-3..3e-3));
             let th: [f64; 3] = std::array::from_fn(|_| rng.random_range(-0.02..0.02));
             let r = rotation_exp(&th);
             for a in 0..3 {
                 x[(3 * i + a) * v + j] = (0..3).map(|b| spin[a][b] * p[b]).sum();
-                spun[(3 * i + a) * v + j] = (0..3).map(|b| spin[a][b] * base.x[i][b]).sum();
+                spun[(3 * i + a) * v + j] = (0..3).map(|b| spin[a][b] * base[i][b]).sum();
                 for c in 0..3 {
                     rot[(9 * i + 3 * a + c) * v + j] = (0..3).map(|m| spin[a][m] * r[m][c]).sum();
                 }
@@ -199,8 +199,7 @@ fn gpu_beam_with_kinks_matches_the_twin() {
             let th: [f64; 3] = std::array::from_fn(|_| rng.random_range(-0.02..0.02));
             let r = rotation_exp(&th);
             for a in 0..3 {
-                x[(3 * i + a) * v + j] =
-                    base.x[i][a] - model.nodes[i].position[a] + rng.random_range(-3e-3..3e-3);
+                x[(3 * i + a) * v + j] = base.u[i][a] + rng.random_range(-3e-3..3e-3);
                 for c in 0..3 {
                     rot[(9 * i + 3 * a + c) * v + j] = r[a][c];
                 }

@@ -491,7 +491,7 @@ fn an_imbalance_swept_through_a_predicted_critical_speed_peaks_there() {
             let mut amp: f64 = 0.0;
             let mut observe = |_: &Dynamics, q: &DynamicState| {
                 if q.t > 0.6 * settings.duration {
-                    let dx: Vec<f64> = (0..3).map(|j| q.q.x[probe][j] - nd.position[j]).collect();
+                    let dx: Vec<f64> = q.q.u[probe].to_vec();
                     let along: f64 = (0..3).map(|j| dx[j] * nd.hole_axis[j]).sum();
                     let sq: f64 = dx.iter().map(|v| v * v).sum();
                     amp = amp.max((sq - along * along).max(0.0).sqrt());

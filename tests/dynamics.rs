@@ -55,11 +55,11 @@ fn run_with(
     let mut dynamics = Dynamics::new(m, options, &|_| RHO);
     let mut s: DynamicState = dynamics.initial_state(start.clone()).unwrap();
     let bit = m.nodes.len() - 1;
-    let mut tip = vec![s.q.x[bit][0]];
+    let mut tip = vec![s.q.u[bit][0]];
     let mut energy = vec![dynamics.kinetic_energy(&s) + strain_energy(m, &s.q)];
     for _ in 0..steps {
         dynamics.step(&mut s, dt).unwrap();
-        tip.push(s.q.x[bit][0]);
+        tip.push(s.q.u[bit][0]);
         energy.push(dynamics.kinetic_energy(&s) + strain_energy(m, &s.q));
     }
     (tip, energy)
@@ -139,7 +139,7 @@ fn hook_lowered_at_rop_carries_the_string_down() {
     // The top follows the hook exactly; the bit with it, up to the axial vibration the
     // ramp's kinks excite (inertia ≈ 70 N over EA/L: about 1e-7 m, ±1e-4 m/s).
     for (i, tol_x, tol_v) in [(0, 1e-12, 1e-12), (bit, 1e-6, 0.02 * rop)] {
-        let dz = s.q.x[i][2] - m.nodes[i].position[2];
+        let dz = s.q.u[i][2];
         eprintln!(
             "node {i}: lowered {dz:.9} m vs {expected:.9} m, at {:.6} m/s",
             s.v[6 * i + 2]
@@ -181,7 +181,7 @@ fn error_shrinks_at_second_order_in_the_step() {
         for _ in 0..steps {
             dynamics.step(&mut s, dt).unwrap();
         }
-        s.q.x[bit][0]
+        s.q.u[bit][0]
     };
     for rho_inf in [1.0, 0.8, 0.5] {
         let reference = at(t_end / 1280.0, rho_inf);
@@ -203,7 +203,7 @@ fn damped_run_settles_to_the_static_solution() {
     let mut m = cantilever(10.0, 10);
     let bit = m.nodes.len() - 1;
     m.point_loads = vec![(bit, [2000.0, 0.0, 0.0, 0.0, 0.0, 0.0])];
-    let static_tip = solve_static(&m, &StaticOptions::default()).unwrap().state.x[bit][0];
+    let static_tip = solve_static(&m, &StaticOptions::default()).unwrap().state.u[bit][0];
     // Mass-proportional Rayleigh damping, about 30 % of critical in the first mode (1.29 Hz).
     let options = DynamicOptions {
         dt: 0.01,
@@ -218,10 +218,10 @@ fn damped_run_settles_to_the_static_solution() {
     let mut peak: f64 = 0.0;
     dynamics
         .run(&mut s, 12.0, &mut |_, st| {
-            peak = peak.max(st.q.x[bit][0]);
+            peak = peak.max(st.q.u[bit][0]);
         })
         .unwrap();
-    let tip = s.q.x[bit][0];
+    let tip = s.q.u[bit][0];
     eprintln!("settled tip {tip:.6e} m vs static {static_tip:.6e} m (overshoot peak {peak:.4e} m)");
     assert!(
         peak > 1.2 * static_tip,
@@ -266,14 +266,14 @@ fn spinning_bent_string_energy_error(dt: f64, t_end: f64) -> f64 {
     let (mut m, start) = released(&m, 2500.0);
     m.top = holewall::model::TopBoundary::Free;
     let n = m.nodes.len();
-    let centre: [f64; 3] =
-        std::array::from_fn(|k| start.x.iter().map(|x| x[k]).sum::<f64>() / n as f64);
+    let x0 = start.positions(&m);
+    let centre: [f64; 3] = std::array::from_fn(|k| x0.iter().map(|x| x[k]).sum::<f64>() / n as f64);
     // Spin 20 rad/s about the (vertical) string axis, tumbling at 2 rad/s about a
     // horizontal one.
     let w = [0.0, 2.0, 20.0];
     let mut v = vec![0.0; 6 * n];
     for i in 0..n {
-        let r: [f64; 3] = std::array::from_fn(|k| start.x[i][k] - centre[k]);
+        let r: [f64; 3] = std::array::from_fn(|k| x0[i][k] - centre[k]);
         let u = [
             w[1] * r[2] - w[2] * r[1],
             w[2] * r[0] - w[0] * r[2],
@@ -328,9 +328,9 @@ fn from_mode(
 ) -> holewall::solve::statics::StaticState {
     let eps = amplitude / shape.iter().fold(0.0f64, |a, x| a.max(x.abs()));
     let mut start = state.clone();
-    for i in 0..start.x.len() {
+    for i in 0..start.u.len() {
         for k in 0..3 {
-            start.x[i][k] += eps * shape[6 * i + k];
+            start.u[i][k] += eps * shape[6 * i + k];
         }
         let th: [f64; 3] = std::array::from_fn(|k| eps * shape[6 * i + 3 + k]);
         start.rot[i] = holewall::physics::beam::rotation_exp(&th);
@@ -466,10 +466,7 @@ fn whirl(mu: f64, t_end: f64) -> (f64, f64, f64) {
     let n = m.nodes.len();
     let mut v = vec![0.0; 6 * n];
     for i in 0..n {
-        let d = [
-            start.x[i][0] - m.nodes[i].position[0],
-            start.x[i][1] - m.nodes[i].position[1],
-        ];
+        let d = [start.u[i][0], start.u[i][1]];
         v[6 * i] = -w0 * d[1];
         v[6 * i + 1] = w0 * d[0];
         v[6 * i + 5] = spin;
@@ -486,7 +483,7 @@ fn whirl(mu: f64, t_end: f64) -> (f64, f64, f64) {
     let mut unwrapped = 0.0;
     dynamics
         .run(&mut s, t_end, &mut |_, st| {
-            let d = [st.q.x[bit][0], st.q.x[bit][1]];
+            let d = [st.q.u[bit][0], st.q.u[bit][1]];
             let a = d[1].atan2(d[0]);
             if let Some(l) = last {
                 let mut da = a - l;
@@ -558,7 +555,7 @@ fn bit_held_laterally_in_an_inclined_hole() {
     let mut axial: f64 = 0.0;
     dynamics
         .run(&mut s, 0.05, &mut |_, st| {
-            let d: [f64; 3] = std::array::from_fn(|k| st.q.x[bit][k] - nd.position[k]);
+            let d: [f64; 3] = st.q.u[bit];
             let along: f64 = (0..3).map(|k| d[k] * nd.hole_axis[k]).sum();
             let lateral = (0..3)
                 .map(|k| (d[k] - along * nd.hole_axis[k]).powi(2))

@@ -39,7 +39,7 @@ fn cpu_runs(
             d.run(&mut s, t_end, &mut |_, st| {
                 let u: Vec<f64> = (0..m.nodes.len())
                     .flat_map(|i| (0..3).map(move |k| (i, k)))
-                    .map(|(i, k)| st.q.x[i][k] - m.nodes[i].position[k])
+                    .map(|(i, k)| st.q.u[i][k])
                     .collect();
                 steps.push((u, st.v.clone()));
             })
@@ -523,13 +523,11 @@ fn a_failing_variant_fails_alone_in_the_dynamic_engine() {
     let m = &models[0];
     let node = m.sites[m.sites.len() / 2].node;
     let t = m.nodes[node].hole_axis;
-    let d: Vec<f64> = (0..3)
-        .map(|k| pushed.x[node][k] - m.nodes[node].position[k])
-        .collect();
+    let d: Vec<f64> = (0..3).map(|k| pushed.u[node][k]).collect();
     let along: f64 = (0..3).map(|k| d[k] * t[k]).sum();
     let lateral: Vec<f64> = (0..3).map(|k| d[k] - along * t[k]).collect();
     let len = lateral.iter().map(|x| x * x).sum::<f64>().sqrt();
-    for x in pushed.x.iter_mut() {
+    for x in pushed.u.iter_mut() {
         for k in 0..3 {
             x[k] += 0.02 * lateral[k] / len;
         }
@@ -759,7 +757,7 @@ fn a_variant_whose_step_fails_is_cut_on_its_own_in_the_engine() {
     let n = m.nodes.len();
     let cpu_u: Vec<f64> = (0..n)
         .flat_map(|i| (0..3).map(move |k| (i, k)))
-        .map(|(i, k)| s.q.x[i][k] - m.nodes[i].position[k])
+        .map(|(i, k)| s.q.u[i][k])
         .collect();
     let check = |label: &str,
                  path: &dyn Fn() -> Vec<holewall::engine::dynamic::DynamicResult>,
@@ -967,12 +965,12 @@ fn a_run_that_cuts_and_regrows_takes_the_cpu_integrators_steps_in_the_engine() {
     let n = m.nodes.len();
     let cpu_u: Vec<f64> = (0..n)
         .flat_map(|i| (0..3).map(move |k| (i, k)))
-        .map(|(i, k)| s.q.x[i][k] - m.nodes[i].position[k])
+        .map(|(i, k)| s.q.u[i][k])
         .collect();
     let scale = cpu_u.iter().fold(0.0f64, |m, x| m.max(x.abs()));
     let spread = (0..3 * n).fold(0.0f64, |m, k| {
         let (i, c) = (k / 3, k % 3);
-        m.max((perturbed.q.x[i][c] - s.q.x[i][c]).abs())
+        m.max((perturbed.q.u[i][c] - s.q.u[i][c]).abs())
     });
     eprintln!(
         "CPU integrator alone, ε changed by 1e-13: ends {:.2e} of the largest apart",

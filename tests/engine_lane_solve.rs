@@ -57,7 +57,7 @@ fn engines_match_the_twin_path(ctx: &'static holewall::gpu::GpuContext, form: Lu
         let mut diff: f64 = 0.0;
         for ((status, state), t) in states.iter().zip(&twin) {
             assert_eq!(*status, EngineStatus::Converged);
-            for (xg, xt) in state.x.iter().zip(&t.state.x) {
+            for (xg, xt) in state.u.iter().zip(&t.state.u) {
                 for k in 0..3 {
                     diff = diff.max((xg[k] - xt[k]).abs());
                 }

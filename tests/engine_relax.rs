@@ -43,8 +43,8 @@ fn models() -> Vec<Model> {
 
 /// Largest translation difference between two states (m).
 fn largest_difference(a: &StaticState, b: &StaticState) -> f64 {
-    a.x.iter()
-        .zip(&b.x)
+    a.u.iter()
+        .zip(&b.u)
         .flat_map(|(p, q)| (0..3).map(move |k| (p[k] - q[k]).abs()))
         .fold(0.0, f64::max)
 }

@@ -157,7 +157,7 @@ fn static_trials_formed_in_rounds_give_the_solve_of_trials_one_at_a_time() {
             .unwrap()
             .into_iter()
             .map(|r| {
-                let bits = r.state.x.iter().flatten().map(|x| x.to_bits()).collect();
+                let bits = r.state.u.iter().flatten().map(|x| x.to_bits()).collect();
                 (r.status, bits, r.iterations)
             })
             .collect();

@@ -92,7 +92,7 @@ fn dawson_paslay_sinusoidal_buckling(inclination_deg: f64, length: f64) -> f64 {
     let t = m.nodes[0].hole_axis;
     let low = [-t[0] * t[2], -t[1] * t[2], 1.0 - t[2] * t[2]];
     let low_len = (low[0] * low[0] + low[1] * low[1] + low[2] * low[2]).sqrt();
-    for x in start.x.iter_mut().skip(1) {
+    for x in start.u.iter_mut().skip(1) {
         for k in 0..3 {
             x[k] += (clearance + w / settings().wall_stiffness) * low[k] / low_len;
         }

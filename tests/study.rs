@@ -88,9 +88,10 @@ fn precision_study_of_the_short_spin_up() {
 
 /// `holewall study stability` on the deviated well without dynamics: a cell that fails is
 /// recorded as failed (not skipped). Since stop 69 the WOB far past helical buckling (534
-/// kN, the string buckled and turning in the vertical hole) solves at the whirl's average;
-/// the one failure left is the soft law (m = 2/3) at k_e = 1e11 N/m^m, which the start of
-/// stop 69 failed as well (stalling at λ 0.22).
+/// kN, the string buckled and turning in the vertical hole) solves at the whirl's average.
+/// Since stop 70 the soft law (m = 2/3) at k_e = 1e11 N/m^m solves too: it stalled at λ
+/// 0.22 on the rounding of positions kept from the surface (the static unknowns are now
+/// displacements from the hole axis). No cell fails.
 #[test]
 fn stability_map_of_the_build_and_hold_well() {
     let case = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("cases/build_and_hold.toml");
@@ -118,11 +119,12 @@ fn stability_map_of_the_build_and_hold_well() {
         .map(|c| format!("{} {}", c["parameter"], c["value"]))
         .collect();
     eprintln!("failed: {failed:?}; step cuts: {}", s["step_cut"]);
-    assert_eq!(
-        failed,
-        vec!["\"k_e at m = 0.6667\" \"1e11 N/m^m\"".to_string()],
-        "{failed:?}"
-    );
+    assert!(failed.is_empty(), "{failed:?}");
+    let stiff = map
+        .iter()
+        .find(|c| c["parameter"] == "k_e at m = 0.6667" && c["value"] == "1e11 N/m^m")
+        .unwrap();
+    assert_ne!(stiff["status"], "failed", "{stiff}");
     let wob = map
         .iter()
         .find(|c| c["parameter"] == "wob" && c["value"] == "534 kN")

@@ -69,8 +69,8 @@ fn jeffcott(r: f64, zeta: f64, eps: f64) -> (f64, f64, f64, f64) {
     let mut last = None::<f64>;
     let mut unwrapped = 0.0;
     d.run(&mut s, t_end, &mut |_, st| {
-        let x = st.q.x[k_max][0] - m.nodes[k_max].position[0];
-        let y = st.q.x[k_max][1] - m.nodes[k_max].position[1];
+        let x = st.q.u[k_max][0];
+        let y = st.q.u[k_max][1];
         let a = y.atan2(x);
         if let Some(l) = last {
             let mut da = a - l;
@@ -172,8 +172,8 @@ fn imbalance_against_the_wall(
     d.run(&mut s, t_end, &mut |dd, st| {
         step += 1;
         if step.is_multiple_of(every) && st.t > 0.5 * t_end {
-            x.push(st.q.x[bit][0] - m.nodes[bit].position[0]);
-            y.push(st.q.x[bit][1] - m.nodes[bit].position[1]);
+            x.push(st.q.u[bit][0]);
+            y.push(st.q.u[bit][1]);
             spins.push(st.v[6 * bit + 5]);
             let f = dd.contact_forces(st);
             normal.push(if f[0].contact { 1.0 } else { 0.0 });
@@ -402,7 +402,7 @@ fn the_initial_offset_is_a_half_sine_over_the_bha_within_its_clearance() {
     let bit_md = m.nodes.last().unwrap().md;
     let mut largest = 0.0f64;
     for (i, nd) in m.nodes.iter().enumerate() {
-        let d: Vec<f64> = (0..3).map(|k| q.x[i][k] - q0.x[i][k]).collect();
+        let d: Vec<f64> = (0..3).map(|k| q.u[i][k] - q0.u[i][k]).collect();
         let w = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
         let s = (bit_md - nd.md) / case.bha_length;
         let expect = if s <= 1.0 && i + 1 < m.nodes.len() {
@@ -760,9 +760,8 @@ fn an_offset_start_stays_in_the_hole_in_an_inclined_hole() {
     let rest = solve_static(m, &StaticOptions::default()).unwrap().state;
     let share = case.offset_scale(m, &rest);
     let (q, _) = case.dynamic_start(m, rest.clone());
-    let lateral = |x: &[f64; 3], i: usize| {
+    let lateral = |d: &[f64; 3], i: usize| {
         let nd = &m.nodes[i];
-        let d: Vec<f64> = (0..3).map(|k| x[k] - nd.position[k]).collect();
         let along: f64 = (0..3).map(|k| d[k] * nd.hole_axis[k]).sum();
         (0..3)
             .map(|k| (d[k] - along * nd.hole_axis[k]).powi(2))
@@ -772,10 +771,10 @@ fn an_offset_start_stays_in_the_hole_in_an_inclined_hole() {
     let (mut moved, mut tight) = (0.0f64, f64::INFINITY);
     for site in &m.sites {
         let i = site.node;
-        let (before, after) = (lateral(&rest.x[i], i), lateral(&q.x[i], i));
+        let (before, after) = (lateral(&rest.u[i], i), lateral(&q.u[i], i));
         let room = site.params.clearance.max(before);
         assert!(after <= room + 1e-12, "node {i}: {after} m past {room} m");
-        let step: f64 = (0..3).map(|k| (q.x[i][k] - rest.x[i][k]).powi(2)).sum();
+        let step: f64 = (0..3).map(|k| (q.u[i][k] - rest.u[i][k]).powi(2)).sum();
         moved = moved.max(step.sqrt());
         tight = tight.min(room - after);
     }

@@ -85,7 +85,7 @@ pub struct CriticalSpeeds {
 /// piece of `state`.
 pub fn lower_part(model: &Model, state: &StaticState, first: usize) -> (Model, StaticState) {
     let st = StaticState {
-        x: state.x[first..].to_vec(),
+        u: state.u[first..].to_vec(),
         rot: state.rot[first..].to_vec(),
     };
     (model.lower_part(first), st)

@@ -182,7 +182,7 @@ impl Case {
                     continue;
                 };
                 let w = scale * d.initial_lateral_offset * shape;
-                for (x, a) in q.x[i].iter_mut().zip(lateral(i)) {
+                for (x, a) in q.u[i].iter_mut().zip(lateral(i)) {
                     *x += w * a;
                 }
             }
@@ -262,7 +262,7 @@ impl Case {
             let w = sign * d.initial_lateral_offset * shape;
             let f = &nd.frame0;
             // Lateral position p in the hole and the offset b (⊥ the hole axis).
-            let dx: [f64; 3] = std::array::from_fn(|k| q.x[i][k] - nd.position[k]);
+            let dx: [f64; 3] = q.u[i];
             let along: f64 = (0..3).map(|k| dx[k] * nd.hole_axis[k]).sum();
             let p: [f64; 3] = std::array::from_fn(|k| dx[k] - along * nd.hole_axis[k]);
             let b: [f64; 3] = std::array::from_fn(|k| w * f[k][1]);

@@ -244,7 +244,7 @@ fn run_cpu(
             let mut s = d.initial_state(start.clone()).map_err(|e| e.to_string())?;
             d.run(&mut s, t_end, &mut |_, _| {})
                 .map_err(|e| e.to_string())?;
-            Ok((d.iterations.iter().sum(), s.q.x.clone()))
+            Ok((d.iterations.iter().sum(), s.q.positions(m)))
         })
         .collect();
     let mut its = 0;
@@ -469,7 +469,7 @@ pub fn run(
         let t_end = 0.02;
         options.dt = 0.5e-3 / 8.0;
         let (_, reference) = run_cpu(&models, &start, &density, &options, t_end)?;
-        let x0: Vec<[f64; 3]> = start.x.clone();
+        let x0: Vec<[f64; 3]> = start.positions(&models[0]);
         for dt in [2e-3, 1e-3, 0.5e-3] {
             options.dt = dt;
             for &path in &paths {

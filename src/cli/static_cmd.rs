@@ -173,12 +173,13 @@ pub fn run(
         StaticModel::Fe => {
             let sol = fe.ok_or(Error::failed("no FE solution"))?;
             let (rows, hook, torque, w) = fe_rows(model, &sol);
-            through_wall = crate::diagnose::through_wall_warning(&case, model, &sol.state.x);
+            through_wall =
+                crate::diagnose::through_wall_warning(&case, model, &sol.state.positions(model));
             let element_axial: Vec<f64> = sol.section_forces.iter().map(|f| f.axial).collect();
             span_sag = crate::diagnose::span_through_wall_warning(
                 &case,
                 model,
-                &sol.state.x,
+                &sol.state.positions(model),
                 &sol.state.rot,
                 &element_axial,
             );

@@ -175,7 +175,7 @@ fn a_string_held_only_at_its_stabilizer_sags_through_the_wall() {
             &crate::solve::statics::StaticOptions::default(),
         )
         .expect("solves");
-        let t = through_wall(case, &case.model, &sol.state.x);
+        let t = through_wall(case, &case.model, &sol.state.positions(&case.model));
         // The ensemble's QoI of the same equilibrium.
         let q = crate::ensemble::qoi::static_result(case, "v", &case.model, &sol);
         assert_eq!(q.string.outside_hole_m, Some(t.map_or(0.0, |t| t.excess_m)));
@@ -228,8 +228,11 @@ fn a_string_that_meets_the_wall_is_held_there() {
         .iter()
         .zip(&model.sites)
         .all(|(c, s)| c.0 || s.stabilizer));
-    assert_eq!(through_wall(&case, &model, &sol.state.x), None);
-    assert!(crate::diagnose::beyond_wall(&case, &model, &sol.state.x).is_empty());
+    assert_eq!(
+        through_wall(&case, &model, &sol.state.positions(&model)),
+        None
+    );
+    assert!(crate::diagnose::beyond_wall(&case, &model, &sol.state.positions(&model)).is_empty());
     let measure = crate::solve::statics::residual_measure_at(&model, &sol.state);
     assert!(
         measure < 1e-8,
@@ -250,9 +253,9 @@ fn a_string_that_meets_the_wall_is_held_there() {
     assert!((a / b - 1.0).abs() < 1e-9, "{a} vs {b}");
     let far = sol
         .state
-        .x
+        .u
         .iter()
-        .zip(&reference.state.x)
+        .zip(&reference.state.u)
         .map(|(p, q)| (0..3).map(|k| (p[k] - q[k]).abs()).fold(0.0, f64::max))
         .fold(0.0, f64::max);
     assert!(far < 1e-6, "{far} m");
@@ -343,7 +346,7 @@ fn a_guarded_solve_that_fails_is_tried_with_the_models_own_sites() {
             lambda: 1.0,
             none_at: 1.0,
             model: m.clone(),
-            x: sol.state.x,
+            u: sol.state.u,
             rot: sol.state.rot,
         };
         let mut e = failure("stops");
@@ -728,7 +731,13 @@ fn solve_rotating_pipe(
     let model = &case.model;
     let (_, _, torque, _) = crate::profile::fe_rows(model, &sol);
     let axial: Vec<f64> = sol.section_forces.iter().map(|f| f.axial).collect();
-    let span = span_through_wall(&case, model, &sol.state.x, &sol.state.rot, &axial);
+    let span = span_through_wall(
+        &case,
+        model,
+        &sol.state.positions(model),
+        &sol.state.rot,
+        &axial,
+    );
     (torque.abs(), span, model.elements[1].clone())
 }
 

@@ -359,11 +359,7 @@ mod tests {
         let (a, b) = (1.0f64, 0.6f64);
         let e1 = [a / (a * a + b * b).sqrt(), b / (a * a + b * b).sqrt(), 0.0];
         let depth = site.params.clearance + 2e-3;
-        state.x[50] = [
-            node.position[0] + depth * e1[0],
-            node.position[1] + depth * e1[1],
-            node.position[2] + 0.1,
-        ];
+        state.u[50] = [depth * e1[0], depth * e1[1], 0.1];
         let mut whirling = model.clone();
         whirling.sites[0].params.side_friction = 0.0;
         let full = site_response(&model, &state, &model.sites[0]);
@@ -393,7 +389,7 @@ mod tests {
             let h = 1e-7;
             let at = |d: f64| {
                 let mut s2 = state.clone();
-                s2.x[50][c] += d;
+                s2.u[50][c] += d;
                 site_response(&whirling, &s2, &whirling.sites[0]).g
             };
             let (gp, gm) = (at(h), at(-h));

@@ -506,7 +506,7 @@ fn state_of<T: Real>(
     for i in 0..n {
         for k in 0..3 {
             let at = (3 * i + k) * v + j;
-            s.x[i][k] = tables.node_ref[3 * i + k] + tables.base[at] + config.x[at].to_f64_lossy();
+            s.u[i][k] = tables.base[at] + config.x[at].to_f64_lossy();
         }
         for r in 0..3 {
             for c in 0..3 {

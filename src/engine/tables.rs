@@ -94,9 +94,7 @@ pub fn ensemble_tables_from<T: Real>(
                 .map(crate::solve::statics::static_start)
                 .collect();
             (
-                variant_fastest(3 * n, v, 3, |r, j| {
-                    t(laid[j].x[r / 3][r % 3] - base.nodes[r / 3].position[r % 3])
-                }),
+                variant_fastest(3 * n, v, 3, |r, j| t(laid[j].u[r / 3][r % 3])),
                 variant_fastest(
                     9 * n,
                     v,

@@ -146,7 +146,7 @@ pub(crate) fn lateral(
     node: usize,
 ) -> (f64, f64) {
     let nd = &model.nodes[node];
-    let d = sub(&q.x[node], &nd.position);
+    let d = q.u[node];
     let d_t = sub(&d, &scale(&nd.hole_axis, dot(&d, &nd.hole_axis)));
     let f = &nd.frame0;
     (
@@ -332,7 +332,8 @@ pub fn static_result(
         helical_buckling: Some(helical),
         stick_slip_severity: None,
         outside_hole_m: Some(
-            crate::diagnose::through_wall(case, model, &sol.state.x).map_or(0.0, |t| t.excess_m),
+            crate::diagnose::through_wall(case, model, &sol.state.positions(model))
+                .map_or(0.0, |t| t.excess_m),
         ),
         stopped_load_factor: None,
     };
@@ -526,7 +527,7 @@ impl DynamicObserver {
             if r > 0.0 {
                 let g = &contact[k].g;
                 let nd = &model.nodes[node];
-                let dd = sub(&st.q.x[node], &nd.position);
+                let dd = st.q.u[node];
                 let d_t = sub(&dd, &scale(&nd.hole_axis, dot(&dd, &nd.hole_axis)));
                 let normal = dot(&[g[0], g[1], g[2]], &d_t) / r / model.tributary_length(node);
                 if normal > self.per_length.0 {
@@ -553,7 +554,7 @@ impl DynamicObserver {
             if r > 0.0 {
                 let g = &contact[k].g;
                 let nd = &model.nodes[node];
-                let d = sub(&st.q.x[node], &nd.position);
+                let d = st.q.u[node];
                 let d_t = sub(&d, &scale(&nd.hole_axis, dot(&d, &nd.hole_axis)));
                 let normal = dot(&[g[0], g[1], g[2]], &d_t) / r;
                 qoi.max_side_force_n = qoi.max_side_force_n.max(normal);

@@ -199,8 +199,7 @@ pub fn run_dynamic_gpu<T: crate::gpu::contact::GpuReal>(
                         state.t = t;
                         for i in 0..n {
                             for k in 0..3 {
-                                state.q.x[i][k] = m.nodes[i].position[k]
-                                    + batch.u[(3 * i + k) * v + j].to_f64_lossy();
+                                state.q.u[i][k] = batch.u[(3 * i + k) * v + j].to_f64_lossy();
                             }
                             for r in 0..3 {
                                 for c in 0..3 {

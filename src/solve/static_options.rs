@@ -111,11 +111,12 @@ pub struct Stopped {
     pub none_at: f64,
     /// The model at those loads (`solve::statics::model_at`).
     pub model: Model,
-    /// The equilibrium there, the string as it stands when it stops: node positions and
-    /// nodal rotations (`solve::statics::StaticState`'s; its section forces, contact
-    /// and reactions: `solve::statics::stopped_solution`).
-    pub x: Vec<crate::physics::vec3::Vec3<f64>>,
-    /// See `x`.
+    /// The equilibrium there, the string as it stands when it stops: node displacements
+    /// from their places on the hole axis and nodal rotations
+    /// (`solve::statics::StaticState`'s; its section forces, contact and reactions:
+    /// `solve::statics::stopped_solution`).
+    pub u: Vec<crate::physics::vec3::Vec3<f64>>,
+    /// See `u`.
     pub rot: Vec<crate::physics::rotation::Mat3<f64>>,
 }
 

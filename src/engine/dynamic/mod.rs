@@ -177,8 +177,7 @@ fn dynamic_tables<'a, T: Real>(
         })
         .collect::<Result<_, crate::error::SystemError>>()?;
     // The tables, variant-fastest, filled a node (or a field) at a time in parallel.
-    let from_reference =
-        |i: usize, k: usize, j: usize| initial[j].1.q.x[i][k] - models[j].nodes[i].position[k];
+    let from_reference = |i: usize, k: usize, j: usize| initial[j].1.q.u[i][k];
     // The base: each node's start, the top's reference (its motion is the top drive's).
     let base = variant_fastest(3 * n, v, 3, |r, j| {
         if r < 3 {

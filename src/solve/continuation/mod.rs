@@ -49,8 +49,8 @@ mod driver;
 mod relax;
 
 pub use driver::{solve_loads, solve_loads_from, StaticSystem};
-pub use relax::LOCK_FOUND;
 use relax::*;
+pub use relax::{LOCK_FOUND, RELAX_STALL_FACTOR};
 
 use super::newton::{NewtonSettings, SolveLimits, FOLD_STALL_ITERATIONS};
 use super::static_options::{StaticError, StaticOptions, GRAVITY_STAGE, LOAD_STAGE};

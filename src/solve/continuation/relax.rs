@@ -65,7 +65,7 @@ pub(super) const RELAX_SUB_REDUCTION: f64 = 0.5;
 /// a relaxation were gone (stop 50 measured 2.4 % with them).
 pub(super) const RELAX_STALL_SUBS: usize = 20;
 /// See [`RELAX_STALL_SUBS`].
-pub(super) const RELAX_STALL_FACTOR: f64 = 100.0;
+pub const RELAX_STALL_FACTOR: f64 = 100.0;
 /// The smallest shift, `s0 ×` this: the proximal points converge at the rate `s / (s + k)`
 /// per sub-solve along a stiffness `k`, and a buckled string's lateral modes are soft (a
 /// span's `EI / L³` less its compression's share), so a high floor costs hundreds of

@@ -26,7 +26,7 @@ use crate::model::Model;
 use crate::physics::beam::{rotation_exp, Mat3};
 use crate::physics::contact::{evaluate, ContactMode, ContactTerms, SpringLaw};
 use crate::physics::mass::MassKind;
-use crate::physics::vec3::{cross, dot, sub, Vec3};
+use crate::physics::vec3::{cross, dot, Vec3};
 use crate::solve::chain::{BlockTridiagonal, ChainSolver};
 use crate::solve::statics::{
     constrain, constrain_residual, constraints, external_loads, for_each_element_response,
@@ -603,7 +603,7 @@ impl<'a> Dynamics<'a> {
         for site in &model.sites {
             let i = site.node;
             let node = &model.nodes[i];
-            let d = sub(&s.q.x[i], &node.position);
+            let d = s.q.u[i];
             let v: Vec3<f64> = std::array::from_fn(|k| s.v[6 * i + k]);
             let w: Vec3<f64> = std::array::from_fn(|k| s.v[6 * i + 3 + k]);
             let spin = dot(&node.hole_axis, &w);
@@ -652,7 +652,7 @@ impl<'a> Dynamics<'a> {
             .map(|site| {
                 let i = site.node;
                 let node = &model.nodes[i];
-                let d = sub(&s.q.x[i], &node.position);
+                let d = s.q.u[i];
                 let v: Vec3<f64> = std::array::from_fn(|k| s.v[6 * i + k]);
                 let w: Vec3<f64> = std::array::from_fn(|k| s.v[6 * i + 3 + k]);
                 evaluate(
@@ -673,7 +673,9 @@ impl<'a> Dynamics<'a> {
         use crate::solve::newton::{Event, Newton, NewtonSettings};
         let settings =
             NewtonSettings::dynamics(self.options.max_iterations, self.options.tolerance, 8);
-        let largest = s.q.x.iter().flatten().fold(0.0f64, |m, x| m.max(x.abs()));
+        let largest = (0..s.q.u.len())
+            .flat_map(|i| s.q.position(self.model, i))
+            .fold(0.0f64, |m, x| m.max(x.abs()));
         let floor = NewtonSettings::step_floor(8, largest);
         let mut sys = CpuStep::new(self, s, h);
         let mut newton = Newton::new(settings, 1);

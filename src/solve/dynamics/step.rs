@@ -93,7 +93,7 @@ impl<'s, 'a> CpuStep<'s, 'a> {
                 })
                 .collect();
             for k in 0..3 {
-                tr.q.x[i][k] = s.q.x[i][k] + h * dq[k];
+                tr.q.u[i][k] = s.q.u[i][k] + h * dq[k];
             }
             tr.q.rot[i] = mat_mul(
                 &rotation_exp(&[h * dq[3], h * dq[4], h * dq[5]]),
@@ -111,7 +111,7 @@ impl<'s, 'a> CpuStep<'s, 'a> {
         }
         if self.lowered {
             for k in 0..3 {
-                tr.q.x[0][k] = top.position[k] + self.hook.0 * n0[k];
+                tr.q.u[0][k] = self.hook.0 * n0[k];
                 tr.v[k] = self.hook.1 * n0[k];
             }
         }

@@ -155,7 +155,7 @@ pub fn site_response(
         mode: ContactMode::Static,
     };
     let node = &model.nodes[site.node];
-    let d = sub(&state.x[site.node], &node.position);
+    let d = state.u[site.node];
     let v = scale(&node.hole_axis, model.axial_speed);
     evaluate(
         &node.hole_axis,
@@ -222,7 +222,7 @@ pub(crate) fn for_each_element_response(
     let element = |i: usize| {
         let e = &model.elements[i];
         let es = ElementState {
-            x: [state.x[i], state.x[i + 1]],
+            x: [state.position(model, i), state.position(model, i + 1)],
             triad: [
                 mat_mul(&state.rot[i], &model.nodes[i].frame0),
                 mat_mul(&state.rot[i + 1], &model.nodes[i + 1].frame0),
@@ -365,13 +365,13 @@ fn update(
     landed: &mut Vec<usize>,
 ) -> StaticState {
     let mut s = state.clone();
-    for i in 0..s.x.len() {
+    for i in 0..s.u.len() {
         let mut du: Vec3<f64> = std::array::from_fn(|k| alpha * delta[6 * i + k]);
         if let Some(b) = &c.basis[i] {
             du = std::array::from_fn(|r| (0..3).map(|k| b[r][k] * du[k]).sum());
         }
         if let Some(w) = &walls[i] {
-            let d = sub(&s.x[i], &w.origin);
+            let d = s.u[i];
             du = crate::physics::contact::wall_following_step(&d, &w.axis, &du, w.min_radius);
             if may_land.get(i).copied().unwrap_or(false) {
                 let l = crate::physics::contact::landing_step(&d, &w.axis, &du, w.clearance);
@@ -384,7 +384,7 @@ fn update(
                 du = crate::physics::contact::deepening_step(&d, &w.axis, &du, w.clearance);
             }
         }
-        for (x, d) in s.x[i].iter_mut().zip(du) {
+        for (x, d) in s.u[i].iter_mut().zip(du) {
             *x += d;
         }
         let dth: Vec3<f64> = std::array::from_fn(|k| alpha * delta[6 * i + 3 + k]);
@@ -393,11 +393,10 @@ fn update(
     s
 }
 
-/// A contact node's hole: its point on the axis, the axis, and the lateral offset from
-/// which its steps follow the wall.
+/// A contact node's hole: its axis and the lateral offset from which its steps follow the
+/// wall (the node's displacement is its offset from the axis point it was placed at).
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Wall {
-    origin: Vec3<f64>,
     axis: Vec3<f64>,
     min_radius: f64,
     clearance: f64,
@@ -411,7 +410,6 @@ pub(crate) fn walls(model: &Model) -> Vec<Option<Wall>> {
     for site in &model.sites {
         let node = &model.nodes[site.node];
         w[site.node] = Some(Wall {
-            origin: node.position,
             axis: node.hole_axis,
             min_radius: crate::physics::contact::wall_following_radius(site.params.clearance),
             clearance: site.params.clearance,
@@ -601,7 +599,7 @@ pub fn solve_static_monitored(
                         lambda,
                         none_at,
                         model: model_at(model, &target),
-                        x: state.x,
+                        u: state.u,
                         rot: state.rot,
                     }));
                 }
@@ -622,7 +620,7 @@ pub fn solve_static_monitored(
 /// ([`Stopped`]), in its model at those loads.
 pub fn stopped_solution(stopped: &Stopped) -> StaticSolution {
     let state = StaticState {
-        x: stopped.x.clone(),
+        u: stopped.u.clone(),
         rot: stopped.rot.clone(),
     };
     solution_at(&stopped.model, state)

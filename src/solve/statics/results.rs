@@ -69,8 +69,8 @@ pub fn element_deformation(
     let t1 = mat_mul(&state.rot[i], &model.nodes[i].frame0);
     let t2 = mat_mul(&state.rot[i + 1], &model.nodes[i + 1].frame0);
     local_deformation(
-        &state.x[i],
-        &state.x[i + 1],
+        &state.position(model, i),
+        &state.position(model, i + 1),
         &t1,
         &t2,
         model.elements[i].length0,
@@ -116,7 +116,7 @@ pub(super) fn finish(
         .iter()
         .map(|site| {
             let node = &model.nodes[site.node];
-            let d = sub(&state.x[site.node], &node.position);
+            let d = state.u[site.node];
             let out = site_response(model, &state, site);
             // Normal force: the radial part of the internal force.
             let d_t = sub(&d, &scale(&node.hole_axis, dot(&d, &node.hole_axis)));

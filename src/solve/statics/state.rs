@@ -5,16 +5,48 @@
 
 use super::*;
 
-/// Nodal configuration.
+/// Nodal configuration: each node's displacement from its place on the hole axis
+/// (`Model::nodes[i].position`) and its rotation.
+///
+/// The displacements, not the positions, are the unknowns, as in the engine (its
+/// configuration is kept from the reference, `crate::engine`): a position 1,500 m from the
+/// surface is rounded to 2.3e-13 m, and a contact's penetration is a difference of two
+/// such positions. On a stiff soft-law wall (k_e = 1e11 N/m^m, m = 2/3; onset stiffness
+/// ≈ 6e12 N/m) that rounding alone moved the contact forces by about 1 N, a residual of
+/// 1e-6 of the force scale that no Newton update could lower; kept as displacements
+/// (millimetres, rounded to 1e-19 m) the same solve converges (docs/stability.md).
 #[derive(Clone, Debug)]
 pub struct StaticState {
-    /// Node positions.
-    pub x: Vec<Vec3<f64>>,
+    /// Node displacements from their places on the hole axis (m).
+    pub u: Vec<Vec3<f64>>,
     /// Nodal rotations (from the initial configuration).
     pub rot: Vec<Mat3<f64>>,
 }
 
 impl StaticState {
+    /// Node `i`'s position (its place on the hole axis plus its displacement).
+    pub fn position(&self, model: &Model, i: usize) -> Vec3<f64> {
+        let p = model.nodes[i].position;
+        std::array::from_fn(|k| p[k] + self.u[i][k])
+    }
+
+    /// Every node's position ([`StaticState::position`]).
+    pub fn positions(&self, model: &Model) -> Vec<Vec3<f64>> {
+        (0..self.u.len()).map(|i| self.position(model, i)).collect()
+    }
+
+    /// The configuration with these node positions and rotations (the displacements taken
+    /// from the model's node places).
+    pub fn from_positions(model: &Model, x: &[Vec3<f64>], rot: Vec<Mat3<f64>>) -> StaticState {
+        StaticState {
+            u: x.iter()
+                .zip(&model.nodes)
+                .map(|(x, n)| sub(x, &n.position))
+                .collect(),
+            rot,
+        }
+    }
+
     /// A first guess near the equilibrium under gravity (the load path's first stage), from
     /// the frictionless soft-string solution without bit loads (issue 22):
     /// - **prestressed**: each node moved along its hole axis by the stretch `∫ F/EA` of
@@ -71,7 +103,7 @@ impl StaticState {
                 u[e] = u[e + 1] - stretch[e];
             }
         }
-        for ((x, ui), node) in s.x.iter_mut().zip(&u).zip(&model.nodes) {
+        for ((x, ui), node) in s.u.iter_mut().zip(&u).zip(&model.nodes) {
             for (xk, tk) in x.iter_mut().zip(node.hole_axis) {
                 *xk += ui * tk;
             }
@@ -172,7 +204,7 @@ impl StaticState {
         }
         for i in 0..n {
             if let Some((dir, _)) = offset[i] {
-                for (x, d) in s.x[i].iter_mut().zip(dir) {
+                for (x, d) in s.u[i].iter_mut().zip(dir) {
                     *x += magnitude[i] * d;
                 }
             }
@@ -184,7 +216,7 @@ impl StaticState {
     pub fn initial(model: &Model) -> StaticState {
         let eye = rotation_exp(&[0.0; 3]);
         StaticState {
-            x: model.nodes.iter().map(|n| n.position).collect(),
+            u: vec![[0.0; 3]; model.nodes.len()],
             rot: vec![eye; model.nodes.len()],
         }
     }

@@ -49,7 +49,7 @@ pub fn relax_scale(model: &Model, f_ref: f64) -> f64 {
     f_ref / shortest.max(1e-3)
 }
 
-/// Adds a proximal shift `s (x − a)` to the translations' residual and `s I` to their
+/// Adds a proximal shift `s (u − a)` to the translations' residual (`u` the displacements) and `s I` to their
 /// tangent blocks (before the constraints: `s I` is the same in any node basis).
 fn add_shift(
     s: f64,
@@ -159,7 +159,7 @@ impl crate::solve::newton::NewtonSystem for CpuStatic<'_> {
             );
             add_shift(
                 self.shift,
-                &self.state.x,
+                &self.state.u,
                 &self.anchor,
                 &mut self.residual,
                 Some(&mut self.tangent),
@@ -194,7 +194,7 @@ impl crate::solve::newton::NewtonSystem for CpuStatic<'_> {
     ) -> Result<crate::solve::newton::TrialProbe, crate::error::SystemError> {
         let (s, landed) = self.moved(alpha[0]);
         assemble(&self.loaded, &s, 1.0, &self.f_step, &mut self.trial, None);
-        add_shift(self.shift, &s.x, &self.anchor, &mut self.trial, None);
+        add_shift(self.shift, &s.u, &self.anchor, &mut self.trial, None);
         constrain_residual(&self.c, &mut self.trial);
         self.trial_state = Some((alpha[0], s, landed));
         Ok(crate::solve::newton::TrialProbe {
@@ -271,8 +271,8 @@ impl crate::solve::continuation::StaticSystem for CpuStatic<'_> {
         // by name, so a field added to the state cannot be left out unnoticed.
         match &mut self.kept {
             Some((state, t)) => {
-                let StaticState { x, rot } = &self.state;
-                state.x.clone_from(x);
+                let StaticState { u, rot } = &self.state;
+                state.u.clone_from(u);
                 state.rot.clone_from(rot);
                 *t = *target;
             }
@@ -284,17 +284,15 @@ impl crate::solve::continuation::StaticSystem for CpuStatic<'_> {
         self.anchor = if s == 0.0 {
             Vec::new()
         } else {
-            self.state.x.clone()
+            self.state.u.clone()
         };
         self.evaluated = false;
         Ok(())
     }
     fn step_floor(&mut self, _j: usize) -> Result<f64, crate::error::SystemError> {
-        let largest = self
-            .state
-            .x
-            .iter()
-            .flatten()
+        // Of the positions from the origin, as the engine's f64 floor.
+        let largest = (0..self.state.u.len())
+            .flat_map(|i| self.state.position(self.model, i))
             .fold(0.0f64, |m, x| m.max(x.abs()));
         Ok(crate::solve::newton::NewtonSettings::step_floor(8, largest))
     }
