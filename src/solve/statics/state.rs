@@ -12,8 +12,8 @@ use super::*;
 /// configuration is kept from the reference, `crate::engine`): a position 1,500 m from the
 /// surface is rounded to 2.3e-13 m, and a contact's penetration is a difference of two
 /// such positions. On a stiff soft-law wall (k_e = 1e11 N/m^m, m = 2/3; onset stiffness
-/// ≈ 6e12 N/m) that rounding alone moved the contact forces by about 1 N, a residual of
-/// 1e-6 of the force scale that no Newton update could lower; kept as displacements
+/// ≈ 6e12 N/m) that rounding alone moved the contact forces by about 1 N, a residual of a
+/// few 1e-6 of the force scale that no Newton update could lower; kept as displacements
 /// (millimetres, rounded to 1e-19 m) the same solve converges (docs/stability.md).
 #[derive(Clone, Debug)]
 pub struct StaticState {
@@ -33,18 +33,6 @@ impl StaticState {
     /// Every node's position ([`StaticState::position`]).
     pub fn positions(&self, model: &Model) -> Vec<Vec3<f64>> {
         (0..self.u.len()).map(|i| self.position(model, i)).collect()
-    }
-
-    /// The configuration with these node positions and rotations (the displacements taken
-    /// from the model's node places).
-    pub fn from_positions(model: &Model, x: &[Vec3<f64>], rot: Vec<Mat3<f64>>) -> StaticState {
-        StaticState {
-            u: x.iter()
-                .zip(&model.nodes)
-                .map(|(x, n)| sub(x, &n.position))
-                .collect(),
-            rot,
-        }
     }
 
     /// A first guess near the equilibrium under gravity (the load path's first stage), from
