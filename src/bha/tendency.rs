@@ -359,9 +359,17 @@ pub fn tendency(
         settings: *settings,
         ..Default::default()
     };
+    // A curvature asked again (the rates' first difference is the equilibrium's first
+    // secant step, (PROBE, 0)) is not solved again: the same solve gives the same loads.
+    let mut solved: Vec<((f64, f64), (BitLoads, HoleFrame))> = Vec::new();
     let mut solve = |k: (f64, f64)| {
+        if let Some((_, s)) = solved.iter().find(|s| s.0 == k) {
+            return Ok(*s);
+        }
         out.solves += 1;
-        bit_at(model, first, k, wob, toolface, settings.deadline)
+        let s = bit_at(model, first, k, wob, toolface, settings.deadline)?;
+        solved.push((k, s));
+        Ok::<_, BitSolveError>(s)
     };
     let to_rate = RAD_PER_M_TO_DEG_PER_30M;
     let limit = 30.0 / to_rate;
