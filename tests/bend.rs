@@ -421,9 +421,7 @@ fn a_bent_collar_that_meets_the_wall_runs_on_the_engine_held_there() {
     if common::gpu().is_none() {
         return;
     }
-    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
-    let text = std::fs::read_to_string(root.join("cases/spinup_short.toml"))
-        .unwrap()
+    let text = common::shipped_case_text("spinup_short.toml")
         .replacen(
             "length = \"9.25 m\"",
             "length = \"9.25 m\"\nbend = \"1 deg\"\nbend_toolface = \"30 deg\"",

@@ -327,13 +327,10 @@ fn compacted_static_variants_go_on_bit_for_bit() {
 /// says so).
 #[test]
 fn a_stiff_soft_law_wall_solves_on_the_cpu_as_in_the_engine() {
-    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
-    let text = std::fs::read_to_string(root.join("cases/build_and_hold.toml"))
-        .unwrap()
-        .replace(
-            "sites = \"all_nodes\"",
-            "sites = \"all_nodes\"\nwall_stiffness = 1e11\nexponent = 0.6666667",
-        );
+    let text = common::shipped_case_text("build_and_hold.toml").replace(
+        "sites = \"all_nodes\"",
+        "sites = \"all_nodes\"\nwall_stiffness = 1e11\nexponent = 0.6666667",
+    );
     assert!(text.contains("wall_stiffness = 1e11"));
     let case = holewall::case::parse_case(std::path::Path::new("stiff.toml"), &text).unwrap();
     let model = &case.model;

@@ -570,10 +570,7 @@ fn the_dynamic_engine_starts_from_the_offset_and_kick() {
     if common::gpu().is_none() {
         return;
     }
-    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
-    let text = std::fs::read_to_string(root.join("cases/spinup_short.toml"))
-        .unwrap()
-        .replace(
+    let text = common::shipped_case_text("spinup_short.toml").replace(
             "rho_inf = 0.8",
             "rho_inf = 0.8\ninitial_lateral_offset = \"2 mm\"\ninitial_lateral_velocity = \"0.02 m/s\"",
         )
@@ -602,9 +599,7 @@ fn the_dynamic_engine_runs_a_mass_imbalance_as_the_cpu_does() {
     if common::gpu().is_none() {
         return;
     }
-    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
-    let text = std::fs::read_to_string(root.join("cases/spinup_short.toml"))
-        .unwrap()
+    let text = common::shipped_case_text("spinup_short.toml")
         .replace("duration = \"1 s\"", "duration = \"0.3 s\"")
         .replace("ramp_time = \"0.5 s\"", "ramp_time = \"0.1 s\"");
     let grid =
@@ -743,9 +738,7 @@ fn an_offset_start_stays_in_the_hole_in_an_inclined_hole() {
         "md_m, inclination_deg, azimuth_deg\n0, 60, 30\n60, 60, 30\n",
     )
     .unwrap();
-    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
-    let text = std::fs::read_to_string(root.join("cases/spinup_short.toml"))
-        .unwrap()
+    let text = common::shipped_case_text("spinup_short.toml")
         .replace(
             "profile = \"vertical\"",
             "profile = \"survey\"\nsurvey = \"straight.csv\"",

@@ -305,3 +305,11 @@ pub fn summary_agrees_with_csv(
         out.display()
     );
 }
+
+/// The text of the shipped case `cases/NAME`.
+pub fn shipped_case_text(name: &str) -> String {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("cases")
+        .join(name);
+    std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+}
