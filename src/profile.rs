@@ -333,10 +333,7 @@ pub(crate) fn hold_in_hole(
         .max_seconds
         .map(|s| (s - clock.elapsed().as_secs_f64()).max(0.0));
     match solve(model, &options) {
-        Ok(sol)
-            if crate::diagnose::beyond_wall(case, model, &sol.state.positions(model))
-                .is_empty() =>
-        {
+        Ok(sol) if crate::diagnose::beyond_wall(case, model, &sol.state).is_empty() => {
             let mut sol = said(sol);
             sol.log.push(format!(
                 "the solve with a guard site at every node failed ({}); the string solved at \

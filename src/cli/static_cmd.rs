@@ -173,14 +173,12 @@ pub fn run(
         StaticModel::Fe => {
             let sol = fe.ok_or(Error::failed("no FE solution"))?;
             let (rows, hook, torque, w) = fe_rows(model, &sol);
-            through_wall =
-                crate::diagnose::through_wall_warning(&case, model, &sol.state.positions(model));
+            through_wall = crate::diagnose::through_wall_warning(&case, model, &sol.state);
             let element_axial: Vec<f64> = sol.section_forces.iter().map(|f| f.axial).collect();
             span_sag = crate::diagnose::span_through_wall_warning(
                 &case,
                 model,
-                &sol.state.positions(model),
-                &sol.state.rot,
+                &sol.state,
                 &element_axial,
             );
             wob = w;

@@ -618,19 +618,12 @@ pub fn run_well(
             let (_, hook, torque, _) = crate::profile::fe_rows(model, &sol);
             r.solved = true;
             r.fe_reached = 1.0;
-            r.through_wall_mm =
-                crate::diagnose::through_wall(&case, model, &sol.state.positions(model))
-                    .map_or(0.0, |t| 1e3 * t.excess_m);
+            r.through_wall_mm = crate::diagnose::through_wall(&case, model, &sol.state)
+                .map_or(0.0, |t| 1e3 * t.excess_m);
             let axial: Vec<f64> = sol.section_forces.iter().map(|f| f.axial).collect();
             r.past_yield = crate::diagnose::past_yield(&case, &axial).is_some();
-            r.span_sag_mm = crate::diagnose::span_through_wall(
-                &case,
-                model,
-                &sol.state.positions(model),
-                &sol.state.rot,
-                &axial,
-            )
-            .map_or(0.0, |t| 1e3 * t.excess_m);
+            r.span_sag_mm = crate::diagnose::span_through_wall(&case, model, &sol.state, &axial)
+                .map_or(0.0, |t| 1e3 * t.excess_m);
             r.load_steps = sol.iterations.len();
             r.step_cuts = crate::profile::path_events(&sol.log);
             r.relaxed = sol

@@ -323,10 +323,10 @@ pub struct ThroughWall {
 pub fn through_wall(
     case: &Case,
     model: &Model,
-    x: &[crate::physics::vec3::Vec3<f64>],
+    state: &crate::solve::statics::StaticState,
 ) -> Option<ThroughWall> {
     let mut out: Option<ThroughWall> = None;
-    for (i, excess) in beyond_wall(case, model, x) {
+    for (i, excess) in beyond_wall(case, model, state) {
         if excess <= THROUGH_WALL_TOLERANCE {
             continue;
         }
@@ -348,14 +348,14 @@ pub fn through_wall(
     out
 }
 
-/// Every node of `x` without a contact site that lies beyond the wall of `case`'s hole at
+/// Every node of `state` without a contact site that lies beyond the wall of `case`'s hole at
 /// all, with how far (m), measured as [`through_wall`] measures it (there: only those
 /// beyond [`THROUGH_WALL_TOLERANCE`] count). The nodes a static solve gives contact sites
 /// ([`crate::profile::solve_in_hole`]).
 pub fn beyond_wall(
     case: &Case,
     model: &Model,
-    x: &[crate::physics::vec3::Vec3<f64>],
+    state: &crate::solve::statics::StaticState,
 ) -> Vec<(usize, f64)> {
     let held = model.site_nodes();
     let mut out = Vec::new();
@@ -363,7 +363,7 @@ pub fn beyond_wall(
         if held[i] {
             continue;
         }
-        let excess = lateral_offset(model, x, i)
+        let excess = lateral_offset(model, state, i)
             - (0.5 * case.hole_at(node.md).diameter - model.pipe_radius_at(i));
         if excess > 0.0 {
             out.push((i, excess));
@@ -372,12 +372,12 @@ pub fn beyond_wall(
     out
 }
 
-/// Node `i`'s lateral offset in `x` (m): its displacement from its hole axis with the part
-/// along the axis removed, as a contact site measures it.
-fn lateral_offset(model: &Model, x: &[crate::physics::vec3::Vec3<f64>], i: usize) -> f64 {
+/// Node `i`'s lateral offset in `state` (m): its displacement from its hole axis with the
+/// part along the axis removed, as a contact site measures it.
+fn lateral_offset(model: &Model, state: &crate::solve::statics::StaticState, i: usize) -> f64 {
     use crate::physics::vec3::{dot, scale, sub};
     let node = &model.nodes[i];
-    let d = sub(&x[i], &node.position);
+    let d = state.u[i];
     let d_t = sub(&d, &scale(&node.hole_axis, dot(&d, &node.hole_axis)));
     dot(&d_t, &d_t).sqrt()
 }
@@ -387,9 +387,9 @@ fn lateral_offset(model: &Model, x: &[crate::physics::vec3::Vec3<f64>], i: usize
 pub fn through_wall_warning(
     case: &Case,
     model: &Model,
-    x: &[crate::physics::vec3::Vec3<f64>],
+    state: &crate::solve::statics::StaticState,
 ) -> Option<String> {
-    let t = through_wall(case, model, x)?;
+    let t = through_wall(case, model, state)?;
     Some(format!(
         "the string lies outside the hole at {} nodes without a contact site between MD \
          {:.0} m and {:.0} m, up to {:.0} mm beyond the wall (at MD {:.0} m): this is the equilibrium of a string partly \
@@ -465,8 +465,7 @@ pub fn clamped_span_sag(q: f64, l: f64, ei: f64, t: f64) -> f64 {
 pub fn span_through_wall(
     case: &Case,
     model: &Model,
-    x: &[crate::physics::vec3::Vec3<f64>],
-    rot: &[crate::physics::rotation::Mat3<f64>],
+    state: &crate::solve::statics::StaticState,
     axial: &[f64],
 ) -> Option<SpanSag> {
     use crate::physics::vec3::{add, dot, scale, sub};
@@ -486,9 +485,15 @@ pub fn span_through_wall(
         let (na, nb) = (&model.nodes[i], &model.nodes[i + 1]);
         let l = e.length0;
         let axis_mid = middle(&na.position, &nb.position, &na.hole_axis, &nb.hole_axis, l);
-        let ta = turn(&rot[i], &na.hole_axis);
-        let tb = turn(&rot[i + 1], &nb.hole_axis);
-        let pipe_mid = middle(&x[i], &x[i + 1], &ta, &tb, l);
+        let ta = turn(&state.rot[i], &na.hole_axis);
+        let tb = turn(&state.rot[i + 1], &nb.hole_axis);
+        let pipe_mid = middle(
+            &state.position(model, i),
+            &state.position(model, i + 1),
+            &ta,
+            &tb,
+            l,
+        );
         let sum = add(&na.hole_axis, &nb.hole_axis);
         let t = scale(&sum, 1.0 / dot(&sum, &sum).sqrt());
         let across = |v: &[f64; 3]| sub(v, &scale(&t, dot(v, &t)));
@@ -509,8 +514,8 @@ pub fn span_through_wall(
         // span's own sag, not the wall's give.
         let clearance = 0.5 * (case.hole_at(md).diameter - e.outer_diameter);
         let allowed = clearance
-            .max(lateral_offset(model, x, i))
-            .max(lateral_offset(model, x, i + 1));
+            .max(lateral_offset(model, state, i))
+            .max(lateral_offset(model, state, i + 1));
         let excess = dot(&d, &d).sqrt() - allowed;
         if excess <= THROUGH_WALL_TOLERANCE {
             continue;
@@ -548,11 +553,10 @@ pub fn span_through_wall(
 pub fn span_through_wall_warning(
     case: &Case,
     model: &Model,
-    x: &[crate::physics::vec3::Vec3<f64>],
-    rot: &[crate::physics::rotation::Mat3<f64>],
+    state: &crate::solve::statics::StaticState,
     axial: &[f64],
 ) -> Option<String> {
-    let w = span_through_wall(case, model, x, rot, axial)?;
+    let w = span_through_wall(case, model, state, axial)?;
     if w.excess_m <= SPAN_SAG_WARNING * w.clearance_m {
         return None;
     }

@@ -120,7 +120,7 @@ fn lock_up_fraction_is_where_the_riccati_runaway_reaches_the_surface() {
 fn through_wall_finds_a_node_past_its_clearance() {
     let case = vertical_bha(50.0, "stabilizers");
     let model = &case.model;
-    let mut x: Vec<_> = model.nodes.iter().map(|n| n.position).collect();
+    let mut x = crate::solve::statics::StaticState::initial(model);
     assert_eq!(through_wall(&case, model, &x), None);
     let held: Vec<usize> = model.sites.iter().map(|s| s.node).collect();
     let free = (1..model.nodes.len() - 1)
@@ -140,9 +140,8 @@ fn through_wall_finds_a_node_past_its_clearance() {
         [-t[2], 0.0, t[0]]
     };
     let norm = across.iter().map(|a| a * a).sum::<f64>().sqrt();
-    let place = |x: &mut Vec<[f64; 3]>, offset: f64, along: f64| {
-        x[free] =
-            std::array::from_fn(|k| node.position[k] + offset * across[k] / norm + along * t[k]);
+    let place = |x: &mut crate::solve::statics::StaticState, offset: f64, along: f64| {
+        x.u[free] = std::array::from_fn(|k| offset * across[k] / norm + along * t[k]);
     };
     // At the wall, and metres along the axis: inside.
     place(&mut x, clearance + 0.5 * THROUGH_WALL_TOLERANCE, 3.0);
@@ -156,8 +155,8 @@ fn through_wall_finds_a_node_past_its_clearance() {
     assert!((t.excess_m - 0.02).abs() < 1e-9, "{}", t.excess_m);
     // A site's node is held by the wall: never reported.
     let site = held[0];
-    x[free] = node.position;
-    x[site][0] += 1.0;
+    x.u[free] = [0.0; 3];
+    x.u[site][0] += 1.0;
     assert_eq!(through_wall(&case, model, &x), None);
 }
 
@@ -175,7 +174,7 @@ fn a_string_held_only_at_its_stabilizer_sags_through_the_wall() {
             &crate::solve::statics::StaticOptions::default(),
         )
         .expect("solves");
-        let t = through_wall(case, &case.model, &sol.state.positions(&case.model));
+        let t = through_wall(case, &case.model, &sol.state);
         // The ensemble's QoI of the same equilibrium.
         let q = crate::ensemble::qoi::static_result(case, "v", &case.model, &sol);
         assert_eq!(q.string.outside_hole_m, Some(t.map_or(0.0, |t| t.excess_m)));
@@ -228,11 +227,8 @@ fn a_string_that_meets_the_wall_is_held_there() {
         .iter()
         .zip(&model.sites)
         .all(|(c, s)| c.0 || s.stabilizer));
-    assert_eq!(
-        through_wall(&case, &model, &sol.state.positions(&model)),
-        None
-    );
-    assert!(crate::diagnose::beyond_wall(&case, &model, &sol.state.positions(&model)).is_empty());
+    assert_eq!(through_wall(&case, &model, &sol.state), None);
+    assert!(crate::diagnose::beyond_wall(&case, &model, &sol.state).is_empty());
     let measure = crate::solve::statics::residual_measure_at(&model, &sol.state);
     assert!(
         measure < 1e-8,
@@ -685,15 +681,13 @@ fn a_long_span_laid_on_the_wall_sags_through_it_by_its_weight() {
         let model = &case.model;
         let e = &model.elements[1];
         let clearance = 0.5 * (case.hole_at(model.nodes[1].md).diameter - e.outer_diameter);
-        let x: Vec<_> = model
-            .nodes
-            .iter()
-            .map(|n| [n.position[0], n.position[1], n.position[2] + clearance])
-            .collect();
-        let identity = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
-        let rot = vec![identity; model.nodes.len()];
+        // Every node `clearance` below its axis, unrotated.
+        let mut x = crate::solve::statics::StaticState::initial(model);
+        for u in x.u.iter_mut() {
+            *u = [0.0, 0.0, clearance];
+        }
         let axial = vec![0.0; model.elements.len()];
-        let found = span_through_wall(&case, model, &x, &rot, &axial);
+        let found = span_through_wall(&case, model, &x, &axial);
         let sag = e.buoyed_weight_per_length * e.length0.powi(4)
             / (384.0 * e.section.bending_stiffness());
         eprintln!("{element_m} m elements, sites {sites}: sag {sag:.3e} m, found {found:?}");
@@ -702,7 +696,7 @@ fn a_long_span_laid_on_the_wall_sags_through_it_by_its_weight() {
             flagged,
             "{element_m} m: {found:?}"
         );
-        let warning = span_through_wall_warning(&case, model, &x, &rot, &axial);
+        let warning = span_through_wall_warning(&case, model, &x, &axial);
         assert_eq!(warning.is_some(), flagged.is_some(), "{warning:?}");
         if let Some(w) = found {
             assert!(
@@ -731,13 +725,7 @@ fn solve_rotating_pipe(
     let model = &case.model;
     let (_, _, torque, _) = crate::profile::fe_rows(model, &sol);
     let axial: Vec<f64> = sol.section_forces.iter().map(|f| f.axial).collect();
-    let span = span_through_wall(
-        &case,
-        model,
-        &sol.state.positions(model),
-        &sol.state.rot,
-        &axial,
-    );
+    let span = span_through_wall(&case, model, &sol.state, &axial);
     (torque.abs(), span, model.elements[1].clone())
 }
 

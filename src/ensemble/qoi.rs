@@ -332,8 +332,7 @@ pub fn static_result(
         helical_buckling: Some(helical),
         stick_slip_severity: None,
         outside_hole_m: Some(
-            crate::diagnose::through_wall(case, model, &sol.state.positions(model))
-                .map_or(0.0, |t| t.excess_m),
+            crate::diagnose::through_wall(case, model, &sol.state).map_or(0.0, |t| t.excess_m),
         ),
         stopped_load_factor: None,
     };
