@@ -25,7 +25,7 @@
 //! has `θ̄⁰ = 0`.
 
 use super::dual::{Dual, DualN};
-use super::rotation::{cross, mat_mul, mat_tmul, norm};
+use super::rotation::{by3, cross, mat_mul, mat_tmul, norm};
 pub use super::rotation::{rotation_exp, rotation_log, rotation_log_and_jacobian, Mat3, Trig};
 use super::Real;
 
@@ -297,6 +297,7 @@ impl<T: Real> Chord<T> {
     }
 }
 
+#[inline(always)]
 fn dot<T: Real>(a: &[T; 3], b: &[T; 3]) -> T {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
@@ -329,7 +330,7 @@ pub fn element_force<T: Trig>(
     let e1 = [d[0] / l, d[1] / l, d[2] / l];
     let half = T::from_f64_lossy(0.5);
     let b = [0, 1].map(|i| [triad[i][0][1], triad[i][1][1], triad[i][2][1]]);
-    let p: [T; 3] = std::array::from_fn(|r| half * (b[0][r] + b[1][r]));
+    let p: [T; 3] = by3(|r| half * (b[0][r] + b[1][r]));
     let a = cross(&e1, &p);
     let n = norm(&a);
     let e3 = [a[0] / n, a[1] / n, a[2] / n];
@@ -343,8 +344,8 @@ pub fn element_force<T: Trig>(
     let (th1, c1) = rotation_log_and_jacobian(&mat_tmul(&rr, &triad[0]));
     let (th2, c2) = rotation_log_and_jacobian(&mat_tmul(&rr, &triad[1]));
     // Local moments m̄_i = ∂E/∂θ̄_i, of the rotations from the unstrained state.
-    let s1: [T; 3] = std::array::from_fn(|r| th1[r] - k.rest[0][r]);
-    let s2: [T; 3] = std::array::from_fn(|r| th2[r] - k.rest[1][r]);
+    let s1: [T; 3] = by3(|r| th1[r] - k.rest[0][r]);
+    let s2: [T; 3] = by3(|r| th2[r] - k.rest[1][r]);
     let twist = k.torsion * (s2[0] - s1[0]);
     let (two, four) = (T::from_f64_lossy(2.0), T::from_f64_lossy(4.0));
     let bend = |a: T, b: T| k.bending * (four * a + two * b);
@@ -354,18 +355,18 @@ pub fn element_force<T: Trig>(
     let jt = |th: &[T; 3], c: T, m: &[T; 3]| -> [T; 3] {
         let tm = cross(th, m);
         let ttm = cross(th, &tm);
-        std::array::from_fn(|r| m[r] + half * tm[r] + c * ttm[r])
+        by3(|r| m[r] + half * tm[r] + c * ttm[r])
     };
     let v1 = jt(&th1, c1, &m1);
     let v2 = jt(&th2, c2, &m2);
-    let vs: [T; 3] = std::array::from_fn(|r| v1[r] + v2[r]);
+    let vs: [T; 3] = by3(|r| v1[r] + v2[r]);
     let axial = k.axial * elongation;
     let (g3, g2) = ((eta * vs[0] + vs[1]) / l, vs[2] / l);
-    let g: [T; 3] = std::array::from_fn(|r| axial * e1[r] + g3 * e3[r] - g2 * e2[r]);
+    let g: [T; 3] = by3(|r| axial * e1[r] + g3 * e3[r] - g2 * e2[r]);
     let q = vs[0] / (n + n);
     let spin = |v: &[T; 3], b: &[T; 3]| -> [T; 3] {
         let be = cross(b, &e3);
-        std::array::from_fn(|r| rr[r][0] * v[0] + rr[r][1] * v[1] + rr[r][2] * v[2] - q * be[r])
+        by3(|r| rr[r][0] * v[0] + rr[r][1] * v[1] + rr[r][2] * v[2] - q * be[r])
     };
     let f1 = spin(&v1, &b[0]);
     let f2 = spin(&v2, &b[1]);

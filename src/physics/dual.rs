@@ -261,12 +261,15 @@ impl<T: Real, const N: usize> PartialOrd for DualN<T, N> {
 }
 
 impl<T: Real, const N: usize> Real for DualN<T, N> {
+    #[inline(always)]
     fn zero() -> Self {
         Self::constant(T::zero())
     }
+    #[inline(always)]
     fn one() -> Self {
         Self::constant(T::one())
     }
+    #[inline(always)]
     fn abs(self) -> Self {
         if self.re < T::zero() {
             -self
@@ -274,17 +277,21 @@ impl<T: Real, const N: usize> Real for DualN<T, N> {
             self
         }
     }
+    #[inline(always)]
     fn sqrt(self) -> Self {
         let s = self.re.sqrt();
         self.chain(s, T::from_f64_lossy(0.5) / s)
     }
+    #[inline(always)]
     fn powf(self, e: Self) -> Self {
         let p = self.re.powf(e.re);
         self.chain(p, e.re * p / self.re)
     }
+    #[inline(always)]
     fn from_f64_lossy(x: f64) -> Self {
         Self::constant(T::from_f64_lossy(x))
     }
+    #[inline(always)]
     fn to_f64_lossy(self) -> f64 {
         self.re.to_f64_lossy()
     }
@@ -293,12 +300,15 @@ impl<T: Real, const N: usize> Real for DualN<T, N> {
 }
 
 impl<T: Trig, const N: usize> Trig for DualN<T, N> {
+    #[inline(always)]
     fn sin(self) -> Self {
         self.chain(self.re.sin(), self.re.cos())
     }
+    #[inline(always)]
     fn cos(self) -> Self {
         self.chain(self.re.cos(), -self.re.sin())
     }
+    #[inline(always)]
     fn atan2(self, x: Self) -> Self {
         let y = self;
         let r2 = x.re * x.re + y.re * y.re;
