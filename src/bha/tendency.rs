@@ -27,9 +27,10 @@
 //! is `κ_b`, the turn rate the azimuth's rate `κ_t / sin I`; both in °/30 m.
 //!
 //! A static analysis holds the string in one orientation. An assembly with a bend that
-//! rotates ([`assembly_tendency`]) drills the mean of its toolfaces: its rates are the
-//! means over 12 toolfaces (every 30°), each a sliding-style BHA model with the rotation's
-//! friction; a bend that slides keeps its toolface.
+//! rotates ([`assembly_tendency`]) takes every toolface in turn in one hole: at each hole
+//! curvature its bit's loads are the means over 12 toolfaces (every 30°), each a
+//! sliding-style BHA model with the rotation's friction, and its rates and equilibrium
+//! curvature are those of the means; a bend that slides keeps its toolface.
 
 use serde::{Deserialize, Serialize};
 
@@ -352,6 +353,33 @@ pub fn tendency(
     toolface: Option<f64>,
     settings: &TendencySettings,
 ) -> Tendency {
+    tendency_over(model, bha_length, wob, &[toolface], settings)
+}
+
+/// What the iterations read of a curvature's BHA-model solves: the bit's high-side force
+/// and its drilling direction's two angles from the hole axis ([`drilling_angles`]), each
+/// the mean over the toolfaces solved; and the first toolface's bit loads.
+#[derive(Clone, Copy, Debug)]
+struct AtCurvature {
+    high_side_force_n: f64,
+    angles: (f64, f64),
+    first: BitLoads,
+}
+
+/// [`tendency`] with every curvature's bit loads the means over `toolfaces` (one entry:
+/// that toolface, or the bends' own for `None`): an assembly with a bend that rotates
+/// takes every toolface in turn in one hole, so its steady state is the curvature at which
+/// the drilling direction averaged over a revolution follows the hole, and its equilibrium
+/// curvature the one at which the high-side force averaged over a revolution vanishes
+/// ([`assembly_tendency`]).
+fn tendency_over(
+    model: &Model,
+    bha_length: f64,
+    wob: f64,
+    toolfaces: &[Option<f64>],
+    settings: &TendencySettings,
+) -> Tendency {
+    use rayon::prelude::*;
     let first = bha_model_top(model, bha_length, settings);
     let bit_md = model.nodes[model.nodes.len() - 1].md;
     let mut out = Tendency {
@@ -361,15 +389,33 @@ pub fn tendency(
     };
     // A curvature asked again (the rates' first difference is the equilibrium's first
     // secant step, (PROBE, 0)) is not solved again: the same solve gives the same loads.
-    let mut solved: Vec<((f64, f64), (BitLoads, HoleFrame))> = Vec::new();
+    let mut solved: Vec<((f64, f64), AtCurvature)> = Vec::new();
     let mut solve = |k: (f64, f64)| {
         if let Some((_, s)) = solved.iter().find(|s| s.0 == k) {
             return Ok(*s);
         }
-        out.solves += 1;
-        let s = bit_at(model, first, k, wob, toolface, settings.deadline)?;
-        solved.push((k, s));
-        Ok::<_, BitSolveError>(s)
+        out.solves += toolfaces.len();
+        // The toolfaces are independent solves: in parallel (rayon keeps their order, so
+        // the means are summed in it).
+        let each: Vec<Result<(BitLoads, HoleFrame), BitSolveError>> = toolfaces
+            .par_iter()
+            .map(|&tf| bit_at(model, first, k, wob, tf, settings.deadline))
+            .collect();
+        let each = each.into_iter().collect::<Result<Vec<_>, _>>()?;
+        let n = each.len() as f64;
+        let mut at = AtCurvature {
+            high_side_force_n: 0.0,
+            angles: (0.0, 0.0),
+            first: each[0].0,
+        };
+        for (bit, frame) in &each {
+            let (x, y) = drilling_angles(bit, wob, frame, settings);
+            at.high_side_force_n += bit.high_side_force_n / n;
+            at.angles.0 += x / n;
+            at.angles.1 += y / n;
+        }
+        solved.push((k, at));
+        Ok::<_, BitSolveError>(at)
     };
     let to_rate = RAD_PER_M_TO_DEG_PER_30M;
     let limit = 30.0 / to_rate;
@@ -381,13 +427,13 @@ pub fn tendency(
             return out;
         }
     };
-    out.bit_straight_hole = Some(straight.0);
+    out.bit_straight_hole = Some(straight.first);
     // Equilibrium curvature: secant on the high-side force, from 0 and PROBE.
-    let mut a = (0.0, straight.0.high_side_force_n);
+    let mut a = (0.0, straight.high_side_force_n);
     let mut b = {
         let k = PROBE / to_rate;
         match solve((k, 0.0)) {
-            Ok(s) => (k, s.0.high_side_force_n),
+            Ok(s) => (k, s.high_side_force_n),
             Err(e) => {
                 out.notes.push(format!("equilibrium curvature: {e}"));
                 (f64::NAN, f64::NAN)
@@ -407,7 +453,7 @@ pub fn tendency(
         match solve((k, 0.0)) {
             Ok(s) => {
                 a = b;
-                b = (k, s.0.high_side_force_n);
+                b = (k, s.high_side_force_n);
             }
             Err(e) => {
                 out.notes.push(format!(
@@ -417,7 +463,7 @@ pub fn tendency(
                 break;
             }
         }
-        if b.1.abs() < 1e-6 * (1.0 + straight.0.side_force_n) {
+        if b.1.abs() < 1e-6 * (1.0 + straight.first.side_force_n) {
             equilibrium = Some(b.0);
             break;
         }
@@ -434,7 +480,7 @@ pub fn tendency(
             .push("no weight on bit: the bit does not drill, no build or turn rate".into());
         return out;
     }
-    let angles = |s: &(BitLoads, HoleFrame)| drilling_angles(&s.0, wob, &s.1, settings);
+    let angles = |s: &AtCurvature| s.angles;
     let mut k = [0.0, 0.0];
     let mut g = {
         let (x, y) = angles(&straight);
@@ -522,10 +568,17 @@ pub fn tendency(
 }
 
 /// The tendency of the case's assembly as it is operated: [`tendency`] at the bends'
-/// toolfaces, or — for an assembly with a bend that rotates — the means over 12 toolfaces
-/// (every 30°) of each rate (the bit's straight-hole loads are the first toolface's; the
-/// notes say so and count the toolfaces that settled). The one policy `holewall static` and
-/// `holewall tendency` report.
+/// toolfaces, or — for an assembly with a bend that rotates — [`tendency_over`] the 12
+/// toolfaces every 30°: at each hole curvature the bit's high-side force and drilling
+/// direction are the means over a revolution, and the rates are where that mean direction
+/// follows the hole (the bit's straight-hole loads are the first toolface's; the notes say
+/// so). The one policy `holewall static` and `holewall tendency` report.
+///
+/// One hole, one curvature: a rotating assembly cannot drill each toolface's own steady
+/// curvature, so the mean of 12 sliding steady states (the rule until stop 71) answered
+/// another question, and it needed all 12 of them to settle — a sliding bend's steady state
+/// lies far from a straight hole (±10–30°/30 m), where the rates' iterations from κ = 0
+/// strayed: 8 of the tendency corpus's 22 rotating bends got no rate (docs/validation.md).
 pub fn assembly_tendency(
     model: &Model,
     bha_length: f64,
@@ -535,42 +588,19 @@ pub fn assembly_tendency(
     if model.bends.is_empty() || model.rotation_speed == 0.0 {
         return tendency(model, bha_length, wob, None, settings);
     }
-    // The 12 toolfaces are independent solves: in parallel (rayon keeps their order, so
-    // the means are summed as before).
-    use rayon::prelude::*;
-    let all: Vec<Tendency> = (0..12)
-        .into_par_iter()
-        .map(|k| {
-            tendency(
-                model,
-                bha_length,
-                wob,
-                Some((30.0 * k as f64).to_radians()),
-                settings,
-            )
-        })
+    let toolfaces: Vec<Option<f64>> = (0..ROTATING_TOOLFACES)
+        .map(|k| Some((360.0 * k as f64 / ROTATING_TOOLFACES as f64).to_radians()))
         .collect();
-    let mean = |f: fn(&Tendency) -> Option<f64>| -> Option<f64> {
-        let v: Vec<f64> = all.iter().filter_map(f).collect();
-        (v.len() == all.len()).then(|| v.iter().sum::<f64>() / v.len() as f64)
-    };
-    let settled = all
-        .iter()
-        .filter(|t| t.build_rate_deg_per_30m.is_some())
-        .count();
-    let mut notes = vec![format!(
-        "a rotating bend: the means over 12 toolfaces, {settled} of which settled"
-    )];
-    notes.extend(all.iter().flat_map(|t| t.notes.iter().cloned()).take(4));
-    Tendency {
-        build_rate_deg_per_30m: mean(|t| t.build_rate_deg_per_30m),
-        turn_rate_deg_per_30m: mean(|t| t.turn_rate_deg_per_30m),
-        walk_curvature_deg_per_30m: mean(|t| t.walk_curvature_deg_per_30m),
-        equilibrium_curvature_deg_per_30m: mean(|t| t.equilibrium_curvature_deg_per_30m),
-        bit_straight_hole: all[0].bit_straight_hole,
-        model_length_m: all[0].model_length_m,
-        settings: *settings,
-        solves: all.iter().map(|t| t.solves).sum(),
-        notes,
-    }
+    let mut t = tendency_over(model, bha_length, wob, &toolfaces, settings);
+    t.notes.insert(
+        0,
+        format!(
+            "a rotating bend: at each hole curvature the bit's loads are the means over \
+             {ROTATING_TOOLFACES} toolfaces (the straight-hole loads are toolface 0°'s)"
+        ),
+    );
+    t
 }
+
+/// Toolfaces a rotating bend's revolution is averaged over (every 30°).
+pub const ROTATING_TOOLFACES: usize = 12;
