@@ -697,10 +697,11 @@ fn a_rotating_bend_drills_where_its_mean_direction_follows_the_hole() {
         assembly_tendency, bha_model, bha_model_top, drilling_angles, TendencySettings,
         RAD_PER_M_TO_DEG_PER_30M, ROTATING_TOOLFACES,
     };
-    let dir = common::scratch_dir("bha", "rotating_bend");
-    let path = dir.join("bent_housing.toml");
-    std::fs::write(&path, common::shipped_case_text("bent_housing.toml")).unwrap();
-    let case = holewall::case::load_case(&path).unwrap();
+    let case = holewall::case::parse_case(
+        std::path::Path::new("bent_housing.toml"),
+        &common::shipped_case_text("bent_housing.toml"),
+    )
+    .unwrap();
     let m = &case.model;
     assert!(!m.bends.is_empty() && m.rotation_speed > 0.0);
     let wob = m.weight_on_bit;

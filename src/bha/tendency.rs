@@ -480,10 +480,9 @@ fn tendency_over(
             .push("no weight on bit: the bit does not drill, no build or turn rate".into());
         return out;
     }
-    let angles = |s: &AtCurvature| s.angles;
     let mut k = [0.0, 0.0];
     let mut g = {
-        let (x, y) = angles(&straight);
+        let (x, y) = straight.angles;
         [x, y]
     };
     // Jacobian by differences of PROBE.
@@ -492,7 +491,7 @@ fn tendency_over(
     for (j, kk) in [(d, 0.0), (0.0, d)].into_iter().enumerate() {
         match solve(kk) {
             Ok(s) => {
-                let (x, y) = angles(&s);
+                let (x, y) = s.angles;
                 jac[0][j] = (x - g[0]) / d;
                 jac[1][j] = (y - g[1]) / d;
             }
@@ -524,7 +523,7 @@ fn tendency_over(
                 break;
             }
         };
-        let (x, y) = angles(&s);
+        let (x, y) = s.angles;
         let gn = [x, y];
         // Broyden's update of the Jacobian.
         let dg = [gn[0] - g[0], gn[1] - g[1]];
