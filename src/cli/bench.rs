@@ -516,7 +516,8 @@ pub fn element_flops() -> ElementFlops {
 pub fn element(states: usize, repeats: usize, json: Option<&Path>) -> Result<(), Error> {
     use crate::physics::beam::{
         element_force, force_and_tangent_by_direction, force_and_tangent_closed,
-        force_and_tangent_hyperdual, BeamSection, Chord, ElementStiffness,
+        force_and_tangent_hyperdual, force_and_tangent_variation, BeamSection, Chord,
+        ElementStiffness,
     };
     use crate::physics::count::{count, Counted};
     let section = BeamSection::tube(0.165, 0.071, 2.1e11, 0.3);
@@ -578,6 +579,8 @@ pub fn element(states: usize, repeats: usize, json: Option<&Path>) -> Result<(),
         count(|| force_and_tangent_by_direction(&cx, &ct, &cform, &ck)).1,
         count(|| force_and_tangent_closed(&cx, &ct, &cform, &ck)).1,
         count(|| force_and_tangent_closed(&cx, &ct, &cform, &ck)).1,
+        count(|| force_and_tangent_variation(&cx, &ct, &cform, &ck)).1,
+        count(|| force_and_tangent_variation(&cx, &ct, &cform, &ck)).1,
     ];
     let sink = std::cell::Cell::new(0.0f64);
     let per = |f: &mut dyn FnMut()| -> Result<f64, Error> {
@@ -632,6 +635,18 @@ pub fn element(states: usize, repeats: usize, json: Option<&Path>) -> Result<(),
                 sink.set(sink.get() + r.1[3][4] as f64);
             }
         })?,
+        per(&mut || {
+            for s in &list {
+                let r = force_and_tangent_variation(&s.x, &s.triad, &form, &k64);
+                sink.set(sink.get() + r.1[3][4]);
+            }
+        })?,
+        per(&mut || {
+            for (x, t, b) in &f32_inputs {
+                let r = force_and_tangent_variation(x, t, b, &k32);
+                sink.set(sink.get() + r.1[3][4] as f64);
+            }
+        })?,
     ];
     std::hint::black_box(sink.get());
     let names = [
@@ -641,6 +656,8 @@ pub fn element(states: usize, repeats: usize, json: Option<&Path>) -> Result<(),
         "closed form, force and tangent one direction at a time (the GPU kernel's form), f64",
         "closed form, force and tangent in one 12-direction pass (CPU), f64",
         "closed form, force and tangent in one 12-direction pass (CPU), f32",
+        "closed form, the tangent written out (not the CPU path: docs/performance.md, stop 72), f64",
+        "closed form, the tangent written out, f32",
     ];
     let closed = (counts[4].flops(TRANSCENDENTAL_FLOPS), times[4]);
     let rows = (0..names.len())

@@ -13,8 +13,13 @@
 //! spatial rotation increments (`R_i ← exp([δθ]×) R_i`), written out in closed form
 //! ([`element_force`], Battini & Pacoste's `f = N r + E Pᵀ T⁻ᵀ m̄` for this frame, ≈ 400
 //! operations), and the consistent tangent is its derivative with respect to the Newton
-//! increment applied the same way, by that force evaluated in dual numbers once per column
-//! ([`force_and_tangent_closed`], `src/physics/dual.rs`). The tangent so contains the
+//! increment applied the same way, by that force evaluated in dual numbers
+//! ([`force_and_tangent_closed`], one pass, the CPU path; [`force_and_tangent_by_direction`],
+//! one column at a time, as `shaders/beam.wgsl`; `src/physics/dual.rs`), or written out,
+//! each intermediate value's first variation on the values the force computed
+//! ([`force_and_tangent_variation`]: equal to rounding and 1.5× faster, not the CPU path —
+//! a change at rounding level moves the load paths of marginal wells, docs/performance.md,
+//! stop 72). The tangent so contains the
 //! geometric stiffness: an axial force `N` adds `N/l` to the lateral stiffness, so
 //! compression softens the string and buckling appears. The oracle is the energy itself,
 //! differentiated twice by hyper-dual numbers ([`force_and_tangent_hyperdual`]).
@@ -326,6 +331,57 @@ pub fn element_force<T: Trig>(
     chord: &Chord<T>,
     k: &ElementStiffness<T>,
 ) -> [T; 12] {
+    element_values(x, triad, chord, k).force
+}
+
+/// The closed form's intermediate values ([`element_force`]'s notation): what the force is
+/// made of, and what its hand-written derivative ([`force_and_tangent_variation`]) reuses.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct ElementValues<T> {
+    /// Chord length `l`.
+    pub l: T,
+    /// Frame axes `e1, e2, e3` (the columns of `R_r`).
+    pub e: [[T; 3]; 3],
+    /// The triads' second axes `b_i`.
+    pub b: [[T; 3]; 2],
+    /// `p = ½(b₁ + b₂)`.
+    pub p: [T; 3],
+    /// `n = |e1 × p|`.
+    pub n: T,
+    /// `η = p·e1/n`.
+    pub eta: T,
+    /// Local rotations `θ̄_i`.
+    pub theta: [[T; 3]; 2],
+    /// `c(θ̄_i)` of `J⁻¹(θ̄_i)` ([`rotation_log_and_jacobian`]).
+    pub c: [T; 2],
+    /// Local moments `m̄_i`.
+    pub m: [[T; 3]; 2],
+    /// `v̄_i = J⁻ᵀ(θ̄_i) m̄_i`.
+    pub v: [[T; 3]; 2],
+    /// `V = v̄₁ + v̄₂`.
+    pub vs: [T; 3],
+    /// `N = EA/l0·ū`.
+    pub axial: T,
+    /// `(η V₁ + V₂)/l` and `V₃/l`.
+    pub g3: T,
+    /// `V₃/l`.
+    pub g2: T,
+    /// `q = V₁/(2n)`.
+    pub q: T,
+    /// `b_i × e3`.
+    pub be: [[T; 3]; 2],
+    /// The internal force.
+    pub force: [T; 12],
+}
+
+/// [`element_force`]'s computation, keeping its intermediate values.
+#[inline(always)]
+pub(crate) fn element_values<T: Trig>(
+    x: &[[T; 3]; 2],
+    triad: &[Mat3<T>; 2],
+    chord: &Chord<T>,
+    k: &ElementStiffness<T>,
+) -> ElementValues<T> {
     let (d, l, elongation) = chord.resolve(x);
     let e1 = [d[0] / l, d[1] / l, d[2] / l];
     let half = T::from_f64_lossy(0.5);
@@ -364,15 +420,33 @@ pub fn element_force<T: Trig>(
     let (g3, g2) = ((eta * vs[0] + vs[1]) / l, vs[2] / l);
     let g: [T; 3] = by3(|r| axial * e1[r] + g3 * e3[r] - g2 * e2[r]);
     let q = vs[0] / (n + n);
-    let spin = |v: &[T; 3], b: &[T; 3]| -> [T; 3] {
-        let be = cross(b, &e3);
+    let be = [cross(&b[0], &e3), cross(&b[1], &e3)];
+    let spin = |v: &[T; 3], be: &[T; 3]| -> [T; 3] {
         by3(|r| rr[r][0] * v[0] + rr[r][1] * v[1] + rr[r][2] * v[2] - q * be[r])
     };
-    let f1 = spin(&v1, &b[0]);
-    let f2 = spin(&v2, &b[1]);
-    [
-        -g[0], -g[1], -g[2], f1[0], f1[1], f1[2], g[0], g[1], g[2], f2[0], f2[1], f2[2],
-    ]
+    let f1 = spin(&v1, &be[0]);
+    let f2 = spin(&v2, &be[1]);
+    ElementValues {
+        l,
+        e: [e1, e2, e3],
+        b,
+        p,
+        n,
+        eta,
+        theta: [th1, th2],
+        c: [c1, c2],
+        m: [m1, m2],
+        v: [v1, v2],
+        vs,
+        axial,
+        g3,
+        g2,
+        q,
+        be,
+        force: [
+            -g[0], -g[1], -g[2], f1[0], f1[1], f1[2], g[0], g[1], g[2], f2[0], f2[1], f2[2],
+        ],
+    }
 }
 
 /// Internal force (12) and consistent tangent (12×12) from the closed form: the force
@@ -613,6 +687,10 @@ pub fn force_and_tangent_full(
         false,
     )
 }
+
+#[path = "beam_tangent.rs"]
+mod tangent;
+pub use tangent::force_and_tangent_variation;
 
 #[cfg(test)]
 #[path = "beam_tests.rs"]

@@ -369,3 +369,75 @@ fn a_kinked_elements_force_and_tangent_are_the_energys_derivatives() {
     assert!(wf <= 1e-12 && wk <= 1e-12, "{wf:e} {wk:e}");
     assert!(wd <= 1e-6, "{wd:e}");
 }
+
+#[test]
+fn the_written_out_tangent_is_the_dual_numbers_tangent() {
+    // Straight and kinked, positions and base-chord forms, relative rotations near π,
+    // through the series branches (1e-4, 0.3 rad) and between; f64 to 1e-12 of the
+    // largest entry against the dual-number form and the hyper-dual oracle, f32 to its own
+    // rounding; the force bit for bit the closed form's.
+    let l = 9.0;
+    let kinked = kink_rest_rotation(2f64.to_radians(), 1.1, l);
+    let (mut wd, mut wo, mut w32) = (0.0f64, 0.0f64, 0.0f64);
+    for (rel, seed) in [(2.5, 12345), (3.1, 777), (1e-4, 99), (0.3, 5), (0.6, 8)] {
+        for (i, s) in random_states(40, rel, seed).iter().enumerate() {
+            let rest = if i % 2 == 0 { [[0.0; 3]; 2] } else { kinked };
+            let k = ElementStiffness::of(&section(), l).with_rest(rest);
+            let d: [f64; 3] = std::array::from_fn(|c| s.x[1][c] - s.x[0][c]);
+            let c = d.map(|v| v as f32 as f64);
+            let lc = norm(&c);
+            let base = Chord::Base {
+                chord: c,
+                stretch: lc - l,
+                length: lc,
+            };
+            let w2: [f64; 3] = std::array::from_fn(|j| d[j] - c[j]);
+            let forms = [
+                (s.x, Chord::Positions { length0: l }),
+                ([[0.0; 3], w2], base),
+            ];
+            let (_, k0) = force_and_tangent_hyperdual(&s.x, &s.triad, &section(), l, &rest, false);
+            let ks = k0.iter().flatten().fold(0.0f64, |m, x| m.max(x.abs()));
+            for (x, form) in forms {
+                let (f, kk) = force_and_tangent_variation(&x, &s.triad, &form, &k);
+                let (fd, kd) = force_and_tangent_closed(&x, &s.triad, &form, &k);
+                assert_eq!(f, fd, "the force is the closed form's");
+                assert_eq!(f, element_force(&x, &s.triad, &form, &k));
+                for a in 0..12 {
+                    for b in 0..12 {
+                        wd = wd.max((kk[a][b] - kd[a][b]).abs() / ks);
+                        wo = wo.max((kk[a][b] - k0[a][b]).abs() / ks);
+                    }
+                }
+                let x32 = x.map(|p| p.map(|v| v as f32));
+                let t32 = s.triad.map(|m| m.map(|r| r.map(|v| v as f32)));
+                let (form32, k32) = (form.map(|v| v as f32), k.map(|v| v as f32));
+                let (_, ka) = force_and_tangent_variation(&x32, &t32, &form32, &k32);
+                let (_, kb) = force_and_tangent_closed(&x32, &t32, &form32, &k32);
+                for a in 0..12 {
+                    for b in 0..12 {
+                        w32 = w32.max((ka[a][b] as f64 - kb[a][b] as f64).abs() / ks);
+                    }
+                }
+            }
+        }
+    }
+    eprintln!("written-out tangent: {wd:.1e} vs dual numbers, {wo:.1e} vs hyper-dual; f32 {w32:.1e} vs f32 dual numbers");
+    assert!(wd <= 1e-12 && wo <= 1e-12, "{wd:e} {wo:e}");
+    assert!(w32 <= 1e-4, "{w32:e}");
+}
+
+#[test]
+fn the_jacobian_coefficients_slope_is_its_derivative() {
+    // dc/d(θ²) against central differences of c on both sides of the series' edge.
+    let c_of = |t: f64| rotation_log_and_jacobian(&rotation_exp(&[t, 0.0, 0.0])).1;
+    for t in [1e-3, 0.05, 0.2, 0.31, 0.32, 0.5, 1.0, 2.0, 3.0] {
+        let h = 1e-4 * f64::max(t, 0.1);
+        let fd = (c_of(t + h) - c_of(t - h)) / (2.0 * h) / (2.0 * t);
+        let slope = super::tangent::jacobian_coefficient_slope(t * t, c_of(t));
+        assert!(
+            (slope - fd).abs() <= 1e-6 * slope.abs(),
+            "θ = {t}: {slope:e} vs {fd:e}"
+        );
+    }
+}
