@@ -335,6 +335,43 @@ fn folds_beyond_the_sample_solve_by_relaxation() {
     }
 }
 
+/// `holewall static` says where its answer came by relaxation past a fold, whose
+/// equilibrium is one of several (`holewall::diagnose::relaxed_warning`): corpus well 17
+/// (horizontal, tripped in, 10 m elements) relaxes and is told so; well 1 (tripped out,
+/// 30 m) does not relax and gets no such warning.
+#[test]
+fn a_relaxed_answer_says_it_is_one_of_several() {
+    let dir = tempdir::Dir::new("corpus_relaxed");
+    for (seed, relaxes) in [(17, true), (1, false)] {
+        let well = write_well(seed, dir.path()).unwrap();
+        let out = dir.path().join(format!("out_{seed}"));
+        let status = std::process::Command::new(env!("CARGO_BIN_EXE_holewall"))
+            .arg("static")
+            .arg("--quiet")
+            .arg("--out")
+            .arg(&out)
+            .arg(&well.case_path)
+            .status()
+            .unwrap();
+        assert!(status.success(), "seed {seed}: holewall static failed");
+        let summary: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap())
+                .unwrap();
+        let logged = summary["solver_log"].as_array().unwrap().iter().any(|l| {
+            l.as_str()
+                .unwrap()
+                .contains(holewall::solve::continuation::RELAXED)
+        });
+        // (`warnings` is left out of the summary where there is none.)
+        let warned = summary["warnings"].as_array().is_some_and(|ws| {
+            ws.iter()
+                .any(|w| w.as_str().unwrap().contains("relaxation past a fold"))
+        });
+        assert_eq!(logged, relaxes, "seed {seed}: relaxed");
+        assert_eq!(warned, relaxes, "seed {seed}: {:?}", summary["warnings"]);
+    }
+}
+
 /// `cases/build_and_hold_2500.toml` with its operation and mesh replaced.
 fn reproducer(mode: &str, element: f64) -> holewall::case::Case {
     let text = std::fs::read_to_string(concat!(

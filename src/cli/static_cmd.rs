@@ -304,7 +304,11 @@ pub fn run(
             .iter()
             .find(|l| l.starts_with(crate::profile::WHIRL_AVERAGED))
             .cloned();
-        for w in [through_wall, span_sag, whirl].into_iter().flatten() {
+        let relaxed = crate::diagnose::relaxed_warning(&solver_log);
+        for w in [through_wall, span_sag, whirl, relaxed]
+            .into_iter()
+            .flatten()
+        {
             eprintln!("holewall: warning: {w}");
             warnings.push(w);
         }
