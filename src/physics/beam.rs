@@ -362,7 +362,7 @@ pub(crate) struct ElementValues<T> {
     pub vs: [T; 3],
     /// `N = EA/l0·ū`.
     pub axial: T,
-    /// `(η V₁ + V₂)/l` and `V₃/l`.
+    /// `(η V₁ + V₂)/l`.
     pub g3: T,
     /// `V₃/l`.
     pub g2: T,

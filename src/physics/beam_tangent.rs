@@ -1,11 +1,11 @@
 //! The element's consistent tangent written out: the first variation of each intermediate
-//! value of [`super::element_force`], one direction at a time, on the values the force computed
-//! once ([`ElementValues`]). It is the derivative the dual numbers of
-//! [`super::force_and_tangent_closed`] take, without carrying nine derivatives through the rotation
-//! log, its transcendentals and the two 3×3 products `R_rᵀ t_i`: those are replaced by the
-//! log's known response to a spin, `δθ̄_i = J⁻¹(θ̄_i) R_rᵀ(δθ_i − δω)` (`δω` the frame's
-//! spin). The oracles are that dual-number form and the energy's hyper-dual derivatives
-//! (`beam_tests.rs`).
+//! value of [`super::element_force`], a group of directions at a time (the translations,
+//! the spins), on the values the force computed once ([`ElementValues`]). It is the
+//! derivative the dual numbers of [`super::force_and_tangent_closed`] take, without carrying
+//! nine derivatives through the rotation log, its transcendentals and the two 3×3 products
+//! `R_rᵀ t_i`: those are replaced by the log's known response to a spin,
+//! `δθ̄_i = J⁻¹(θ̄_i) R_rᵀ(δθ_i − δω)` (`δω` the frame's spin). The oracles are that
+//! dual-number form and the energy's hyper-dual derivatives (`beam_tests.rs`).
 
 use std::ops::{Add, Mul, Sub};
 
