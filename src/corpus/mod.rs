@@ -626,10 +626,7 @@ pub fn run_well(
                 .map_or(0.0, |t| 1e3 * t.excess_m);
             r.load_steps = sol.iterations.len();
             r.step_cuts = crate::profile::path_events(&sol.log);
-            r.relaxed = sol
-                .log
-                .iter()
-                .any(|l| l.contains(crate::solve::continuation::RELAXED));
+            r.relaxed = crate::solve::continuation::relaxed(&sol.log);
             r.iterations = sol.iterations.iter().sum();
             r.fe_hook_load_n = hook;
             r.hook_load_ratio = hook / r.soft_hook_load_n;

@@ -238,8 +238,8 @@ pub fn locked_up_warning(case: &Case, hook_load: f64) -> Option<String> {
     ))
 }
 
-/// A warning for an FE answer that came by relaxation past a fold (its solver `log` names
-/// [`crate::solve::continuation::RELAXED`]): a string buckled or held by its friction past
+/// A warning for an FE answer that came by relaxation past a fold (its solver `log` says so,
+/// [`crate::solve::continuation::relaxed`]): a string buckled or held by its friction past
 /// a fold has several equilibria, and which one the solve reaches depends on its path.
 /// Measured (docs/performance.md, stop 72): the beam tangent changed at rounding level (its
 /// entries by ≤ 2.3e-14 of the largest) left the hook load of every well that relaxed on
@@ -247,16 +247,14 @@ pub fn locked_up_warning(case: &Case, hook_load: f64) -> Option<String> {
 /// 500 wells 18 of 65 by more than 1e-6, 4 by more than 1 %, at most 2.6 %; on the user-style
 /// seeds 0–289 14 of 37, 4 by more than 1 %, at most 6.5 %. `None` where it did not relax.
 pub fn relaxed_warning(log: &[String]) -> Option<String> {
-    log.iter()
-        .any(|l| l.contains(crate::solve::continuation::RELAXED))
-        .then(|| {
-            "this equilibrium was reached by relaxation past a fold (a buckled or \
-             friction-held string): such a string has several equilibria, and which one a \
-             solve reaches depends on its path — on the test corpus, rounding-level changes \
-             moved such answers' hook loads by up to 6.5 %; read hook load, torque and side \
-             forces to a few percent"
-                .to_string()
-        })
+    crate::solve::continuation::relaxed(log).then(|| {
+        "this equilibrium was reached by relaxation past a fold (a buckled or \
+         friction-held string): such a string has several equilibria, and which one a \
+         solve reaches depends on its path — on the test corpus, rounding-level changes \
+         moved such answers' hook loads by up to 6.5 %; read hook load, torque and side \
+         forces to a few percent"
+            .to_string()
+    })
 }
 
 /// A warning for a solved FE profile (nodal axial forces, tension +) whose compression

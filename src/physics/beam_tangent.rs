@@ -288,7 +288,6 @@ fn variation<T: Trig, const N: usize>(
 /// Nine directions as there: node 2's translations (node 1's columns their negation), node
 /// 1's spins, node 2's spins. Both chord forms have `∂ū/∂d = e1` (exactly,
 /// [`Chord::resolve`]'s two expressions of `l − l0`), which is what the translations use.
-#[allow(clippy::needless_range_loop)]
 pub fn force_and_tangent_variation<T: Trig>(
     x: &[[T; 3]; 2],
     triad: &[Mat3<T>; 2],

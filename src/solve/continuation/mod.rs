@@ -105,6 +105,12 @@ enum Stage {
 /// The words a relaxation's log line carries (the corpus counts the wells it solved).
 pub const RELAXED: &str = "relaxed by proximal points";
 
+/// Whether a solve's `log` says its answer came by relaxation ([`RELAXED`]): the corpus's
+/// `relaxed` column and `crate::diagnose::relaxed_warning` read it so.
+pub fn relaxed(log: &[String]) -> bool {
+    log.iter().any(|l| l.contains(RELAXED))
+}
+
 /// One variant's load path (module docs).
 #[derive(Clone, Debug)]
 pub struct LoadPath {
