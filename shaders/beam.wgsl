@@ -1,16 +1,20 @@
-// Twin: src/kernels/beam.rs (formulas: src/physics/beam.rs, `element_force` and
-// `force_and_tangent_closed`, the co-rotational element in closed form).
+// Twin: src/kernels/beam.rs (formulas: src/physics/beam.rs, `element_values` and
+// src/physics/beam_tangent.rs, `force_and_tangent_variation`: the co-rotational element in
+// closed form and its consistent tangent written out).
 //
 // One invocation per (element, variant), index = element · V + variant. The internal force
 // is the closed form of physics::beam::element_force (frame: chord and the mean of the
 // nodal triads' second axes; local moments through J⁻ᵀ of the rotation logs, the frame's
 // spin through η and n):
 //   f_x₂ = −f_x₁ = N e1 + ((η V₁ + V₂) e3 − V₃ e2)/l,  f_θᵢ = R_r v̄_i − V₁/(2n)·(b_i × e3).
-// The consistent tangent is that force in dual numbers (value, derivative) — here
-// vec2<real>, vectors as (value, derivative) pairs of vec3<real> — once per seed: a DOF
-// seeded as a translation or a left spin (I + [ε e]×)·triad. K_jk = ∂f_j/∂Δ_k; nine seeds
-// give the twelve columns (node 1's translation columns are node 2's negated). Built with
-// FORCE_ONLY it evaluates the force alone (line-search trials: 1/9 of the work and no
+// Its values are formed once (`Values`, the twin's ElementValues). The consistent tangent
+// K_jk = ∂f_j/∂Δ_k is the first variation of each of those values along a direction — a
+// DOF moved as a translation or a left spin (I + [ε e]×)·triad — one direction at a time
+// (`variation`): nine directions give the twelve columns (node 1's translation columns are
+// node 2's negated). The rotation logs' transcendentals are not differentiated: a log
+// responds to a spin as δθ̄_i = J⁻¹(θ̄_i) R_rᵀ(δθ_i − δω), δω the frame's spin, and the
+// coefficient c of J⁻¹ changes with θ² by dc/dθ² = (¼ − 3c + c²θ²)/(2θ²) (its series below
+// θ² = 0.1). Built with FORCE_ONLY it evaluates the force alone (line-search trials: no
 // tangent written). Outputs in the assembly's layout: [(12 e + j) V + v] and
 // [(144 e + 12 j + k) V + v].
 //
@@ -23,7 +27,7 @@
 // physics::beam::Chord::Positions) and the elongation as l − l0; in single precision
 // (Chord::Base) the elongation is s + (2 c·Δw + Δw·Δw)/(l + |c|), without the cancellation
 // of l − l0 (a strain of 1e-5 would keep two digits) and without the metres the base has
-// moved.
+// moved. Both forms have ∂ū/∂d = e1, which the translations' variation uses.
 //
 // Built with KINK the moments act on the rotations from each element's unstrained ones
 // (a bent sub: physics::beam::ElementStiffness::rest), read per (element, variant).
@@ -75,66 +79,12 @@
 #endif
 #endif
 
-// A dual number (value, derivative) and a dual 3-vector.
-alias dl = vec2<real>;
-struct DV {
-    v: vec3<real>,
-    d: vec3<real>,
-}
-
-fn dmul(a: dl, b: dl) -> dl {
-    return dl(a.x * b.x, a.x * b.y + a.y * b.x);
-}
-
-fn ddiv(a: dl, b: dl) -> dl {
-    let q = a.x / b.x;
-    return dl(q, (a.y - q * b.y) / b.x);
-}
-
-fn dsqrt(a: dl) -> dl {
-    let s = sqrt(a.x);
-    return dl(s, real(0.5) * a.y / s);
-}
-
-fn dc(a: real) -> dl {
-    return dl(a, real(0.0));
-}
-
 fn cr(a: vec3<real>, b: vec3<real>) -> vec3<real> {
     return a.yzx * b.zxy - a.zxy * b.yzx;
 }
 
 fn dt(a: vec3<real>, b: vec3<real>) -> real {
     return a.x * b.x + a.y * b.y + a.z * b.z;
-}
-
-fn vdot(a: DV, b: DV) -> dl {
-    return dl(dt(a.v, b.v), dt(a.d, b.v) + dt(a.v, b.d));
-}
-
-fn vcross(a: DV, b: DV) -> DV {
-    return DV(cr(a.v, b.v), cr(a.d, b.v) + cr(a.v, b.d));
-}
-
-fn vscale(a: DV, s: dl) -> DV {
-    return DV(a.v * s.x, a.d * s.x + a.v * s.y);
-}
-
-fn vdivs(a: DV, s: dl) -> DV {
-    let q = a.v / s.x;
-    return DV(q, (a.d - q * s.y) / s.x);
-}
-
-fn vadd(a: DV, b: DV) -> DV {
-    return DV(a.v + b.v, a.d + b.d);
-}
-
-fn vsub(a: DV, b: DV) -> DV {
-    return DV(a.v - b.v, a.d - b.d);
-}
-
-fn vnorm(a: DV) -> dl {
-    return dsqrt(vdot(a, a));
 }
 
 #if F64
@@ -179,127 +129,256 @@ fn atan2_real(y: real, x: real) -> real {
 }
 #endif
 
-fn datan2(y: dl, x: dl) -> dl {
-    return dl(atan2_real(y.x, x.x), (x.x * y.y - y.x * x.y) / (x.x * x.x + y.x * y.x));
-}
-
 // A nodal triad by its columns (the element's initial axes carried by the node).
 struct Triad {
-    c0: DV,
-    c1: DV,
-    c2: DV,
+    c0: vec3<real>,
+    c1: vec3<real>,
+    c2: vec3<real>,
 }
 
 // The rotation vector of Rrᵀ·t (Rr = [e1 e2 e3]) and the coefficient c(θ) of J⁻¹(θ),
-// as physics::beam::rotation_log_and_jacobian.
+// as physics::rotation::rotation_log_and_jacobian.
 struct LogJ {
-    th: DV,
-    c: dl,
+    th: vec3<real>,
+    c: real,
 }
 
-fn rel_log(e1: DV, e2: DV, e3: DV, t: Triad) -> LogJ {
+fn rel_log(e1: vec3<real>, e2: vec3<real>, e3: vec3<real>, t: Triad) -> LogJ {
     let half = real(0.5);
     // r[a][b] = e_a · t_b.
-    let w = DV(
-        half * vec3<real>(vdot(e3, t.c1).x - vdot(e2, t.c2).x, vdot(e1, t.c2).x - vdot(e3, t.c0).x,
-                          vdot(e2, t.c0).x - vdot(e1, t.c1).x),
-        half * vec3<real>(vdot(e3, t.c1).y - vdot(e2, t.c2).y, vdot(e1, t.c2).y - vdot(e3, t.c0).y,
-                          vdot(e2, t.c0).y - vdot(e1, t.c1).y),
-    );
-    let s2 = vdot(w, w);
-    let c = half * (vdot(e1, t.c0) + vdot(e2, t.c1) + vdot(e3, t.c2) - dc(real(1.0)));
-    var factor: dl;
-    var s = dc(real(0.0));
-    let series = s2.x < real(1e-6) && c.x > real(0.0);
+    let w = half * vec3<real>(dt(e3, t.c1) - dt(e2, t.c2), dt(e1, t.c2) - dt(e3, t.c0),
+                              dt(e2, t.c0) - dt(e1, t.c1));
+    let s2 = dt(w, w);
+    let c = half * (dt(e1, t.c0) + dt(e2, t.c1) + dt(e3, t.c2) - real(1.0));
+    var factor: real;
+    var s = real(0.0);
+    let series = s2 < real(1e-6) && c > real(0.0);
     if (series) {
-        factor = dc(real(1.0)) + dmul(s2, dc(real(1.0) / real(6.0)) + dmul(s2, dc(real(3.0) / real(40.0))));
+        factor = real(1.0) + s2 * (real(1.0) / real(6.0) + s2 * (real(3.0) / real(40.0)));
     } else {
-        s = dsqrt(s2);
-        factor = ddiv(datan2(s, c), s);
+        s = sqrt(s2);
+        factor = atan2_real(s, c) / s;
     }
-    let theta2 = dmul(dmul(factor, factor), s2);
-    var coefficient: dl;
-    if (!series && theta2.x >= real(0.1)) {
-        let theta = dmul(factor, s);
-        coefficient = ddiv(dc(real(1.0)) - ddiv(dmul(theta, dc(real(1.0)) + c), s + s), theta2);
+    let theta2 = factor * factor * s2;
+    var coefficient: real;
+    if (!series && theta2 >= real(0.1)) {
+        let theta = factor * s;
+        coefficient = (real(1.0) - theta * (real(1.0) + c) / (s + s)) / theta2;
     } else {
-        coefficient = dc(real(1.0) / real(12.0)) + dmul(theta2, dc(real(1.0) / real(720.0))
-            + dmul(theta2, dc(real(1.0) / real(30240.0)) + dmul(theta2, dc(real(1.0) / real(1209600.0))
-            + dmul(theta2, dc(real(1.0) / real(47900160.0))))));
+        coefficient = real(1.0) / real(12.0) + theta2 * (real(1.0) / real(720.0)
+            + theta2 * (real(1.0) / real(30240.0) + theta2 * (real(1.0) / real(1209600.0)
+            + theta2 * (real(1.0) / real(47900160.0)))));
     }
-    return LogJ(vscale(w, factor), coefficient);
+    return LogJ(w * factor, coefficient);
 }
 
-// v̄ = J⁻ᵀ(θ) m̄ = m̄ + ½ θ × m̄ + c θ × (θ × m̄).
-fn jt(l: LogJ, m: DV) -> DV {
-    let tm = vcross(l.th, m);
-    let ttm = vcross(l.th, tm);
-    return vadd(vadd(m, vscale(tm, dc(real(0.5)))), vscale(ttm, l.c));
+// dc/d(θ²) of J⁻¹'s coefficient, from c itself (physics::beam::tangent::
+// jacobian_coefficient_slope): (¼ − 3c + c²θ²)/(2θ²); below θ² = 0.1 the series'.
+fn coefficient_slope(theta2: real, c: real) -> real {
+    if (theta2 < real(0.1)) {
+        return real(1.0) / real(720.0) + theta2 * (real(2.0) / real(30240.0)
+            + theta2 * (real(3.0) / real(1209600.0) + theta2 * (real(4.0) / real(47900160.0))));
+    }
+    return (real(0.25) - real(3.0) * c + c * c * theta2) / (theta2 + theta2);
 }
 
-// The force (12, as dual numbers) of the element with chord d, elongation u and triads t1,
-// t2; stiffness k = (EA/l0, GJ/l0, EI/l0); unstrained rotations r1, r2 (the moments act on
-// θ̄ − θ̄⁰: constants, so the derivative parts are θ̄'s).
-struct Force {
-    x1: DV,
-    t1: DV,
-    x2: DV,
-    t2: DV,
+// The closed form's values (the twin's ElementValues), with what the tangent reuses:
+// θ̄_i × m̄_i, θ̄_i × (θ̄_i × m̄_i) and dc/dθ² per node.
+struct Values {
+    l: real,
+    e1: vec3<real>,
+    e2: vec3<real>,
+    e3: vec3<real>,
+    b1: vec3<real>,
+    b2: vec3<real>,
+    p: vec3<real>,
+    n: real,
+    eta: real,
+    th1: vec3<real>,
+    th2: vec3<real>,
+    c1: real,
+    c2: real,
+    m1: vec3<real>,
+    m2: vec3<real>,
+    v1: vec3<real>,
+    v2: vec3<real>,
+    vs: vec3<real>,
+    axial: real,
+    g3: real,
+    g2: real,
+    q: real,
+    be1: vec3<real>,
+    be2: vec3<real>,
+    tm1: vec3<real>,
+    tm2: vec3<real>,
+    ttm1: vec3<real>,
+    ttm2: vec3<real>,
+    slope1: real,
+    slope2: real,
 }
 
-fn element_force(d: DV, u: dl, t1: Triad, t2: Triad, k: vec3<real>, r1: vec3<real>, r2: vec3<real>) -> Force {
-    let half = dc(real(0.5));
-    let l = vnorm(d);
-    let e1 = vdivs(d, l);
-    let p = vscale(vadd(t1.c1, t2.c1), half);
-    let a = vcross(e1, p);
-    let n = vnorm(a);
-    let e3 = vdivs(a, n);
-    let e2 = vcross(e3, e1);
-    let eta = ddiv(vdot(p, e1), n);
+// The element's twelve forces or one direction's twelve variations: (x₁, θ₁, x₂, θ₂).
+struct Twelve {
+    x1: vec3<real>,
+    t1: vec3<real>,
+    x2: vec3<real>,
+    t2: vec3<real>,
+}
+
+// The values of the element with chord d (length l), elongation u and triads t1, t2;
+// stiffness k = (EA/l0, GJ/l0, EI/l0); unstrained rotations r1, r2 (the moments act on
+// θ̄ − θ̄⁰). The force: (−g, f₁, g, f₂).
+fn element_values(d: vec3<real>, l: real, u: real, t1: Triad, t2: Triad, k: vec3<real>, r1: vec3<real>, r2: vec3<real>) -> Values {
+    let half = real(0.5);
+    let e1 = d / l;
+    let b1 = t1.c1;
+    let b2 = t2.c1;
+    let p = half * (b1 + b2);
+    let a = cr(e1, p);
+    let n = sqrt(dt(a, a));
+    let e3 = a / n;
+    let e2 = cr(e3, e1);
+    let eta = dt(p, e1) / n;
     let l1 = rel_log(e1, e2, e3, t1);
     let l2 = rel_log(e1, e2, e3, t2);
-    let s1 = l1.th.v - r1;
-    let s2 = l2.th.v - r2;
-    let twist = dmul(dc(k.y), dl(s2.x - s1.x, l2.th.d.x - l1.th.d.x));
-    let four = dc(real(4.0) * k.z);
-    let two = dc(real(2.0) * k.z);
-    let t1y = dl(s1.y, l1.th.d.y);
-    let t1z = dl(s1.z, l1.th.d.z);
-    let t2y = dl(s2.y, l2.th.d.y);
-    let t2z = dl(s2.z, l2.th.d.z);
-    let m1y = dmul(four, t1y) + dmul(two, t2y);
-    let m1z = dmul(four, t1z) + dmul(two, t2z);
-    let m2y = dmul(four, t2y) + dmul(two, t1y);
-    let m2z = dmul(four, t2z) + dmul(two, t1z);
-    let m1 = DV(vec3<real>(-twist.x, m1y.x, m1z.x), vec3<real>(-twist.y, m1y.y, m1z.y));
-    let m2 = DV(vec3<real>(twist.x, m2y.x, m2z.x), vec3<real>(twist.y, m2y.y, m2z.y));
-    let v1 = jt(l1, m1);
-    let v2 = jt(l2, m2);
-    let vs = vadd(v1, v2);
-    let vs0 = dl(vs.v.x, vs.d.x);
-    let vs1 = dl(vs.v.y, vs.d.y);
-    let vs2 = dl(vs.v.z, vs.d.z);
-    let axial = dmul(dc(k.x), u);
-    let g3 = ddiv(dmul(eta, vs0) + vs1, l);
-    let g2 = ddiv(vs2, l);
-    let g = vsub(vadd(vscale(e1, axial), vscale(e3, g3)), vscale(e2, g2));
-    let q = ddiv(vs0, n + n);
+    let s1 = l1.th - r1;
+    let s2 = l2.th - r2;
+    let twist = k.y * (s2.x - s1.x);
+    let m1 = vec3<real>(-twist, k.z * (real(4.0) * s1.y + real(2.0) * s2.y), k.z * (real(4.0) * s1.z + real(2.0) * s2.z));
+    let m2 = vec3<real>(twist, k.z * (real(4.0) * s2.y + real(2.0) * s1.y), k.z * (real(4.0) * s2.z + real(2.0) * s1.z));
+    // v̄ = J⁻ᵀ(θ) m̄ = m̄ + ½ θ × m̄ + c θ × (θ × m̄).
+    let tm1 = cr(l1.th, m1);
+    let ttm1 = cr(l1.th, tm1);
+    let tm2 = cr(l2.th, m2);
+    let ttm2 = cr(l2.th, tm2);
+    let v1 = m1 + half * tm1 + l1.c * ttm1;
+    let v2 = m2 + half * tm2 + l2.c * ttm2;
+    let vs = v1 + v2;
+    let axial = k.x * u;
+    let g3 = (eta * vs.x + vs.y) / l;
+    let g2 = vs.z / l;
+    let q = vs.x / (n + n);
+    let be1 = cr(b1, e3);
+    let be2 = cr(b2, e3);
+    return Values(l, e1, e2, e3, b1, b2, p, n, eta, l1.th, l2.th, l1.c, l2.c, m1, m2, v1, v2, vs,
+                  axial, g3, g2, q, be1, be2, tm1, tm2, ttm1, ttm2,
+                  coefficient_slope(dt(l1.th, l1.th), l1.c), coefficient_slope(dt(l2.th, l2.th), l2.c));
+}
+
+fn element_force(v: Values) -> Twelve {
+    let g = v.axial * v.e1 + v.g3 * v.e3 - v.g2 * v.e2;
     // R_r v̄ − q (b × e3).
-    let f1 = vsub(vadd(vadd(vscale(e1, dl(v1.v.x, v1.d.x)), vscale(e2, dl(v1.v.y, v1.d.y))),
-                       vscale(e3, dl(v1.v.z, v1.d.z))), vscale(vcross(t1.c1, e3), q));
-    let f2 = vsub(vadd(vadd(vscale(e1, dl(v2.v.x, v2.d.x)), vscale(e2, dl(v2.v.y, v2.d.y))),
-                       vscale(e3, dl(v2.v.z, v2.d.z))), vscale(vcross(t2.c1, e3), q));
-    return Force(DV(-g.v, -g.d), f1, g, f2);
+    let f1 = v.e1 * v.v1.x + v.e2 * v.v1.y + v.e3 * v.v1.z - v.q * v.be1;
+    let f2 = v.e1 * v.v2.x + v.e2 * v.v2.y + v.e3 * v.v2.z - v.q * v.be2;
+    return Twelve(-g, f1, g, f2);
 }
 
-fn constant(v: vec3<real>) -> DV {
-    return DV(v, vec3<real>(real(0.0)));
+// δθ̄ = J⁻¹(θ̄) x, J⁻¹x = x − ½ θ × x + c θ × (θ × x).
+fn jinv(th: vec3<real>, c: real, x: vec3<real>) -> vec3<real> {
+    let tx = cr(th, x);
+    return x - real(0.5) * tx + c * cr(th, tx);
 }
 
-// The triad's columns with the derivative of a spin about `axis` (zero: none).
-fn spun(t: Triad, axis: vec3<real>) -> Triad {
-    return Triad(DV(t.c0.v, cr(axis, t.c0.v)), DV(t.c1.v, cr(axis, t.c1.v)), DV(t.c2.v, cr(axis, t.c2.v)));
+// δv̄ of v̄ = J⁻ᵀ(θ̄) m̄ (c a function of θ²).
+fn dvbar(th: vec3<real>, c: real, slope: real, m: vec3<real>, tm: vec3<real>, ttm: vec3<real>, dth: vec3<real>, dm: vec3<real>) -> vec3<real> {
+    let dtm = cr(dth, m) + cr(th, dm);
+    let dttm = cr(dth, tm) + cr(th, dtm);
+    let dc = dt(th, dth) * (slope * real(2.0));
+    return (dm + real(0.5) * dtm) + (dc * ttm + c * dttm);
+}
+
+// The variation of the force along one direction (physics::beam::tangent::variation): the
+// chord's unit vector and length changing by de1, dl (moved, a translation of node 2), or
+// node `node`'s triad spun by the global spin s (not moved).
+fn variation(v: Values, k: vec3<real>, moved: bool, de1: vec3<real>, dl: real, node: u32, s: vec3<real>) -> Twelve {
+    let half = real(0.5);
+    let zero = vec3<real>(real(0.0));
+    let inv_n = real(1.0) / v.n;
+    let inv_l = real(1.0) / v.l;
+    // δb_i = δθ_i × b_i for the spun node.
+    var db1 = zero;
+    var db2 = zero;
+    var da: vec3<real>;
+    var dp = zero;
+    if (moved) {
+        da = cr(de1, v.p);
+    } else {
+        if (node == 0u) {
+            db1 = cr(s, v.b1);
+        } else {
+            db2 = cr(s, v.b2);
+        }
+        dp = half * (db1 + db2);
+        da = cr(v.e1, dp);
+    }
+    // a = e1 × p, n = |a|, e3 = a/n, e2 = e3 × e1, η = p·e1/n.
+    let dn = dt(v.e3, da);
+    let de3 = (da - dn * v.e3) * inv_n;
+    var de2 = cr(de3, v.e1);
+    var deta: real;
+    var w3 = real(0.0);
+    if (moved) {
+        de2 = de2 + cr(v.e3, de1);
+        deta = (dt(v.p, de1) - dn * v.eta) * inv_n;
+        w3 = dt(v.e2, de1);
+    } else {
+        deta = (dt(v.e1, dp) - dn * v.eta) * inv_n;
+    }
+    // The frame's spin in its own components: δe_k = δω × e_k.
+    let omega = vec3<real>(dt(v.e3, de2), dt(v.e1, de3), w3);
+    // R_rᵀ δθ_i − ω.
+    var x1 = -omega;
+    var x2 = -omega;
+    if (!moved) {
+        let local = vec3<real>(dt(v.e1, s), dt(v.e2, s), dt(v.e3, s)) - omega;
+        if (node == 0u) {
+            x1 = local;
+        } else {
+            x2 = local;
+        }
+    }
+    let dth1 = jinv(v.th1, v.c1, x1);
+    let dth2 = jinv(v.th2, v.c2, x2);
+    let dtwist = (dth2.x - dth1.x) * k.y;
+    let dm1 = vec3<real>(-dtwist, (dth1.y * real(4.0) + dth2.y * real(2.0)) * k.z, (dth1.z * real(4.0) + dth2.z * real(2.0)) * k.z);
+    let dm2 = vec3<real>(dtwist, (dth2.y * real(4.0) + dth1.y * real(2.0)) * k.z, (dth2.z * real(4.0) + dth1.z * real(2.0)) * k.z);
+    let dv1 = dvbar(v.th1, v.c1, v.slope1, v.m1, v.tm1, v.ttm1, dth1, dm1);
+    let dv2 = dvbar(v.th2, v.c2, v.slope2, v.m2, v.tm2, v.ttm2, dth2, dm2);
+    let dvs = dv1 + dv2;
+    var dg3 = deta * v.vs.x + dvs.x * v.eta + dvs.y;
+    var dg2 = dvs.z;
+    if (moved) {
+        dg3 = dg3 - dl * v.g3;
+        dg2 = dg2 - dl * v.g2;
+    }
+    dg3 = dg3 * inv_l;
+    dg2 = dg2 * inv_l;
+    var dg = (dg3 * v.e3 + v.g3 * de3) - (dg2 * v.e2 + v.g2 * de2);
+    if (moved) {
+        dg = dg + ((dl * k.x) * v.e1 + v.axial * de1);
+    }
+    let dq = (dvs.x * half - dn * v.q) * inv_n;
+    // f_θi = R_r v̄_i − q (b_i × e3).
+    var turned1 = v.v1.y * de2 + v.v1.z * de3;
+    var turned2 = v.v2.y * de2 + v.v2.z * de3;
+    if (moved) {
+        turned1 = turned1 + v.v1.x * de1;
+        turned2 = turned2 + v.v2.x * de1;
+    }
+    let own1 = dv1.x * v.e1 + dv1.y * v.e2 + dv1.z * v.e3;
+    let own2 = dv2.x * v.e1 + dv2.y * v.e2 + dv2.z * v.e3;
+    var dbe1 = cr(v.b1, de3);
+    var dbe2 = cr(v.b2, de3);
+    if (!moved) {
+        if (node == 0u) {
+            dbe1 = dbe1 + cr(db1, v.e3);
+        } else {
+            dbe2 = dbe2 + cr(db2, v.e3);
+        }
+    }
+    let df1 = (turned1 + own1) - (dq * v.be1 + v.q * dbe1);
+    let df2 = (turned2 + own2) - (dq * v.be2 + v.q * dbe2);
+    return Twelve(-dg, df1, dg, df2);
 }
 
 @compute @workgroup_size(64)
@@ -346,63 +425,49 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
                 cols[c][r] = s;
             }
         }
-        tri[node] = Triad(constant(cols[0]), constant(cols[1]), constant(cols[2]));
+        tri[node] = Triad(cols[0], cols[1], cols[2]);
     }
 #if F64
     // Node 2 at c + w₂ (the twin's positions): d = (c + w₂) − w₁, ū = |d| − l0.
-    let d0 = (base + w[1]) - w[0];
+    let d = (base + w[1]) - w[0];
+    let l = sqrt(dt(d, d));
+    let u = l - l0;
 #else
     let dw = w[1] - w[0];
-    let d0 = base + dw;
+    let d = base + dw;
+    let l = sqrt(dt(d, d));
     let lc = sqrt(dt(base, base));
+    let u = stretch + (real(2.0) * dt(base, dw) + dt(dw, dw)) / (l + lc);
 #endif
+    let vals = element_values(d, l, u, tri[0], tri[1], k, r1, r2);
+    let f = element_force(vals);
+    let out = array<vec3<real>, 4>(f.x1, f.t1, f.x2, f.t2);
+    for (var j = 0u; j < 12u; j = j + 1u) {
+        elem_force[(12u * e + j) * nv + v] = out[j / 3u][j % 3u];
+    }
+#if !FORCE_ONLY
+    // Nine directions, not twelve: the element sees the translations only through x₂ − x₁,
+    // so node 1's translation columns are node 2's negated. Direction a of node 2's
+    // translations: δl = e1[a], δe1 = (e_a − e1 e1[a])/l.
     let zero = vec3<real>(real(0.0));
-#if FORCE_ONLY
-    let seeds = 1u;
-#else
-    // Nine passes, not twelve: the element sees the translations only through x₂ − x₁, so
-    // node 1's translation columns are node 2's negated, exactly (a seed of −1 negates every
-    // derivative without changing a rounding; the twin's DualN<9> carries the same nine).
-    let seeds = 9u;
-#endif
-    for (var seed = 0u; seed < seeds; seed++) {
-        // Seed k: 0–2 node 2's translations (columns 6–8), 3–5 node 1's spins (columns
-        // 3–5), 6–8 node 2's spins (columns 9–11); the force alone: none.
-        var dd = zero;
-        var spin = array<vec3<real>, 2>(zero, zero);
-#if !FORCE_ONLY
-        let node = select(1u, 0u, seed >= 3u && seed < 6u);
+    for (var dir = 0u; dir < 9u; dir++) {
+        // 0–2 node 2's translations (columns 6–8), 3–5 node 1's spins (columns 3–5), 6–8
+        // node 2's spins (columns 9–11).
         var unit = zero;
-        unit[seed % 3u] = real(1.0);
-        if (seed < 3u) {
-            dd = unit;
-        } else {
-            spin[node] = unit;
-        }
-        let col = select(select(seed + 3u, seed, seed < 6u), seed + 6u, seed < 3u);
-#endif
-        let d = DV(d0, dd);
-#if F64
-        let u = vnorm(d) - dc(l0);
-#else
-        let dwd = DV(dw, dd);
-        let bd = constant(base);
-        let num = dmul(dc(real(2.0)), vdot(bd, dwd)) + vdot(dwd, dwd);
-        let u = dc(stretch) + ddiv(num, vnorm(d) + dc(lc));
-#endif
-        let f = element_force(d, u, spun(tri[0], spin[0]), spun(tri[1], spin[1]), k, r1, r2);
-        let out = array<DV, 4>(f.x1, f.t1, f.x2, f.t2);
+        unit[dir % 3u] = real(1.0);
+        let moved = dir < 3u;
+        let node = select(1u, 0u, dir < 6u);
+        let de1 = (unit - vals.e1 * vals.e1[dir % 3u]) / vals.l;
+        let dv = variation(vals, k, moved, de1, vals.e1[dir % 3u], node, unit);
+        let col = select(select(dir + 3u, dir, dir < 6u), dir + 6u, dir < 3u);
+        let parts = array<vec3<real>, 4>(dv.x1, dv.t1, dv.x2, dv.t2);
         for (var j = 0u; j < 12u; j = j + 1u) {
-            let part = out[j / 3u];
-            if (seed == 0u) {
-                elem_force[(12u * e + j) * nv + v] = part.v[j % 3u];
+            let value = parts[j / 3u][j % 3u];
+            elem_tangent[(144u * e + 12u * j + col) * nv + v] = value;
+            if (moved) {
+                elem_tangent[(144u * e + 12u * j + dir) * nv + v] = -value;
             }
-#if !FORCE_ONLY
-            elem_tangent[(144u * e + 12u * j + col) * nv + v] = part.d[j % 3u];
-            if (seed < 3u) {
-                elem_tangent[(144u * e + 12u * j + seed) * nv + v] = -part.d[j % 3u];
-            }
-#endif
         }
     }
+#endif
 }

@@ -480,8 +480,9 @@ fn element_states(count: usize) -> Vec<crate::physics::beam::ElementState> {
 /// (the GPU kernel), in one 12-direction pass (the CPU), and the force alone.
 #[derive(Clone, Copy, Debug, Serialize)]
 pub struct ElementFlops {
-    /// Force and tangent, one direction at a time.
-    pub by_direction: u64,
+    /// Force and tangent written out (the values once, their variation per direction: the
+    /// GPU kernel's form and its twin's).
+    pub written_out: u64,
     /// Force and tangent in one pass.
     pub one_pass: u64,
     /// Force alone.
@@ -491,8 +492,8 @@ pub struct ElementFlops {
 /// [`ElementFlops`], counted.
 pub fn element_flops() -> ElementFlops {
     use crate::physics::beam::{
-        element_force, force_and_tangent_by_direction, force_and_tangent_closed, BeamSection,
-        Chord, ElementStiffness,
+        element_force, force_and_tangent_closed, force_and_tangent_variation, BeamSection, Chord,
+        ElementStiffness,
     };
     use crate::physics::count::{count, Counted};
     let s = element_states(1)[0];
@@ -502,7 +503,7 @@ pub fn element_flops() -> ElementFlops {
     let k = ElementStiffness::of(&BeamSection::tube(0.165, 0.071, 2.1e11, 0.3), 9.0).map(Counted);
     let flops = |c: crate::physics::count::OpCounts| c.flops(TRANSCENDENTAL_FLOPS);
     ElementFlops {
-        by_direction: flops(count(|| force_and_tangent_by_direction(&x, &t, &form, &k)).1),
+        written_out: flops(count(|| force_and_tangent_variation(&x, &t, &form, &k)).1),
         one_pass: flops(count(|| force_and_tangent_closed(&x, &t, &form, &k)).1),
         force: flops(count(|| element_force(&x, &t, &form, &k)).1),
     }

@@ -428,7 +428,7 @@ pub fn run(
                 cell.variant_steps_per_s = Some((v * steps) as f64 / t);
                 cell.newton_iterations_per_step = Some(per_it);
                 let tangent = if path.starts_with("GPU") {
-                    e.by_direction
+                    e.written_out
                 } else {
                     e.one_pass
                 };

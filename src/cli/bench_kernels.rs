@@ -165,8 +165,9 @@ fn counts(n: usize) -> Counts {
     let block_cr = counted(|| crate::kernels::block_cr::block_cr(&b));
     Counts {
         contact_per_pair: contact,
-        // The kernel's form: the closed form one dual direction at a time (9 passes).
-        beam_per_element: super::bench::element_flops().by_direction as f64,
+        // The kernel's form: the closed form's values once and their variation along each
+        // of 9 directions (physics::beam::tangent, the twin's).
+        beam_per_element: super::bench::element_flops().written_out as f64,
         assemble,
         block_lu,
         block_cr,

@@ -1,6 +1,7 @@
 //! Twin of `shaders/beam.wgsl`: internal force (12) and consistent tangent (12×12) of every
-//! (element, variant), by [`crate::physics::beam::force_and_tangent_closed`] (the closed-form
-//! force, and its derivative in dual numbers per column, as the kernel) — or the force alone
+//! (element, variant), by [`crate::physics::beam::force_and_tangent_variation`] (the
+//! closed-form force's values once, and their first variation along each direction, as the
+//! kernel) — or the force alone
 //! ([`crate::physics::beam::element_force`], the kernel built with `FORCE_ONLY`) — laid out for the assembly:
 //! `[(12 e + j) V + v]` and `[(144 e + 12 j + k) V + v]`. Inputs: displacements `w` from
 //! each variant's *base* configuration `X + b` `[(3 i + k) V + v]`, rotations
@@ -18,7 +19,7 @@ use rayon::prelude::*;
 
 use crate::model::Model;
 use crate::physics::beam::{
-    element_force, force_and_tangent_closed, Chord, ElementStiffness, Mat3,
+    element_force, force_and_tangent_variation, Chord, ElementStiffness, Mat3,
 };
 
 /// Per element: `EA/l0, GJ/l0, EI/l0, l0` (the kernel's `section` binding).
@@ -176,7 +177,7 @@ pub fn beam(
                     });
                 }
                 if tangent {
-                    let (f, kt) = force_and_tangent_closed(&x, &t, &form, &k);
+                    let (f, kt) = force_and_tangent_variation(&x, &t, &form, &k);
                     for j in 0..12 {
                         f_slab[j * nv + v] = f[j];
                         for c in 0..12 {

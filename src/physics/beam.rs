@@ -15,11 +15,12 @@
 //! operations), and the consistent tangent is its derivative with respect to the Newton
 //! increment applied the same way, by that force evaluated in dual numbers
 //! ([`force_and_tangent_closed`], one pass, the CPU path; [`force_and_tangent_by_direction`],
-//! one column at a time, as `shaders/beam.wgsl`; `src/physics/dual.rs`), or written out,
-//! each intermediate value's first variation on the values the force computed
-//! ([`force_and_tangent_variation`]: equal to rounding and 1.5× faster, not the CPU path —
-//! a change at rounding level moves the load paths of marginal wells, docs/performance.md,
-//! stop 72). The tangent so contains the
+//! one column at a time, `shaders/beam.wgsl`'s form until stop 73; `src/physics/dual.rs`),
+//! or written out, each intermediate value's first variation on the values the force
+//! computed ([`force_and_tangent_variation`]: equal to rounding and 1.5× faster; the GPU
+//! kernel's form and its twin's since stop 73, not the CPU path — a change at rounding level
+//! moves the load paths of marginal wells, docs/performance.md, stop 72). The tangent so
+//! contains the
 //! geometric stiffness: an axial force `N` adds `N/l` to the lateral stiffness, so
 //! compression softens the string and buckling appears. The oracle is the energy itself,
 //! differentiated twice by hyper-dual numbers ([`force_and_tangent_hyperdual`]).
@@ -499,11 +500,11 @@ pub fn force_and_tangent_closed<T: Trig>(
     (force, tangent)
 }
 
-/// [`force_and_tangent_closed`] one direction at a time, as `shaders/beam.wgsl` runs it
-/// (9 passes of [`element_force`] on [`Dual`], one per seed — node 2's translations, node
+/// [`force_and_tangent_closed`] one direction at a time, as `shaders/beam.wgsl` ran it until
+/// stop 73 (9 passes of [`element_force`] on [`Dual`], one per seed — node 2's translations, node
 /// 1's spins, node 2's spins — and node 1's translation columns as node 2's negated: fewer
-/// registers, the value part computed 9 times); the same numbers. For the FLOP count of the
-/// kernel, the benchmark and the test of that identity.
+/// registers, the value part computed 9 times); the same numbers. For the benchmark's
+/// comparison and the test of that identity.
 #[allow(clippy::needless_range_loop)]
 pub fn force_and_tangent_by_direction<T: Trig>(
     x: &[[T; 3]; 2],

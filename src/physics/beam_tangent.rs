@@ -5,7 +5,9 @@
 //! nine derivatives through the rotation log, its transcendentals and the two 3×3 products
 //! `R_rᵀ t_i`: those are replaced by the log's known response to a spin,
 //! `δθ̄_i = J⁻¹(θ̄_i) R_rᵀ(δθ_i − δω)` (`δω` the frame's spin). The oracles are that
-//! dual-number form and the energy's hyper-dual derivatives (`beam_tests.rs`).
+//! dual-number form and the energy's hyper-dual derivatives (`beam_tests.rs`). The GPU beam
+//! kernel (`shaders/beam.wgsl`) runs this form one direction at a time, and its twin
+//! (`crate::kernels::beam`) calls [`force_and_tangent_variation`].
 
 use std::ops::{Add, Mul, Sub};
 
