@@ -372,6 +372,43 @@ fn a_relaxed_answer_says_it_is_one_of_several() {
     }
 }
 
+/// An ensemble says which variants relaxed (`variants.csv`: `relaxed`; `summary.json`:
+/// `relaxed`, with a warning): corpus well 17 tripped in relaxes (as above), tripped out it
+/// does not.
+#[test]
+fn an_ensemble_counts_its_relaxed_variants() {
+    let dir = tempdir::Dir::new("corpus_relaxed_ensemble");
+    let well = write_well(17, dir.path()).unwrap();
+    let variants = dir.path().join("modes.csv");
+    std::fs::write(&variants, "mode\ntripping_in\ntripping_out\n").unwrap();
+    let out = dir.path().join("out");
+    let s = holewall::ensemble::job::run(
+        &well.case_path,
+        Some(&variants),
+        holewall::backend::BackendChoice::Cpu,
+        holewall::backend::Precision::F64,
+        &out,
+        false,
+        &Default::default(),
+    )
+    .unwrap();
+    assert_eq!((s.variants, s.failed, s.relaxed), (2, 0, 1), "{s:?}");
+    assert!(
+        s.notices()
+            .iter()
+            .any(|n| n.contains("1 of 2 variants reached their equilibria by relaxation")),
+        "{:?}",
+        s.notices()
+    );
+    let mut csv = csv::Reader::from_path(out.join("variants.csv")).unwrap();
+    let at = csv.headers().unwrap().iter().position(|h| h == "relaxed");
+    let relaxed: Vec<String> = csv
+        .records()
+        .map(|r| r.unwrap()[at.unwrap()].to_string())
+        .collect();
+    assert_eq!(relaxed, ["true", "false"]);
+}
+
 /// `cases/build_and_hold_2500.toml` with its operation and mesh replaced.
 fn reproducer(mode: &str, element: f64) -> holewall::case::Case {
     let text = std::fs::read_to_string(concat!(

@@ -248,12 +248,27 @@ pub fn locked_up_warning(case: &Case, hook_load: f64) -> Option<String> {
 /// seeds 0–289 14 of 37, 4 by more than 1 %, at most 6.5 %. `None` where it did not relax.
 pub fn relaxed_warning(log: &[String]) -> Option<String> {
     crate::solve::continuation::relaxed(log).then(|| {
-        "this equilibrium was reached by relaxation past a fold (a buckled or \
-         friction-held string): such a string has several equilibria, and which one a \
-         solve reaches depends on its path — on the test corpus, rounding-level changes \
-         moved such answers' hook loads by up to 6.5 %; read hook load, torque and side \
-         forces to a few percent"
-            .to_string()
+        format!(
+            "this equilibrium was reached by relaxation past a fold (a buckled or \
+             friction-held string): {RELAXED_MEANS}"
+        )
+    })
+}
+
+/// What a relaxed answer means for its reader ([`relaxed_warning`]).
+const RELAXED_MEANS: &str = "such a string has several equilibria, and which one a solve \
+     reaches depends on its path — on the test corpus, rounding-level changes moved such \
+     answers' hook loads by up to 6.5 %; read hook load, torque and side forces to a few \
+     percent";
+
+/// The ensemble's form of [`relaxed_warning`]: `relaxed` of `variants` variants reached
+/// their equilibria by relaxation past a fold. `None` where none did.
+pub fn relaxed_variants(relaxed: usize, variants: usize) -> Option<String> {
+    (relaxed > 0).then(|| {
+        format!(
+            "{relaxed} of {variants} variants reached their equilibria by relaxation past a \
+             fold (variants.csv: relaxed): {RELAXED_MEANS}"
+        )
     })
 }
 

@@ -271,6 +271,7 @@ pub fn run(
             failures: Vec::new(),
             outside_hole: 0,
             stopped: 0,
+            relaxed: 0,
             solved_by_engine: 0,
             solved_by_cpu: 0,
             seconds: 0.0,
@@ -375,6 +376,10 @@ pub fn run(
         stopped: results
             .iter()
             .filter(|r| r.string.stopped_load_factor.is_some())
+            .count(),
+        relaxed: results
+            .iter()
+            .filter(|r| r.status != Status::Failed && r.string.relaxed == Some(true))
             .count(),
         solved_by_engine: results
             .iter()

@@ -58,6 +58,11 @@ pub struct StringQoi {
     /// and bit loads at which the FE found an equilibrium.
     #[serde(default)]
     pub stopped_load_factor: Option<f64>,
+    /// A solved static variant whose equilibrium came by relaxation past a fold
+    /// ([`crate::solve::continuation::relaxed`]): one of several equilibria, which the
+    /// solve's path chose ([`crate::diagnose::relaxed_warning`]).
+    #[serde(default)]
+    pub relaxed: Option<bool>,
 }
 
 /// How a variant ended.
@@ -335,6 +340,7 @@ pub fn static_result(
             crate::diagnose::through_wall(case, model, &sol.state).map_or(0.0, |t| t.excess_m),
         ),
         stopped_load_factor: None,
+        relaxed: Some(crate::solve::continuation::relaxed(&sol.log)),
     };
     let travel = crate::rig::Travel::of_axial_speed(model.axial_speed);
     VariantResult {
@@ -609,6 +615,7 @@ impl DynamicObserver {
             stick_slip_severity: severity,
             outside_hole_m: None,
             stopped_load_factor: None,
+            relaxed: None,
         };
         finished(
             name,

@@ -48,6 +48,10 @@ pub struct EnsembleSummary {
     /// lock-up; `variants.csv`: `stopped_load_factor`).
     #[serde(default)]
     pub stopped: usize,
+    /// Solved static variants whose equilibrium came by relaxation past a fold, one of
+    /// several (`variants.csv`: `relaxed`; [`crate::diagnose::relaxed_variants`]).
+    #[serde(default)]
+    pub relaxed: usize,
     /// Variants the kernel engine solved.
     pub solved_by_engine: usize,
     /// Variants the CPU solved: all of them on the CPU backend; on the GPU backend, the
@@ -118,6 +122,9 @@ impl EnsembleSummary {
                  friction and bit loads at which each has one",
                 self.stopped, self.variants
             ));
+        }
+        if let Some(w) = crate::diagnose::relaxed_variants(self.relaxed, self.variants) {
+            n.push(format!("warning: {w}"));
         }
         if self.backend == "gpu" && self.solved_by_cpu > 0 {
             n.push(format!(
@@ -220,6 +227,7 @@ pub(crate) fn variants_csv(
                 "helical_buckling",
                 "outside_hole_m",
                 "stopped_load_factor",
+                "relaxed",
             ]
             .map(String::from),
         );
@@ -298,6 +306,7 @@ pub(crate) fn variants_csv(
             row.push(flag(r.string.helical_buckling));
             row.push(opt(r.string.outside_hole_m));
             row.push(opt(r.string.stopped_load_factor));
+            row.push(flag(r.string.relaxed));
             match &r.bit {
                 Some(b) => row.extend(b.columns().map(fmt)),
                 None => row.extend(crate::bha::BIT_COLUMNS.map(|_| String::new())),
