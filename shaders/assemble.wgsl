@@ -145,6 +145,24 @@ fn mul3(a: array<vec3<real>, 3>, b: array<vec3<real>, 3>) -> array<vec3<real>, 3
 #endif
 
 #if !FORCE_ONLY
+// Entry (j, k) of element e's 12×12 tangent from the beam kernel's 81 independent entries
+// [(81 e + 9 r + d) V + v] (kernels::beam::tangent_slot): rows 0–2 are rows 6–8 negated,
+// columns 0–2 columns 6–8 negated; the directions d are columns 6–8, 3–5 and 9–11.
+fn tangent_at(e: u32, j: u32, k: u32, nv: u32, v: u32) -> real {
+    let r = select(j - 3u, j + 3u, j < 3u);
+    var negated = j < 3u;
+    var d = k;
+    if (k < 3u) {
+        negated = !negated;
+    } else if (k >= 9u) {
+        d = k - 3u;
+    } else if (k >= 6u) {
+        d = k - 6u;
+    }
+    let x = elem_tangent[(81u * e + 9u * r + d) * nv + v];
+    return select(x, -x, negated);
+}
+
 // block ← diag(B_a, I)ᵀ · block · diag(B_b, I): rows of node a, then columns of node b.
 fn transform(blk: ptr<function, array<real, 36>>, a: u32, b: u32) {
     var rows: array<real, 18>;
@@ -219,7 +237,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
             r[k] = r[k] + elem_force[(12u * e + 6u + k) * nv + v];
 #if !FORCE_ONLY
             for (var c = 0u; c < 6u; c = c + 1u) {
-                d[6u * k + c] = d[6u * k + c] + elem_tangent[(144u * e + 12u * (6u + k) + 6u + c) * nv + v];
+                d[6u * k + c] = d[6u * k + c] + tangent_at(e, 6u + k, 6u + c, nv, v);
             }
 #endif
         }
@@ -230,9 +248,9 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
             r[k] = r[k] + elem_force[(12u * e + k) * nv + v];
 #if !FORCE_ONLY
             for (var c = 0u; c < 6u; c = c + 1u) {
-                d[6u * k + c] = d[6u * k + c] + elem_tangent[(144u * e + 12u * k + c) * nv + v];
-                u[6u * k + c] = elem_tangent[(144u * e + 12u * k + 6u + c) * nv + v];
-                l[6u * k + c] = elem_tangent[(144u * e + 12u * (6u + k) + c) * nv + v];
+                d[6u * k + c] = d[6u * k + c] + tangent_at(e, k, c, nv, v);
+                u[6u * k + c] = tangent_at(e, k, 6u + c, nv, v);
+                l[6u * k + c] = tangent_at(e, 6u + k, c, nv, v);
             }
 #endif
         }

@@ -15,8 +15,10 @@
 // responds to a spin as δθ̄_i = J⁻¹(θ̄_i) R_rᵀ(δθ_i − δω), δω the frame's spin, and the
 // coefficient c of J⁻¹ changes with θ² by dc/dθ² = (¼ − 3c + c²θ²)/(2θ²) (its series below
 // θ² = 0.1). Built with FORCE_ONLY it evaluates the force alone (line-search trials: no
-// tangent written). Outputs in the assembly's layout: [(12 e + j) V + v] and
-// [(144 e + 12 j + k) V + v].
+// tangent written). Outputs in the assembly's layout: [(12 e + j) V + v] and the tangent's
+// 81 independent entries [(81 e + 9 r + d) V + v] (kernels::beam::TANGENT_LEN): rows
+// j = r + 3 (θ₁, x₂, θ₂) along the nine directions d; rows 0–2 and columns 0–2 are those
+// negated, which the assembly forms (tangent_at).
 //
 // States are displacements w from each variant's base configuration X + b (kilometres of
 // string lose their millimetres in f32 otherwise; the dynamic engine's base is the static
@@ -447,26 +449,21 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
 #if !FORCE_ONLY
     // Nine directions, not twelve: the element sees the translations only through x₂ − x₁,
-    // so node 1's translation columns are node 2's negated. Direction a of node 2's
-    // translations: δl = e1[a], δe1 = (e_a − e1 e1[a])/l.
+    // so node 1's translation columns are node 2's negated; and of the twelve rows nine, as
+    // f_x₁ = −f_x₂. Direction a of node 2's translations: δl = e1[a], δe1 = (e_a − e1 e1[a])/l.
     let zero = vec3<real>(real(0.0));
     for (var dir = 0u; dir < 9u; dir++) {
-        // 0–2 node 2's translations (columns 6–8), 3–5 node 1's spins (columns 3–5), 6–8
-        // node 2's spins (columns 9–11).
+        // d: 0–2 node 2's translations (columns 6–8), 3–5 node 1's spins (columns 3–5),
+        // 6–8 node 2's spins (columns 9–11).
         var unit = zero;
         unit[dir % 3u] = real(1.0);
         let moved = dir < 3u;
         let node = select(1u, 0u, dir < 6u);
         let de1 = (unit - vals.e1 * vals.e1[dir % 3u]) / vals.l;
         let dv = variation(vals, k, moved, de1, vals.e1[dir % 3u], node, unit);
-        let col = select(select(dir + 3u, dir, dir < 6u), dir + 6u, dir < 3u);
-        let parts = array<vec3<real>, 4>(dv.x1, dv.t1, dv.x2, dv.t2);
-        for (var j = 0u; j < 12u; j = j + 1u) {
-            let value = parts[j / 3u][j % 3u];
-            elem_tangent[(144u * e + 12u * j + col) * nv + v] = value;
-            if (moved) {
-                elem_tangent[(144u * e + 12u * j + dir) * nv + v] = -value;
-            }
+        let rows = array<vec3<real>, 3>(dv.t1, dv.x2, dv.t2);
+        for (var r = 0u; r < 9u; r = r + 1u) {
+            elem_tangent[(81u * e + 9u * r + dir) * nv + v] = rows[r / 3u][r % 3u];
         }
     }
 #endif

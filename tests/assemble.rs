@@ -7,6 +7,7 @@ mod common;
 use common::runners::assemble_residual_gpu;
 use holewall::gpu::assemble::assemble_gpu;
 use holewall::kernels::assemble::{assemble, assemble_residual, AssemblyInputs, NO_SITE};
+use holewall::kernels::beam::{tangent_slot, tangent_source, TANGENT_LEN};
 use holewall::kernels::contact::{response_fields, OUTPUT_LEN};
 use holewall::physics::beam::{force_and_tangent, ElementState};
 use holewall::solve::statics::{
@@ -69,7 +70,7 @@ fn inputs(
         num_nodes: n,
         num_sites: sites,
         elem_force: vec![0.0; 12 * e * v],
-        elem_tangent: vec![0.0; 144 * e * v],
+        elem_tangent: vec![0.0; TANGENT_LEN * e * v],
         contact: vec![0.0; OUTPUT_LEN * sites * v],
         contact_flag: vec![0; sites * v],
         node_site: vec![NO_SITE; n * v],
@@ -104,8 +105,16 @@ fn inputs(
             let (f, k) = force_and_tangent(&es, &el.section, el.length0);
             for r in 0..12 {
                 a.elem_force[(12 * i + r) * v + j] = f[r];
+            }
+            // The beam kernel's 81 entries hold the solver's 144 exactly: the others are
+            // their negations, bit for bit.
+            for r in 0..12 {
                 for c in 0..12 {
-                    a.elem_tangent[(144 * i + 12 * r + c) * v + j] = k[r][c];
+                    let (slot, negated) = tangent_slot(r, c);
+                    let (sr, sc) = tangent_source(slot / 9, slot % 9);
+                    let held = if negated { -k[sr][sc] } else { k[sr][sc] };
+                    assert_eq!(held.to_bits(), k[r][c].to_bits(), "K[{r}][{c}]");
+                    a.elem_tangent[(TANGENT_LEN * i + slot) * v + j] = k[sr][sc];
                 }
             }
         }

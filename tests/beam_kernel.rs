@@ -5,7 +5,7 @@
 mod common;
 
 use holewall::gpu::beam::beam_gpu;
-use holewall::kernels::beam::{base_chords, beam};
+use holewall::kernels::beam::{base_chords, beam, tangent_slot, TANGENT_LEN};
 use holewall::physics::beam::rotation_exp;
 use holewall::solve::statics::StaticState;
 use rand::{Rng, SeedableRng};
@@ -64,11 +64,11 @@ fn gpu_beam_matches_the_twin() {
                     let i = (12 * e + a) * v + j;
                     df += (f[i] - f_twin[i]).powi(2);
                     nf += f_twin[i].powi(2);
-                    for b in 0..12 {
-                        let i = (144 * e + 12 * a + b) * v + j;
-                        dk += (k[i] - k_twin[i]).powi(2);
-                        nk += k_twin[i].powi(2);
-                    }
+                }
+                for b in 0..TANGENT_LEN {
+                    let i = (TANGENT_LEN * e + b) * v + j;
+                    dk += (k[i] - k_twin[i]).powi(2);
+                    nk += k_twin[i].powi(2);
                 }
                 w.0 = w.0.max((df / nf.max(1e-300)).sqrt());
                 w.1 = w.1.max((dk / nk).sqrt());
@@ -210,7 +210,7 @@ fn gpu_beam_with_kinks_matches_the_twin() {
     let (f, k) = beam(&model, v, &x, &rot, &chords, &rest, true);
     // Variant 0 (kinks in full) element by element against the physics.
     let ne = n - 1;
-    let mut worst_phys: f64 = 0.0;
+    let (mut worst_phys, mut worst_tangent): (f64, f64) = (0.0, 0.0);
     for e in 0..ne {
         let pos = |i: usize| -> [f64; 3] {
             std::array::from_fn(|a| model.nodes[i].position[a] + x[(3 * i + a) * v])
@@ -225,7 +225,7 @@ fn gpu_beam_with_kinks_matches_the_twin() {
                 })
             })
         };
-        let (fp, _) = holewall::physics::beam::force_and_tangent_closed(
+        let (fp, kp) = holewall::physics::beam::force_and_tangent_closed(
             &[pos(e), pos(e + 1)],
             &[triad(e), triad(e + 1)],
             &holewall::physics::beam::Chord::Positions {
@@ -237,9 +237,22 @@ fn gpu_beam_with_kinks_matches_the_twin() {
         for a in 0..12 {
             worst_phys = worst_phys.max((f[(12 * e + a) * v] - fp[a]).abs() / scale);
         }
+        // The tangent's 144 entries from the kernel's 81 (`tangent_slot`).
+        let k_scale = kp.iter().flatten().fold(0.0f64, |m, y| m.max(y.abs()));
+        for a in 0..12 {
+            for b in 0..12 {
+                let (slot, negated) = tangent_slot(a, b);
+                let held = k[(TANGENT_LEN * e + slot) * v];
+                let entry = if negated { -held } else { held };
+                worst_tangent = worst_tangent.max((entry - kp[a][b]).abs() / k_scale);
+            }
+        }
     }
-    eprintln!("kinked twin vs physics (variant 0): {worst_phys:.1e}");
+    eprintln!(
+        "kinked twin vs physics (variant 0): force {worst_phys:.1e}, tangent {worst_tangent:.1e}"
+    );
     assert!(worst_phys <= 1e-9, "{worst_phys:e}");
+    assert!(worst_tangent <= 1e-9, "{worst_tangent:e}");
     let Some(ctx) = common::gpu() else { return };
     let rel = |a: &[f64], b: &[f64]| {
         let scale = b.iter().fold(0.0f64, |m, x| m.max(x.abs()));

@@ -353,7 +353,11 @@ fn dynamic_kernels_equal_their_twins() {
         num_nodes: n,
         num_sites: s,
         elem_force: r(-1e4, 1e4, 12 * (n - 1) * v),
-        elem_tangent: r(-1e6, 1e6, 144 * (n - 1) * v),
+        elem_tangent: r(
+            -1e6,
+            1e6,
+            holewall::kernels::beam::TANGENT_LEN * (n - 1) * v,
+        ),
         contact: r(-1e3, 1e3, 48 * p),
         contact_flag: (0..p).map(|i| (i % 3 != 0) as u32).collect(),
         node_site,

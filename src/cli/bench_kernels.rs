@@ -124,7 +124,7 @@ fn assembly_inputs(n: usize, v: usize) -> AssemblyInputs<f64> {
         num_nodes: n,
         num_sites: n,
         elem_force: vec![1.0; 12 * e * v],
-        elem_tangent: vec![1.0; 144 * e * v],
+        elem_tangent: vec![1.0; crate::kernels::beam::TANGENT_LEN * e * v],
         contact: vec![1.0; OUTPUT_LEN * n * v],
         contact_flag: vec![1; n * v],
         node_site: (0..n).flat_map(|i| vec![i as u32; v]).collect(),

@@ -6,7 +6,7 @@ use crate::gpu::contact::GpuReal;
 use crate::gpu::dispatch::{run_once, Out};
 use crate::gpu::layout::BeamDims;
 use crate::gpu::GpuContext;
-use crate::kernels::beam::{frame_table, section_table};
+use crate::kernels::beam::{frame_table, section_table, TANGENT_LEN};
 use crate::model::Model;
 
 /// The WGSL text of the beam kernel at a precision: force and tangent, or (`force_only`)
@@ -56,7 +56,7 @@ pub fn beam_gpu<T: GpuReal>(
     crate::gpu::contact::require_precision::<T>(ctx)?;
     let ne = model.elements.len();
     let size = std::mem::size_of::<T>();
-    if (144 * ne * num_variants * size) as u64 > ctx.max_binding_bytes() {
+    if (TANGENT_LEN * ne * num_variants * size) as u64 > ctx.max_binding_bytes() {
         return Err(GpuError::Unsupported(
             "element tangents exceed one binding; split the variants".into(),
         ));
@@ -76,7 +76,7 @@ pub fn beam_gpu<T: GpuReal>(
     };
     let outputs = [
         Out::Empty(12 * ne * num_variants * size),
-        Out::Empty(144 * ne * num_variants * size),
+        Out::Empty(TANGENT_LEN * ne * num_variants * size),
     ];
     let inputs: [&[u8]; 6] = [
         bytemuck::cast_slice(u),

@@ -12,17 +12,19 @@
 //! U_i   = K_i[0..6][6..12],   L_i = K_i[6..12][0..6]      (i < n − 1)
 //! ```
 //!
-//! Inputs are the beam kernel's element force (12) and tangent (144) per (element, variant)
+//! Inputs are the beam kernel's element force (12) and tangent (its 81 independent entries,
+//! [`crate::kernels::beam::TANGENT_LEN`]; the 144 of `K` by [`tangent_slot`]) per (element, variant)
 //! and the contact kernel's outputs per (site, variant), in their layouts; outputs are in
 //! the [`crate::kernels::block_lu::ChainBatch`] layout, ready for the block solve. Layout:
 //! element field `j` of element `e`, variant `v` at `[(12 e + j) V + v]` (force) and
-//! `[(144 e + j) V + v]` (tangent, row-major); contact field `k` of pair `s·V + v` at
+//! `[(81 e + 9 r + d) V + v]` (tangent); contact field `k` of pair `s·V + v` at
 //! `[k · S V + s V + v]`; `node_site[i V + v]` is the site at node `i` or `u32::MAX`.
 
 // Index loops mirror the WGSL kernel line for line.
 #![allow(clippy::needless_range_loop)]
 use rayon::prelude::*;
 
+use crate::kernels::beam::{tangent_slot, TANGENT_LEN};
 use crate::kernels::block_lu::ChainBatch;
 use crate::kernels::contact::{OUT_C, OUT_C_OMEGA, OUT_G, OUT_K};
 use crate::physics::Real;
@@ -41,7 +43,7 @@ pub struct AssemblyInputs<T> {
     pub num_sites: usize,
     /// Element internal forces, `12 (n−1) V`.
     pub elem_force: Vec<T>,
-    /// Element tangents, `144 (n−1) V`.
+    /// Element tangents, `81 (n−1) V` ([`crate::kernels::beam::TANGENT_LEN`]).
     pub elem_tangent: Vec<T>,
     /// Contact outputs (the contact kernel's `values`), `48 S V`.
     pub contact: Vec<T>,
@@ -184,6 +186,16 @@ fn node_blocks<T: Real>(
     let mut d = [T::zero(); 36];
     let mut u = [T::zero(); 36];
     let mut l = [T::zero(); 36];
+    // Entry (j, k) of element e's tangent.
+    let tan = |e: usize, j: usize, k: usize| -> T {
+        let (slot, negated) = tangent_slot(j, k);
+        let x = a.elem_tangent[(TANGENT_LEN * e + slot) * nv + v];
+        if negated {
+            -x
+        } else {
+            x
+        }
+    };
     for k in 0..6 {
         r[k] = T::zero() - a.f_ext[(6 * i + k) * nv + v];
     }
@@ -195,8 +207,7 @@ fn node_blocks<T: Real>(
                 continue;
             }
             for c in 0..6 {
-                d[6 * k + c] =
-                    d[6 * k + c] + a.elem_tangent[(144 * e + 12 * (6 + k) + 6 + c) * nv + v];
+                d[6 * k + c] = d[6 * k + c] + tan(e, 6 + k, 6 + c);
             }
         }
     }
@@ -208,9 +219,9 @@ fn node_blocks<T: Real>(
                 continue;
             }
             for c in 0..6 {
-                d[6 * k + c] = d[6 * k + c] + a.elem_tangent[(144 * e + 12 * k + c) * nv + v];
-                u[6 * k + c] = a.elem_tangent[(144 * e + 12 * k + 6 + c) * nv + v];
-                l[6 * k + c] = a.elem_tangent[(144 * e + 12 * (6 + k) + c) * nv + v];
+                d[6 * k + c] = d[6 * k + c] + tan(e, k, c);
+                u[6 * k + c] = tan(e, k, 6 + c);
+                l[6 * k + c] = tan(e, 6 + k, c);
             }
         }
     }

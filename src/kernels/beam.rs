@@ -1,9 +1,9 @@
 //! Twin of `shaders/beam.wgsl`: internal force (12) and consistent tangent (12×12) of every
 //! (element, variant), by [`crate::physics::beam::force_and_tangent_variation`] (the
 //! closed-form force's values once, and their first variation along each direction, as the
-//! kernel) — or the force alone
-//! ([`crate::physics::beam::element_force`], the kernel built with `FORCE_ONLY`) — laid out for the assembly:
-//! `[(12 e + j) V + v]` and `[(144 e + 12 j + k) V + v]`. Inputs: displacements `w` from
+//! kernel) — or the force alone ([`crate::physics::beam::element_force`], the kernel built
+//! with `FORCE_ONLY`) — laid out for the assembly: `[(12 e + j) V + v]` and the tangent's 81
+//! independent entries `[(81 e + 9 r + d) V + v]` ([`tangent_slot`]). Inputs: displacements `w` from
 //! each variant's *base* configuration `X + b` `[(3 i + k) V + v]`, rotations
 //! `[(9 i + 3 r + c) V + v]` (the twin takes them in f64), reference triads per node and
 //! sections per element (shared by the variants), and per element and variant the base
@@ -21,6 +21,41 @@ use crate::model::Model;
 use crate::physics::beam::{
     element_force, force_and_tangent_variation, Chord, ElementStiffness, Mat3,
 };
+
+/// Values of an element's tangent per (element, variant) in the beam kernel's output: of
+/// the 144 entries of `K_jk = ∂f_j/∂Δ_k`, the 81 it computes — rows 3–11 (`θ₁`, `x₂`,
+/// `θ₂`) along its nine directions `d` (0–2 node 2's translations, columns 6–8; 3–5 node
+/// 1's spins, columns 3–5; 6–8 node 2's spins, columns 9–11), at `[(81 e + 9 r + d) V + v]`
+/// with `r = j − 3`. The rest are their negations, exactly: `f_x₁ = −f_x₂` (rows 0–2 are
+/// rows 6–8 negated) and the element sees the translations only through `x₂ − x₁` (columns
+/// 0–2 are columns 6–8 negated). The element tangents are the largest array between the
+/// beam kernel and the assembly: 81 values instead of 144 to write and read.
+pub const TANGENT_LEN: usize = 81;
+
+/// Where entry `(j, k)` of an element's 12×12 tangent lies in the beam kernel's output
+/// ([`TANGENT_LEN`]): its index `9 r + d` there, and whether the entry is that value
+/// negated. `shaders/assemble.wgsl`'s `tangent_at` is the same map.
+pub const fn tangent_slot(j: usize, k: usize) -> (usize, bool) {
+    let (r, row_negated) = if j < 3 { (j + 3, true) } else { (j - 3, false) };
+    let (d, col_negated) = match k {
+        0..=2 => (k, true),
+        3..=5 => (k, false),
+        6..=8 => (k - 6, false),
+        _ => (k - 3, false),
+    };
+    (9 * r + d, row_negated != col_negated)
+}
+
+/// The beam kernel's output entry `(r, d)` ([`TANGENT_LEN`]) as an entry `(j, k)` of the
+/// 12×12 tangent: `j = r + 3`, `k` the column of direction `d`.
+pub const fn tangent_source(r: usize, d: usize) -> (usize, usize) {
+    let k = match d {
+        0..=2 => d + 6,
+        3..=5 => d,
+        _ => d + 3,
+    };
+    (r + 3, k)
+}
 
 /// Per element: `EA/l0, GJ/l0, EI/l0, l0` (the kernel's `section` binding).
 pub fn section_table(model: &Model) -> Vec<f64> {
@@ -114,7 +149,7 @@ pub fn set_rest_column<T: crate::physics::Real>(
 }
 
 /// Element forces and tangents of V variants (rayon over elements, each writing its own
-/// slab of the outputs) at displacements `u` from the base whose chords are `chords`
+/// slab of the outputs; the tangents' 81 independent entries, [`TANGENT_LEN`]) at displacements `u` from the base whose chords are `chords`
 /// ([`base_chords`]) and rotations `rot`, with the unstrained rotations `rest`
 /// ([`rest_table`]; empty: none); with `tangent` false the forces alone (the tangents
 /// returned are empty, as the force-only kernel leaves its tangent binding out).
@@ -131,14 +166,14 @@ pub fn beam(
     let ne = model.elements.len();
     let mut force = vec![0.0; 12 * ne * nv];
     let mut tangent_out = if tangent {
-        vec![0.0; 144 * ne * nv]
+        vec![0.0; TANGENT_LEN * ne * nv]
     } else {
         Vec::new()
     };
-    // Element e's entries are `[(12 e + j) V + v]` and `[(144 e + 12 j + c) V + v]`: one
+    // Element e's entries are `[(12 e + j) V + v]` and `[(81 e + 9 r + d) V + v]`: one
     // contiguous slab of each output per element.
     let tangent_slabs: Vec<&mut [f64]> = if tangent {
-        tangent_out.chunks_mut((144 * nv).max(1)).collect()
+        tangent_out.chunks_mut((TANGENT_LEN * nv).max(1)).collect()
     } else {
         (0..ne).map(|_| <&mut [f64]>::default()).collect()
     };
@@ -180,8 +215,11 @@ pub fn beam(
                     let (f, kt) = force_and_tangent_variation(&x, &t, &form, &k);
                     for j in 0..12 {
                         f_slab[j * nv + v] = f[j];
-                        for c in 0..12 {
-                            k_slab[(12 * j + c) * nv + v] = kt[j][c];
+                    }
+                    for r in 0..9 {
+                        for d in 0..9 {
+                            let (j, c) = tangent_source(r, d);
+                            k_slab[(9 * r + d) * nv + v] = kt[j][c];
                         }
                     }
                 } else {

@@ -246,7 +246,11 @@ impl Common {
             params: given("pair_params", params, PARAMS_LEN * p),
             f_ext: given("f_ext", f_ext, 6 * n * v),
             elem_force: empty(ctx, "elem_force", 12 * m * v * size),
-            elem_tangent: empty(ctx, "elem_tangent", 144 * m * v * size),
+            elem_tangent: empty(
+                ctx,
+                "elem_tangent",
+                crate::kernels::beam::TANGENT_LEN * m * v * size,
+            ),
             values: empty(
                 ctx,
                 "contact_values",

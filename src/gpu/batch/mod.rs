@@ -23,6 +23,7 @@ use crate::gpu::kernel::Kernel;
 use crate::gpu::layout::{AssembleDims, BeamDims, ChainDims, ContactDims};
 use crate::gpu::readback::values;
 use crate::gpu::GpuContext;
+use crate::kernels::beam::TANGENT_LEN;
 use crate::kernels::contact::{OUTPUT_LEN, STATE_LEN};
 use crate::kernels::update::{ConfigBatch, Norms};
 use crate::model::Model;
@@ -50,7 +51,7 @@ pub fn bytes_per_variant(n: usize, s: usize, size: usize) -> usize {
     let m = n.saturating_sub(1);
     let reals = 2 * 12 * n            // x, rot: two slots
         + 4 * m                       // base chords and stretches
-        + 12 * m + 144 * m            // element force, tangent
+        + 12 * m + TANGENT_LEN * m    // element force, tangent
         + (OUTPUT_LEN + STATE_LEN + PARAMS_LEN + 6) * s // contact out, state, params, normals, base
         + 6 * n                       // loads
         + 2 * (36 * n + 72 * m + 6 * n) // two systems
@@ -63,7 +64,7 @@ pub fn bytes_per_variant(n: usize, s: usize, size: usize) -> usize {
 /// (The block solve's workspace in its largest form: the form depends on the batch's size.)
 fn largest_binding_per_variant(n: usize, s: usize, size: usize) -> usize {
     let m = n.saturating_sub(1);
-    size * (144 * m)
+    size * (TANGENT_LEN * m)
         .max(36 * n)
         .max(OUTPUT_LEN * s)
         .max(LuForm::Cyclic.workspace(n).0)
