@@ -401,7 +401,8 @@ pub fn run(
 }
 
 /// `roofline.png`: the ceilings of each precision and every kernel's points (a set per
-/// kernel and precision, its V values together).
+/// kernel and precision, its V values together; a colour per kernel, circles f32 and
+/// triangles f64).
 fn roofline(path: &Path, r: &KernelsReport) -> std::io::Result<()> {
     let c = &r.ceilings;
     let intensities: Vec<f64> = (0..=60)
@@ -423,13 +424,25 @@ fn roofline(path: &Path, r: &KernelsReport) -> std::io::Result<()> {
     if let Some(p) = c.fma_gflops_f64 {
         roofs.push((format!("f64 roof: FMA {p:.1} GFLOP/s"), roof(p)));
     }
-    let mut sets: Vec<(String, Vec<(f64, f64)>)> = Vec::new();
+    let mut kernels: Vec<&str> = Vec::new();
+    let mut sets: Vec<(String, (usize, usize), Vec<(f64, f64)>)> = Vec::new();
     for k in &r.rows {
+        let colour = kernels
+            .iter()
+            .position(|n| *n == k.kernel)
+            .unwrap_or_else(|| {
+                kernels.push(&k.kernel);
+                kernels.len() - 1
+            });
         let name = format!("{} {}", k.kernel, k.precision);
         let point = (k.intensity, k.gflops);
-        match sets.iter_mut().find(|(n, _)| *n == name) {
-            Some((_, p)) => p.push(point),
-            None => sets.push((name, vec![point])),
+        match sets.iter_mut().find(|(n, _, _)| *n == name) {
+            Some((_, _, p)) => p.push(point),
+            None => sets.push((
+                name,
+                (colour, usize::from(k.precision == "f64")),
+                vec![point],
+            )),
         }
     }
     let vs = r

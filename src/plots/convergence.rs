@@ -163,18 +163,21 @@ pub fn loglog_plot(
 
 /// A roofline: on log–log axes of arithmetic intensity (FLOP/byte) and GFLOP/s, each `roofs`
 /// line (name, its points: the bound `min(peak, bandwidth × intensity)`) and each `kernels`
-/// point set (name, (intensity, achieved GFLOP/s)), one colour and shape per set.
+/// point set (name, its style, (intensity, achieved GFLOP/s)): the style's colour (an index
+/// into a palette of 8: a kernel) and shape (0 a circle, 1 a triangle: a precision), so no
+/// two sets look alike unless the caller says so.
 pub fn roofline_plot(
     path: &Path,
     title: &str,
     roofs: &[(String, Vec<(f64, f64)>)],
-    kernels: &[(String, Vec<(f64, f64)>)],
+    kernels: &[(String, (usize, usize), Vec<(f64, f64)>)],
 ) -> std::io::Result<()> {
     let positive = |p: &&(f64, f64)| p.0 > 0.0 && p.1 > 0.0 && p.0.is_finite() && p.1.is_finite();
     let all: Vec<(f64, f64)> = roofs
         .iter()
-        .chain(kernels)
-        .flat_map(|(_, p)| p.iter().filter(positive).copied())
+        .map(|(_, p)| p)
+        .chain(kernels.iter().map(|(_, _, p)| p))
+        .flat_map(|p| p.iter().filter(positive).copied())
         .collect();
     let range = |f: &dyn Fn(&(f64, f64)) -> f64| {
         all.iter()
@@ -219,10 +222,10 @@ pub fn roofline_plot(
             RGBColor(90, 0, 120),
             RGBColor(0, 100, 60),
         ];
-        for (k, (name, p)) in kernels.iter().enumerate() {
-            let c = colours[k % colours.len()].filled();
+        for (name, (colour, shape), p) in kernels {
+            let c = colours[colour % colours.len()].filled();
             let pts: Vec<(f64, f64)> = p.iter().filter(positive).copied().collect();
-            if k % 2 == 0 {
+            if shape % 2 == 0 {
                 chart
                     .draw_series(pts.iter().map(|&q| Circle::new(q, 6, c)))?
                     .label(name.as_str())
