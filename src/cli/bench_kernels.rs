@@ -425,7 +425,7 @@ fn roofline(path: &Path, r: &KernelsReport) -> std::io::Result<()> {
         roofs.push((format!("f64 roof: FMA {p:.1} GFLOP/s"), roof(p)));
     }
     let mut kernels: Vec<&str> = Vec::new();
-    let mut sets: Vec<(String, (usize, usize), Vec<(f64, f64)>)> = Vec::new();
+    let mut sets: Vec<crate::plots::RooflineSet> = Vec::new();
     for k in &r.rows {
         let colour = kernels
             .iter()

@@ -161,6 +161,10 @@ pub fn loglog_plot(
     })
 }
 
+/// One kernel's points on a [`roofline_plot`]: its name, its style (colour, shape) and its
+/// (intensity, GFLOP/s) points.
+pub type RooflineSet = (String, (usize, usize), Vec<(f64, f64)>);
+
 /// A roofline: on log–log axes of arithmetic intensity (FLOP/byte) and GFLOP/s, each `roofs`
 /// line (name, its points: the bound `min(peak, bandwidth × intensity)`) and each `kernels`
 /// point set (name, its style, (intensity, achieved GFLOP/s)): the style's colour (an index
@@ -170,7 +174,7 @@ pub fn roofline_plot(
     path: &Path,
     title: &str,
     roofs: &[(String, Vec<(f64, f64)>)],
-    kernels: &[(String, (usize, usize), Vec<(f64, f64)>)],
+    kernels: &[RooflineSet],
 ) -> std::io::Result<()> {
     let positive = |p: &&(f64, f64)| p.0 > 0.0 && p.1 > 0.0 && p.0.is_finite() && p.1.is_finite();
     let all: Vec<(f64, f64)> = roofs

@@ -7,7 +7,7 @@ use plotters::prelude::*;
 mod convergence;
 mod distributions;
 mod maps;
-pub use convergence::{convergence_plot, log_ticks, loglog_plot, roofline_plot};
+pub use convergence::{convergence_plot, log_ticks, loglog_plot, roofline_plot, RooflineSet};
 pub use distributions::{histogram, scatter, tornado};
 pub use maps::{class_scatter, heat_map, tile_map, Tile};
 
