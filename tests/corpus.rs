@@ -382,16 +382,7 @@ fn an_ensemble_counts_its_relaxed_variants() {
     let variants = dir.path().join("modes.csv");
     std::fs::write(&variants, "mode\ntripping_in\ntripping_out\n").unwrap();
     let out = dir.path().join("out");
-    let s = holewall::ensemble::job::run(
-        &well.case_path,
-        Some(&variants),
-        holewall::backend::BackendChoice::Cpu,
-        holewall::backend::Precision::F64,
-        &out,
-        false,
-        &Default::default(),
-    )
-    .unwrap();
+    let s = common::ensemble_on_cpu(&well.case_path, Some(&variants), &out);
     assert_eq!((s.variants, s.failed, s.relaxed), (2, 0, 1), "{s:?}");
     assert!(
         s.notices()

@@ -130,16 +130,7 @@ fn an_ensemble_variant_that_stops_says_where() {
     );
     std::fs::write(&path, text).unwrap();
     let out = path.parent().unwrap().join("out");
-    let s = holewall::ensemble::job::run(
-        &path,
-        None,
-        holewall::backend::BackendChoice::Cpu,
-        holewall::backend::Precision::F64,
-        &out,
-        false,
-        &Default::default(),
-    )
-    .unwrap();
+    let s = common::ensemble_on_cpu(&path, None, &out);
     assert_eq!((s.variants, s.failed, s.stopped), (2, 1, 1), "{s:?}");
     assert!(s.notices().iter().any(|n| n.contains("stop on their way")));
     let mut csv = csv::Reader::from_path(out.join("variants.csv")).unwrap();

@@ -433,24 +433,6 @@ fn the_initial_offset_is_a_half_sine_over_the_bha_within_its_clearance() {
     );
 }
 
-/// `holewall ensemble CASE [--variants FILE] --backend cpu --out OUT`, through the library.
-fn ensemble_on_cpu(
-    case: &std::path::Path,
-    variants: Option<&std::path::Path>,
-    out: &std::path::Path,
-) -> holewall::ensemble::report::EnsembleSummary {
-    holewall::ensemble::job::run(
-        case,
-        variants,
-        holewall::backend::BackendChoice::Cpu,
-        holewall::backend::Precision::F64,
-        out,
-        false,
-        &Default::default(),
-    )
-    .unwrap()
-}
-
 /// The shipped whirl map (`cases/whirl_map.toml`: a 3 mm collar imbalance, RPM × WOB ×
 /// friction): with μ = 0.1 the stabilizer whirls forward and synchronously everywhere; with
 /// μ = 0.5 it turns to backward whirl from 180 rpm on (its dominant frequency against the
@@ -460,7 +442,7 @@ fn the_shipped_whirl_map() {
     let case = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("cases/whirl_map.toml");
     let out = std::env::temp_dir().join(format!("holewall-whirl-map-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&out);
-    let s = ensemble_on_cpu(&case, None, &out);
+    let s = common::ensemble_on_cpu(&case, None, &out);
     assert_eq!((s.variants, s.failed), (16, 0));
     let csv = std::fs::read_to_string(out.join("variants.csv")).unwrap();
     let mut rows = csv.lines();
@@ -526,7 +508,7 @@ fn a_drawn_friction_is_mapped_in_ranges() {
     }
     std::fs::write(dir.join("variants.csv"), csv).unwrap();
     let out = dir.join("out");
-    let s = ensemble_on_cpu(
+    let s = common::ensemble_on_cpu(
         &dir.join("case.toml"),
         Some(&dir.join("variants.csv")),
         &out,

@@ -313,3 +313,21 @@ pub fn shipped_case_text(name: &str) -> String {
         .join(name);
     std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
 }
+
+/// `holewall ensemble CASE [--variants FILE] --backend cpu --out OUT`, through the library.
+pub fn ensemble_on_cpu(
+    case: &std::path::Path,
+    variants: Option<&std::path::Path>,
+    out: &std::path::Path,
+) -> holewall::ensemble::report::EnsembleSummary {
+    holewall::ensemble::job::run(
+        case,
+        variants,
+        holewall::backend::BackendChoice::Cpu,
+        holewall::backend::Precision::F64,
+        out,
+        false,
+        &Default::default(),
+    )
+    .unwrap()
+}
