@@ -13,11 +13,11 @@
 //! ```
 //!
 //! Inputs are the beam kernel's element force (12) and tangent (its 81 independent entries,
-//! [`crate::kernels::beam::TANGENT_LEN`]; the 144 of `K` by [`tangent_slot`]) per (element, variant)
-//! and the contact kernel's outputs per (site, variant), in their layouts; outputs are in
-//! the [`crate::kernels::block_lu::ChainBatch`] layout, ready for the block solve. Layout:
-//! element field `j` of element `e`, variant `v` at `[(12 e + j) V + v]` (force) and
-//! `[(81 e + 9 r + d) V + v]` (tangent); contact field `k` of pair `s·V + v` at
+//! [`crate::kernels::beam::TANGENT_LEN`]; the 144 of `K` by [`tangent_slot`]) per (element,
+//! variant) and the contact kernel's outputs per (site, variant), in their layouts; outputs
+//! are in the [`crate::kernels::block_lu::ChainBatch`] layout, ready for the block solve.
+//! Layout: element field `j` of element `e`, variant `v` at `[(12 e + j) V + v]` (force)
+//! and `[(81 e + 9 r + d) V + v]` (tangent); contact field `k` of pair `s·V + v` at
 //! `[k · S V + s V + v]`; `node_site[i V + v]` is the site at node `i` or `u32::MAX`.
 
 // Index loops mirror the WGSL kernel line for line.

@@ -3,8 +3,8 @@
 //! closed-form force's values once, and their first variation along each direction, as the
 //! kernel) — or the force alone ([`crate::physics::beam::element_force`], the kernel built
 //! with `FORCE_ONLY`) — laid out for the assembly: `[(12 e + j) V + v]` and the tangent's 81
-//! independent entries `[(81 e + 9 r + d) V + v]` ([`tangent_slot`]). Inputs: displacements `w` from
-//! each variant's *base* configuration `X + b` `[(3 i + k) V + v]`, rotations
+//! independent entries `[(81 e + 9 r + d) V + v]` ([`tangent_slot`]). Inputs: displacements
+//! `w` from each variant's *base* configuration `X + b` `[(3 i + k) V + v]`, rotations
 //! `[(9 i + 3 r + c) V + v]` (the twin takes them in f64), reference triads per node and
 //! sections per element (shared by the variants), and per element and variant the base
 //! chord `c = (X₂ + b₂) − (X₁ + b₁)` with its stretch `|c| − l0` ([`base_chords`]). An
@@ -149,10 +149,11 @@ pub fn set_rest_column<T: crate::physics::Real>(
 }
 
 /// Element forces and tangents of V variants (rayon over elements, each writing its own
-/// slab of the outputs; the tangents' 81 independent entries, [`TANGENT_LEN`]) at displacements `u` from the base whose chords are `chords`
-/// ([`base_chords`]) and rotations `rot`, with the unstrained rotations `rest`
-/// ([`rest_table`]; empty: none); with `tangent` false the forces alone (the tangents
-/// returned are empty, as the force-only kernel leaves its tangent binding out).
+/// slab of the outputs; the tangents' 81 independent entries, [`TANGENT_LEN`]) at
+/// displacements `u` from the base whose chords are `chords` ([`base_chords`]) and rotations
+/// `rot`, with the unstrained rotations `rest` ([`rest_table`]; empty: none); with `tangent`
+/// false the forces alone (the tangents returned are empty, as the force-only kernel leaves
+/// its tangent binding out).
 pub fn beam(
     model: &Model,
     num_variants: usize,
