@@ -374,30 +374,58 @@ fn a_relaxed_answer_says_it_is_one_of_several() {
 
 /// An ensemble says which variants relaxed (`variants.csv`: `relaxed`; `summary.json`:
 /// `relaxed`, with a warning): corpus well 17 tripped in relaxes (as above), tripped out it
-/// does not.
+/// does not — as a static ensemble, and as a dynamic one (6 ms) whose static starts are
+/// those equilibria, on the CPU and through the engine.
 #[test]
 fn an_ensemble_counts_its_relaxed_variants() {
+    use holewall::backend::BackendChoice;
     let dir = tempdir::Dir::new("corpus_relaxed_ensemble");
     let well = write_well(17, dir.path()).unwrap();
     let variants = dir.path().join("modes.csv");
     std::fs::write(&variants, "mode\ntripping_in\ntripping_out\n").unwrap();
-    let out = dir.path().join("out");
-    let s = common::ensemble_on_cpu(&well.case_path, Some(&variants), &out);
-    assert_eq!((s.variants, s.failed, s.relaxed), (2, 0, 1), "{s:?}");
-    assert!(
-        s.notices()
+    let dynamic = dir.path().join("dynamic.toml");
+    let text = std::fs::read_to_string(&well.case_path).unwrap();
+    std::fs::write(
+        &dynamic,
+        format!(
+            "{text}\n[dynamics]\nduration = \"0.006 s\"\ntime_step = \"2 ms\"\n\
+             output_interval = \"2 ms\"\nramp_time = \"0.002 s\"\n\n[ensemble]\n\
+             analysis = \"dynamic\"\n"
+        ),
+    )
+    .unwrap();
+    let gpu = common::gpu().is_some();
+    let runs = [
+        (
+            &well.case_path,
+            BackendChoice::Cpu,
+            "reached their equilibria",
+        ),
+        (
+            &dynamic,
+            BackendChoice::Cpu,
+            "started their dynamic runs from static",
+        ),
+    ]
+    .into_iter()
+    .chain(gpu.then_some((&dynamic, BackendChoice::Gpu, "started their dynamic runs")));
+    for (k, (case, backend, said)) in runs.enumerate() {
+        let out = dir.path().join(format!("out_{k}"));
+        let s = common::ensemble_on(case, Some(&variants), backend, &out);
+        assert_eq!((s.variants, s.failed, s.relaxed), (2, 0, 1), "{s:?}");
+        let told = s
+            .notices()
             .iter()
-            .any(|n| n.contains("1 of 2 variants reached their equilibria by relaxation")),
-        "{:?}",
-        s.notices()
-    );
-    let mut csv = csv::Reader::from_path(out.join("variants.csv")).unwrap();
-    let at = csv.headers().unwrap().iter().position(|h| h == "relaxed");
-    let relaxed: Vec<String> = csv
-        .records()
-        .map(|r| r.unwrap()[at.unwrap()].to_string())
-        .collect();
-    assert_eq!(relaxed, ["true", "false"]);
+            .any(|n| n.contains(&format!("1 of 2 variants {said}")));
+        assert!(told, "{:?}", s.notices());
+        let mut csv = csv::Reader::from_path(out.join("variants.csv")).unwrap();
+        let at = csv.headers().unwrap().iter().position(|h| h == "relaxed");
+        let relaxed: Vec<String> = csv
+            .records()
+            .map(|r| r.unwrap()[at.unwrap()].to_string())
+            .collect();
+        assert_eq!(relaxed, ["true", "false"], "run {k}");
+    }
 }
 
 /// `cases/build_and_hold_2500.toml` with its operation and mesh replaced.

@@ -262,12 +262,18 @@ const RELAXED_MEANS: &str = "such a string has several equilibria, and which one
      percent";
 
 /// The ensemble's form of [`relaxed_warning`]: `relaxed` of `variants` variants reached
-/// their equilibria by relaxation past a fold. `None` where none did.
-pub fn relaxed_variants(relaxed: usize, variants: usize) -> Option<String> {
+/// their equilibria (`dynamic`: their dynamic runs' static starts) by relaxation past a
+/// fold. `None` where none did.
+pub fn relaxed_variants(relaxed: usize, variants: usize, dynamic: bool) -> Option<String> {
     (relaxed > 0).then(|| {
+        let what = if dynamic {
+            "started their dynamic runs from static equilibria reached"
+        } else {
+            "reached their equilibria"
+        };
         format!(
-            "{relaxed} of {variants} variants reached their equilibria by relaxation past a \
-             fold (variants.csv: relaxed): {RELAXED_MEANS}"
+            "{relaxed} of {variants} variants {what} by relaxation past a fold (variants.csv: \
+             relaxed): {RELAXED_MEANS}"
         )
     })
 }

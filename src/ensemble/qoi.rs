@@ -60,7 +60,8 @@ pub struct StringQoi {
     pub stopped_load_factor: Option<f64>,
     /// A solved static variant whose equilibrium came by relaxation past a fold
     /// ([`crate::solve::continuation::relaxed`]): one of several equilibria, which the
-    /// solve's path chose ([`crate::diagnose::relaxed_warning`]).
+    /// solve's path chose ([`crate::diagnose::relaxed_warning`]); for a dynamic variant,
+    /// its static start's.
     #[serde(default)]
     pub relaxed: Option<bool>,
 }
@@ -436,6 +437,7 @@ fn dynamic_held(
             )
         }
     };
+    let relaxed_start = crate::solve::continuation::relaxed(&start.log);
     let mass = track_energy
         .then(|| crate::solve::dynamics::lumped_mass(model, &|e| case.element_density[e]).0);
     let options = case.settings().dynamics();
@@ -484,10 +486,9 @@ fn dynamic_held(
         f.step_cuts = cuts;
         return (f, energy_growth);
     }
-    (
-        observer.finish(case, name, model, &s, &dynamics.log, &dynamics.iterations),
-        energy_growth,
-    )
+    let mut done = observer.finish(case, name, model, &s, &dynamics.log, &dynamics.iterations);
+    done.string.relaxed = Some(relaxed_start);
+    (done, energy_growth)
 }
 
 /// The quantities of interest of a dynamic run, accumulated step by step (the CPU

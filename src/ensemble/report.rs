@@ -49,7 +49,8 @@ pub struct EnsembleSummary {
     #[serde(default)]
     pub stopped: usize,
     /// Solved static variants whose equilibrium came by relaxation past a fold, one of
-    /// several (`variants.csv`: `relaxed`; [`crate::diagnose::relaxed_variants`]).
+    /// several — dynamic: variants whose static start did (`variants.csv`: `relaxed`;
+    /// [`crate::diagnose::relaxed_variants`]).
     #[serde(default)]
     pub relaxed: usize,
     /// Variants the kernel engine solved.
@@ -123,7 +124,8 @@ impl EnsembleSummary {
                 self.stopped, self.variants
             ));
         }
-        if let Some(w) = crate::diagnose::relaxed_variants(self.relaxed, self.variants) {
+        let dynamic = self.analysis == "dynamic";
+        if let Some(w) = crate::diagnose::relaxed_variants(self.relaxed, self.variants, dynamic) {
             n.push(format!("warning: {w}"));
         }
         if self.backend == "gpu" && self.solved_by_cpu > 0 {
@@ -219,7 +221,7 @@ pub(crate) fn variants_csv(
         header.insert(at, "weight_indicator_n".into());
     }
     if dynamic {
-        header.push("stick_slip_severity".into());
+        header.extend(["stick_slip_severity", "relaxed"].map(String::from));
     } else {
         header.extend(
             [
@@ -301,6 +303,7 @@ pub(crate) fn variants_csv(
         row.push(opt(r.string.max_side_force_md_m));
         if dynamic {
             row.push(opt(r.string.stick_slip_severity));
+            row.push(flag(r.string.relaxed));
         } else {
             row.push(flag(r.string.sinusoidal_buckling));
             row.push(flag(r.string.helical_buckling));

@@ -235,6 +235,7 @@ pub fn run_dynamic_gpu<T: crate::gpu::contact::GpuReal>(
                 let model = held[j].as_ref().unwrap_or(&models[j]);
                 let mut done = obs.finish(case, name, model, &state, &r.log, &r.iterations);
                 done.solved_by = SolvedBy::Engine;
+                done.string.relaxed = Some(crate::solve::continuation::relaxed(&statics[j].log));
                 let kept = model.sites.len() - models[j].sites.len();
                 if kept > 0 {
                     done.reason = format!(

@@ -320,10 +320,21 @@ pub fn ensemble_on_cpu(
     variants: Option<&std::path::Path>,
     out: &std::path::Path,
 ) -> holewall::ensemble::report::EnsembleSummary {
+    ensemble_on(case, variants, holewall::backend::BackendChoice::Cpu, out)
+}
+
+/// `holewall ensemble CASE [--variants FILE] --backend B --out OUT` (f64), through the
+/// library.
+pub fn ensemble_on(
+    case: &std::path::Path,
+    variants: Option<&std::path::Path>,
+    backend: holewall::backend::BackendChoice,
+    out: &std::path::Path,
+) -> holewall::ensemble::report::EnsembleSummary {
     holewall::ensemble::job::run(
         case,
         variants,
-        holewall::backend::BackendChoice::Cpu,
+        backend,
         holewall::backend::Precision::F64,
         out,
         false,
