@@ -217,6 +217,9 @@ struct Values {
     ttm2: vec3<real>,
     slope1: real,
     slope2: real,
+    // 1/n and 1/l, once for the nine directions.
+    inv_n: real,
+    inv_l: real,
 }
 
 // The element's twelve forces or one direction's twelve variations: (x₁, θ₁, x₂, θ₂).
@@ -264,7 +267,8 @@ fn element_values(d: vec3<real>, l: real, u: real, t1: Triad, t2: Triad, k: vec3
     let be2 = cr(b2, e3);
     return Values(l, e1, e2, e3, b1, b2, p, n, eta, l1.th, l2.th, l1.c, l2.c, m1, m2, v1, v2, vs,
                   axial, g3, g2, q, be1, be2, tm1, tm2, ttm1, ttm2,
-                  coefficient_slope(dt(l1.th, l1.th), l1.c), coefficient_slope(dt(l2.th, l2.th), l2.c));
+                  coefficient_slope(dt(l1.th, l1.th), l1.c), coefficient_slope(dt(l2.th, l2.th), l2.c),
+                  real(1.0) / n, real(1.0) / l);
 }
 
 fn element_force(v: Values) -> Twelve {
@@ -295,8 +299,8 @@ fn dvbar(th: vec3<real>, c: real, slope: real, m: vec3<real>, tm: vec3<real>, tt
 fn variation(v: Values, k: vec3<real>, moved: bool, de1: vec3<real>, dl: real, node: u32, s: vec3<real>) -> Twelve {
     let half = real(0.5);
     let zero = vec3<real>(real(0.0));
-    let inv_n = real(1.0) / v.n;
-    let inv_l = real(1.0) / v.l;
+    let inv_n = v.inv_n;
+    let inv_l = v.inv_l;
     // δb_i = δθ_i × b_i for the spun node.
     var db1 = zero;
     var db2 = zero;
@@ -450,7 +454,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
 #if !FORCE_ONLY
     // Nine directions, not twelve: the element sees the translations only through x₂ − x₁,
     // so node 1's translation columns are node 2's negated; and of the twelve rows nine, as
-    // f_x₁ = −f_x₂. Direction a of node 2's translations: δl = e1[a], δe1 = (e_a − e1 e1[a])/l.
+    // f_x₁ = −f_x₂.
     let zero = vec3<real>(real(0.0));
     for (var dir = 0u; dir < 9u; dir++) {
         // d: 0–2 node 2's translations (columns 6–8), 3–5 node 1's spins (columns 3–5),
@@ -459,7 +463,12 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         unit[dir % 3u] = real(1.0);
         let moved = dir < 3u;
         let node = select(1u, 0u, dir < 6u);
-        let de1 = (unit - vals.e1 * vals.e1[dir % 3u]) / vals.l;
+        // Node 2's translation along e_a: δl = e1[a], δe1 = (e_a − e1 e1[a])/l (the spins
+        // leave the chord alone).
+        var de1 = zero;
+        if (moved) {
+            de1 = (unit - vals.e1 * vals.e1[dir % 3u]) / vals.l;
+        }
         let dv = variation(vals, k, moved, de1, vals.e1[dir % 3u], node, unit);
         let rows = array<vec3<real>, 3>(dv.t1, dv.x2, dv.t2);
         for (var r = 0u; r < 9u; r = r + 1u) {
