@@ -567,7 +567,7 @@ fn tendency_over(
 }
 
 /// The tendency of the case's assembly as it is operated: [`tendency`] at the bends'
-/// toolfaces, or — for an assembly with a bend that rotates — [`tendency_over`] the 12
+/// toolfaces, or — for an assembly with a bend that rotates — `tendency_over` the 12
 /// toolfaces every 30°: at each hole curvature the bit's high-side force and drilling
 /// direction are the means over a revolution, and the rates are where that mean direction
 /// follows the hole (the bit's straight-hole loads are the first toolface's; the notes say

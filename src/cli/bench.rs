@@ -475,7 +475,7 @@ fn element_states(count: usize) -> Vec<crate::physics::beam::ElementState> {
         .collect()
 }
 
-/// Floating-point operations per element, counted ([`TRANSCENDENTAL_FLOPS`] per
+/// Floating-point operations per element, counted (`TRANSCENDENTAL_FLOPS` per
 /// transcendental) on a deformed element: the force and tangent one direction at a time
 /// (the GPU kernel), in one 12-direction pass (the CPU), and the force alone.
 #[derive(Clone, Copy, Debug, Serialize)]

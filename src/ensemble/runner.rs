@@ -15,7 +15,7 @@ use crate::solve::statics::StaticState;
 
 /// Static equilibria of every variant through the GPU kernels (in `T`), held in the hole as
 /// the CPU holds them (guard sites at every node without one, those in contact kept:
-/// `guarded_models`, [`crate::profile::keep_touching`]); the variants that fail there re-run
+/// `guarded_models`, `crate::profile::keep_touching`); the variants that fail there re-run
 /// on the CPU with step control (their reason says so). Stabilizer
 /// moves run there too (each pair carries its node). `Err` with the reason when the
 /// variants do not share the number of sites, or need what only the CPU has: the caller
@@ -285,7 +285,7 @@ pub fn run_dynamic_gpu<T: crate::gpu::contact::GpuReal>(
 /// The models the engine solves for `variants` (`own`: each variant's model): each with a
 /// guard site at every node it has none at, with the variant's overrides, as
 /// [`crate::profile::solve_in_hole`] solves a model on the CPU (its answer then kept by
-/// [`crate::profile::keep_touching`]); `own` where every node has a site. `Err` where the
+/// `crate::profile::keep_touching`); `own` where every node has a site. `Err` where the
 /// guarded models do not share a mesh (the caller runs the CPU).
 fn guarded_models(
     case: &Case,

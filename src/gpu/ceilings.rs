@@ -95,7 +95,7 @@ pub struct CopyPoint {
     pub gbytes_per_s: f64,
     /// The faster form's element (`vec4<f32>` or `f32`).
     pub form: &'static str,
-    /// Each form's bandwidth (GB/s), in [`COPY_FORMS`]' order: on lavapipe a storage
+    /// Each form's bandwidth (GB/s), in `COPY_FORMS`' order: on lavapipe a storage
     /// access is a loop over the SIMD lanes (Mesa's `emit_load_mem`), which a `vec4` pays
     /// once for four elements.
     pub by_form: [f64; 2],
@@ -147,7 +147,7 @@ fn fastest(x: Vec<f64>) -> f64 {
 const MIN_SECONDS: f64 = 0.01;
 
 /// Measures the ceilings on `ctx`: `repeats` timed runs each, at a size grown by doubling
-/// until the fastest run takes [`MIN_SECONDS`] — a fixed size that suits lavapipe
+/// until the fastest run takes `MIN_SECONDS` — a fixed size that suits lavapipe
 /// (seconds) is over in microseconds on an H100, where the launch then dominates (the first
 /// H100 run read 4.9 TFLOP/s and 0.5 TB/s at the old fixed sizes).
 pub fn measure(ctx: &GpuContext, repeats: usize) -> Result<Ceilings, GpuError> {

@@ -284,7 +284,7 @@ fn variation<T: Trig, const N: usize>(
 }
 
 /// Internal force (12) and consistent tangent (12×12), the tangent written out
-/// ([`variation`], the translations and the spins each as one group) — the same
+/// (`variation`, the translations and the spins each as one group) — the same
 /// `K_jk = ∂f_j/∂Δ_k` as [`super::force_and_tangent_closed`] (translations, and left spins
 /// `(I + [ε e]×)·t`), to rounding; the force is [`super::element_force`]'s bit for bit.
 /// Nine directions as there: node 2's translations (node 1's columns their negation), node

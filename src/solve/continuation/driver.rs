@@ -25,7 +25,7 @@ pub trait StaticSystem: NewtonSystem {
         None
     }
     /// The first proximal shift of a relaxation of variant `j` (N/m on the translations;
-    /// [`super::Stage::Relax`]); `None` where the system cannot relax (its variants fail where a
+    /// `super::Stage::Relax`); `None` where the system cannot relax (its variants fail where a
     /// step fails at the smallest size).
     fn relax_scale(&mut self, _j: usize) -> Option<f64> {
         None

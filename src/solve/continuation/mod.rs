@@ -17,31 +17,31 @@
 //!    ([`StaticSystem::relax_scale`]: the CPU solve and the engine), the variant
 //!    **relaxes** from the last equilibrium — at once where every spring law is linear; a
 //!    soft or hard law first cuts the step in half from the last converged state, down to
-//!    [`RELAX_AFTER_STEP`]; a system that cannot relax cuts down to `min_step` and fails
+//!    `RELAX_AFTER_STEP`; a system that cannot relax cuts down to `min_step` and fails
 //!    there.
 //!    Cutting first, down to `min_step`, cost corpus wells 0, 17 and 28 (horizontal,
 //!    10 m elements) 12–13 failed steps of 20–80 iterations each and only found the fold
 //!    more closely; relaxing at the first failure took them 1,085 / 1,509 / 1,058 → 683 /
 //!    1,059 / 598 Newton iterations (docs/validation.md, stop 56). The relaxation goes to
-//!    the full loads by proximal points ([`Stage::Relax`]): sub-solves of
+//!    the full loads by proximal points (`Stage::Relax`): sub-solves of
 //!    `r(x) + s (x − a) = 0` for the translations, each from and anchored at the last
-//!    one's answer `a`, `s` lowered as they get easy (to [`RELAX_FLOOR`] × its start) and
+//!    one's answer `a`, `s` lowered as they get easy (to `RELAX_FLOOR` × its start) and
 //!    raised where one fails (not lowered again to a shift that failed lately), each
-//!    solved inexactly (to [`RELAX_SUB_REDUCTION`] of its residual at the anchor), until an
+//!    solved inexactly (to `RELAX_SUB_REDUCTION` of its residual at the anchor), until an
 //!    answer is an equilibrium without the shift ([`LoadPath::shift_settled`]); it fails at
-//!    its budget ([`RELAX_MAX_BUDGET`]) or once that residual has stopped falling
-//!    ([`RELAX_STAGNANT_SUBS`]). The shift
+//!    its budget (`RELAX_MAX_BUDGET`) or once that residual has stopped falling
+//!    (`RELAX_STAGNANT_SUBS`). The shift
 //!    keeps each sub-solve's tangent positive where the string's own is not, and accepts a
 //!    step whose plain residual grows: the path crosses the fold as an overdamped string
 //!    would. The same follows a gravity stage that failed.
 //! 3. At λ = 1 one more full Newton step polishes the answer to rounding level (so it does
 //!    not depend on the load path). In f32 the full load is solved a second time from its
 //!    own converged state as base ([`LoadPath::new`]'s `refine`), and so is a relaxation's
-//!    answer at the full loads, in f32 and f64 ([`Stage::Refine`]; where that solve fails,
+//!    answer at the full loads, in f32 and f64 (`Stage::Refine`; where that solve fails,
 //!    the first answer stands).
 //!
 //! [`solve_loads`] runs the paths of every variant of a [`StaticSystem`] through one
-//! [`Newton`], all variants advancing in the same evaluations: a variant that completes a
+//! [`crate::solve::newton::Newton`], all variants advancing in the same evaluations: a variant that completes a
 //! step starts its next one in the same iteration, one that fails is returned to its
 //! restart point, and a finished one stops costing line searches.
 
@@ -314,7 +314,7 @@ impl LoadPath {
     }
 
     /// The Newton iterations the solve being run may take, where fewer than the settings'
-    /// (a relaxation's shifted sub-solve: [`RELAX_SUB_ITERATIONS`]).
+    /// (a relaxation's shifted sub-solve: `RELAX_SUB_ITERATIONS`).
     pub fn iteration_limit(&self) -> Option<usize> {
         (self.shift() > 0.0).then_some(RELAX_SUB_ITERATIONS)
     }
@@ -447,7 +447,7 @@ impl LoadPath {
                         return self.bracket(lock);
                     }
                     // At the full loads the answer is solved once more without the shift
-                    // and polished ([`Stage::Refine`]): a relaxation settles within the
+                    // and polished (`Stage::Refine`): a relaxation settles within the
                     // tolerance, which leaves a buckled string's soft modes µm apart
                     // between paths (the engine's twin and the CPU solve on a bent string,
                     // `tests/bend.rs`: 4.5e-6 m), where a polished answer is the same to
@@ -684,7 +684,7 @@ impl LoadPath {
             Stage::Load => {
                 self.load_failures += 1;
                 // With linear spring laws the first load step that fails relaxes; with a
-                // soft or hard law the step is cut down to [`RELAX_AFTER_STEP`] first.
+                // soft or hard law the step is cut down to `RELAX_AFTER_STEP` first.
                 let relax = relax.filter(|_| {
                     self.linear_law || self.step / 2.0 < RELAX_AFTER_STEP.max(self.min_step)
                 });

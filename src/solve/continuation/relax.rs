@@ -64,7 +64,7 @@ pub(super) const RELAX_SUB_REDUCTION: f64 = 0.5;
 /// 1,059 → 999, 598 → 538, 580 → 520) — 5–10 % of them once the failed load steps before
 /// a relaxation were gone (stop 50 measured 2.4 % with them).
 pub(super) const RELAX_STALL_SUBS: usize = 20;
-/// See [`RELAX_STALL_SUBS`].
+/// See `RELAX_STALL_SUBS`.
 pub const RELAX_STALL_FACTOR: f64 = 100.0;
 /// The smallest shift, `s0 ×` this: the proximal points converge at the rate `s / (s + k)`
 /// per sub-solve along a stiffness `k`, and a buckled string's lateral modes are soft (a
@@ -99,7 +99,7 @@ pub(super) const RELAX_CEILING: f64 = 1e6;
 /// from a failure at the first step).
 pub(super) const LOCK_BRACKET: f64 = 0.125;
 /// The words of a failure whose load path bracketed where the string stops
-/// ([`super::LoadPath::bracket`]); `crate::diagnose::static_failure` reads them.
+/// (`super::LoadPath::bracket`); `crate::diagnose::static_failure` reads them.
 pub const LOCK_FOUND: &str = "relaxations to smaller loads found an equilibrium at";
 
 /// A relaxation's state ([`super::Stage::Relax`]).
@@ -165,7 +165,7 @@ impl Relax {
     }
 }
 
-/// Where a path whose relaxation to the full loads failed stops ([`super::LoadPath::bracket`]).
+/// Where a path whose relaxation to the full loads failed stops (`super::LoadPath::bracket`).
 #[derive(Clone, Debug)]
 pub(super) struct Lock {
     /// The largest load factor at which the path has an equilibrium.

@@ -51,7 +51,7 @@ impl StaticState {
     ///   hundreds of MN).
     ///
     /// - **turning around the wall** where the lateral load flips side between
-    ///   neighbouring nodes ([`turn_around_side_flips`]).
+    ///   neighbouring nodes (`turn_around_side_flips`).
     ///
     /// This is where every static solve with contact sites starts
     /// ([`super::static_start`]). (A second start without the turns, tried where the
