@@ -6,7 +6,7 @@ mod common;
 
 use holewall::gpu::block_lu::{block_lu_gpu, block_lu_gpu_chunked, block_lu_gpu_form, LuForm};
 use holewall::kernels::block_cr::block_cr;
-use holewall::kernels::block_lu::{block_lu, ChainBatch, SINGULAR, SOLVED};
+use holewall::kernels::block_lu::{block_lu, block_lu_one, ChainBatch, SINGULAR, SOLVED};
 use holewall::solve::chain::{BlockTridiagonal, ChainSolver};
 use rand::{Rng, SeedableRng};
 
@@ -140,6 +140,20 @@ fn twin_matches_faer_on_paper_tangents_and_random_systems() {
         );
         assert!(res <= 1e-10, "{name}: residual {res:e}");
         assert!(err <= 1e-8, "{name}: differs from faer by {err:e}");
+        // The CPU solvers' walk on the node-major system (no packing, no other thread):
+        // the twin's numbers bit for bit, and a singular system singular.
+        let (one, one_status) = block_lu_one(a, b);
+        assert_eq!(one_status, SOLVED, "{name}");
+        assert!(
+            one.iter().zip(&x).all(|(p, q)| p.to_bits() == q.to_bits()),
+            "{name}: block_lu_one differs from the twin"
+        );
+        let cpu = ChainSolver::new().solve(a, b).unwrap();
+        assert!(cpu.iter().zip(&x).all(|(p, q)| p.to_bits() == q.to_bits()));
+        let mut singular = a.clone();
+        singular.diag[a.nodes() / 2] = [[0.0; 6]; 6];
+        singular.lower[a.nodes() / 2 - 1] = [[0.0; 6]; 6];
+        assert_eq!(block_lu_one(&singular, b).1, SINGULAR, "{name}");
     }
 }
 

@@ -6,7 +6,7 @@ use std::path::Path;
 use serde::Serialize;
 
 use crate::backend::{Backend, BackendChoice, Precision};
-use crate::error::Error;
+use crate::error::{Error, SystemError};
 use crate::gpu::contact::{GpuContactRun, GpuReal};
 use crate::gpu::GpuContext;
 use crate::kernels::contact::{contact as contact_twin, ContactBatch, ContactOutputs};
@@ -440,6 +440,89 @@ struct ElementReport {
     /// Worst difference of the closed form in f32 (base chord form) from the f64 oracle.
     closed_f32_vs_hyperdual_f64: (f64, f64),
     rows: Vec<ElementRow>,
+    /// The rest of a CPU Newton iteration's linear algebra: the block solve per node.
+    chain: Vec<ChainRow>,
+}
+
+/// One form of the CPU block solve, timed on a random block-diagonally dominant system.
+#[derive(Serialize)]
+struct ChainRow {
+    method: String,
+    nodes: usize,
+    median_us_per_node: f64,
+}
+
+/// Nodes of the system `bench element` times the block solves on.
+const CHAIN_NODES: usize = 1000;
+
+/// The block solve per node on a random dominant `CHAIN_NODES`-node system (f64, one
+/// core): the walk on the node-major system (`ChainSolver::solve` since stop 74), the same
+/// walk on a packed one-variant batch through rayon (the form before, the engine twin's),
+/// and faer's sparse LU (the fallback), with their largest difference.
+fn chain_rows(repeats: usize) -> Result<(Vec<ChainRow>, f64), Error> {
+    use crate::kernels::block_lu::{block_lu, block_lu_one, ChainBatch};
+    use crate::solve::chain::{BlockTridiagonal, ChainSolver};
+    use rand::{Rng, SeedableRng};
+    let n = CHAIN_NODES;
+    let mut rng = rand::rngs::StdRng::seed_from_u64(17);
+    let mut a = BlockTridiagonal::zeros(n);
+    for (i, d) in a.diag.iter_mut().enumerate() {
+        for (r, row) in d.iter_mut().enumerate() {
+            for (c, x) in row.iter_mut().enumerate() {
+                *x = rng.random_range(-1.0..1.0) + if r == c { 20.0 } else { 0.0 };
+                if i + 1 < n {
+                    a.upper[i][r][c] = rng.random_range(-1.0..1.0);
+                    a.lower[i][r][c] = rng.random_range(-1.0..1.0);
+                }
+            }
+        }
+    }
+    let b: Vec<f64> = (0..6 * n).map(|_| rng.random_range(-1.0..1.0)).collect();
+    let mut solver = ChainSolver::new();
+    let (walk, packed) = (
+        block_lu_one(&a, &b).0,
+        block_lu(&ChainBatch::from_systems(&[(&a, &b)])).0,
+    );
+    let sparse = solver
+        .solve_sparse(&a, &b)
+        .map_err(|e| Error::System(SystemError::Linear(e.to_string())))?;
+    let differ = walk
+        .iter()
+        .zip(&packed)
+        .chain(walk.iter().zip(&sparse))
+        .fold(0.0f64, |m, (p, q)| m.max((p - q).abs()));
+    let sink = std::cell::Cell::new(0.0f64);
+    let time = |f: &mut dyn FnMut() -> f64| -> Result<f64, Error> {
+        let t = median_seconds::<Error>(repeats, || {
+            sink.set(sink.get() + f());
+            Ok(())
+        })?;
+        Ok(1e6 * t / n as f64)
+    };
+    let rows = [
+        (
+            "block LU, the walk on the node-major system (ChainSolver::solve, the CPU path)",
+            time(&mut || block_lu_one(&a, &b).0[0])?,
+        ),
+        (
+            "block LU, the same walk on a packed one-variant batch through rayon (the CPU path before stop 74; the engine twin's form)",
+            time(&mut || block_lu(&ChainBatch::from_systems(&[(&a, &b)])).0[0])?,
+        ),
+        (
+            "faer sparse LU (ChainSolver::solve_sparse: the fallback where a pivot block is singular)",
+            time(&mut || solver.solve_sparse(&a, &b).map_or(0.0, |x| x[0]))?,
+        ),
+    ];
+    std::hint::black_box(sink.get());
+    let rows = rows
+        .into_iter()
+        .map(|(method, us)| ChainRow {
+            method: method.to_string(),
+            nodes: n,
+            median_us_per_node: us,
+        })
+        .collect();
+    Ok((rows, differ))
 }
 
 /// Cost per transcendental (sin, cos, atan2, powf) in the FLOP figures: a polynomial of
@@ -671,12 +754,19 @@ pub fn element(states: usize, repeats: usize, json: Option<&Path>) -> Result<(),
             time_ratio_to_closed: times[i] / closed.1,
         })
         .collect();
+    let (chain, chain_differ) = chain_rows(repeats)?;
+    if chain_differ > 1e-12 {
+        return Err(Error::failed(format!(
+            "the block solves disagree by {chain_differ:e} on the benchmark system"
+        )));
+    }
     let report = ElementReport {
         states: list.len(),
         repeats,
         closed_vs_hyperdual_f64: agree64,
         closed_f32_vs_hyperdual_f64: agree32,
         rows,
+        chain,
     };
     let text = serde_json::to_string_pretty(&report).unwrap_or_default();
     println!("{text}");

@@ -138,6 +138,27 @@ pub fn eliminate<T: Real>(aug: &mut [[T; 13]; 6]) -> bool {
 fn solve_one<T: Real>(b: &ChainBatch<T>, j: usize) -> (Vec<T>, u32) {
     let (n, v) = (b.num_nodes, b.num_variants);
     let at = |i: usize, r: usize, c: usize| (36 * i + 6 * r + c) * v + j;
+    walk(
+        n,
+        |i, r, c| b.diag[at(i, r, c)],
+        |i, r, c| b.upper[at(i, r, c)],
+        |i, r, c| b.lower[at(i, r, c)],
+        |i, r| b.rhs[(6 * i + r) * v + j],
+    )
+}
+
+/// The chain walk of one system of `n` nodes, its blocks' entries `(i, r, c)` and its
+/// right-hand side's `(i, r)` read through the accessors: the one form of the block LU,
+/// for a variant of a field-major batch ([`block_lu`], the GPU kernel's twin) and for the
+/// CPU solvers' node-major [`BlockTridiagonal`] ([`block_lu_one`]) alike, so the two give
+/// the same numbers. Returns the node-major solution and the status.
+pub fn walk<T: Real>(
+    n: usize,
+    diag: impl Fn(usize, usize, usize) -> T,
+    upper: impl Fn(usize, usize, usize) -> T,
+    lower: impl Fn(usize, usize, usize) -> T,
+    rhs: impl Fn(usize, usize) -> T,
+) -> (Vec<T>, u32) {
     let mut xs = vec![[[T::zero(); 6]; 6]; n.saturating_sub(1)];
     let mut zs = vec![[T::zero(); 6]; n];
     let mut prev_x = [[T::zero(); 6]; 6];
@@ -146,15 +167,15 @@ fn solve_one<T: Real>(b: &ChainBatch<T>, j: usize) -> (Vec<T>, u32) {
         let mut aug = [[T::zero(); 13]; 6];
         for r in 0..6 {
             for c in 0..6 {
-                aug[r][c] = b.diag[at(i, r, c)];
+                aug[r][c] = diag(i, r, c);
                 if i + 1 < n {
-                    aug[r][6 + c] = b.upper[at(i, r, c)];
+                    aug[r][6 + c] = upper(i, r, c);
                 }
             }
-            aug[r][12] = b.rhs[(6 * i + r) * v + j];
+            aug[r][12] = rhs(i, r);
             if i > 0 {
                 for k in 0..6 {
-                    let l = b.lower[at(i - 1, r, k)];
+                    let l = lower(i - 1, r, k);
                     for c in 0..6 {
                         aug[r][c] = aug[r][c] - l * prev_x[k][c];
                     }
@@ -189,6 +210,20 @@ fn solve_one<T: Real>(b: &ChainBatch<T>, j: usize) -> (Vec<T>, u32) {
         }
     }
     (x, SOLVED)
+}
+
+/// Solves one node-major system `A x = b` by [`walk`] on the calling thread (the CPU
+/// solvers' block LU, [`crate::solve::chain::ChainSolver::solve`]): the numbers of
+/// [`block_lu`] on a batch of that one system, without packing it field-major or handing it
+/// to another thread. Returns the solution and the status.
+pub fn block_lu_one(a: &BlockTridiagonal, b: &[f64]) -> (Vec<f64>, u32) {
+    walk(
+        a.nodes(),
+        |i, r, c| a.diag[i][r][c],
+        |i, r, c| a.upper[i][r][c],
+        |i, r, c| a.lower[i][r][c],
+        |i, r| b[6 * i + r],
+    )
 }
 
 /// Solves every variant's system (rayon over variants). Returns the field-major solution

@@ -38,10 +38,10 @@ impl ChainSolver {
     /// ([`ChainSolver::solve_sparse`], which pivots across blocks) where a pivot block is
     /// singular or the solution not finite.
     pub fn solve(&mut self, a: &BlockTridiagonal, b: &[f64]) -> Result<Vec<f64>, LinearSolveError> {
-        use crate::kernels::block_lu::{block_lu, ChainBatch, SOLVED};
+        use crate::kernels::block_lu::{block_lu_one, SOLVED};
         if b.iter().all(|x| x.is_finite()) {
-            let (x, status) = block_lu(&ChainBatch::<f64>::from_systems(&[(a, b)]));
-            if status[0] == SOLVED && x.iter().all(|v| v.is_finite()) {
+            let (x, status) = block_lu_one(a, b);
+            if status == SOLVED && x.iter().all(|v| v.is_finite()) {
                 return Ok(x);
             }
         }
