@@ -738,9 +738,9 @@ pub fn element(states: usize, repeats: usize, json: Option<&Path>) -> Result<(),
         "hyper-dual, 78 evaluations (CPU path before)",
         "closed form, force only (line-search trials)",
         "closed form, force and tangent one direction at a time (the GPU kernel's form until stop 73), f64",
-        "closed form, force and tangent in one 12-direction pass (CPU), f64",
-        "closed form, force and tangent in one 12-direction pass (CPU), f32",
-        "closed form, the tangent written out (the GPU kernel's and its twin's; not the CPU path: docs/performance.md, stop 72), f64",
+        "closed form, force and tangent in one 12-direction pass (the CPU static solve), f64",
+        "closed form, force and tangent in one 12-direction pass (the CPU static solve), f32",
+        "closed form, the tangent written out (the GPU kernel's, its twin's and, since stop 74, the CPU dynamic integrator's; not the CPU static solve's: docs/performance.md, stop 72), f64",
         "closed form, the tangent written out, f32",
     ];
     let closed = (counts[4].flops(TRANSCENDENTAL_FLOPS), times[4]);

@@ -14,12 +14,14 @@
 //! ([`element_force`], Battini & Pacoste's `f = N r + E Pᵀ T⁻ᵀ m̄` for this frame, ≈ 400
 //! operations), and the consistent tangent is its derivative with respect to the Newton
 //! increment applied the same way, by that force evaluated in dual numbers
-//! ([`force_and_tangent_closed`], one pass, the CPU path; [`force_and_tangent_by_direction`],
+//! ([`force_and_tangent_closed`], one pass, the CPU static solve; [`force_and_tangent_by_direction`],
 //! one column at a time, `shaders/beam.wgsl`'s form until stop 73; `src/physics/dual.rs`),
 //! or written out, each intermediate value's first variation on the values the force
 //! computed ([`force_and_tangent_variation`]: equal to rounding and 1.5× faster; the GPU
-//! kernel's form and its twin's since stop 73, not the CPU path — a change at rounding level
-//! moves the load paths of marginal wells, docs/performance.md, stop 72). The tangent so
+//! kernel's form and its twin's since stop 73, the CPU dynamic integrator's since stop 74,
+//! not the CPU static solve's — a change at rounding level moves the load paths of marginal
+//! wells, docs/performance.md, stop 72; the choice: `crate::solve::statics::TangentForm`).
+//! The tangent so
 //! contains the
 //! geometric stiffness: an axial force `N` adds `N/l` to the lateral stiffness, so
 //! compression softens the string and buckling appears. The oracle is the energy itself,

@@ -184,14 +184,20 @@ fn assemble(
         *r = -lambda * f;
     }
     let with_tangent = tangent.is_some();
-    for_each_element_response(model, state, with_tangent, |i, f, k| {
-        if let (Some(t), Some(k)) = (tangent.as_deref_mut(), k) {
-            t.add_element(i, k);
-        }
-        for j in 0..12 {
-            residual[6 * i + j] += f[j];
-        }
-    });
+    for_each_element_response(
+        model,
+        state,
+        with_tangent,
+        TangentForm::OnePass,
+        |i, f, k| {
+            if let (Some(t), Some(k)) = (tangent.as_deref_mut(), k) {
+                t.add_element(i, k);
+            }
+            for j in 0..12 {
+                residual[6 * i + j] += f[j];
+            }
+        },
+    );
     for site in &model.sites {
         let out = site_response(model, state, site);
         if !out.contact {
@@ -208,14 +214,31 @@ fn assemble(
     }
 }
 
-/// Internal force (12) and, if `with_tangent`, tangent (12×12) of every element at a
-/// configuration, computed in parallel over elements (rayon) and handed to `sink` in
+/// Which closed form of the element tangent a CPU solve runs: the one place that says so.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum TangentForm {
+    /// `force_and_tangent_closed`: the force's twelve first derivatives in one pass of dual
+    /// numbers. The CPU static solve keeps it: which marginal (relaxed) corpus wells settle
+    /// is decided at rounding level, and `tests/corpus.rs` holds seed 44, which settles
+    /// with this form and not with the other (docs/performance.md, stop 72).
+    OnePass,
+    /// `force_and_tangent_variation`: the values once, their variation per direction —
+    /// the GPU kernel's and its twin's form, 4,746 FLOP against 7,774 (`holewall bench
+    /// element`: 0.50 against 0.79 µs an element). The CPU dynamic integrator runs it
+    /// (stop 74): a time step's Newton solve converges from the last step's state, with
+    /// no fold to cross, and its oracle role is towards the engine, which runs this form.
+    WrittenOut,
+}
+
+/// Internal force (12) and, if `with_tangent`, tangent (12×12, in `form`) of every element
+/// at a configuration, computed in parallel over elements (rayon) and handed to `sink` in
 /// element order (so sums do not depend on the thread count). A force-only call (a line
 /// search's trial) forms no tangent storage at all.
 pub(crate) fn for_each_element_response(
     model: &Model,
     state: &StaticState,
     with_tangent: bool,
+    form: TangentForm,
     mut sink: impl FnMut(usize, &[f64; 12], Option<&[[f64; 12]; 12]>),
 ) {
     use rayon::prelude::*;
@@ -242,8 +265,13 @@ pub(crate) fn for_each_element_response(
     let count = model.elements.len();
     if with_tangent {
         let out = each(count, |i| {
-            let (es, k, form) = element(i);
-            force_and_tangent_closed(&es.x, &es.triad, &form, &k)
+            let (es, k, chord) = element(i);
+            match form {
+                TangentForm::OnePass => force_and_tangent_closed(&es.x, &es.triad, &chord, &k),
+                TangentForm::WrittenOut => {
+                    crate::physics::beam::force_and_tangent_variation(&es.x, &es.triad, &chord, &k)
+                }
+            }
         });
         for (i, (f, k)) in out.iter().enumerate() {
             sink(i, f, Some(k));
