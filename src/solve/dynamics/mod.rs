@@ -464,7 +464,7 @@ impl<'a> Dynamics<'a> {
         // formed only where that damping is asked for (`a1 ≠ 0`).
         let first_k0 = self.k0.is_none() && self.options.rayleigh.1 != 0.0;
         let with_tangent = with_matrix || first_k0;
-        let form = crate::solve::statics::TangentForm::WrittenOut;
+        let form = crate::solve::statics::DYNAMIC_TANGENT;
         for_each_element_response(model, &s.q, with_tangent, form, |i, f, k| {
             for j in 0..12 {
                 r[6 * i + j] += f[j];

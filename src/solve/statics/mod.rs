@@ -184,20 +184,14 @@ fn assemble(
         *r = -lambda * f;
     }
     let with_tangent = tangent.is_some();
-    for_each_element_response(
-        model,
-        state,
-        with_tangent,
-        TangentForm::OnePass,
-        |i, f, k| {
-            if let (Some(t), Some(k)) = (tangent.as_deref_mut(), k) {
-                t.add_element(i, k);
-            }
-            for j in 0..12 {
-                residual[6 * i + j] += f[j];
-            }
-        },
-    );
+    for_each_element_response(model, state, with_tangent, STATIC_TANGENT, |i, f, k| {
+        if let (Some(t), Some(k)) = (tangent.as_deref_mut(), k) {
+            t.add_element(i, k);
+        }
+        for j in 0..12 {
+            residual[6 * i + j] += f[j];
+        }
+    });
     for site in &model.sites {
         let out = site_response(model, state, site);
         if !out.contact {
@@ -214,7 +208,8 @@ fn assemble(
     }
 }
 
-/// Which closed form of the element tangent a CPU solve runs: the one place that says so.
+/// Which closed form of the element tangent a CPU solve runs; [`STATIC_TANGENT`] and
+/// [`DYNAMIC_TANGENT`] below are the one place that says which solve runs which.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) enum TangentForm {
     /// `force_and_tangent_closed`: the force's twelve first derivatives in one pass of dual
@@ -229,6 +224,11 @@ pub(crate) enum TangentForm {
     /// no fold to cross, and its oracle role is towards the engine, which runs this form.
     WrittenOut,
 }
+
+/// The tangent form of the CPU static solve ([`TangentForm`]).
+pub(crate) const STATIC_TANGENT: TangentForm = TangentForm::OnePass;
+/// The tangent form of the CPU dynamic integrator ([`TangentForm`]).
+pub(crate) const DYNAMIC_TANGENT: TangentForm = TangentForm::WrittenOut;
 
 /// Internal force (12) and, if `with_tangent`, tangent (12×12, in `form`) of every element
 /// at a configuration, computed in parallel over elements (rayon) and handed to `sink` in
