@@ -37,6 +37,7 @@ pub mod solve;
 pub mod strength;
 pub mod study;
 pub mod tally;
+pub mod threads;
 pub mod units;
 pub mod uq;
 pub mod well;

@@ -342,6 +342,7 @@ fn print_ensemble_summary(
 
 fn main() -> ExitCode {
     holewall::allocator::keep_freed_memory();
+    holewall::threads::main_thread_in_pool();
     let args = Args::parse();
     holewall::display_units::set(args.units);
     match args.command {

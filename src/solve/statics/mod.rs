@@ -192,8 +192,13 @@ fn assemble(
             residual[6 * i + j] += f[j];
         }
     });
-    for site in &model.sites {
-        let out = site_response(model, state, site);
+    // The sites' responses in parallel (each its own node's), summed in site order.
+    let responses: Vec<ContactResponse<f64>> = {
+        use rayon::prelude::*;
+        let each = |site| site_response(model, state, site);
+        model.sites.par_iter().with_min_len(64).map(each).collect()
+    };
+    for (site, out) in model.sites.iter().zip(&responses) {
         if !out.contact {
             continue;
         }
@@ -392,19 +397,21 @@ fn update(
     may_land: &[bool],
     landed: &mut Vec<usize>,
 ) -> StaticState {
-    let mut s = state.clone();
-    for i in 0..s.u.len() {
+    use rayon::prelude::*;
+    // Every node in parallel (each moves alone), the landings listed in node order.
+    let node = |i: usize| {
         let mut du: Vec3<f64> = std::array::from_fn(|k| alpha * delta[6 * i + k]);
+        let mut lands = false;
         if let Some(b) = &c.basis[i] {
             du = std::array::from_fn(|r| (0..3).map(|k| b[r][k] * du[k]).sum());
         }
         if let Some(w) = &walls[i] {
-            let d = s.u[i];
+            let d = state.u[i];
             du = crate::physics::contact::wall_following_step(&d, &w.axis, &du, w.min_radius);
             if may_land.get(i).copied().unwrap_or(false) {
                 let l = crate::physics::contact::landing_step(&d, &w.axis, &du, w.clearance);
                 if l != du {
-                    landed.push(i);
+                    lands = true;
                     du = l;
                 }
             }
@@ -412,13 +419,29 @@ fn update(
                 du = crate::physics::contact::deepening_step(&d, &w.axis, &du, w.clearance);
             }
         }
-        for (x, d) in s.u[i].iter_mut().zip(du) {
+        let mut u = state.u[i];
+        for (x, d) in u.iter_mut().zip(du) {
             *x += d;
         }
         let dth: Vec3<f64> = std::array::from_fn(|k| alpha * delta[6 * i + 3 + k]);
-        s.rot[i] = mat_mul(&rotation_exp(&dth), &s.rot[i]);
+        (u, mat_mul(&rotation_exp(&dth), &state.rot[i]), lands)
+    };
+    let nodes: Vec<(Vec3<f64>, Mat3<f64>, bool)> = (0..state.u.len())
+        .into_par_iter()
+        .with_min_len(64)
+        .map(node)
+        .collect();
+    landed.extend(
+        nodes
+            .iter()
+            .enumerate()
+            .filter(|(_, n)| n.2)
+            .map(|(i, _)| i),
+    );
+    StaticState {
+        u: nodes.iter().map(|n| n.0).collect(),
+        rot: nodes.iter().map(|n| n.1).collect(),
     }
-    s
 }
 
 /// A contact node's hole: its axis and the lateral offset from which its steps follow the
