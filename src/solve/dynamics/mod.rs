@@ -594,21 +594,10 @@ impl<'a> Dynamics<'a> {
                 }
             }
         }
-        // Contact, dynamic mode: spin = n·ω.
-        let terms = ContactTerms {
-            spring: SpringLaw::PowerBlend,
-            damping: true,
-            friction: Some(model.friction),
-            mode: ContactMode::Dynamic,
-        };
-        for site in &model.sites {
+        // Contact, dynamic mode: spin = n·ω ([`Self::contact_forces`]).
+        for (site, out) in model.sites.iter().zip(self.contact_forces(s)) {
             let i = site.node;
             let node = &model.nodes[i];
-            let d = s.q.u[i];
-            let v: Vec3<f64> = std::array::from_fn(|k| s.v[6 * i + k]);
-            let w: Vec3<f64> = std::array::from_fn(|k| s.v[6 * i + 3 + k]);
-            let spin = dot(&node.hole_axis, &w);
-            let out = evaluate(&node.hole_axis, &d, &v, spin, &site.params, &terms);
             if !out.contact {
                 continue;
             }
@@ -647,9 +636,12 @@ impl<'a> Dynamics<'a> {
             friction: Some(model.friction),
             mode: ContactMode::Dynamic,
         };
+        // In parallel (each site its own node's), in site order.
+        use rayon::prelude::*;
         model
             .sites
-            .iter()
+            .par_iter()
+            .with_min_len(64)
             .map(|site| {
                 let i = site.node;
                 let node = &model.nodes[i];

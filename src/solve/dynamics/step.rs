@@ -85,21 +85,26 @@ impl<'s, 'a> CpuStep<'s, 'a> {
             tr.a[dof] = a1;
             tr.v[dof] = s.v[dof] + h * ((1.0 - p.gamma) * s.a[dof] + p.gamma * a1);
         }
-        for i in 0..n {
-            let dq: Vec<f64> = (0..6)
-                .map(|k| {
-                    s.v[6 * i + k]
-                        + h * ((0.5 - p.beta) * s.a[6 * i + k] + p.beta * tr.a[6 * i + k])
-                })
-                .collect();
-            for k in 0..3 {
-                tr.q.u[i][k] = s.q.u[i][k] + h * dq[k];
-            }
-            tr.q.rot[i] = mat_mul(
-                &rotation_exp(&[h * dq[3], h * dq[4], h * dq[5]]),
-                &s.q.rot[i],
-            );
-        }
+        // Every node in parallel (each moves alone).
+        use rayon::prelude::*;
+        let a = &tr.a;
+        let q = &mut tr.q;
+        (q.u.par_iter_mut(), q.rot.par_iter_mut())
+            .into_par_iter()
+            .enumerate()
+            .with_min_len(64)
+            .for_each(|(i, (u, rot))| {
+                let dq: [f64; 6] = std::array::from_fn(|k| {
+                    s.v[6 * i + k] + h * ((0.5 - p.beta) * s.a[6 * i + k] + p.beta * a[6 * i + k])
+                });
+                for k in 0..3 {
+                    u[k] = s.q.u[i][k] + h * dq[k];
+                }
+                *rot = mat_mul(
+                    &rotation_exp(&[h * dq[3], h * dq[4], h * dq[5]]),
+                    &s.q.rot[i],
+                );
+            });
         // The table turns the top about its hole axis n₀, and the hook lowers it along n₀.
         let top = &self.d.model.nodes[0];
         let n0 = top.hole_axis;
