@@ -446,7 +446,8 @@ impl<'a> Dynamics<'a> {
     }
 
     /// Residual of the equations of motion at a trial state and, if `with_matrix`, the
-    /// iteration matrix `M + hγ' C_t + h²β' K_t` (unconstrained).
+    /// iteration matrix `M + hγ' C_t + h²β' K_t` (unconstrained; without it, an empty
+    /// matrix: a trial's residual forms and zeroes no blocks).
     fn residual_and_matrix(
         &mut self,
         s: &DynamicState,
@@ -458,12 +459,13 @@ impl<'a> Dynamics<'a> {
         let n = model.nodes.len();
         let lambda = self.options.load_factor.map(|f| f(s.t)).unwrap_or(1.0);
         let mut r: Vec<f64> = self.f_ext.iter().map(|f| -lambda * f).collect();
-        let mut k_t = BlockTridiagonal::zeros(n);
-        let mut s_mat = BlockTridiagonal::zeros(n);
         // The initial tangent `K₀` (stiffness-proportional damping's, at the first call) is
         // formed only where that damping is asked for (`a1 ≠ 0`).
         let first_k0 = self.k0.is_none() && self.options.rayleigh.1 != 0.0;
         let with_tangent = with_matrix || first_k0;
+        let blocks = |on: bool| BlockTridiagonal::zeros(if on { n } else { 0 });
+        let mut k_t = blocks(with_tangent);
+        let mut s_mat = blocks(with_matrix);
         let form = crate::solve::statics::DYNAMIC_TANGENT;
         for_each_element_response(model, &s.q, with_tangent, form, |i, f, k| {
             for j in 0..12 {
