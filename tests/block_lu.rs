@@ -10,67 +10,6 @@ use holewall::kernels::block_lu::{block_lu, block_lu_one, ChainBatch, SINGULAR, 
 use holewall::solve::chain::{BlockTridiagonal, ChainSolver};
 use rand::{Rng, SeedableRng};
 
-fn random_system(
-    rng: &mut rand::rngs::StdRng,
-    n: usize,
-    decades: i32,
-) -> (BlockTridiagonal, Vec<f64>) {
-    let mut a = BlockTridiagonal::zeros(n);
-    for blocks in [&mut a.upper, &mut a.lower] {
-        for b in blocks.iter_mut() {
-            for row in b.iter_mut() {
-                for x in row.iter_mut() {
-                    *x = rng.random_range(-1.0..1.0);
-                }
-            }
-        }
-    }
-    for (i, b) in a.diag.iter_mut().enumerate() {
-        for (r, row) in b.iter_mut().enumerate() {
-            for (c, x) in row.iter_mut().enumerate() {
-                *x = rng.random_range(-1.0..1.0);
-                if r == c {
-                    // Dominant: beyond the row sums of the three blocks, scaled per node so
-                    // the entries span `2·decades` orders of magnitude.
-                    *x += 20.0 * scale(i, decades);
-                }
-            }
-        }
-        let s = scale(i, decades);
-        for (r, row) in b.iter_mut().enumerate() {
-            for (c, x) in row.iter_mut().enumerate() {
-                if r != c {
-                    *x *= s;
-                }
-            }
-        }
-        if i > 0 {
-            for row in a.lower[i - 1].iter_mut() {
-                for x in row.iter_mut() {
-                    *x *= s;
-                }
-            }
-        }
-        if i + 1 < n {
-            for row in a.upper[i].iter_mut() {
-                for x in row.iter_mut() {
-                    *x *= s;
-                }
-            }
-        }
-    }
-    let b = (0..6 * n).map(|_| rng.random_range(-1.0..1.0)).collect();
-    (a, b)
-}
-
-fn scale(i: usize, decades: i32) -> f64 {
-    if decades == 0 {
-        1.0
-    } else {
-        10f64.powi((i as i32 % (2 * decades + 1)) - decades)
-    }
-}
-
 fn norm(x: &[f64]) -> f64 {
     x.iter().map(|v| v * v).sum::<f64>().sqrt()
 }
@@ -123,7 +62,7 @@ fn twin_matches_faer_on_paper_tangents_and_random_systems() {
     let mut rng = rand::rngs::StdRng::seed_from_u64(7);
     let mut systems = paper_systems(&mut rng);
     for k in 0..8 {
-        let (a, b) = random_system(&mut rng, 40, 3);
+        let (a, b) = BlockTridiagonal::random_dominant(&mut rng, 40, 3);
         systems.push((format!("random {k}"), a, b));
     }
     for (name, a, b) in &systems {
@@ -184,8 +123,9 @@ fn gpu_matches_the_twin_and_a_singular_variant_fails_alone() {
     let Some(ctx) = common::gpu() else { return };
     let mut rng = rand::rngs::StdRng::seed_from_u64(11);
     let n = 30;
-    let sys: Vec<(BlockTridiagonal, Vec<f64>)> =
-        (0..64).map(|_| random_system(&mut rng, n, 0)).collect();
+    let sys: Vec<(BlockTridiagonal, Vec<f64>)> = (0..64)
+        .map(|_| BlockTridiagonal::random_dominant(&mut rng, n, 0))
+        .collect();
     let refs: Vec<(&BlockTridiagonal, &[f64])> =
         sys.iter().map(|(a, b)| (a, b.as_slice())).collect();
     let b64 = ChainBatch::<f64>::from_systems(&refs);
@@ -329,7 +269,7 @@ fn cyclic_reduction_twin_matches_faer_at_every_length() {
     let mut rng = rand::rngs::StdRng::seed_from_u64(17);
     let mut systems = paper_systems(&mut rng);
     for n in [1, 2, 3, 4, 5, 7, 8, 9, 15, 16, 17, 31, 33, 64, 65, 100, 129] {
-        let (a, b) = random_system(&mut rng, n, 3);
+        let (a, b) = BlockTridiagonal::random_dominant(&mut rng, n, 3);
         systems.push((format!("random, {n} nodes"), a, b));
     }
     for (name, a, b) in &systems {
@@ -357,8 +297,9 @@ fn cyclic_reduction_on_the_gpu_matches_its_twin_and_a_singular_variant_fails_alo
     let Some(ctx) = common::gpu() else { return };
     let mut rng = rand::rngs::StdRng::seed_from_u64(23);
     for n in [1, 2, 3, 6, 30, 33] {
-        let sys: Vec<(BlockTridiagonal, Vec<f64>)> =
-            (0..64).map(|_| random_system(&mut rng, n, 0)).collect();
+        let sys: Vec<(BlockTridiagonal, Vec<f64>)> = (0..64)
+            .map(|_| BlockTridiagonal::random_dominant(&mut rng, n, 0))
+            .collect();
         let refs: Vec<(&BlockTridiagonal, &[f64])> =
             sys.iter().map(|(a, b)| (a, b.as_slice())).collect();
         let b64 = ChainBatch::<f64>::from_systems(&refs);
@@ -412,8 +353,9 @@ fn cyclic_reduction_on_the_gpu_matches_its_twin_and_a_singular_variant_fails_alo
     // A zero block row at node 3 (odd: eliminated at the first level) and a NaN at node 0
     // (solved last): those two variants fail, with a zero solution; the others keep their bits.
     let n = 30;
-    let sys: Vec<(BlockTridiagonal, Vec<f64>)> =
-        (0..16).map(|_| random_system(&mut rng, n, 0)).collect();
+    let sys: Vec<(BlockTridiagonal, Vec<f64>)> = (0..16)
+        .map(|_| BlockTridiagonal::random_dominant(&mut rng, n, 0))
+        .collect();
     let mut bad = sys.clone();
     bad[5].0.diag[3] = [[0.0; 6]; 6];
     bad[5].0.upper[3] = [[0.0; 6]; 6];

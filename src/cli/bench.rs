@@ -462,22 +462,10 @@ const CHAIN_NODES: usize = 1000;
 fn chain_rows(repeats: usize) -> Result<(Vec<ChainRow>, f64), Error> {
     use crate::kernels::block_lu::{block_lu, block_lu_one, ChainBatch};
     use crate::solve::chain::{BlockTridiagonal, ChainSolver};
-    use rand::{Rng, SeedableRng};
+    use rand::SeedableRng;
     let n = CHAIN_NODES;
     let mut rng = rand::rngs::StdRng::seed_from_u64(17);
-    let mut a = BlockTridiagonal::zeros(n);
-    for (i, d) in a.diag.iter_mut().enumerate() {
-        for (r, row) in d.iter_mut().enumerate() {
-            for (c, x) in row.iter_mut().enumerate() {
-                *x = rng.random_range(-1.0..1.0) + if r == c { 20.0 } else { 0.0 };
-                if i + 1 < n {
-                    a.upper[i][r][c] = rng.random_range(-1.0..1.0);
-                    a.lower[i][r][c] = rng.random_range(-1.0..1.0);
-                }
-            }
-        }
-    }
-    let b: Vec<f64> = (0..6 * n).map(|_| rng.random_range(-1.0..1.0)).collect();
+    let (a, b) = BlockTridiagonal::random_dominant(&mut rng, n, 0);
     let mut solver = ChainSolver::new();
     let (walk, packed) = (
         block_lu_one(&a, &b).0,
