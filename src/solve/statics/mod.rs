@@ -398,50 +398,42 @@ fn update(
     landed: &mut Vec<usize>,
 ) -> StaticState {
     use rayon::prelude::*;
-    // Every node in parallel (each moves alone), the landings listed in node order.
-    let node = |i: usize| {
-        let mut du: Vec3<f64> = std::array::from_fn(|k| alpha * delta[6 * i + k]);
-        let mut lands = false;
-        if let Some(b) = &c.basis[i] {
-            du = std::array::from_fn(|r| (0..3).map(|k| b[r][k] * du[k]).sum());
-        }
-        if let Some(w) = &walls[i] {
-            let d = state.u[i];
-            du = crate::physics::contact::wall_following_step(&d, &w.axis, &du, w.min_radius);
-            if may_land.get(i).copied().unwrap_or(false) {
-                let l = crate::physics::contact::landing_step(&d, &w.axis, &du, w.clearance);
-                if l != du {
-                    lands = true;
-                    du = l;
+    // Every node in parallel (each moves alone, in place), the landings listed in node order.
+    let mut s = state.clone();
+    let lands: Vec<usize> = (s.u.par_iter_mut(), s.rot.par_iter_mut())
+        .into_par_iter()
+        .enumerate()
+        .with_min_len(64)
+        .filter_map(|(i, (u, rot))| {
+            let mut du: Vec3<f64> = std::array::from_fn(|k| alpha * delta[6 * i + k]);
+            let mut lands = false;
+            if let Some(b) = &c.basis[i] {
+                du = std::array::from_fn(|r| (0..3).map(|k| b[r][k] * du[k]).sum());
+            }
+            if let Some(w) = &walls[i] {
+                let d = *u;
+                du = crate::physics::contact::wall_following_step(&d, &w.axis, &du, w.min_radius);
+                if may_land.get(i).copied().unwrap_or(false) {
+                    let l = crate::physics::contact::landing_step(&d, &w.axis, &du, w.clearance);
+                    if l != du {
+                        lands = true;
+                        du = l;
+                    }
+                }
+                if w.deepens {
+                    du = crate::physics::contact::deepening_step(&d, &w.axis, &du, w.clearance);
                 }
             }
-            if w.deepens {
-                du = crate::physics::contact::deepening_step(&d, &w.axis, &du, w.clearance);
+            for (x, d) in u.iter_mut().zip(du) {
+                *x += d;
             }
-        }
-        let mut u = state.u[i];
-        for (x, d) in u.iter_mut().zip(du) {
-            *x += d;
-        }
-        let dth: Vec3<f64> = std::array::from_fn(|k| alpha * delta[6 * i + 3 + k]);
-        (u, mat_mul(&rotation_exp(&dth), &state.rot[i]), lands)
-    };
-    let nodes: Vec<(Vec3<f64>, Mat3<f64>, bool)> = (0..state.u.len())
-        .into_par_iter()
-        .with_min_len(64)
-        .map(node)
+            let dth: Vec3<f64> = std::array::from_fn(|k| alpha * delta[6 * i + 3 + k]);
+            *rot = mat_mul(&rotation_exp(&dth), rot);
+            lands.then_some(i)
+        })
         .collect();
-    landed.extend(
-        nodes
-            .iter()
-            .enumerate()
-            .filter(|(_, n)| n.2)
-            .map(|(i, _)| i),
-    );
-    StaticState {
-        u: nodes.iter().map(|n| n.0).collect(),
-        rot: nodes.iter().map(|n| n.1).collect(),
-    }
+    landed.extend(lands);
+    s
 }
 
 /// A contact node's hole: its axis and the lateral offset from which its steps follow the
