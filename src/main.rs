@@ -728,6 +728,7 @@ fn main() -> ExitCode {
             BenchCommand::Corpus {
                 wells,
                 first_seed,
+                seeds,
                 engine_sample,
                 engine_max_nodes,
                 max_seconds,
@@ -737,8 +738,7 @@ fn main() -> ExitCode {
             } => match cli::bench_corpus::run(
                 &out,
                 &cli::bench_corpus::CorpusOptions {
-                    wells,
-                    first_seed,
+                    seeds: cli::bench_corpus::corpus_seeds(wells, first_seed, seeds),
                     engine_sample,
                     engine_max_nodes,
                     max_seconds,

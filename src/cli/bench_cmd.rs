@@ -193,6 +193,10 @@ pub enum BenchCommand {
         /// First seed.
         #[arg(long, default_value_t = 0)]
         first_seed: u64,
+        /// These seeds instead of --wells from --first-seed (comma-separated: the relaxed
+        /// or failed wells of an earlier run, say).
+        #[arg(long, value_delimiter = ',', conflicts_with_all = ["wells", "first_seed"])]
+        seeds: Vec<u64>,
         /// Wells also run through the engine (the first ones of at most --engine-max-nodes).
         #[arg(long, default_value_t = 0)]
         engine_sample: usize,

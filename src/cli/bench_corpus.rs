@@ -15,10 +15,8 @@ use crate::solve::statics::StaticOptions;
 /// Options of the command.
 #[derive(Clone, Debug)]
 pub struct CorpusOptions {
-    /// Wells (seeds `first_seed …`).
-    pub wells: usize,
-    /// First seed.
-    pub first_seed: u64,
+    /// The wells' seeds, in the order they are listed ([`corpus_seeds`]).
+    pub seeds: Vec<u64>,
     /// Wells of the corpus also run through the engine: the first ones with at most
     /// `engine_max_nodes` nodes (lavapipe runs the kernels on the CPU).
     pub engine_sample: usize,
@@ -30,6 +28,17 @@ pub struct CorpusOptions {
     pub show_progress: bool,
     /// How the wells are drawn.
     pub style: crate::corpus::CorpusStyle,
+}
+
+/// The seeds of a corpus run: those listed (`--seeds`; each once, in the order first
+/// listed: two runs of one seed would write the same case file), else `wells` from
+/// `first_seed` on.
+pub fn corpus_seeds(wells: usize, first_seed: u64, listed: Vec<u64>) -> Vec<u64> {
+    if listed.is_empty() {
+        return (first_seed..first_seed + wells as u64).collect();
+    }
+    let mut seen = std::collections::BTreeSet::new();
+    listed.into_iter().filter(|s| seen.insert(*s)).collect()
 }
 
 /// Median and worst of a figure, with the seed of the worst.
@@ -147,7 +156,7 @@ pub fn run(out: &Path, options: &CorpusOptions) -> Result<CorpusSummary, Error> 
     std::fs::create_dir_all(&wells_dir)?;
     let bar = crate::output::progress_bar(
         options.show_progress,
-        options.wells as u64,
+        options.seeds.len() as u64,
         "{bar:40} {pos}/{len} wells, {elapsed} elapsed, {msg}",
     );
     // Wells in parallel (rayon, one well per core): each well's time is measured with the
@@ -155,16 +164,16 @@ pub fn run(out: &Path, options: &CorpusOptions) -> Result<CorpusSummary, Error> 
     use rayon::prelude::*;
     let static_options = StaticOptions::default();
     let done = std::sync::atomic::AtomicUsize::new(0);
-    let outcomes: Vec<Option<(crate::corpus::CorpusWell, WellResult)>> = (0..options.wells)
-        .into_par_iter()
-        .map(|k| {
+    let outcomes: Vec<Option<(crate::corpus::CorpusWell, WellResult)>> = options
+        .seeds
+        .par_iter()
+        .map(|&seed| {
             if options
                 .max_seconds
                 .is_some_and(|s| clock.elapsed().as_secs_f64() > s)
             {
                 return Ok(None);
             }
-            let seed = options.first_seed + k as u64;
             let well = crate::corpus::write_corpus_well(options.style, seed, &wells_dir)?;
             let r = run_well(&well, &static_options)?;
             if r.solved {
@@ -244,7 +253,7 @@ pub fn run(out: &Path, options: &CorpusOptions) -> Result<CorpusSummary, Error> 
     let hook: Vec<f64> = solved.iter().map(|r| r.hook_load_ratio).collect();
     let summary = CorpusSummary {
         wells: results.len(),
-        not_run: options.wells - results.len(),
+        not_run: options.seeds.len() - results.len(),
         solved: solved.len(),
         failed: results
             .iter()
@@ -610,4 +619,15 @@ pub fn tendency(
     let json = serde_json::to_vec_pretty(&summary)?;
     crate::output::write_atomic(&out.join("summary.json"), &json)?;
     Ok(summary)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::corpus_seeds;
+
+    #[test]
+    fn listed_seeds_run_once_each_in_their_order_else_a_range() {
+        assert_eq!(corpus_seeds(3, 5, Vec::new()), vec![5, 6, 7]);
+        assert_eq!(corpus_seeds(3, 5, vec![9, 2, 9, 4, 2]), vec![9, 2, 4]);
+    }
 }
