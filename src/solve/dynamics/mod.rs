@@ -29,7 +29,7 @@ use crate::physics::mass::MassKind;
 use crate::physics::vec3::{cross, dot, Vec3};
 use crate::solve::chain::{BlockTridiagonal, ChainSolver};
 use crate::solve::statics::{
-    constrain, constrain_residual, constraints, external_loads, for_each_element_response,
+    add_element_responses, constrain, constrain_residual, constraints, external_loads,
     reference_force, to_global, StaticState,
 };
 
@@ -467,14 +467,7 @@ impl<'a> Dynamics<'a> {
         let mut k_t = blocks(with_tangent);
         let mut s_mat = blocks(with_matrix);
         let form = crate::solve::statics::DYNAMIC_TANGENT;
-        for_each_element_response(model, &s.q, with_tangent, form, |i, f, k| {
-            for j in 0..12 {
-                r[6 * i + j] += f[j];
-            }
-            if let Some(k) = k {
-                k_t.add_element(i, k);
-            }
-        });
+        add_element_responses(model, &s.q, form, &mut r, with_tangent.then_some(&mut k_t));
         if first_k0 {
             self.k0 = Some(k_t.clone());
         }

@@ -183,15 +183,13 @@ fn assemble(
     for (r, f) in residual.iter_mut().zip(f_ext) {
         *r = -lambda * f;
     }
-    let with_tangent = tangent.is_some();
-    for_each_element_response(model, state, with_tangent, STATIC_TANGENT, |i, f, k| {
-        if let (Some(t), Some(k)) = (tangent.as_deref_mut(), k) {
-            t.add_element(i, k);
-        }
-        for j in 0..12 {
-            residual[6 * i + j] += f[j];
-        }
-    });
+    add_element_responses(
+        model,
+        state,
+        STATIC_TANGENT,
+        residual,
+        tangent.as_deref_mut(),
+    );
     // The sites' responses in parallel (each its own node's), summed in site order.
     let responses: Vec<ContactResponse<f64>> = {
         use rayon::prelude::*;
@@ -235,16 +233,18 @@ pub(crate) const STATIC_TANGENT: TangentForm = TangentForm::OnePass;
 /// The tangent form of the CPU dynamic integrator ([`TangentForm`]).
 pub(crate) const DYNAMIC_TANGENT: TangentForm = TangentForm::WrittenOut;
 
-/// Internal force (12) and, if `with_tangent`, tangent (12×12, in `form`) of every element
-/// at a configuration, computed in parallel over elements (rayon) and handed to `sink` in
-/// element order (so sums do not depend on the thread count). A force-only call (a line
-/// search's trial) forms no tangent storage at all.
-pub(crate) fn for_each_element_response(
+/// Adds every element's internal force (12) to `residual` and, where `tangent` is given,
+/// its tangent (12×12, in `form`) to the blocks: the elements are computed in parallel
+/// (rayon, in tasks of 32), then each node gathers from its two elements in parallel, the
+/// element before it first, as a scatter in element order adds them — the same sums to
+/// the bit whatever the thread count. A force-only call (a line search's trial) forms no
+/// tangent storage at all.
+pub(crate) fn add_element_responses(
     model: &Model,
     state: &StaticState,
-    with_tangent: bool,
     form: TangentForm,
-    mut sink: impl FnMut(usize, &[f64; 12], Option<&[[f64; 12]; 12]>),
+    residual: &mut [f64],
+    tangent: Option<&mut BlockTridiagonal>,
 ) {
     use rayon::prelude::*;
     let element = |i: usize| {
@@ -268,28 +268,80 @@ pub(crate) fn for_each_element_response(
         (0..count).into_par_iter().with_min_len(32).map(f).collect()
     }
     let count = model.elements.len();
-    if with_tangent {
-        let out = each(count, |i| {
-            let (es, k, chord) = element(i);
-            match form {
-                TangentForm::OnePass => force_and_tangent_closed(&es.x, &es.triad, &chord, &k),
-                TangentForm::WrittenOut => {
-                    crate::physics::beam::force_and_tangent_variation(&es.x, &es.triad, &chord, &k)
-                }
+    // Node `i`'s residual: from element `i − 1`'s second half, then element `i`'s first.
+    fn gather(i: usize, count: usize, r: &mut [f64], force: impl Fn(usize) -> [f64; 12]) {
+        if i > 0 {
+            let f = force(i - 1);
+            for a in 0..6 {
+                r[a] += f[6 + a];
             }
-        });
-        for (i, (f, k)) in out.iter().enumerate() {
-            sink(i, f, Some(k));
         }
-    } else {
+        if i < count {
+            let f = force(i);
+            for a in 0..6 {
+                r[a] += f[a];
+            }
+        }
+    }
+    let Some(t) = tangent else {
         let out = each(count, |i| {
             let (es, k, form) = element(i);
             element_force(&es.x, &es.triad, &form, &k)
         });
-        for (i, f) in out.iter().enumerate() {
-            sink(i, f, None);
+        residual
+            .par_chunks_mut(6)
+            .with_min_len(64)
+            .enumerate()
+            .for_each(|(i, r)| gather(i, count, r, |e| out[e]));
+        return;
+    };
+    let out = each(count, |i| {
+        let (es, k, chord) = element(i);
+        match form {
+            TangentForm::OnePass => force_and_tangent_closed(&es.x, &es.triad, &chord, &k),
+            TangentForm::WrittenOut => {
+                crate::physics::beam::force_and_tangent_variation(&es.x, &es.triad, &chord, &k)
+            }
         }
-    }
+    });
+    residual
+        .par_chunks_mut(6)
+        .zip(t.diag.par_iter_mut())
+        .with_min_len(64)
+        .enumerate()
+        .for_each(|(i, (r, d))| {
+            gather(i, count, r, |e| out[e].0);
+            if i > 0 {
+                let k = &out[i - 1].1;
+                for (a, row) in d.iter_mut().enumerate() {
+                    for (b, x) in row.iter_mut().enumerate() {
+                        *x += k[a + 6][b + 6];
+                    }
+                }
+            }
+            if i < count {
+                let k = &out[i].1;
+                for (a, row) in d.iter_mut().enumerate() {
+                    for (b, x) in row.iter_mut().enumerate() {
+                        *x += k[a][b];
+                    }
+                }
+            }
+        });
+    t.upper
+        .par_iter_mut()
+        .zip(t.lower.par_iter_mut())
+        .with_min_len(64)
+        .enumerate()
+        .for_each(|(i, (u, l))| {
+            let k = &out[i].1;
+            for a in 0..6 {
+                for b in 0..6 {
+                    u[a][b] += k[a][b + 6];
+                    l[a][b] += k[a + 6][b];
+                }
+            }
+        });
 }
 
 /// Applies the translation bases and fixed DOFs to a residual (only).
