@@ -53,8 +53,8 @@ pub(super) const RELAX_SUB_ITERATIONS: usize = 20;
 /// tolerance, 20,198 at 0.5, 21,150 at 0.9; 0.1 without the memory 29,112 against 30,450.
 pub(super) const RELAX_SUB_REDUCTION: f64 = 0.5;
 /// A relaxation settles where its unshifted measure has not improved by 1 % in this many
-/// sub-solves and is below [`RELAX_STALL_FACTOR`] × the tolerance (f64; f32: below its own
-/// tolerance). Measured on corpus well 0 (horizontal, sliding, 532 nodes): the measure fell
+/// sub-solves and is below the residual a Newton solve accepts at its rounding floor
+/// (`super::relax_stall_tolerance`; 1e-6 of the force scale in f64). Measured on corpus well 0 (horizontal, sliding, 532 nodes): the measure fell
 /// to 1.7e-9 of the force scale in 156 sub-solves and stayed at 1.98e-9 (2 mN of a 1 MN
 /// force scale) for the next 840 until the sub-solve bound ended it — the smallest residual
 /// sits at a contact onset's kink, as the load step's two-cycle did; on well 126, which
@@ -64,8 +64,6 @@ pub(super) const RELAX_SUB_REDUCTION: f64 = 0.5;
 /// 1,059 → 999, 598 → 538, 580 → 520) — 5–10 % of them once the failed load steps before
 /// a relaxation were gone (stop 50 measured 2.4 % with them).
 pub(super) const RELAX_STALL_SUBS: usize = 20;
-/// See `RELAX_STALL_SUBS`.
-pub const RELAX_STALL_FACTOR: f64 = 100.0;
 /// The smallest shift, `s0 ×` this: the proximal points converge at the rate `s / (s + k)`
 /// per sub-solve along a stiffness `k`, and a buckled string's lateral modes are soft (a
 /// span's `EI / L³` less its compression's share), so a high floor costs hundreds of

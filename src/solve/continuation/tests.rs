@@ -100,8 +100,9 @@ fn a_gravity_stage_that_fails_says_so() {
 
 #[test]
 fn a_relaxation_whose_residual_stalls_just_above_the_tolerance_settles_saying_so() {
-    // Stalled at 2e-9 (f64 tolerance 1e-9, stall bound 1e-7): settles once
-    // RELAX_STALL_SUBS sub-solves have not improved it by 1 %.
+    // Stalled at 2e-9 (f64 tolerance 1e-9, stall bound 1e-6: the residual Newton accepts
+    // at its rounding floor): settles once RELAX_STALL_SUBS sub-solves have not improved it
+    // by 1 %.
     let (mut p, _) = stuck(Some(1e6));
     let mut subs = 0;
     loop {
@@ -126,10 +127,22 @@ fn a_relaxation_whose_residual_stalls_just_above_the_tolerance_settles_saying_so
         log.contains(RELAXED) && log.contains("stalled at 2.0e-9"),
         "{log}"
     );
-    // Stalled at 1e-6 (a thousand tolerances): not an equilibrium, it goes on.
+    // Stalled at 8.5e-7 (unseen corpus well 1827's stall): settles as well.
+    let (mut p, _) = stuck(Some(1e6));
+    let mut subs = 0;
+    while p.shift() > 0.0 {
+        p.shift_settled(8.5e-7);
+        p.converged(2);
+        subs += 1;
+        assert!(subs < 200, "never settled");
+    }
+    assert_eq!(subs, RELAX_STALL_SUBS + 1);
+    assert!(p.log.last().unwrap().contains("stalled at 8.5e-7"));
+    // Stalled at 2e-6 (above what Newton accepts at its floor): not an equilibrium, it
+    // goes on.
     let (mut p, _) = stuck(Some(1e6));
     for _ in 0..3 * RELAX_STALL_SUBS {
-        p.shift_settled(1e-6);
+        p.shift_settled(2e-6);
         assert_eq!(p.converged(2), Next::Step);
     }
 }
