@@ -8,6 +8,17 @@ use faer::sparse::Triplet;
 /// A 6×6 block.
 pub type Block6 = [[f64; 6]; 6];
 
+/// Adds the 6×6 quarter of an element matrix `k` (12×12, nodes `i` and `i+1`) that starts
+/// at row `r0` and column `c0` (0 or 6) to `block`: where each of its blocks goes in the
+/// chain ([`BlockTridiagonal::add_element`]; the parallel assembly's per-node gather).
+pub fn add_quarter(block: &mut Block6, k: &[[f64; 12]; 12], r0: usize, c0: usize) {
+    for (r, row) in block.iter_mut().enumerate() {
+        for (c, x) in row.iter_mut().enumerate() {
+            *x += k[r0 + r][c0 + c];
+        }
+    }
+}
+
 /// Block-tridiagonal matrix over `n` nodes.
 #[derive(Clone, Debug)]
 pub struct BlockTridiagonal {
@@ -110,14 +121,10 @@ impl BlockTridiagonal {
 
     /// Adds a 12×12 element matrix coupling nodes `i` and `i+1`.
     pub fn add_element(&mut self, i: usize, k: &[[f64; 12]; 12]) {
-        for r in 0..6 {
-            for c in 0..6 {
-                self.diag[i][r][c] += k[r][c];
-                self.upper[i][r][c] += k[r][c + 6];
-                self.lower[i][r][c] += k[r + 6][c];
-                self.diag[i + 1][r][c] += k[r + 6][c + 6];
-            }
-        }
+        add_quarter(&mut self.diag[i], k, 0, 0);
+        add_quarter(&mut self.upper[i], k, 0, 6);
+        add_quarter(&mut self.lower[i], k, 6, 0);
+        add_quarter(&mut self.diag[i + 1], k, 6, 6);
     }
 
     /// `y = A x`.

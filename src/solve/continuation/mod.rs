@@ -166,7 +166,7 @@ pub struct LoadPath {
 /// (`engine::verify_f32`) follow.
 fn relax_tolerance(options: &StaticOptions, f32: bool) -> f64 {
     if f32 {
-        NewtonSettings::statics(options.max_iterations, options.tolerance, 4).small_residual
+        relax_stall_tolerance(options, true)
     } else {
         options.tolerance
     }

@@ -246,6 +246,7 @@ pub(crate) fn add_element_responses(
     residual: &mut [f64],
     tangent: Option<&mut BlockTridiagonal>,
 ) {
+    use crate::kernels::tridiagonal::add_quarter;
     use rayon::prelude::*;
     let element = |i: usize| {
         let e = &model.elements[i];
@@ -312,20 +313,10 @@ pub(crate) fn add_element_responses(
         .for_each(|(i, (r, d))| {
             gather(i, count, r, |e| out[e].0);
             if i > 0 {
-                let k = &out[i - 1].1;
-                for (a, row) in d.iter_mut().enumerate() {
-                    for (b, x) in row.iter_mut().enumerate() {
-                        *x += k[a + 6][b + 6];
-                    }
-                }
+                add_quarter(d, &out[i - 1].1, 6, 6);
             }
             if i < count {
-                let k = &out[i].1;
-                for (a, row) in d.iter_mut().enumerate() {
-                    for (b, x) in row.iter_mut().enumerate() {
-                        *x += k[a][b];
-                    }
-                }
+                add_quarter(d, &out[i].1, 0, 0);
             }
         });
     t.upper
@@ -334,13 +325,8 @@ pub(crate) fn add_element_responses(
         .with_min_len(64)
         .enumerate()
         .for_each(|(i, (u, l))| {
-            let k = &out[i].1;
-            for a in 0..6 {
-                for b in 0..6 {
-                    u[a][b] += k[a][b + 6];
-                    l[a][b] += k[a + 6][b];
-                }
-            }
+            add_quarter(u, &out[i].1, 0, 6);
+            add_quarter(l, &out[i].1, 6, 0);
         });
 }
 
