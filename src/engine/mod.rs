@@ -405,9 +405,11 @@ fn solve_batch<T: Real + Send + Sync, P: KernelPath<T>>(
         tables.set_base(mesh, columns(&sys.tables.base, m, &keep));
         let saved = keep.iter().map(|&i| sys.saved[i].clone()).collect();
         let shifts = keep.iter().map(|&i| sys.shifts[i].clone()).collect();
+        let best = keep.iter().map(|&i| sys.best[i].take()).collect();
         let kept_models = keep.iter().map(|&i| sys.models[i]).collect();
         let ensemble = path.open(mesh, &tables)?;
         sys = EngineStatic::new(kept_models, ensemble, tables, Some(saved), Some(shifts));
+        sys.best = best;
         resume = Some(keep.iter().map(|&i| states[i].clone()).collect::<Vec<_>>());
         members = keep.iter().map(|&i| members[i]).collect();
     }

@@ -22,6 +22,11 @@ pub(super) struct EngineStatic<'a, T> {
     pub(super) saved: Vec<(Vec<f64>, Vec<f64>)>,
     to_save: Vec<usize>,
     to_restore: Vec<usize>,
+    /// Per variant: its relaxation's best state ([`StaticSystem::keep_best`]), as `saved`.
+    pub(super) best: Vec<Option<(Vec<f64>, Vec<f64>)>>,
+    /// Variants whose state is to be kept as their best, and those to go back to it.
+    to_keep: Vec<usize>,
+    to_best: Vec<usize>,
     /// Per variant the landing epoch counter (one more at each target and restart), and
     /// whether the epochs the ensemble holds are stale.
     land_epoch: Vec<u32>,
@@ -92,6 +97,9 @@ impl<'a, T: Real> EngineStatic<'a, T> {
             saved,
             to_save: Vec::new(),
             to_restore: Vec::new(),
+            best: vec![None; v],
+            to_keep: Vec::new(),
+            to_best: Vec::new(),
             land_epoch: vec![1; v],
             epochs_changed: true,
             to_rebase: false,
@@ -103,18 +111,31 @@ impl<'a, T: Real> EngineStatic<'a, T> {
     /// Carries out the gathered saves, restores (and f32 rebase) and load changes.
     pub(super) fn flush(&mut self) -> Result<(), crate::error::SystemError> {
         let v = self.tables.num_variants;
-        if !self.to_save.is_empty() || !self.to_restore.is_empty() {
+        if !self.to_save.is_empty() || !self.to_restore.is_empty() || !self.to_keep.is_empty() {
             let mut config = self.ensemble.config()?;
-            for j in std::mem::take(&mut self.to_save) {
-                let (x, rot) = &mut self.saved[j];
+            // Variant `j`'s state now into `(x, rot)`, as `saved` holds it.
+            let read = |j: usize, (x, rot): &mut (Vec<f64>, Vec<f64>)| {
                 for (k, x) in x.iter_mut().enumerate() {
                     *x = self.tables.base[k * v + j] + config.x[k * v + j].to_f64_lossy();
                 }
                 for (k, r) in rot.iter_mut().enumerate() {
                     *r = config.rot[k * v + j].to_f64_lossy();
                 }
+            };
+            for j in std::mem::take(&mut self.to_keep) {
+                let best = self.best[j].get_or_insert_with(|| self.saved[j].clone());
+                read(j, best);
+            }
+            for j in std::mem::take(&mut self.to_save) {
+                read(j, &mut self.saved[j]);
                 if std::mem::size_of::<T>() == 4 {
                     self.to_rebase = true;
+                }
+            }
+            // After the saves: a variant sent back to its best has it as restart point.
+            for j in std::mem::take(&mut self.to_best) {
+                if let Some(best) = &self.best[j] {
+                    self.saved[j].clone_from(best);
                 }
             }
             let restores = std::mem::take(&mut self.to_restore);
@@ -376,6 +397,19 @@ impl<T: Real> StaticSystem for EngineStatic<'_, T> {
         }
         self.unshifted.as_ref().map_or(f64::INFINITY, |m| m[j])
     }
+    fn keep_best(&mut self, j: usize) -> Result<(), crate::error::SystemError> {
+        self.to_keep.push(j);
+        Ok(())
+    }
+    fn back_to_best(&mut self, j: usize) -> Result<(), crate::error::SystemError> {
+        if self.best[j].is_none() && !self.to_keep.contains(&j) {
+            return Err(crate::error::SystemError::Unsupported(
+                "no relaxation state was kept".into(),
+            ));
+        }
+        self.to_best.push(j);
+        self.restore(j)
+    }
     fn set_shift(&mut self, j: usize, s: f64) -> Result<(), crate::error::SystemError> {
         if s == 0.0 && self.shifts[j].0 == 0.0 {
             return Ok(());
@@ -384,5 +418,61 @@ impl<T: Real> StaticSystem for EngineStatic<'_, T> {
         self.to_anchor.push(j);
         self.epochs_changed = true;
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A relaxation's best state (`StaticSystem::keep_best`) is read at the next flush, and
+    /// a variant sent back to it (`back_to_best`, after the driver's save of the state it
+    /// leaves) has it as state and restart point; the other variant keeps its own.
+    #[test]
+    fn a_variant_sent_back_to_its_best_state_restarts_there() {
+        let case = crate::case::load_case(std::path::Path::new("cases/paper_one_stabilizer.toml"))
+            .unwrap();
+        let models = vec![case.model.clone(), case.model.clone()];
+        let tables = ensemble_tables::<f64>(&models).unwrap();
+        let ensemble = TwinPath.open(&models[0], &tables).unwrap();
+        let mut sys = EngineStatic::new(models.iter().collect(), ensemble, tables, None, None);
+        let v = 2;
+        let start = sys.ensemble.config().unwrap();
+        // Variant 1 moved by `d` from where it starts.
+        let moved = |sys: &mut EngineStatic<f64>, d: f64| {
+            let mut c = sys.ensemble.config().unwrap();
+            for k in 0..c.x.len() / v {
+                c.x[k * v + 1] += d;
+            }
+            sys.ensemble.set_config(&c).unwrap();
+        };
+        // No best kept: refused.
+        assert!(sys.back_to_best(1).is_err());
+        sys.to_restore.clear();
+        // The best kept at 1 mm; the state moves on to 3 mm and is saved there; back.
+        moved(&mut sys, 1e-3);
+        sys.keep_best(1).unwrap();
+        sys.flush().unwrap();
+        moved(&mut sys, 2e-3);
+        sys.save(1).unwrap();
+        sys.back_to_best(1).unwrap();
+        sys.flush().unwrap();
+        let now = sys.ensemble.config().unwrap();
+        for k in 0..now.x.len() / v {
+            assert_eq!(now.x[k * v], start.x[k * v], "variant 0 moved");
+            let want = start.x[k * v + 1] + 1e-3;
+            assert_eq!(now.x[k * v + 1], want, "variant 1 not at its best");
+            assert_eq!(sys.saved[1].0[k], sys.tables.base[k * v + 1] + want);
+        }
+        // Kept, saved and sent back in one flush: the state it has.
+        moved(&mut sys, 5e-3);
+        sys.keep_best(1).unwrap();
+        sys.save(1).unwrap();
+        sys.back_to_best(1).unwrap();
+        sys.flush().unwrap();
+        let now = sys.ensemble.config().unwrap();
+        for k in 0..now.x.len() / v {
+            assert_eq!(now.x[k * v + 1], start.x[k * v + 1] + 1e-3 + 5e-3);
+        }
     }
 }

@@ -39,6 +39,12 @@ pub trait StaticSystem: NewtonSystem {
     /// ([`LoadPath::take_equilibrium`]), as where its string stands should its path fail
     /// where the string stops. Systems without a use for it keep nothing.
     fn keep_equilibrium(&mut self, _j: usize, _target: &LoadTarget) {}
+    /// Keeps variant `j`'s current state, a relaxation's best sub-solve so far
+    /// ([`LoadPath::take_keep_best`]), for [`StaticSystem::back_to_best`].
+    fn keep_best(&mut self, j: usize) -> Result<(), crate::error::SystemError>;
+    /// Returns variant `j`'s state and restart point to the state [`StaticSystem::keep_best`]
+    /// kept last ([`LoadPath::take_back_to_best`]).
+    fn back_to_best(&mut self, j: usize) -> Result<(), crate::error::SystemError>;
     /// Sets variant `j`'s proximal shift `s` (0: none), anchored at its current state:
     /// the residual gains `s (x − a)` on the translations, the tangent `s I`.
     fn set_shift(&mut self, _j: usize, s: f64) -> Result<(), crate::error::SystemError> {
@@ -131,8 +137,16 @@ fn next_steps(
             Event::Converged(its) => {
                 if path.shift() > 0.0 {
                     path.shift_settled(sys.unshifted_measure(j));
+                    if path.take_keep_best() {
+                        sys.keep_best(j)?;
+                    }
                 }
                 let next = path.converged(its);
+                if path.take_back_to_best() {
+                    // Before the equilibrium is kept and the restart point saved: both
+                    // are then the best state.
+                    sys.back_to_best(j)?;
+                }
                 if let Some(target) = path.take_equilibrium() {
                     sys.keep_equilibrium(j, &target);
                 }

@@ -154,6 +154,8 @@ pub struct LoadPath {
     /// failed from it: a small residual says less there (near a fold the tangent is nearly
     /// singular), so the f32 engine confirms such an answer in f64 (`engine::verify_f32`).
     pub doubtful: bool,
+    /// The relaxation just settled at its best state ([`LoadPath::take_back_to_best`]).
+    back_to_best: bool,
 }
 
 /// The residual measure below which a relaxation's answer is an equilibrium: in f64 (the
@@ -227,6 +229,7 @@ impl LoadPath {
             log: Vec::new(),
             error: None,
             doubtful: false,
+            back_to_best: false,
             lock: None,
             equilibrium: None,
             stopped: None,
@@ -316,13 +319,19 @@ impl LoadPath {
             if measure < 0.99 * r.best {
                 r.best = measure;
                 r.best_at = r.subs;
+                r.keep_best = measure <= self.stall_tolerance;
             }
-            if !r.settled
-                && measure <= self.stall_tolerance
-                && r.subs >= r.best_at + RELAX_STALL_SUBS
-            {
-                r.settled = true;
-                r.stalled = Some(measure);
+            if !r.settled && r.subs >= r.best_at + RELAX_STALL_SUBS {
+                if measure <= self.stall_tolerance {
+                    r.settled = true;
+                    r.stalled = Some(measure);
+                } else if r.best <= self.stall_tolerance {
+                    // The iterates hover above the level they reached once: back to that
+                    // state, which the system kept ([`LoadPath::take_keep_best`]).
+                    r.settled = true;
+                    r.stalled = Some(r.best);
+                    r.back_to_best = true;
+                }
             }
         }
     }
@@ -361,6 +370,24 @@ impl LoadPath {
     /// later fails where it stops ([`LoadPath::stopped_between`]).
     pub fn take_equilibrium(&mut self) -> Option<LoadTarget> {
         self.equilibrium.take()
+    }
+
+    /// Whether the relaxation's sub-solve that just converged is its best so far at or
+    /// below the stall level ([`relax_stall_tolerance`]): the system is to keep its state
+    /// ([`StaticSystem::keep_best`]) — the state the relaxation settles at should its
+    /// iterates hover above that level from there on ([`LoadPath::take_back_to_best`]).
+    pub fn take_keep_best(&mut self) -> bool {
+        self.relax
+            .as_mut()
+            .is_some_and(|r| std::mem::take(&mut r.keep_best))
+    }
+
+    /// Whether the relaxation just settled at its best state, not at the last sub-solve's
+    /// (its unshifted measure reached the stall level once, then hovered above it for
+    /// [`RELAX_STALL_SUBS`] sub-solves without a 1 % gain): the system is to return there
+    /// ([`StaticSystem::back_to_best`]) before the answer is polished.
+    pub fn take_back_to_best(&mut self) -> bool {
+        std::mem::take(&mut self.back_to_best)
     }
 
     /// Where a failed path bracketed where the string stops: the largest load factor at
@@ -441,13 +468,21 @@ impl LoadPath {
                 if r.settled {
                     // A sub-solve whose answer is an equilibrium without the shift (or
                     // stalled just above the tolerance): an equilibrium at the target.
-                    let stall = r.stalled.map_or(String::new(), |m| {
-                        format!(
+                    let stall = match (r.stalled, r.back_to_best) {
+                        (Some(m), false) => format!(
                             "; its residual stalled at {m:.1e} of the force scale, above the \
                              tolerance {:.0e}",
                             self.tolerance
-                        )
-                    });
+                        ),
+                        (Some(m), true) => format!(
+                            "; its residual fell to {m:.1e} of the force scale, above the \
+                             tolerance {:.0e}, and hovered above that since: settled at that \
+                             sub-solve's state",
+                            self.tolerance
+                        ),
+                        (None, _) => String::new(),
+                    };
+                    self.back_to_best = r.back_to_best;
                     self.log.push(format!(
                         "{}; {RELAXED} to an equilibrium at λ = {} ({} sub-solves, {} Newton iterations{stall})",
                         r.reason, r.target.lambda, r.subs, r.iterations
@@ -579,6 +614,8 @@ impl LoadPath {
             best: f64::INFINITY,
             best_at: 0,
             stalled: None,
+            keep_best: false,
+            back_to_best: false,
             failed_at: 0.0,
             reason,
             cause,

@@ -122,6 +122,13 @@ pub(super) struct Relax {
     pub(super) best_at: usize,
     /// Settled on a stall: the unshifted measure it stalled at.
     pub(super) stalled: Option<f64>,
+    /// The system keeps the best sub-solve's state (its measure at or below the stall
+    /// level): the driver is to keep the state it has now
+    /// ([`super::LoadPath::take_keep_best`]).
+    pub(super) keep_best: bool,
+    /// Settled at the best sub-solve's state, not the last one's: the driver is to return
+    /// the system there ([`super::LoadPath::take_back_to_best`]).
+    pub(super) back_to_best: bool,
     /// The shift of the last sub-solve that failed, halved at each one that converges
     /// since (0: none): the shift is not lowered below twice it, so the next try at that
     /// shift comes after two sub-solves that converge, not one, and from a failure on

@@ -143,8 +143,62 @@ fn a_relaxation_whose_residual_stalls_just_above_the_tolerance_settles_saying_so
     let (mut p, _) = stuck(Some(1e6));
     for _ in 0..3 * RELAX_STALL_SUBS {
         p.shift_settled(2e-6);
+        assert!(!p.take_keep_best());
         assert_eq!(p.converged(2), Next::Step);
+        assert!(!p.take_back_to_best());
     }
+}
+
+/// A relaxation whose measure reached the stall level once (8.8e-7, unseen user well 0 with
+/// the written-out tangent, stop 77) and then hovers above it (2e-6 – 8e-6) settles
+/// [`RELAX_STALL_SUBS`] sub-solves after that best, at the best's state: the path asks the
+/// system to keep each best at or below the level, and to go back to the last one.
+#[test]
+fn a_relaxation_that_hovers_above_its_best_settles_back_at_the_best() {
+    let (mut p, _) = stuck(Some(1e6));
+    let measures = [1e-4, 3e-6, 9e-7, 8.8e-7, 8.0e-7, 2e-6];
+    let mut kept = Vec::new();
+    let mut subs = 0;
+    while p.shift() > 0.0 {
+        let m = *measures
+            .get(subs)
+            .unwrap_or(&(2e-6 + 6e-6 * (subs % 2) as f64));
+        p.shift_settled(m);
+        if p.take_keep_best() {
+            kept.push(subs);
+        }
+        p.converged(3);
+        if p.take_back_to_best() {
+            // Sent back once, as it settles.
+            assert_eq!(p.shift(), 0.0);
+            assert!(!p.take_back_to_best());
+        } else {
+            assert!(p.shift() > 0.0, "settled without going back to its best");
+        }
+        subs += 1;
+        assert!(subs < 200, "never settled");
+    }
+    // Kept at each 1 % gain at or below 1e-6.
+    assert_eq!(kept, vec![2, 3, 4]);
+    assert_eq!(subs, 4 + RELAX_STALL_SUBS + 1);
+    assert_eq!(p.stage, Stage::Refine);
+    let log = p.log.last().unwrap();
+    assert!(
+        log.contains(RELAXED) && log.contains("fell to 8.0e-7") && log.contains("hovered"),
+        "{log}"
+    );
+    // Where the hover itself comes back to the level, the last state stands (as before).
+    let (mut p, _) = stuck(Some(1e6));
+    let mut subs = 0;
+    while p.shift() > 0.0 {
+        p.shift_settled(if subs == 0 { 8e-7 } else { 9e-7 });
+        p.take_keep_best();
+        p.converged(3);
+        assert!(!p.take_back_to_best());
+        subs += 1;
+        assert!(subs < 200, "never settled");
+    }
+    assert!(p.log.last().unwrap().contains("stalled at 9.0e-7"));
 }
 
 #[test]

@@ -34,6 +34,8 @@ pub(super) struct CpuStatic<'a> {
     /// The last equilibrium the load path reached, with its loads
     /// ([`StaticSystem::keep_equilibrium`]).
     pub(super) kept: Option<(StaticState, crate::solve::continuation::LoadTarget)>,
+    /// A relaxation's best sub-solve ([`StaticSystem::keep_best`]).
+    best: Option<StaticState>,
 }
 
 /// The first proximal shift of a relaxation of `model` (N/m; [`StaticSystem::relax_scale`]
@@ -102,6 +104,7 @@ impl<'a> CpuStatic<'a> {
             shift: 0.0,
             anchor: Vec::new(),
             kept: None,
+            best: None,
         }
     }
 }
@@ -278,6 +281,23 @@ impl crate::solve::continuation::StaticSystem for CpuStatic<'_> {
             }
             None => self.kept = Some((self.state.clone(), *target)),
         }
+    }
+    fn keep_best(&mut self, _j: usize) -> Result<(), crate::error::SystemError> {
+        match &mut self.best {
+            Some(best) => best.clone_from(&self.state),
+            None => self.best = Some(self.state.clone()),
+        }
+        Ok(())
+    }
+    fn back_to_best(&mut self, _j: usize) -> Result<(), crate::error::SystemError> {
+        let best = self.best.as_ref().ok_or_else(|| {
+            crate::error::SystemError::Unsupported("no relaxation state was kept".into())
+        })?;
+        self.state.clone_from(best);
+        self.saved.clone_from(best);
+        self.evaluated = false;
+        self.reset_landing();
+        Ok(())
     }
     fn set_shift(&mut self, _j: usize, s: f64) -> Result<(), crate::error::SystemError> {
         self.shift = s;
