@@ -28,7 +28,9 @@
 //!    one's answer `a`, `s` lowered as they get easy (to `RELAX_FLOOR` × its start) and
 //!    raised where one fails (not lowered again to a shift that failed lately), each
 //!    solved inexactly (to `RELAX_SUB_REDUCTION` of its residual at the anchor), until an
-//!    answer is an equilibrium without the shift ([`LoadPath::shift_settled`]); it fails at
+//!    answer is an equilibrium without the shift ([`LoadPath::shift_settled`]; where the
+//!    residual stalls below Newton's floor level, or hovers above a best that was below it,
+//!    at that state: `RELAX_STALL_SUBS`); it fails at
 //!    its budget (`RELAX_MAX_BUDGET`) or once that residual has stopped falling
 //!    (`RELAX_STAGNANT_SUBS`). The shift
 //!    keeps each sub-solve's tangent positive where the string's own is not, and accepts a
