@@ -54,7 +54,7 @@ pub use driver::{solve_loads, solve_loads_from, StaticSystem};
 pub use relax::LOCK_FOUND;
 use relax::*;
 
-use super::newton::{NewtonSettings, SolveLimits, FOLD_STALL_ITERATIONS};
+use super::newton::{SolveLimits, FOLD_STALL_ITERATIONS};
 use super::static_options::{StaticError, StaticOptions, GRAVITY_STAGE, LOAD_STAGE};
 
 /// The loads a variant is solved for: each a factor of the full value.
@@ -158,40 +158,6 @@ pub struct LoadPath {
     pub doubtful: bool,
     /// The relaxation just settled at its best state ([`LoadPath::take_back_to_best`]).
     back_to_best: bool,
-}
-
-/// The residual measure below which a relaxation's answer is an equilibrium: in f64 (the
-/// CPU solve, the twins, the GPU f64) the solve's tolerance; in f32 (the refining path)
-/// the residual an f32 Newton accepts at its rounding floor
-/// ([`NewtonSettings::small_residual`]) — measured on the 60 m test bed
-/// (`tests/engine_relax.rs`), f32's unshifted residual after a sub-solve stays at
-/// 1.0–1.9e-4 of the force scale, above its Newton tolerance 2.4e-5, and a relaxation held
-/// to that never settles. The f32 path's closing full-load solve and its f64 check
-/// (`engine::verify_f32`) follow.
-fn relax_tolerance(options: &StaticOptions, f32: bool) -> f64 {
-    if f32 {
-        relax_stall_tolerance(options, true)
-    } else {
-        options.tolerance
-    }
-}
-
-/// The residual measure below which a relaxation whose unshifted measure has stalled
-/// ([`RELAX_STALL_SUBS`] sub-solves without a 1 % gain) settles: the residual a Newton
-/// solve of that precision accepts once its step is at the rounding floor
-/// ([`NewtonSettings::small_residual`]: 1e-6 of the force scale in f64; in f32 that is
-/// also [`relax_tolerance`]) — a proximal iteration that can no longer lower its residual
-/// stands where a Newton solve that can no longer move would. It was `100 ×` the
-/// tolerance (1e-7) until stop 76: unseen corpus well 1827 (horizontal, sliding, 5 m
-/// elements, a 5.9e8 N/m wall) stalled at 6.3e-7 and failed after 799 sub-solves, where its
-/// neighbours in mesh (2.5, 3 and 10 m) and wall stiffness (5.9e7) solve; at 1e-6 it
-/// settles after 228 (hook load 36.5 kN, between theirs). On the relaxed set (102 wells,
-/// docs/performance.md, stop 76) 139,939 → 123,744 Newton iterations, all 102 solved, 95
-/// with the same path; the hook loads of the other seven within 1 N but drawn 44 (77 N)
-/// and 195 (0.9 kN of 32 kN, another member of its family of equilibria).
-fn relax_stall_tolerance(options: &StaticOptions, f32: bool) -> f64 {
-    let size = if f32 { 4 } else { 8 };
-    NewtonSettings::statics(options.max_iterations, options.tolerance, size).small_residual
 }
 
 impl LoadPath {
