@@ -40,7 +40,7 @@ pub trait StaticSystem: NewtonSystem {
     /// where the string stops. Systems without a use for it keep nothing.
     fn keep_equilibrium(&mut self, _j: usize, _target: &LoadTarget) {}
     /// Keeps variant `j`'s current state, a relaxation's best sub-solve so far
-    /// ([`LoadPath::take_keep_best`]), for [`StaticSystem::back_to_best`].
+    /// ([`LoadPath::shift_settled`]), for [`StaticSystem::back_to_best`].
     fn keep_best(&mut self, j: usize) -> Result<(), crate::error::SystemError>;
     /// Returns variant `j`'s state and restart point to the state [`StaticSystem::keep_best`]
     /// kept last ([`LoadPath::take_back_to_best`]).
@@ -135,11 +135,8 @@ fn next_steps(
         let path = &mut paths[j];
         let (next, converged) = match event {
             Event::Converged(its) => {
-                if path.shift() > 0.0 {
-                    path.shift_settled(sys.unshifted_measure(j));
-                    if path.take_keep_best() {
-                        sys.keep_best(j)?;
-                    }
+                if path.shift() > 0.0 && path.shift_settled(sys.unshifted_measure(j)) {
+                    sys.keep_best(j)?;
                 }
                 let next = path.converged(its);
                 if path.take_back_to_best() {

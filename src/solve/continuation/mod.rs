@@ -51,8 +51,8 @@ mod driver;
 mod relax;
 
 pub use driver::{solve_loads, solve_loads_from, StaticSystem};
-pub use relax::LOCK_FOUND;
 use relax::*;
+pub use relax::{relax_stall_tolerance, LOCK_FOUND};
 
 use super::newton::{SolveLimits, FOLD_STALL_ITERATIONS};
 use super::static_options::{StaticError, StaticOptions, GRAVITY_STAGE, LOAD_STAGE};
@@ -280,14 +280,19 @@ impl LoadPath {
 
     /// A shifted sub-solve converged where the residual without the shift has the measure
     /// `measure` ([`StaticSystem::unshifted_measure`]): below the tolerance, the answer is
-    /// an equilibrium and the relaxation ends there.
-    pub fn shift_settled(&mut self, measure: f64) {
+    /// an equilibrium and the relaxation ends there. Returns whether this sub-solve is the
+    /// relaxation's best so far at or below the stall level ([`relax_stall_tolerance`]):
+    /// the system is then to keep its state ([`StaticSystem::keep_best`]), the state the
+    /// relaxation settles at should its iterates hover above that level from there on
+    /// ([`LoadPath::take_back_to_best`]).
+    pub fn shift_settled(&mut self, measure: f64) -> bool {
+        let mut keep = false;
         if let (Stage::Relax, Some(r)) = (&self.stage, self.relax.as_mut()) {
             r.settled = measure < self.tolerance;
             if measure < 0.99 * r.best {
                 r.best = measure;
                 r.best_at = r.subs;
-                r.keep_best = measure <= self.stall_tolerance;
+                keep = measure <= self.stall_tolerance;
             }
             if !r.settled && r.subs >= r.best_at + RELAX_STALL_SUBS {
                 if measure <= self.stall_tolerance {
@@ -295,13 +300,14 @@ impl LoadPath {
                     r.stalled = Some(measure);
                 } else if r.best <= self.stall_tolerance {
                     // The iterates hover above the level they reached once: back to that
-                    // state, which the system kept ([`LoadPath::take_keep_best`]).
+                    // state, which the system kept (`keep` of the best's call).
                     r.settled = true;
                     r.stalled = Some(r.best);
                     r.back_to_best = true;
                 }
             }
         }
+        keep
     }
 
     /// The Newton iterations the solve being run may take, where fewer than the settings'
@@ -338,16 +344,6 @@ impl LoadPath {
     /// later fails where it stops ([`LoadPath::stopped_between`]).
     pub fn take_equilibrium(&mut self) -> Option<LoadTarget> {
         self.equilibrium.take()
-    }
-
-    /// Whether the relaxation's sub-solve that just converged is its best so far at or
-    /// below the stall level ([`relax_stall_tolerance`]): the system is to keep its state
-    /// ([`StaticSystem::keep_best`]) — the state the relaxation settles at should its
-    /// iterates hover above that level from there on ([`LoadPath::take_back_to_best`]).
-    pub fn take_keep_best(&mut self) -> bool {
-        self.relax
-            .as_mut()
-            .is_some_and(|r| std::mem::take(&mut r.keep_best))
     }
 
     /// Whether the relaxation just settled at its best state, not at the last sub-solve's
@@ -582,7 +578,6 @@ impl LoadPath {
             best: f64::INFINITY,
             best_at: 0,
             stalled: None,
-            keep_best: false,
             back_to_best: false,
             failed_at: 0.0,
             reason,

@@ -129,10 +129,6 @@ pub(super) struct Relax {
     pub(super) best_at: usize,
     /// Settled on a stall: the unshifted measure it stalled at.
     pub(super) stalled: Option<f64>,
-    /// The system keeps the best sub-solve's state (its measure at or below the stall
-    /// level): the driver is to keep the state it has now
-    /// ([`super::LoadPath::take_keep_best`]).
-    pub(super) keep_best: bool,
     /// Settled at the best sub-solve's state, not the last one's: the driver is to return
     /// the system there ([`super::LoadPath::take_back_to_best`]).
     pub(super) back_to_best: bool,
@@ -219,7 +215,7 @@ pub(super) fn relax_tolerance(options: &StaticOptions, f32: bool) -> f64 {
 /// docs/performance.md, stop 76) 139,939 → 123,744 Newton iterations, all 102 solved, 95
 /// with the same path; the hook loads of the other seven within 1 N but drawn 44 (77 N)
 /// and 195 (0.9 kN of 32 kN, another member of its family of equilibria).
-pub(super) fn relax_stall_tolerance(options: &StaticOptions, f32: bool) -> f64 {
+pub fn relax_stall_tolerance(options: &StaticOptions, f32: bool) -> f64 {
     let size = if f32 { 4 } else { 8 };
     NewtonSettings::statics(options.max_iterations, options.tolerance, size).small_residual
 }

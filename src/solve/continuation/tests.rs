@@ -142,8 +142,7 @@ fn a_relaxation_whose_residual_stalls_just_above_the_tolerance_settles_saying_so
     // goes on.
     let (mut p, _) = stuck(Some(1e6));
     for _ in 0..3 * RELAX_STALL_SUBS {
-        p.shift_settled(2e-6);
-        assert!(!p.take_keep_best());
+        assert!(!p.shift_settled(2e-6));
         assert_eq!(p.converged(2), Next::Step);
         assert!(!p.take_back_to_best());
     }
@@ -163,8 +162,7 @@ fn a_relaxation_that_hovers_above_its_best_settles_back_at_the_best() {
         let m = *measures
             .get(subs)
             .unwrap_or(&(2e-6 + 6e-6 * (subs % 2) as f64));
-        p.shift_settled(m);
-        if p.take_keep_best() {
+        if p.shift_settled(m) {
             kept.push(subs);
         }
         p.converged(3);
@@ -192,7 +190,6 @@ fn a_relaxation_that_hovers_above_its_best_settles_back_at_the_best() {
     let mut subs = 0;
     while p.shift() > 0.0 {
         p.shift_settled(if subs == 0 { 8e-7 } else { 9e-7 });
-        p.take_keep_best();
         p.converged(3);
         assert!(!p.take_back_to_best());
         subs += 1;
