@@ -406,10 +406,15 @@ fn solve_batch<T: Real + Send + Sync, P: KernelPath<T>>(
         let saved = keep.iter().map(|&i| sys.saved[i].clone()).collect();
         let shifts = keep.iter().map(|&i| sys.shifts[i].clone()).collect();
         let best = keep.iter().map(|&i| sys.best[i].take()).collect();
+        let anchor_base = keep
+            .iter()
+            .map(|&i| std::mem::take(&mut sys.anchor_base[i]))
+            .collect();
         let kept_models = keep.iter().map(|&i| sys.models[i]).collect();
         let ensemble = path.open(mesh, &tables)?;
         sys = EngineStatic::new(kept_models, ensemble, tables, Some(saved), Some(shifts));
         sys.best = best;
+        sys.anchor_base = anchor_base;
         resume = Some(keep.iter().map(|&i| states[i].clone()).collect::<Vec<_>>());
         members = keep.iter().map(|&i| members[i]).collect();
     }

@@ -36,8 +36,12 @@ pub(super) struct EngineStatic<'a, T> {
     /// reference, `3 n`; empty without a shift).
     pub(super) shifts: Vec<(f64, Vec<f64>)>,
     /// Variants whose shift was set since the last flush (anchored at their restart point,
-    /// where the load path leaves them before it sets a shift).
-    to_anchor: Vec<usize>,
+    /// where the load path leaves them before it sets a shift), with the momentum that
+    /// carries the anchor on ([`StaticSystem::set_shift`]).
+    to_anchor: Vec<(usize, f64)>,
+    /// Per variant: the restart point its anchor was last set at (positions, `3 n`; empty
+    /// without a shift), `x₋` of [`StaticSystem::set_shift`].
+    pub(super) anchor_base: Vec<Vec<f64>>,
     /// The shifts differ from what the ensemble holds.
     shift_changed: bool,
     /// Each variant's residual measure without its shift at the current states (kept
@@ -84,6 +88,7 @@ impl<'a, T: Real> EngineStatic<'a, T> {
             shift_changed: shifts.iter().any(|s| s.0 != 0.0),
             shifts,
             to_anchor: Vec::new(),
+            anchor_base: vec![Vec::new(); v],
             unshifted: None,
             loads: models.iter().map(|m| split_loads(m)).collect(),
             f_ref: models.iter().map(|m| reference_force(m)).collect(),
@@ -168,13 +173,17 @@ impl<'a, T: Real> EngineStatic<'a, T> {
                 self.shift_changed |= self.shifts.iter().any(|s| s.0 != 0.0);
             }
         }
-        for j in std::mem::take(&mut self.to_anchor) {
+        for (j, momentum) in std::mem::take(&mut self.to_anchor) {
             let (s, anchor) = &mut self.shifts[j];
-            *anchor = if *s == 0.0 {
-                Vec::new()
+            let base = &mut self.anchor_base[j];
+            if *s == 0.0 {
+                anchor.clear();
+                base.clear();
             } else {
-                self.saved[j].0.clone()
-            };
+                let x = &self.saved[j].0;
+                *anchor = crate::solve::continuation::carried_anchor(x, base, momentum);
+                base.clone_from(x);
+            }
             self.shift_changed = true;
         }
         if std::mem::take(&mut self.shift_changed) {
@@ -410,12 +419,17 @@ impl<T: Real> StaticSystem for EngineStatic<'_, T> {
         self.to_best.push(j);
         self.restore(j)
     }
-    fn set_shift(&mut self, j: usize, s: f64) -> Result<(), crate::error::SystemError> {
+    fn set_shift(
+        &mut self,
+        j: usize,
+        s: f64,
+        momentum: f64,
+    ) -> Result<(), crate::error::SystemError> {
         if s == 0.0 && self.shifts[j].0 == 0.0 {
             return Ok(());
         }
         self.shifts[j].0 = s;
-        self.to_anchor.push(j);
+        self.to_anchor.push((j, momentum));
         self.epochs_changed = true;
         Ok(())
     }
@@ -474,5 +488,44 @@ mod tests {
         for k in 0..now.x.len() / v {
             assert_eq!(now.x[k * v + 1], start.x[k * v + 1] + 1e-3 + 5e-3);
         }
+    }
+
+    /// A shift set with momentum anchors at the restart point carried on by the momentum
+    /// times its move since the last anchor (`StaticSystem::set_shift`): at the restart
+    /// point for the first anchor, after a restore (no move), and not at all without a
+    /// shift; the other variant keeps none.
+    #[test]
+    fn a_shift_with_momentum_anchors_ahead_of_the_restart_point() {
+        let case = crate::case::load_case(std::path::Path::new("cases/paper_one_stabilizer.toml"))
+            .unwrap();
+        let models = vec![case.model.clone(), case.model.clone()];
+        let tables = ensemble_tables::<f64>(&models).unwrap();
+        let ensemble = TwinPath.open(&models[0], &tables).unwrap();
+        let mut sys = EngineStatic::new(models.iter().collect(), ensemble, tables, None, None);
+        let v = 2;
+        let anchored = |sys: &mut EngineStatic<f64>, s: f64| {
+            sys.set_shift(1, s, 0.9).unwrap();
+            sys.flush().unwrap();
+            sys.shifts[1].1.clone()
+        };
+        sys.save(1).unwrap();
+        let x0 = sys.saved[1].0.clone();
+        assert_eq!(anchored(&mut sys, 1e3), x0);
+        let mut c = sys.ensemble.config().unwrap();
+        for k in 0..c.x.len() / v {
+            c.x[k * v + 1] += 1e-3;
+        }
+        sys.ensemble.set_config(&c).unwrap();
+        sys.save(1).unwrap();
+        sys.flush().unwrap();
+        let x1 = sys.saved[1].0.clone();
+        let ahead: Vec<f64> = x1.iter().zip(&x0).map(|(a, b)| a + 0.9 * (a - b)).collect();
+        assert!(ahead.iter().zip(&x1).all(|(a, x)| a != x));
+        assert_eq!(anchored(&mut sys, 1e3), ahead);
+        sys.restore(1).unwrap();
+        assert_eq!(anchored(&mut sys, 4e3), x1);
+        assert!(anchored(&mut sys, 0.0).is_empty());
+        assert!(sys.anchor_base[1].is_empty());
+        assert_eq!(sys.shifts[0], (0.0, Vec::new()));
     }
 }

@@ -45,9 +45,16 @@ pub trait StaticSystem: NewtonSystem {
     /// Returns variant `j`'s state and restart point to the state [`StaticSystem::keep_best`]
     /// kept last ([`LoadPath::take_back_to_best`]).
     fn back_to_best(&mut self, j: usize) -> Result<(), crate::error::SystemError>;
-    /// Sets variant `j`'s proximal shift `s` (0: none), anchored at its current state:
-    /// the residual gains `s (x − a)` on the translations, the tangent `s I`.
-    fn set_shift(&mut self, _j: usize, s: f64) -> Result<(), crate::error::SystemError> {
+    /// Sets variant `j`'s proximal shift `s` (0: none), anchored at its current state `x`
+    /// carried on by `momentum` times its move since the last anchor's state `x₋`:
+    /// `a = x + β (x − x₋)` on the translations (β 0: at `x`; [`LoadPath::momentum`]); the
+    /// residual gains `s (x − a)` on the translations, the tangent `s I`.
+    fn set_shift(
+        &mut self,
+        _j: usize,
+        s: f64,
+        _momentum: f64,
+    ) -> Result<(), crate::error::SystemError> {
         if s == 0.0 {
             Ok(())
         } else {
@@ -162,7 +169,7 @@ fn next_steps(
         }
         if next == Next::Step {
             sys.set_target(j, &path.target())?;
-            sys.set_shift(j, path.shift())?;
+            sys.set_shift(j, path.shift(), path.momentum())?;
             let floor = sys.step_floor(j)?;
             newton.start_limited(j, floor, path.polish(), path.limits());
         }

@@ -27,7 +27,9 @@
 //!    `r(x) + s (x − a) = 0` for the translations, each from and anchored at the last
 //!    one's answer `a`, `s` lowered as they get easy (to `RELAX_FLOOR` × its start) and
 //!    raised where one fails (not lowered again to a shift that failed lately), each
-//!    solved inexactly (to `RELAX_SUB_REDUCTION` of its residual at the anchor), until an
+//!    solved inexactly (to `RELAX_SUB_REDUCTION` of its residual at the anchor), the
+//!    anchor carried on by the last move's momentum after `RELAX_MOMENTUM_AFTER`
+//!    sub-solves (`RELAX_MOMENTUM`; [`LoadPath::momentum`]), until an
 //!    answer is an equilibrium without the shift ([`LoadPath::shift_settled`]; where the
 //!    residual stalls below Newton's floor level, or hovers above a best that was below it,
 //!    at that state: `RELAX_STALL_SUBS`); it fails at
@@ -52,7 +54,7 @@ mod relax;
 
 pub use driver::{solve_loads, solve_loads_from, StaticSystem};
 use relax::*;
-pub use relax::{relax_stall_tolerance, LOCK_FOUND};
+pub use relax::{carried_anchor, relax_stall_tolerance, LOCK_FOUND};
 
 use super::newton::{SolveLimits, FOLD_STALL_ITERATIONS};
 use super::static_options::{StaticError, StaticOptions, GRAVITY_STAGE, LOAD_STAGE};
@@ -286,28 +288,19 @@ impl LoadPath {
     /// relaxation settles at should its iterates hover above that level from there on
     /// ([`LoadPath::take_back_to_best`]).
     pub fn shift_settled(&mut self, measure: f64) -> bool {
-        let mut keep = false;
-        if let (Stage::Relax, Some(r)) = (&self.stage, self.relax.as_mut()) {
-            r.settled = measure < self.tolerance;
-            if measure < 0.99 * r.best {
-                r.best = measure;
-                r.best_at = r.subs;
-                keep = measure <= self.stall_tolerance;
-            }
-            if !r.settled && r.subs >= r.best_at + RELAX_STALL_SUBS {
-                if measure <= self.stall_tolerance {
-                    r.settled = true;
-                    r.stalled = Some(measure);
-                } else if r.best <= self.stall_tolerance {
-                    // The iterates hover above the level they reached once: back to that
-                    // state, which the system kept (`keep` of the best's call).
-                    r.settled = true;
-                    r.stalled = Some(r.best);
-                    r.back_to_best = true;
-                }
-            }
+        match (&self.stage, self.relax.as_mut()) {
+            (Stage::Relax, Some(r)) => r.settle(measure, self.tolerance, self.stall_tolerance),
+            _ => false,
         }
-        keep
+    }
+
+    /// The momentum that carries the next sub-solve's anchor on from the last
+    /// ([`StaticSystem::set_shift`]; [`Relax::momentum`]); 0 outside a relaxation.
+    pub fn momentum(&self) -> f64 {
+        match (&self.stage, &self.relax) {
+            (Stage::Relax, Some(r)) => r.momentum(),
+            _ => 0.0,
+        }
     }
 
     /// The Newton iterations the solve being run may take, where fewer than the settings'

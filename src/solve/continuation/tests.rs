@@ -497,3 +497,45 @@ fn a_failed_full_load_relaxation_brackets_where_the_string_stops() {
     assert_eq!(e.reached(), 0.75);
     assert!(e.to_string().contains("none at λ = 0.8750"), "{e}");
 }
+
+/// A relaxation's anchor carries no momentum for its first [`RELAX_MOMENTUM_AFTER`]
+/// sub-solves (converged or failed), [`RELAX_MOMENTUM`] from there; a path that is not
+/// relaxing carries none.
+#[test]
+fn a_relaxation_carries_its_anchor_on_once_it_has_crawled_a_while() {
+    let mut p = LoadPath::new(&StaticOptions::default(), true, true, false);
+    assert_eq!(p.momentum(), 0.0);
+    let (mut p2, next) = stuck(Some(1e6));
+    assert_eq!(next, Next::Step);
+    assert_eq!(p2.stage, Stage::Relax);
+    for k in 0..RELAX_MOMENTUM_AFTER {
+        assert_eq!(p2.momentum(), 0.0, "sub-solve {k}");
+        p2.shift_settled(1e-3);
+        if k % 3 == 1 {
+            p2.failed_at("no".into(), None, Some(1e6));
+        } else {
+            p2.converged(8);
+        }
+    }
+    assert_eq!(p2.momentum(), RELAX_MOMENTUM);
+    p2.failed_at("no".into(), None, Some(1e6));
+    assert_eq!(p2.momentum(), RELAX_MOMENTUM);
+    // Once settled, the path refines without a shift and without momentum.
+    p2.shift_settled(1e-12);
+    p2.converged(3);
+    assert_eq!(p2.stage, Stage::Refine);
+    assert_eq!((p2.shift(), p2.momentum()), (0.0, 0.0));
+    p.converged(5);
+    assert_eq!(p.momentum(), 0.0);
+}
+
+/// The anchor `x + β (x − x₋)`: at `x` without momentum or without an earlier anchor
+/// state.
+#[test]
+fn a_carried_anchor_moves_on_by_the_momentum_times_the_last_move() {
+    let x = [1.0, -2.0, 0.5];
+    let base = [0.5, -1.0, 0.5];
+    assert_eq!(carried_anchor(&x, &base, 0.9), vec![1.45, -2.9, 0.5]);
+    assert_eq!(carried_anchor(&x, &base, 0.0), x.to_vec());
+    assert_eq!(carried_anchor(&x, &[], 0.9), x.to_vec());
+}

@@ -31,6 +31,9 @@ pub(super) struct CpuStatic<'a> {
     /// Proximal shift (N/m) and its anchor ([`crate::solve::continuation`]'s relaxation).
     shift: f64,
     anchor: Vec<Vec3<f64>>,
+    /// The state the anchor was last set at (`x₋` of
+    /// [`crate::solve::continuation::StaticSystem::set_shift`]).
+    anchor_base: Vec<Vec3<f64>>,
     /// The last equilibrium the load path reached, with its loads
     /// ([`StaticSystem::keep_equilibrium`]).
     pub(super) kept: Option<(StaticState, crate::solve::continuation::LoadTarget)>,
@@ -103,6 +106,7 @@ impl<'a> CpuStatic<'a> {
             evaluated: false,
             shift: 0.0,
             anchor: Vec::new(),
+            anchor_base: Vec::new(),
             kept: None,
             best: None,
         }
@@ -299,13 +303,25 @@ impl crate::solve::continuation::StaticSystem for CpuStatic<'_> {
         self.reset_landing();
         Ok(())
     }
-    fn set_shift(&mut self, _j: usize, s: f64) -> Result<(), crate::error::SystemError> {
+    fn set_shift(
+        &mut self,
+        _j: usize,
+        s: f64,
+        momentum: f64,
+    ) -> Result<(), crate::error::SystemError> {
         self.shift = s;
-        self.anchor = if s == 0.0 {
-            Vec::new()
+        if s == 0.0 {
+            self.anchor.clear();
+            self.anchor_base.clear();
         } else {
-            self.state.u.clone()
-        };
+            let a = crate::solve::continuation::carried_anchor(
+                self.state.u.as_flattened(),
+                self.anchor_base.as_flattened(),
+                momentum,
+            );
+            self.anchor = a.chunks(3).map(|c| [c[0], c[1], c[2]]).collect();
+            self.anchor_base.clone_from(&self.state.u);
+        }
         self.evaluated = false;
         Ok(())
     }
