@@ -439,17 +439,27 @@ impl<T: Real> StaticSystem for EngineStatic<'_, T> {
 mod tests {
     use super::*;
 
+    /// Two variants of the paper's one-stabilizer case.
+    fn two_variants() -> Vec<Model> {
+        let case = crate::case::load_case(std::path::Path::new("cases/paper_one_stabilizer.toml"))
+            .unwrap();
+        vec![case.model.clone(), case.model]
+    }
+
+    /// The engine's static system of `models` on the twin kernels.
+    fn twin_system(models: &[Model]) -> EngineStatic<'_, f64> {
+        let tables = ensemble_tables::<f64>(models).unwrap();
+        let ensemble = TwinPath.open(&models[0], &tables).unwrap();
+        EngineStatic::new(models.iter().collect(), ensemble, tables, None, None)
+    }
+
     /// A relaxation's best state (`StaticSystem::keep_best`) is read at the next flush, and
     /// a variant sent back to it (`back_to_best`, after the driver's save of the state it
     /// leaves) has it as state and restart point; the other variant keeps its own.
     #[test]
     fn a_variant_sent_back_to_its_best_state_restarts_there() {
-        let case = crate::case::load_case(std::path::Path::new("cases/paper_one_stabilizer.toml"))
-            .unwrap();
-        let models = vec![case.model.clone(), case.model.clone()];
-        let tables = ensemble_tables::<f64>(&models).unwrap();
-        let ensemble = TwinPath.open(&models[0], &tables).unwrap();
-        let mut sys = EngineStatic::new(models.iter().collect(), ensemble, tables, None, None);
+        let models = two_variants();
+        let mut sys = twin_system(&models);
         let v = 2;
         let start = sys.ensemble.config().unwrap();
         // Variant 1 moved by `d` from where it starts.
@@ -496,12 +506,8 @@ mod tests {
     /// shift; the other variant keeps none.
     #[test]
     fn a_shift_with_momentum_anchors_ahead_of_the_restart_point() {
-        let case = crate::case::load_case(std::path::Path::new("cases/paper_one_stabilizer.toml"))
-            .unwrap();
-        let models = vec![case.model.clone(), case.model.clone()];
-        let tables = ensemble_tables::<f64>(&models).unwrap();
-        let ensemble = TwinPath.open(&models[0], &tables).unwrap();
-        let mut sys = EngineStatic::new(models.iter().collect(), ensemble, tables, None, None);
+        let models = two_variants();
+        let mut sys = twin_system(&models);
         let v = 2;
         let anchored = |sys: &mut EngineStatic<f64>, s: f64| {
             sys.set_shift(1, s, 0.9).unwrap();
