@@ -181,7 +181,8 @@ impl<'a, T: Real> EngineStatic<'a, T> {
                 base.clear();
             } else {
                 let x = &self.saved[j].0;
-                *anchor = crate::solve::continuation::carried_anchor(x, base, momentum);
+                anchor.clone_from(x);
+                crate::solve::continuation::carry_anchor(anchor, base, momentum);
                 base.clone_from(x);
             }
             self.shift_changed = true;

@@ -54,7 +54,7 @@ mod relax;
 
 pub use driver::{solve_loads, solve_loads_from, StaticSystem};
 use relax::*;
-pub use relax::{carried_anchor, relax_stall_tolerance, LOCK_FOUND};
+pub use relax::{carry_anchor, relax_stall_tolerance, LOCK_FOUND};
 
 use super::newton::{SolveLimits, FOLD_STALL_ITERATIONS};
 use super::static_options::{StaticError, StaticOptions, GRAVITY_STAGE, LOAD_STAGE};

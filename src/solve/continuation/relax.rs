@@ -92,17 +92,16 @@ pub(super) const RELAX_MOMENTUM: f64 = 0.9;
 /// Sub-solves a relaxation takes before its anchor carries momentum ([`RELAX_MOMENTUM`]).
 pub(super) const RELAX_MOMENTUM_AFTER: usize = 20;
 
-/// The anchor `x + β (x − x₋)` of a proximal shift ([`super::StaticSystem::set_shift`]),
-/// on flat coordinates: `x` itself where `β` is 0 or there is no earlier anchor state
-/// (`base` empty).
-pub fn carried_anchor(x: &[f64], base: &[f64], beta: f64) -> Vec<f64> {
-    if beta == 0.0 || base.len() != x.len() {
-        return x.to_vec();
+/// Carries a proximal shift's anchor on, in place ([`super::StaticSystem::set_shift`]):
+/// `anchor`, set to the state `x`, becomes `x + β (x − x₋)` on flat coordinates; it stays
+/// at `x` where `β` is 0 or there is no earlier anchor state (`base` empty).
+pub fn carry_anchor(anchor: &mut [f64], base: &[f64], beta: f64) {
+    if beta == 0.0 || base.len() != anchor.len() {
+        return;
     }
-    x.iter()
-        .zip(base)
-        .map(|(x, b)| x + beta * (x - b))
-        .collect()
+    for (a, b) in anchor.iter_mut().zip(base) {
+        *a += beta * (*a - b);
+    }
 }
 
 /// The smallest shift, `s0 ×` this: the proximal points converge at the rate `s / (s + k)`

@@ -314,12 +314,12 @@ impl crate::solve::continuation::StaticSystem for CpuStatic<'_> {
             self.anchor.clear();
             self.anchor_base.clear();
         } else {
-            let a = crate::solve::continuation::carried_anchor(
-                self.state.u.as_flattened(),
+            self.anchor.clone_from(&self.state.u);
+            crate::solve::continuation::carry_anchor(
+                self.anchor.as_flattened_mut(),
                 self.anchor_base.as_flattened(),
                 momentum,
             );
-            self.anchor = a.chunks(3).map(|c| [c[0], c[1], c[2]]).collect();
             self.anchor_base.clone_from(&self.state.u);
         }
         self.evaluated = false;
