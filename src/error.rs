@@ -45,7 +45,7 @@ pub enum SystemError {
 
 /// An input error: names the source, line, key and the allowed range. Exit code 2.
 /// Shown as `source:line: key: message`, or `source: key: message` where no line applies
-/// (`line` 0: a command-line option, a whole file).
+/// (`line` 0: a command-line option, a whole file); the key is left out where it is `-`.
 #[derive(Clone, Debug, Error)]
 pub struct InputError {
     /// File name, or `<stdin>`.
@@ -65,7 +65,10 @@ impl std::fmt::Display for InputError {
         } else {
             write!(f, "{}: ", self.source_name)?;
         }
-        write!(f, "{}: {}", self.key, self.message)
+        if self.key != "-" {
+            write!(f, "{}: ", self.key)?;
+        }
+        f.write_str(&self.message)
     }
 }
 
@@ -127,5 +130,41 @@ impl Error {
             Error::Stopped(_) => 3,
             _ => 1,
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::InputError;
+
+    #[test]
+    fn an_input_error_names_its_key_unless_the_whole_line_or_file_is_wrong() {
+        let e = |line, key: &str| InputError {
+            source_name: "case.toml".into(),
+            line,
+            key: key.into(),
+            message: "a message".into(),
+        };
+        assert_eq!(
+            e(3, "hole.friction").to_string(),
+            "case.toml:3: hole.friction: a message"
+        );
+        assert_eq!(
+            e(0, "--variants").to_string(),
+            "case.toml: --variants: a message"
+        );
+        assert_eq!(e(3, "-").to_string(), "case.toml:3: a message");
+        assert_eq!(e(0, "-").to_string(), "case.toml: a message");
+    }
+
+    #[test]
+    fn a_case_file_that_cannot_be_read_says_so() {
+        let path = std::path::Path::new("/no/such/folder/case.toml");
+        let err = crate::case::load_case(path).expect_err("no such file");
+        let text = err.to_string();
+        assert!(
+            text.starts_with("/no/such/folder/case.toml: cannot read the case file: "),
+            "{text}"
+        );
     }
 }

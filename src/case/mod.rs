@@ -326,7 +326,7 @@ pub fn load_case(path: &Path) -> Result<Case, InputError> {
         source_name: path.display().to_string(),
         line: 0,
         key: "-".into(),
-        message: e.to_string(),
+        message: format!("cannot read the case file: {e}"),
     })?;
     parse_case(path, &text)
 }
