@@ -39,7 +39,8 @@
 //!   27, item 3: fewer round trips).
 //! - **Failure** per variant: a non-finite residual, a singular tangent, or no convergence
 //!   within `max_iterations` updates, or (statics) a residual that has not halved in
-//!   [`STATIC_STALL_ITERATIONS`]. The failing variant stops; the others go on.
+//!   [`STATIC_STALL_ITERATIONS`] (in f64, in [`FIRST_HALVING_ITERATIONS`] where it has not
+//!   halved once since the start of a solve started with [`SolveLimits::first_halving`]). The failing variant stops; the others go on.
 
 /// Which step the convergence test looks at.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -95,6 +96,10 @@ pub struct NewtonSettings {
     /// A solve started with [`SolveLimits::fold_stall`] stalls after that many updates once
     /// its residual measure is below this level (0: never; f32, whose floor lies near it).
     pub fold_level: f64,
+    /// A solve started with [`SolveLimits::first_halving`] whose residual measure has not
+    /// halved once since its start fails after this many updates (`usize::MAX`: never;
+    /// statics in f64: [`FIRST_HALVING_ITERATIONS`]).
+    pub first_halving: usize,
 }
 
 /// Statics: a load step's Newton solve that has not halved its residual in this many
@@ -125,6 +130,24 @@ pub const FOLD_LEVEL: f64 = 1e-4;
 /// after 20 flat iterations, 179 → 2,193 iterations; 10 instead of 20 lost nothing on
 /// seeds 0–49 but slowed well 28 (1,966 → 3,086).
 pub const FOLD_STALL_ITERATIONS: usize = 20;
+
+/// Statics in f64: a load step on a path that cuts its failed steps (a soft or hard spring
+/// law; [`SolveLimits::first_halving`]) fails once its residual measure has not halved in
+/// this many updates from its start; one that has halved keeps [`STATIC_STALL_ITERATIONS`].
+/// Traced on corpus seeds 0–59 of both styles (every load step's Newton measures; stop 79):
+/// the 24 load steps that ran the full 80 iterations without once halving their residual
+/// all failed (1,920 Newton iterations; drawn well 1511 spent 160 of its 1,381 so
+/// before its steps were cut), while 21 that converged had not halved in their first 20
+/// (they took 28–200). Applied to every load step, those fail and are cut — and on linear
+/// laws, where a first failure relaxes, a well that solved by load steps comes out relaxed
+/// (unseen drawn 2068: 77 → 204 iterations), its answer path-dependent; unseen drawn seeds
+/// 2012–2071 went 50,926 → 52,320 Newton iterations. On soft and hard laws only
+/// (`holewall bench corpus --wells 60 --first-seed S [--style user]`, docs/performance.md,
+/// stop 79): drawn seeds 0–59 and 2012–2071 the same but one row (10,479; 50,926 → 51,038),
+/// user seeds 0–59 15,997 → 15,274 and 1130–1189 24,144 → 21,135, the relaxed set 109,125
+/// → 106,740; every well solved that solved before. Not in f32: a load step near that
+/// precision's floor cannot halve its residual.
+pub const FIRST_HALVING_ITERATIONS: usize = 20;
 
 /// The unit roundoff of a float type of `size` bytes.
 pub fn unit_roundoff(size: usize) -> f64 {
@@ -244,6 +267,8 @@ struct Track {
     fold_stall: Option<usize>,
     /// Converged at this fraction of `start_measure` ([`SolveLimits::relative`]).
     relative: Option<f64>,
+    /// [`SolveLimits::first_halving`].
+    first_halving: bool,
     /// The residual measure at the solve's start (NaN before its first test).
     start_measure: f64,
 }
@@ -260,6 +285,10 @@ pub struct SolveLimits {
     /// Converged once an update has brought the residual measure to this fraction of its
     /// value at the solve's start (an inexact sub-solve of a relaxation).
     pub relative: Option<f64>,
+    /// The solve fails after [`NewtonSettings::first_halving`] updates where its residual
+    /// measure has not halved once since its start (a load step on a path that cuts its
+    /// steps where they fail: a soft or hard spring law).
+    pub first_halving: bool,
 }
 
 /// One variant's Newton state ([`Newton::state`]).
@@ -326,6 +355,7 @@ impl Newton {
             best_at: 0,
             fold_stall: limits.fold_stall,
             relative: limits.relative,
+            first_halving: limits.first_halving,
             start_measure: f64::NAN,
         };
         if let Some(a) = self.round.alpha.get_mut(j) {
@@ -462,6 +492,10 @@ impl Newton {
             }
             let stall = match track.fold_stall {
                 Some(f) if track.best < s.fold_level => s.stall_iterations.min(f),
+                // Not halved once since the start (`best` is the start's measure).
+                _ if track.first_halving && track.best_at == 0 => {
+                    s.stall_iterations.min(s.first_halving)
+                }
                 _ => s.stall_iterations,
             };
             if track.updates >= track.best_at.saturating_add(stall) {

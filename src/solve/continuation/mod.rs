@@ -318,6 +318,7 @@ impl LoadPath {
             fold_stall: (self.stage == Stage::Load && self.load_failures > 0)
                 .then_some(FOLD_STALL_ITERATIONS),
             relative: (self.shift() > 0.0).then_some(RELAX_SUB_REDUCTION),
+            first_halving: self.stage == Stage::Load && !self.linear_law,
         }
     }
 

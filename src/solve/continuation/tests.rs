@@ -43,6 +43,7 @@ fn a_failed_load_step_relaxes_at_once_where_the_system_can_and_else_stalls_soone
             iterations: Some(RELAX_SUB_ITERATIONS),
             fold_stall: None,
             relative: Some(RELAX_SUB_REDUCTION),
+            first_halving: false,
         }
     );
     // With a soft or hard law the step is cut first, and relaxes once it would go below
@@ -543,4 +544,26 @@ fn a_carried_anchor_moves_on_by_the_momentum_times_the_last_move() {
     assert_eq!(carried(&base, 0.9), [1.45, -2.9, 0.5]);
     assert_eq!(carried(&base, 0.0), x);
     assert_eq!(carried(&[], 0.9), x);
+}
+
+#[test]
+fn only_a_path_that_cuts_its_load_steps_fails_one_that_has_not_halved_its_residual_soon() {
+    // Linear laws relax at the first failed load step: no early failure there.
+    let mut p = LoadPath::new(&StaticOptions::default(), true, true, false);
+    assert!(!p.limits().first_halving);
+    assert_eq!(p.converged(10), Next::Step);
+    assert_eq!(p.stage, Stage::Load);
+    assert!(!p.limits().first_halving);
+    // A soft or hard law cuts them: its load steps carry the limit, not its gravity stage
+    // nor its relaxation's sub-solves.
+    let mut p = LoadPath::new(&StaticOptions::default(), true, false, false);
+    assert!(!p.limits().first_halving);
+    assert_eq!(p.converged(10), Next::Step);
+    assert_eq!(p.stage, Stage::Load);
+    assert!(p.limits().first_halving);
+    while p.stage == Stage::Load {
+        p.failed_at("no".into(), None, Some(1e6));
+    }
+    assert_eq!(p.stage, Stage::Relax);
+    assert!(!p.limits().first_halving);
 }

@@ -24,6 +24,11 @@ impl NewtonSettings {
             noise_band_at_floor: size == 4,
             stall_iterations: STATIC_STALL_ITERATIONS,
             fold_level: if size == 8 { FOLD_LEVEL } else { 0.0 },
+            first_halving: if size == 8 {
+                FIRST_HALVING_ITERATIONS
+            } else {
+                usize::MAX
+            },
         }
     }
 
@@ -77,6 +82,7 @@ impl NewtonSettings {
             noise_band_at_floor: size == 4,
             stall_iterations: usize::MAX,
             fold_level: 0.0,
+            first_halving: usize::MAX,
         }
     }
 

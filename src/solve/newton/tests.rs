@@ -119,8 +119,13 @@ impl NewtonSystem for Kink {
 
 /// How a solve of [`Kink`] from `x = 1` ends, and after how many updates.
 fn kink(c: f64, size: usize, limits: SolveLimits) -> (String, usize) {
+    kink_from(1.0, c, size, limits)
+}
+
+/// How a solve of [`Kink`] from `x0` ends, and after how many updates.
+fn kink_from(x0: f64, c: f64, size: usize, limits: SolveLimits) -> (String, usize) {
     let mut sys = Kink {
-        x: 1.0,
+        x: x0,
         c,
         delta: 0.0,
     };
@@ -162,6 +167,42 @@ fn a_solve_stalled_near_a_kink_ends_sooner_where_its_path_has_met_a_fold() {
         );
         assert!(updates >= STATIC_STALL_ITERATIONS, "{updates}");
     }
+}
+
+#[test]
+fn a_solve_that_never_halves_its_first_residual_ends_sooner_in_f64() {
+    // From the kink itself (x = 0: the least residual there is, c, above the level of the
+    // fold's stall): the measure never comes below half its start.
+    let first = SolveLimits {
+        first_halving: true,
+        ..SolveLimits::default()
+    };
+    let (why, updates) = kink_from(0.0, 1e-2, 8, first);
+    assert!(
+        why.contains(&format!("did not halve in {FIRST_HALVING_ITERATIONS} ")),
+        "{why}"
+    );
+    assert_eq!(updates, FIRST_HALVING_ITERATIONS);
+    // In f32 the plain stall; and in f64 where the start is above the kink (x = 1), the
+    // residual halves on the first updates and the plain stall counts from there.
+    let (why, updates) = kink_from(0.0, 1e-2, 4, first);
+    assert!(
+        why.contains(&format!("did not halve in {STATIC_STALL_ITERATIONS} ")),
+        "{why}"
+    );
+    assert_eq!(updates, STATIC_STALL_ITERATIONS);
+    let (why, updates) = kink_from(1.0, 1e-2, 8, first);
+    assert!(
+        why.contains(&format!("did not halve in {STATIC_STALL_ITERATIONS} ")),
+        "{why}"
+    );
+    assert!(updates > STATIC_STALL_ITERATIONS, "{updates}");
+    // A solve started without the limit: the plain stall.
+    let (why, _) = kink_from(0.0, 1e-2, 8, SolveLimits::default());
+    assert!(
+        why.contains(&format!("did not halve in {STATIC_STALL_ITERATIONS} ")),
+        "{why}"
+    );
 }
 
 #[test]
