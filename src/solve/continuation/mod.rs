@@ -17,8 +17,9 @@
 //!    ([`StaticSystem::relax_scale`]: the CPU solve and the engine), the variant
 //!    **relaxes** from the last equilibrium — at once where every spring law is linear; a
 //!    soft or hard law first cuts the step in half from the last converged state, down to
-//!    `RELAX_AFTER_STEP`; a system that cannot relax cuts down to `min_step` and fails
-//!    there.
+//!    `RELAX_AFTER_STEP` (its load steps fail once their residual has not halved in
+//!    [`crate::solve::newton::FIRST_HALVING_ITERATIONS`]); a system that cannot relax cuts
+//!    down to `min_step` and fails there.
 //!    Cutting first, down to `min_step`, cost corpus wells 0, 17 and 28 (horizontal,
 //!    10 m elements) 12–13 failed steps of 20–80 iterations each and only found the fold
 //!    more closely; relaxing at the first failure took them 1,085 / 1,509 / 1,058 → 683 /
