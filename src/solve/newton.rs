@@ -40,7 +40,8 @@
 //! - **Failure** per variant: a non-finite residual, a singular tangent, or no convergence
 //!   within `max_iterations` updates, or (statics) a residual that has not halved in
 //!   [`STATIC_STALL_ITERATIONS`] (in f64, in [`FIRST_HALVING_ITERATIONS`] where it has not
-//!   halved once since the start of a solve started with [`SolveLimits::first_halving`]). The failing variant stops; the others go on.
+//!   halved once since the start of a solve started with [`SolveLimits::first_halving`]).
+//!   The failing variant stops; the others go on.
 
 /// Which step the convergence test looks at.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
