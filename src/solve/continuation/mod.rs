@@ -275,10 +275,12 @@ impl LoadPath {
     /// The proximal shift of the sub-solve being run (N/m on the translations; 0 outside a
     /// relaxation).
     pub fn shift(&self) -> f64 {
-        match (&self.stage, &self.relax) {
-            (Stage::Relax, Some(r)) => r.s,
-            _ => 0.0,
-        }
+        self.relaxing().map_or(0.0, |r| r.s)
+    }
+
+    /// The relaxation being run (none outside [`Stage::Relax`]).
+    fn relaxing(&self) -> Option<&Relax> {
+        self.relax.as_ref().filter(|_| self.stage == Stage::Relax)
     }
 
     /// A shifted sub-solve converged where the residual without the shift has the measure
@@ -298,10 +300,7 @@ impl LoadPath {
     /// The momentum that carries the next sub-solve's anchor on from the last
     /// ([`StaticSystem::set_shift`]; [`Relax::momentum`]); 0 outside a relaxation.
     pub fn momentum(&self) -> f64 {
-        match (&self.stage, &self.relax) {
-            (Stage::Relax, Some(r)) => r.momentum(),
-            _ => 0.0,
-        }
+        self.relaxing().map_or(0.0, Relax::momentum)
     }
 
     /// The Newton iterations the solve being run may take, where fewer than the settings'
