@@ -240,3 +240,35 @@ fn hook_load_given_puts_the_rest_on_the_bit() {
         "{np_from_bit} vs {expected_np}"
     );
 }
+
+/// One rayon worker or two, the same answer to the bit: with one worker the main thread is
+/// that worker (`holewall::threads::main_thread_in_pool`), so its parallel loops run in
+/// place instead of being handed to a pool thread, and nothing waits on a thread that
+/// never runs them.
+#[test]
+fn one_worker_or_two_give_the_same_static_answer() {
+    let case = concat!(env!("CARGO_MANIFEST_DIR"), "/cases/build_and_hold.toml");
+    let profile = |workers: &str| {
+        let out = std::env::temp_dir().join(format!(
+            "holewall-statics-{}-workers-{workers}",
+            std::process::id()
+        ));
+        let _ = std::fs::remove_dir_all(&out);
+        let run = std::process::Command::new(env!("CARGO_BIN_EXE_holewall"))
+            .args(["static", case, "--quiet", "--out", out.to_str().unwrap()])
+            .env("RAYON_NUM_THREADS", workers)
+            .output()
+            .unwrap();
+        assert!(
+            run.status.success(),
+            "RAYON_NUM_THREADS={workers}: {}",
+            String::from_utf8_lossy(&run.stderr)
+        );
+        let csv = std::fs::read_to_string(out.join("profile.csv")).unwrap();
+        let _ = std::fs::remove_dir_all(&out);
+        csv
+    };
+    let (one, two) = (profile("1"), profile("2"));
+    assert!(one.lines().count() > 100, "a profile of the whole string");
+    assert_eq!(one, two);
+}
