@@ -14,7 +14,7 @@
 //! bit for bit (every loop keeps its sums in element, site and node order).
 
 /// Makes the calling thread (the main thread) worker 0 of rayon's global pool, with as many
-/// workers as rayon would start (`RAYON_NUM_THREADS`, else the cores). Call it first in
+/// workers as rayon starts by itself (`RAYON_NUM_THREADS`, else the cores). Call it first in
 /// `main`, before anything uses rayon.
 ///
 /// With one worker too (`RAYON_NUM_THREADS=1`, a task given one CPU): the main thread is
@@ -26,15 +26,9 @@
 /// the main one starts rayon work, which a main thread blocked outside rayon would leave
 /// waiting.
 pub fn main_thread_in_pool() {
-    let from_env = std::env::var("RAYON_NUM_THREADS")
-        .ok()
-        .and_then(|v| v.trim().parse::<usize>().ok())
-        .filter(|&n| n > 0);
-    let workers =
-        from_env.unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
-    // Fails only if the pool was built already; it is then used as it is.
+    // `num_threads` left at rayon's default: `RAYON_NUM_THREADS` where a positive integer,
+    // else the cores. Fails only if the pool was built already; it is then used as it is.
     let _ = rayon::ThreadPoolBuilder::new()
-        .num_threads(workers)
         .use_current_thread()
         .build_global();
 }
