@@ -1,5 +1,7 @@
 //! Static solver against closed forms (f64).
 
+mod common;
+
 use holewall::model::{mesh_string, Model, TopBoundary, Tubular, GRAVITY};
 use holewall::physics::beam::rotation_exp;
 use holewall::solve::chain::BlockTridiagonal;
@@ -249,11 +251,7 @@ fn hook_load_given_puts_the_rest_on_the_bit() {
 fn one_worker_or_two_give_the_same_static_answer() {
     let case = concat!(env!("CARGO_MANIFEST_DIR"), "/cases/build_and_hold.toml");
     let profile = |workers: &str| {
-        let out = std::env::temp_dir().join(format!(
-            "holewall-statics-{}-workers-{workers}",
-            std::process::id()
-        ));
-        let _ = std::fs::remove_dir_all(&out);
+        let out = common::scratch_dir("statics", &format!("workers-{workers}"));
         let run = std::process::Command::new(env!("CARGO_BIN_EXE_holewall"))
             .args(["static", case, "--quiet", "--out", out.to_str().unwrap()])
             .env("RAYON_NUM_THREADS", workers)
