@@ -441,6 +441,17 @@ fn plausible_but_wrong_inputs_are_refused_with_the_likely_intent() {
             "weight_on_bit = 20",
             "\"20 kN\" or \"20 klbf\"",
         ),
+        (
+            "a string listed from the top down (the bit second)",
+            GOOD.replace(
+                "[[string]]\nkind = \"stabilizer\"",
+                "[[string]]\nkind = \"bit\"\nlength = \"0.3 m\"\nod = \"6.5 in\"\n\
+                 id = \"2.8125 in\"\n\n[[string]]\nkind = \"stabilizer\"",
+            ),
+            "string.kind",
+            "kind = \"bit\"",
+            "the bit must be the first component",
+        ),
     ];
     let mut table = String::new();
     for (what, text, key, marker, words) in cases {
@@ -477,6 +488,28 @@ fn plausible_but_wrong_inputs_are_refused_with_the_likely_intent() {
         let case = write_case(&dir, &GOOD.replace(from, to));
         assert!(holewall::case::load_case(&case).is_ok(), "{to}");
     }
+    // Components above the one that reaches the surface are left out of the mesh, as a
+    // string list written for a deeper well means: accepted, with a warning naming them
+    // (a list written from the top down without a bit would show its BHA there).
+    let dir = scratch("plausible-above-surface");
+    let case = write_case(
+        &dir,
+        &GOOD.replace("length = \"30 m\"", "length = \"400 m\""),
+    );
+    let warnings = holewall::case::load_case(&case).unwrap().warnings;
+    assert!(
+        warnings.iter().any(|w| w.contains(
+            "components 2–3 (stabilizer, drill_pipe) lie above the surface: the first \
+             component alone reaches it from the bit at 300 m"
+        )),
+        "{warnings:?}"
+    );
+    let case = write_case(&dir, GOOD);
+    let warnings = holewall::case::load_case(&case).unwrap().warnings;
+    assert!(
+        !warnings.iter().any(|w| w.contains("above the surface")),
+        "{warnings:?}"
+    );
     println!("{table}");
 }
 

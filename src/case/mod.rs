@@ -475,7 +475,9 @@ fn build_case(path: &Path, mut source: CaseSource) -> Result<Case, InputError> {
         strength,
         eccentricities,
         bends,
+        warnings: string_warnings,
     } = read_string(&ctx, spec, &hole, bit_md, (el_pipe, el_bha))?;
+    warnings.extend(string_warnings);
 
     // The mesh's size, before it is built: memory and time grow with the nodes.
     {

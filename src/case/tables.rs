@@ -14,6 +14,8 @@ pub(super) struct StringRead {
     pub(super) strength: Vec<Option<crate::strength::PipeStrength>>,
     pub(super) eccentricities: Vec<f64>,
     pub(super) bends: Vec<(f64, f64, f64, std::ops::Range<usize>)>,
+    /// What the reader noticed and a user should see (components above the surface).
+    pub(super) warnings: Vec<String>,
 }
 
 /// `[[string]]`: the components from the bit up, read and checked against the hole
@@ -43,8 +45,21 @@ pub(super) fn read_string(
     let mut strength = Vec::new();
     let mut eccentricities: Vec<f64> = Vec::new();
     let mut bends = Vec::new();
-    for c in &spec.string {
+    for (k, c) in spec.string.iter().enumerate() {
         let kind = c.kind.get_ref().clone();
+        if kind == "bit" && k > 0 {
+            // Listed from the top down, the string would be meshed upside down (the
+            // pipe at the bit) and give a plausible-looking, wrong answer.
+            return Err(ctx.err(
+                c.kind.span(),
+                "string.kind",
+                format!(
+                    "\"bit\" is component {} of the [[string]] list, which runs from the bit \
+                     up: the bit must be the first component",
+                    k + 1
+                ),
+            ));
+        }
         let length = ctx.quantity(&c.length, "string.length", Dimension::Length, pos, "> 0")?;
         let od = ctx.quantity(
             &c.od,
@@ -337,6 +352,7 @@ pub(super) fn read_string(
         return Err(ctx.err(last, "string.length", format!("the string is {} m long, shorter than the bit depth {} m: it must reach the surface", crate::units::show(string_length), crate::units::show(bit_md))));
     }
     Ok(StringRead {
+        warnings: above_surface(&tubulars, bit_md).into_iter().collect(),
         tubulars,
         blades,
         tool_joints,
@@ -344,6 +360,39 @@ pub(super) fn read_string(
         eccentricities,
         bends,
     })
+}
+
+/// The warning for components listed above the one that reaches the surface (from the
+/// bit at `bit_md`): the mesh leaves them out ([`crate::model::mesh_string`]), which is
+/// what a string list written for a deeper well means, and what a list written from the
+/// top down would silently do to its BHA.
+fn above_surface(tubulars: &[Tubular], bit_md: f64) -> Option<String> {
+    let mut bottom = bit_md;
+    let first = tubulars.iter().position(|t| {
+        let above = bottom <= 0.0;
+        bottom -= t.length;
+        above
+    })?;
+    let names: Vec<&str> = tubulars[first..].iter().map(|t| t.name.as_str()).collect();
+    Some(format!(
+        "[[string]] component{} {} ({}) lie{} above the surface: {} it \
+         from the bit at {} m, so the mesh leaves {} out (the list runs from the bit up)",
+        if names.len() > 1 { "s" } else { "" },
+        if names.len() > 1 {
+            format!("{}–{}", first + 1, tubulars.len())
+        } else {
+            (first + 1).to_string()
+        },
+        names.join(", "),
+        if names.len() > 1 { "" } else { "s" },
+        if first > 1 {
+            format!("the {first} components below already reach")
+        } else {
+            "the first component alone reaches".to_string()
+        },
+        crate::units::show(bit_md),
+        if names.len() > 1 { "them" } else { "it" },
+    ))
 }
 
 /// What `[operation]` sets on the model.
