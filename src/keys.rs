@@ -365,9 +365,19 @@ impl Key {
     }
 
     /// The key's unit dimension (for parsing a number written with a unit), its range in SI
-    /// and the range in words.
+    /// and the range in words ([`Param::range`]).
     fn range(&self) -> (Option<Dimension>, fn(f64) -> bool, &'static str) {
-        match self.param {
+        self.param.range()
+    }
+}
+
+impl Param {
+    /// The parameter's unit dimension, its range in SI (or of its codes) and the range in
+    /// words: the one range an ensemble's override and the case file's own key
+    /// (`operation.weight_on_bit`, `contact.exponent`, … : `crate::case`) are checked
+    /// against.
+    pub fn range(self) -> (Option<Dimension>, fn(f64) -> bool, &'static str) {
+        match self {
             Param::Mode => (
                 None,
                 |x| x.fract() == 0.0 && (0.0..Mode::ALL.len() as f64).contains(&x),

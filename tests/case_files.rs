@@ -442,6 +442,13 @@ fn plausible_but_wrong_inputs_are_refused_with_the_likely_intent() {
             "\"20 kN\" or \"20 klbf\"",
         ),
         (
+            "a WOB of 1e30 N (out of the ensemble's wob range too)",
+            GOOD.replace("weight_on_bit = \"20 klbf\"", "weight_on_bit = \"1e30 N\""),
+            "operation.weight_on_bit",
+            "weight_on_bit = \"1e30 N\"",
+            "0 … 1e7 N",
+        ),
+        (
             "a string listed from the top down (the bit second)",
             GOOD.replace(
                 "[[string]]\nkind = \"stabilizer\"",

@@ -1,6 +1,7 @@
 //! The readers of `[[hole]]`, `[[string]]`, `[operation]` and `[contact]`.
 
 use super::*;
+use crate::keys::Param;
 
 /// What `[[string]]` gives: the tubulars from the bit up, each stabilizer's blade
 /// diameter, each component's centre-of-mass offset, and the kinks of bent subs/housings
@@ -412,13 +413,8 @@ pub(super) fn read_operation(ctx: &Ctx, spec: &CaseSpec) -> Result<Operation, In
         .weight_on_bit
         .as_ref()
         .map(|q| {
-            ctx.quantity(
-                q,
-                "operation.weight_on_bit",
-                Dimension::Force,
-                |x| x >= 0.0,
-                "≥ 0",
-            )
+            let (_, ok, words) = Param::Wob.range();
+            ctx.quantity(q, "operation.weight_on_bit", Dimension::Force, ok, words)
         })
         .transpose()?
         .unwrap_or(0.0);
@@ -426,13 +422,8 @@ pub(super) fn read_operation(ctx: &Ctx, spec: &CaseSpec) -> Result<Operation, In
         .torque_on_bit
         .as_ref()
         .map(|q| {
-            ctx.quantity(
-                q,
-                "operation.torque_on_bit",
-                Dimension::Torque,
-                |x| x >= 0.0,
-                "≥ 0",
-            )
+            let (_, ok, words) = Param::Tob.range();
+            ctx.quantity(q, "operation.torque_on_bit", Dimension::Torque, ok, words)
         })
         .transpose()?
         .unwrap_or(0.0);
@@ -440,13 +431,8 @@ pub(super) fn read_operation(ctx: &Ctx, spec: &CaseSpec) -> Result<Operation, In
         .rpm
         .as_ref()
         .map(|q| {
-            ctx.quantity(
-                q,
-                "operation.rpm",
-                Dimension::AngularSpeed,
-                |x| (0.0..100.0).contains(&x),
-                "0 … 955 rpm",
-            )
+            let (_, ok, words) = Param::Rpm.range();
+            ctx.quantity(q, "operation.rpm", Dimension::AngularSpeed, ok, words)
         })
         .transpose()?
         .unwrap_or(0.0);
@@ -553,17 +539,22 @@ pub(super) fn read_contact(
             None => Ok(default),
         }
     };
+    // The ranges an ensemble's overrides of these keys are checked against too.
+    let (_, stiffness_ok, stiffness_words) = Param::WallStiffness.range();
+    let (_, exponent_ok, exponent_words) = Param::Exponent.range();
+    let (_, damping_ok, damping_words) = Param::WallDamping.range();
+    let (_, eps_ok, eps_words) = Param::Eps.range();
     let settings = ContactSettings {
         wall_stiffness: q_or(
             cs.as_ref().and_then(|c| c.wall_stiffness.clone()),
             "contact.wall_stiffness",
             Dimension::Stiffness,
             6e7,
-            &|x| x > 0.0 && x <= 1e12,
-            "0 < k_e ≤ 1e12 N/m",
+            &stiffness_ok,
+            stiffness_words,
         )?,
         spring_exponent: match cs.as_ref().and_then(|c| c.exponent.clone()) {
-            Some(q) => ctx.number(&q, "contact.exponent", |x| x > 0.0 && x <= 3.0, "0 < m ≤ 3")?,
+            Some(q) => ctx.number(&q, "contact.exponent", exponent_ok, exponent_words)?,
             None => 1.0,
         },
         wall_damping: q_or(
@@ -571,16 +562,16 @@ pub(super) fn read_contact(
             "contact.damping",
             Dimension::Damping,
             8e3,
-            &|x| x >= 0.0,
-            "≥ 0",
+            &damping_ok,
+            damping_words,
         )?,
         eps: q_or(
             cs.as_ref().and_then(|c| c.eps.clone()),
             "contact.eps",
             Dimension::Speed,
             1e-3,
-            &|x| x > 0.0,
-            "> 0",
+            &eps_ok,
+            eps_words,
         )?,
         soft_blend: q_or(
             cs.as_ref().and_then(|c| c.soft_blend.clone()),
@@ -649,12 +640,8 @@ pub(super) fn read_hole(
             |x| x > 0.0 && x < 2.0,
             "0 < diameter < 2 m",
         )?;
-        let mu = ctx.number(
-            &h.friction,
-            "hole.friction",
-            |x| (0.0..=2.0).contains(&x),
-            "0 ≤ friction ≤ 2",
-        )?;
+        let (_, mu_ok, mu_words) = Param::Mu.range();
+        let mu = ctx.number(&h.friction, "hole.friction", mu_ok, mu_words)?;
         hole.push(HoleSection {
             bottom_md: bottom,
             diameter: d,

@@ -12,9 +12,9 @@
 //! | `k_e` (`.stabK`) | wall stiffness | N/m^m | 0 < … ≤ 1e12 |
 //! | `c` (`.stabK`) | wall damping | N·s/m | ≥ 0 |
 //! | `m` (`.stabK`) | spring exponent | – | 0 < … ≤ 3 |
-//! | `eps` (`.stabK`) | friction regularisation speed | m/s | > 0 |
+//! | `eps` (`.stabK`) | friction regularisation speed | m/s | 0 < … ≤ 10 |
 //! | `rpm` | rotary speed | rad/s | 0 … 1000 rpm |
-//! | `wob`, `tob` | weight and torque on bit | N, N·m | ≥ 0 |
+//! | `wob`, `tob` | weight and torque on bit | N, N·m | 0 … 1e7 N, 0 … 1e6 N·m |
 //! | `stabK.blade` | blade diameter of stabilizer K | m | ≤ hole diameter |
 //! | `stabK.from_bit` | distance of stabilizer K's site from the bit | m | 0 < … < bit MD |
 //! | `depth` | bit depth (MD): the case rebuilt with `well.total_md` there (the string cut at the surface, the hole sections kept) | m | 0 < … ≤ 20 km, within the hole |
@@ -22,6 +22,9 @@
 //! | `ecc` | centre-of-mass offset of every BHA component (dynamics: a mass imbalance; replaces the case's) | m | 0 … 50 mm |
 //! | `bend` | angle of every bent sub / bent housing of the case (`[[string]].bend`) | degrees unless a unit is given | 0 … 5° |
 //! | `layout` | one of the case's `ensemble.layouts` (1, 2, …): its `stabK.from_bit` / `stabK.blade` values together | – | 1 … number of layouts |
+//!
+//! The case file's own keys for the same inputs (`operation.weight_on_bit`, `contact.eps`,
+//! `hole.friction`, …) take the same ranges ([`crate::keys::Param::range`]).
 //!
 //! Stabilizers are numbered from the bit up (`stab1` nearest the bit); a key without
 //! `.stabK` applies to every contact site.
