@@ -747,20 +747,7 @@ fn main() -> ExitCode {
                 },
             ) {
                 Ok(s) => {
-                    println!(
-                        "{} of {} wells solved ({} not run; {} of the solved lie outside the hole between contact sites); time per well median {:.2} s, worst {:.2} s (seed {:?}); at 10 m elements median {:.2} s, worst {:.2} s; engine {:?}; {}",
-                        s.solved,
-                        s.wells,
-                        s.not_run,
-                        s.solved_through_wall.len(),
-                        s.seconds.median,
-                        s.seconds.worst,
-                        s.seconds.worst_seed,
-                        s.seconds_10m.median,
-                        s.seconds_10m.worst,
-                        s.engine,
-                        out.join("summary.json").display()
-                    );
+                    println!("{}", s.line(&out));
                     ExitCode::SUCCESS
                 }
                 Err(e) => fail(&[e]),

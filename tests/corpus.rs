@@ -101,6 +101,49 @@ fn user_style_sample_solves_and_agrees_with_the_soft_string() {
     );
 }
 
+/// `holewall bench corpus` names the solved wells the surface pushes (FE hook load below
+/// zero: the equilibrium past a lock-up, docs/performance.md stop 81) in `summary.json` and
+/// its line, and lists the wells of about 10 m elements over 2 s with whether they are
+/// pushed. Drawn 2256 (tripped in, 20 m elements) is pushed with 9.7 kN; 2283 (drilling)
+/// hangs from the hook.
+#[test]
+fn the_corpus_summary_names_the_pushed_strings() {
+    let dir = common::scratch_dir("corpus", "pushed");
+    let out = dir.join("out");
+    let (code, stdout, stderr) = common::holewall(&[
+        "bench",
+        "corpus",
+        "--seeds",
+        "2256,2283",
+        "--quiet",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{stderr}");
+    assert!(
+        stdout.contains("2 of 2 wells solved") && stdout.contains("1 pushed from the surface"),
+        "{stdout}"
+    );
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    assert_eq!(
+        summary["solved_pushed"],
+        serde_json::json!([2256]),
+        "{summary}"
+    );
+    let rows = std::fs::read_to_string(out.join("corpus.csv")).unwrap();
+    let header: Vec<&str> = rows.lines().next().unwrap().split(',').collect();
+    let col = |k: &str| header.iter().position(|h| *h == k).unwrap();
+    for line in rows.lines().skip(1) {
+        let f: Vec<&str> = line.split(',').collect();
+        let hook: f64 = f[col("fe_hook_load_n")].parse().unwrap();
+        let seed: u64 = f[col("seed")].parse().unwrap();
+        assert_eq!(hook < 0.0, seed == 2256, "seed {seed}: hook load {hook} N");
+    }
+    // Neither well is meshed at about 10 m: none is listed against the 2 s.
+    assert_eq!(summary["over_2s_10m"], serde_json::json!([]), "{summary}");
+}
+
 /// Checks every solved well of `rows` against the soft string and every failure's words;
 /// returns the wells solved inside their hole.
 fn solved_and_agreeing(rows: &[(holewall::corpus::CorpusWell, WellResult)]) -> usize {

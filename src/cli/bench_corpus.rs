@@ -121,8 +121,17 @@ pub struct CorpusSummary {
     pub solved_through_wall: Vec<(u64, f64)>,
     /// Time per well (s), every well.
     pub seconds: Spread,
-    /// Time per well (s), wells meshed with 10 m pipe elements.
+    /// Solved wells whose FE hook load is below zero: the string pushed from the surface,
+    /// the equilibrium past a lock-up that [`crate::diagnose::locked_up_warning`] calls one
+    /// the string does not reach by being run in. At 10 m elements every solved well that
+    /// took over 1,200 Newton iterations on the unseen slices and the relaxed set of stop 81
+    /// is one (docs/performance.md).
+    pub solved_pushed: Vec<u64>,
+    /// Time per well (s), wells meshed with pipe elements of about 10 m (9–11 m: the user
+    /// style's 30 ft joints, 9.144 m, are of them).
     pub seconds_10m: Spread,
+    /// Those wells over issue 22's 2 s: (seed, seconds, pushed from the surface).
+    pub over_2s_10m: Vec<(u64, f64, bool)>,
     /// Newton iterations per solved well (its completed load steps).
     pub iterations: Spread,
     /// Every Newton iteration per well, failed tries, cut steps and relaxations included,
@@ -138,6 +147,43 @@ pub struct CorpusSummary {
     pub engine_hook_difference: BTreeMap<String, f64>,
     /// Total wall time (s).
     pub wall_seconds: f64,
+}
+
+/// A well meshed with pipe elements of about 10 m ([`CorpusSummary::seconds_10m`]).
+fn ten_m(r: &WellResult) -> bool {
+    (9.0..=11.0).contains(&r.spec.element_m)
+}
+
+/// A solved well whose string the surface pushes ([`CorpusSummary::solved_pushed`]).
+fn pushed(r: &WellResult) -> bool {
+    r.solved && r.fe_hook_load_n < 0.0
+}
+
+impl CorpusSummary {
+    /// The run in one line (what `holewall bench corpus` prints), `out` its folder.
+    pub fn line(&self, out: &Path) -> String {
+        let over = &self.over_2s_10m;
+        format!(
+            "{} of {} wells solved ({} not run; {} of the solved lie outside the hole between \
+             contact sites; {} pushed from the surface); time per well median {:.2} s, worst \
+             {:.2} s (seed {:?}); at 10 m elements median {:.2} s, worst {:.2} s, {} over 2 s \
+             ({} of them pushed); engine {:?}; {}",
+            self.solved,
+            self.wells,
+            self.not_run,
+            self.solved_through_wall.len(),
+            self.solved_pushed.len(),
+            self.seconds.median,
+            self.seconds.worst,
+            self.seconds.worst_seed,
+            self.seconds_10m.median,
+            self.seconds_10m.worst,
+            over.len(),
+            over.iter().filter(|o| o.2).count(),
+            self.engine,
+            out.join("summary.json").display()
+        )
+    }
 }
 
 fn min_med_max(mut v: Vec<f64>) -> (f64, f64, f64) {
@@ -306,13 +352,23 @@ pub fn run(out: &Path, options: &CorpusOptions) -> Result<CorpusSummary, Error> 
                 .map(|r| (r.spec.seed, r.seconds))
                 .collect::<Vec<_>>(),
         ),
+        solved_pushed: solved
+            .iter()
+            .filter(|r| pushed(r))
+            .map(|r| r.spec.seed)
+            .collect(),
         seconds_10m: spread(
             &results
                 .iter()
-                .filter(|r| r.spec.element_m == 10.0)
+                .filter(|r| ten_m(r))
                 .map(|r| (r.spec.seed, r.seconds))
                 .collect::<Vec<_>>(),
         ),
+        over_2s_10m: results
+            .iter()
+            .filter(|r| ten_m(r) && r.seconds > 2.0)
+            .map(|r| (r.spec.seed, r.seconds, pushed(r)))
+            .collect(),
         iterations: spread(
             &solved
                 .iter()
