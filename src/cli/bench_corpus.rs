@@ -124,7 +124,7 @@ pub struct CorpusSummary {
     /// Solved wells whose FE hook load is below zero: the string pushed from the surface,
     /// the equilibrium past a lock-up that [`crate::diagnose::locked_up_warning`] calls one
     /// the string does not reach by being run in. At 10 m elements every solved well that
-    /// took over 1,200 Newton iterations on the unseen slices and the relaxed set of stop 81
+    /// took over 1,500 Newton iterations on the unseen slices and the relaxed set of stop 81
     /// is one (docs/performance.md).
     pub solved_pushed: Vec<u64>,
     /// Time per well (s), wells meshed with pipe elements of about 10 m (9–11 m: the user
