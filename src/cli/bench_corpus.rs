@@ -166,7 +166,7 @@ impl CorpusSummary {
         format!(
             "{} of {} wells solved ({} not run; {} of the solved lie outside the hole between \
              contact sites; {} pushed from the surface); time per well median {:.2} s, worst \
-             {:.2} s (seed {:?}); at 10 m elements median {:.2} s, worst {:.2} s, {} over 2 s \
+             {:.2} s (seed {:?}); at about 10 m elements (9–11 m) median {:.2} s, worst {:.2} s, {} over 2 s \
              ({} of them pushed); engine {:?}; {}",
             self.solved,
             self.wells,
