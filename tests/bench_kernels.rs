@@ -30,8 +30,7 @@ fn the_roofline_bench_measures_every_kernel_under_its_ceilings() {
             "{stdout}"
         );
     }
-    let r: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(out.join("kernels.json")).unwrap()).unwrap();
+    let r: serde_json::Value = common::json(&out.join("kernels.json"));
     let c = &r["ceilings"];
     let fma32 = c["fma_gflops_f32"].as_f64().unwrap();
     let copy = c["copy_gbytes_per_s"].as_f64().unwrap();

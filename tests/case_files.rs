@@ -77,9 +77,7 @@ fn paper_cases_run_end_to_end_with_both_models() {
                 out.to_str().unwrap(),
             ]);
             assert_eq!(code, 0, "{case} {model}: {stderr}");
-            let summary: serde_json::Value =
-                serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap())
-                    .unwrap();
+            let summary: serde_json::Value = common::json(&out.join("summary.json"));
             assert_eq!(
                 serde_json::from_str::<serde_json::Value>(&stdout).unwrap(),
                 summary
@@ -897,8 +895,7 @@ fn a_turning_string_far_past_helical_buckling_solves_at_the_whirls_average_and_w
             && stderr.contains("cannot follow"),
         "{stderr}"
     );
-    let summary: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    let summary: serde_json::Value = common::json(&out.join("summary.json"));
     assert!(summary["stopped"].is_null(), "{summary}");
     assert_eq!(summary["weight_on_bit_n"].as_f64().unwrap(), 1e6);
     // Pushed from the surface: the hook load is negative.

@@ -124,8 +124,7 @@ fn the_corpus_summary_names_the_pushed_strings() {
         stdout.contains("2 of 2 wells solved") && stdout.contains("1 pushed from the surface"),
         "{stdout}"
     );
-    let summary: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    let summary: serde_json::Value = common::json(&out.join("summary.json"));
     assert_eq!(
         summary["solved_pushed"],
         serde_json::json!([2256]),
@@ -397,9 +396,7 @@ fn a_relaxed_answer_says_it_is_one_of_several() {
             .status()
             .unwrap();
         assert!(status.success(), "seed {seed}: holewall static failed");
-        let summary: serde_json::Value =
-            serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap())
-                .unwrap();
+        let summary: serde_json::Value = common::json(&out.join("summary.json"));
         let logged = summary["solver_log"].as_array().unwrap().iter().any(|l| {
             l.as_str()
                 .unwrap()

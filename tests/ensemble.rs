@@ -442,8 +442,7 @@ fn the_job_bench_times_a_users_job_on_every_path() {
     let (code, stdout, stderr) = run("4");
     assert_eq!(code, 0, "{stderr}");
     assert!(stdout.contains("| CPU f64 | 2 |"), "{stdout}");
-    let r: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(out.join("job.json")).unwrap()).unwrap();
+    let r: serde_json::Value = common::json(&out.join("job.json"));
     let paths = match common::gpu() {
         Some(ctx) if ctx.has_f64 => 3,
         Some(_) => 2,
@@ -505,8 +504,7 @@ fn the_job_bench_times_a_users_job_on_every_path() {
     let (code, stdout, stderr) = with_file(&[]);
     assert_eq!(code, 0, "{stderr}");
     assert!(stdout.contains("--variants"), "{stdout}");
-    let r: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(out.join("job.json")).unwrap()).unwrap();
+    let r: serde_json::Value = common::json(&out.join("job.json"));
     assert!(
         r["variants_file"].as_str().unwrap().ends_with("v.csv"),
         "{r}"

@@ -111,8 +111,7 @@ fn the_static_command_writes_the_string_where_it_stops_and_fails() {
     ]);
     assert_eq!(code, 1, "{stderr}");
     assert!(stderr.contains("the string where it stops"), "{stderr}");
-    let summary: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    let summary: serde_json::Value = common::json(&out.join("summary.json"));
     let stopped = &summary["stopped"];
     let lambda = stopped["load_factor"].as_f64().unwrap();
     assert!(lambda > 0.5 && lambda < 1.0, "{stopped}");

@@ -131,8 +131,7 @@ fn a_dogleg_typo_is_refused_and_a_sharp_build_warned() {
         stderr.contains("warning") && stderr.contains("°/30 m"),
         "{stderr}"
     );
-    let summary: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    let summary: serde_json::Value = common::json(&out.join("summary.json"));
     assert_eq!(
         summary["warnings"].as_array().map(|w| w.len()),
         Some(1),

@@ -462,8 +462,7 @@ fn the_tool_joint_broomstick_orders_its_modes() {
     ]);
     assert_eq!(code, 0, "{stderr}");
     // The measurements over the hook-load and torque broomsticks.
-    let summary: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    let summary: serde_json::Value = common::json(&out.join("summary.json"));
     for f in ["broomstick.png", "broomstick_torque.png"] {
         assert!(summary["outputs"]
             .as_array()
@@ -750,9 +749,7 @@ fn field_units_translate_every_output() {
         si["neutral_point_from_bit_m"].as_f64().unwrap()
     ));
     // summary.json on disk as printed.
-    let on_disk: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(dir.join("field/summary.json")).unwrap())
-            .unwrap();
+    let on_disk: serde_json::Value = common::json(&dir.join("field/summary.json"));
     assert_eq!(on_disk["hook_load_klbf"], field["hook_load_klbf"]);
     let read = |out: &str| {
         let text = std::fs::read_to_string(dir.join(out).join("profile.csv")).unwrap();
@@ -798,8 +795,7 @@ fn the_tool_joint_make_up_torque_is_checked_along_the_string() {
     let (code, _, stderr) =
         common::holewall(&["static", case, "--out", out.to_str().unwrap(), "--quiet"]);
     assert_eq!(code, 0, "{stderr}");
-    let summary: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    let summary: serde_json::Value = common::json(&out.join("summary.json"));
     let u = summary["strength"]["max_makeup_torque_utilisation"]
         .as_f64()
         .unwrap();

@@ -255,6 +255,12 @@ pub fn holewall(args: &[&str]) -> (i32, String, String) {
 }
 
 /// A fresh, empty scratch folder `holewall-<tag>-<pid>-<name>` under the temp dir.
+/// A JSON file a command wrote (`summary.json`, `job.json`, …), parsed.
+pub fn json(path: &std::path::Path) -> serde_json::Value {
+    let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    serde_json::from_str(&text).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+}
+
 pub fn scratch_dir(tag: &str, name: &str) -> std::path::PathBuf {
     let d = std::env::temp_dir().join(format!("holewall-{tag}-{}-{name}", std::process::id()));
     let _ = std::fs::remove_dir_all(&d);
