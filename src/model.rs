@@ -286,6 +286,21 @@ pub fn mesh_string(
     mesh_string_two_fluids(well, tubulars_from_bit, bit_md, mud_density, mud_density)
 }
 
+/// How many of `tubulars_from_bit` the string takes from the bit at `bit_md` up to the
+/// surface: the components listed above the one that reaches it lie above the surface and
+/// are left out of the mesh ([`mesh_string`]; the case reader warns of them).
+pub fn components_in_hole(tubulars_from_bit: &[Tubular], bit_md: f64) -> usize {
+    let mut bottom = bit_md;
+    tubulars_from_bit
+        .iter()
+        .take_while(|t| {
+            let below_surface = bottom > 0.0;
+            bottom -= t.length;
+            below_surface
+        })
+        .count()
+}
+
 /// [`mesh_string`] with one fluid in the annulus (`outside`, kg/m³) and another inside the
 /// string (`inside`): the buoyed weight per length from the two columns,
 /// `g (ρ_s A_s + ρ_i A_i − ρ_o A_o)` (`A_i`, `A_o` the bore's and the outer diameter's areas;
@@ -301,13 +316,11 @@ pub fn mesh_string_two_fluids(
     // MD breakpoints from the top down.
     let mut pieces: Vec<(usize, f64, f64)> = Vec::new(); // (component, top md, bottom md)
     let mut bottom = bit_md;
-    for (k, t) in tubulars_from_bit.iter().enumerate() {
+    let in_hole = components_in_hole(tubulars_from_bit, bit_md);
+    for (k, t) in tubulars_from_bit[..in_hole].iter().enumerate() {
         let top = (bottom - t.length).max(0.0);
         pieces.push((k, top, bottom));
         bottom = top;
-        if top <= 0.0 {
-            break;
-        }
     }
     pieces.reverse();
     let mut mds = vec![pieces.first().map(|p| p.1).unwrap_or(0.0)];

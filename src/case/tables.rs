@@ -364,16 +364,14 @@ pub(super) fn read_string(
 }
 
 /// The warning for components listed above the one that reaches the surface (from the
-/// bit at `bit_md`): the mesh leaves them out ([`crate::model::mesh_string`]), which is
-/// what a string list written for a deeper well means, and what a list written from the
+/// bit at `bit_md`): the mesh leaves them out ([`crate::model::components_in_hole`]), which
+/// is what a string list written for a deeper well means, and what a list written from the
 /// top down would silently do to its BHA.
 fn above_surface(tubulars: &[Tubular], bit_md: f64) -> Option<String> {
-    let mut bottom = bit_md;
-    let first = tubulars.iter().position(|t| {
-        let above = bottom <= 0.0;
-        bottom -= t.length;
-        above
-    })?;
+    let first = crate::model::components_in_hole(tubulars, bit_md);
+    if first == tubulars.len() {
+        return None;
+    }
     let names: Vec<&str> = tubulars[first..].iter().map(|t| t.name.as_str()).collect();
     Some(format!(
         "[[string]] component{} {} ({}) lie{} above the surface: {} it \
