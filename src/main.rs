@@ -309,9 +309,19 @@ fn summary_text<T: serde::Serialize>(summary: &T) -> String {
 }
 
 fn print_summary<T: serde::Serialize>(result: Result<T, holewall::Error>) -> ExitCode {
+    print_line(result.map(|s| summary_text(&s)))
+}
+
+/// A command's exit code: success, or its error reported.
+fn done<T>(result: Result<T, holewall::Error>) -> ExitCode {
+    result.map_or_else(|e| fail(&[e]), |_| ExitCode::SUCCESS)
+}
+
+/// A command's one line on stdout, or its error.
+fn print_line(result: Result<String, holewall::Error>) -> ExitCode {
     match result {
-        Ok(summary) => {
-            println!("{}", summary_text(&summary));
+        Ok(line) => {
+            println!("{line}");
             ExitCode::SUCCESS
         }
         Err(e) => fail(&[e]),
@@ -573,28 +583,28 @@ fn main() -> ExitCode {
             &out,
             quiet,
         ),
-        Command::GpuInfo { pairs } => match cli::gpu_info::run(pairs) {
-            Ok(()) => ExitCode::SUCCESS,
-            Err(e) => fail(&[e]),
-        },
+        Command::GpuInfo { pairs } => done(cli::gpu_info::run(pairs)),
         Command::Bench { what } => match what {
             BenchCommand::Specialisation {
                 pairs,
                 repeats,
                 json,
-            } => match cli::bench_specialisation::specialisation(pairs, repeats, json.as_deref()) {
-                Ok(()) => ExitCode::SUCCESS,
-                Err(e) => fail(&[e]),
-            },
+            } => done(cli::bench_specialisation::specialisation(
+                pairs,
+                repeats,
+                json.as_deref(),
+            )),
             BenchCommand::Contact {
                 pairs,
                 repeats,
                 backend,
                 json,
-            } => match cli::bench::contact(pairs, repeats, backend, json.as_deref()) {
-                Ok(()) => ExitCode::SUCCESS,
-                Err(e) => fail(&[e]),
-            },
+            } => done(cli::bench::contact(
+                pairs,
+                repeats,
+                backend,
+                json.as_deref(),
+            )),
             BenchCommand::Ensemble {
                 nodes,
                 variants,
@@ -618,10 +628,7 @@ fn main() -> ExitCode {
                     precision_nodes,
                     json.as_deref(),
                 );
-                match r {
-                    Ok(()) => ExitCode::SUCCESS,
-                    Err(e) => fail(&[e]),
-                }
+                done(r)
             }
             BenchCommand::Statics {
                 case,
@@ -632,37 +639,35 @@ fn main() -> ExitCode {
                 json,
             } => {
                 cli::bench_cmd::apply_forms(lu_form, trial_round);
-                match cli::bench::statics(&case, variants.as_deref(), repeats, json.as_deref()) {
-                    Ok(()) => ExitCode::SUCCESS,
-                    Err(e) => fail(&[e]),
-                }
+                done(cli::bench::statics(
+                    &case,
+                    variants.as_deref(),
+                    repeats,
+                    json.as_deref(),
+                ))
             }
             BenchCommand::Device {
                 out,
                 cases,
                 quick,
                 quiet,
-            } => match cli::bench_device::run(
+            } => done(cli::bench_device::run(
                 &out,
                 &cases,
                 cli::bench_device::DeviceOptions {
                     quick,
                     show_progress: !quiet,
                 },
-            ) {
-                Ok(()) => ExitCode::SUCCESS,
-                Err(e) => fail(&[e]),
-            },
+            )),
             BenchCommand::Kernels {
                 variants,
                 nodes,
                 repeats,
                 out,
                 quiet,
-            } => match cli::bench_kernels::run(&variants, nodes, repeats, &out, !quiet) {
-                Ok(_) => ExitCode::SUCCESS,
-                Err(e) => fail(&[e]),
-            },
+            } => done(cli::bench_kernels::run(
+                &variants, nodes, repeats, &out, !quiet,
+            )),
             BenchCommand::Job {
                 case,
                 samples,
@@ -671,29 +676,23 @@ fn main() -> ExitCode {
                 repeats,
                 out,
                 quiet,
-            } => match cli::bench_job::run(
-                &case,
-                variants.as_deref(),
-                samples,
-                seed,
-                repeats,
-                &out,
-                !quiet,
-            ) {
-                Ok(b) => {
-                    print!("{}", cli::bench_job::markdown(&b));
-                    ExitCode::SUCCESS
-                }
-                Err(e) => fail(&[e]),
-            },
+            } => done(
+                cli::bench_job::run(
+                    &case,
+                    variants.as_deref(),
+                    samples,
+                    seed,
+                    repeats,
+                    &out,
+                    !quiet,
+                )
+                .map(|b| print!("{}", cli::bench_job::markdown(&b))),
+            ),
             BenchCommand::Element {
                 states,
                 repeats,
                 json,
-            } => match cli::bench::element(states, repeats, json.as_deref()) {
-                Ok(()) => ExitCode::SUCCESS,
-                Err(e) => fail(&[e]),
-            },
+            } => done(cli::bench::element(states, repeats, json.as_deref())),
             BenchCommand::CalibrateCorpus {
                 wells,
                 first_seed,
@@ -719,6 +718,26 @@ fn main() -> ExitCode {
                     show_progress: !quiet,
                 },
             )),
+            BenchCommand::CriticalCorpus {
+                wells,
+                first_seed,
+                seeds,
+                style,
+                dense_max_dofs,
+                out,
+                quiet,
+            } => print_line(
+                cli::bench_critical::run(
+                    &out,
+                    &cli::bench_critical::CriticalCorpusOptions {
+                        seeds: cli::bench_corpus::corpus_seeds(wells, first_seed, seeds),
+                        style,
+                        dense_max_dofs,
+                        show_progress: !quiet,
+                    },
+                )
+                .map(|s| s.line(&out)),
+            ),
             BenchCommand::TendencyCorpus {
                 wells,
                 first_seed,
@@ -735,38 +754,29 @@ fn main() -> ExitCode {
                 out,
                 quiet,
                 style,
-            } => match cli::bench_corpus::run(
-                &out,
-                &cli::bench_corpus::CorpusOptions {
-                    seeds: cli::bench_corpus::corpus_seeds(wells, first_seed, seeds),
-                    engine_sample,
-                    engine_max_nodes,
-                    max_seconds,
-                    show_progress: !quiet,
-                    style,
-                },
-            ) {
-                Ok(s) => {
-                    println!("{}", s.line(&out));
-                    ExitCode::SUCCESS
-                }
-                Err(e) => fail(&[e]),
-            },
+            } => print_line(
+                cli::bench_corpus::run(
+                    &out,
+                    &cli::bench_corpus::CorpusOptions {
+                        seeds: cli::bench_corpus::corpus_seeds(wells, first_seed, seeds),
+                        engine_sample,
+                        engine_max_nodes,
+                        max_seconds,
+                        show_progress: !quiet,
+                        style,
+                    },
+                )
+                .map(|s| s.line(&out)),
+            ),
             BenchCommand::Mesh { seeds, out, quiet } => {
-                match cli::bench_corpus::mesh(&out, seeds, !quiet) {
-                    Ok(_) => ExitCode::SUCCESS,
-                    Err(e) => fail(&[e]),
-                }
+                done(cli::bench_corpus::mesh(&out, seeds, !quiet))
             }
             BenchCommand::Dynamics {
                 case,
                 steps,
                 repeats,
                 json,
-            } => match cli::bench::dynamics(&case, steps, repeats, json.as_deref()) {
-                Ok(()) => ExitCode::SUCCESS,
-                Err(e) => fail(&[e]),
-            },
+            } => done(cli::bench::dynamics(&case, steps, repeats, json.as_deref())),
         },
     }
 }

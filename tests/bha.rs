@@ -409,6 +409,7 @@ fn critical_speed_of_a_pinned_collar_span_is_euler_bernoulli_with_axial_load() {
             modes: 2,
             mud_density: 0.0,
             mud_inside_density: 0.0,
+            dense: false,
         };
         let cs = critical_speeds(&m, &sol.state, 0, &|_| rho, &options);
         let k = std::f64::consts::PI / l;
@@ -459,6 +460,7 @@ fn an_imbalance_swept_through_a_predicted_critical_speed_peaks_there() {
         modes: 6,
         mud_density: 0.0,
         mud_inside_density: 0.0,
+        dense: false,
     };
     let cs = critical_speeds(m0, &st.state, first, &|i| case.element_density[i], &options);
     let mode = cs
@@ -755,4 +757,43 @@ fn a_rotating_bend_drills_where_its_mean_direction_follows_the_hole() {
     // A single toolface's loads round the revolution are far from their mean: the check
     // above is not one toolface's.
     assert!(largest > 100.0 * f.abs());
+}
+
+/// `holewall bench critical-corpus` on a sample of unseen corpus wells: every well's static
+/// solve and all six lateral modes; the Krylov solve on the BHAs of up to 11,592 DOFs, within
+/// 1e-6 of the dense solve's frequencies where that runs (up to 1,000 DOFs here).
+#[test]
+fn critical_speeds_of_corpus_bhas_match_the_dense_solve() {
+    let out = common::scratch_dir("bha", "critical-corpus").join("cc");
+    let (code, stdout, stderr) = common::holewall(&[
+        "bench",
+        "critical-corpus",
+        "--seeds",
+        "2401,2414,2415,2428,2429",
+        "--dense-max-dofs",
+        "1000",
+        "--quiet",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{stdout}\n{stderr}");
+    println!("{stdout}");
+    let s = common::json(&out.join("summary.json"));
+    assert_eq!(s["wells"], 5);
+    assert_eq!(s["analysed"], 5);
+    assert_eq!(s["all_modes_found"], 5);
+    assert_eq!(s["krylov"], 4);
+    assert_eq!(s["compared"], 4);
+    assert!(s["mismatched"].as_array().unwrap().is_empty(), "{s}");
+    assert!(
+        s["dense_difference"]["worst"].as_f64().unwrap() < 1e-6,
+        "{s}"
+    );
+    let rows = std::fs::read_to_string(out.join("critical_corpus.csv")).unwrap();
+    let big = rows.lines().find(|l| l.starts_with("2429,")).unwrap();
+    assert!(
+        big.contains("shift-invert block Lanczos") && big.contains(",11592,"),
+        "{big}"
+    );
+    assert!(out.join("critical_corpus_time.png").exists());
 }

@@ -22,7 +22,7 @@ use serde::Serialize;
 use crate::bha::HoleFrame;
 use crate::model::Model;
 use crate::physics::mass::MassKind;
-use crate::solve::modal::{mass_matrix_with_added, modes};
+use crate::solve::modal::{lowest_modes, mass_matrix_with_added, Mode};
 use crate::solve::statics::StaticState;
 
 /// Options of the critical-speed analysis.
@@ -39,6 +39,46 @@ pub struct CriticalOptions {
     pub mud_density: f64,
     /// Density of the fluid inside the string (kg/m³) for the added mass.
     pub mud_inside_density: f64,
+    /// Solve the eigenproblem densely whatever its size (the oracle of
+    /// [`crate::solve::modal::lowest_modes`]'s Krylov solve).
+    pub dense: bool,
+}
+
+impl CriticalOptions {
+    /// The options for `case`: its mud's added mass where `added_mass` (else none, as the
+    /// dynamics), the other fields as given.
+    pub fn for_case(
+        case: &crate::case::Case,
+        max_rpm: f64,
+        blades: usize,
+        modes: usize,
+        added_mass: bool,
+        dense: bool,
+    ) -> Self {
+        let rho = |d: f64| if added_mass { d } else { 0.0 };
+        CriticalOptions {
+            max_rpm,
+            blades,
+            modes,
+            mud_density: rho(case.mud_density),
+            mud_inside_density: rho(case.mud_inside_density),
+            dense,
+        }
+    }
+}
+
+/// The critical speeds of `case`'s BHA (the part from
+/// [`crate::bha::tendency::bha_model_top`] to the bit) about its static `state`: the one call
+/// of `holewall critical-speeds` and `holewall bench critical-corpus`.
+pub fn critical_speeds_of_case(
+    case: &crate::case::Case,
+    state: &StaticState,
+    options: &CriticalOptions,
+) -> CriticalSpeeds {
+    let model = &case.model;
+    let first =
+        crate::bha::tendency::bha_model_top(model, case.bha_length, &case.tendency.settings);
+    critical_speeds(model, state, first, &|i| case.element_density[i], options)
 }
 
 /// One lateral mode.
@@ -79,6 +119,36 @@ pub struct CriticalSpeeds {
     pub part_md: (f64, f64),
     /// Degrees of freedom of the eigenproblem.
     pub dofs: usize,
+    /// How the modes were found: `dense` or `shift-invert block Lanczos`
+    /// ([`crate::solve::modal::lowest_modes`]).
+    pub eigen_method: String,
+    /// The Krylov basis (the free DOFs where dense).
+    pub eigen_basis: usize,
+    /// The largest relative residual `‖K φ − ω² M φ‖ / (‖K φ‖ + ω² ‖M φ‖)` of the modes
+    /// found (0 where dense).
+    pub eigen_worst_residual: f64,
+}
+
+/// A mode's share of its translations across the hole axis and its lateral shape (per node
+/// of the part: MD, lateral displacement across the axis).
+fn lateral_share(part: &Model, frames: &[HoleFrame], m: &Mode) -> (f64, Vec<(f64, f64)>) {
+    let (mut across, mut total) = (0.0, 0.0);
+    let mut shape = Vec::with_capacity(frames.len());
+    for (i, f) in frames.iter().enumerate() {
+        let u = [m.shape[6 * i], m.shape[6 * i + 1], m.shape[6 * i + 2]];
+        let (h, r) = f.across(&u);
+        across += h * h + r * r;
+        total += u.iter().map(|x| x * x).sum::<f64>();
+        shape.push((part.nodes[i].md, h.hypot(r)));
+    }
+    let share = if total > 0.0 { across / total } else { 0.0 };
+    (share, shape)
+}
+
+/// A mode is lateral: more than 80 % of its translations' squares across the hole axis,
+/// and a positive frequency.
+fn is_lateral(share: f64, m: &Mode) -> bool {
+    share > 0.8 && m.frequency_hz > 0.0
 }
 
 /// The part of `model` from node `first` to the bit ([`Model::lower_part`]) and its
@@ -113,22 +183,21 @@ pub fn critical_speeds(
         &|i| density_of(i + first),
         &added,
     );
-    let all = modes(&part, &st, &mass);
     let n = part.nodes.len();
     let frames: Vec<HoleFrame> = (0..n).map(|i| HoleFrame::at_node(&part, i)).collect();
+    // The lowest modes, until they hold the lateral modes asked for.
+    let enough = |found: &[Mode]| {
+        found
+            .iter()
+            .filter(|m| is_lateral(lateral_share(&part, &frames, m).0, m))
+            .count()
+            >= options.modes
+    };
+    let all = lowest_modes(&part, &st, &mass, &enough, options.dense);
     let mut lateral = Vec::new();
-    for m in &all {
-        let (mut across, mut total) = (0.0, 0.0);
-        let mut shape = Vec::with_capacity(n);
-        for (i, f) in frames.iter().enumerate() {
-            let u = [m.shape[6 * i], m.shape[6 * i + 1], m.shape[6 * i + 2]];
-            let (h, r) = f.across(&u);
-            across += h * h + r * r;
-            total += u.iter().map(|x| x * x).sum::<f64>();
-            shape.push((part.nodes[i].md, h.hypot(r)));
-        }
-        let share = if total > 0.0 { across / total } else { 0.0 };
-        if share > 0.8 && m.frequency_hz > 0.0 {
+    for m in &all.modes {
+        let (share, mut shape) = lateral_share(&part, &frames, m);
+        if is_lateral(share, m) {
             let peak = shape.iter().map(|s| s.1).fold(0.0f64, f64::max).max(1e-300);
             for s in &mut shape {
                 s.1 /= peak;
@@ -178,5 +247,8 @@ pub fn critical_speeds(
         critical,
         part_md: (part.nodes[0].md, part.nodes[n - 1].md),
         dofs: 6 * n,
+        eigen_method: all.method.to_string(),
+        eigen_basis: all.basis,
+        eigen_worst_residual: all.worst_residual,
     }
 }

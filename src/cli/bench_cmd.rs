@@ -263,6 +263,32 @@ pub enum BenchCommand {
         #[arg(long)]
         quiet: bool,
     },
+    /// Critical speeds on corpus wells: time per well against the eigenproblem's size,
+    /// lateral modes found, frequencies against the dense eigensolve where it is small
+    /// enough (critical_corpus.csv, summary.json, critical_corpus_time.png).
+    CriticalCorpus {
+        /// Wells (seeds first-seed, first-seed + 1, …).
+        #[arg(long, default_value_t = 100)]
+        wells: usize,
+        /// First seed.
+        #[arg(long, default_value_t = 0)]
+        first_seed: u64,
+        /// These seeds instead of --wells from --first-seed (comma-separated).
+        #[arg(long, value_delimiter = ',')]
+        seeds: Vec<u64>,
+        /// How the wells are drawn.
+        #[arg(long, value_enum, default_value_t)]
+        style: crate::corpus::CorpusStyle,
+        /// The dense oracle runs where the BHA part has at most this many DOFs.
+        #[arg(long, default_value_t = 2000)]
+        dense_max_dofs: usize,
+        /// Output folder.
+        #[arg(long)]
+        out: PathBuf,
+        /// No progress bar.
+        #[arg(long)]
+        quiet: bool,
+    },
     /// The BHA tendency (build/turn rates, equilibrium curvature) of corpus wells at their
     /// own WOB: settled / total with the unsettled and why (tendency_corpus.csv).
     TendencyCorpus {

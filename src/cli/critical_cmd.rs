@@ -6,7 +6,7 @@ use std::path::Path;
 
 use serde::Serialize;
 
-use crate::bha::critical::{critical_speeds, CriticalOptions, CriticalSpeed};
+use crate::bha::critical::{critical_speeds_of_case, CriticalOptions, CriticalSpeed};
 use crate::case::load_case;
 use crate::error::Error;
 use crate::output::RunFolder;
@@ -24,6 +24,10 @@ pub struct CriticalSummary {
     pub part_md: (f64, f64),
     /// Options.
     pub options: CriticalOptions,
+    /// How the eigenproblem was solved: `dense` or `shift-invert block Lanczos`
+    /// ([`crate::solve::modal::lowest_modes`]), as (method, DOFs of the part,
+    /// Krylov basis, largest relative residual of the modes).
+    pub eigen: (String, usize, usize, f64),
     /// Files written.
     pub outputs: Vec<String>,
     /// Wall time (s).
@@ -59,30 +63,15 @@ pub fn run(
     let sol = crate::profile::solve_with_progress(&mut case, statics, options.show_progress)?;
     let case = case;
     let model = &case.model;
-    let first =
-        crate::bha::tendency::bha_model_top(model, case.bha_length, &case.tendency.settings);
-    let opts = CriticalOptions {
-        max_rpm: options.max_rpm,
-        blades: options.blades,
-        modes: options.modes,
-        mud_density: if options.added_mass {
-            case.mud_density
-        } else {
-            0.0
-        },
-        mud_inside_density: if options.added_mass {
-            case.mud_inside_density
-        } else {
-            0.0
-        },
-    };
-    let cs = critical_speeds(
-        model,
-        &sol.state,
-        first,
-        &|i| case.element_density[i],
-        &opts,
+    let opts = CriticalOptions::for_case(
+        &case,
+        options.max_rpm,
+        options.blades,
+        options.modes,
+        options.added_mass,
+        false,
     );
+    let cs = critical_speeds_of_case(&case, &sol.state, &opts);
     let dir = folder.path();
     let io = Error::from;
     let mut w = csv::Writer::from_writer(Vec::new());
@@ -120,6 +109,12 @@ pub fn run(
         critical: cs.critical.clone(),
         part_md: cs.part_md,
         options: opts,
+        eigen: (
+            cs.eigen_method.clone(),
+            cs.dofs,
+            cs.eigen_basis,
+            cs.eigen_worst_residual,
+        ),
         outputs: [
             "modes.csv",
             "critical_speeds.csv",

@@ -4,6 +4,7 @@ pub mod bench;
 pub mod bench_calibrate;
 pub mod bench_cmd;
 pub mod bench_corpus;
+pub mod bench_critical;
 pub mod bench_device;
 pub mod bench_dynamic_corpus;
 pub mod bench_ensemble;

@@ -100,3 +100,6 @@ pub fn participation(mode: &Mode, k: usize) -> f64 {
         0.0
     }
 }
+
+mod krylov;
+pub use krylov::{krylov_modes, lowest_modes, LowestModes, DENSE_MAX_DOFS};
