@@ -25,9 +25,11 @@ use crate::model::Model;
 use crate::solve::chain::BlockTridiagonal;
 use crate::solve::statics::{constrain, constrained_tangent, constraints, StaticState};
 
-/// Free DOFs up to which [`lowest_modes`] solves densely ([`super::modes`]): below this
-/// the dense solve takes well under a second and is exact.
-pub const DENSE_MAX_DOFS: usize = 600;
+/// Free DOFs up to which [`lowest_modes`] solves densely ([`super::modes`]). On the
+/// corpus (`holewall bench critical-corpus`, docs/validation.md) the dense solve of 352–556
+/// free DOFs took 0.07–0.30 s where the Krylov solve of 636 took 0.006 s; below 300 it
+/// takes a few hundredths and a Krylov basis would be a large share of the space.
+pub const DENSE_MAX_DOFS: usize = 300;
 /// Vectors per Krylov block.
 const BLOCK: usize = 3;
 /// The basis before its first Rayleigh–Ritz (then doubled).
