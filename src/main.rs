@@ -6,6 +6,7 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 use holewall::backend::{Backend, BackendChoice, Precision};
+use holewall::bha::critical;
 use holewall::cli;
 use holewall::cli::bench_cmd::{positive_seconds, BenchCommand};
 
@@ -103,13 +104,13 @@ enum Command {
         #[arg(long)]
         out: PathBuf,
         /// Highest rotary speed of the map (rpm).
-        #[arg(long, default_value_t = 300.0)]
+        #[arg(long, default_value_t = critical::DEFAULT_MAX_RPM)]
         max_rpm: f64,
         /// Blades of the stabilizers and bit (blade-pass excitation).
-        #[arg(long, default_value_t = 3)]
+        #[arg(long, default_value_t = critical::DEFAULT_BLADES)]
         blades: usize,
         /// Lateral modes reported.
-        #[arg(long, default_value_t = 6)]
+        #[arg(long, default_value_t = critical::DEFAULT_MODES)]
         modes: usize,
         /// Leave the mud's added mass out of the modes (as the dynamics does).
         #[arg(long)]

@@ -25,6 +25,14 @@ use crate::physics::mass::MassKind;
 use crate::solve::modal::{lowest_modes, mass_matrix_with_added, Mode};
 use crate::solve::statics::StaticState;
 
+/// The highest rotary speed of the map by default (rpm): `holewall critical-speeds` and
+/// `holewall bench critical-corpus`.
+pub const DEFAULT_MAX_RPM: f64 = 300.0;
+/// Blades of the stabilizers and bit by default (blade pass).
+pub const DEFAULT_BLADES: usize = 3;
+/// Lateral modes reported by default.
+pub const DEFAULT_MODES: usize = 6;
+
 /// Options of the critical-speed analysis.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct CriticalOptions {

@@ -10,12 +10,12 @@ use std::path::Path;
 use serde::Serialize;
 
 use super::bench_corpus::{spread, Spread};
-use crate::bha::critical::{critical_speeds_of_case, CriticalOptions, CriticalSpeeds};
+use crate::bha::critical::{
+    critical_speeds_of_case, CriticalOptions, CriticalSpeeds, DEFAULT_BLADES, DEFAULT_MAX_RPM,
+    DEFAULT_MODES as MODES,
+};
 use crate::corpus::{write_corpus_well, CorpusStyle};
 use crate::error::Error;
-
-/// Lateral modes asked for on each well (the command's default).
-const MODES: usize = 6;
 
 /// Options of the benchmark.
 #[derive(Clone, Debug)]
@@ -170,7 +170,8 @@ fn well_row(seed: u64, options: &CriticalCorpusOptions, dir: &Path) -> Result<Cr
             return Ok(row);
         }
     };
-    let opts = CriticalOptions::for_case(&case, 300.0, 3, MODES, true, false);
+    let opts =
+        CriticalOptions::for_case(&case, DEFAULT_MAX_RPM, DEFAULT_BLADES, MODES, true, false);
     let (cs, seconds) = timed(|| critical_speeds_of_case(&case, &sol.state, &opts));
     row.static_solved = true;
     row.part_dofs = cs.dofs;

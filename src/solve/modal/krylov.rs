@@ -157,12 +157,11 @@ pub fn krylov_modes(
     let mat = SparseColMat::<usize, f64>::try_new_from_triplets(n, n, &a.triplets()).ok()?;
     let symbolic = SymbolicLu::try_new(mat.symbolic()).ok()?;
     let lu = Lu::try_new_with_symbolic(symbolic, mat.as_ref()).ok()?;
-    // `A⁻¹ M x` for each of a block of vectors, the fixed DOFs zero.
-    let apply = |xs: &[Vec<f64>]| -> Vec<Vec<f64>> {
-        let mx: Vec<Vec<f64>> = xs.iter().map(|x| m.mul(x)).collect();
-        let rhs = faer::Mat::<f64>::from_fn(n, xs.len(), |r, j| mx[j][r]);
-        let sol = lu.solve(&rhs);
-        (0..xs.len())
+    // `A⁻¹ b` for each right-hand side `b` of a block, the fixed DOFs zero.
+    let solve = |rhs: &[&[f64]]| -> Vec<Vec<f64>> {
+        let b = faer::Mat::<f64>::from_fn(n, rhs.len(), |r, j| rhs[j][r]);
+        let sol = lu.solve(&b);
+        (0..rhs.len())
             .map(|j| {
                 (0..n)
                     .map(|r| if free[r] { sol[(r, j)] } else { 0.0 })
@@ -170,42 +169,11 @@ pub fn krylov_modes(
             })
             .collect()
     };
-
-    let mut rng = StdRng::seed_from_u64(0x6d6f646573);
-    let mut basis: Vec<Vec<f64>> = Vec::new();
-    let mut m_basis: Vec<Vec<f64>> = Vec::new();
-    let mut k_basis: Vec<Vec<f64>> = Vec::new();
-    // M-orthonormalises `w` against the basis (twice) and appends it; false where it lies
-    // in the basis already.
-    let append = |w: Vec<f64>,
-                  basis: &mut Vec<Vec<f64>>,
-                  m_basis: &mut Vec<Vec<f64>>,
-                  k_basis: &mut Vec<Vec<f64>>|
-     -> bool {
-        let mut w = w;
-        let before = dot(&w, &m.mul(&w)).sqrt();
-        for _ in 0..2 {
-            for (v, mv) in basis.iter().zip(m_basis.iter()) {
-                let h = dot(&w, mv);
-                for (x, y) in w.iter_mut().zip(v) {
-                    *x -= h * y;
-                }
-            }
-        }
-        let mw = m.mul(&w);
-        let norm = dot(&w, &mw).sqrt();
-        if norm.is_nan() || norm <= 1e-10 * before || !norm.is_finite() {
-            return false;
-        }
-        basis.push(w.iter().map(|x| x / norm).collect());
-        m_basis.push(mw.iter().map(|x| x / norm).collect());
-        k_basis.push(k.mul(basis.last().expect("just pushed")));
-        true
-    };
+    // `M x` for a block of random vectors on the free DOFs.
     let random_block = |rng: &mut StdRng| -> Vec<Vec<f64>> {
         (0..BLOCK)
             .map(|_| {
-                (0..n)
+                let x: Vec<f64> = (0..n)
                     .map(|r| {
                         if free[r] {
                             rng.random_range(-1.0..1.0)
@@ -213,37 +181,42 @@ pub fn krylov_modes(
                             0.0
                         }
                     })
-                    .collect()
+                    .collect();
+                m.mul(&x)
             })
             .collect()
     };
+    let mut rng = StdRng::seed_from_u64(0x6d6f646573);
+    let mut basis = Basis::default();
     // The first block: random vectors through the operator once (into its range).
-    let mut last: Vec<Vec<f64>> = Vec::new();
-    for w in apply(&random_block(&mut rng)) {
-        let len = basis.len();
-        if append(w, &mut basis, &mut m_basis, &mut k_basis) {
-            last.push(basis[len].clone());
-        }
-    }
+    let first = random_block(&mut rng);
+    let mut last = basis.extend(
+        solve(&first.iter().map(|b| b.as_slice()).collect::<Vec<_>>()),
+        &m,
+        &k,
+    );
     let mut target = FIRST_BASIS.min(nf);
     loop {
-        while basis.len() < target {
-            if last.is_empty() {
+        while basis.v.len() < target {
+            let next = if last.is_empty() {
                 // The Krylov space is invariant: go on from fresh random vectors.
-                last = random_block(&mut rng);
-            }
-            let next = apply(&last);
-            last.clear();
-            for w in next {
-                let len = basis.len();
-                if append(w, &mut basis, &mut m_basis, &mut k_basis) {
-                    last.push(basis[len].clone());
-                }
-            }
+                let fresh = random_block(&mut rng);
+                solve(&fresh.iter().map(|b| b.as_slice()).collect::<Vec<_>>())
+            } else {
+                // `A⁻¹ M v` of the last block, its `M v` kept with it.
+                solve(
+                    &last
+                        .clone()
+                        .map(|i| basis.mv[i].as_slice())
+                        .collect::<Vec<_>>(),
+                )
+            };
+            last = basis.extend(next, &m, &k);
         }
-        let dim = basis.len();
+        let Basis { v, mv, kv } = &basis;
+        let dim = v.len();
         let h = DMatrix::from_fn(dim, dim, |i, j| {
-            0.5 * (dot(&basis[i], &k_basis[j]) + dot(&basis[j], &k_basis[i]))
+            0.5 * (dot(&v[i], &kv[j]) + dot(&v[j], &kv[i]))
         });
         let eig = nalgebra::linalg::SymmetricEigen::new(h);
         let mut order: Vec<usize> = (0..dim).collect();
@@ -263,9 +236,9 @@ pub fn krylov_modes(
             let mut mphi = vec![0.0; n];
             for (i, &yi) in y.iter().enumerate() {
                 for r in 0..n {
-                    phi[r] += yi * basis[i][r];
-                    kphi[r] += yi * k_basis[i][r];
-                    mphi[r] += yi * m_basis[i][r];
+                    phi[r] += yi * v[i][r];
+                    kphi[r] += yi * kv[i][r];
+                    mphi[r] += yi * mv[i][r];
                 }
             }
             let res: f64 = kphi
@@ -299,5 +272,47 @@ pub fn krylov_modes(
             return None;
         }
         target = (2 * dim).min(nf);
+    }
+}
+
+/// An M-orthonormal Krylov basis with `M v` and `K v` of each vector.
+#[derive(Default)]
+struct Basis {
+    v: Vec<Vec<f64>>,
+    mv: Vec<Vec<f64>>,
+    kv: Vec<Vec<f64>>,
+}
+
+impl Basis {
+    /// M-orthonormalises each of `block` against the basis (twice) and appends it, where it
+    /// does not lie in the basis already; returns the indices of those appended.
+    fn extend(
+        &mut self,
+        block: Vec<Vec<f64>>,
+        m: &BlockTridiagonal,
+        k: &BlockTridiagonal,
+    ) -> std::ops::Range<usize> {
+        let first = self.v.len();
+        for mut w in block {
+            let before = dot(&w, &m.mul(&w)).sqrt();
+            for _ in 0..2 {
+                for (v, mv) in self.v.iter().zip(&self.mv) {
+                    let h = dot(&w, mv);
+                    for (x, y) in w.iter_mut().zip(v) {
+                        *x -= h * y;
+                    }
+                }
+            }
+            let mw = m.mul(&w);
+            let norm = dot(&w, &mw).sqrt();
+            if norm.is_nan() || norm <= 1e-10 * before || !norm.is_finite() {
+                continue;
+            }
+            let v: Vec<f64> = w.iter().map(|x| x / norm).collect();
+            self.kv.push(k.mul(&v));
+            self.mv.push(mw.iter().map(|x| x / norm).collect());
+            self.v.push(v);
+        }
+        first..self.v.len()
     }
 }
