@@ -283,7 +283,43 @@ pub fn mesh_string(
     bit_md: f64,
     mud_density: f64,
 ) -> (Vec<Node>, Vec<Element>) {
-    mesh_string_two_fluids(well, tubulars_from_bit, bit_md, mud_density, mud_density)
+    mesh_string_two_fluids(
+        well,
+        tubulars_from_bit,
+        bit_md,
+        mud_density,
+        mud_density,
+        &[],
+    )
+}
+
+/// How far from a node an MD asked for by [`mesh_string_two_fluids`]'s `nodes_at` may
+/// stand, and the shortest element the asked nodes make (m). The asked MDs are taken in
+/// clusters no wider than twice this, a node at each cluster's middle ([`nodes_at_kept`]);
+/// one closer than this to a component's end takes that end's node, and an evenly spaced
+/// node closer than this to an asked one gives way to it. A stabilizer an ensemble places
+/// (`stabK.from_bit`) then stands within this of where its variant puts it.
+pub const NODE_AT_GAP: f64 = 0.1;
+
+/// The MDs at which [`mesh_string_two_fluids`] puts nodes for those asked (`wanted`), in
+/// ascending order: the middles of clusters of the asked no wider than twice
+/// [`NODE_AT_GAP`] (each asked MD within the gap of its node; neighbouring nodes more than
+/// the gap apart).
+pub fn nodes_at_kept(wanted: &[f64]) -> Vec<f64> {
+    let mut sorted: Vec<f64> = wanted.iter().copied().filter(|x| x.is_finite()).collect();
+    sorted.sort_by(f64::total_cmp);
+    let mut kept = Vec::new();
+    let mut i = 0;
+    while i < sorted.len() {
+        let first = sorted[i];
+        let mut last = first;
+        while i < sorted.len() && sorted[i] - first <= 2.0 * NODE_AT_GAP {
+            last = sorted[i];
+            i += 1;
+        }
+        kept.push(0.5 * (first + last));
+    }
+    kept
 }
 
 /// How many of `tubulars_from_bit` the string takes from the bit at `bit_md` up to the
@@ -306,13 +342,19 @@ pub fn components_in_hole(tubulars_from_bit: &[Tubular], bit_md: f64) -> usize {
 /// `g (ρ_s A_s + ρ_i A_i − ρ_o A_o)` (`A_i`, `A_o` the bore's and the outer diameter's areas;
 /// Lubinski's effective force then carries the two pressures). Equal fluids give
 /// `ρ_s A_s g (1 − ρ/ρ_s)`.
+///
+/// `nodes_at`: MDs that are to have a node (a stabilizer an ensemble places there): a node
+/// at each of [`nodes_at_kept`] that lies inside a component more than [`NODE_AT_GAP`] from
+/// its ends; the component's evenly spaced nodes within the gap of one give way.
 pub fn mesh_string_two_fluids(
     well: &WellPath,
     tubulars_from_bit: &[Tubular],
     bit_md: f64,
     outside: f64,
     inside: f64,
+    nodes_at: &[f64],
 ) -> (Vec<Node>, Vec<Element>) {
+    let wanted = nodes_at_kept(nodes_at);
     // MD breakpoints from the top down.
     let mut pieces: Vec<(usize, f64, f64)> = Vec::new(); // (component, top md, bottom md)
     let mut bottom = bit_md;
@@ -329,8 +371,19 @@ pub fn mesh_string_two_fluids(
         let n = ((bot - top) / tubulars_from_bit[k].element_length)
             .ceil()
             .max(1.0) as usize;
-        for j in 1..=n {
-            mds.push(top + (bot - top) * j as f64 / n as f64);
+        let asked: Vec<f64> = wanted
+            .iter()
+            .copied()
+            .filter(|&md| md > top + NODE_AT_GAP && md < bot - NODE_AT_GAP)
+            .collect();
+        let mut points: Vec<f64> = (1..=n)
+            .map(|j| top + (bot - top) * j as f64 / n as f64)
+            .filter(|&p| p == bot || asked.iter().all(|&a| (p - a).abs() >= NODE_AT_GAP))
+            .collect();
+        points.extend(&asked);
+        points.sort_by(f64::total_cmp);
+        for p in points {
+            mds.push(p);
             owner.push(k);
         }
     }
@@ -652,5 +705,38 @@ impl Model {
             r = r.max(0.5 * self.elements[i].contact_diameter);
         }
         r
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{nodes_at_kept, NODE_AT_GAP};
+
+    /// Each asked MD lies within the gap of a kept one; kept ones lie more than the gap
+    /// apart; a lone MD keeps its own node; NaN is dropped.
+    #[test]
+    fn asked_nodes_are_kept_in_clusters_within_the_gap() {
+        let asked = [5.0, 3.0, 3.05, 3.1, 3.15, 3.35, 7.0, f64::NAN, 7.0];
+        let kept = nodes_at_kept(&asked);
+        let expected = [3.075, 3.35, 5.0, 7.0];
+        assert_eq!(kept.len(), expected.len(), "{kept:?}");
+        assert!(
+            kept.iter()
+                .zip(expected)
+                .all(|(k, e)| (k - e).abs() < 1e-12),
+            "{kept:?}"
+        );
+        for a in asked.iter().filter(|a| a.is_finite()) {
+            let near = kept
+                .iter()
+                .map(|k| (k - a).abs())
+                .fold(f64::INFINITY, f64::min);
+            assert!(near <= NODE_AT_GAP + 1e-12, "{a}: {near} from {kept:?}");
+        }
+        assert!(
+            kept.windows(2).all(|w| w[1] - w[0] > NODE_AT_GAP),
+            "{kept:?}"
+        );
+        assert!(nodes_at_kept(&[]).is_empty());
     }
 }

@@ -116,6 +116,86 @@ fn stabilizer_layout_moves_the_site() {
         .contains("wider than the hole"));
 }
 
+/// Stabilizers placed by an ensemble stand where they are placed, not at the case mesh's
+/// nearest node: before, placements over 16–24 m from the bit on the bed's mesh ran at the
+/// few nodes there, the same model for many draws.
+#[test]
+fn placed_stabilizers_stand_within_the_gap_of_where_they_are_placed() {
+    use holewall::ensemble::placed_case;
+    use holewall::model::NODE_AT_GAP;
+    let dir = tmp("placed");
+    let case = parse_case(&dir.join("base.toml"), &bed("0.3", "20 kN")).unwrap();
+    let asked: Vec<f64> = (0..40)
+        .map(|k| 16.0 + 8.0 * (k as f64 / 39.0).powi(2))
+        .collect();
+    let csv = asked.iter().fold("stab1.from_bit\n".to_string(), |t, d| {
+        t + &format!("{d} m\n")
+    });
+    let variants = variants_from_csv_text("v.csv", &csv).unwrap();
+    let ran = |case: &holewall::case::Case| -> Vec<f64> {
+        variants
+            .iter()
+            .map(|v| {
+                let m = apply(case, v).unwrap();
+                let stab = m.sites.iter().find(|s| s.stabilizer).unwrap();
+                case.bit_md - m.nodes[stab.node].md
+            })
+            .collect()
+    };
+    let distinct = |d: &[f64]| {
+        let mut d = d.to_vec();
+        d.sort_by(f64::total_cmp);
+        d.dedup();
+        d.len()
+    };
+    let before = ran(&case);
+    let placed = placed_case(&case, &variants)
+        .unwrap()
+        .expect("variants place stab1");
+    let after = ran(&placed);
+    let worst = |r: &[f64]| {
+        r.iter()
+            .zip(&asked)
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0f64, f64::max)
+    };
+    // Within the gap (twice it beside a component's end: the bed's string is one collar
+    // from its stabilizer up, so none here).
+    assert!(worst(&after) <= NODE_AT_GAP + 1e-9, "placed {after:?}");
+    assert!(
+        worst(&before) > 2.0 * NODE_AT_GAP,
+        "the bed's mesh already fine: {before:?}"
+    );
+    assert!(
+        distinct(&after) >= 3 * distinct(&before),
+        "{before:?} → {after:?}"
+    );
+    // No element shorter than the gap, and the nodes away from the placements unmoved.
+    let mesh = &placed.model;
+    assert!(mesh
+        .elements
+        .iter()
+        .all(|e| e.length0 >= NODE_AT_GAP - 1e-9));
+    let far = |md: f64| (case.bit_md - md) < 15.0 || (case.bit_md - md) > 25.0;
+    let old: Vec<f64> = case
+        .model
+        .nodes
+        .iter()
+        .map(|n| n.md)
+        .filter(|&m| far(m))
+        .collect();
+    let new: Vec<f64> = mesh
+        .nodes
+        .iter()
+        .map(|n| n.md)
+        .filter(|&m| far(m))
+        .collect();
+    assert_eq!(old, new);
+    // No placement: the case as it was.
+    let none = variants_from_csv_text("v.csv", "mu\n0.2\n").unwrap();
+    assert!(placed_case(&case, &none).unwrap().is_none());
+}
+
 #[test]
 fn grid_dynamic_ensemble_writes_variants_and_series() {
     let dir = tmp("grid");

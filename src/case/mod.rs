@@ -83,6 +83,9 @@ pub struct CaseSource {
     pub spec: CaseSpec,
     /// The survey's path and stations (with their lines), where the well is a survey.
     pub survey: Option<(PathBuf, Vec<(SurveyStation, usize)>)>,
+    /// Distances from the bit (m) at which the mesh is to have a node: where an ensemble
+    /// places stabilizers ([`Case::with_nodes_from_bit`]); none from a case file.
+    pub nodes_from_bit: Vec<f64>,
 }
 
 /// A hole section (`[[hole]]`): from the previous section's bottom (or the surface) down to
@@ -340,6 +343,7 @@ pub fn parse_case(path: &Path, text: &str) -> Result<Case, InputError> {
             text: text.to_string(),
             spec,
             survey: None,
+            nodes_from_bit: Vec::new(),
         },
     )
 }
@@ -351,6 +355,18 @@ impl Case {
     pub fn rebuilt(&self, edit: impl FnOnce(&mut CaseSpec)) -> Result<Case, InputError> {
         let mut source = (*self.source).clone();
         edit(&mut source.spec);
+        build_case(&self.path, source)
+    }
+
+    /// This case meshed again with a node at each distance from the bit in `from_bit` (m;
+    /// [`crate::model::NODE_AT_GAP`] apart at least, each more than the gap inside a
+    /// component), besides the ones it had: where an ensemble places its stabilizers
+    /// (`stabK.from_bit`), so each stands where its variant puts it rather than at the
+    /// case mesh's nearest node. A rebuilt case ([`Case::rebuilt`]: another depth) keeps
+    /// them.
+    pub fn with_nodes_from_bit(&self, from_bit: &[f64]) -> Result<Case, InputError> {
+        let mut source = (*self.source).clone();
+        source.nodes_from_bit.extend_from_slice(from_bit);
         build_case(&self.path, source)
     }
 }
@@ -533,8 +549,18 @@ fn build_case(path: &Path, mut source: CaseSource) -> Result<Case, InputError> {
         None if both_ways => FrictionModel::Coupled,
         None => FrictionModel::Split,
     };
-    let (nodes, mut elements) =
-        crate::model::mesh_string_two_fluids(&well, &tubulars, bit_md, mud, mud_inside);
+    let (nodes, mut elements) = crate::model::mesh_string_two_fluids(
+        &well,
+        &tubulars,
+        bit_md,
+        mud,
+        mud_inside,
+        &source
+            .nodes_from_bit
+            .iter()
+            .map(|d| bit_md - d)
+            .collect::<Vec<_>>(),
+    );
     let n = nodes.len();
     // Tool joints: the contact diameter, and the joints' steel (beyond the body's OD, over
     // their share of a joint) in the weight, buoyed by the annulus.

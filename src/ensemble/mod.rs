@@ -42,6 +42,6 @@ mod variant;
 pub use crate::keys::{Key, KeyError, Mode, Param, Value, KEY_FORMS};
 pub(crate) use variant::input_csv;
 pub use variant::{
-    apply, apply_with_sites, case_variants, sample_variants, variant_case, variants_from_csv,
-    variants_from_csv_text, variants_from_grid, Variant, VariantError,
+    apply, apply_with_sites, case_variants, placed_case, sample_variants, variant_case,
+    variants_from_csv, variants_from_csv_text, variants_from_grid, Variant, VariantError,
 };

@@ -93,6 +93,21 @@ pub fn tendency_map(
     progress: &(dyn Fn() + Sync),
 ) -> (MapAxis, Vec<MapCell>) {
     let (axis, xs, wobs) = map_grid(case);
+    // Stabilizer positions stand where asked: the mesh takes a node at each (the case's
+    // own mesh where that cannot be built; each cell then says the distance it got).
+    let key = crate::keys::Key::parse("stab1.from_bit").expect("stab1.from_bit is a key");
+    let at = |x: f64| crate::ensemble::Variant {
+        name: String::new(),
+        overrides: vec![(key.clone(), crate::keys::Value::Number(x))],
+    };
+    let placed = match axis {
+        MapAxis::Stab1FromBit => {
+            let cells: Vec<_> = xs.iter().map(|&x| at(x)).collect();
+            crate::ensemble::placed_case(case, &cells).ok().flatten()
+        }
+        _ => None,
+    };
+    let case = placed.as_ref().unwrap_or(case);
     let cells: Vec<(f64, f64)> = xs
         .iter()
         .flat_map(|&x| wobs.iter().map(move |&w| (x, w)))
@@ -103,14 +118,8 @@ pub fn tendency_map(
         .map(|&(x, w)| {
             let (model, toolface, shown) = match axis {
                 MapAxis::Stab1FromBit => {
-                    let key =
-                        crate::keys::Key::parse("stab1.from_bit").expect("stab1.from_bit is a key");
-                    let variant = crate::ensemble::Variant {
-                        name: String::new(),
-                        overrides: vec![(key, crate::keys::Value::Number(x))],
-                    };
                     // The distance the stabilizer got: its site's node nearest the asked.
-                    let model = crate::ensemble::apply(case, &variant);
+                    let model = crate::ensemble::apply(case, &at(x));
                     let got = model.as_ref().map_or(x, |m| {
                         let site = m.stabilizer_sites()[0];
                         let bit = m.nodes[m.nodes.len() - 1].md;

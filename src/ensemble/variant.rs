@@ -233,6 +233,28 @@ pub fn variants_from_grid(grid: &[(Key, Vec<Value>)]) -> Vec<Variant> {
         .collect()
 }
 
+/// The case the variants run on: `case` meshed again with nodes where the variants place
+/// stabilizers (`stabK.from_bit`; [`Case::with_nodes_from_bit`]: a node within
+/// [`crate::model::NODE_AT_GAP`] of each distance asked — twice that next to a component's
+/// end —, none closer to another than that), so a stabilizer stands there, not at the case
+/// mesh's nearest node: with 1 m BHA elements, placements drawn uniformly over 1–3 m from
+/// the bit ran at 1.05, 1.8 and 2.8 m. Every variant runs on the one mesh, so the engine
+/// takes them together. `None` where no variant places a stabilizer.
+pub fn placed_case(case: &Case, variants: &[Variant]) -> Result<Option<Case>, InputError> {
+    let from_bit: Vec<f64> = variants
+        .iter()
+        .flat_map(|v| &v.overrides)
+        .filter_map(|(key, value)| match (key.param, value) {
+            (Param::FromBit, Value::Number(x)) if *x > 0.0 && *x < case.bit_md => Some(*x),
+            _ => None,
+        })
+        .collect();
+    if from_bit.is_empty() {
+        return Ok(None);
+    }
+    case.with_nodes_from_bit(&from_bit).map(Some)
+}
+
 /// The case's model with a variant's overrides applied. Layout moves come first (a
 /// stabilizer's site goes to the node nearest its new distance from the bit; a pipe-body
 /// site there, if any, takes the old node), then values, in column order.
