@@ -177,11 +177,13 @@ pub const WALL_CONTACT: &str = "contact added where the string met the wall";
 
 /// How often a static solution's load path left plain load steps, by its log: step cuts,
 /// failed steps relaxed past, stage changes, the model's own sites taken where the guarded
-/// solve failed — every line but [`WALL_CONTACT`]'s. The step cuts of `holewall bench
-/// corpus` and of an ensemble's static variants (a variant with any is `step_cut`, not
-/// `converged`).
+/// solve failed — every line but [`WALL_CONTACT`]'s and the [`whirl_note`], which say what
+/// the model is, not how its solve went. The step cuts of `holewall bench corpus` and of an
+/// ensemble's static variants (a variant with any is `step_cut`, not `converged`).
 pub fn path_events(log: &[String]) -> usize {
-    log.iter().filter(|l| !l.starts_with(WALL_CONTACT)).count()
+    log.iter()
+        .filter(|l| !l.starts_with(WALL_CONTACT) && !l.starts_with(WHIRL_AVERAGED))
+        .count()
 }
 
 /// The FE static solution of `model` (the case's, or a variant's of it) with the string
@@ -295,9 +297,7 @@ pub(crate) fn hold_in_hole(
 ) -> Result<crate::solve::statics::StaticSolution, crate::solve::statics::StaticError> {
     let span = crate::diagnose::mark_whirling_sites(case, model);
     let said = |mut sol: crate::solve::statics::StaticSolution| {
-        if let Some((from, to)) = span {
-            sol.log.push(whirl_note(from, to));
-        }
+        note_whirl(&mut sol.log, span);
         sol
     };
     let free = unheld_nodes(model);
@@ -356,6 +356,15 @@ pub fn whirl_note(from: f64, to: f64) -> String {
          there acts as torque alone (its side force averages to nothing over a whirl; \
          `holewall run` gives the motion)"
     )
+}
+
+/// Adds the [`whirl_note`] of a string that whirls over `span` (MD from, to;
+/// [`crate::diagnose::whirl_span`]) to its static solution's `log`: the CPU solve's
+/// ([`solve_in_hole`]) and the engine's variants' alike.
+pub fn note_whirl(log: &mut Vec<String>, span: Option<(f64, f64)>) {
+    if let Some((from, to)) = span {
+        log.push(whirl_note(from, to));
+    }
 }
 
 /// The words that open [`whirl_note`] (`holewall static` finds the note by them to warn).
@@ -430,4 +439,20 @@ pub fn solve_or_stop(
             stopped,
         )
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_model_s_own_notes_are_not_load_path_events() {
+        let mut log = vec![format!("{WALL_CONTACT} at 3 nodes")];
+        note_whirl(&mut log, Some((2400.0, 2500.0)));
+        note_whirl(&mut log, None);
+        assert_eq!(log.len(), 2, "a span-less string gets no note");
+        assert_eq!(path_events(&log), 0);
+        log.push("load step λ 0.5 → 1 cut to 0.75".into());
+        assert_eq!(path_events(&log), 1);
+    }
 }

@@ -59,7 +59,10 @@ pub fn run_static_gpu<T: crate::gpu::contact::GpuReal>(
         .map(|(r, (m, (g, v)))| match r.into_solution(g) {
             Ok(sol) => {
                 // Held in the hole as the CPU holds it: the guards in contact kept.
-                let (held, sol) = crate::profile::keep_touching(m, g.clone(), sol);
+                let (held, mut sol) = crate::profile::keep_touching(m, g.clone(), sol);
+                // The whirl's note, as the CPU solve's log has it (`guarded_models`
+                // marked the span's sites).
+                crate::profile::note_whirl(&mut sol.log, crate::diagnose::whirl_span(case, m));
                 let mut done = static_result(case, &v.name, &held, &sol);
                 done.solved_by = SolvedBy::Engine;
                 done
