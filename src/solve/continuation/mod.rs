@@ -28,7 +28,8 @@
 //!    `r(x) + s (x − a) = 0` for the translations, each from and anchored at the last
 //!    one's answer `a`, `s` lowered as they get easy (to `RELAX_FLOOR` × its start) and
 //!    raised where one fails (not lowered again to a shift that failed lately), each
-//!    solved inexactly (to `RELAX_SUB_REDUCTION` of its residual at the anchor), the
+//!    solved inexactly (to `RELAX_SUB_REDUCTION` of its residual at the anchor; exactly
+//!    while its measure goes round a cycle, `RELAX_CYCLE_REPEATS`), the
 //!    anchor carried on by the last move's momentum after `RELAX_MOMENTUM_AFTER`
 //!    sub-solves (`RELAX_MOMENTUM`; [`LoadPath::momentum`]), until an
 //!    answer is an equilibrium without the shift ([`LoadPath::shift_settled`]; where the
@@ -317,7 +318,8 @@ impl LoadPath {
             iterations: self.iteration_limit(),
             fold_stall: (self.stage == Stage::Load && self.load_failures > 0)
                 .then_some(FOLD_STALL_ITERATIONS),
-            relative: (self.shift() > 0.0).then_some(RELAX_SUB_REDUCTION),
+            relative: (self.shift() > 0.0 && !self.relaxing().is_some_and(|r| r.cycling))
+                .then_some(RELAX_SUB_REDUCTION),
             first_halving: self.stage == Stage::Load && !self.linear_law,
         }
     }
@@ -573,6 +575,8 @@ impl LoadPath {
             best_at: 0,
             stalled: None,
             back_to_best: false,
+            since_best: Vec::new(),
+            cycling: false,
             failed_at: 0.0,
             reason,
             cause,

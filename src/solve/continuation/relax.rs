@@ -71,6 +71,30 @@ pub(super) const RELAX_SUB_REDUCTION: f64 = 0.5;
 /// 1,059 → 999, 598 → 538, 580 → 520) — 5–10 % of them once the failed load steps before
 /// a relaxation were gone (stop 50 measured 2.4 % with them).
 pub(super) const RELAX_STALL_SUBS: usize = 20;
+/// A relaxation whose unshifted measure, since its last 1 % gain, has repeated itself
+/// with a period of 2 to [`RELAX_CYCLE_LONGEST`] converged sub-solves this many times over
+/// (each value within [`RELAX_CYCLE_MATCH`] of the one a period before, the values spanning
+/// a factor of at least [`RELAX_CYCLE_SPAN`]) goes round a cycle: its sub-solves are then
+/// solved exactly (to the tolerance, within [`RELAX_SUB_ITERATIONS`]) rather than to
+/// [`RELAX_SUB_REDUCTION`] of their start, until its next 1 % gain ([`Relax::settle`]).
+/// Inexact sub-solves next to a contact's onset can cycle: unseen user well 2047
+/// (horizontal, rotating with a 0.71° motor, 1 m elements, 5,467 nodes) reached 4.4e-6 of
+/// the force scale and then went round a cycle of six to eight sub-solves (1.6e-5 → 1.1e-4
+/// → 1.6e-5, growing by about 1 % a cycle; the largest residual always at the node 2.3 m
+/// above the bit, beside the bend) until [`RELAX_STAGNANT_SUBS`] failed it; momentum off
+/// made no difference. Switching to exact sub-solves after a fixed number of stagnant ones
+/// instead solved 2047 at every number tried but lost other wells that crawl (lock-ups
+/// that solve) at most of them (docs/performance.md, stop 84): a crawl is not a cycle, and
+/// neither drawn 263 nor user 1982 repeats its measure so (their traces; 0 detections).
+pub(super) const RELAX_CYCLE_REPEATS: usize = 3;
+/// The longest period [`RELAX_CYCLE_REPEATS`] looks for (converged sub-solves).
+pub(super) const RELAX_CYCLE_LONGEST: usize = 12;
+/// How close a cycle's values come back ([`RELAX_CYCLE_REPEATS`]; relative).
+pub(super) const RELAX_CYCLE_MATCH: f64 = 0.1;
+/// The least span (largest over smallest) of a cycle's values ([`RELAX_CYCLE_REPEATS`]): a
+/// crawl's near-constant measure is not a cycle.
+pub(super) const RELAX_CYCLE_SPAN: f64 = 3.0;
+
 /// The momentum of a relaxation's anchor once it has taken [`RELAX_MOMENTUM_AFTER`]
 /// sub-solves ([`Relax::momentum`]): an inertial proximal point iteration (the anchor
 /// carried on by `β` times the last sub-solve's move, as the heavy ball of Polyak and the
@@ -165,6 +189,11 @@ pub(super) struct Relax {
     /// Settled at the best sub-solve's state, not the last one's: the driver is to return
     /// the system there ([`super::LoadPath::take_back_to_best`]).
     pub(super) back_to_best: bool,
+    /// The unshifted measures of the converged sub-solves since the best
+    /// ([`RELAX_CYCLE_REPEATS`]).
+    pub(super) since_best: Vec<f64>,
+    /// They go round a cycle: the sub-solves are solved exactly until the next best.
+    pub(super) cycling: bool,
     /// The shift of the last sub-solve that failed, halved at each one that converges
     /// since (0: none): the shift is not lowered below twice it, so the next try at that
     /// shift comes after two sub-solves that converge, not one, and from a failure on
@@ -196,7 +225,11 @@ impl Relax {
             self.best = measure;
             self.best_at = self.subs;
             keep = measure <= stall;
+            self.since_best.clear();
+            self.cycling = false;
         }
+        self.since_best.push(measure);
+        self.cycling = self.cycling || goes_round(&self.since_best);
         if !self.settled && self.subs >= self.best_at + RELAX_STALL_SUBS {
             if measure <= stall {
                 self.settled = true;
@@ -243,6 +276,24 @@ impl Relax {
             None
         }
     }
+}
+
+/// Whether the last of `measures` repeat themselves as a cycle ([`RELAX_CYCLE_REPEATS`]).
+pub(super) fn goes_round(measures: &[f64]) -> bool {
+    (2..=RELAX_CYCLE_LONGEST).any(|p| {
+        let w = RELAX_CYCLE_REPEATS * p;
+        if measures.len() < w + p {
+            return false;
+        }
+        let n = measures.len();
+        let last = &measures[n - w..];
+        let (lo, hi) = last.iter().fold((f64::INFINITY, 0.0f64), |(lo, hi), &m| {
+            (lo.min(m), hi.max(m))
+        });
+        hi >= RELAX_CYCLE_SPAN * lo
+            && (n - w..n)
+                .all(|i| (measures[i] - measures[i - p]).abs() <= RELAX_CYCLE_MATCH * measures[i])
+    })
 }
 
 /// Where a path whose relaxation to the full loads failed stops (`super::LoadPath::bracket`).

@@ -567,3 +567,64 @@ fn only_a_path_that_cuts_its_load_steps_fails_one_that_has_not_halved_its_residu
     assert_eq!(p.stage, Stage::Relax);
     assert!(!p.limits().first_halving);
 }
+
+/// A cycle is a measure that repeats itself with a period over a span of values; a crawl
+/// (near-constant or slowly falling), noise without a period, and too few repeats are not.
+#[test]
+fn a_cycle_is_a_measure_that_repeats_itself_over_a_span() {
+    // User well 2047's shape: eight values from 1.6e-5 to 1.1e-4, growing 1 % a cycle.
+    let shape = [
+        1.6e-5, 4.0e-5, 2.1e-5, 4.2e-5, 1.1e-4, 7.0e-5, 8.6e-5, 3.4e-5,
+    ];
+    let cycle: Vec<f64> = (0..40)
+        .map(|k| shape[k % 8] * 1.01f64.powi((k / 8) as i32))
+        .collect();
+    let needed = (RELAX_CYCLE_REPEATS + 1) * 8;
+    assert!(!goes_round(&cycle[..needed - 1]));
+    assert!(goes_round(&cycle[..needed]));
+    // A crawl: within a few percent, falling slowly.
+    let crawl: Vec<f64> = (0..200)
+        .map(|k| 1e-4 * (1.0 - 1e-4 * k as f64) * (1.0 + 0.02 * ((k * 7) % 5) as f64))
+        .collect();
+    assert!(!goes_round(&crawl));
+    // Noise over a span, without a period.
+    let mut x = 0.3f64;
+    let noise: Vec<f64> = (0..200)
+        .map(|_| {
+            x = 3.9 * x * (1.0 - x);
+            1e-5 * (1.0 + 9.0 * x)
+        })
+        .collect();
+    assert!(!goes_round(&noise));
+}
+
+/// While its measure goes round a cycle, a relaxation solves its sub-solves exactly; its
+/// next 1 % gain makes them inexact again. A load step is never solved inexactly.
+#[test]
+fn a_relaxation_that_goes_round_a_cycle_solves_its_sub_solves_exactly() {
+    let p = LoadPath::new(&StaticOptions::default(), true, true, false);
+    assert_eq!(p.limits().relative, None);
+    let (mut p, _) = stuck(Some(1e6));
+    assert_eq!(p.stage, Stage::Relax);
+    p.shift_settled(1e-5);
+    p.converged(4);
+    let shape = [2e-5, 6e-5, 1.1e-4, 4e-5];
+    let mut k = 0;
+    while p.limits().relative.is_some() {
+        assert!(
+            k < (RELAX_CYCLE_REPEATS + 1) * 4,
+            "no cycle found after {k}"
+        );
+        p.shift_settled(shape[k % 4]);
+        p.converged(4);
+        k += 1;
+    }
+    assert_eq!(k, (RELAX_CYCLE_REPEATS + 1) * 4);
+    assert_eq!(p.stage, Stage::Relax);
+    // A failed sub-solve does not end it; a new best does.
+    p.failed_at("no".into(), None, Some(1e6));
+    assert_eq!(p.limits().relative, None);
+    p.shift_settled(0.98e-5);
+    p.converged(4);
+    assert_eq!(p.limits().relative, Some(RELAX_SUB_REDUCTION));
+}
