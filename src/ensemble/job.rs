@@ -78,10 +78,7 @@ pub fn run(
     };
     // Stabilizers the variants place stand where they are placed: the mesh takes a node
     // there (`ran.stabK.from_bit_m` in variants.csv says where each ran).
-    let case = match crate::ensemble::placed_case(&case, &variants)? {
-        Some(placed) => placed,
-        None => case,
-    };
+    let case = crate::ensemble::placed_case(&case, &variants)?.unwrap_or(case);
     let analysis = settings
         .as_ref()
         .map(|s| s.analysis)

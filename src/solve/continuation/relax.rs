@@ -189,8 +189,8 @@ pub(super) struct Relax {
     /// Settled at the best sub-solve's state, not the last one's: the driver is to return
     /// the system there ([`super::LoadPath::take_back_to_best`]).
     pub(super) back_to_best: bool,
-    /// The unshifted measures of the converged sub-solves since the best
-    /// ([`RELAX_CYCLE_REPEATS`]).
+    /// The unshifted measures of the converged sub-solves since the best, the last
+    /// `(RELAX_CYCLE_REPEATS + 1) × RELAX_CYCLE_LONGEST` of them ([`RELAX_CYCLE_REPEATS`]).
     pub(super) since_best: Vec<f64>,
     /// They go round a cycle: the sub-solves are solved exactly until the next best.
     pub(super) cycling: bool,
@@ -229,6 +229,11 @@ impl Relax {
             self.cycling = false;
         }
         self.since_best.push(measure);
+        // `goes_round` looks at no more than the last (repeats + 1) × the longest period.
+        let kept = (RELAX_CYCLE_REPEATS + 1) * RELAX_CYCLE_LONGEST;
+        if self.since_best.len() > kept {
+            self.since_best.drain(..self.since_best.len() - kept);
+        }
         self.cycling = self.cycling || goes_round(&self.since_best);
         if !self.settled && self.subs >= self.best_at + RELAX_STALL_SUBS {
             if measure <= stall {
