@@ -797,3 +797,42 @@ fn critical_speeds_of_corpus_bhas_match_the_dense_solve() {
     );
     assert!(out.join("critical_corpus_time.png").exists());
 }
+
+/// The equilibrium curvature's secant search on unseen corpus well 5059 (horizontal, a
+/// slick BHA, drilling at 33.6 kN): its step to −5.32°/30 m leaves a BHA model that does not
+/// stand (the string locks up past λ = 0.53), and the search used to end there with "no
+/// equilibrium curvature within ±30°/30 m". The step halved toward the last curvature
+/// solved (−4.50 fails too) reaches one that solves, and the search settles between.
+#[test]
+fn a_failed_secant_step_of_the_equilibrium_curvature_is_halved() {
+    let out = common::scratch_dir("bha", "tendency-5059").join("t");
+    let (code, stdout, stderr) = common::holewall(&[
+        "bench",
+        "tendency-corpus",
+        "--wells",
+        "1",
+        "--first-seed",
+        "5059",
+        "--quiet",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{stdout}\n{stderr}");
+    let s = common::json(&out.join("summary.json"));
+    assert_eq!(s["settled"], 1, "{s}");
+    assert_eq!(s["equilibrium_found"], 1, "{s}");
+    let rows = std::fs::read_to_string(out.join("tendency_corpus.csv")).unwrap();
+    let row = rows.lines().find(|l| l.starts_with("5059,")).unwrap();
+    assert!(
+        row.contains("equilibrium curvature at -5.32°/30 m"),
+        "{row}"
+    );
+    assert!(!row.contains("no equilibrium curvature"), "{row}");
+    let header: Vec<&str> = rows.lines().next().unwrap().split(',').collect();
+    let col = header
+        .iter()
+        .position(|h| *h == "equilibrium_curvature_deg_per_30m")
+        .unwrap();
+    let k: f64 = row.split(',').nth(col).unwrap().parse().unwrap();
+    assert!(k > -4.5 && k < 0.0, "{k}");
+}

@@ -48,6 +48,10 @@ const PROBE: f64 = 0.25;
 /// jitter by more than any finer one).
 const SETTLE: f64 = 0.005;
 
+/// How many times a curvature of the equilibrium curvature's search whose BHA model fails
+/// is halved toward the last one solved before the search stops ([`tendency_over`]).
+const SECANT_HALVINGS: usize = 3;
+
 /// Radians per metre to degrees per 30 m.
 pub const RAD_PER_M_TO_DEG_PER_30M: f64 = 30.0 * 180.0 / std::f64::consts::PI;
 
@@ -430,14 +434,34 @@ fn tendency_over(
     out.bit_straight_hole = Some(straight.first);
     // Equilibrium curvature: secant on the high-side force, from 0 and PROBE.
     let mut a = (0.0, straight.high_side_force_n);
-    let mut b = {
-        let k = PROBE / to_rate;
-        match solve((k, 0.0)) {
-            Ok(s) => (k, s.high_side_force_n),
-            Err(e) => {
-                out.notes.push(format!("equilibrium curvature: {e}"));
-                (f64::NAN, f64::NAN)
+    // A curvature whose BHA model fails is halved toward the last one solved, up to
+    // [`SECANT_HALVINGS`] times: a secant step can overshoot into a hole the model does not
+    // stand in (unseen corpus well 5059, a slick BHA at 91°, 33.6 kN: the step to
+    // −5.32°/30 m and its first halving, −4.50, fail; the second solves and the search
+    // settles at −4.32); what failed is noted, and a search that ends there says so.
+    let mut stopped = false;
+    let mut toward = |from: f64, mut k: f64, notes: &mut Vec<String>| {
+        for halving in 0..=SECANT_HALVINGS {
+            match solve((k, 0.0)) {
+                Ok(s) => return Some((k, s.high_side_force_n)),
+                Err(e) => {
+                    notes.push(format!(
+                        "equilibrium curvature at {:.2}°/30 m: {e}",
+                        k * to_rate
+                    ));
+                    if halving < SECANT_HALVINGS {
+                        k = from + 0.5 * (k - from);
+                    }
+                }
             }
+        }
+        None
+    };
+    let mut b = match toward(0.0, PROBE / to_rate, &mut out.notes) {
+        Some(b) => b,
+        None => {
+            stopped = true;
+            (f64::NAN, f64::NAN)
         }
     };
     let mut equilibrium = None;
@@ -450,16 +474,13 @@ fn tendency_over(
             equilibrium = Some(k);
             break;
         }
-        match solve((k, 0.0)) {
-            Ok(s) => {
+        match toward(b.0, k, &mut out.notes) {
+            Some(next) => {
                 a = b;
-                b = (k, s.high_side_force_n);
+                b = next;
             }
-            Err(e) => {
-                out.notes.push(format!(
-                    "equilibrium curvature at {:.2}°/30 m: {e}",
-                    k * to_rate
-                ));
+            None => {
+                stopped = true;
                 break;
             }
         }
@@ -470,6 +491,10 @@ fn tendency_over(
     }
     match equilibrium {
         Some(k) if k.abs() < limit => out.equilibrium_curvature_deg_per_30m = Some(k * to_rate),
+        _ if stopped => out.notes.push(
+            "no equilibrium curvature: its search stopped where the BHA model failed (above)"
+                .to_string(),
+        ),
         _ => out
             .notes
             .push("no equilibrium curvature within ±30°/30 m".to_string()),
