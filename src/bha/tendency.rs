@@ -48,8 +48,12 @@ const PROBE: f64 = 0.25;
 /// jitter by more than any finer one).
 const SETTLE: f64 = 0.005;
 
-/// How many times a curvature of the equilibrium curvature's search whose BHA model fails
-/// is halved toward the last one solved before the search stops ([`tendency_over`]).
+/// How many times in all the equilibrium curvature's search halves a curvature whose BHA
+/// model fails toward the last one solved ([`tendency_over`]). A failed BHA-model solve is
+/// the dearest kind (a relaxation run out, then its bracket; twelve of them at a curvature
+/// for a rotating bend): three halvings a step took the 500-well tendency corpus's
+/// unsettled wells 31, 192, 199 and the rotating bend 261 from 4–84 solves to 13–372 (261:
+/// 298 s → 1,857 s, with a CI run on the other core) and won none of them.
 const SECANT_HALVINGS: usize = 3;
 
 /// Radians per metre to degrees per 30 m.
@@ -434,28 +438,28 @@ fn tendency_over(
     out.bit_straight_hole = Some(straight.first);
     // Equilibrium curvature: secant on the high-side force, from 0 and PROBE.
     let mut a = (0.0, straight.high_side_force_n);
-    // A curvature whose BHA model fails is halved toward the last one solved, up to
-    // [`SECANT_HALVINGS`] times: a secant step can overshoot into a hole the model does not
-    // stand in (unseen corpus well 5059, a slick BHA at 91°, 33.6 kN: the step to
-    // −5.32°/30 m and its first halving, −4.50, fail; the second solves and the search
-    // settles at −4.32); what failed is noted, and a search that ends there says so.
+    // A curvature whose BHA model fails is halved toward the last one solved, at most
+    // [`SECANT_HALVINGS`] times in the search: a secant step can overshoot into a hole the
+    // model does not stand in (unseen corpus well 5059, a slick BHA at 91°, 33.6 kN: the
+    // step to −5.32°/30 m and its first halving, −4.50, fail; the second solves and the
+    // search settles at −4.32); what failed is noted, and a search that ends there says so.
     let mut stopped = false;
-    let mut toward = |from: f64, mut k: f64, notes: &mut Vec<String>| {
-        for halving in 0..=SECANT_HALVINGS {
-            match solve((k, 0.0)) {
-                Ok(s) => return Some((k, s.high_side_force_n)),
-                Err(e) => {
-                    notes.push(format!(
-                        "equilibrium curvature at {:.2}°/30 m: {e}",
-                        k * to_rate
-                    ));
-                    if halving < SECANT_HALVINGS {
-                        k = from + 0.5 * (k - from);
-                    }
+    let mut halvings = SECANT_HALVINGS;
+    let mut toward = |from: f64, mut k: f64, notes: &mut Vec<String>| loop {
+        match solve((k, 0.0)) {
+            Ok(s) => return Some((k, s.high_side_force_n)),
+            Err(e) => {
+                notes.push(format!(
+                    "equilibrium curvature at {:.2}°/30 m: {e}",
+                    k * to_rate
+                ));
+                if halvings == 0 {
+                    return None;
                 }
+                halvings -= 1;
+                k = from + 0.5 * (k - from);
             }
         }
-        None
     };
     let mut b = match toward(0.0, PROBE / to_rate, &mut out.notes) {
         Some(b) => b,
