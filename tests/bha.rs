@@ -821,18 +821,26 @@ fn a_failed_secant_step_of_the_equilibrium_curvature_is_halved() {
     let s = common::json(&out.join("summary.json"));
     assert_eq!(s["settled"], 1, "{s}");
     assert_eq!(s["equilibrium_found"], 1, "{s}");
-    let rows = std::fs::read_to_string(out.join("tendency_corpus.csv")).unwrap();
-    let row = rows.lines().find(|l| l.starts_with("5059,")).unwrap();
-    assert!(
-        row.contains("equilibrium curvature at -5.32°/30 m"),
-        "{row}"
-    );
-    assert!(!row.contains("no equilibrium curvature"), "{row}");
-    let header: Vec<&str> = rows.lines().next().unwrap().split(',').collect();
-    let col = header
-        .iter()
-        .position(|h| *h == "equilibrium_curvature_deg_per_30m")
+    // A CSV reader: the notes hold commas, quoted.
+    let mut csv = csv::Reader::from_path(out.join("tendency_corpus.csv")).unwrap();
+    let headers = csv.headers().unwrap().clone();
+    let field = |r: &csv::StringRecord, name: &str| {
+        let k = headers.iter().position(|h| h == name).unwrap();
+        r[k].to_string()
+    };
+    let row = csv
+        .records()
+        .map(|r| r.unwrap())
+        .find(|r| field(r, "seed") == "5059")
         .unwrap();
-    let k: f64 = row.split(',').nth(col).unwrap().parse().unwrap();
+    let notes = field(&row, "notes");
+    assert!(
+        notes.contains("equilibrium curvature at -5.32°/30 m"),
+        "{notes}"
+    );
+    assert!(!notes.contains("no equilibrium curvature"), "{notes}");
+    let k: f64 = field(&row, "equilibrium_curvature_deg_per_30m")
+        .parse()
+        .unwrap();
     assert!(k > -4.5 && k < 0.0, "{k}");
 }
