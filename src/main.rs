@@ -739,6 +739,7 @@ fn main() -> ExitCode {
                 )
                 .map(|s| s.line(&out)),
             ),
+            BenchCommand::McCorpus(a) => print_line(a.run()),
             BenchCommand::TendencyCorpus {
                 wells,
                 first_seed,

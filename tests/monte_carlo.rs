@@ -660,3 +660,67 @@ fn variants_are_held_in_the_hole_with_their_own_friction() {
     assert!((1.8..2.2).contains(&ratio), "torque ratio {ratio}");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// `holewall bench mc-corpus` on a sample of corpus wells (the benchmark's CI sample):
+/// friction, wall stiffness and WOB uncertain, 4 Latin-hypercube variants a well, on the
+/// CPU backend and the GPU engine in f64 and f32. Every variant solves on every path, the
+/// engine solves them itself (no CPU re-run), and each variant's hook load, surface torque
+/// and largest side force per length agree with the CPU's: f64 to 1e-9, f32 to 1e-4.
+/// Drawn seeds 3676 (build and hold, drilling, 389 nodes), 3780 (build and hold, drilling,
+/// 365) and 3825 (horizontal, drilling, 30 m elements).
+#[test]
+fn monte_carlo_on_corpus_wells_agrees_across_paths() {
+    if common::gpu().is_none() {
+        return;
+    }
+    let out = common::scratch_dir("mc-corpus", "sample");
+    let o = out.to_str().unwrap();
+    let (code, stdout, stderr) = common::holewall(&[
+        "bench",
+        "mc-corpus",
+        "--seeds",
+        "3676,3780,3825",
+        "--samples",
+        "4",
+        "--quiet",
+        "--out",
+        o,
+    ]);
+    assert_eq!(code, 0, "{stdout}\n{stderr}");
+    let s = common::json(&out.join("summary.json"));
+    assert_eq!(s["run"], 3, "{s}");
+    for (path, tolerance) in [("cpu_f64", 0.0), ("gpu_f64", 1e-9), ("gpu_f32", 1e-4)] {
+        let p = &s["paths"][path];
+        assert_eq!(p["variants"], 12, "{path}: {p}");
+        assert_eq!(p["solved"], 12, "{path}: {p}");
+        assert_eq!(p["solved_here_only"], 0, "{path}: {p}");
+        if path != "cpu_f64" {
+            assert_eq!(p["by_engine"], 12, "{path}: {p}");
+        }
+        for q in ["hook_load_rel", "torque_rel", "side_force_rel"] {
+            let worst = p[q]["worst"].as_f64().unwrap();
+            assert!(
+                worst <= tolerance,
+                "{path} {q}: {worst:e} over {tolerance:e}: {p}"
+            );
+        }
+    }
+    // The inputs were drawn in their ranges, and every hook load is in the CSV.
+    let text = std::fs::read_to_string(out.join("mc_variants.csv")).unwrap();
+    let mut rows = csv::Reader::from_reader(text.as_bytes());
+    let header = rows.headers().unwrap().clone();
+    let col = |name: &str| header.iter().position(|h| h == name).unwrap();
+    let mut n = 0;
+    for r in rows.records() {
+        let r = r.unwrap();
+        let mu: f64 = r[col("mu")].parse().unwrap();
+        assert!((0.15..=0.40).contains(&mu), "mu {mu}");
+        for p in ["cpu_f64", "gpu_f64", "gpu_f32"] {
+            let h: f64 = r[col(&format!("{p}_hook_load_n"))].parse().unwrap();
+            assert!(h.is_finite(), "{p}: {h}");
+        }
+        n += 1;
+    }
+    assert_eq!(n, 12);
+    assert!(out.join("mc_corpus_agreement.png").is_file());
+}

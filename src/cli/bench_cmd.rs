@@ -305,6 +305,11 @@ pub enum BenchCommand {
         #[arg(long)]
         quiet: bool,
     },
+    /// Monte Carlo static ensembles on corpus wells: friction, wall stiffness and WOB
+    /// uncertain, the variants on the CPU backend (f64) and the GPU engine (f64, f32) — solved
+    /// / total per path, each variant's hook load, torque and side force against the CPU's,
+    /// P10/P50/P90, wall time (mc_corpus.csv, mc_variants.csv, summary.json, plot).
+    McCorpus(McCorpusArgs),
     /// Mesh convergence on corpus wells: hook load, torque, the largest side force and the
     /// stabilizer forces as the pipe elements shrink from 30 m to 0.5 m (mesh.csv, mesh.md).
     Mesh {
@@ -370,5 +375,56 @@ impl LuFormArg {
             LuFormArg::Lanes => LuForm::Lanes,
             LuFormArg::Cyclic => LuForm::Cyclic,
         }));
+    }
+}
+
+/// `holewall bench mc-corpus`'s arguments.
+#[derive(clap::Args)]
+pub struct McCorpusArgs {
+    /// Wells (seeds first-seed, first-seed + 1, …).
+    #[arg(long, default_value_t = 12)]
+    wells: usize,
+    /// First seed.
+    #[arg(long, default_value_t = 0)]
+    first_seed: u64,
+    /// These seeds instead of --wells from --first-seed (comma-separated).
+    #[arg(long, value_delimiter = ',', conflicts_with_all = ["wells", "first_seed"])]
+    seeds: Vec<u64>,
+    /// How the wells are drawn.
+    #[arg(long, value_enum, default_value_t)]
+    style: crate::corpus::CorpusStyle,
+    /// Monte Carlo samples (variants) per well (Latin hypercube).
+    #[arg(long, default_value_t = 32, value_parser = clap::value_parser!(u64).range(1..=4096))]
+    samples: u64,
+    /// Wells with more nodes are not run (lavapipe runs the kernels on the CPU).
+    #[arg(long, default_value_t = 700)]
+    max_nodes: usize,
+    /// Start no new well after this many seconds (the rest are reported as not run).
+    #[arg(long, value_parser = positive_seconds)]
+    max_seconds: Option<f64>,
+    /// Output folder (created; wells/ holds each well's case and survey).
+    #[arg(long)]
+    out: PathBuf,
+    /// No progress bar.
+    #[arg(long)]
+    quiet: bool,
+}
+
+impl McCorpusArgs {
+    /// Runs the benchmark: the line it prints.
+    pub fn run(&self) -> Result<String, crate::Error> {
+        let options = super::bench_mc_corpus::McCorpusOptions {
+            seeds: super::bench_corpus::corpus_seeds(
+                self.wells,
+                self.first_seed,
+                self.seeds.clone(),
+            ),
+            style: self.style,
+            samples: self.samples as usize,
+            max_nodes: self.max_nodes,
+            max_seconds: self.max_seconds,
+            show_progress: !self.quiet,
+        };
+        super::bench_mc_corpus::run(&self.out, &options).map(|s| s.line(&self.out))
     }
 }

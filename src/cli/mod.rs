@@ -10,6 +10,7 @@ pub mod bench_dynamic_corpus;
 pub mod bench_ensemble;
 pub mod bench_job;
 pub mod bench_kernels;
+pub mod bench_mc_corpus;
 pub mod bench_specialisation;
 pub mod calibrate_cmd;
 pub mod contact;
