@@ -351,37 +351,24 @@ pub fn run(out: &Path, options: &McCorpusOptions) -> Result<McCorpusSummary, Err
             };
             let seconds = t.elapsed().as_secs_f64();
             bar.inc(1);
-            let (rs, note) = match ran {
-                Ok((rs, _, note)) => (rs, note.unwrap_or_default()),
-                Err(why) => {
-                    results.push(None);
-                    rows.push(McRow {
-                        seed,
-                        trajectory: well.spec.trajectory.name().to_string(),
-                        mode: well.spec.mode.clone(),
-                        nodes: case.model.nodes.len(),
-                        path: name.into(),
-                        variants: variants.len(),
-                        solved: 0,
-                        by_engine: 0,
-                        relaxed: 0,
-                        seconds: f64::NAN,
-                        hook_load_rel: f64::NAN,
-                        torque_rel: f64::NAN,
-                        side_force_rel: f64::NAN,
-                        hook_load_rel_relaxed: f64::NAN,
-                        solved_here_only: 0,
-                        hook_load_p10_n: f64::NAN,
-                        hook_load_p50_n: f64::NAN,
-                        hook_load_p90_n: f64::NAN,
-                        note: why,
-                    });
-                    continue;
-                }
+            // A path that did not run (no GPU, or the engine refused the case) has a row
+            // with its reason and no results.
+            let (rs, note, ran) = match ran {
+                Ok((rs, _, note)) => (rs, note.unwrap_or_default(), true),
+                Err(why) => (Vec::new(), why, false),
             };
             let cpu = results.first().and_then(Option::as_ref).unwrap_or(&rs);
-            let diff = differences(&rs, cpu, false);
-            let diff_relaxed = differences(&rs, cpu, true);
+            let nan = [f64::NAN; 3];
+            let diff = if ran {
+                differences(&rs, cpu, false)
+            } else {
+                nan
+            };
+            let diff_relaxed = if ran {
+                differences(&rs, cpu, true)
+            } else {
+                nan
+            };
             let one_sided = rs
                 .iter()
                 .zip(cpu)
@@ -408,14 +395,14 @@ pub fn run(out: &Path, options: &McCorpusOptions) -> Result<McCorpusSummary, Err
                 mode: well.spec.mode.clone(),
                 nodes: case.model.nodes.len(),
                 path: name.into(),
-                variants: rs.len(),
+                variants: variants.len(),
                 solved: rs.iter().filter(|r| solved(r)).count(),
                 by_engine: rs
                     .iter()
                     .filter(|r| solved(r) && r.solved_by == SolvedBy::Engine)
                     .count(),
                 relaxed: rs.iter().filter(|r| relaxed(r)).count(),
-                seconds,
+                seconds: if ran { seconds } else { f64::NAN },
                 hook_load_rel: diff[0],
                 torque_rel: diff[1],
                 side_force_rel: diff[2],
@@ -426,7 +413,7 @@ pub fn run(out: &Path, options: &McCorpusOptions) -> Result<McCorpusSummary, Err
                 hook_load_p90_n: p[2],
                 note,
             });
-            results.push(Some(rs));
+            results.push(ran.then_some(rs));
         }
         let hook = |k: usize, j: usize| -> f64 {
             results[k]
