@@ -238,12 +238,14 @@ fn relaxed(r: &VariantResult) -> bool {
 /// neither reached by relaxation (`of_relaxed` false), or those either did — an answer
 /// past a fold is one of several equilibria, which the path chose
 /// ([`crate::diagnose::relaxed_warning`]), so the paths may part there by more than rounding.
+/// NaN where no variant is of the kind.
 fn differences(rs: &[VariantResult], cpu: &[VariantResult], of_relaxed: bool) -> [f64; 3] {
-    let mut worst = [0.0f64; 3];
+    let mut worst = [f64::NAN; 3];
     for (r, c) in rs.iter().zip(cpu) {
         if !(solved(r) && solved(c)) || (relaxed(r) || relaxed(c)) != of_relaxed {
             continue;
         }
+        worst = worst.map(|w| if w.is_nan() { 0.0 } else { w });
         let (a, b) = (quantities(r), quantities(c));
         for k in 0..3 {
             let d = (a[k] - b[k]).abs() / b[k].abs().max(FLOORS[k]);
