@@ -245,10 +245,9 @@ pub fn locked_up_warning(case: &Case, hook_load: f64) -> Option<String> {
 /// entries by ≤ 2.3e-14 of the largest) left the hook load of every well that relaxed on
 /// neither path within 1.4e-7, and moved those that relaxed on either: on the drawn corpus's
 /// 500 wells 18 of 65 by more than 1e-6, 4 by more than 1 %, at most 2.6 %; on the user-style
-/// seeds 0–289 14 of 37, 4 by more than 1 %, at most 6.5 %. The GPU engine against the CPU
-/// on Monte Carlo variants of corpus wells (docs/validation.md, stop 86): relaxed hook loads
-/// parted by up to 6.7 % (drawn well 3740, −203.7 against −189.9 kN in f64) and, on a hook
-/// load near zero, by 0.57 kN of 5.4 kN (3654, f32). `None` where it did not relax.
+/// seeds 0–289 14 of 37, 4 by more than 1 %, at most 6.5 %. GPU against CPU on corpus Monte
+/// Carlo variants (docs/validation.md, stop 86): up to 6.7 % (drawn 3740, −203.7 against
+/// −189.9 kN, f64), 0.57 kN of 5.4 kN near zero (3654, f32). `None` where it did not relax.
 pub fn relaxed_warning(log: &[String]) -> Option<String> {
     crate::solve::continuation::relaxed(log).then(|| {
         format!(
