@@ -288,6 +288,13 @@ pub(crate) fn keep_touching(
 
 /// [`solve_in_hole`]'s policy with the static solve given (`solve`; the tests give one that
 /// fails where they want).
+///
+/// A turning string whose solve fails (not for its time budget) where the FE string stood
+/// is judged again by the whirl's rule on its own axial forces there, carried to the full
+/// loads ([`crate::diagnose::whirl_span_where_stopped`]): where that names a span the soft string's
+/// compression did not (the FE string's neutral point higher, its drag more), the model is
+/// solved once more at the whirl's average over both spans, and an answer says so in its
+/// log ([`WHIRL_FROM_FE`]); where that solve fails too, the first failure is the answer.
 pub(crate) fn hold_in_hole(
     case: &Case,
     model: &mut Model,
@@ -295,7 +302,60 @@ pub(crate) fn hold_in_hole(
     options: &crate::solve::statics::StaticOptions,
     solve: &mut StaticSolve<'_>,
 ) -> Result<crate::solve::statics::StaticSolution, crate::solve::statics::StaticError> {
+    let clock = std::time::Instant::now();
     let span = crate::diagnose::mark_whirling_sites(case, model);
+    let mut failed = match hold_in_hole_at(case, model, add, options, solve, span) {
+        Err(e) if !matches!(e, crate::solve::statics::StaticError::Budget { .. }) => e,
+        done => return done,
+    };
+    let Some(stopped) = failed.stopped_mut() else {
+        return Err(failed);
+    };
+    let Some(fe) = crate::diagnose::whirl_span_where_stopped(case, model, stopped) else {
+        return Err(failed);
+    };
+    let both = span.map_or(fe, |(a, b)| (a.min(fe.0), b.max(fe.1)));
+    if Some(both) == span {
+        return Err(failed);
+    }
+    crate::diagnose::mark_span(model, Some(both));
+    let mut options = *options;
+    options.max_seconds = options
+        .max_seconds
+        .map(|s| (s - clock.elapsed().as_secs_f64()).max(0.0));
+    match hold_in_hole_at(case, model, add, &options, solve, Some(both)) {
+        Ok(mut sol) => {
+            sol.log.push(format!(
+                "{WHIRL_FROM_FE} ({}); the FE string's compression where it stopped, \
+                 carried to the full loads, whirls between MD {:.0} and {:.0} m, where the \
+                 soft string's did not: solved again at the whirl's average there",
+                failed.to_string().lines().next().unwrap_or_default(),
+                fe.0,
+                fe.1
+            ));
+            Ok(sol)
+        }
+        Err(_) => {
+            crate::diagnose::mark_span(model, span);
+            Err(failed)
+        }
+    }
+}
+
+/// The words that open the log line of an answer [`hold_in_hole`] found by the whirl's rule
+/// on the FE string's own compression after a first solve failed (the corpus counts them).
+pub const WHIRL_FROM_FE: &str = "the first solve failed";
+
+/// [`hold_in_hole`] with the sites of the whirl's `span` marked: the solve with a guard
+/// site at each node without one, then the model's own sites where that fails.
+fn hold_in_hole_at(
+    case: &Case,
+    model: &mut Model,
+    add: &mut dyn FnMut(&mut Model, &[usize]),
+    options: &crate::solve::statics::StaticOptions,
+    solve: &mut StaticSolve<'_>,
+    span: Option<(f64, f64)>,
+) -> Result<crate::solve::statics::StaticSolution, crate::solve::statics::StaticError> {
     let said = |mut sol: crate::solve::statics::StaticSolution| {
         note_whirl(&mut sol.log, span);
         sol

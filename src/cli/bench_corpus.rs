@@ -104,6 +104,10 @@ pub struct CorpusSummary {
     /// the span [`crate::diagnose::whirl_span`] widens it to (the circumferential friction
     /// there as torque alone; the solver log says so).
     pub solved_whirling: usize,
+    /// Seeds of the wells solved only by a second solve at the whirl's average over the
+    /// span the FE string's own compression names, where the first failed
+    /// ([`crate::profile::WHIRL_FROM_FE`]; of `solved_with_cuts`).
+    pub solved_whirl_from_fe: Vec<u64>,
     /// Solved wells whose answer stresses the pipe past every API grade's yield
     /// ([`crate::diagnose::past_yield`]): counted solved, an answer no pipe carries.
     pub solved_past_yield: Vec<u64>,
@@ -326,6 +330,11 @@ pub fn run(out: &Path, options: &CorpusOptions) -> Result<CorpusSummary, Error> 
             .filter(|r| !r.solved && !r.lock_up_md_m.is_finite() && r.whirl_md_m.is_finite())
             .count(),
         solved_whirling: solved.iter().filter(|r| r.whirl_md_m.is_finite()).count(),
+        solved_whirl_from_fe: solved
+            .iter()
+            .filter(|r| r.whirl_from_fe)
+            .map(|r| r.spec.seed)
+            .collect(),
         solved_past_yield: solved
             .iter()
             .filter(|r| r.past_yield)

@@ -518,6 +518,10 @@ pub struct WellResult {
     /// Where a turning buckled string presses the wall harder than anything holds it: the
     /// MD of its worst element (m; NaN where none: [`crate::diagnose::rotating_whirl`]).
     pub whirl_md_m: f64,
+    /// Solved by a second solve after the first failed, at the whirl's average over the
+    /// span the FE string's own compression names ([`crate::profile::WHIRL_FROM_FE`]): a
+    /// result to report (counted in `step_cuts` too).
+    pub whirl_from_fe: bool,
     /// The load factor the FE solve reached: 1 when solved, where its load path stopped
     /// when not ([`crate::solve::statics::StaticError::reached`]; 0 in the gravity stage).
     pub fe_reached: f64,
@@ -598,6 +602,7 @@ pub fn run_well(
         lock_up_fraction: crate::diagnose::lock_up_fraction(&case).unwrap_or(f64::NAN),
         whirl_md_m: crate::diagnose::rotating_whirl(&case, &soft.tension, &soft.side_force)
             .map_or(f64::NAN, |w| w.md),
+        whirl_from_fe: false,
         fe_reached: 0.0,
         stopped_hook_load_n: f64::NAN,
         through_wall_mm: f64::NAN,
@@ -627,6 +632,10 @@ pub fn run_well(
             r.load_steps = sol.iterations.len();
             r.step_cuts = crate::profile::path_events(&sol.log);
             r.relaxed = crate::solve::continuation::relaxed(&sol.log);
+            r.whirl_from_fe = sol
+                .log
+                .iter()
+                .any(|l| l.starts_with(crate::profile::WHIRL_FROM_FE));
             r.iterations = sol.iterations.iter().sum();
             r.fe_hook_load_n = hook;
             r.hook_load_ratio = hook / r.soft_hook_load_n;

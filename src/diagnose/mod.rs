@@ -16,7 +16,7 @@ mod whirl;
 pub use past_yield::{past_yield, past_yield_warning, STRONGEST_API_YIELD_PA};
 pub use whirl::{
     mark_span, mark_whirling_sites, rotating_whirl, rotating_whirl_of, whirl_reason, whirl_span,
-    Whirl, NEAR_VERTICAL_DEG,
+    whirl_span_where_stopped, Whirl, NEAR_VERTICAL_DEG,
 };
 
 /// The sinusoidal and helical buckling loads of element `e` (N of compression) in a hole of

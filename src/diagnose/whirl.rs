@@ -55,6 +55,53 @@ pub fn whirl_span(case: &Case, model: &Model) -> Option<(f64, f64)> {
     Some(widened(model, &w))
 }
 
+/// [`whirl_span`] with the FE string's own compression in place of the soft string's: its
+/// axial forces where it stood when its solve failed (`stopped`, at a load factor `λ` below
+/// 1), carried to the full loads by the soft string's own change from `λ` to 1 (friction and
+/// bit loads scaled as the FE path scales them); the soft string's side force still the
+/// hold. `profile::hold_in_hole` solves again at the whirl's average over a span this names
+/// and [`whirl_span`] did not.
+///
+/// Where the FE string carries more drag than the soft string, its neutral point sits
+/// higher and its compression in a near-vertical hole is more than the soft string's by
+/// that drag. Measured (docs/performance.md, stop 87): unseen user-style well 2771
+/// (horizontal, 5,342 m, reaming 3½ in pipe, 2 m elements) — the soft string's neutral
+/// point at 1,102 m and 10 kN of compression at the kick-off (1,170 m), short of the
+/// rule's whirl; the FE string, solved at the whirl's average, has its neutral point at
+/// 1,010 m and 24 kN there. Without it, the FE string wound into a helix (its lateral
+/// displacement the whole clearance, turning round the hole node by node) whose relaxation
+/// crawled along the helix's turn for 1,300 sub-solves, pushed by 2–3 N a node of
+/// circumferential friction, and failed (110 s).
+pub fn whirl_span_where_stopped(
+    case: &Case,
+    model: &Model,
+    stopped: &crate::solve::statics::Stopped,
+) -> Option<(f64, f64)> {
+    use crate::solve::soft_string::{soft_string_with, Operation};
+    if model.rotation_speed == 0.0 || stopped.model.nodes.len() != model.nodes.len() {
+        return None;
+    }
+    let sol = crate::solve::statics::stopped_solution(stopped);
+    let element: Vec<f64> = sol.section_forces.iter().map(|f| f.axial).collect();
+    let fe = crate::profile::nodal_axial_forces(&element);
+    let lambda = stopped.lambda;
+    let full = case.soft_string_of(model);
+    let op = case.operation_of(&stopped.model);
+    let at = soft_string_with(
+        &stopped.model,
+        &Operation {
+            friction: lambda * op.friction,
+            ..op
+        },
+        &|md| lambda * case.hole_at(md).friction,
+    );
+    let axial: Vec<f64> = (0..fe.len())
+        .map(|i| fe[i] + full.tension[i] - at.tension[i])
+        .collect();
+    let w = rotating_whirl_of(case, model, &axial, &full.side_force)?;
+    Some(widened(model, &w))
+}
+
 /// The rule's span `w` on `model`, widened through the near-vertical hole on either side
 /// ([`whirl_span`]).
 fn widened(model: &Model, w: &Whirl) -> (f64, f64) {
@@ -438,6 +485,91 @@ mod tests {
             (torque / soft_torque - 1.0).abs() < 0.25,
             "{torque} {soft_torque}"
         );
+    }
+
+    /// A turning string whose solve fails where the FE string, standing more compressed than
+    /// the soft string says, whirls by the rule on its own compression
+    /// ([`whirl_span_where_stopped`]) is solved once more at the whirl's average over that
+    /// span, and its log says so; where the FE string's compression names no span, the first
+    /// failure is the answer and nothing is solved again.
+    #[test]
+    fn a_failed_solve_whose_own_compression_whirls_is_solved_again_at_the_whirls_average() {
+        use crate::solve::statics::{StaticError, StaticOptions, Stopped};
+        // Off bottom the vertical pipe hangs in tension: the soft string names no whirl.
+        let case = well(1200.0, "rotating", 0.0, 0.25);
+        assert_eq!(whirl_span(&case, &case.model), None);
+        let solve_in_hole = |case: &Case| {
+            let mut model = case.model.clone();
+            let add = &mut |m: &mut Model, nodes: &[usize]| {
+                crate::profile::add_wall_sites(case, m, nodes)
+            };
+            let options = StaticOptions::default();
+            let sol = crate::profile::solve_in_hole(case, &mut model, add, &options, &mut |_| {});
+            (model, sol.expect("solves"))
+        };
+        // Where a string drilled at 150 kN stands: buckled in the vertical hole.
+        let (_, heavy) = solve_in_hole(&well(1200.0, "rotating", 150.0, 0.25));
+        let (_, light) = solve_in_hole(&case);
+        let run = |stood: &crate::solve::statics::StaticSolution| {
+            let stopped = Stopped {
+                lambda: 1.0,
+                none_at: 1.0,
+                model: case.model.clone(),
+                u: stood.state.u.clone(),
+                rot: stood.state.rot.clone(),
+            };
+            let span = whirl_span_where_stopped(&case, &case.model, &stopped);
+            let mut first = Some(StaticError::LoadStep {
+                stage: "a load step".into(),
+                from: 0.5,
+                step: 0.0,
+                min: 0.0,
+                reason: "stalled".into(),
+                at_md: None,
+                stopped: Some(Box::new(stopped)),
+            });
+            let mut model = case.model.clone();
+            let mut calls = Vec::new();
+            let out = crate::profile::hold_in_hole(
+                &case,
+                &mut model,
+                &mut |m, nodes| crate::profile::add_wall_sites(&case, m, nodes),
+                &StaticOptions::default(),
+                &mut |m, o| {
+                    calls.push(m.sites.iter().any(|s| s.whirls()));
+                    match first.take() {
+                        Some(e) => Err(e),
+                        None => crate::solve::statics::solve_static(m, o),
+                    }
+                },
+            );
+            (span, model, out, calls)
+        };
+        let (span, model, out, calls) = run(&heavy);
+        let (from, to) = span.expect("the buckled FE string whirls");
+        // The vertical hole in it (and the build below, held by the light string's side
+        // force only, by this test's construction).
+        assert!(from < 1000.0 && to > 1200.0, "{span:?}");
+        // The guarded solve (fails), the model's own sites (none: its answer lies beyond the
+        // wall), then the guarded solve at the whirl's average.
+        assert_eq!(calls, [false, false, true]);
+        let sol = out.expect("solved again at the whirl's average");
+        let said = sol
+            .log
+            .iter()
+            .find(|l| l.starts_with(crate::profile::WHIRL_FROM_FE))
+            .expect("the log says so");
+        assert!(
+            said.contains(&format!("between MD {from:.0} and {to:.0} m")),
+            "{said}"
+        );
+        assert!(model.sites.iter().any(|s| s.whirls()));
+        // Its own tension names no span: the first failure stands, nothing marked.
+        let (span, model, out, calls) = run(&light);
+        assert_eq!(span, None);
+        assert_eq!(calls, [false, false]);
+        assert!(matches!(out, Err(StaticError::LoadStep { .. })));
+        assert!(!model.sites.iter().any(|s| s.whirls()));
     }
 
     /// A turning string whose load path brackets an equilibrium has nowhere to stop: its
