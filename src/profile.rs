@@ -335,8 +335,17 @@ pub(crate) fn hold_in_hole(
             ));
             Ok(sol)
         }
-        Err(_) => {
+        Err(again) => {
             crate::diagnose::mark_span(model, span);
+            if let crate::solve::statics::StaticError::LoadStep { reason, .. } = &mut failed {
+                reason.push_str(&format!(
+                    "; solved again at the whirl's average between MD {:.0} and {:.0} m, \
+                     where the FE string's compression whirls: that failed too ({})",
+                    both.0,
+                    both.1,
+                    again.to_string().lines().next().unwrap_or_default()
+                ));
+            }
             Err(failed)
         }
     }

@@ -510,7 +510,7 @@ mod tests {
         // Where a string drilled at 150 kN stands: buckled in the vertical hole.
         let (_, heavy) = solve_in_hole(&well(1200.0, "rotating", 150.0, 0.25));
         let (_, light) = solve_in_hole(&case);
-        let run = |stood: &crate::solve::statics::StaticSolution| {
+        let run = |stood: &crate::solve::statics::StaticSolution, again: bool| {
             let stopped = Stopped {
                 lambda: 1.0,
                 none_at: 1.0,
@@ -519,15 +519,16 @@ mod tests {
                 rot: stood.state.rot.clone(),
             };
             let span = whirl_span_where_stopped(&case, &case.model, &stopped);
-            let mut first = Some(StaticError::LoadStep {
+            let failure = |stopped| StaticError::LoadStep {
                 stage: "a load step".into(),
                 from: 0.5,
                 step: 0.0,
                 min: 0.0,
                 reason: "stalled".into(),
                 at_md: None,
-                stopped: Some(Box::new(stopped)),
-            });
+                stopped,
+            };
+            let mut first = Some(failure(Some(Box::new(stopped))));
             let mut model = case.model.clone();
             let mut calls = Vec::new();
             let out = crate::profile::hold_in_hole(
@@ -539,13 +540,14 @@ mod tests {
                     calls.push(m.sites.iter().any(|s| s.whirls()));
                     match first.take() {
                         Some(e) => Err(e),
+                        None if again => Err(failure(None)),
                         None => crate::solve::statics::solve_static(m, o),
                     }
                 },
             );
             (span, model, out, calls)
         };
-        let (span, model, out, calls) = run(&heavy);
+        let (span, model, out, calls) = run(&heavy, false);
         let (from, to) = span.expect("the buckled FE string whirls");
         // The vertical hole in it (and the build below, held by the light string's side
         // force only, by this test's construction).
@@ -565,10 +567,21 @@ mod tests {
         );
         assert!(model.sites.iter().any(|s| s.whirls()));
         // Its own tension names no span: the first failure stands, nothing marked.
-        let (span, model, out, calls) = run(&light);
+        let (span, model, out, calls) = run(&light, false);
         assert_eq!(span, None);
         assert_eq!(calls, [false, false]);
         assert!(matches!(out, Err(StaticError::LoadStep { .. })));
+        assert!(!model.sites.iter().any(|s| s.whirls()));
+        // Solved again and failed again: the first failure, saying what was tried, nothing
+        // left marked.
+        let (_, model, out, calls) = run(&heavy, true);
+        assert_eq!(calls, [false, false, true, false]);
+        let said = out.expect_err("fails").to_string();
+        assert!(
+            said.contains("stalled; solved again at the whirl's average between MD")
+                && said.contains("that failed too (a load step failed: stalled)"),
+            "{said}"
+        );
         assert!(!model.sites.iter().any(|s| s.whirls()));
     }
 
