@@ -211,7 +211,8 @@ pub fn path_events(log: &[String]) -> usize {
 ///
 /// `add(model, nodes)` gives `model` its sites at `nodes` ([`add_wall_sites`] for a case's
 /// model; a variant's applies its own overrides to them too,
-/// [`crate::ensemble::apply_with_sites`]); it is called once, with every node that has no
+/// [`crate::ensemble::apply_with_sites`]); it is called once a solve (a second time where
+/// a failure is judged again for a whirl, [`hold_in_hole`]), with every node that has no
 /// site.
 pub fn solve_in_hole(
     case: &Case,
@@ -291,10 +292,11 @@ pub(crate) fn keep_touching(
 ///
 /// A turning string whose solve fails (not for its time budget) where the FE string stood
 /// is judged again by the whirl's rule on its own axial forces there, carried to the full
-/// loads ([`crate::diagnose::whirl_span_where_stopped`]): where that names a span the soft string's
-/// compression did not (the FE string's neutral point higher, its drag more), the model is
-/// solved once more at the whirl's average over both spans, and an answer says so in its
-/// log ([`WHIRL_FROM_FE`]); where that solve fails too, the first failure is the answer.
+/// loads ([`crate::diagnose::whirl_span_where_stopped`]): where that names a span the soft
+/// string's compression did not (the FE string's neutral point higher, its drag more), the
+/// model is solved once more at the whirl's average over both spans, and an answer says so
+/// in its log ([`WHIRL_FROM_FE`]); where that solve fails too, the first failure is the
+/// answer and says what was tried.
 pub(crate) fn hold_in_hole(
     case: &Case,
     model: &mut Model,
