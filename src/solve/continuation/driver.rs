@@ -42,6 +42,24 @@ pub trait StaticSystem: NewtonSystem {
     /// Keeps variant `j`'s current state, a relaxation's best sub-solve so far
     /// ([`LoadPath::shift_settled`]), for [`StaticSystem::back_to_best`].
     fn keep_best(&mut self, j: usize) -> Result<(), crate::error::SystemError>;
+    /// Whether the system shifts rotations as well as translations
+    /// ([`StaticSystem::set_rotation_shift`]); those that do not decline it, and a
+    /// relaxation whose translational shift reaches its ceiling ends there.
+    fn shifts_rotations(&self) -> bool {
+        false
+    }
+    /// Sets variant `j`'s rotational proximal shift `s` (N·m/rad; 0: none), anchored at its
+    /// current rotations ([`LoadPath::rotation_shift`]): the moment residual gains `s θ`,
+    /// `θ` the rotation since the anchor, the rotational diagonal blocks `s I`.
+    fn set_rotation_shift(&mut self, _j: usize, s: f64) -> Result<(), crate::error::SystemError> {
+        if s == 0.0 {
+            Ok(())
+        } else {
+            Err(crate::error::SystemError::Unsupported(
+                "this system shifts translations only".into(),
+            ))
+        }
+    }
     /// Returns variant `j`'s state and restart point to the state [`StaticSystem::keep_best`]
     /// kept last ([`LoadPath::take_back_to_best`]).
     fn back_to_best(&mut self, j: usize) -> Result<(), crate::error::SystemError>;
@@ -103,7 +121,9 @@ pub fn solve_loads_from(
 ) -> Result<Vec<NewtonState>, crate::error::SystemError> {
     let v = sys.variants();
     let mut newton = Newton::new(settings, v);
-    for (j, path) in paths.iter().enumerate() {
+    let rotations = sys.shifts_rotations();
+    for (j, path) in paths.iter_mut().enumerate() {
+        path.allow_rotation_shift(rotations);
         if path.finished() {
             continue;
         }
@@ -170,6 +190,7 @@ fn next_steps(
         if next == Next::Step {
             sys.set_target(j, &path.target())?;
             sys.set_shift(j, path.shift(), path.momentum())?;
+            sys.set_rotation_shift(j, path.rotation_shift())?;
             let floor = sys.step_floor(j)?;
             newton.start_limited(j, floor, path.polish(), path.limits());
         }

@@ -162,6 +162,8 @@ pub struct LoadPath {
     pub doubtful: bool,
     /// The relaxation just settled at its best state ([`LoadPath::take_back_to_best`]).
     back_to_best: bool,
+    /// The system shifts rotations ([`LoadPath::allow_rotation_shift`]).
+    rotations_shift: bool,
 }
 
 impl LoadPath {
@@ -197,6 +199,7 @@ impl LoadPath {
             stall_tolerance: relax_stall_tolerance(options, refine),
             gravity_reason: String::new(),
             relax: None,
+            rotations_shift: false,
             iterations: Vec::new(),
             log: Vec::new(),
             error: None,
@@ -277,6 +280,20 @@ impl LoadPath {
     /// relaxation).
     pub fn shift(&self) -> f64 {
         self.relaxing().map_or(0.0, |r| r.s)
+    }
+
+    /// The rotations' proximal shift of the sub-solve being run (N·m/rad; 0 but in a
+    /// relaxation whose translational shift reached its ceiling, `RELAX_ROTATION_SHIFT`).
+    pub fn rotation_shift(&self) -> f64 {
+        self.relaxing()
+            .filter(|r| r.rotations)
+            .map_or(0.0, |r| RELAX_ROTATION_SHIFT * r.s)
+    }
+
+    /// Whether the system shifts rotations ([`StaticSystem::shifts_rotations`]): set by
+    /// [`solve_loads`] before the paths run.
+    pub fn allow_rotation_shift(&mut self, yes: bool) {
+        self.rotations_shift = yes;
     }
 
     /// The relaxation being run (none outside [`Stage::Relax`]).
@@ -577,6 +594,7 @@ impl LoadPath {
             back_to_best: false,
             since_best: Vec::new(),
             cycling: false,
+            rotations: false,
             failed_at: 0.0,
             reason,
             cause,
@@ -732,7 +750,20 @@ impl LoadPath {
                 r.failed_at = r.s;
                 r.s *= 4.0;
                 let ends = r.exhausted(self.max_iterations);
-                if r.s > RELAX_CEILING * r.s0 || ends.is_some() {
+                if r.s > RELAX_CEILING * r.s0
+                    && ends.is_none()
+                    && !r.rotations
+                    && self.rotations_shift
+                {
+                    r.rotations = true;
+                    r.s = r.s0;
+                    r.failed_at = 0.0;
+                    self.log.push(format!(
+                        "relaxation after \"{}\": its shift passed {RELAX_CEILING:.0e} times its start \
+                         after {} sub-solves ({reason}); the rotations shifted too from there",
+                        r.reason, r.subs
+                    ));
+                } else if r.s > RELAX_CEILING * r.s0 || ends.is_some() {
                     // A sub-solve that failed as the relaxation ran out says both.
                     let reason = match ends {
                         Some(e) if !reason.contains(&e) => format!("{reason}; {e}"),

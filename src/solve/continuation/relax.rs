@@ -154,8 +154,22 @@ pub(super) const RELAX_FLOOR: f64 = 1e-5;
 /// steps). At 1 (relax at the first failure) the m = 2/3 wells took 14,143 iterations, but
 /// the m = 0.1 case fails; at 1/16 13,736, and it fails.
 pub(super) const RELAX_AFTER_STEP: f64 = 1.0 / 64.0;
-/// A shift above `s0 ×` this ends a relaxation that cannot make progress.
+/// A shift above `s0 ×` this ends a relaxation that cannot make progress — or, the first
+/// time, on a system that can ([`super::StaticSystem::shifts_rotations`]), starts it again
+/// from `s0` with the rotations shifted too ([`RELAX_ROTATION_SHIFT`]).
 pub(super) const RELAX_CEILING: f64 = 1e6;
+/// The rotations' shift (N·m/rad) per unit of the translations' (N/m), in m², of a
+/// relaxation whose translational shift reached [`RELAX_CEILING`]: sub-solves that fail
+/// even at a translational shift of a million times its start fail in the rotations,
+/// which that shift does not touch. Unseen user well 3163 (horizontal, drilling with a
+/// 1.66° motor 1.4 m above the bit, 1 m BHA elements) at 30 and 35 m pipe elements ended
+/// its relaxation there after 12 sub-solves and failed (it solves at 5–32 m and 40 m); with
+/// the rotations shifted from the start at 0.01, 0.1 and 1 m² it solved at 30 m (117,
+/// 171, 904 sub-solves; 187.36 kN against the soft string's 187.40), at 100 m² it failed.
+/// Shifting them in every relaxation moved every relaxed path and lost user well 0
+/// (docs/performance.md, stop 87); from the ceiling on, only relaxations that end there
+/// otherwise change.
+pub(super) const RELAX_ROTATION_SHIFT: f64 = 0.01;
 /// Where the relaxation to the full loads failed, relaxations to smaller loads bracket
 /// the largest load with an equilibrium to this width of the load factor (at most three
 /// from a failure at the first step).
@@ -194,6 +208,9 @@ pub(super) struct Relax {
     pub(super) since_best: Vec<f64>,
     /// They go round a cycle: the sub-solves are solved exactly until the next best.
     pub(super) cycling: bool,
+    /// The rotations are shifted too ([`RELAX_ROTATION_SHIFT`]; since the translational
+    /// shift reached [`RELAX_CEILING`]).
+    pub(super) rotations: bool,
     /// The shift of the last sub-solve that failed, halved at each one that converges
     /// since (0: none): the shift is not lowered below twice it, so the next try at that
     /// shift comes after two sub-solves that converge, not one, and from a failure on

@@ -628,3 +628,35 @@ fn a_relaxation_that_goes_round_a_cycle_solves_its_sub_solves_exactly() {
     p.converged(4);
     assert_eq!(p.limits().relative, Some(RELAX_SUB_REDUCTION));
 }
+
+/// A relaxation whose sub-solves fail until its shift passes [`RELAX_CEILING`] starts again
+/// from its first shift with the rotations shifted too ([`RELAX_ROTATION_SHIFT`] of the
+/// translations' shift), once, where the system shifts rotations; where it does not, the
+/// relaxation ends at the ceiling as before.
+#[test]
+fn a_relaxation_at_its_ceiling_shifts_the_rotations_too_once() {
+    // 4¹⁰ > 1e6: the tenth failed sub-solve passes the ceiling from a shift scale of 1.
+    for (rotations, subs) in [(false, 10), (true, 20)] {
+        let (mut p, _) = stuck(Some(1.0));
+        p.allow_rotation_shift(rotations);
+        assert_eq!((p.shift(), p.rotation_shift()), (1.0, 0.0));
+        let mut failed = 0;
+        while p.stage == Stage::Relax && p.target().lambda == 1.0 {
+            p.failed("no".into());
+            failed += 1;
+            if failed < 10 {
+                assert_eq!(p.rotation_shift(), 0.0);
+            } else if failed < 20 && rotations {
+                // From its first shift again, the rotations shifted with it.
+                assert_eq!(p.shift(), 4f64.powi(failed - 10));
+                assert_eq!(p.rotation_shift(), RELAX_ROTATION_SHIFT * p.shift());
+            }
+        }
+        assert_eq!(failed, subs, "rotations {rotations}");
+        let said = p
+            .log
+            .iter()
+            .any(|l| l.contains("the rotations shifted too"));
+        assert_eq!(said, rotations);
+    }
+}

@@ -34,6 +34,10 @@ pub(super) struct CpuStatic<'a> {
     /// The state the anchor was last set at (`x₋` of
     /// [`crate::solve::continuation::StaticSystem::set_shift`]).
     anchor_base: Vec<Vec3<f64>>,
+    /// A relaxation's rotational shift (N·m/rad) and its anchor rotations
+    /// ([`crate::solve::continuation::StaticSystem::set_rotation_shift`]).
+    rotation_shift: f64,
+    anchor_rot: Vec<Mat3<f64>>,
     /// The last equilibrium the load path reached, with its loads
     /// ([`StaticSystem::keep_equilibrium`]).
     pub(super) kept: Option<(StaticState, crate::solve::continuation::LoadTarget)>,
@@ -52,6 +56,37 @@ pub fn relax_scale(model: &Model, f_ref: f64) -> f64 {
         .map(|e| e.length0)
         .fold(f64::INFINITY, f64::min);
     f_ref / shortest.max(1e-3)
+}
+
+/// Adds a rotational proximal shift `s θ` to the moments' residual, `θ = log(R R_aᵀ)` each
+/// node's rotation since its anchor `R_a` (spatial, as the Newton update
+/// `R ← exp(Δθ) R` turns it), and `s I` to their tangent blocks (the exact derivative at
+/// `θ = 0`; a proximal term needs no more).
+fn add_rotation_shift(
+    s: f64,
+    rot: &[Mat3<f64>],
+    anchor: &[Mat3<f64>],
+    residual: &mut [f64],
+    tangent: Option<&mut BlockTridiagonal>,
+) {
+    if s == 0.0 || anchor.len() != rot.len() {
+        return;
+    }
+    for (i, (r, a)) in rot.iter().zip(anchor).enumerate() {
+        let at: Mat3<f64> = std::array::from_fn(|p| std::array::from_fn(|q| a[q][p]));
+        let theta =
+            crate::physics::rotation::rotation_log(&crate::physics::rotation::mat_mul(r, &at));
+        for k in 0..3 {
+            residual[6 * i + 3 + k] += s * theta[k];
+        }
+    }
+    if let Some(t) = tangent {
+        for d in t.diag.iter_mut() {
+            for (k, row) in d.iter_mut().enumerate().skip(3) {
+                row[k] += s;
+            }
+        }
+    }
 }
 
 /// Adds a proximal shift `s (u − a)` to the translations' residual (`u` the displacements) and `s I` to their
@@ -107,6 +142,8 @@ impl<'a> CpuStatic<'a> {
             shift: 0.0,
             anchor: Vec::new(),
             anchor_base: Vec::new(),
+            rotation_shift: 0.0,
+            anchor_rot: Vec::new(),
             kept: None,
             best: None,
         }
@@ -171,6 +208,13 @@ impl crate::solve::newton::NewtonSystem for CpuStatic<'_> {
                 &mut self.residual,
                 Some(&mut self.tangent),
             );
+            add_rotation_shift(
+                self.rotation_shift,
+                &self.state.rot,
+                &self.anchor_rot,
+                &mut self.residual,
+                Some(&mut self.tangent),
+            );
             constrain(&self.c, &mut self.residual, &mut self.tangent);
             self.evaluated = true;
         }
@@ -202,6 +246,13 @@ impl crate::solve::newton::NewtonSystem for CpuStatic<'_> {
         let (s, landed) = self.moved(alpha[0]);
         assemble(&self.loaded, &s, 1.0, &self.f_step, &mut self.trial, None);
         add_shift(self.shift, &s.u, &self.anchor, &mut self.trial, None);
+        add_rotation_shift(
+            self.rotation_shift,
+            &s.rot,
+            &self.anchor_rot,
+            &mut self.trial,
+            None,
+        );
         constrain_residual(&self.c, &mut self.trial);
         self.trial_state = Some((alpha[0], s, landed));
         Ok(crate::solve::newton::TrialProbe {
@@ -325,6 +376,19 @@ impl crate::solve::continuation::StaticSystem for CpuStatic<'_> {
         self.evaluated = false;
         Ok(())
     }
+    fn shifts_rotations(&self) -> bool {
+        true
+    }
+    fn set_rotation_shift(&mut self, _j: usize, s: f64) -> Result<(), crate::error::SystemError> {
+        self.rotation_shift = s;
+        if s == 0.0 {
+            self.anchor_rot.clear();
+        } else {
+            self.anchor_rot.clone_from(&self.state.rot);
+        }
+        self.evaluated = false;
+        Ok(())
+    }
     fn step_floor(&mut self, _j: usize) -> Result<f64, crate::error::SystemError> {
         // Of the positions from the origin, as the engine's f64 floor.
         let largest = (0..self.state.u.len())
@@ -336,4 +400,38 @@ impl crate::solve::continuation::StaticSystem for CpuStatic<'_> {
 
 fn dot_n(a: &[f64], b: &[f64]) -> f64 {
     a.iter().zip(b).map(|(x, y)| x * y).sum()
+}
+
+#[cfg(test)]
+mod rotation_shift_tests {
+    use super::*;
+
+    /// The rotational shift adds `s θ` to each node's moment rows, `θ` its rotation since
+    /// the anchor (`R = exp(θ) R_a`), nothing to the force rows, and `s` to its rotational
+    /// diagonal; no anchor, nothing.
+    #[test]
+    fn the_rotational_shift_adds_s_theta_to_the_moments() {
+        let anchor = [
+            rotation_exp(&[0.1, -0.2, 0.3]),
+            rotation_exp(&[0.0, 0.0, 0.0]),
+        ];
+        let theta = [[0.01, 0.02, -0.03], [-0.2, 0.1, 0.05]];
+        let rot: Vec<Mat3<f64>> = (0..2)
+            .map(|i| crate::physics::rotation::mat_mul(&rotation_exp(&theta[i]), &anchor[i]))
+            .collect();
+        let mut r = vec![0.0; 12];
+        add_rotation_shift(7.0, &rot, &anchor, &mut r, None);
+        for i in 0..2 {
+            for k in 0..3 {
+                assert_eq!(r[6 * i + k], 0.0);
+                assert!(
+                    (r[6 * i + 3 + k] - 7.0 * theta[i][k]).abs() < 1e-13,
+                    "{r:?}"
+                );
+            }
+        }
+        let mut none = vec![0.0; 12];
+        add_rotation_shift(7.0, &rot, &[], &mut none, None);
+        assert!(none.iter().all(|&x| x == 0.0));
+    }
 }
