@@ -282,20 +282,6 @@ impl LoadPath {
         self.relaxing().map_or(0.0, |r| r.s)
     }
 
-    /// The rotations' proximal shift of the sub-solve being run (N·m/rad; 0 but in a
-    /// relaxation whose translational shift reached its ceiling, `RELAX_ROTATION_SHIFT`).
-    pub fn rotation_shift(&self) -> f64 {
-        self.relaxing()
-            .filter(|r| r.rotations)
-            .map_or(0.0, |r| RELAX_ROTATION_SHIFT * r.s)
-    }
-
-    /// Whether the system shifts rotations ([`StaticSystem::shifts_rotations`]): set by
-    /// [`solve_loads`] before the paths run.
-    pub fn allow_rotation_shift(&mut self, yes: bool) {
-        self.rotations_shift = yes;
-    }
-
     /// The relaxation being run (none outside [`Stage::Relax`]).
     fn relaxing(&self) -> Option<&Relax> {
         self.relax.as_ref().filter(|_| self.stage == Stage::Relax)
@@ -750,19 +736,10 @@ impl LoadPath {
                 r.failed_at = r.s;
                 r.s *= 4.0;
                 let ends = r.exhausted(self.max_iterations);
-                if r.s > RELAX_CEILING * r.s0
-                    && ends.is_none()
-                    && !r.rotations
-                    && self.rotations_shift
-                {
-                    r.rotations = true;
-                    r.s = r.s0;
-                    r.failed_at = 0.0;
-                    self.log.push(format!(
-                        "relaxation after \"{}\": its shift passed {RELAX_CEILING:.0e} times its start \
-                         after {} sub-solves ({reason}); the rotations shifted too from there",
-                        r.reason, r.subs
-                    ));
+                let again = ends.is_none() && r.rotations_at_ceiling(self.rotations_shift);
+                if again {
+                    let line = r.rotations_note(&reason);
+                    self.log.push(line);
                 } else if r.s > RELAX_CEILING * r.s0 || ends.is_some() {
                     // A sub-solve that failed as the relaxation ran out says both.
                     let reason = match ends {

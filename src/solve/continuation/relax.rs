@@ -300,6 +300,46 @@ impl Relax {
     }
 }
 
+impl Relax {
+    /// A sub-solve failed and the shift passed [`RELAX_CEILING`]: where the system shifts
+    /// rotations (`allowed`) and they are not shifted yet, the relaxation starts again from
+    /// its first shift with them shifted too (and says so, [`Relax::rotations_note`]).
+    pub(super) fn rotations_at_ceiling(&mut self, allowed: bool) -> bool {
+        if !allowed || self.rotations || self.s <= RELAX_CEILING * self.s0 {
+            return false;
+        }
+        self.rotations = true;
+        self.s = self.s0;
+        self.failed_at = 0.0;
+        true
+    }
+
+    /// The log's line for [`Relax::rotations_at_ceiling`], with the last failure `reason`.
+    pub(super) fn rotations_note(&self, reason: &str) -> String {
+        format!(
+            "relaxation after \"{}\": its shift passed {RELAX_CEILING:.0e} times its start after \
+             {} sub-solves ({reason}); the rotations shifted too from there",
+            self.reason, self.subs
+        )
+    }
+}
+
+impl super::LoadPath {
+    /// The rotations' proximal shift of the sub-solve being run (N·m/rad; 0 but in a
+    /// relaxation whose translational shift reached its ceiling, [`RELAX_ROTATION_SHIFT`]).
+    pub fn rotation_shift(&self) -> f64 {
+        self.relaxing()
+            .filter(|r| r.rotations)
+            .map_or(0.0, |r| RELAX_ROTATION_SHIFT * r.s)
+    }
+
+    /// Whether the system shifts rotations ([`super::StaticSystem::shifts_rotations`]): set
+    /// by [`super::solve_loads`] before the paths run.
+    pub fn allow_rotation_shift(&mut self, yes: bool) {
+        self.rotations_shift = yes;
+    }
+}
+
 /// Whether the last of `measures` repeat themselves as a cycle ([`RELAX_CYCLE_REPEATS`]).
 pub(super) fn goes_round(measures: &[f64]) -> bool {
     (2..=RELAX_CYCLE_LONGEST).any(|p| {
