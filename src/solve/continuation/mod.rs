@@ -736,7 +736,10 @@ impl LoadPath {
                 r.failed_at = r.s;
                 r.s *= 4.0;
                 let ends = r.exhausted(self.max_iterations);
-                let again = ends.is_none() && r.rotations_at_ceiling(self.rotations_shift);
+                // Not in a failure's bracket (`self.lock`; `RELAX_ROTATION_SHIFT`).
+                let again = ends.is_none()
+                    && self.lock.is_none()
+                    && r.rotations_at_ceiling(self.rotations_shift);
                 if again {
                     let line = r.rotations_note(&reason);
                     self.log.push(line);
