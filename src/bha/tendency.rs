@@ -342,8 +342,11 @@ fn bit_at(
         }
     };
     let m = bha_model(model, first, curvature, wob, toolface);
+    // A curvature whose model fails is halved or given up (`equilibrium_curvature`):
+    // where such a model's string would stop is not needed.
     let options = StaticOptions {
         max_seconds,
+        find_stop: false,
         ..StaticOptions::default()
     };
     let sol = solve_static(&m, &options)?;

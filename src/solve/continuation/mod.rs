@@ -164,6 +164,8 @@ pub struct LoadPath {
     back_to_best: bool,
     /// The system shifts rotations ([`LoadPath::allow_rotation_shift`]).
     rotations_shift: bool,
+    /// [`StaticOptions::find_stop`].
+    find_stop: bool,
 }
 
 impl LoadPath {
@@ -209,6 +211,7 @@ impl LoadPath {
             equilibrium: None,
             stopped: None,
             load_failures: 0,
+            find_stop: options.find_stop,
         };
         p.set_target();
         p
@@ -500,54 +503,6 @@ impl LoadPath {
         } else {
             Next::Step
         }
-    }
-
-    /// After the relaxation to the full loads failed (the string may stop on its way in):
-    /// relaxations to loads between the largest with an equilibrium (`lock.lo`) and the
-    /// smallest without (`lock.hi`), each from where the last one ended, halve that
-    /// interval down to [`LOCK_BRACKET`]; then the path fails, its message saying where
-    /// between the two the string stops. Corpus well 419 (tripping in, 2 m elements) fails
-    /// at its first step, yet the case with its friction scaled to 0.4–0.7 solves on a
-    /// path of its own (docs/performance.md, stop 64).
-    fn bracket(&mut self, lock: Lock) -> Next {
-        if lock.hi - lock.lo <= LOCK_BRACKET * (1.0 + 1e-9) {
-            self.log.push(format!(
-                // "The load path", not "the string": a string that is not run in or out
-                // (turning on or off bottom) does not stop (crate::diagnose::stops).
-                "where the load path stops: an equilibrium at λ = {:.4}, none found at λ = {:.4}",
-                lock.lo, lock.hi
-            ));
-            self.stopped = Some((lock.lo, lock.hi));
-            self.error = Some(StaticError::LoadStep {
-                stage: LOAD_STAGE.into(),
-                from: lock.lo,
-                step: 0.0,
-                min: self.min_step,
-                reason: format!(
-                    "{}; {LOCK_FOUND} λ = {:.4} and none at λ = {:.4}",
-                    lock.why, lock.lo, lock.hi
-                ),
-                at_md: None,
-                stopped: None,
-            });
-            self.stage = Stage::Failed;
-            return Next::Failed;
-        }
-        let mid = 0.5 * (lock.lo + lock.hi);
-        let target = LoadTarget {
-            lambda: mid,
-            friction: mid,
-            ..self.target
-        };
-        let (s0, from) = (lock.s0, lock.lo);
-        self.lock = Some(lock);
-        let next = self.relax_after(target, s0, String::new(), false);
-        if let Some(r) = self.relax.as_mut() {
-            r.reason =
-                format!("where the load path stops: relaxation from λ = {from:.4} to {mid:.4}");
-            r.cause = r.reason.clone();
-        }
-        next
     }
 
     /// The step failed (`reason`): what follows, from the last converged state

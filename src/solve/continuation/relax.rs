@@ -2,9 +2,10 @@
 //! sub-solves, when it settles, stops or starts, and the bracket of where the string stops
 //! after it failed. The policy that drives them is [`super::LoadPath`]'s.
 
-use super::LoadTarget;
+use super::{LoadTarget, Next, Stage};
 use crate::solve::newton::NewtonSettings;
 use crate::solve::static_options::StaticOptions;
+use crate::solve::static_options::{StaticError, LOAD_STAGE};
 
 /// Sub-solves a relaxation may take before the variant fails (a run of one- or
 /// two-iteration sub-solves at the smallest shift that never settles would otherwise spend
@@ -338,6 +339,69 @@ impl super::LoadPath {
     /// by [`super::solve_loads`] before the paths run.
     pub fn allow_rotation_shift(&mut self, yes: bool) {
         self.rotations_shift = yes;
+    }
+
+    /// After the relaxation to the full loads failed (the string may stop on its way in):
+    /// relaxations to loads between the largest with an equilibrium (`lock.lo`) and the
+    /// smallest without (`lock.hi`), each from where the last one ended, halve that
+    /// interval down to [`LOCK_BRACKET`]; then the path fails, its message saying where
+    /// between the two the string stops. Corpus well 419 (tripping in, 2 m elements) fails
+    /// at its first step, yet the case with its friction scaled to 0.4–0.7 solves on a
+    /// path of its own (docs/performance.md, stop 64). Where [`StaticOptions::find_stop`]
+    /// is off, the path fails at once, saying why the relaxation failed.
+    pub(super) fn bracket(&mut self, lock: Lock) -> Next {
+        if !self.find_stop {
+            // The first failure, as it is ([`StaticOptions::find_stop`]).
+            self.error = Some(StaticError::LoadStep {
+                stage: LOAD_STAGE.into(),
+                from: lock.lo,
+                step: 0.0,
+                min: self.min_step,
+                reason: lock.why,
+                at_md: None,
+                stopped: None,
+            });
+            self.stage = Stage::Failed;
+            return Next::Failed;
+        }
+        if lock.hi - lock.lo <= LOCK_BRACKET * (1.0 + 1e-9) {
+            self.log.push(format!(
+                // "The load path", not "the string": a string that is not run in or out
+                // (turning on or off bottom) does not stop (crate::diagnose::stops).
+                "where the load path stops: an equilibrium at λ = {:.4}, none found at λ = {:.4}",
+                lock.lo, lock.hi
+            ));
+            self.stopped = Some((lock.lo, lock.hi));
+            self.error = Some(StaticError::LoadStep {
+                stage: LOAD_STAGE.into(),
+                from: lock.lo,
+                step: 0.0,
+                min: self.min_step,
+                reason: format!(
+                    "{}; {LOCK_FOUND} λ = {:.4} and none at λ = {:.4}",
+                    lock.why, lock.lo, lock.hi
+                ),
+                at_md: None,
+                stopped: None,
+            });
+            self.stage = Stage::Failed;
+            return Next::Failed;
+        }
+        let mid = 0.5 * (lock.lo + lock.hi);
+        let target = LoadTarget {
+            lambda: mid,
+            friction: mid,
+            ..self.target
+        };
+        let (s0, from) = (lock.s0, lock.lo);
+        self.lock = Some(lock);
+        let next = self.relax_after(target, s0, String::new(), false);
+        if let Some(r) = self.relax.as_mut() {
+            r.reason =
+                format!("where the load path stops: relaxation from λ = {from:.4} to {mid:.4}");
+            r.cause = r.reason.clone();
+        }
+        next
     }
 }
 

@@ -499,6 +499,45 @@ fn a_failed_full_load_relaxation_brackets_where_the_string_stops() {
     assert!(e.to_string().contains("none at λ = 0.8750"), "{e}");
 }
 
+/// Without [`StaticOptions::find_stop`] the failed relaxation to the full loads is the
+/// failure: no relaxation to smaller loads, no bracket, the step that failed named.
+#[test]
+fn without_find_stop_a_failed_full_load_relaxation_fails_at_once() {
+    let options = StaticOptions {
+        find_stop: false,
+        ..StaticOptions::default()
+    };
+    let mut p = LoadPath::new(&options, true, true, false);
+    assert_eq!(p.converged(10), Next::Step);
+    assert_eq!(p.converged(10), Next::Step);
+    assert_eq!(p.lambda, 0.25);
+    assert_eq!(p.failed_at("no".into(), None, Some(1e6)), Next::Step);
+    assert_eq!((p.stage, p.target().lambda), (Stage::Relax, 1.0));
+    let mut next = Next::Step;
+    let mut subs = 0;
+    while next == Next::Step {
+        assert_eq!(p.target().lambda, 1.0, "no relaxation to smaller loads");
+        next = p.failed("no".into());
+        subs += 1;
+        assert!(subs < 1000, "the relaxation ends");
+    }
+    assert_eq!(next, Next::Failed);
+    assert_eq!(p.stage, Stage::Failed);
+    assert_eq!(p.stopped_between(), None);
+    let e = p.error.clone().unwrap();
+    assert_eq!(e.reached(), 0.25);
+    let e = e.to_string();
+    assert!(
+        e.contains("load step λ 0.250000 → 0.500000 failed (no)"),
+        "{e}"
+    );
+    assert!(
+        e.contains("found no equilibrium at the full loads either"),
+        "{e}"
+    );
+    assert!(!e.contains(LOCK_FOUND), "{e}");
+}
+
 /// A relaxation's anchor carries no momentum for its first [`RELAX_MOMENTUM_AFTER`]
 /// sub-solves (converged or failed), [`RELAX_MOMENTUM`] from there; a path that is not
 /// relaxing carries none.
