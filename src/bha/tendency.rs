@@ -439,7 +439,7 @@ fn tendency_over(
         // the means are summed in it). A curvature fails with its first toolface in order
         // that fails, so once one has failed, the toolfaces after it that have not begun
         // are not solved (a failed BHA model is the dearest solve: tendency-corpus well
-        // 5442, a rotating bend, 127 → 61 s with a corpus run alongside; the same row).
+        // 5442, a rotating bend, 127 → 30 s alone; the same row).
         let each = all_in_order(toolfaces, |&tf| {
             bit_at(model, first, k, wob, tf, settings.deadline)
         })?;
