@@ -350,37 +350,30 @@ impl super::LoadPath {
     /// path of its own (docs/performance.md, stop 64). Where [`StaticOptions::find_stop`]
     /// is off, the path fails at once, saying why the relaxation failed.
     pub(super) fn bracket(&mut self, lock: Lock) -> Next {
-        if !self.find_stop {
-            // The first failure, as it is ([`StaticOptions::find_stop`]).
-            self.error = Some(StaticError::LoadStep {
-                stage: LOAD_STAGE.into(),
-                from: lock.lo,
-                step: 0.0,
-                min: self.min_step,
-                reason: lock.why,
-                at_md: None,
-                stopped: None,
-            });
-            self.stage = Stage::Failed;
-            return Next::Failed;
-        }
-        if lock.hi - lock.lo <= LOCK_BRACKET * (1.0 + 1e-9) {
-            self.log.push(format!(
-                // "The load path", not "the string": a string that is not run in or out
-                // (turning on or off bottom) does not stop (crate::diagnose::stops).
-                "where the load path stops: an equilibrium at λ = {:.4}, none found at λ = {:.4}",
-                lock.lo, lock.hi
-            ));
-            self.stopped = Some((lock.lo, lock.hi));
-            self.error = Some(StaticError::LoadStep {
-                stage: LOAD_STAGE.into(),
-                from: lock.lo,
-                step: 0.0,
-                min: self.min_step,
-                reason: format!(
+        let closed = lock.hi - lock.lo <= LOCK_BRACKET * (1.0 + 1e-9);
+        if closed || !self.find_stop {
+            // Without `find_stop`, the first failure as it is.
+            let reason = if self.find_stop {
+                self.log.push(format!(
+                    // "The load path", not "the string": a string that is not run in or
+                    // out (turning on or off bottom) does not stop (crate::diagnose::stops).
+                    "where the load path stops: an equilibrium at λ = {:.4}, none found at λ = {:.4}",
+                    lock.lo, lock.hi
+                ));
+                self.stopped = Some((lock.lo, lock.hi));
+                format!(
                     "{}; {LOCK_FOUND} λ = {:.4} and none at λ = {:.4}",
                     lock.why, lock.lo, lock.hi
-                ),
+                )
+            } else {
+                lock.why
+            };
+            self.error = Some(StaticError::LoadStep {
+                stage: LOAD_STAGE.into(),
+                from: lock.lo,
+                step: 0.0,
+                min: self.min_step,
+                reason,
                 at_md: None,
                 stopped: None,
             });
