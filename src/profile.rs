@@ -219,7 +219,7 @@ pub fn solve_in_hole(
     model: &mut Model,
     add: &mut dyn FnMut(&mut Model, &[usize]),
     options: &crate::solve::statics::StaticOptions,
-    progress: &mut dyn FnMut(f64),
+    progress: &mut dyn FnMut(&crate::solve::continuation::Progress),
 ) -> Result<crate::solve::statics::StaticSolution, crate::solve::statics::StaticError> {
     hold_in_hole(case, model, add, options, &mut |m, o| {
         crate::solve::statics::solve_static_started(m, o, progress)
@@ -491,7 +491,7 @@ pub fn solve_or_stop(
     let bar = crate::output::progress_bar(
         show_progress,
         1000,
-        "{bar:40} {percent:>3}% of the loads (static), {elapsed} elapsed",
+        "{bar:40} {percent:>3}% of the loads (static), {elapsed} elapsed\n{wide_msg}",
     );
     let mut model = case.model.clone();
     let solved = solve_in_hole(
@@ -499,7 +499,15 @@ pub fn solve_or_stop(
         &mut model,
         &mut |m, nodes| add_wall_sites(case, m, nodes),
         &options,
-        &mut |lambda| bar.set_position((1000.0 * lambda) as u64),
+        &mut |p| {
+            bar.set_position((1000.0 * p.fraction()) as u64);
+            if bar.is_hidden() {
+                return;
+            }
+            if let Some(note) = p.note() {
+                bar.set_message(note);
+            }
+        },
     );
     bar.finish_and_clear();
     case.model = model;

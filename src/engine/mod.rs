@@ -376,7 +376,9 @@ fn solve_batch<T: Real + Send + Sync, P: KernelPath<T>>(
         let m = members.len();
         let mut sub: Vec<LoadPath> = members.iter().map(|&j| paths[j].clone()).collect();
         let done_before = (v - m) as f64;
-        let mut report = |f: f64| progress((done_before + f * m as f64) / v as f64);
+        let mut report = |p: &crate::solve::continuation::Progress| {
+            progress((done_before + p.fraction() * m as f64) / v as f64)
+        };
         let states = solve_loads_from(
             &mut sys,
             &mut sub,

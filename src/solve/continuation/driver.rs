@@ -2,7 +2,7 @@
 //! through its loads by one [`Newton`], each path's policy ([`LoadPath`]) deciding what
 //! follows a step's end.
 
-use super::{LoadPath, LoadTarget, Next};
+use super::{LoadPath, LoadTarget, Next, Progress};
 use crate::solve::newton::{Event, Newton, NewtonSettings, NewtonState, NewtonSystem};
 
 /// A static problem of V variants that [`solve_loads`] can step through its loads.
@@ -83,13 +83,14 @@ pub trait StaticSystem: NewtonSystem {
     }
 }
 
-/// Runs every variant's load path to its end through one [`Newton`]; `progress` gets the
-/// mean load factor reached after each iteration. Returns the Newton's solve count.
+/// Runs every variant's load path to its end through one [`Newton`]; `progress` sees the
+/// paths after each iteration ([`Progress`]: the mean load factor reached, and one
+/// variant's stage in words). Returns the Newton's solve count.
 pub fn solve_loads(
     sys: &mut dyn StaticSystem,
     paths: &mut [LoadPath],
     settings: NewtonSettings,
-    progress: &mut dyn FnMut(f64),
+    progress: &mut dyn FnMut(&Progress),
 ) -> Result<usize, crate::error::SystemError> {
     let mut solves = 0;
     solve_loads_from(
@@ -117,7 +118,7 @@ pub fn solve_loads_from(
     resume: Option<&[NewtonState]>,
     stop: &dyn Fn(usize, usize) -> bool,
     solves: &mut usize,
-    progress: &mut dyn FnMut(f64),
+    progress: &mut dyn FnMut(&Progress),
 ) -> Result<Vec<NewtonState>, crate::error::SystemError> {
     let v = sys.variants();
     let mut newton = Newton::new(settings, v);
@@ -142,7 +143,7 @@ pub fn solve_loads_from(
         next_steps(sys, paths, &mut newton, events)?;
         let events = newton.advance(sys)?;
         next_steps(sys, paths, &mut newton, events)?;
-        progress(paths.iter().map(LoadPath::progress).sum::<f64>() / v.max(1) as f64);
+        progress(&Progress::of(paths));
         if stop(newton.running_count(), v) {
             break;
         }

@@ -52,9 +52,11 @@
 //! restart point, and a finished one stops costing line searches.
 
 mod driver;
+mod progress;
 mod relax;
 
 pub use driver::{solve_loads, solve_loads_from, StaticSystem};
+pub use progress::Progress;
 use relax::*;
 pub use relax::{carry_anchor, relax_stall_tolerance, LOCK_FOUND};
 

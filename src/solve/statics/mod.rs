@@ -540,11 +540,12 @@ pub fn solve_static(model: &Model, options: &StaticOptions) -> Result<StaticSolu
     solve_static_started(model, options, &mut |_| {})
 }
 
-/// [`solve_static_monitored`] from [`static_start`]; `progress` sees the load factor.
+/// [`solve_static_monitored`] from [`static_start`]; `progress` sees the load path
+/// ([`crate::solve::continuation::Progress`]).
 pub fn solve_static_started(
     model: &Model,
     options: &StaticOptions,
-    progress: &mut dyn FnMut(f64),
+    progress: &mut dyn FnMut(&crate::solve::continuation::Progress),
 ) -> Result<StaticSolution, StaticError> {
     solve_static_monitored(model, static_start(model), options, progress)
 }
@@ -633,13 +634,14 @@ pub fn solve_static_from(
     solve_static_monitored(model, start, options, &mut |_| {})
 }
 
-/// As [`solve_static_from`], calling `progress` with the load factor reached (0 … 1) after
-/// every Newton iteration, and stopping once `options.max_seconds` are spent.
+/// As [`solve_static_from`], calling `progress` with the load path after every Newton
+/// iteration ([`crate::solve::continuation::Progress`]: the load factor reached, the
+/// stage), and stopping once `options.max_seconds` are spent.
 pub fn solve_static_monitored(
     model: &Model,
     start: StaticState,
     options: &StaticOptions,
-    progress: &mut dyn FnMut(f64),
+    progress: &mut dyn FnMut(&crate::solve::continuation::Progress),
 ) -> Result<StaticSolution, StaticError> {
     use crate::solve::continuation::{solve_loads_from, LoadPath};
     let clock = std::time::Instant::now();
