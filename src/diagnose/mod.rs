@@ -241,18 +241,11 @@ pub fn locked_up_warning(case: &Case, hook_load: f64) -> Option<String> {
 /// A warning for an FE answer that came by relaxation past a fold (its solver `log` says so,
 /// [`crate::solve::continuation::relaxed`]): a string buckled or held by its friction past
 /// a fold has several equilibria, and which one the solve reaches depends on its path.
-/// Measured (docs/performance.md, stop 72): the beam tangent changed at rounding level (its
-/// entries by ≤ 2.3e-14 of the largest) left the hook load of every well that relaxed on
-/// neither path within 1.4e-7, and moved those that relaxed on either: on the drawn corpus's
-/// 500 wells 18 of 65 by more than 1e-6, 4 by more than 1 %, at most 2.6 %; on the user-style
-/// seeds 0–289 14 of 37, 4 by more than 1 %, at most 6.5 %. GPU against CPU on corpus Monte
-/// Carlo variants (docs/validation.md, stop 86): up to 6.7 % (drawn 3740, −203.7 against
-/// −189.9 kN, f64), 0.57 kN of 5.4 kN near zero (3654, f32). Stop 89 (docs/performance.md):
-/// the written-out tangent moved drawn 283's pushed −6.70 MN to −7.24 MN (8.1 %), and the
-/// engine sample of unseen user well 4386 (sliding, friction-held, its soft string locking
-/// up at 0.83) read 11.7 kN on the CPU, 15.6 kN on the twin, 14.9 kN in GPU f64 and
-/// 10.7 kN in f32: 3.9 kN, 33 % of a hook load that is a small difference of the string's
-/// weight and its drag. `None` where it did not relax.
+/// Measured (docs/performance.md, stops 72 and 89; docs/validation.md, stop 86): the beam
+/// tangent changed at rounding level left every unrelaxed hook load within 1.4e-7 and moved
+/// relaxed ones by up to 6.5 % (user seeds 0–289) and 8.1 % (drawn 283's −6.70 MN push to
+/// −7.24 MN); the engine against the CPU, up to 6.7 % (drawn 3740) and 3.9 kN of 11.7 kN
+/// (user 4386, friction-held near a lock-up). `None` where it did not relax.
 pub fn relaxed_warning(log: &[String]) -> Option<String> {
     crate::solve::continuation::relaxed(log).then(|| {
         format!(
