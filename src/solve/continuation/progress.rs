@@ -2,8 +2,8 @@
 //! the stage it is in — a relaxation that runs for minutes (a string that locks up) says
 //! how far it has come and when it gives up, where the load factor alone stands still.
 
+use super::RELAX_MAX_SUBS;
 use super::{LoadPath, Stage};
-use super::{RELAX_MAX_SUBS, RELAX_STAGNANT_SUBS};
 
 /// The state of the load paths after a Newton iteration, as the progress callback of
 /// [`super::solve_loads_from`] sees it. The words ([`Progress::note`]) are formed only when
@@ -37,8 +37,8 @@ impl<'a> Progress<'a> {
 impl LoadPath {
     /// The stage being solved, in words for a progress bar (`None` once finished): the load
     /// step, or the relaxation with its sub-solves, its best residual without the shift and
-    /// the sub-solve at which it gives up without a 1 % gain ([`RELAX_STAGNANT_SUBS`] after
-    /// the best, at most [`RELAX_MAX_SUBS`]; its iteration budget may end it sooner), or the
+    /// the sub-solve at which it gives up without a 1 % gain (`Relax::stagnant_at`,
+    /// at most [`RELAX_MAX_SUBS`]; its iteration budget may end it sooner), or the
     /// relaxations to smaller loads that bracket where the string stops.
     pub fn stage_note(&self) -> Option<String> {
         let stage = match self.stage {
@@ -70,7 +70,7 @@ impl LoadPath {
                 } else {
                     "none converged yet".to_string()
                 };
-                let ends = (r.best_at + RELAX_STAGNANT_SUBS).min(RELAX_MAX_SUBS);
+                let ends = r.stagnant_at().min(RELAX_MAX_SUBS);
                 format!(
                     "{to}: sub-solve {}, ends by {ends} unless it gains 1 %; {best}; {} \
                      Newton iterations in it",

@@ -281,6 +281,13 @@ impl Relax {
         }
     }
 
+    /// The sub-solve at which the relaxation stops without a 1 % gain of its unshifted
+    /// measure ([`RELAX_STAGNANT_SUBS`] after its best; [`Relax::exhausted`], and the
+    /// progress bar's note).
+    pub(super) fn stagnant_at(&self) -> usize {
+        self.best_at + RELAX_STAGNANT_SUBS
+    }
+
     /// Why the relaxation stops without an equilibrium, where it does: its budget
     /// ([`RELAX_MAX_BUDGET`], [`RELAX_MAX_SUBS`]) ran out, or its unshifted measure has not
     /// improved by 1 % in [`RELAX_STAGNANT_SUBS`] sub-solves.
@@ -290,7 +297,7 @@ impl Relax {
                 "the relaxation's budget of {} Newton iterations or {RELAX_MAX_SUBS} sub-solves ran out",
                 RELAX_MAX_BUDGET * max_iterations
             ))
-        } else if self.subs >= self.best_at + RELAX_STAGNANT_SUBS {
+        } else if self.subs >= self.stagnant_at() {
             Some(format!(
                 "its residual without the shift has not fallen by 1 % in {RELAX_STAGNANT_SUBS} \
                  sub-solves (at best {:.1e} of the force scale, {} sub-solves in)",
