@@ -4,13 +4,17 @@
 // residual (lumped mass, gyroscopic moments, mass-proportional Rayleigh damping); with
 // UNBALANCE also each node's mass imbalance as a rigid eccentric mass
 // (physics::mass::unbalance_terms). With SHIFT (static only) a relaxation's proximal shift
-// (solve::continuation's Stage::Relax), its three bindings last.
+// (solve::continuation's Stage::Relax) on the translations and the rotations, its six
+// bindings last.
 //
 // One invocation per (node, variant), index = node · V + variant; each gathers the halves of
 // its two elements and its contact site, so no two invocations write the same entry, then
 // applies the constraints to the blocks it owns. Layouts as in the twin's documentation.
 #include "shared/layout.wgsl"
 #include "shared/listed.wgsl"
+#if SHIFT
+#include "shared/rotation_log.wgsl"
+#endif
 
 @group(0) @binding(0) var<storage, read> dims: AssembleDims;
 @group(0) @binding(1) var<storage, read> elem_force: array<real>;
@@ -31,6 +35,9 @@
 @group(0) @binding(10) var<storage, read> shift: array<real>;
 @group(0) @binding(11) var<storage, read> anchor: array<real>;
 @group(0) @binding(12) var<storage, read> x_now: array<real>;
+@group(0) @binding(13) var<storage, read> rot_shift: array<real>;
+@group(0) @binding(14) var<storage, read> anchor_rot: array<real>;
+@group(0) @binding(15) var<storage, read> rot_now: array<real>;
 #endif
 #if DYNAMIC
 // The dynamic residual alone (the dynamic engine's trials): its inputs after the output
@@ -50,6 +57,9 @@
 @group(0) @binding(9) var<storage, read> shift: array<real>;
 @group(0) @binding(10) var<storage, read> anchor: array<real>;
 @group(0) @binding(11) var<storage, read> x_now: array<real>;
+@group(0) @binding(12) var<storage, read> rot_shift: array<real>;
+@group(0) @binding(13) var<storage, read> anchor_rot: array<real>;
+@group(0) @binding(14) var<storage, read> rot_now: array<real>;
 #endif
 #if DYNAMIC
 @group(0) @binding(9) var<storage, read> dyn_coef: array<real>;
@@ -115,6 +125,9 @@ const OUT_C_OMEGA: u32 = 42u;
 @group(0) @binding(13) var<storage, read> shift: array<real>;
 @group(0) @binding(14) var<storage, read> anchor: array<real>;
 @group(0) @binding(15) var<storage, read> x_now: array<real>;
+@group(0) @binding(16) var<storage, read> rot_shift: array<real>;
+@group(0) @binding(17) var<storage, read> anchor_rot: array<real>;
+@group(0) @binding(18) var<storage, read> rot_now: array<real>;
 #endif
 #endif
 #endif
@@ -419,6 +432,30 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
             r[k] = r[k] + s_v * (x_now[at] - anchor[at]);
 #if !FORCE_ONLY
             d[7u * k] = d[7u * k] + s_v;
+#endif
+        }
+    }
+    // Once the translations' shift reached its ceiling, the rotations' too: s_r log(R R_aᵀ)
+    // on the moments' residual (R the node's rotation, R_a its anchor's; rows of both
+    // [(9 i + 3 a + k) V + v]) and s_r I on their diagonal block (the CPU solve's
+    // add_rotation_shift).
+    let s_r = rot_shift[v];
+    if (s_r != real(0.0)) {
+        var rel: array<vec3<real>, 3>;
+        for (var a = 0u; a < 3u; a = a + 1u) {
+            var row = vec3<real>(real(0.0), real(0.0), real(0.0));
+            for (var k = 0u; k < 3u; k = k + 1u) {
+                let r_ak = rot_now[(9u * i + 3u * a + k) * nv + v];
+                row = row + r_ak * vec3<real>(anchor_rot[(9u * i + k) * nv + v],
+                    anchor_rot[(9u * i + 3u + k) * nv + v], anchor_rot[(9u * i + 6u + k) * nv + v]);
+            }
+            rel[a] = row;
+        }
+        let theta = rotation_log(rel);
+        for (var k = 0u; k < 3u; k = k + 1u) {
+            r[3u + k] = r[3u + k] + s_r * theta[k];
+#if !FORCE_ONLY
+            d[7u * (3u + k)] = d[7u * (3u + k)] + s_r;
 #endif
         }
     }

@@ -89,47 +89,7 @@ fn dt(a: vec3<real>, b: vec3<real>) -> real {
     return a.x * b.x + a.y * b.y + a.z * b.z;
 }
 
-#if F64
-// atan on [0, 1] by two half-angle reductions and a Taylor series (no f64 atan on Vulkan).
-fn atan_unit(t: real) -> real {
-    var u = t / (real(1.0) + sqrt(real(1.0) + t * t));
-    u = u / (real(1.0) + sqrt(real(1.0) + u * u));
-    let u2 = u * u;
-    var s = real(0.0);
-    for (var step = 0u; step < 14u; step = step + 1u) {
-        let k = 13u - step;
-        var sign = real(1.0);
-        if (k % 2u == 1u) {
-            sign = real(-1.0);
-        }
-        s = s * u2 + sign / real(2u * k + 1u);
-    }
-    return real(4.0) * u * s;
-}
-
-fn atan2_real(y: real, x: real) -> real {
-    let pi = real(3.141592653589793);
-    let ay = abs(y);
-    let ax = abs(x);
-    var a: real;
-    if (ay <= ax) {
-        a = atan_unit(ay / ax);
-    } else {
-        a = real(0.5) * pi - atan_unit(ax / ay);
-    }
-    if (x < real(0.0)) {
-        a = pi - a;
-    }
-    if (y < real(0.0)) {
-        a = -a;
-    }
-    return a;
-}
-#else
-fn atan2_real(y: real, x: real) -> real {
-    return atan2(y, x);
-}
-#endif
+#include "shared/rotation_log.wgsl"
 
 // A nodal triad by its columns (the element's initial axes carried by the node).
 struct Triad {

@@ -114,3 +114,67 @@ fn forced_folds_relax_on_every_engine_path_to_the_cpu_equilibrium() {
         }
     }
 }
+
+/// A relaxation whose translational shift passes its ceiling starts again with the
+/// rotations shifted too on the engine as on the CPU (the assembly built `SHIFT` adds
+/// `s_r log(R R_aᵀ)` to the moments; `solve::continuation`'s `RELAX_ROTATION_SHIFT`).
+/// Unseen user well 3163 (horizontal, 4,767 m, a 1.66° motor 1.4 m above the bit, 1 m BHA
+/// elements) ends its relaxation at the ceiling after 12 sub-solves at 30 and 35 m pipe
+/// elements without it (docs/performance.md, stops 87 and 90); the CPU solves both so.
+/// Which path reaches the ceiling at which mesh is the rounding's: measured, the twin does
+/// at 30 m (it failed there before) and lavapipe's GPU f64 at 35 m (it failed there
+/// before). Each must solve to the CPU's hook load; the twin (f64 on the CPU, as the CPU
+/// solve) and lavapipe must say they shifted the rotations (another device's rounding
+/// may take another path: reported).
+#[test]
+fn a_relaxation_at_its_ceiling_shifts_the_rotations_on_the_engine_too() {
+    const SHIFTED: &str = "the rotations shifted too from there";
+    let dir = common::scratch_dir("rotations", "3163");
+    let drawn =
+        holewall::corpus::write_corpus_well(holewall::corpus::CorpusStyle::User, 3163, &dir)
+            .unwrap();
+    let options = StaticOptions::default();
+    let gpu = common::gpu();
+    let mut paths = vec![("twin", 30.0)];
+    if gpu.is_some_and(|ctx| ctx.has_f64) {
+        paths.push(("gpu f64", 35.0));
+    }
+    for (name, element) in paths {
+        let well = holewall::corpus::remesh(&drawn, element, 1.0).unwrap();
+        let model = holewall::case::load_case(&well.case_path).unwrap().model;
+        let cpu = solve_static(&model, &options).expect("the CPU solve shifts the rotations");
+        assert!(
+            cpu.log.iter().any(|l| l.contains(SHIFTED)),
+            "{element} m: the CPU should shift the rotations: {:?}",
+            cpu.log
+        );
+        let want = holewall::profile::fe_rows(&model, &cpu).1;
+        let models = [model.clone()];
+        let results = match (name, gpu) {
+            ("gpu f64", Some(ctx)) => {
+                solve_static_ensemble::<f64, _>(&models, &GpuPath(ctx), &options)
+            }
+            _ => solve_static_ensemble(&models, &TwinPath, &options),
+        }
+        .unwrap();
+        let r = results.into_iter().next().unwrap();
+        assert_eq!(r.status, EngineStatus::Converged, "{name}: {:?}", r.log);
+        let shifted = r.log.iter().any(|l| l.contains(SHIFTED));
+        let iterations = r.iterations.iter().sum::<usize>();
+        let log = r.log.clone();
+        let sol = r.into_solution(&model).unwrap();
+        let got = holewall::profile::fe_rows(&model, &sol).1;
+        eprintln!(
+            "{name} at {element} m: hook load {got:.3} N (CPU {want:.3} N), rotations shifted: {shifted}, {iterations} Newton iterations"
+        );
+        let lavapipe = gpu.is_some_and(|c| c.describe().contains("llvmpipe"));
+        if name == "twin" || lavapipe {
+            assert!(shifted, "{name} should shift the rotations: {log:?}");
+        }
+        assert!(
+            (got - want).abs() <= 1e-6 * want.abs(),
+            "{name}: hook load {got} N against the CPU's {want} N"
+        );
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}

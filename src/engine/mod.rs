@@ -180,7 +180,8 @@ pub trait ResidentStatic<T>: ResidentTrials<T> {
     fn set_config(&mut self, config: &ConfigBatch<T>) -> Result<(), crate::error::SystemError>;
     /// Sets a relaxation's proximal shift (`None`: none; [`Shift`]): every evaluation from
     /// now on adds `s_v (u − a_v)` to each node's translations' residual and `s_v I` to their
-    /// diagonal block (the systems must be evaluated again).
+    /// diagonal block, and `r_v log(R R_aᵀ)` and `r_v I` to its rotations' (the systems must
+    /// be evaluated again).
     fn set_shift(&mut self, shift: Option<&Shift<T>>) -> Result<(), crate::error::SystemError>;
     /// Sets each variant's landing epoch (`V`; [`crate::kernels::update::UpdateWalls::epoch`]:
     /// a contact node lands on its wall once an epoch, none in epoch 0).
@@ -201,6 +202,12 @@ pub struct Shift<T> {
     /// Each variant's anchor as displacements from the current base, `3 n V`
     /// (`[(3 i + k) V + v]`; zero where the variant has no shift).
     pub anchor: Vec<T>,
+    /// The rotations' shift per variant (N·m/rad; 0: none), `V`: a relaxation's whose
+    /// translational shift reached its ceiling (`LoadPath::rotation_shift`). Empty: none.
+    pub rot_shift: Vec<T>,
+    /// Each variant's anchor rotations, `9 n V` (`[(9 i + 3 a + k) V + v]`; identity or
+    /// anything where the variant has no rotational shift; empty with `rot_shift`).
+    pub anchor_rot: Vec<T>,
 }
 
 /// A kernel path: makes the [`ResidentStatic`] of a batch of variants.

@@ -32,13 +32,15 @@ pub(super) struct EngineStatic<'a, T> {
     land_epoch: Vec<u32>,
     epochs_changed: bool,
     to_rebase: bool,
-    /// Per variant: a relaxation's shift (0: none) and its anchor (displacements from the
-    /// reference, `3 n`; empty without a shift).
-    pub(super) shifts: Vec<(f64, Vec<f64>)>,
+    /// Per variant: a relaxation's shifts and their anchors.
+    pub(super) shifts: Vec<VariantShift>,
     /// Variants whose shift was set since the last flush (anchored at their restart point,
     /// where the load path leaves them before it sets a shift), with the momentum that
     /// carries the anchor on ([`StaticSystem::set_shift`]).
     to_anchor: Vec<(usize, f64)>,
+    /// Variants whose rotations' shift was set since the last flush (anchored at their
+    /// restart point's rotations, [`StaticSystem::set_rotation_shift`]).
+    to_anchor_rot: Vec<usize>,
     /// Per variant: the restart point its anchor was last set at (positions, `3 n`; empty
     /// without a shift), `x₋` of [`StaticSystem::set_shift`].
     pub(super) anchor_base: Vec<Vec<f64>>,
@@ -63,7 +65,7 @@ impl<'a, T: Real> EngineStatic<'a, T> {
         ensemble: Box<dyn ResidentStatic<T> + 'a>,
         tables: BatchTables<T>,
         saved: Option<Vec<(Vec<f64>, Vec<f64>)>>,
-        shifts: Option<Vec<(f64, Vec<f64>)>>,
+        shifts: Option<Vec<VariantShift>>,
     ) -> Self {
         let (v, n, p) = (
             tables.num_variants,
@@ -83,11 +85,12 @@ impl<'a, T: Real> EngineStatic<'a, T> {
                 })
                 .collect()
         });
-        let shifts = shifts.unwrap_or_else(|| vec![(0.0, Vec::new()); v]);
+        let shifts = shifts.unwrap_or_else(|| vec![VariantShift::default(); v]);
         EngineStatic {
-            shift_changed: shifts.iter().any(|s| s.0 != 0.0),
+            shift_changed: shifts.iter().any(VariantShift::any),
             shifts,
             to_anchor: Vec::new(),
+            to_anchor_rot: Vec::new(),
             anchor_base: vec![Vec::new(); v],
             unshifted: None,
             loads: models.iter().map(|m| split_loads(m)).collect(),
@@ -170,11 +173,11 @@ impl<'a, T: Real> EngineStatic<'a, T> {
                 self.evaluated = false;
                 self.unshifted = None;
                 // The anchors are held as displacements from the base.
-                self.shift_changed |= self.shifts.iter().any(|s| s.0 != 0.0);
+                self.shift_changed |= self.shifts.iter().any(VariantShift::any);
             }
         }
         for (j, momentum) in std::mem::take(&mut self.to_anchor) {
-            let (s, anchor) = &mut self.shifts[j];
+            let VariantShift { s, anchor, .. } = &mut self.shifts[j];
             let base = &mut self.anchor_base[j];
             if *s == 0.0 {
                 anchor.clear();
@@ -184,6 +187,17 @@ impl<'a, T: Real> EngineStatic<'a, T> {
                 anchor.clone_from(x);
                 crate::solve::continuation::carry_anchor(anchor, base, momentum);
                 base.clone_from(x);
+            }
+            self.shift_changed = true;
+        }
+        for j in std::mem::take(&mut self.to_anchor_rot) {
+            let VariantShift {
+                s_rot, anchor_rot, ..
+            } = &mut self.shifts[j];
+            if *s_rot == 0.0 {
+                anchor_rot.clear();
+            } else {
+                anchor_rot.clone_from(&self.saved[j].1);
             }
             self.shift_changed = true;
         }
@@ -199,7 +213,7 @@ impl<'a, T: Real> EngineStatic<'a, T> {
                 .land_epoch
                 .iter()
                 .zip(&self.shifts)
-                .map(|(&e, s)| if lands && s.0 == 0.0 { e } else { 0 })
+                .map(|(&e, s)| if lands && s.s == 0.0 { e } else { 0 })
                 .collect();
             self.ensemble.set_landing_epochs(&epochs)?;
         }
@@ -213,25 +227,65 @@ impl<'a, T: Real> EngineStatic<'a, T> {
     }
 }
 
+/// A variant's relaxation shifts and their anchors ([`StaticSystem::set_shift`],
+/// [`StaticSystem::set_rotation_shift`]).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub(super) struct VariantShift {
+    /// The translations' shift (N/m; 0: none).
+    pub(super) s: f64,
+    /// Its anchor (displacements from the reference, `3 n`; empty without a shift).
+    pub(super) anchor: Vec<f64>,
+    /// The rotations' shift (N·m/rad; 0: none; [`crate::solve::continuation::LoadPath::rotation_shift`]).
+    pub(super) s_rot: f64,
+    /// Its anchor rotations (`9 n`; empty without a shift).
+    pub(super) anchor_rot: Vec<f64>,
+}
+
+impl VariantShift {
+    /// Any shift at all.
+    fn any(&self) -> bool {
+        self.s != 0.0 || self.s_rot != 0.0
+    }
+}
+
 impl<T: Real> EngineStatic<'_, T> {
     /// Gives the ensemble the shifts and anchors (none where no variant has a shift).
     fn upload_shift(&mut self) -> Result<(), crate::error::SystemError> {
         let (v, n) = (self.tables.num_variants, self.tables.num_nodes);
         self.evaluated = false;
-        if self.shifts.iter().all(|s| s.0 == 0.0) {
+        if !self.shifts.iter().any(VariantShift::any) {
             return self.ensemble.set_shift(None);
         }
         let mut anchor = vec![T::zero(); 3 * n * v];
-        for (j, (s, a)) in self.shifts.iter().enumerate() {
-            if *s != 0.0 {
-                for (k, a) in a.iter().enumerate() {
+        for (j, sh) in self.shifts.iter().enumerate() {
+            if sh.s != 0.0 {
+                for (k, a) in sh.anchor.iter().enumerate() {
                     anchor[k * v + j] = T::from_f64_lossy(a - self.tables.base[k * v + j]);
                 }
             }
         }
+        // The rotations' only where a variant has one (a relaxation at its ceiling).
+        let rotations = self.shifts.iter().any(|sh| sh.s_rot != 0.0);
+        let mut anchor_rot = vec![T::zero(); if rotations { 9 * n * v } else { 0 }];
+        for (j, sh) in self.shifts.iter().enumerate() {
+            if sh.s_rot != 0.0 {
+                for (k, r) in sh.anchor_rot.iter().enumerate() {
+                    anchor_rot[k * v + j] = T::from_f64_lossy(*r);
+                }
+            }
+        }
         let shift = Shift {
-            shift: self.shifts.iter().map(|s| T::from_f64_lossy(s.0)).collect(),
+            shift: self.shifts.iter().map(|s| T::from_f64_lossy(s.s)).collect(),
             anchor,
+            rot_shift: if rotations {
+                self.shifts
+                    .iter()
+                    .map(|s| T::from_f64_lossy(s.s_rot))
+                    .collect()
+            } else {
+                Vec::new()
+            },
+            anchor_rot,
         };
         self.ensemble.set_shift(Some(&shift))
     }
@@ -243,7 +297,7 @@ impl<T: Real> EngineStatic<'_, T> {
     fn unshifted_measures(&mut self) -> Result<Vec<f64>, crate::error::SystemError> {
         self.flush()?;
         let v = self.tables.num_variants;
-        if self.shifts.iter().any(|s| s.0 != 0.0) {
+        if self.shifts.iter().any(VariantShift::any) {
             self.ensemble.set_shift(None)?;
             self.shift_changed = true;
             self.evaluated = false;
@@ -426,12 +480,23 @@ impl<T: Real> StaticSystem for EngineStatic<'_, T> {
         s: f64,
         momentum: f64,
     ) -> Result<(), crate::error::SystemError> {
-        if s == 0.0 && self.shifts[j].0 == 0.0 {
+        if s == 0.0 && self.shifts[j].s == 0.0 {
             return Ok(());
         }
-        self.shifts[j].0 = s;
+        self.shifts[j].s = s;
         self.to_anchor.push((j, momentum));
         self.epochs_changed = true;
+        Ok(())
+    }
+    fn shifts_rotations(&self) -> bool {
+        true
+    }
+    fn set_rotation_shift(&mut self, j: usize, s: f64) -> Result<(), crate::error::SystemError> {
+        if s == 0.0 && self.shifts[j].s_rot == 0.0 {
+            return Ok(());
+        }
+        self.shifts[j].s_rot = s;
+        self.to_anchor_rot.push(j);
         Ok(())
     }
 }
@@ -513,7 +578,7 @@ mod tests {
         let anchored = |sys: &mut EngineStatic<f64>, s: f64| {
             sys.set_shift(1, s, 0.9).unwrap();
             sys.flush().unwrap();
-            sys.shifts[1].1.clone()
+            sys.shifts[1].anchor.clone()
         };
         sys.save(1).unwrap();
         let x0 = sys.saved[1].0.clone();
@@ -533,6 +598,6 @@ mod tests {
         assert_eq!(anchored(&mut sys, 4e3), x1);
         assert!(anchored(&mut sys, 0.0).is_empty());
         assert!(sys.anchor_base[1].is_empty());
-        assert_eq!(sys.shifts[0], (0.0, Vec::new()));
+        assert_eq!(sys.shifts[0], VariantShift::default());
     }
 }

@@ -85,6 +85,13 @@ pub(crate) fn twin_evaluate(
                         shift: sh.shift.clone(),
                         anchor: sh.anchor.clone(),
                         x: x.to_vec(),
+                        rot_shift: sh.rot_shift.clone(),
+                        anchor_rot: sh.anchor_rot.clone(),
+                        rot: if sh.rot_shift.is_empty() {
+                            Vec::new()
+                        } else {
+                            rot.to_vec()
+                        },
                     }),
                 };
                 system = Some(if tangent {

@@ -76,7 +76,8 @@ pub fn assemble_force_wgsl_with(
 }
 
 /// The WGSL text of the static assembly built `SHIFT` (a relaxation's proximal shift,
-/// [`crate::kernels::assemble::ShiftInputs`]; its bindings `shift`, `anchor`, `x` last):
+/// [`crate::kernels::assemble::ShiftInputs`]; its bindings `shift`, `anchor`, `x`,
+/// `rot_shift`, `anchor_rot`, `rot` last):
 /// `force_only` the residual alone, `masked` as [`assemble_force_wgsl`].
 pub fn assemble_shift_wgsl(f64: bool, force_only: bool, masked: bool) -> Result<String, GpuError> {
     compose_if(
@@ -90,17 +91,29 @@ pub fn assemble_shift_wgsl(f64: bool, force_only: bool, masked: bool) -> Result<
     )
 }
 
-/// The shift's inputs of `a` (`shift`, `anchor`, `x`), empty without one: bound after
-/// the kernel's outputs, so passed as outputs that start with them (the kernel only reads
-/// them).
+/// The shift's inputs of `a` (`shift`, `anchor`, `x`, `rot_shift`, `anchor_rot`, `rot`),
+/// empty without one: bound after the kernel's outputs, so passed as outputs that start
+/// with them (the kernel only reads them). Where no rotation is shifted (`rot_shift`
+/// empty), `rot_shift` is a fresh buffer (wgpu zeroes it) and the rotations, then unread,
+/// one node's worth.
 pub fn shift_bindings<T: GpuReal>(a: &AssemblyInputs<T>) -> Vec<Out<'_>> {
     a.shift
         .iter()
         .flat_map(|sh| {
+            fn bytes<T: GpuReal>(x: &[T], or: usize) -> Out<'_> {
+                if x.is_empty() {
+                    Out::Empty(or * std::mem::size_of::<T>())
+                } else {
+                    Out::From(bytemuck::cast_slice(x))
+                }
+            }
             [
                 Out::From(bytemuck::cast_slice(&sh.shift)),
                 Out::From(bytemuck::cast_slice(&sh.anchor)),
                 Out::From(bytemuck::cast_slice(&sh.x)),
+                bytes(&sh.rot_shift, a.num_variants),
+                bytes(&sh.anchor_rot, 9),
+                bytes(&sh.rot, 9),
             ]
         })
         .collect()

@@ -36,6 +36,10 @@ pub const SHADERS: &[(&str, &str)] = &[
         include_str!("../../shaders/shared/rotation_exp.wgsl"),
     ),
     (
+        "shared/rotation_log.wgsl",
+        include_str!("../../shaders/shared/rotation_log.wgsl"),
+    ),
+    (
         "shared/chain_solve.wgsl",
         include_str!("../../shaders/shared/chain_solve.wgsl"),
     ),

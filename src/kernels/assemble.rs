@@ -27,6 +27,7 @@ use rayon::prelude::*;
 use crate::kernels::beam::{tangent_slot, TANGENT_LEN};
 use crate::kernels::block_lu::ChainBatch;
 use crate::kernels::contact::{OUT_C, OUT_C_OMEGA, OUT_G, OUT_K};
+use crate::physics::rotation::Trig;
 use crate::physics::Real;
 
 /// No contact site at a node.
@@ -76,6 +77,16 @@ pub struct ShiftInputs<T> {
     pub anchor: Vec<T>,
     /// The configuration's displacements from the base, `3 n V`.
     pub x: Vec<T>,
+    /// The rotations' shift per variant (N·m/rad; 0: none), `V`: once a relaxation's
+    /// translational shift reached its ceiling, `s_r log(R R_aᵀ)` on each node's moments'
+    /// residual and `s_r I` on their diagonal block (the CPU solve's `add_rotation_shift`).
+    /// Empty: no variant's rotations shifted.
+    pub rot_shift: Vec<T>,
+    /// The anchor's rotations `R_a`, `9 n V` (`[(9 i + 3 a + k) V + v]`, as the
+    /// configuration's; empty with `rot_shift`).
+    pub anchor_rot: Vec<T>,
+    /// The configuration's rotations `R`, `9 n V` (empty with `rot_shift`).
+    pub rot: Vec<T>,
 }
 
 impl AssemblyInputs<f64> {
@@ -100,6 +111,9 @@ impl AssemblyInputs<f64> {
                 shift: c(&sh.shift),
                 anchor: c(&sh.anchor),
                 x: c(&sh.x),
+                rot_shift: c(&sh.rot_shift),
+                anchor_rot: c(&sh.anchor_rot),
+                rot: c(&sh.rot),
             }),
         }
     }
@@ -173,7 +187,7 @@ fn clear_fixed<T: Real>(blk: &mut [T; 36], row_mask: u32, col_mask: u32) {
 /// upper and lower (36 each). With `tangent` false (the kernel built `FORCE_ONLY`, static
 /// or dynamic) the residual alone: the element tangents are not read and the blocks stay
 /// zero.
-fn node_blocks<T: Real>(
+fn node_blocks<T: Trig>(
     a: &AssemblyInputs<T>,
     i: usize,
     v: usize,
@@ -361,6 +375,23 @@ fn node_blocks<T: Real>(
                 }
             }
         }
+        if let Some(&s_r) = sh.rot_shift.get(v).filter(|s| **s != T::zero()) {
+            let at = |m: &[T], a: usize, k: usize| m[(9 * i + 3 * a + k) * nv + v];
+            let rel: crate::physics::rotation::Mat3<T> = std::array::from_fn(|a| {
+                std::array::from_fn(|b| {
+                    (0..3).fold(T::zero(), |acc, k| {
+                        acc + at(&sh.rot, a, k) * at(&sh.anchor_rot, b, k)
+                    })
+                })
+            });
+            let theta = crate::physics::rotation::rotation_log(&rel);
+            for k in 0..3 {
+                r[3 + k] = r[3 + k] + s_r * theta[k];
+                if tangent {
+                    d[7 * (3 + k)] = d[7 * (3 + k)] + s_r;
+                }
+            }
+        }
     }
     // Constraints (as statics::constrain): bases, then fixed DOFs.
     let b_i = &a.basis[9 * i..9 * i + 9];
@@ -404,7 +435,7 @@ fn node_blocks<T: Real>(
 
 /// Assembles every variant (rayon over nodes × variants). Returns the tangents with the
 /// residuals as right-hand sides (`rhs = r`; the Newton step solves `K Δ = −r`).
-pub fn assemble<T: Real + Send + Sync>(a: &AssemblyInputs<T>) -> ChainBatch<T> {
+pub fn assemble<T: Trig + Send + Sync>(a: &AssemblyInputs<T>) -> ChainBatch<T> {
     let (n, nv) = (a.num_nodes, a.num_variants);
     let per: Vec<_> = (0..n * nv)
         .into_par_iter()
@@ -439,7 +470,7 @@ pub fn assemble<T: Real + Send + Sync>(a: &AssemblyInputs<T>) -> ChainBatch<T> {
 /// `FORCE_ONLY`, the line-search trials'): `rhs` as [`assemble`] gives it, the same sums in
 /// the same order, without reading the element tangents (`a.elem_tangent` may be empty)
 /// or forming a block.
-pub fn assemble_residual<T: Real + Send + Sync>(a: &AssemblyInputs<T>) -> Vec<T> {
+pub fn assemble_residual<T: Trig + Send + Sync>(a: &AssemblyInputs<T>) -> Vec<T> {
     let (n, nv) = (a.num_nodes, a.num_variants);
     let per: Vec<[T; 6]> = (0..n * nv)
         .into_par_iter()

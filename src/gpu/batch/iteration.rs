@@ -182,6 +182,14 @@ impl<T: GpuReal> ResidentStatic<T> for GpuStatic<T> {
                 let q = &self.ctx.queue;
                 q.write_buffer(&parts.shift, 0, bytemuck::cast_slice(&sh.shift));
                 q.write_buffer(&parts.anchor, 0, bytemuck::cast_slice(&sh.anchor));
+                // No rotations' shift: zeros (the kernel reads no anchor rotation then).
+                if sh.rot_shift.is_empty() {
+                    let zero = vec![T::zero(); self.num_variants];
+                    q.write_buffer(&parts.rot_shift, 0, bytemuck::cast_slice(&zero));
+                } else {
+                    q.write_buffer(&parts.rot_shift, 0, bytemuck::cast_slice(&sh.rot_shift));
+                    q.write_buffer(&parts.anchor_rot, 0, bytemuck::cast_slice(&sh.anchor_rot));
+                }
                 self.shifted = true;
             }
         }

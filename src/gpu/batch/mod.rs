@@ -107,13 +107,15 @@ struct Slot {
 }
 
 /// A relaxation's proximal shift on the GPU, made when a batch first relaxes: the
-/// assembly built `SHIFT` (full and trial forms), the shift per variant and the anchors,
-/// and each slot's bind groups of those kernels.
+/// assembly built `SHIFT` (full and trial forms), the shifts per variant and the anchors
+/// (translations', rotations'), and each slot's bind groups of those kernels.
 struct ShiftParts {
     assemble: Arc<wgpu::ComputePipeline>,
     assemble_force: Arc<wgpu::ComputePipeline>,
     shift: wgpu::Buffer,
     anchor: wgpu::Buffer,
+    rot_shift: wgpu::Buffer,
+    anchor_rot: wgpu::Buffer,
     /// Per slot: the full assembly's group and the trials'.
     groups: [(wgpu::BindGroup, wgpu::BindGroup); 2],
 }
@@ -441,11 +443,13 @@ impl<T: GpuReal> GpuStatic<T> {
         let assemble_force = Kernel::AssembleShift { trial: true }.pipeline(ctx, f64)?;
         let shift = empty(ctx, "shift", v * size);
         let anchor = empty(ctx, "anchor", 3 * n * v * size);
+        let rot_shift = empty(ctx, "rot_shift", v * size);
+        let anchor_rot = empty(ctx, "anchor_rot", 9 * n * v * size);
         let c = &self.c;
         let groups = [0, 1].map(|k| {
             let slot = &self.slots[k];
             let [diag, upper, lower, rhs] = &slot.system;
-            let tail = [&shift, &anchor, &slot.x];
+            let tail = [&shift, &anchor, &slot.x, &rot_shift, &anchor_rot, &slot.rot];
             let full = bind(
                 ctx,
                 &assemble,
@@ -470,6 +474,8 @@ impl<T: GpuReal> GpuStatic<T> {
             assemble_force,
             shift,
             anchor,
+            rot_shift,
+            anchor_rot,
             groups,
         })
     }
