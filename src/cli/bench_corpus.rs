@@ -108,6 +108,9 @@ pub struct CorpusSummary {
     /// span the FE string's own compression names, where the first failed
     /// ([`crate::profile::WHIRL_FROM_FE`]; of `solved_with_cuts`).
     pub solved_whirl_from_fe: Vec<u64>,
+    /// Solved wells whose relaxation reached its ceiling and shifted the rotations too
+    /// ([`crate::solve::continuation::ROTATIONS_SHIFTED`]; of `solved_by_relaxation`).
+    pub solved_rotations_shifted: Vec<u64>,
     /// Solved wells whose answer stresses the pipe past every API grade's yield
     /// ([`crate::diagnose::past_yield`]): counted solved, an answer no pipe carries.
     pub solved_past_yield: Vec<u64>,
@@ -355,6 +358,11 @@ pub fn run(out: &Path, options: &CorpusOptions) -> Result<CorpusSummary, Error> 
         solved_whirl_from_fe: solved
             .iter()
             .filter(|r| r.whirl_from_fe)
+            .map(|r| r.spec.seed)
+            .collect(),
+        solved_rotations_shifted: solved
+            .iter()
+            .filter(|r| r.rotations_shifted)
             .map(|r| r.spec.seed)
             .collect(),
         solved_past_yield: solved

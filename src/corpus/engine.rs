@@ -36,6 +36,9 @@ pub struct EngineOutcome {
     /// Pipe-body contact sites kept where the engine's string lies on the wall (as the CPU
     /// run's `wall_sites`).
     pub wall_sites: usize,
+    /// Solved by a relaxation that reached its ceiling and shifted the rotations too
+    /// ([`crate::solve::continuation::ROTATIONS_SHIFTED`]).
+    pub rotations_shifted: bool,
     /// Why it failed (empty when solved).
     pub error: String,
 }
@@ -122,9 +125,14 @@ pub fn run_well_engine(well: &CorpusWell, path: EnginePath) -> Result<EngineOutc
         return Err(e);
     }
     let seconds = clock.elapsed().as_secs_f64();
-    let (solved, error, hook_load_n) = match held {
-        Ok(sol) => (true, String::new(), crate::profile::fe_rows(&model, &sol).1),
-        Err(e) => (false, e.to_string(), f64::NAN),
+    let (solved, error, hook_load_n, rotations_shifted) = match held {
+        Ok(sol) => (
+            true,
+            String::new(),
+            crate::profile::fe_rows(&model, &sol).1,
+            crate::solve::continuation::rotations_shifted(&sol.log),
+        ),
+        Err(e) => (false, e.to_string(), f64::NAN, false),
     };
     Ok(EngineOutcome {
         seed: well.spec.seed,
@@ -135,6 +143,7 @@ pub fn run_well_engine(well: &CorpusWell, path: EnginePath) -> Result<EngineOutc
         seconds,
         hook_load_n,
         wall_sites: model.sites.len() - case.model.sites.len(),
+        rotations_shifted,
         error,
     })
 }

@@ -522,6 +522,9 @@ pub struct WellResult {
     /// span the FE string's own compression names ([`crate::profile::WHIRL_FROM_FE`]): a
     /// result to report (counted in `step_cuts` too).
     pub whirl_from_fe: bool,
+    /// Solved by a relaxation that reached its ceiling and shifted the rotations too
+    /// ([`crate::solve::continuation::ROTATIONS_SHIFTED`]): a result to report.
+    pub rotations_shifted: bool,
     /// The load factor the FE solve reached: 1 when solved, where its load path stopped
     /// when not ([`crate::solve::statics::StaticError::reached`]; 0 in the gravity stage).
     pub fe_reached: f64,
@@ -603,6 +606,7 @@ pub fn run_well(
         whirl_md_m: crate::diagnose::rotating_whirl(&case, &soft.tension, &soft.side_force)
             .map_or(f64::NAN, |w| w.md),
         whirl_from_fe: false,
+        rotations_shifted: false,
         fe_reached: 0.0,
         stopped_hook_load_n: f64::NAN,
         through_wall_mm: f64::NAN,
@@ -636,6 +640,7 @@ pub fn run_well(
                 .log
                 .iter()
                 .any(|l| l.starts_with(crate::profile::WHIRL_FROM_FE));
+            r.rotations_shifted = crate::solve::continuation::rotations_shifted(&sol.log);
             r.iterations = sol.iterations.iter().sum();
             r.fe_hook_load_n = hook;
             r.hook_load_ratio = hook / r.soft_hook_load_n;

@@ -58,7 +58,9 @@ mod relax;
 pub use driver::{solve_loads, solve_loads_from, StaticSystem};
 pub use progress::Progress;
 use relax::*;
-pub use relax::{carry_anchor, relax_stall_tolerance, LOCK_FOUND};
+pub use relax::{
+    carry_anchor, relax_stall_tolerance, rotations_shifted, LOCK_FOUND, ROTATIONS_SHIFTED,
+};
 
 use super::newton::{SolveLimits, FOLD_STALL_ITERATIONS};
 use super::static_options::{StaticError, StaticOptions, GRAVITY_STAGE, LOAD_STAGE};

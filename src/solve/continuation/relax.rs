@@ -176,6 +176,15 @@ pub(super) const RELAX_ROTATION_SHIFT: f64 = 0.01;
 /// the largest load with an equilibrium to this width of the load factor (at most three
 /// from a failure at the first step).
 pub(super) const LOCK_BRACKET: f64 = 0.125;
+/// The words of the log line of a relaxation that reached its ceiling and shifted the
+/// rotations too ([`RELAX_ROTATION_SHIFT`]; the corpus counts the wells it solved).
+pub const ROTATIONS_SHIFTED: &str = "the rotations shifted too from there";
+
+/// Whether a solve's `log` says a relaxation shifted its rotations ([`ROTATIONS_SHIFTED`]).
+pub fn rotations_shifted(log: &[String]) -> bool {
+    log.iter().any(|l| l.contains(ROTATIONS_SHIFTED))
+}
+
 /// The words of a failure whose load path bracketed where the string stops
 /// (`super::LoadPath::bracket`); `crate::diagnose::static_failure` reads them.
 pub const LOCK_FOUND: &str = "relaxations to smaller loads found an equilibrium at";
@@ -323,11 +332,12 @@ impl Relax {
         true
     }
 
-    /// The log's line for [`Relax::rotations_at_ceiling`], with the last failure `reason`.
+    /// The log's line for [`Relax::rotations_at_ceiling`], with the last failure `reason`
+    /// (it ends with [`ROTATIONS_SHIFTED`]).
     pub(super) fn rotations_note(&self, reason: &str) -> String {
         format!(
             "relaxation after \"{}\": its shift passed {RELAX_CEILING:.0e} times its start after \
-             {} sub-solves ({reason}); the rotations shifted too from there",
+             {} sub-solves ({reason}); {ROTATIONS_SHIFTED}",
             self.reason, self.subs
         )
     }
