@@ -202,11 +202,12 @@ pub struct Shift<T> {
     /// Each variant's anchor as displacements from the current base, `3 n V`
     /// (`[(3 i + k) V + v]`; zero where the variant has no shift).
     pub anchor: Vec<T>,
-    /// The rotations' shift per variant (N·m/rad; 0: none), `V`: a relaxation's whose
-    /// translational shift reached its ceiling (`LoadPath::rotation_shift`). Empty: none.
+    /// The rotations' shift per variant (N·m/rad; 0: none), `V`: that of a relaxation
+    /// whose translational shift reached its ceiling (`LoadPath::rotation_shift`). Empty:
+    /// no variant has one.
     pub rot_shift: Vec<T>,
-    /// Each variant's anchor rotations, `9 n V` (`[(9 i + 3 a + k) V + v]`; identity or
-    /// anything where the variant has no rotational shift; empty with `rot_shift`).
+    /// Each variant's anchor rotations, `9 n V` (`[(9 i + 3 a + k) V + v]`; zero where the
+    /// variant has no rotational shift; empty with `rot_shift`).
     pub anchor_rot: Vec<T>,
 }
 
