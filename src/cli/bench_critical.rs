@@ -9,11 +9,11 @@ use std::path::Path;
 
 use serde::Serialize;
 
-use super::bench_corpus::{spread, Spread};
 use crate::bha::critical::{
     critical_speeds_of_case, CriticalOptions, CriticalSpeeds, DEFAULT_BLADES, DEFAULT_MAX_RPM,
     DEFAULT_MODES as MODES,
 };
+use crate::corpus::{spread, Spread};
 use crate::corpus::{write_corpus_well, CorpusStyle};
 use crate::error::Error;
 

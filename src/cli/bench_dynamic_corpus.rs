@@ -11,11 +11,11 @@ use std::path::Path;
 use rayon::prelude::*;
 use serde::Serialize;
 
-use super::bench_corpus::{spread, Spread};
 use crate::corpus::dynamic::{
     run_case_dynamic, run_case_engine, run_case_perturbed, write_dynamic_case, DynamicEngineRow,
     DynamicRow,
 };
+use crate::corpus::{spread, Spread};
 use crate::error::Error;
 
 /// Options of the benchmark.

@@ -14,9 +14,9 @@ use std::path::Path;
 
 use serde::Serialize;
 
-use super::bench_corpus::{spread, Spread};
 use crate::backend::Precision;
 use crate::case::{load_case, Analysis};
+use crate::corpus::{spread, Spread};
 use crate::corpus::{write_corpus_well, CorpusStyle};
 use crate::ensemble::qoi::{SolvedBy, Status, VariantResult};
 use crate::error::Error;

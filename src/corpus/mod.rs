@@ -40,9 +40,12 @@ mod draw;
 pub mod dynamic;
 mod engine;
 mod row;
+mod summary;
 pub mod user;
 pub use engine::{run_well_engine, EngineOutcome, EnginePath};
 pub use row::WellRow;
+pub(crate) use summary::{min_med_max, spread};
+pub use summary::{CorpusSummary, Spread};
 
 /// Kinds of trajectory in the corpus.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
