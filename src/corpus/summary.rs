@@ -177,6 +177,14 @@ impl CorpusSummary {
         };
         let solved: Vec<&WellResult> = results.iter().filter(|r| r.solved).collect();
         let hook: Vec<f64> = solved.iter().map(|r| r.hook_load_ratio).collect();
+        // The seeds of the solved wells a rule names.
+        let solved_seeds = |f: &dyn Fn(&WellResult) -> bool| -> Vec<u64> {
+            solved
+                .iter()
+                .filter(|r| f(r))
+                .map(|r| r.spec.seed)
+                .collect()
+        };
         CorpusSummary {
             wells: results.len(),
             not_run,
@@ -206,21 +214,9 @@ impl CorpusSummary {
                 .filter(|r| !r.solved && !r.lock_up_md_m.is_finite() && r.whirl_md_m.is_finite())
                 .count(),
             solved_whirling: solved.iter().filter(|r| r.whirl_md_m.is_finite()).count(),
-            solved_whirl_from_fe: solved
-                .iter()
-                .filter(|r| r.whirl_from_fe)
-                .map(|r| r.spec.seed)
-                .collect(),
-            solved_rotations_shifted: solved
-                .iter()
-                .filter(|r| r.rotations_shifted)
-                .map(|r| r.spec.seed)
-                .collect(),
-            solved_past_yield: solved
-                .iter()
-                .filter(|r| r.past_yield)
-                .map(|r| r.spec.seed)
-                .collect(),
+            solved_whirl_from_fe: solved_seeds(&|r| r.whirl_from_fe),
+            solved_rotations_shifted: solved_seeds(&|r| r.rotations_shifted),
+            solved_past_yield: solved_seeds(&|r| r.past_yield),
             lock_up_factors: results
                 .iter()
                 .filter(|r| !r.solved && r.lock_up_fraction.is_finite())
@@ -242,11 +238,7 @@ impl CorpusSummary {
                     .map(|r| (r.spec.seed, r.seconds))
                     .collect::<Vec<_>>(),
             ),
-            solved_pushed: solved
-                .iter()
-                .filter(|r| pushed(r))
-                .map(|r| r.spec.seed)
-                .collect(),
+            solved_pushed: solved_seeds(&pushed),
             seconds_10m: spread(
                 &results
                     .iter()
