@@ -112,15 +112,11 @@ fn rel_log(e1: vec3<real>, e2: vec3<real>, e3: vec3<real>, t: Triad) -> LogJ {
                               dt(e2, t.c0) - dt(e1, t.c1));
     let s2 = dt(w, w);
     let c = half * (dt(e1, t.c0) + dt(e2, t.c1) + dt(e3, t.c2) - real(1.0));
-    var factor: real;
-    var s = real(0.0);
+    // θ / sin θ and sin θ (0 where the series is taken), shared with the assembly's log.
+    let fs = log_factor(s2, c);
+    let factor = fs.x;
+    let s = fs.y;
     let series = s2 < real(1e-6) && c > real(0.0);
-    if (series) {
-        factor = real(1.0) + s2 * (real(1.0) / real(6.0) + s2 * (real(3.0) / real(40.0)));
-    } else {
-        s = sqrt(s2);
-        factor = atan2_real(s, c) / s;
-    }
     let theta2 = factor * factor * s2;
     var coefficient: real;
     if (!series && theta2 >= real(0.1)) {

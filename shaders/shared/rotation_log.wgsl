@@ -1,6 +1,7 @@
-// atan2 in either precision and the rotation vector of a rotation matrix.
+// atan2 in either precision, θ / sin θ of a rotation and the rotation vector of a rotation
+// matrix.
 // Twin: physics::rotation::rotation_log (its log without the Jacobian's coefficient);
-// included by beam.wgsl (its rel_log's atan2) and assemble.wgsl built SHIFT (a
+// included by beam.wgsl (its rel_log's factor) and assemble.wgsl built SHIFT (a
 // relaxation's rotational shift, log(R R_aᵀ)).
 
 #if F64
@@ -45,20 +46,24 @@ fn atan2_real(y: real, x: real) -> real {
 }
 #endif
 
+// θ / sin θ of a rotation from s² = sin²θ and c = cos θ (physics::rotation::
+// rotation_log_and_jacobian's factor), with sin θ: by its series in s² near θ = 0 (where
+// sin θ is returned as 0, not formed), else atan2(s, c) / s.
+fn log_factor(s2: real, c: real) -> vec2<real> {
+    if (s2 < real(1e-6) && c > real(0.0)) {
+        return vec2<real>(real(1.0) + s2 * (real(1.0) / real(6.0) + s2 * (real(3.0) / real(40.0))),
+                          real(0.0));
+    }
+    let s = sqrt(s2);
+    return vec2<real>(atan2_real(s, c) / s, s);
+}
+
 // log(M) of a rotation matrix M given by rows (m[a][b] = M_ab): the rotation vector θ with
 // M = exp([θ]×), as physics::rotation::rotation_log: the skew part's axial vector w
-// (|w| = sin θ) times θ / sin θ, by its series in sin²θ near θ = 0.
+// (|w| = sin θ) times θ / sin θ (log_factor).
 fn rotation_log(m: array<vec3<real>, 3>) -> vec3<real> {
     let half = real(0.5);
     let w = half * vec3<real>(m[2][1] - m[1][2], m[0][2] - m[2][0], m[1][0] - m[0][1]);
-    let s2 = dot(w, w);
     let c = half * (m[0][0] + m[1][1] + m[2][2] - real(1.0));
-    var factor: real;
-    if (s2 < real(1e-6) && c > real(0.0)) {
-        factor = real(1.0) + s2 * (real(1.0) / real(6.0) + s2 * (real(3.0) / real(40.0)));
-    } else {
-        let s = sqrt(s2);
-        factor = atan2_real(s, c) / s;
-    }
-    return w * factor;
+    return w * log_factor(dot(w, w), c).x;
 }

@@ -178,17 +178,19 @@ impl<T: GpuReal> ResidentStatic<T> for GpuStatic<T> {
                             .map_err(crate::error::SystemError::from)?,
                     );
                 }
-                let parts = self.shift.as_ref().expect("made above");
+                let parts = self.shift.as_mut().expect("made above");
                 let q = &self.ctx.queue;
                 q.write_buffer(&parts.shift, 0, bytemuck::cast_slice(&sh.shift));
                 q.write_buffer(&parts.anchor, 0, bytemuck::cast_slice(&sh.anchor));
-                // No rotations' shift: zeros (the kernel reads no anchor rotation then).
-                if sh.rot_shift.is_empty() {
-                    let zero = vec![T::zero(); self.num_variants];
-                    q.write_buffer(&parts.rot_shift, 0, bytemuck::cast_slice(&zero));
-                } else {
+                // No rotations' shift: zeros (the kernel reads no anchor rotation then),
+                // written only where the buffer held one.
+                if !sh.rot_shift.is_empty() {
                     q.write_buffer(&parts.rot_shift, 0, bytemuck::cast_slice(&sh.rot_shift));
                     q.write_buffer(&parts.anchor_rot, 0, bytemuck::cast_slice(&sh.anchor_rot));
+                    parts.rotations = true;
+                } else if std::mem::take(&mut parts.rotations) {
+                    let zero = vec![T::zero(); self.num_variants];
+                    q.write_buffer(&parts.rot_shift, 0, bytemuck::cast_slice(&zero));
                 }
                 self.shifted = true;
             }

@@ -116,6 +116,8 @@ struct ShiftParts {
     anchor: wgpu::Buffer,
     rot_shift: wgpu::Buffer,
     anchor_rot: wgpu::Buffer,
+    /// `rot_shift` holds a rotations' shift (else zeros: a fresh buffer, or cleared).
+    rotations: bool,
     /// Per slot: the full assembly's group and the trials'.
     groups: [(wgpu::BindGroup, wgpu::BindGroup); 2],
 }
@@ -476,6 +478,7 @@ impl<T: GpuReal> GpuStatic<T> {
             anchor,
             rot_shift,
             anchor_rot,
+            rotations: false,
             groups,
         })
     }
