@@ -17,6 +17,12 @@ use std::path::PathBuf;
 /// Corpus well 242 with 5 m elements and an open-hole friction of 0.45, in a scratch folder
 /// `tag`.
 fn lock_up_case(tag: &str) -> PathBuf {
+    lock_up_case_with(tag, "5 m", "1 m", "0.45")
+}
+
+/// Corpus well 242 with `element` long elements (`bha` in the BHA) and an open-hole
+/// friction of `mu`, in a scratch folder `tag`.
+fn lock_up_case_with(tag: &str, element: &str, bha: &str, mu: &str) -> PathBuf {
     let dir = common::scratch_dir("lock-up", tag);
     let well = holewall::corpus::write_well(242, &dir).unwrap();
     let text = std::fs::read_to_string(&well.case_path).unwrap();
@@ -24,17 +30,17 @@ fn lock_up_case(tag: &str) -> PathBuf {
         text.contains("\nfriction = 0.368\n"),
         "the corpus's open hole"
     );
-    let text: Vec<&str> = text
+    let text: Vec<String> = text
         .lines()
         .map(|l| {
             if l.starts_with("element_length") {
-                "element_length = \"5 m\""
+                format!("element_length = \"{element}\"")
             } else if l.starts_with("bha_element_length") {
-                "bha_element_length = \"1 m\""
+                format!("bha_element_length = \"{bha}\"")
             } else if l == "friction = 0.368" {
-                "friction = 0.45"
+                format!("friction = {mu}")
             } else {
-                l
+                l.to_string()
             }
         })
         .collect();
@@ -172,4 +178,78 @@ fn an_ensemble_variant_that_stops_says_where() {
     assert_eq!(rows[1].0, "failed");
     let lambda: f64 = rows[1].1.parse().unwrap();
     assert!(lambda > 0.5 && lambda < 1.0, "{rows:?}");
+}
+
+/// The engine runs the CPU's load path, bracket and all: the well above meshed coarser (10 m
+/// elements, 2 m in the BHA) with open-hole friction 0.2 and 0.7, an ensemble through the
+/// engine on its twin (the kernels' CPU twins, f64; the GPU's runner,
+/// `ensemble::runner::run_static_engine`). At 0.7 the string stops on its way in, and the
+/// engine's path says where (`EngineResult::stops`), as the CPU solve's does: the variant
+/// fails there with its `stopped_load_factor`, not run again on the CPU.
+#[test]
+fn the_engine_says_where_the_string_stops_as_the_cpu_does() {
+    use holewall::ensemble::qoi::{SolvedBy, Status};
+    let path = lock_up_case_with("engine", "10 m", "2 m", "0.7");
+    let mut text = std::fs::read_to_string(&path).unwrap();
+    text.push_str(
+        "\n[ensemble]\nanalysis = \"static\"\n[ensemble.grid]\n\"mu.open\" = [0.2, 0.7]\n",
+    );
+    std::fs::write(&path, text).unwrap();
+    let mut case = holewall::case::load_case(&path).unwrap();
+    let variants = holewall::ensemble::case_variants(&case, None)
+        .unwrap()
+        .expect("a grid");
+    let bar = indicatif::ProgressBar::hidden();
+    let results = holewall::ensemble::runner::run_static_engine::<f64, _>(
+        &case,
+        &variants,
+        &holewall::engine::TwinPath,
+        &bar,
+    )
+    .unwrap()
+    .expect("the engine runs this ensemble");
+    assert_eq!(
+        results[0].status,
+        Status::Converged,
+        "{}",
+        results[0].reason
+    );
+    assert_eq!(results[0].solved_by, SolvedBy::Engine);
+    let stops = &results[1];
+    assert_eq!(
+        (stops.status, stops.solved_by),
+        (Status::Failed, SolvedBy::Engine),
+        "{}",
+        stops.reason
+    );
+    assert!(
+        !stops.reason.contains("re-run on the CPU"),
+        "{}",
+        stops.reason
+    );
+    let lo = stops.string.stopped_load_factor.expect("where it stops");
+    assert!(
+        stops.reason.contains(&format!(
+            "{} λ = {lo:.4} and none at λ = ",
+            holewall::solve::continuation::LOCK_FOUND
+        )),
+        "{}",
+        stops.reason
+    );
+    assert!(lo > 0.0 && lo < 1.0, "{lo}");
+    // The CPU solve of the case at 0.7: the same bracket, or one beside it (the two paths
+    // round apart).
+    let options = case.settings().statics();
+    let (_, stopped) = holewall::profile::solve_or_stop(&mut case, options, false)
+        .expect_err("the string stops on the CPU too");
+    let st = stopped.expect("where it stands");
+    eprintln!(
+        "engine's twin: stops above λ {lo}; CPU: λ {} to {}",
+        st.lambda, st.none_at
+    );
+    assert!(
+        (st.lambda - lo).abs() <= 0.125 + 1e-12,
+        "{} against {lo}",
+        st.lambda
+    );
 }

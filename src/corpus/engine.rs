@@ -39,6 +39,10 @@ pub struct EngineOutcome {
     /// Solved by a relaxation that reached its ceiling and shifted the rotations too
     /// ([`crate::solve::continuation::ROTATIONS_SHIFTED`]).
     pub rotations_shifted: bool,
+    /// Failed where its load path bracketed where the string stops: the largest load factor
+    /// at which the engine found an equilibrium ([`crate::engine::EngineResult::stops`]; the
+    /// CPU's is `corpus.csv`'s `fe_reached`); else NaN.
+    pub stopped_load_factor: f64,
     /// Why it failed (empty when solved).
     pub error: String,
 }
@@ -85,7 +89,7 @@ pub fn run_well_engine(well: &CorpusWell, path: EnginePath) -> Result<EngineOutc
                 .ok_or_else(|| Error::failed("the engine returned no result"))
         };
     let mut model = case.model.clone();
-    let (mut iterations, mut step_cuts) = (0, 0);
+    let (mut iterations, mut step_cuts, mut stopped_load_factor) = (0, 0, f64::NAN);
     let mut unavailable = None;
     let clock = std::time::Instant::now();
     let held = crate::profile::hold_in_hole(
@@ -107,6 +111,7 @@ pub fn run_well_engine(well: &CorpusWell, path: EnginePath) -> Result<EngineOutc
                 Ok(r) => {
                     iterations += r.iterations.iter().sum::<usize>();
                     step_cuts += r.log.len();
+                    stopped_load_factor = r.stops().unwrap_or(f64::NAN);
                     r.into_solution(m).map_err(failed)
                 }
                 Err(e) => {
@@ -144,6 +149,7 @@ pub fn run_well_engine(well: &CorpusWell, path: EnginePath) -> Result<EngineOutc
         hook_load_n,
         wall_sites: model.sites.len() - case.model.sites.len(),
         rotations_shifted,
+        stopped_load_factor,
         error,
     })
 }

@@ -295,6 +295,10 @@ pub struct EngineResult {
     /// Its load path's answer is doubtful ([`LoadPath::doubtful`]: relaxed past a fold, or
     /// f32's second solve failed from it).
     pub doubtful: bool,
+    /// Where its failed load path stops (a lock-up): the largest load factor at which it
+    /// found an equilibrium and the smallest at which it found none
+    /// ([`LoadPath::stopped_between`]); `None` for every other end.
+    pub stopped: Option<(f64, f64)>,
 }
 
 impl EngineResult {
@@ -312,6 +316,20 @@ impl EngineResult {
                 Ok(sol)
             }
             EngineStatus::Failed(why) => Err(why),
+        }
+    }
+
+    /// Whether its failure is its answer, not a reason to solve it again on the CPU: its
+    /// load path bracketed where the string stops ([`EngineResult::stopped`]), as the CPU
+    /// solve's does for a lock-up. The engine runs the CPU's load path ([`LoadPath`]: the
+    /// same steps, relaxations and bracket), so a re-run would repeat the whole path — the
+    /// relaxation to the full loads that fails and the relaxations to smaller loads — on
+    /// the CPU, 7–140 s a variant on the lock-ups measured (docs/performance.md, stop
+    /// 91), for a bracket that differs from the engine's only by the rounding of its path.
+    pub fn stops(&self) -> Option<f64> {
+        match self.status {
+            EngineStatus::Failed(_) => self.stopped.map(|(lo, _)| lo),
+            EngineStatus::Converged => None,
         }
     }
 }
@@ -437,6 +455,7 @@ fn solve_batch<T: Real + Send + Sync, P: KernelPath<T>>(
                 None => EngineStatus::Converged,
                 Some(e) => EngineStatus::Failed(e.to_string()),
             },
+            stopped: path.stopped_between().filter(|_| path.error.is_some()),
             iterations: path.iterations,
             log: path.log,
             doubtful: path.doubtful,

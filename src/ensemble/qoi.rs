@@ -179,6 +179,22 @@ pub(crate) fn failed(name: &str, reason: String, stabs: usize) -> VariantResult 
     }
 }
 
+/// A variant whose static solve (or a dynamic run's static start) failed (`reason`): where
+/// its load path bracketed where the string stops (a lock-up), `at` is the largest load
+/// factor at which it found an equilibrium (`variants.csv`'s `stopped_load_factor`; the
+/// CPU solve's [`crate::solve::statics::StaticError::stopped`], the engine's
+/// [`crate::engine::EngineResult::stops`]).
+pub(crate) fn failed_stopping(
+    name: &str,
+    reason: String,
+    stabs: usize,
+    at: Option<f64>,
+) -> VariantResult {
+    let mut r = failed(name, reason, stabs);
+    r.string.stopped_load_factor = at;
+    r
+}
+
 /// A variant that finished: converged, or with `cuts` step cuts (or other departures from
 /// its plain steps) that its solver log `log` records.
 #[allow(clippy::too_many_arguments)]
@@ -291,11 +307,12 @@ fn solve_held(
     let (model, solved) = held_start(case, model, add);
     match solved {
         Ok(sol) => static_result(case, name, &model, &sol),
-        Err(e) => {
-            let mut r = failed(name, e.to_string(), model.stabilizer_sites().len());
-            r.string.stopped_load_factor = e.stopped().map(|s| s.lambda);
-            r
-        }
+        Err(e) => failed_stopping(
+            name,
+            e.to_string(),
+            model.stabilizer_sites().len(),
+            e.stopped().map(|s| s.lambda),
+        ),
     }
 }
 
@@ -431,10 +448,11 @@ fn dynamic_held(
     let start = match solved {
         Ok(s) => s,
         Err(e) => {
+            let at = e.stopped().map(|s| s.lambda);
             return (
-                failed(name, format!("static start: {e}"), stabs.len()),
+                failed_stopping(name, format!("static start: {e}"), stabs.len(), at),
                 None,
-            )
+            );
         }
     };
     let relaxed_start = crate::solve::continuation::relaxed(&start.log);

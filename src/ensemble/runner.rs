@@ -13,21 +13,36 @@ use crate::model::Model;
 use crate::solve::dynamics::{DynamicState, Dynamics};
 use crate::solve::statics::StaticState;
 
-/// Static equilibria of every variant through the GPU kernels (in `T`), held in the hole as
-/// the CPU holds them (guard sites at every node without one, those in contact kept:
-/// `guarded_models`, `crate::profile::keep_touching`); the variants that fail there re-run
-/// on the CPU with step control (their reason says so). Stabilizer
-/// moves run there too (each pair carries its node). `Err` with the reason when the
-/// variants do not share the number of sites, or need what only the CPU has: the caller
-/// runs the CPU and says why.
+/// Static equilibria of every variant through the GPU kernels (in `T`):
+/// [`run_static_engine`] on [`crate::gpu::GpuPath`].
 pub fn run_static_gpu<T: crate::gpu::contact::GpuReal>(
     case: &Case,
     variants: &[Variant],
     ctx: &'static crate::gpu::GpuContext,
     bar: &indicatif::ProgressBar,
 ) -> Result<Result<Vec<VariantResult>, SystemError>, Error> {
+    run_static_engine::<T, _>(case, variants, &crate::gpu::GpuPath(ctx), bar)
+}
+
+/// Static equilibria of every variant through the engine on `path` (in `T`), held in the
+/// hole as the CPU holds them (guard sites at every node without one, those in contact kept:
+/// `guarded_models`, `crate::profile::keep_touching`); the variants that fail there re-run
+/// on the CPU with step control (their reason says so), but for those whose load path
+/// stopped where the string does ([`crate::engine::EngineResult::stops`]: failed there, as
+/// the CPU fails them). Stabilizer moves run there too (each pair carries its node). `Err`
+/// with the reason when the variants do not share the number of sites, or need what only
+/// the CPU has: the caller runs the CPU and says why.
+pub fn run_static_engine<T, P>(
+    case: &Case,
+    variants: &[Variant],
+    path: &P,
+    bar: &indicatif::ProgressBar,
+) -> Result<Result<Vec<VariantResult>, SystemError>, Error>
+where
+    T: crate::physics::Real + Send + Sync,
+    P: crate::engine::KernelPath<T>,
+{
     use crate::engine::solve_static_ensemble_with_progress;
-    use crate::gpu::GpuPath;
     let models: Vec<Model> = variants
         .iter()
         .map(|v| apply(case, v))
@@ -44,7 +59,7 @@ pub fn run_static_gpu<T: crate::gpu::contact::GpuReal>(
     };
     let results = solve_static_ensemble_with_progress::<T, _>(
         &guarded,
-        &GpuPath(ctx),
+        path,
         &case.settings().statics(),
         &mut |f| bar.set_position((f * variants.len() as f64) as u64),
     )
@@ -56,7 +71,11 @@ pub fn run_static_gpu<T: crate::gpu::contact::GpuReal>(
                 .par_iter()
                 .zip(guarded.par_iter().zip(variants.par_iter())),
         )
-        .map(|(r, (m, (g, v)))| match r.into_solution(g) {
+        .map(|(r, (m, (g, v)))| {
+            let stops = r.stops();
+            (r, m, g, v, stops)
+        })
+        .map(|(r, m, g, v, stops)| match r.into_solution(g) {
             Ok(sol) => {
                 // Held in the hole as the CPU holds it: the guards in contact kept.
                 let (held, mut sol) = crate::profile::keep_touching(m, g.clone(), sol);
@@ -67,13 +86,26 @@ pub fn run_static_gpu<T: crate::gpu::contact::GpuReal>(
                 done.solved_by = SolvedBy::Engine;
                 done
             }
-            Err(why) => {
-                let mut again = static_variant_of(case, v, m);
-                again.reason = format!("GPU: {why}; re-run on the CPU: {}", again.reason);
-                again
-            }
+            Err(why) => match stops {
+                // A lock-up: the engine's answer (`EngineResult::stops`).
+                Some(at) => engine_stopped(&v.name, format!("GPU: {why}"), m, at),
+                None => {
+                    let mut again = static_variant_of(case, v, m);
+                    again.reason = format!("GPU: {why}; re-run on the CPU: {}", again.reason);
+                    again
+                }
+            },
         })
         .collect()))
+}
+
+/// A variant whose load path on the engine stopped where its string does (a lock-up,
+/// [`crate::engine::EngineResult::stops`]; `at`: the largest load factor with an
+/// equilibrium): failed there, as the CPU's solve fails it, and not run again.
+fn engine_stopped(name: &str, why: String, model: &Model, at: f64) -> VariantResult {
+    let mut r = failed_stopping(name, why, model.stabilizer_sites().len(), Some(at));
+    r.solved_by = SolvedBy::Engine;
+    r
 }
 
 /// The `[dynamics]` runs of every variant through the GPU engine (in `T`): static starts
@@ -274,6 +306,10 @@ pub fn run_dynamic_gpu<T: crate::gpu::contact::GpuReal>(
                     // Not reached: a converged start is held and runs on the engine.
                     EngineStatus::Converged => "not run on the engine".into(),
                 };
+                if let Some(at) = statics[j].stops() {
+                    let why = format!("GPU: static start: {why}");
+                    return engine_stopped(&variants[j].name, why, &models[j], at);
+                }
                 let mut again = dynamic_variant_of(case, &variants[j], &models[j]);
                 again.reason = format!(
                     "GPU static start: {why}; re-run on the CPU: {}",
