@@ -59,8 +59,9 @@ fn the_roofline_bench_measures_every_kernel_under_its_ceilings() {
     let precisions = if ctx.has_f64 { 2 } else { 1 };
     assert_eq!(
         rows.len(),
-        6 * 2 * precisions,
-        "4 kernels (the block solve in 3 forms) × 2 sizes × precisions"
+        7 * 2 * precisions,
+        "4 kernels (the assembly also as a relaxation past its ceiling assembles, the block \
+         solve in 3 forms) × 2 sizes × precisions"
     );
     for k in rows {
         let f = |key: &str| k[key].as_f64().unwrap_or(f64::NAN);
@@ -89,6 +90,25 @@ fn the_roofline_bench_measures_every_kernel_under_its_ceilings() {
         assert!(
             lu.len() == 2 && (lu[1] / lu[0] - 4.0).abs() < 1e-9,
             "{lu:?}"
+        );
+    }
+    // The assembly of a relaxation past its ceiling (translations and rotations shifted,
+    // the kernel built `SHIFT`) counts the shift's FLOPs and its bindings' bytes on top of
+    // the plain assembly's.
+    let of = |name: &str, key: &str| -> Vec<f64> {
+        rows.iter()
+            .filter(|k| k["kernel"] == name && k["precision"] == "f32")
+            .map(|k| k[key].as_f64().unwrap())
+            .collect()
+    };
+    for key in ["flops", "bytes"] {
+        let (plain, shifted) = (
+            of("assemble", key),
+            of("assemble (relaxation, rotations shifted)", key),
+        );
+        assert!(
+            shifted.len() == 2 && (0..2).all(|i| shifted[i] > plain[i]),
+            "{key}: {plain:?} {shifted:?}"
         );
     }
     for f in ["kernels.md", "roofline.png"] {

@@ -112,6 +112,38 @@ fn chain_batch(n: usize, v: usize) -> ChainBatch<f64> {
     }
 }
 
+/// The assembly inputs of [`assembly_inputs`] as a relaxation's sub-solve past its ceiling
+/// assembles them (the kernel built `SHIFT`, [`crate::kernels::assemble::ShiftInputs`]):
+/// every variant's translations and rotations shifted, each node 1 mm and 0.01 rad (about
+/// the string's axis and a lateral one) from its anchor.
+fn shifted_assembly_inputs(n: usize, v: usize) -> AssemblyInputs<f64> {
+    use crate::kernels::assemble::ShiftInputs;
+    let (c, s) = (0.01f64.cos(), 0.01f64.sin());
+    // Rotation by 0.01 rad about z, then about x: `[(9 i + 3 a + k) V + v]`.
+    let rz = [[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]];
+    let rx = [[1.0, 0.0, 0.0], [0.0, c, -s], [0.0, s, c]];
+    let r: Vec<f64> = (0..9)
+        .map(|ak| (0..3).map(|m| rx[ak / 3][m] * rz[m][ak % 3]).sum())
+        .collect();
+    let identity = [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0];
+    let per_node = |m: &[f64]| -> Vec<f64> {
+        (0..n)
+            .flat_map(|_| m.iter().flat_map(|&x| vec![x; v]).collect::<Vec<_>>())
+            .collect()
+    };
+    AssemblyInputs {
+        shift: Some(ShiftInputs {
+            shift: vec![1e6; v],
+            anchor: vec![0.0; 3 * n * v],
+            x: vec![1e-3; 3 * n * v],
+            rot_shift: vec![1e4; v],
+            anchor_rot: per_node(&identity),
+            rot: per_node(&r),
+        }),
+        ..assembly_inputs(n, v)
+    }
+}
+
 /// Assembly inputs of `n` nodes, a contact site at every node, every site in contact.
 fn assembly_inputs(n: usize, v: usize) -> AssemblyInputs<f64> {
     use crate::kernels::contact::OUTPUT_LEN;
@@ -143,6 +175,8 @@ struct Counts {
     contact_per_pair: f64,
     beam_per_element: f64,
     assemble: f64,
+    /// The assembly of a relaxation past its ceiling ([`shifted_assembly_inputs`]).
+    assemble_shifted: f64,
     block_lu: f64,
     block_cr: f64,
 }
@@ -160,6 +194,8 @@ fn counts(n: usize) -> Counts {
     }) / pairs as f64;
     let a = assembly_inputs(n, 1).map_static(Counted);
     let assemble = counted(|| crate::kernels::assemble::assemble(&a));
+    let a = shifted_assembly_inputs(n, 1).map_static(Counted);
+    let assemble_shifted = counted(|| crate::kernels::assemble::assemble(&a));
     let b = chain_batch(n, 1).map(Counted);
     let block_lu = counted(|| crate::kernels::block_lu::block_lu(&b));
     let block_cr = counted(|| crate::kernels::block_cr::block_cr(&b));
@@ -169,6 +205,7 @@ fn counts(n: usize) -> Counts {
         // of 9 directions (physics::beam::tangent, the twin's).
         beam_per_element: super::bench::element_flops().written_out as f64,
         assemble,
+        assemble_shifted,
         block_lu,
         block_cr,
     }
@@ -280,6 +317,14 @@ fn run_size<T: GpuReal>(
     rows.push((
         "assemble".into(),
         c.assemble * v as f64,
+        r.map_err(|e| e.to_string()).and_then(|_| of(t)),
+    ));
+    let a = shifted_assembly_inputs(n, v).map_static(to_t);
+    let (r, t) =
+        crate::gpu::dispatch::timed(repeats, || crate::gpu::assemble::assemble_gpu::<T>(ctx, &a));
+    rows.push((
+        "assemble (relaxation, rotations shifted)".into(),
+        c.assemble_shifted * v as f64,
         r.map_err(|e| e.to_string()).and_then(|_| of(t)),
     ));
     // The block-tridiagonal solve, in every form (the engine runs the adapter's:
