@@ -71,11 +71,8 @@ where
                 .par_iter()
                 .zip(guarded.par_iter().zip(variants.par_iter())),
         )
-        .map(|(r, (m, (g, v)))| {
-            let stops = r.stops();
-            (r, m, g, v, stops)
-        })
-        .map(|(r, m, g, v, stops)| match r.into_solution(g) {
+        .map(|(r, (m, (g, v)))| (r.stops(), r, m, g, v))
+        .map(|(stops, r, m, g, v)| match r.into_solution(g) {
             Ok(sol) => {
                 // Held in the hole as the CPU holds it: the guards in contact kept.
                 let (held, mut sol) = crate::profile::keep_touching(m, g.clone(), sol);
