@@ -416,3 +416,88 @@ pub(crate) fn ran_row(m: &Model, stabs: usize) -> Vec<String> {
     }
     row
 }
+
+/// The quantities of interest of every variant as columns (NaN where a variant has none).
+pub fn qoi_columns(
+    results: &[VariantResult],
+    stabs: usize,
+    dynamic: bool,
+) -> Vec<crate::uq::report::Qoi> {
+    use crate::uq::report::{Qoi, Unit};
+    let col = |name: String, unit: Unit, f: &dyn Fn(&VariantResult) -> Option<f64>| Qoi {
+        name,
+        unit,
+        values: results.iter().map(|r| f(r).unwrap_or(f64::NAN)).collect(),
+    };
+    let mut q = vec![
+        col("neutral_point_from_bit_m".into(), Unit::Length, &|r| {
+            r.neutral_point_from_bit_m
+        }),
+        col("hook_load_n".into(), Unit::Force, &|r| r.hook_load_n),
+    ];
+    if results.iter().any(|r| r.weight_indicator_n.is_some()) {
+        q.push(col("weight_indicator_n".into(), Unit::Force, &|r| {
+            r.weight_indicator_n
+        }));
+    }
+    q.extend([
+        col("max_surface_torque_nm".into(), Unit::Torque, &|r| {
+            Some(r.max_surface_torque_nm)
+        }),
+        col(
+            "max_side_force_per_length_n_per_m".into(),
+            Unit::ForcePerLength,
+            &|r| r.string.max_side_force_per_length_n_per_m,
+        ),
+    ]);
+    if !dynamic {
+        // The bit's loads and attitude (issue 25).
+        for (j, name) in crate::bha::BIT_COLUMNS.iter().enumerate() {
+            let unit = if name.ends_with("_deg") {
+                Unit::Degrees
+            } else {
+                Unit::Force
+            };
+            q.push(col(name.to_string(), unit, &|r| {
+                r.bit.as_ref().map(|b| b.columns()[j])
+            }));
+        }
+    }
+    // Flags as 0/1: their mean is the probability (e.g. that the string buckles).
+    let as_number = |b: Option<bool>| b.map(|b| if b { 1.0 } else { 0.0 });
+    if dynamic {
+        q.push(col("stick_slip_severity".into(), Unit::Ratio, &|r| {
+            r.string.stick_slip_severity
+        }));
+    } else {
+        q.push(col("sinusoidal_buckling".into(), Unit::Ratio, &|r| {
+            as_number(r.string.sinusoidal_buckling)
+        }));
+        q.push(col("helical_buckling".into(), Unit::Ratio, &|r| {
+            as_number(r.string.helical_buckling)
+        }));
+        q.push(col("outside_hole".into(), Unit::Ratio, &|r| {
+            as_number(r.string.outside_hole_m.map(|m| m > 0.0))
+        }));
+    }
+    for k in 0..stabs {
+        q.push(col(
+            format!("{}_max_side_force_n", crate::model::stabilizer_name(k + 1)),
+            Unit::Force,
+            &|r| r.stabilizers.get(k).map(|s| s.max_side_force_n),
+        ));
+        q.push(col(
+            format!("{}_max_lateral_m", crate::model::stabilizer_name(k + 1)),
+            Unit::Length,
+            &|r| r.stabilizers.get(k).map(|s| s.max_lateral_m),
+        ));
+        if dynamic {
+            q.push(col(
+                format!("{}_whirl_hz", crate::model::stabilizer_name(k + 1)),
+                Unit::Frequency,
+                &|r| r.stabilizers.get(k).and_then(|s| s.whirl_hz),
+            ));
+        }
+    }
+    q
+}
