@@ -569,7 +569,7 @@ pub fn stability(
                 })
                 .map(|(variant, model)| match analysis {
                     "static" => (
-                        crate::ensemble::qoi::static_variant_of(&this, &variant, &model),
+                        crate::ensemble::qoi::static_variant_of(&this, &variant, &model, true),
                         None,
                     ),
                     _ => crate::ensemble::qoi::dynamic_variant_tracked(&this, "cell", &model, true),

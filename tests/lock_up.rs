@@ -184,8 +184,9 @@ fn an_ensemble_variant_that_stops_says_where() {
 /// elements, 2 m in the BHA) with open-hole friction 0.2 and 0.7, an ensemble through the
 /// engine on its twin (the kernels' CPU twins, f64; the GPU's runner,
 /// `ensemble::runner::run_static_engine`). At 0.7 the string stops on its way in, and the
-/// engine's path says where (`EngineResult::stops`), as the CPU solve's does: the variant
-/// fails there with its `stopped_load_factor`, not run again on the CPU.
+/// engine's path says where (`EngineResult::stops`), as the CPU solve's does: the CPU tries
+/// the full loads once more without a bracket of its own, fails too, and the variant fails
+/// with the engine's `stopped_load_factor`.
 #[test]
 fn the_engine_says_where_the_string_stops_as_the_cpu_does() {
     use holewall::ensemble::qoi::{SolvedBy, Status};
@@ -222,8 +223,16 @@ fn the_engine_says_where_the_string_stops_as_the_cpu_does() {
         "{}",
         stops.reason
     );
+    // The CPU tried the full loads once more without a bracket of its own and failed too.
     assert!(
         !stops.reason.contains("re-run on the CPU"),
+        "{}",
+        stops.reason
+    );
+    assert!(
+        stops
+            .reason
+            .contains("without a bracket of its own, it failed there too"),
         "{}",
         stops.reason
     );

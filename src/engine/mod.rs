@@ -319,13 +319,12 @@ impl EngineResult {
         }
     }
 
-    /// Whether its failure is its answer, not a reason to solve it again on the CPU: its
-    /// load path bracketed where the string stops ([`EngineResult::stopped`]), as the CPU
-    /// solve's does for a lock-up. The engine runs the CPU's load path ([`LoadPath`]: the
-    /// same steps, relaxations and bracket), so a re-run would repeat the whole path — the
-    /// relaxation to the full loads that fails and the relaxations to smaller loads — on
-    /// the CPU, 7–140 s a variant on the lock-ups measured (docs/performance.md, stop
-    /// 91), for a bracket that differs from the engine's only by the rounding of its path.
+    /// Where its load path bracketed where the string stops ([`EngineResult::stopped`]), as
+    /// the CPU solve's does for a lock-up: the largest load factor with an equilibrium. The
+    /// engine runs the CPU's load path ([`LoadPath`]: the same steps, relaxations and
+    /// bracket), so an ensemble's CPU re-run of such a variant brackets nothing again — the
+    /// relaxations to smaller loads, about half a lock-up's 7–140 s there — and where it fails
+    /// too, this is the variant's answer (`ensemble::runner`; docs/performance.md, stop 91).
     /// In f64 only: f32's bracket is cleared (`verify_f32`).
     pub fn stops(&self) -> Option<f64> {
         match self.status {

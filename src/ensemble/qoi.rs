@@ -195,6 +195,9 @@ pub(crate) fn failed_stopping(
     r
 }
 
+/// How a dynamic variant's failure in its static start begins its reason.
+pub(crate) const STATIC_START: &str = "static start: ";
+
 /// A variant that finished: converged, or with `cuts` step cuts (or other departures from
 /// its plain steps) that its solver log `log` records.
 #[allow(clippy::too_many_arguments)]
@@ -240,29 +243,40 @@ fn dynamic_cuts(log: &[String]) -> usize {
 /// hole wherever it meets the wall ([`crate::profile::solve_in_hole`]: sites added there
 /// take the case's wall law).
 pub fn static_variant(case: &Case, name: &str, model: &Model) -> VariantResult {
-    solve_held(case, name, model, &mut |m, nodes| {
+    solve_held(case, name, model, true, &mut |m, nodes| {
         crate::profile::add_wall_sites(case, m, nodes)
     })
 }
 
 /// Static equilibrium of variant `v`'s model (`model`, [`crate::ensemble::apply`]), held in
 /// the hole wherever it meets the wall: the sites added there get the variant's overrides
-/// too ([`crate::ensemble::apply_with_sites`]).
+/// too ([`crate::ensemble::apply_with_sites`]). `find_stop`: a load path that fails brackets
+/// where the string stops ([`crate::solve::statics::StaticOptions::find_stop`]; off where the
+/// engine's path did so already, `ensemble::runner`).
 pub fn static_variant_of(
     case: &Case,
     v: &crate::ensemble::Variant,
     model: &Model,
+    find_stop: bool,
 ) -> VariantResult {
-    solve_held(case, &v.name, model, &mut variant_wall_sites(case, v))
+    solve_held(
+        case,
+        &v.name,
+        model,
+        find_stop,
+        &mut variant_wall_sites(case, v),
+    )
 }
 
 /// The static start of `model` held in the hole wherever the string meets the wall
 /// ([`crate::profile::solve_in_hole`], `add` giving the sites): the model with those sites,
 /// and the solve. The one start of every static and dynamic variant on the CPU (the
-/// engine's solves the same guarded models: `ensemble::runner`).
+/// engine's solves the same guarded models: `ensemble::runner`). `find_stop`: as
+/// [`static_variant_of`]'s.
 fn held_start(
     case: &Case,
     model: &Model,
+    find_stop: bool,
     add: &mut dyn FnMut(&mut Model, &[usize]),
 ) -> (
     Model,
@@ -273,7 +287,10 @@ fn held_start(
         case,
         &mut held,
         add,
-        &case.settings().statics(),
+        &crate::solve::statics::StaticOptions {
+            find_stop,
+            ..case.settings().statics()
+        },
         &mut |_| {},
     );
     (held, solved)
@@ -302,9 +319,10 @@ fn solve_held(
     case: &Case,
     name: &str,
     model: &Model,
+    find_stop: bool,
     add: &mut dyn FnMut(&mut Model, &[usize]),
 ) -> VariantResult {
-    let (model, solved) = held_start(case, model, add);
+    let (model, solved) = held_start(case, model, find_stop, add);
     match solved {
         Ok(sol) => static_result(case, name, &model, &sol),
         Err(e) => failed_stopping(
@@ -399,24 +417,26 @@ pub fn dynamic_variant_tracked(
     model: &Model,
     track_energy: bool,
 ) -> (VariantResult, Option<f64>) {
-    dynamic_held(case, name, model, track_energy, &mut |m, nodes| {
+    dynamic_held(case, name, model, track_energy, true, &mut |m, nodes| {
         crate::profile::add_wall_sites(case, m, nodes)
     })
 }
 
 /// [`dynamic_variant`] of variant `v` (its model `model`): the sites its static start adds
 /// where the string meets the wall get the variant's overrides too, as
-/// [`static_variant_of`]'s.
+/// [`static_variant_of`]'s (and its `find_stop`, for the static start).
 pub fn dynamic_variant_of(
     case: &Case,
     v: &crate::ensemble::Variant,
     model: &Model,
+    find_stop: bool,
 ) -> VariantResult {
     dynamic_held(
         case,
         &v.name,
         model,
         false,
+        find_stop,
         &mut variant_wall_sites(case, v),
     )
     .0
@@ -430,6 +450,7 @@ fn dynamic_held(
     name: &str,
     model: &Model,
     track_energy: bool,
+    find_stop: bool,
     add: &mut dyn FnMut(&mut Model, &[usize]),
 ) -> (VariantResult, Option<f64>) {
     let Some(settings) = case.dynamics.clone() else {
@@ -442,7 +463,7 @@ fn dynamic_held(
             None,
         );
     };
-    let (held, solved) = held_start(case, model, add);
+    let (held, solved) = held_start(case, model, find_stop, add);
     let model = &held;
     let stabs = model.stabilizer_sites();
     let start = match solved {
@@ -450,7 +471,7 @@ fn dynamic_held(
         Err(e) => {
             let at = e.stopped().map(|s| s.lambda);
             return (
-                failed_stopping(name, format!("static start: {e}"), stabs.len(), at),
+                failed_stopping(name, format!("{STATIC_START}{e}"), stabs.len(), at),
                 None,
             );
         }
