@@ -94,14 +94,15 @@ where
 }
 
 /// A variant the engine failed (`why`), run again on the CPU (`cpu(find_stop)`: its static
-/// solve, or, `dynamic`, its dynamic run from its static start). Where the engine's load path bracketed
-/// where the string stops (`stops`: [`crate::engine::EngineResult::stops`], the largest load
-/// factor with an equilibrium), the CPU tries the loads once more on its own path but brackets
-/// nothing: in another rounding it may reach an equilibrium the engine's path did not (the
-/// relaxed user well 0, pushed with 678 kN: the engine stops at 0.906, the CPU solves it in
-/// 1.3 s; docs/performance.md, stop 91), and where its static solve fails too, the engine's
-/// bracket is the answer (failed there, `solved_by` engine) — a second bracket on the CPU
-/// would cost the lock-up's relaxations to smaller loads again, about half its time there.
+/// solve, or, `dynamic`, its dynamic run from its static start). Where the engine's load
+/// path bracketed where the string stops (`stops`: [`crate::engine::EngineResult::stops`],
+/// the largest load factor with an equilibrium), the CPU tries the loads once more on its
+/// own path but brackets nothing: in another rounding it may reach an equilibrium the
+/// engine's path did not (the relaxed user well 0, pushed with 678 kN: the engine stops at
+/// 0.906, the CPU solves it in 1.3 s; docs/performance.md, stop 91), and where its static
+/// solve fails too, the engine's bracket is the answer (failed there, `solved_by` engine) —
+/// a second bracket on the CPU would cost the lock-up's relaxations to smaller loads again,
+/// 60–65 % of its time there.
 fn after_engine_failure(
     name: &str,
     why: String,
