@@ -112,33 +112,29 @@ fn chain_batch(n: usize, v: usize) -> ChainBatch<f64> {
     }
 }
 
+/// Every node of every variant at the rotation `m`, laid out as the kernels read rotations
+/// (`[(9 i + 3 a + k) V + v]`).
+fn rotations(m: &crate::physics::rotation::Mat3<f64>, n: usize, v: usize) -> Vec<f64> {
+    (0..9 * n * v)
+        .map(|k| m[k / v % 9 / 3][k / v % 3])
+        .collect()
+}
+
 /// The assembly inputs of [`assembly_inputs`] as a relaxation's sub-solve past its ceiling
 /// assembles them (the kernel built `SHIFT`, [`crate::kernels::assemble::ShiftInputs`]):
-/// every variant's translations and rotations shifted, each node 1 mm and 0.01 rad (about
-/// the string's axis and a lateral one) from its anchor.
+/// every variant's translations and rotations shifted, each node 1 mm and about 0.01 rad
+/// (about the string's axis and a lateral one) from its anchor.
 fn shifted_assembly_inputs(n: usize, v: usize) -> AssemblyInputs<f64> {
     use crate::kernels::assemble::ShiftInputs;
-    let (c, s) = (0.01f64.cos(), 0.01f64.sin());
-    // Rotation by 0.01 rad about z, then about x: `[(9 i + 3 a + k) V + v]`.
-    let rz = [[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]];
-    let rx = [[1.0, 0.0, 0.0], [0.0, c, -s], [0.0, s, c]];
-    let r: Vec<f64> = (0..9)
-        .map(|ak| (0..3).map(|m| rx[ak / 3][m] * rz[m][ak % 3]).sum())
-        .collect();
-    let identity = [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0];
-    let per_node = |m: &[f64]| -> Vec<f64> {
-        (0..n)
-            .flat_map(|_| m.iter().flat_map(|&x| vec![x; v]).collect::<Vec<_>>())
-            .collect()
-    };
+    use crate::physics::rotation::rotation_exp;
     AssemblyInputs {
         shift: Some(ShiftInputs {
             shift: vec![1e6; v],
             anchor: vec![0.0; 3 * n * v],
             x: vec![1e-3; 3 * n * v],
             rot_shift: vec![1e4; v],
-            anchor_rot: per_node(&identity),
-            rot: per_node(&r),
+            anchor_rot: rotations(&rotation_exp(&[0.0; 3]), n, v),
+            rot: rotations(&rotation_exp(&[0.01, 0.0, 0.01]), n, v),
         }),
         ..assembly_inputs(n, v)
     }
@@ -292,15 +288,8 @@ fn run_size<T: GpuReal>(
     // The beam element, force and tangent.
     let model = string_model(n);
     let u = vec![T::zero(); 3 * n * v];
-    let rot: Vec<T> = (0..n * v * 9)
-        .map(|k| {
-            to_t(if [0, 4, 8].contains(&(k / v % 9)) {
-                1.0
-            } else {
-                0.0
-            })
-        })
-        .collect();
+    let identity = crate::physics::rotation::rotation_exp(&[0.0; 3]);
+    let rot: Vec<T> = rotations(&identity, n, v).into_iter().map(to_t).collect();
     let chords = crate::kernels::beam::base_chords(&model, &vec![0.0; 3 * n * v], v);
     let (r, t) = crate::gpu::dispatch::timed(repeats, || {
         crate::gpu::beam::beam_gpu::<T>(ctx, &model, v, &u, &rot, &chords, &[], true)

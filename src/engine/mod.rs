@@ -455,7 +455,7 @@ fn solve_batch<T: Real + Send + Sync, P: KernelPath<T>>(
                 None => EngineStatus::Converged,
                 Some(e) => EngineStatus::Failed(e.to_string()),
             },
-            stopped: path.stopped_between().filter(|_| path.error.is_some()),
+            stopped: path.stopped_between(),
             iterations: path.iterations,
             log: path.log,
             doubtful: path.doubtful,
