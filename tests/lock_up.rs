@@ -1,8 +1,9 @@
 //! A string that stops on its way into the hole (issue 22): corpus well 242 (horizontal,
 //! 2,455 m, 9⅞ in hole, tripping in, friction 0.21 cased) meshed with 5 m elements (1 m in
 //! the BHA), its open-hole friction raised from 0.368 to 0.45. Its load path finds no
-//! equilibrium at the full friction (best 1.2e-4 of the force scale), and relaxations to
-//! smaller loads bracket where the string stops (λ 0.8125 to 0.906). At the corpus's 0.368
+//! equilibrium at the full friction (best 1.3e-4 of the force scale), and relaxations up
+//! from its last equilibrium in steps of 1/8 bracket where the string stops (λ 0.75 to
+//! 0.875 since stop 92; 0.719 to 0.8125 when they halved the interval). At the corpus's 0.368
 //! the relaxation to the full loads stalls at 8.4e-7 and settles there since stop 76
 //! (`relax_stall_tolerance`): an equilibrium pushed with 212 kN from the surface, which the
 //! lock-up warning calls one the string does not reach by being run in. The solve then gives the

@@ -433,7 +433,8 @@ fn solve_batch<T: Real + Send + Sync, P: KernelPath<T>>(
         tables.set_base(mesh, columns(&sys.tables.base, m, &keep));
         let saved = keep.iter().map(|&i| sys.saved[i].clone()).collect();
         let shifts = keep.iter().map(|&i| sys.shifts[i].clone()).collect();
-        let best = keep.iter().map(|&i| sys.best[i].take()).collect();
+        let best = sys.best.take_columns(&keep);
+        let equilibrium = sys.equilibrium.take_columns(&keep);
         let anchor_base = keep
             .iter()
             .map(|&i| std::mem::take(&mut sys.anchor_base[i]))
@@ -442,6 +443,7 @@ fn solve_batch<T: Real + Send + Sync, P: KernelPath<T>>(
         let ensemble = path.open(mesh, &tables)?;
         sys = EngineStatic::new(kept_models, ensemble, tables, Some(saved), Some(shifts));
         sys.best = best;
+        sys.equilibrium = equilibrium;
         sys.anchor_base = anchor_base;
         resume = Some(keep.iter().map(|&i| states[i].clone()).collect::<Vec<_>>());
         members = keep.iter().map(|&i| members[i]).collect();

@@ -22,11 +22,10 @@ pub(super) struct EngineStatic<'a, T> {
     pub(super) saved: Vec<(Vec<f64>, Vec<f64>)>,
     to_save: Vec<usize>,
     to_restore: Vec<usize>,
-    /// Per variant: its relaxation's best state ([`StaticSystem::keep_best`]), as `saved`.
-    pub(super) best: Vec<Option<(Vec<f64>, Vec<f64>)>>,
-    /// Variants whose state is to be kept as their best, and those to go back to it.
-    to_keep: Vec<usize>,
-    to_best: Vec<usize>,
+    /// Per variant: its relaxation's best state ([`StaticSystem::keep_best`]).
+    pub(super) best: Kept,
+    /// Per variant: its last equilibrium ([`StaticSystem::keep_equilibrium`]).
+    pub(super) equilibrium: Kept,
     /// Per variant the landing epoch counter (one more at each target and restart), and
     /// whether the epochs the ensemble holds are stale.
     land_epoch: Vec<u32>,
@@ -105,9 +104,8 @@ impl<'a, T: Real> EngineStatic<'a, T> {
             saved,
             to_save: Vec::new(),
             to_restore: Vec::new(),
-            best: vec![None; v],
-            to_keep: Vec::new(),
-            to_best: Vec::new(),
+            best: Kept::new(v),
+            equilibrium: Kept::new(v),
             land_epoch: vec![1; v],
             epochs_changed: true,
             to_rebase: false,
@@ -119,7 +117,8 @@ impl<'a, T: Real> EngineStatic<'a, T> {
     /// Carries out the gathered saves, restores (and f32 rebase) and load changes.
     pub(super) fn flush(&mut self) -> Result<(), crate::error::SystemError> {
         let v = self.tables.num_variants;
-        if !self.to_save.is_empty() || !self.to_restore.is_empty() || !self.to_keep.is_empty() {
+        let keeps = !self.best.to_keep.is_empty() || !self.equilibrium.to_keep.is_empty();
+        if !self.to_save.is_empty() || !self.to_restore.is_empty() || keeps {
             let mut config = self.ensemble.config()?;
             // Variant `j`'s state now into `(x, rot)`, as `saved` holds it.
             let read = |j: usize, (x, rot): &mut (Vec<f64>, Vec<f64>)| {
@@ -130,9 +129,18 @@ impl<'a, T: Real> EngineStatic<'a, T> {
                     *r = config.rot[k * v + j].to_f64_lossy();
                 }
             };
-            for j in std::mem::take(&mut self.to_keep) {
-                let best = self.best[j].get_or_insert_with(|| self.saved[j].clone());
+            // In the driver's order: a relaxation's best, then the equilibrium (which is
+            // the best where the variant went back to it in between), then the save.
+            for j in std::mem::take(&mut self.best.to_keep) {
+                let best = self.best.states[j].get_or_insert_with(|| self.saved[j].clone());
                 read(j, best);
+            }
+            for j in std::mem::take(&mut self.equilibrium.to_keep) {
+                let kept = self.equilibrium.states[j].get_or_insert_with(|| self.saved[j].clone());
+                match &self.best.states[j] {
+                    Some(best) if self.best.to_go_back.contains(&j) => kept.clone_from(best),
+                    _ => read(j, kept),
+                }
             }
             for j in std::mem::take(&mut self.to_save) {
                 read(j, &mut self.saved[j]);
@@ -140,12 +148,9 @@ impl<'a, T: Real> EngineStatic<'a, T> {
                     self.to_rebase = true;
                 }
             }
-            // After the saves: a variant sent back to its best has it as restart point.
-            for j in std::mem::take(&mut self.to_best) {
-                if let Some(best) = &self.best[j] {
-                    self.saved[j].clone_from(best);
-                }
-            }
+            // After the saves: a variant sent back to a kept state has it as restart point.
+            self.best.go_back(&mut self.saved);
+            self.equilibrium.go_back(&mut self.saved);
             let restores = std::mem::take(&mut self.to_restore);
             for &j in &restores {
                 let (x, rot) = &self.saved[j];
@@ -239,6 +244,58 @@ pub(super) struct VariantShift {
     pub(super) s_rot: f64,
     /// Its anchor rotations (`9 n`; empty without a shift).
     pub(super) anchor_rot: Vec<f64>,
+}
+
+/// A state per variant that the load path may send it back to ([`StaticSystem::back_to_best`],
+/// [`StaticSystem::back_to_equilibrium`]), kept on the host as `EngineStatic::saved` is; the
+/// keeps and returns are carried out at the next flush.
+#[derive(Clone, Debug)]
+pub(super) struct Kept {
+    /// Per variant the state kept last (`None`: none yet).
+    pub(super) states: Vec<Option<(Vec<f64>, Vec<f64>)>>,
+    /// Variants whose current state is to be kept, and those to go back to theirs.
+    to_keep: Vec<usize>,
+    to_go_back: Vec<usize>,
+}
+
+impl Kept {
+    fn new(v: usize) -> Self {
+        Kept {
+            states: vec![None; v],
+            to_keep: Vec::new(),
+            to_go_back: Vec::new(),
+        }
+    }
+
+    /// The kept states of variants `keep` (in that order; taken from `self`).
+    pub(super) fn take_columns(&mut self, keep: &[usize]) -> Self {
+        Kept {
+            states: keep.iter().map(|&i| self.states[i].take()).collect(),
+            to_keep: Vec::new(),
+            to_go_back: Vec::new(),
+        }
+    }
+
+    /// Variant `j` is to go back to its kept state (refused where none is kept or pending:
+    /// `what` says which).
+    fn send_back(&mut self, j: usize, what: &str) -> Result<(), crate::error::SystemError> {
+        if self.states[j].is_none() && !self.to_keep.contains(&j) {
+            return Err(crate::error::SystemError::Unsupported(format!(
+                "no {what} was kept"
+            )));
+        }
+        self.to_go_back.push(j);
+        Ok(())
+    }
+
+    /// The variants sent back: their kept states as restart points in `saved`.
+    fn go_back(&mut self, saved: &mut [(Vec<f64>, Vec<f64>)]) {
+        for j in std::mem::take(&mut self.to_go_back) {
+            if let Some(state) = &self.states[j] {
+                saved[j].clone_from(state);
+            }
+        }
+    }
 }
 
 impl VariantShift {
@@ -462,16 +519,23 @@ impl<T: Real> StaticSystem for EngineStatic<'_, T> {
         self.unshifted.as_ref().map_or(f64::INFINITY, |m| m[j])
     }
     fn keep_best(&mut self, j: usize) -> Result<(), crate::error::SystemError> {
-        self.to_keep.push(j);
+        self.best.to_keep.push(j);
         Ok(())
     }
     fn back_to_best(&mut self, j: usize) -> Result<(), crate::error::SystemError> {
-        if self.best[j].is_none() && !self.to_keep.contains(&j) {
-            return Err(crate::error::SystemError::Unsupported(
-                "no relaxation state was kept".into(),
-            ));
-        }
-        self.to_best.push(j);
+        self.best.send_back(j, "relaxation state")?;
+        self.restore(j)
+    }
+    fn keep_equilibrium(
+        &mut self,
+        j: usize,
+        _target: &LoadTarget,
+    ) -> Result<(), crate::error::SystemError> {
+        self.equilibrium.to_keep.push(j);
+        Ok(())
+    }
+    fn back_to_equilibrium(&mut self, j: usize) -> Result<(), crate::error::SystemError> {
+        self.equilibrium.send_back(j, "equilibrium")?;
         self.restore(j)
     }
     fn set_shift(
@@ -564,6 +628,77 @@ mod tests {
         for k in 0..now.x.len() / v {
             assert_eq!(now.x[k * v + 1], start.x[k * v + 1] + 1e-3 + 5e-3);
         }
+    }
+
+    /// A variant's last equilibrium (`StaticSystem::keep_equilibrium`) is read at the next
+    /// flush, and a variant sent back to it (`back_to_equilibrium`, the start of a
+    /// relaxation bracketing where its string stops) has it as state and restart point; in
+    /// a flush that also sends it back to a relaxation's best (a relaxation that settled
+    /// there), the equilibrium kept is that best, as the CPU solve keeps it.
+    #[test]
+    fn a_variant_sent_back_to_its_equilibrium_restarts_there() {
+        let models = two_variants();
+        let mut sys = twin_system(&models);
+        let v = 2;
+        let start = sys.ensemble.config().unwrap();
+        let moved = |sys: &mut EngineStatic<f64>, d: f64| {
+            let mut c = sys.ensemble.config().unwrap();
+            for k in 0..c.x.len() / v {
+                c.x[k * v + 1] += d;
+            }
+            sys.ensemble.set_config(&c).unwrap();
+        };
+        // Variant 1's displacements now, to be kept.
+        let now = |sys: &mut EngineStatic<f64>| sys.ensemble.config().unwrap().x;
+        // Variant 1 at `kept` (as a restore writes it back), variant 0 where it started.
+        let at = |sys: &mut EngineStatic<f64>, kept: &[f64]| {
+            let now = sys.ensemble.config().unwrap();
+            for k in 0..now.x.len() / v {
+                assert_eq!(now.x[k * v], start.x[k * v], "variant 0 moved");
+                let saved = sys.tables.base[k * v + 1] + kept[k * v + 1];
+                assert_eq!(sys.saved[1].0[k], saved);
+                assert_eq!(
+                    now.x[k * v + 1],
+                    saved - sys.tables.base[k * v + 1],
+                    "variant 1 not where it should be"
+                );
+            }
+        };
+        let target = LoadTarget {
+            gravity: 1.0,
+            lambda: 0.5,
+            friction: 0.5,
+            exponent: 1.0,
+        };
+        assert!(sys.back_to_equilibrium(1).is_err(), "none kept");
+        sys.to_restore.clear();
+        // Kept at 1 mm and saved; a relaxation moves on to 3 mm and is saved there; back.
+        moved(&mut sys, 1e-3);
+        let equilibrium = now(&mut sys);
+        sys.keep_equilibrium(1, &target).unwrap();
+        sys.save(1).unwrap();
+        sys.flush().unwrap();
+        moved(&mut sys, 2e-3);
+        sys.save(1).unwrap();
+        sys.flush().unwrap();
+        sys.back_to_equilibrium(1).unwrap();
+        sys.flush().unwrap();
+        at(&mut sys, &equilibrium);
+        // A relaxation's best 1 mm on; it goes on 2 mm more, settles back at its best, which
+        // is kept as the equilibrium, and the next relaxation starts from there.
+        moved(&mut sys, 1e-3);
+        let best = now(&mut sys);
+        sys.keep_best(1).unwrap();
+        sys.save(1).unwrap();
+        sys.flush().unwrap();
+        moved(&mut sys, 2e-3);
+        sys.back_to_best(1).unwrap();
+        sys.keep_equilibrium(1, &target).unwrap();
+        sys.save(1).unwrap();
+        sys.back_to_equilibrium(1).unwrap();
+        sys.flush().unwrap();
+        at(&mut sys, &best);
+        assert_eq!(sys.equilibrium.states[1], sys.best.states[1]);
     }
 
     /// A shift set with momentum anchors at the restart point carried on by the momentum

@@ -36,9 +36,17 @@ pub trait StaticSystem: NewtonSystem {
         f64::INFINITY
     }
     /// Keeps variant `j`'s current state, an equilibrium at the loads `target`
-    /// ([`LoadPath::take_equilibrium`]), as where its string stands should its path fail
-    /// where the string stops. Systems without a use for it keep nothing.
-    fn keep_equilibrium(&mut self, _j: usize, _target: &LoadTarget) {}
+    /// ([`LoadPath::take_equilibrium`]): where its string stands should its path fail
+    /// where the string stops, and where the relaxations bracketing that start
+    /// ([`StaticSystem::back_to_equilibrium`]).
+    fn keep_equilibrium(
+        &mut self,
+        j: usize,
+        target: &LoadTarget,
+    ) -> Result<(), crate::error::SystemError>;
+    /// Returns variant `j`'s state and restart point to the equilibrium
+    /// [`StaticSystem::keep_equilibrium`] kept last ([`LoadPath::take_back_to_equilibrium`]).
+    fn back_to_equilibrium(&mut self, j: usize) -> Result<(), crate::error::SystemError>;
     /// Keeps variant `j`'s current state, a relaxation's best sub-solve so far
     /// ([`LoadPath::shift_settled`]), for [`StaticSystem::back_to_best`].
     fn keep_best(&mut self, j: usize) -> Result<(), crate::error::SystemError>;
@@ -173,7 +181,7 @@ fn next_steps(
                     sys.back_to_best(j)?;
                 }
                 if let Some(target) = path.take_equilibrium() {
-                    sys.keep_equilibrium(j, &target);
+                    sys.keep_equilibrium(j, &target)?;
                 }
                 (next, true)
             }
@@ -187,6 +195,10 @@ fn next_steps(
             (Next::Step, true) => sys.save(j)?,
             (Next::Step | Next::Finished, false) => sys.restore(j)?,
             _ => {}
+        }
+        if path.take_back_to_equilibrium() {
+            // After the save or restore: the equilibrium is then the restart point too.
+            sys.back_to_equilibrium(j)?;
         }
         if next == Next::Step {
             sys.set_target(j, &path.target())?;

@@ -166,6 +166,9 @@ pub struct LoadPath {
     pub doubtful: bool,
     /// The relaxation just settled at its best state ([`LoadPath::take_back_to_best`]).
     back_to_best: bool,
+    /// A relaxation bracketing where the string stops starts from the equilibrium at the
+    /// bracket's lower end ([`LoadPath::take_back_to_equilibrium`]).
+    back_to_equilibrium: bool,
     /// The system shifts rotations ([`LoadPath::allow_rotation_shift`]).
     rotations_shift: bool,
     /// [`StaticOptions::find_stop`].
@@ -211,6 +214,7 @@ impl LoadPath {
             error: None,
             doubtful: false,
             back_to_best: false,
+            back_to_equilibrium: false,
             lock: None,
             equilibrium: None,
             stopped: None,
@@ -347,9 +351,17 @@ impl LoadPath {
     /// a gravity step or a relaxation that settled; `None` after a relaxation's
     /// unsettled sub-solve), once: the driver keeps that state
     /// ([`StaticSystem::keep_equilibrium`]), which is where the string stands if the path
-    /// later fails where it stops ([`LoadPath::stopped_between`]).
+    /// later fails where it stops ([`LoadPath::stopped_between`]), and where each
+    /// relaxation bracketing that starts ([`LoadPath::take_back_to_equilibrium`]).
     pub fn take_equilibrium(&mut self) -> Option<LoadTarget> {
         self.equilibrium.take()
+    }
+
+    /// Whether a relaxation bracketing where the string stops is to start from the
+    /// equilibrium the system kept last, at the bracket's lower end
+    /// ([`StaticSystem::back_to_equilibrium`]), not from where the last relaxation ended.
+    pub fn take_back_to_equilibrium(&mut self) -> bool {
+        std::mem::take(&mut self.back_to_equilibrium)
     }
 
     /// Whether the relaxation just settled at its best state, not at the last sub-solve's

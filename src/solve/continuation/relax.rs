@@ -172,9 +172,9 @@ pub(super) const RELAX_CEILING: f64 = 1e6;
 /// otherwise change — not those bracketing where a failed path stops, where it took the
 /// lock-up 2915 from 38,048 Newton iterations to 74,657 and failed as before.
 pub(super) const RELAX_ROTATION_SHIFT: f64 = 0.01;
-/// Where the relaxation to the full loads failed, relaxations to smaller loads bracket
-/// the largest load with an equilibrium to this width of the load factor (at most three
-/// from a failure at the first step).
+/// Where the relaxation to the full loads failed, relaxations up from the last equilibrium
+/// in steps of this width of the load factor bracket where the string stops
+/// ([`super::LoadPath::bracket`]; at most seven from a failure at the first step).
 pub(super) const LOCK_BRACKET: f64 = 0.125;
 /// The words of the log line of a relaxation that reached its ceiling and shifted the
 /// rotations too ([`RELAX_ROTATION_SHIFT`]; the corpus counts the wells it solved).
@@ -359,10 +359,21 @@ impl super::LoadPath {
     }
 
     /// After the relaxation to the full loads failed (the string may stop on its way in):
-    /// relaxations to loads between the largest with an equilibrium (`lock.lo`) and the
-    /// smallest without (`lock.hi`), each from where the last one ended, halve that
-    /// interval down to [`LOCK_BRACKET`]; then the path fails, its message saying where
-    /// between the two the string stops. Corpus well 419 (tripping in, 2 m elements) fails
+    /// relaxations up from the largest load with an equilibrium (`lock.lo`) in steps of
+    /// [`LOCK_BRACKET`], each from the equilibrium the last one reached
+    /// ([`super::LoadPath::take_back_to_equilibrium`]), until one finds none (`lock.hi`) or
+    /// the next would pass the full loads' failure; then the path fails, its message saying
+    /// where between the two the string stops: the first step up from an equilibrium that
+    /// reaches none, as the string is run in with its friction growing.
+    ///
+    /// Until stop 92 the relaxations halved the interval, each from where the last one
+    /// ended: after one that failed, a string that had slid on without an equilibrium, from
+    /// which the next failed where a relaxation from the equilibrium below settles — and a
+    /// relaxation across a wide interval fails where short steps from equilibria pass.
+    /// Corpus well 242 at 10 m elements with open-hole friction 0.7 stopped between 0.625 and
+    /// 0.719 on the CPU and 0.5 and 0.625 on the engine's twin; halving from the equilibrium
+    /// below, between 0.531 and 0.625 on the CPU and above 0.875 on the twin; in steps, above
+    /// 0.875 on both (docs/performance.md, stop 92). Corpus well 419 (tripping in, 2 m elements) fails
     /// at its first step, yet the case with its friction scaled to 0.4–0.7 solves on a
     /// path of its own (docs/performance.md, stop 64). Where [`StaticOptions::find_stop`]
     /// is off, the path fails at once, saying why the relaxation failed.
@@ -397,18 +408,19 @@ impl super::LoadPath {
             self.stage = Stage::Failed;
             return Next::Failed;
         }
-        let mid = 0.5 * (lock.lo + lock.hi);
+        let up = lock.lo + LOCK_BRACKET;
         let target = LoadTarget {
-            lambda: mid,
-            friction: mid,
+            lambda: up,
+            friction: up,
             ..self.target
         };
         let (s0, from) = (lock.s0, lock.lo);
         self.lock = Some(lock);
+        self.back_to_equilibrium = true;
         let next = self.relax_after(target, s0, String::new(), false);
         if let Some(r) = self.relax.as_mut() {
             r.reason =
-                format!("where the load path stops: relaxation from λ = {from:.4} to {mid:.4}");
+                format!("where the load path stops: relaxation from λ = {from:.4} to {up:.4}");
             r.cause = r.reason.clone();
         }
         next

@@ -407,10 +407,10 @@ fn a_failed_gravity_step_relaxes_at_once_where_the_system_can_and_ramps_where_it
     assert!(p.target().gravity < 1.0);
 }
 
-/// Where the relaxation to the full loads fails, relaxations to smaller loads bracket where
-/// the string stops to [`LOCK_BRACKET`]: each from where the last ended, lower after one
-/// that fails, higher after one that settles; the message names the bracket and the
-/// failure's load factor is its lower end.
+/// Where the relaxation to the full loads fails, relaxations up from the last equilibrium in
+/// steps of [`LOCK_BRACKET`] bracket where the string stops: each from the equilibrium the
+/// last one reached, until one finds none; the message names the bracket and the failure's
+/// load factor is its lower end.
 #[test]
 fn a_failed_full_load_relaxation_brackets_where_the_string_stops() {
     let (mut p, next) = stuck(Some(1e6));
@@ -442,29 +442,33 @@ fn a_failed_full_load_relaxation_brackets_where_the_string_stops() {
     assert_eq!(p.converged(3), Next::Step);
     assert_eq!(p.take_equilibrium(), None);
     assert_eq!(p.stopped_between(), None);
-    // The full loads fail: a relaxation to 0.5 from where it ended.
+    assert!(
+        !p.take_back_to_equilibrium(),
+        "the relaxation to the full loads goes on"
+    );
+    // The full loads fail: a relaxation to 0.125 from the equilibrium at 0.
     assert_eq!(fail_relaxation(&mut p), Next::Step);
     assert_eq!((p.stage, p.lambda), (Stage::Relax, 0.0));
+    assert!(p.take_back_to_equilibrium());
+    assert!(!p.take_back_to_equilibrium(), "taken once");
     let t = p.target();
-    assert_eq!((t.lambda, t.friction, t.gravity), (0.5, 0.5, 1.0));
-    // 0.5 settles: on to 0.75.
-    assert_eq!(settle(&mut p), Next::Step);
-    assert_eq!(
-        (p.stage, p.lambda, p.target().lambda),
-        (Stage::Relax, 0.5, 0.75)
-    );
-    // 0.75 fails: back to 0.625.
-    assert_eq!(fail_relaxation(&mut p), Next::Step);
-    assert_eq!(
-        (p.stage, p.lambda, p.target().lambda),
-        (Stage::Relax, 0.5, 0.625)
-    );
-    // 0.625 settles: the bracket [0.625, 0.75] is narrow enough; the path fails there.
+    assert_eq!((t.lambda, t.friction, t.gravity), (0.125, 0.125, 1.0));
+    // 0.125 and 0.25 settle: on to 0.375, each from the equilibrium the last reached.
+    for lambda in [0.125, 0.25] {
+        assert_eq!(settle(&mut p), Next::Step);
+        assert_eq!(
+            (p.stage, p.lambda, p.target().lambda),
+            (Stage::Relax, lambda, lambda + 0.125)
+        );
+        assert!(p.take_back_to_equilibrium());
+    }
+    // 0.375 fails: the bracket [0.25, 0.375] is closed; the path fails there.
     assert_eq!(p.stopped_between(), None);
-    assert_eq!(settle(&mut p), Next::Failed);
-    assert_eq!(p.stopped_between(), Some((0.625, 0.75)));
+    assert_eq!(fail_relaxation(&mut p), Next::Failed);
+    assert!(!p.take_back_to_equilibrium(), "no relaxation follows");
+    assert_eq!(p.stopped_between(), Some((0.25, 0.375)));
     let e = p.error.clone().unwrap();
-    assert_eq!(e.reached(), 0.625);
+    assert_eq!(e.reached(), 0.25);
     let e = e.to_string();
     // The step that failed is named once, the bracket after it.
     assert!(
@@ -472,7 +476,7 @@ fn a_failed_full_load_relaxation_brackets_where_the_string_stops() {
         "{e}"
     );
     assert!(
-        e.contains(&format!("{LOCK_FOUND} λ = 0.6250 and none at λ = 0.7500")),
+        e.contains(&format!("{LOCK_FOUND} λ = 0.2500 and none at λ = 0.3750")),
         "{e}"
     );
     assert!(
@@ -480,6 +484,17 @@ fn a_failed_full_load_relaxation_brackets_where_the_string_stops() {
         "{e}"
     );
     assert!(p.log.last().unwrap().contains("where the load path stops"));
+    // Up to 0.875 and no further: the full loads' failure closes the bracket.
+    let (mut r, _) = stuck(Some(1e6));
+    assert_eq!(fail_relaxation(&mut r), Next::Step);
+    let mut next = Next::Step;
+    let mut relaxations = 0;
+    while next == Next::Step {
+        next = settle(&mut r);
+        relaxations += 1;
+    }
+    assert_eq!((next, relaxations), (Next::Failed, 7));
+    assert_eq!(r.stopped_between(), Some((0.875, 1.0)));
     // From a failed step at λ 0.75: one relaxation, to 0.875, which fails there too.
     let mut q = LoadPath::new(&StaticOptions::default(), true, true, false);
     assert_eq!(q.converged(10), Next::Step);
@@ -524,6 +539,7 @@ fn without_find_stop_a_failed_full_load_relaxation_fails_at_once() {
     assert_eq!(next, Next::Failed);
     assert_eq!(p.stage, Stage::Failed);
     assert_eq!(p.stopped_between(), None);
+    assert!(!p.take_back_to_equilibrium());
     let e = p.error.clone().unwrap();
     assert_eq!(e.reached(), 0.25);
     let e = e.to_string();

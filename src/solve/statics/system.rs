@@ -164,6 +164,21 @@ impl CpuStatic<'_> {
         self.may_land = landing_flags(&self.walls);
     }
 
+    /// The state and restart point set to `to`, a state kept earlier (`None`: none was;
+    /// the error says `what`).
+    fn go_back(
+        &mut self,
+        to: Option<StaticState>,
+        what: &str,
+    ) -> Result<(), crate::error::SystemError> {
+        let to = to.ok_or_else(|| crate::error::SystemError::Unsupported(what.into()))?;
+        self.saved.clone_from(&to);
+        self.state = to;
+        self.evaluated = false;
+        self.reset_landing();
+        Ok(())
+    }
+
     /// The state moved by `α Δ`, and the nodes that landed on their wall in it.
     fn moved(&self, alpha: f64) -> (StaticState, Vec<usize>) {
         let mut landed = Vec::new();
@@ -324,7 +339,11 @@ impl crate::solve::continuation::StaticSystem for CpuStatic<'_> {
         constrain_residual(&self.c, &mut r);
         residual_measure(&r, self.f_ref)
     }
-    fn keep_equilibrium(&mut self, _j: usize, target: &crate::solve::continuation::LoadTarget) {
+    fn keep_equilibrium(
+        &mut self,
+        _j: usize,
+        target: &crate::solve::continuation::LoadTarget,
+    ) -> Result<(), crate::error::SystemError> {
         // Into the buffers of the last one kept: no allocation a converged step. Every field
         // by name, so a field added to the state cannot be left out unnoticed.
         match &mut self.kept {
@@ -336,6 +355,11 @@ impl crate::solve::continuation::StaticSystem for CpuStatic<'_> {
             }
             None => self.kept = Some((self.state.clone(), *target)),
         }
+        Ok(())
+    }
+    fn back_to_equilibrium(&mut self, _j: usize) -> Result<(), crate::error::SystemError> {
+        let kept = self.kept.as_ref().map(|(state, _)| state.clone());
+        self.go_back(kept, "no equilibrium was kept")
     }
     fn keep_best(&mut self, _j: usize) -> Result<(), crate::error::SystemError> {
         match &mut self.best {
@@ -345,14 +369,8 @@ impl crate::solve::continuation::StaticSystem for CpuStatic<'_> {
         Ok(())
     }
     fn back_to_best(&mut self, _j: usize) -> Result<(), crate::error::SystemError> {
-        let best = self.best.as_ref().ok_or_else(|| {
-            crate::error::SystemError::Unsupported("no relaxation state was kept".into())
-        })?;
-        self.state.clone_from(best);
-        self.saved.clone_from(best);
-        self.evaluated = false;
-        self.reset_landing();
-        Ok(())
+        let best = self.best.clone();
+        self.go_back(best, "no relaxation state was kept")
     }
     fn set_shift(
         &mut self,
