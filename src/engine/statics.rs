@@ -583,6 +583,15 @@ mod tests {
         EngineStatic::new(models.iter().collect(), ensemble, tables, None, None)
     }
 
+    /// Variant 1 of two moved by `d` from where it stands.
+    fn moved(sys: &mut EngineStatic<f64>, d: f64) {
+        let mut c = sys.ensemble.config().unwrap();
+        for k in 0..c.x.len() / 2 {
+            c.x[k * 2 + 1] += d;
+        }
+        sys.ensemble.set_config(&c).unwrap();
+    }
+
     /// A relaxation's best state (`StaticSystem::keep_best`) is read at the next flush, and
     /// a variant sent back to it (`back_to_best`, after the driver's save of the state it
     /// leaves) has it as state and restart point; the other variant keeps its own.
@@ -592,14 +601,6 @@ mod tests {
         let mut sys = twin_system(&models);
         let v = 2;
         let start = sys.ensemble.config().unwrap();
-        // Variant 1 moved by `d` from where it starts.
-        let moved = |sys: &mut EngineStatic<f64>, d: f64| {
-            let mut c = sys.ensemble.config().unwrap();
-            for k in 0..c.x.len() / v {
-                c.x[k * v + 1] += d;
-            }
-            sys.ensemble.set_config(&c).unwrap();
-        };
         // No best kept: refused.
         assert!(sys.back_to_best(1).is_err());
         sys.to_restore.clear();
@@ -641,13 +642,6 @@ mod tests {
         let mut sys = twin_system(&models);
         let v = 2;
         let start = sys.ensemble.config().unwrap();
-        let moved = |sys: &mut EngineStatic<f64>, d: f64| {
-            let mut c = sys.ensemble.config().unwrap();
-            for k in 0..c.x.len() / v {
-                c.x[k * v + 1] += d;
-            }
-            sys.ensemble.set_config(&c).unwrap();
-        };
         // Variant 1's displacements now, to be kept.
         let now = |sys: &mut EngineStatic<f64>| sys.ensemble.config().unwrap().x;
         // Variant 1 at `kept` (as a restore writes it back), variant 0 where it started.
