@@ -323,7 +323,7 @@ impl EngineResult {
     /// the CPU solve's does for a lock-up: the largest load factor with an equilibrium. The
     /// engine runs the CPU's load path ([`LoadPath`]: the same steps, relaxations and
     /// bracket), so an ensemble's CPU re-run of such a variant brackets nothing again — the
-    /// relaxations to smaller loads, 60–65 % of a lock-up's time there — and where it fails
+    /// relaxations below the full loads, 60–65 % of a lock-up's time there — and where it fails
     /// too, this is the variant's answer (`ensemble::runner`; docs/performance.md, stop 91).
     /// In f64 only: f32's bracket is cleared (`verify_f32`).
     pub fn stops(&self) -> Option<f64> {

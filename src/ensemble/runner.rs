@@ -101,7 +101,7 @@ where
 /// engine's path did not (the relaxed user well 0, pushed with 678 kN: the engine stops at
 /// 0.906, the CPU solves it in 1.3 s; docs/performance.md, stop 91), and where its static
 /// solve fails too, the engine's bracket is the answer (failed there, `solved_by` engine) —
-/// a second bracket on the CPU would cost the lock-up's relaxations to smaller loads again,
+/// a second bracket on the CPU would cost the lock-up's relaxations below the full loads again,
 /// 60–65 % of its time there.
 fn after_engine_failure(
     name: &str,

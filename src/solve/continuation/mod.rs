@@ -169,6 +169,9 @@ pub struct LoadPath {
     /// A relaxation bracketing where the string stops starts from the equilibrium at the
     /// bracket's lower end ([`LoadPath::take_back_to_equilibrium`]).
     back_to_equilibrium: bool,
+    /// A step of the path has converged to an equilibrium (not so a polish's path,
+    /// [`LoadPath::at_full_load`], until its step converges): one to bracket from.
+    any_equilibrium: bool,
     /// The system shifts rotations ([`LoadPath::allow_rotation_shift`]).
     rotations_shift: bool,
     /// [`StaticOptions::find_stop`].
@@ -215,6 +218,7 @@ impl LoadPath {
             doubtful: false,
             back_to_best: false,
             back_to_equilibrium: false,
+            any_equilibrium: false,
             lock: None,
             equilibrium: None,
             stopped: None,
@@ -401,6 +405,7 @@ impl LoadPath {
             (Stage::Relax | Stage::Done | Stage::Failed, _) => None,
             _ => Some(self.target),
         };
+        self.any_equilibrium |= self.equilibrium.is_some();
         match self.stage {
             Stage::Gravity => self.stage = Stage::Load,
             Stage::GravityRamp => {

@@ -39,7 +39,7 @@ impl LoadPath {
     /// step, or the relaxation with its sub-solves, its best residual without the shift and
     /// the sub-solve at which it gives up without a 1 % gain (`Relax::stagnant_at`,
     /// at most [`RELAX_MAX_SUBS`]; its iteration budget may end it sooner), or the
-    /// relaxations to smaller loads that bracket where the string stops.
+    /// relaxations up from the last equilibrium that bracket where the string stops.
     pub fn stage_note(&self) -> Option<String> {
         let stage = match self.stage {
             Stage::Gravity => "gravity in full, the string on the low side".to_string(),

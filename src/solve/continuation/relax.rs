@@ -187,7 +187,7 @@ pub fn rotations_shifted(log: &[String]) -> bool {
 
 /// The words of a failure whose load path bracketed where the string stops
 /// (`super::LoadPath::bracket`); `crate::diagnose::static_failure` reads them.
-pub const LOCK_FOUND: &str = "relaxations to smaller loads found an equilibrium at";
+pub const LOCK_FOUND: &str = "relaxations up from the last equilibrium found one at";
 
 /// A relaxation's state ([`super::Stage::Relax`]).
 #[derive(Clone, Debug)]
@@ -364,7 +364,9 @@ impl super::LoadPath {
     /// ([`super::LoadPath::take_back_to_equilibrium`]), until one finds none (`lock.hi`) or
     /// the next would pass the full loads' failure; then the path fails, its message saying
     /// where between the two the string stops: the first step up from an equilibrium that
-    /// reaches none, as the string is run in with its friction growing.
+    /// reaches none, as the string is run in with its friction growing. A path that has
+    /// reached no equilibrium (a polish, [`super::LoadPath::at_full_load`]) fails at once, as
+    /// one without [`StaticOptions::find_stop`] does.
     ///
     /// Until stop 92 the relaxations halved the interval, each from where the last one
     /// ended: after one that failed, a string that had slid on without an equilibrium, from
@@ -379,9 +381,11 @@ impl super::LoadPath {
     /// is off, the path fails at once, saying why the relaxation failed.
     pub(super) fn bracket(&mut self, lock: Lock) -> Next {
         let closed = lock.hi - lock.lo <= LOCK_BRACKET * (1.0 + 1e-9);
-        if closed || !self.find_stop {
-            // Without `find_stop`, the first failure as it is.
-            let reason = if self.find_stop {
+        let bracketing = self.find_stop && self.any_equilibrium;
+        if closed || !bracketing {
+            // Without `find_stop`, or without an equilibrium on the path to step up from (a
+            // polish from a state it was given), the first failure as it is.
+            let reason = if bracketing {
                 self.log.push(format!(
                     // "The load path", not "the string": a string that is not run in or
                     // out (turning on or off bottom) does not stop (crate::diagnose::stops).

@@ -514,6 +514,30 @@ fn a_failed_full_load_relaxation_brackets_where_the_string_stops() {
     assert!(e.to_string().contains("none at λ = 0.8750"), "{e}");
 }
 
+/// A polish's path ([`LoadPath::at_full_load`]) has no equilibrium to step up from: where
+/// its relaxation to the full loads fails, it fails at once, without a bracket.
+#[test]
+fn a_polish_whose_relaxation_fails_fails_without_a_bracket() {
+    let mut p = LoadPath::at_full_load(&StaticOptions::default());
+    assert_eq!(p.target().lambda, 1.0);
+    assert_eq!(p.failed_at("no".into(), None, Some(1e6)), Next::Step);
+    assert_eq!((p.stage, p.target().lambda), (Stage::Relax, 1.0));
+    let mut next = Next::Step;
+    while next == Next::Step {
+        assert_eq!(p.target().lambda, 1.0, "no relaxation to smaller loads");
+        next = p.failed("no".into());
+    }
+    assert_eq!(next, Next::Failed);
+    assert!(!p.take_back_to_equilibrium());
+    assert_eq!(p.stopped_between(), None);
+    let e = p.error.unwrap().to_string();
+    assert!(!e.contains(LOCK_FOUND), "{e}");
+    assert!(
+        e.contains("found no equilibrium at the full loads either"),
+        "{e}"
+    );
+}
+
 /// Without [`StaticOptions::find_stop`] the failed relaxation to the full loads is the
 /// failure: no relaxation to smaller loads, no bracket, the step that failed named.
 #[test]
