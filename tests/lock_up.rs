@@ -123,10 +123,10 @@ fn the_static_command_writes_the_string_where_it_stops_and_fails() {
     let lambda = stopped["load_factor"].as_f64().unwrap();
     assert!(lambda > 0.5 && lambda < 1.0, "{stopped}");
     assert!(stopped["none_at"].as_f64().unwrap() > lambda);
-    assert!(stopped["failure"]
-        .as_str()
-        .unwrap()
-        .contains(&format!("an equilibrium at λ = {lambda:.4}")));
+    assert!(stopped["failure"].as_str().unwrap().contains(&format!(
+        "{} λ = {lambda:.4}",
+        holewall::solve::continuation::LOCK_FOUND
+    )));
     assert!(summary["title"]
         .as_str()
         .unwrap()
