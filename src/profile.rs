@@ -91,6 +91,13 @@ pub fn buckling(case: &Case, model: &Model, rows: &[ProfileRow]) -> (bool, bool)
     crate::diagnose::buckling(case, model, &axial)
 }
 
+/// The hook load (N) of a string where it stops on its way
+/// ([`crate::solve::statics::Stopped`]).
+pub fn stopped_hook_load(stopped: &crate::solve::statics::Stopped) -> f64 {
+    let sol = crate::solve::statics::stopped_solution(stopped);
+    fe_rows(&stopped.model, &sol).1
+}
+
 /// Profile rows, hook load, surface torque and weight on bit of an FE static solution.
 pub fn fe_rows(
     model: &Model,

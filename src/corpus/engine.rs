@@ -43,6 +43,10 @@ pub struct EngineOutcome {
     /// at which the engine found an equilibrium ([`crate::engine::EngineResult::stops`]; the
     /// CPU's is `corpus.csv`'s `fe_reached`); else NaN.
     pub stopped_load_factor: f64,
+    /// Hook load (N) of the engine's string where it stands there
+    /// ([`crate::engine::EngineResult::stands`]; the CPU's is `corpus.csv`'s
+    /// `stopped_hook_load_n`); else NaN.
+    pub stopped_hook_load_n: f64,
     /// Why it failed (empty when solved).
     pub error: String,
 }
@@ -98,21 +102,22 @@ pub fn run_well_engine(well: &CorpusWell, path: EnginePath) -> Result<EngineOutc
         &mut |m, nodes| crate::profile::add_wall_sites(&case, m, nodes),
         &StaticOptions::default(),
         &mut |m, options| {
-            let failed = |reason: String| StaticError::LoadStep {
+            let failed = |reason: String, stopped| StaticError::LoadStep {
                 stage: "the engine's solve".into(),
                 from: 0.0,
                 step: 0.0,
                 min: 0.0,
                 reason,
                 at_md: None,
-                stopped: None,
+                stopped,
             };
             match engine(m, options) {
-                Ok(r) => {
+                Ok(mut r) => {
                     iterations += r.iterations.iter().sum::<usize>();
                     step_cuts += r.log.len();
                     stopped_load_factor = r.stops().unwrap_or(f64::NAN);
-                    r.into_solution(m).map_err(failed)
+                    let stands = r.stands.take();
+                    r.into_solution(m).map_err(|why| failed(why, stands))
                 }
                 Err(e) => {
                     // A path that cannot run: no retry can help (the policy retries no
@@ -130,6 +135,11 @@ pub fn run_well_engine(well: &CorpusWell, path: EnginePath) -> Result<EngineOutc
         return Err(e);
     }
     let seconds = clock.elapsed().as_secs_f64();
+    let stopped_hook_load_n = held
+        .as_ref()
+        .err()
+        .and_then(|e| e.stopped())
+        .map_or(f64::NAN, crate::profile::stopped_hook_load);
     let (solved, error, hook_load_n, rotations_shifted) = match held {
         Ok(sol) => (
             true,
@@ -139,6 +149,7 @@ pub fn run_well_engine(well: &CorpusWell, path: EnginePath) -> Result<EngineOutc
         ),
         Err(e) => (false, e.to_string(), f64::NAN, false),
     };
+
     Ok(EngineOutcome {
         seed: well.spec.seed,
         path,
@@ -150,6 +161,7 @@ pub fn run_well_engine(well: &CorpusWell, path: EnginePath) -> Result<EngineOutc
         wall_sites: model.sites.len() - case.model.sites.len(),
         rotations_shifted,
         stopped_load_factor,
+        stopped_hook_load_n,
         error,
     })
 }

@@ -668,8 +668,7 @@ pub fn run_well(
         Err(e) => {
             r.fe_reached = e.reached();
             if let Some(st) = e.stopped() {
-                let sol = crate::solve::statics::stopped_solution(st);
-                r.stopped_hook_load_n = crate::profile::fe_rows(&st.model, &sol).1;
+                r.stopped_hook_load_n = crate::profile::stopped_hook_load(st);
             }
             r.error = crate::diagnose::static_failure(&case, &e);
         }

@@ -299,6 +299,10 @@ pub struct EngineResult {
     /// found an equilibrium and the smallest at which it found none
     /// ([`LoadPath::stopped_between`]); `None` for every other end.
     pub stopped: Option<(f64, f64)>,
+    /// Where its string stands at the lower end of that bracket: the equilibrium the
+    /// engine kept there, as the CPU solve's [`crate::solve::statics::StaticError::stopped`]
+    /// (`None` where no bracket, and in f32: [`verify_f32`]).
+    pub stands: Option<Box<crate::solve::statics::Stopped>>,
 }
 
 impl EngineResult {
@@ -396,6 +400,7 @@ fn solve_batch<T: Real + Send + Sync, P: KernelPath<T>>(
     let stop = |running: usize, total: usize| total >= COMPACT_MIN && 2 * running <= total;
     let mut members: Vec<usize> = (0..v).collect();
     let mut finals: Vec<Option<StaticState>> = vec![None; v];
+    let mut stands: Vec<Option<Box<crate::solve::statics::Stopped>>> = vec![None; v];
     let mut resume = None;
     let mut solves = 0;
     loop {
@@ -421,6 +426,14 @@ fn solve_batch<T: Real + Send + Sync, P: KernelPath<T>>(
             let j = members[i];
             if path.finished() {
                 finals[j] = Some(state_of(mesh, &sys.tables, &config, i));
+            }
+            // Stopped on its way: where it stands is the equilibrium it kept last.
+            if let Some(between) = path.stopped_between().filter(|_| path.finished()) {
+                if let Some((state, Some(at))) = sys.equilibrium.take_state(i, mesh) {
+                    stands[j] =
+                        crate::solve::statics::Stopped::at_kept(&models[j], between, state, &at)
+                            .map(Box::new);
+                }
             }
             paths[j] = path;
         }
@@ -451,13 +464,15 @@ fn solve_batch<T: Real + Send + Sync, P: KernelPath<T>>(
     let results: Vec<EngineResult> = paths
         .into_iter()
         .zip(finals)
-        .map(|(path, state)| EngineResult {
+        .zip(stands)
+        .map(|((path, state), stands)| EngineResult {
             state: state.unwrap_or_else(|| StaticState::initial(mesh)),
             status: match &path.error {
                 None => EngineStatus::Converged,
                 Some(e) => EngineStatus::Failed(e.to_string()),
             },
             stopped: path.stopped_between(),
+            stands,
             iterations: path.iterations,
             log: path.log,
             doubtful: path.doubtful,
@@ -507,6 +522,7 @@ fn verify_f32(
         .map(|(mut r, m)| {
             if r.status != EngineStatus::Converged {
                 r.stopped = None;
+                r.stands = None;
                 return r;
             }
             let measure = residual_measure_at(m, &r.state);

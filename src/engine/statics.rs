@@ -253,6 +253,9 @@ pub(super) struct VariantShift {
 pub(super) struct Kept {
     /// Per variant the state kept last (`None`: none yet).
     pub(super) states: Vec<Option<(Vec<f64>, Vec<f64>)>>,
+    /// Per variant the loads of the state kept last, where the keep named them (an
+    /// equilibrium's: [`StaticSystem::keep_equilibrium`]).
+    pub(super) at: Vec<Option<LoadTarget>>,
     /// Variants whose current state is to be kept, and those to go back to theirs.
     to_keep: Vec<usize>,
     to_go_back: Vec<usize>,
@@ -262,6 +265,7 @@ impl Kept {
     fn new(v: usize) -> Self {
         Kept {
             states: vec![None; v],
+            at: vec![None; v],
             to_keep: Vec::new(),
             to_go_back: Vec::new(),
         }
@@ -271,9 +275,36 @@ impl Kept {
     pub(super) fn take_columns(&mut self, keep: &[usize]) -> Self {
         Kept {
             states: keep.iter().map(|&i| self.states[i].take()).collect(),
+            at: keep.iter().map(|&i| self.at[i].take()).collect(),
             to_keep: Vec::new(),
             to_go_back: Vec::new(),
         }
+    }
+
+    /// Variant `j`'s current state is to be kept (at the next flush), at the loads `at`.
+    fn keep(&mut self, j: usize, at: Option<LoadTarget>) {
+        self.to_keep.push(j);
+        self.at[j] = at;
+    }
+
+    /// Variant `j`'s kept state as a configuration (of `mesh`'s nodes) and its loads, taken
+    /// out.
+    pub(super) fn take_state(
+        &mut self,
+        j: usize,
+        mesh: &Model,
+    ) -> Option<(StaticState, Option<LoadTarget>)> {
+        let (x, rot) = self.states[j].take()?;
+        let mut s = StaticState::initial(mesh);
+        for (i, (u, r)) in s.u.iter_mut().zip(s.rot.iter_mut()).enumerate() {
+            for k in 0..3 {
+                u[k] = x[3 * i + k];
+                for c in 0..3 {
+                    r[k][c] = rot[9 * i + 3 * k + c];
+                }
+            }
+        }
+        Some((s, self.at[j].take()))
     }
 
     /// Variant `j` is to go back to its kept state (refused where none is kept or pending:
@@ -519,7 +550,7 @@ impl<T: Real> StaticSystem for EngineStatic<'_, T> {
         self.unshifted.as_ref().map_or(f64::INFINITY, |m| m[j])
     }
     fn keep_best(&mut self, j: usize) -> Result<(), crate::error::SystemError> {
-        self.best.to_keep.push(j);
+        self.best.keep(j, None);
         Ok(())
     }
     fn back_to_best(&mut self, j: usize) -> Result<(), crate::error::SystemError> {
@@ -529,9 +560,9 @@ impl<T: Real> StaticSystem for EngineStatic<'_, T> {
     fn keep_equilibrium(
         &mut self,
         j: usize,
-        _target: &LoadTarget,
+        target: &LoadTarget,
     ) -> Result<(), crate::error::SystemError> {
-        self.equilibrium.to_keep.push(j);
+        self.equilibrium.keep(j, Some(*target));
         Ok(())
     }
     fn back_to_equilibrium(&mut self, j: usize) -> Result<(), crate::error::SystemError> {
@@ -693,6 +724,15 @@ mod tests {
         sys.flush().unwrap();
         at(&mut sys, &best);
         assert_eq!(sys.equilibrium.states[1], sys.best.states[1]);
+        // Taken out as a configuration, with the loads it was kept at: variant 1 as it
+        // stands (where a stopped variant's string is reported from); none left to take.
+        let config = sys.ensemble.config().unwrap();
+        let here = state_of(&models[1], &sys.tables, &config, 1);
+        let (state, loads) = sys.equilibrium.take_state(1, &models[1]).unwrap();
+        assert_eq!(loads, Some(target));
+        assert_eq!((state.u, state.rot), (here.u, here.rot));
+        assert!(sys.equilibrium.take_state(1, &models[1]).is_none());
+        assert!(sys.equilibrium.take_state(0, &models[0]).is_none());
     }
 
     /// A shift set with momentum anchors at the restart point carried on by the momentum

@@ -274,6 +274,7 @@ pub fn run(
             failures: Vec::new(),
             outside_hole: 0,
             stopped: 0,
+            stopped_pushed: 0,
             relaxed: 0,
             solved_by_engine: 0,
             solved_by_cpu: 0,
@@ -379,6 +380,10 @@ pub fn run(
         stopped: results
             .iter()
             .filter(|r| r.string.stopped_load_factor.is_some())
+            .count(),
+        stopped_pushed: results
+            .iter()
+            .filter(|r| r.string.stands.is_some_and(|s| s.hook_load_n < 0.0))
             .count(),
         relaxed: results
             .iter()

@@ -143,8 +143,9 @@ fn strongest_key(
     best.map(|(i, _)| i).or_else(|| keys.first().copied())
 }
 
-/// A grid's or CSV's quantities against what the variants vary (`neutral_point.png`, and
-/// `side_force.png` with a line per stabilizer): over the numeric key the quantity depends on
+/// A grid's or CSV's quantities against what the variants vary (`neutral_point.png`;
+/// where a variant stops on its way, `loads_reached.png`; and `side_force.png` with a line
+/// per stabilizer): over the numeric key the quantity depends on
 /// most ([`strongest_key`]), a line per combination of the other keys; where the lines would
 /// hold single points (a CSV's scattered rows) or be more than [`MAX_LINES`], the variants as
 /// points against that key; where only categories (`mode`, `layout`) vary, as points over
@@ -157,92 +158,97 @@ pub(crate) fn over_the_inputs(
     out: &Path,
 ) -> Result<Vec<String>, Error> {
     let keys = varied_keys(variants);
-    // One plot: `picks` are (name prefix, quantity) drawn together (a stabilizer each).
-    let plot =
-        |file: &str, title: &str, y_label: &str, picks: &[(String, &Pick)]| -> Result<(), Error> {
-            let title = format!("{}: {title}", case.title);
-            let largest = |r: &VariantResult| {
-                picks
-                    .iter()
-                    .filter_map(|(_, p)| p(r))
-                    .fold(None, |a: Option<f64>, y| Some(a.map_or(y, |a| a.max(y))))
-            };
-            let Some(x) = strongest_key(variants, results, &keys, &largest) else {
-                // Only categories vary: points over the variant's number.
-                let series: Vec<Series> = picks
-                    .iter()
-                    .map(|(name, pick)| Series {
-                        name,
-                        points: results
-                            .iter()
-                            .enumerate()
-                            .filter_map(|(i, r)| {
-                                pick(r).filter(|y| y.is_finite()).map(|y| (i as f64, y))
-                            })
-                            .collect(),
-                        wide: false,
-                    })
-                    .collect();
-                crate::plots::lines_and_points(
-                    &out.join(file),
-                    &title,
-                    "variant (only categories vary: see variants.csv)",
-                    y_label,
-                    &[],
-                    &series,
-                )?;
-                return Ok(());
-            };
-            let x_label = key_axis(&variants[0].overrides[x].0).0;
-            let groups: Vec<(String, Vec<(f64, f64)>)> = picks
+    // One plot: `picks` are (name prefix, quantity) drawn together (a stabilizer each);
+    // `points`: as points always (a quantity that no line between variants describes).
+    let plot = |file: &str,
+                title: &str,
+                y_label: &str,
+                picks: &[(String, &Pick)],
+                points: bool|
+     -> Result<(), Error> {
+        let title = format!("{}: {title}", case.title);
+        let largest = |r: &VariantResult| {
+            picks
                 .iter()
-                .flat_map(|(prefix, pick)| {
-                    lines_over(variants, results, x, 1.0, *pick)
-                        .into_iter()
-                        .map(move |(l, p)| {
-                            let name = match (prefix.is_empty(), l.is_empty()) {
-                                (true, _) => l,
-                                (false, true) => prefix.clone(),
-                                (false, false) => format!("{prefix}, {l}"),
-                            };
-                            (name, p)
+                .filter_map(|(_, p)| p(r))
+                .fold(None, |a: Option<f64>, y| Some(a.map_or(y, |a| a.max(y))))
+        };
+        let Some(x) = strongest_key(variants, results, &keys, &largest) else {
+            // Only categories vary: points over the variant's number.
+            let series: Vec<Series> = picks
+                .iter()
+                .map(|(name, pick)| Series {
+                    name,
+                    points: results
+                        .iter()
+                        .enumerate()
+                        .filter_map(|(i, r)| {
+                            pick(r).filter(|y| y.is_finite()).map(|y| (i as f64, y))
                         })
+                        .collect(),
+                    wide: false,
                 })
                 .collect();
-            if groups.len() <= MAX_LINES && groups.iter().all(|(_, p)| p.len() > 1) {
-                let series: Vec<Series> = crate::plots::named_series(&groups);
-                line_plot(&out.join(file), &title, &x_label, y_label, &series, &[])?;
-            } else {
-                // Scattered rows or too many lines: the points of each pick against the key.
-                let sets: Vec<(String, Vec<(f64, f64)>)> = picks
-                    .iter()
-                    .map(|(prefix, pick)| {
-                        let pts = lines_over(variants, results, x, 1.0, *pick)
-                            .into_iter()
-                            .flat_map(|(_, p)| p)
-                            .collect();
-                        (
-                            if prefix.is_empty() {
-                                "variants".to_string()
-                            } else {
-                                prefix.clone()
-                            },
-                            pts,
-                        )
-                    })
-                    .collect();
-                let series: Vec<Series> = crate::plots::named_series(&sets);
-                crate::plots::lines_and_points(
-                    &out.join(file),
-                    &title,
-                    &x_label,
-                    y_label,
-                    &[],
-                    &series,
-                )?;
-            }
-            Ok(())
+            crate::plots::lines_and_points(
+                &out.join(file),
+                &title,
+                "variant (only categories vary: see variants.csv)",
+                y_label,
+                &[],
+                &series,
+            )?;
+            return Ok(());
         };
+        let x_label = key_axis(&variants[0].overrides[x].0).0;
+        let groups: Vec<(String, Vec<(f64, f64)>)> = picks
+            .iter()
+            .flat_map(|(prefix, pick)| {
+                lines_over(variants, results, x, 1.0, *pick)
+                    .into_iter()
+                    .map(move |(l, p)| {
+                        let name = match (prefix.is_empty(), l.is_empty()) {
+                            (true, _) => l,
+                            (false, true) => prefix.clone(),
+                            (false, false) => format!("{prefix}, {l}"),
+                        };
+                        (name, p)
+                    })
+            })
+            .collect();
+        if !points && groups.len() <= MAX_LINES && groups.iter().all(|(_, p)| p.len() > 1) {
+            let series: Vec<Series> = crate::plots::named_series(&groups);
+            line_plot(&out.join(file), &title, &x_label, y_label, &series, &[])?;
+        } else {
+            // Scattered rows or too many lines: the points of each pick against the key.
+            let sets: Vec<(String, Vec<(f64, f64)>)> = picks
+                .iter()
+                .map(|(prefix, pick)| {
+                    let pts = lines_over(variants, results, x, 1.0, *pick)
+                        .into_iter()
+                        .flat_map(|(_, p)| p)
+                        .collect();
+                    (
+                        if prefix.is_empty() {
+                            "variants".to_string()
+                        } else {
+                            prefix.clone()
+                        },
+                        pts,
+                    )
+                })
+                .collect();
+            let series: Vec<Series> = crate::plots::named_series(&sets);
+            crate::plots::lines_and_points(
+                &out.join(file),
+                &title,
+                &x_label,
+                y_label,
+                &[],
+                &series,
+            )?;
+        }
+        Ok(())
+    };
     plot(
         "neutral_point.png",
         "neutral point",
@@ -250,9 +256,31 @@ pub(crate) fn over_the_inputs(
         &[(String::new(), &|r: &VariantResult| {
             r.neutral_point_from_bit_m
         })],
+        false,
     )?;
+    let mut files = vec!["neutral_point.png".to_string()];
+    if results
+        .iter()
+        .any(|r| r.string.stopped_load_factor.is_some())
+    {
+        // Where variants stop on their way (a lock-up): how far each got, 1 for those
+        // that reach their loads; the other failures drawn at none. As points: the load
+        // factor between two variants is not a line's.
+        plot(
+            "loads_reached.png",
+            "how far the loads get (below 1: the string stops on its way)",
+            "fraction of the friction and bit loads with an equilibrium",
+            &[(String::new(), &|r: &VariantResult| {
+                r.string
+                    .stopped_load_factor
+                    .or((r.status != Status::Failed).then_some(1.0))
+            })],
+            true,
+        )?;
+        files.push("loads_reached.png".into());
+    }
     if stabs == 0 {
-        return Ok(vec!["neutral_point.png".into()]);
+        return Ok(files);
     }
     let per_stab: Vec<Box<Pick>> = (0..stabs)
         .map(|k| {
@@ -271,8 +299,10 @@ pub(crate) fn over_the_inputs(
         "largest side force per stabilizer",
         "side force (kN)",
         &picks,
+        false,
     )?;
-    Ok(vec!["neutral_point.png".into(), "side_force.png".into()])
+    files.push("side_force.png".into());
+    Ok(files)
 }
 
 /// A limit line further above the loads than this (× the largest) is named in the legend

@@ -58,12 +58,30 @@ pub struct StringQoi {
     /// and bit loads at which the FE found an equilibrium.
     #[serde(default)]
     pub stopped_load_factor: Option<f64>,
+    /// Such a variant's string where it stands, at `stopped_load_factor`.
+    #[serde(default)]
+    pub stands: Option<Stands>,
     /// A solved static variant whose equilibrium came by relaxation past a fold
     /// ([`crate::solve::continuation::relaxed`]): one of several equilibria, which the
     /// solve's path chose ([`crate::diagnose::relaxed_warning`]); for a dynamic variant,
     /// its static start's.
     #[serde(default)]
     pub relaxed: Option<bool>,
+}
+
+/// A stopped variant's string where it stands, at the loads of its last equilibrium
+/// ([`StringQoi::stopped_load_factor`]; `variants.csv`'s `stopped_*` columns): what the rig
+/// reads when the string stops on its way (a lock-up), and where it bears hardest.
+#[derive(Clone, Copy, Debug, Default, Serialize, Deserialize, PartialEq)]
+pub struct Stands {
+    /// Hook load (N).
+    pub hook_load_n: f64,
+    /// Surface torque (N·m).
+    pub surface_torque_nm: f64,
+    /// Largest side force per unit length (N/m) and where it acts (MD, m).
+    pub max_side_force_per_length_n_per_m: f64,
+    /// See `max_side_force_per_length_n_per_m`.
+    pub max_side_force_md_m: Option<f64>,
 }
 
 /// How a variant ended.
@@ -183,15 +201,31 @@ pub(crate) fn failed(name: &str, reason: String, stabs: usize) -> VariantResult 
 /// its load path bracketed where the string stops (a lock-up), `at` is the largest load
 /// factor at which it found an equilibrium (`variants.csv`'s `stopped_load_factor`; the
 /// CPU solve's [`crate::solve::statics::StaticError::stopped`], the engine's
-/// [`crate::engine::EngineResult::stops`]).
+/// [`crate::engine::EngineResult::stops`]) and `stands` the string there, if kept
+/// ([`StringQoi::stands`]).
 pub(crate) fn failed_stopping(
+    case: &Case,
     name: &str,
     reason: String,
     stabs: usize,
     at: Option<f64>,
+    stands: Option<&crate::solve::statics::Stopped>,
 ) -> VariantResult {
     let mut r = failed(name, reason, stabs);
     r.string.stopped_load_factor = at;
+    if let Some(st) = stands.filter(|st| Some(st.lambda) == at) {
+        let sol = crate::solve::statics::stopped_solution(st);
+        let there = static_result(case, name, &st.model, &sol);
+        r.string.stands = Some(Stands {
+            hook_load_n: there.hook_load_n.unwrap_or(f64::NAN),
+            surface_torque_nm: there.max_surface_torque_nm,
+            max_side_force_per_length_n_per_m: there
+                .string
+                .max_side_force_per_length_n_per_m
+                .unwrap_or(f64::NAN),
+            max_side_force_md_m: there.string.max_side_force_md_m,
+        });
+    }
     r
 }
 
@@ -326,10 +360,12 @@ fn solve_held(
     match solved {
         Ok(sol) => static_result(case, name, &model, &sol),
         Err(e) => failed_stopping(
+            case,
             name,
             e.to_string(),
             model.stabilizer_sites().len(),
             e.stopped().map(|s| s.lambda),
+            e.stopped(),
         ),
     }
 }
@@ -376,6 +412,7 @@ pub fn static_result(
             crate::diagnose::through_wall(case, model, &sol.state).map_or(0.0, |t| t.excess_m),
         ),
         stopped_load_factor: None,
+        stands: None,
         relaxed: Some(crate::solve::continuation::relaxed(&sol.log)),
     };
     let travel = crate::rig::Travel::of_axial_speed(model.axial_speed);
@@ -470,8 +507,9 @@ fn dynamic_held(
         Ok(s) => s,
         Err(e) => {
             let at = e.stopped().map(|s| s.lambda);
+            let why = format!("{STATIC_START}{e}");
             return (
-                failed_stopping(name, format!("{STATIC_START}{e}"), stabs.len(), at),
+                failed_stopping(case, name, why, stabs.len(), at, e.stopped()),
                 None,
             );
         }
@@ -655,6 +693,7 @@ impl DynamicObserver {
             stick_slip_severity: severity,
             outside_hole_m: None,
             stopped_load_factor: None,
+            stands: None,
             relaxed: None,
         };
         finished(

@@ -48,6 +48,11 @@ pub struct EnsembleSummary {
     /// lock-up; `variants.csv`: `stopped_load_factor`).
     #[serde(default)]
     pub stopped: usize,
+    /// Of those, the variants whose string stands pushed from the surface where it stops
+    /// (`variants.csv`: `stopped_hook_load_n` below zero): the weight indicator reached
+    /// zero before the string stopped.
+    #[serde(default)]
+    pub stopped_pushed: usize,
     /// Solved static variants whose equilibrium came by relaxation past a fold, one of
     /// several — dynamic: variants whose static start did (`variants.csv`: `relaxed`;
     /// [`crate::diagnose::relaxed_variants`]).
@@ -120,8 +125,17 @@ impl EnsembleSummary {
             n.push(format!(
                 "{} of {} variants stop on their way (a lock-up): no equilibrium found at their \
                  loads; variants.csv's stopped_load_factor gives the largest fraction of the \
-                 friction and bit loads at which each has one",
-                self.stopped, self.variants
+                 friction and bit loads at which each has one, and its stopped_* columns the \
+                 string there (hook load, surface torque, largest side force){}",
+                self.stopped,
+                self.variants,
+                match self.stopped_pushed {
+                    0 => String::new(),
+                    k => format!(
+                        "; {k} of them stand pushed from the surface there (a hook load below \
+                         zero): their weight indicator reads zero before they stop"
+                    ),
+                }
             ));
         }
         let dynamic = self.analysis == "dynamic";
@@ -169,6 +183,16 @@ impl EnsembleSummary {
         t
     }
 }
+
+/// `variants.csv`'s columns of a variant that stops on its way ([`StringQoi`]'s
+/// `stopped_load_factor` and `stands`).
+pub const STOPPED_COLUMNS: [&str; 5] = [
+    "stopped_load_factor",
+    "stopped_hook_load_n",
+    "stopped_surface_torque_nm",
+    "stopped_max_side_force_per_length_n_per_m",
+    "stopped_max_side_force_md_m",
+];
 
 pub(crate) fn fmt(x: f64) -> String {
     if x.is_finite() {
@@ -228,13 +252,15 @@ pub(crate) fn variants_csv(
                 "sinusoidal_buckling",
                 "helical_buckling",
                 "outside_hole_m",
-                "stopped_load_factor",
                 "relaxed",
             ]
             .map(String::from),
         );
         header.extend(crate::bha::BIT_COLUMNS.map(String::from));
     }
+    // A variant that stops on its way (a lock-up; a dynamic run's static start): the
+    // largest fraction of its loads with an equilibrium, and its string there.
+    header.extend(STOPPED_COLUMNS.map(String::from));
     for k in 1..=stabs {
         header.push(format!(
             "{}_max_side_force_n",
@@ -308,13 +334,18 @@ pub(crate) fn variants_csv(
             row.push(flag(r.string.sinusoidal_buckling));
             row.push(flag(r.string.helical_buckling));
             row.push(opt(r.string.outside_hole_m));
-            row.push(opt(r.string.stopped_load_factor));
             row.push(flag(r.string.relaxed));
             match &r.bit {
                 Some(b) => row.extend(b.columns().map(fmt)),
                 None => row.extend(crate::bha::BIT_COLUMNS.map(|_| String::new())),
             }
         }
+        row.push(opt(r.string.stopped_load_factor));
+        let stands = r.string.stands.as_ref();
+        row.push(opt(stands.map(|s| s.hook_load_n)));
+        row.push(opt(stands.map(|s| s.surface_torque_nm)));
+        row.push(opt(stands.map(|s| s.max_side_force_per_length_n_per_m)));
+        row.push(opt(stands.and_then(|s| s.max_side_force_md_m)));
         for q in &r.stabilizers {
             row.push(fmt(q.max_side_force_n));
             row.push(fmt(q.max_lateral_m));

@@ -71,8 +71,8 @@ where
                 .par_iter()
                 .zip(guarded.par_iter().zip(variants.par_iter())),
         )
-        .map(|(r, (m, (g, v)))| (r.stops(), r, m, g, v))
-        .map(|(stops, r, m, g, v)| match r.into_solution(g) {
+        .map(|(mut r, (m, (g, v)))| (r.stops(), r.stands.take(), r, m, g, v))
+        .map(|(stops, stands, r, m, g, v)| match r.into_solution(g) {
             Ok(sol) => {
                 // Held in the hole as the CPU holds it: the guards in contact kept.
                 let (held, mut sol) = crate::profile::keep_touching(m, g.clone(), sol);
@@ -85,7 +85,8 @@ where
             }
             Err(why) => {
                 let why = format!("GPU: {why}");
-                after_engine_failure(&v.name, why, m, stops, false, |fs| {
+                let stops = stops.map(|at| (at, stands.as_deref()));
+                after_engine_failure(case, &v.name, why, m, stops, false, |fs| {
                     static_variant_of(case, v, m, fs)
                 })
             }
@@ -96,7 +97,8 @@ where
 /// A variant the engine failed (`why`), run again on the CPU (`cpu(find_stop)`: its static
 /// solve, or, `dynamic`, its dynamic run from its static start). Where the engine's load
 /// path bracketed where the string stops (`stops`: [`crate::engine::EngineResult::stops`],
-/// the largest load factor with an equilibrium), the CPU tries the loads once more on its
+/// the largest load factor with an equilibrium, and the string there,
+/// [`crate::engine::EngineResult::stands`]), the CPU tries the loads once more on its
 /// own path but brackets nothing: in another rounding it may reach an equilibrium the
 /// engine's path did not (the relaxed user well 0, pushed with 678 kN: the engine stops at
 /// 0.906, the CPU solves it in 1.3 s; docs/performance.md, stop 91), and where its static
@@ -104,17 +106,18 @@ where
 /// a second bracket on the CPU would cost the lock-up's relaxations below the full loads again,
 /// 60–65 % of its time there.
 fn after_engine_failure(
+    case: &Case,
     name: &str,
     why: String,
     model: &Model,
-    stops: Option<f64>,
+    stops: Option<(f64, Option<&crate::solve::statics::Stopped>)>,
     dynamic: bool,
     cpu: impl FnOnce(bool) -> VariantResult,
 ) -> VariantResult {
     let mut again = cpu(stops.is_none());
     match stops {
         // The static solve (or the dynamic run's static start) failed on the CPU too.
-        Some(at)
+        Some((at, stands))
             if again.status == Status::Failed
                 && (!dynamic || again.reason.starts_with(STATIC_START)) =>
         {
@@ -122,7 +125,8 @@ fn after_engine_failure(
                 "{why}; run again on the CPU without a bracket of its own, it failed there too: {}",
                 again.reason
             );
-            let mut r = failed_stopping(name, why, model.stabilizer_sites().len(), Some(at));
+            let stabs = model.stabilizer_sites().len();
+            let mut r = failed_stopping(case, name, why, stabs, Some(at), stands);
             r.solved_by = SolvedBy::Engine;
             r
         }
@@ -316,7 +320,7 @@ pub fn run_dynamic_gpu<T: crate::gpu::contact::GpuReal>(
                     DynamicStatus::Finished => "no initial state".into(),
                 };
                 let why = format!("GPU: {why}");
-                after_engine_failure(name, why, &models[j], None, true, |fs| {
+                after_engine_failure(case, name, why, &models[j], None, true, |fs| {
                     dynamic_variant_of(case, &variants[j], &models[j], fs)
                 })
             }
@@ -333,10 +337,13 @@ pub fn run_dynamic_gpu<T: crate::gpu::contact::GpuReal>(
                     EngineStatus::Converged => "not run on the engine".into(),
                 };
                 after_engine_failure(
+                    case,
                     &variants[j].name,
                     format!("GPU static start: {why}"),
                     &models[j],
-                    statics[j].stops(),
+                    statics[j]
+                        .stops()
+                        .map(|at| (at, statics[j].stands.as_deref())),
                     true,
                     |fs| dynamic_variant_of(case, &variants[j], &models[j], fs),
                 )

@@ -162,7 +162,7 @@ pub fn weightless_collar(l: f64, elements: usize) -> holewall::model::Model {
     holewall::model::vertical_collar(l, elements, STEEL)
 }
 
-/// A column of an ensemble's `variants.csv` in `out`, as numbers.
+/// A column of an ensemble's `variants.csv` in `out`, as numbers (NaN where empty).
 #[allow(dead_code)]
 pub fn variants_column(out: &std::path::Path, name: &str) -> Vec<f64> {
     // A CSV reader: a reason holds commas, quoted.
@@ -174,7 +174,10 @@ pub fn variants_column(out: &std::path::Path, name: &str) -> Vec<f64> {
         .position(|h| h == name)
         .unwrap_or_else(|| panic!("no column {name}"));
     csv.records()
-        .map(|r| r.unwrap()[k].parse().unwrap())
+        .map(|r| match &r.unwrap()[k] {
+            "" => f64::NAN,
+            x => x.parse().unwrap(),
+        })
         .collect()
 }
 

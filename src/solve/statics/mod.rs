@@ -673,19 +673,11 @@ pub fn solve_static_monitored(
     let [mut path] = paths;
     let stopped_between = path.stopped_between();
     if let Some(mut e) = path.error.take() {
-        if let (Some((lambda, none_at)), Some((state, target))) = (stopped_between, sys.kept) {
+        if let (Some(between), Some((state, target))) = (stopped_between, sys.kept) {
             // The string stops on its way: where it stands is the equilibrium kept at the
             // bracket's lower end (a relaxation's end, or the last load step).
             if let StaticError::LoadStep { stopped, .. } = &mut e {
-                if target.lambda == lambda && target.gravity == 1.0 && target.exponent == 1.0 {
-                    *stopped = Some(Box::new(Stopped {
-                        lambda,
-                        none_at,
-                        model: model_at(model, &target),
-                        u: state.u,
-                        rot: state.rot,
-                    }));
-                }
+                *stopped = Stopped::at_kept(model, between, state, &target).map(Box::new);
             }
         }
         return Err(e);
