@@ -563,16 +563,28 @@ fn state_of<T: Real>(
     config: &ConfigBatch<T>,
     j: usize,
 ) -> StaticState {
-    let (v, n) = (tables.num_variants, tables.num_nodes);
+    let v = tables.num_variants;
+    state_from(
+        mesh,
+        |k| tables.base[k * v + j] + config.x[k * v + j].to_f64_lossy(),
+        |k| config.rot[k * v + j].to_f64_lossy(),
+    )
+}
+
+/// A configuration of `mesh`'s nodes from its flat entries: `x(3 i + k)`, node `i`'s
+/// displacement from the reference along `k`; `rot(9 i + 3 r + c)`, its rotation's entry
+/// `(r, c)`.
+pub(super) fn state_from(
+    mesh: &Model,
+    x: impl Fn(usize) -> f64,
+    rot: impl Fn(usize) -> f64,
+) -> StaticState {
     let mut s = StaticState::initial(mesh);
-    for i in 0..n {
-        for k in 0..3 {
-            let at = (3 * i + k) * v + j;
-            s.u[i][k] = tables.base[at] + config.x[at].to_f64_lossy();
-        }
+    for (i, (u, q)) in s.u.iter_mut().zip(s.rot.iter_mut()).enumerate() {
         for r in 0..3 {
+            u[r] = x(3 * i + r);
             for c in 0..3 {
-                s.rot[i][r][c] = config.rot[(9 * i + 3 * r + c) * v + j].to_f64_lossy();
+                q[r][c] = rot(9 * i + 3 * r + c);
             }
         }
     }

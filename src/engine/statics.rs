@@ -295,16 +295,8 @@ impl Kept {
         mesh: &Model,
     ) -> Option<(StaticState, Option<LoadTarget>)> {
         let (x, rot) = self.states[j].take()?;
-        let mut s = StaticState::initial(mesh);
-        for (i, (u, r)) in s.u.iter_mut().zip(s.rot.iter_mut()).enumerate() {
-            for k in 0..3 {
-                u[k] = x[3 * i + k];
-                for c in 0..3 {
-                    r[k][c] = rot[9 * i + 3 * k + c];
-                }
-            }
-        }
-        Some((s, self.at[j].take()))
+        let state = state_from(mesh, |k| x[k], |k| rot[k]);
+        Some((state, self.at[j].take()))
     }
 
     /// Variant `j` is to go back to its kept state (refused where none is kept or pending:

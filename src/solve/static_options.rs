@@ -127,29 +127,6 @@ pub struct Stopped {
     pub rot: Vec<crate::physics::rotation::Mat3<f64>>,
 }
 
-impl Stopped {
-    /// Where `model`'s string stands when its load path bracketed where it stops
-    /// (`between`: [`crate::solve::continuation::LoadPath::stopped_between`]), from the
-    /// equilibrium its system kept last (`state` at the loads `at`); `None` where that is
-    /// not the bracket's lower end at full gravity and spring laws. The CPU solve's and the
-    /// engine's, one rule.
-    pub fn at_kept(
-        model: &Model,
-        between: (f64, f64),
-        state: crate::solve::statics::StaticState,
-        at: &crate::solve::continuation::LoadTarget,
-    ) -> Option<Self> {
-        let (lambda, none_at) = between;
-        (at.lambda == lambda && at.gravity == 1.0 && at.exponent == 1.0).then(|| Stopped {
-            lambda,
-            none_at,
-            model: crate::solve::statics::model_at(model, at),
-            u: state.u,
-            rot: state.rot,
-        })
-    }
-}
-
 /// How a failure in the load path's first stage names it ([`StaticError::LoadStep`]'s
 /// `stage`).
 pub const GRAVITY_STAGE: &str = "laying the string in the hole under its own weight";

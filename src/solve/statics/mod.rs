@@ -691,6 +691,29 @@ pub fn solve_static_monitored(
     Ok(finish(model, sys.state, path.iterations, path.log))
 }
 
+impl Stopped {
+    /// Where `model`'s string stands when its load path bracketed where it stops
+    /// (`between`: [`crate::solve::continuation::LoadPath::stopped_between`]), from the
+    /// equilibrium its system kept last (`state` at the loads `at`); `None` where that is
+    /// not the bracket's lower end at full gravity and spring laws. The CPU solve's and the
+    /// engine's, one rule.
+    pub fn at_kept(
+        model: &Model,
+        between: (f64, f64),
+        state: StaticState,
+        at: &crate::solve::continuation::LoadTarget,
+    ) -> Option<Self> {
+        let (lambda, none_at) = between;
+        (at.lambda == lambda && at.gravity == 1.0 && at.exponent == 1.0).then(|| Stopped {
+            lambda,
+            none_at,
+            model: model_at(model, at),
+            u: state.u,
+            rot: state.rot,
+        })
+    }
+}
+
 /// The solution (section forces, contact, reactions) of the string where it stops
 /// ([`Stopped`]), in its model at those loads.
 pub fn stopped_solution(stopped: &Stopped) -> StaticSolution {
