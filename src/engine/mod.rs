@@ -581,10 +581,10 @@ pub(super) fn state_from(
 ) -> StaticState {
     let mut s = StaticState::initial(mesh);
     for (i, (u, q)) in s.u.iter_mut().zip(s.rot.iter_mut()).enumerate() {
-        for r in 0..3 {
-            u[r] = x(3 * i + r);
-            for c in 0..3 {
-                q[r][c] = rot(9 * i + 3 * r + c);
+        for (r, (u, q)) in u.iter_mut().zip(q.iter_mut()).enumerate() {
+            *u = x(3 * i + r);
+            for (c, q) in q.iter_mut().enumerate() {
+                *q = rot(9 * i + 3 * r + c);
             }
         }
     }
