@@ -126,7 +126,10 @@ impl EnsembleSummary {
                 "{} of {} variants stop on their way (a lock-up): no equilibrium found at their \
                  loads; variants.csv's stopped_load_factor gives the largest fraction of the \
                  friction and bit loads at which each has one, and its stopped_* columns the \
-                 string there (hook load, surface torque, largest side force){}",
+                 string there (hook load, surface torque, largest side force) — one of a \
+                 buckled, friction-held string's several equilibria, which the path chose \
+                 (the CPU's and the engine's hook loads there 0.06–8.5 % apart on the \
+                 lock-ups measured, docs/validation.md){}",
                 self.stopped,
                 self.variants,
                 match self.stopped_pushed {
