@@ -10,8 +10,8 @@
 //! string where it stands — the equilibrium at the bracket's lower end — and `holewall
 //! static` writes its outputs for it before it fails; an ensemble's variant that stops gives
 //! the load factor and its string there (hook load, surface torque, largest side force),
-//! on the CPU and on the engine. About 2 min on 2 cores (the four tests run side by side;
-//! the engine's, on the twin, is the longest).
+//! on the CPU and on the engine; a solved variant the surface pushes is named. About 2 min
+//! on 2 cores (the tests run side by side; the engine's, on the twin, is the longest).
 
 mod common;
 
@@ -349,4 +349,35 @@ fn the_engine_says_where_the_string_stops_as_the_cpu_does() {
         );
     }
     assert!(stands.max_side_force_per_length_n_per_m > 0.0);
+}
+
+/// A solved variant the surface pushes (hook load below zero: past the weight indicator's
+/// lock-up) is counted and warned of, as the corpus names such wells: corpus well 2256
+/// (horizontal, 1,301 m, tripping in, 20 m elements) with open-hole friction 0.1 hangs from
+/// the hook (78.2 kN) and with its own 0.264 is pushed with 9.7 kN. Under a second.
+#[test]
+fn an_ensemble_names_the_variants_the_surface_pushes() {
+    let dir = common::scratch_dir("lock-up", "pushed");
+    let well = holewall::corpus::write_well(2256, &dir).unwrap();
+    let mut text = std::fs::read_to_string(&well.case_path).unwrap();
+    assert!(
+        text.contains("\nfriction = 0.264\n"),
+        "the corpus's open hole"
+    );
+    text.push_str(
+        "\n[ensemble]\nanalysis = \"static\"\n[ensemble.grid]\n\"mu.open\" = [0.1, 0.264]\n",
+    );
+    std::fs::write(&well.case_path, text).unwrap();
+    let out = dir.join("out");
+    let s = common::ensemble_on_cpu(&well.case_path, None, &out);
+    assert_eq!((s.converged, s.stopped, s.pushed), (2, 0, 1), "{s:?}");
+    let hook = common::variants_column(&out, "hook_load_n");
+    assert!(hook[0] > 0.0 && hook[1] < 0.0, "{hook:?}");
+    assert!(
+        s.notices()
+            .iter()
+            .any(|n| n.contains("1 of 2 variants solved pushed from the surface")),
+        "{:?}",
+        s.notices()
+    );
 }

@@ -275,6 +275,7 @@ pub fn run(
             outside_hole: 0,
             stopped: 0,
             stopped_pushed: 0,
+            pushed: 0,
             relaxed: 0,
             solved_by_engine: 0,
             solved_by_cpu: 0,
@@ -380,6 +381,12 @@ pub fn run(
         stopped: results
             .iter()
             .filter(|r| r.string.stopped_load_factor.is_some())
+            .count(),
+        pushed: results
+            .iter()
+            .filter(|r| {
+                !dynamic && r.status != Status::Failed && r.hook_load_n.is_some_and(|h| h < 0.0)
+            })
             .count(),
         stopped_pushed: results
             .iter()

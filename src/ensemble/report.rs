@@ -48,7 +48,13 @@ pub struct EnsembleSummary {
     /// lock-up; `variants.csv`: `stopped_load_factor`).
     #[serde(default)]
     pub stopped: usize,
-    /// Of those, the variants whose string stands pushed from the surface where it stops
+    /// Solved static variants whose hook load is below zero (`variants.csv`:
+    /// `hook_load_n`): the string pushed from the surface, an equilibrium past the weight
+    /// indicator's lock-up that a string run in does not reach by its own weight
+    /// ([`crate::diagnose::locked_up_warning`]; the corpus's `solved_pushed`).
+    #[serde(default)]
+    pub pushed: usize,
+    /// Of the stopped, the variants whose string stands pushed from the surface where it stops
     /// (`variants.csv`: `stopped_hook_load_n` below zero): the weight indicator reached
     /// zero before the string stopped.
     #[serde(default)]
@@ -139,6 +145,14 @@ impl EnsembleSummary {
                          zero): their weight indicator reads zero before they stop"
                     ),
                 }
+            ));
+        }
+        if self.pushed > 0 {
+            n.push(format!(
+                "warning: {} of {} variants solved pushed from the surface (variants.csv: \
+                 hook_load_n below zero): equilibria past the weight indicator's lock-up, which \
+                 a string run in does not reach by its own weight",
+                self.pushed, self.variants
             ));
         }
         let dynamic = self.analysis == "dynamic";
