@@ -381,3 +381,62 @@ fn an_ensemble_names_the_variants_the_surface_pushes() {
         s.notices()
     );
 }
+
+/// A Monte Carlo run says how likely the string stops, and how likely it needs a push:
+/// the well above at 15 m elements (3 m in the BHA), its open-hole friction uniform on
+/// 0.1–0.9, eight Latin-hypercube samples (seed 1). One stops (μ 0.885, at λ 0.875); five of
+/// the seven solved are pushed from the surface; the proportions carry Wilson intervals,
+/// and the loads reached are drawn against the friction. About 5 s.
+#[test]
+fn a_monte_carlo_run_gives_the_chance_the_string_stops() {
+    use holewall::backend::{BackendChoice, Precision};
+    let path = lock_up_case_with("monte-carlo", "15 m", "3 m", "0.368");
+    let mut text = std::fs::read_to_string(&path).unwrap();
+    text.push_str(
+        "\n[ensemble]\nanalysis = \"static\"\n[ensemble.uncertain]\n\
+         \"mu.open\" = { dist = \"uniform\", min = 0.1, max = 0.9 }\n",
+    );
+    std::fs::write(&path, text).unwrap();
+    let mc = holewall::cli::ensemble_cmd::monte_carlo(
+        Some(8),
+        1,
+        holewall::uq::Sampling::Lhs,
+        &[],
+        &[],
+        false,
+    )
+    .unwrap();
+    let out = path.parent().unwrap().join("out");
+    let options = holewall::ensemble::store::EnsembleOptions {
+        monte_carlo: mc,
+        ..Default::default()
+    };
+    let s = holewall::ensemble::job::run(
+        &path,
+        None,
+        BackendChoice::Cpu,
+        Precision::F64,
+        &out,
+        false,
+        &options,
+    )
+    .unwrap();
+    let u = s.uncertainty.as_ref().expect("a Monte Carlo report");
+    let stopped = common::variants_column(&out, "stopped_load_factor");
+    let hook = common::variants_column(&out, "hook_load_n");
+    let stops = stopped.iter().filter(|x| x.is_finite()).count();
+    let pushed = hook.iter().filter(|&&h| h < 0.0).count();
+    eprintln!("stops {stops}, pushed {pushed}; {:?}", u.stops);
+    assert!(stops > 0 && pushed > 0, "{stopped:?} {hook:?}");
+    let p = u.stops.as_ref().expect("runs stop");
+    assert_eq!((p.count, p.of), (stops, 8));
+    assert_eq!(p.probability, stops as f64 / 8.0);
+    assert_eq!(p.ci95, holewall::uq::stats::wilson(stops, 8));
+    let w = u.past_weight_lock_up.as_ref().expect("runs past it");
+    assert_eq!((w.count, w.of), (stops + pushed, 8));
+    assert!(s.digest(&out).contains(&format!(
+        "stops on its way (a lock-up): {stops} of 8 runs, probability {:.3}",
+        p.probability
+    )));
+    assert!(out.join("scatter_loads_reached_vs_mu.open.png").is_file());
+}

@@ -271,9 +271,7 @@ pub(crate) fn over_the_inputs(
             "how far the loads get (below 1: the string stops on its way)",
             "fraction of the friction and bit loads with an equilibrium",
             &[(String::new(), &|r: &VariantResult| {
-                r.string
-                    .stopped_load_factor
-                    .or((r.status != Status::Failed).then_some(1.0))
+                Some(super::report::loads_reached(r)).filter(|x| x.is_finite())
             })],
             true,
         )?;

@@ -193,11 +193,38 @@ impl EnsembleSummary {
         if self.failures.len() > 3 {
             t.push_str(&format!("\n  … {} more failures", self.failures.len() - 3));
         }
+        if let Some(u) = &self.uncertainty {
+            let lines = [
+                ("stops on its way (a lock-up)", &u.stops),
+                (
+                    "past the weight indicator's lock-up (pushed from the surface, or stopped)",
+                    &u.past_weight_lock_up,
+                ),
+            ];
+            for (what, p) in lines {
+                if let Some(p) = p {
+                    t.push_str(&format!(
+                        "\n  {what}: {} of {} runs, probability {:.3} (95 %: {:.3}–{:.3})",
+                        p.count, p.of, p.probability, p.ci95.0, p.ci95.1
+                    ));
+                }
+            }
+        }
         t.push_str(&format!(
             "\n  everything else: {}",
             out.join("summary.json").display()
         ));
         t
+    }
+}
+
+/// How far a variant's loads get: 1 where it reaches them, its stopped load factor where it
+/// stops on its way (a lock-up), NaN where it failed otherwise.
+pub(crate) fn loads_reached(r: &VariantResult) -> f64 {
+    match (r.string.stopped_load_factor, r.status) {
+        (Some(at), _) => at,
+        (None, Status::Failed) => f64::NAN,
+        (None, _) => 1.0,
     }
 }
 
@@ -414,8 +441,32 @@ pub(crate) fn uncertainty_report(
         })
         .collect();
     let failed: Vec<bool> = results.iter().map(|r| r.status == Status::Failed).collect();
-    let report = crate::uq::report::analyse(mc, &inputs, &qois, &failed);
-    let files = crate::uq::report::plot(&report, &inputs, &qois, out, &case.title)?;
+    let mut report = crate::uq::report::analyse(mc, &inputs, &qois, &failed);
+    let mut files = crate::uq::report::plot(&report, &inputs, &qois, out, &case.title)?;
+    // Where runs stop on their way (a lock-up): how likely, of the runs whose outcome is
+    // known, and how far each gets against the inputs.
+    let reached: Vec<f64> = results.iter().map(loads_reached).collect();
+    let sample = &reached[..report.base_samples];
+    let known = sample.iter().filter(|x| x.is_finite()).count();
+    let stopped = sample.iter().filter(|&&x| x < 1.0).count();
+    let pushed = results[..report.base_samples]
+        .iter()
+        .filter(|r| r.status != Status::Failed && r.hook_load_n.is_some_and(|h| h < 0.0))
+        .count();
+    if !dynamic && stopped + pushed > 0 {
+        report.past_weight_lock_up =
+            Some(crate::uq::stats::Proportion::of(stopped + pushed, known));
+    }
+    if stopped > 0 {
+        report.stops = Some(crate::uq::stats::Proportion::of(stopped, known));
+        files.extend(crate::uq::report::plot_reached(
+            &report,
+            &inputs,
+            &reached,
+            out,
+            &case.title,
+        )?);
+    }
     Ok((report, files))
 }
 

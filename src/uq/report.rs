@@ -187,6 +187,16 @@ pub struct UncertaintyReport {
     pub base_samples: usize,
     /// Per quantity.
     pub qois: Vec<QoiReport>,
+    /// Of the runs the statistics use whose outcome is known (solved, or stopped where the
+    /// string does: a lock-up), those that stop on their way, with the probability's Wilson
+    /// 95 % interval; `None` where no run stops (set by the ensemble, which knows stops).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub stops: Option<super::stats::Proportion>,
+    /// Of the same runs, those past the weight indicator's lock-up: solved with the string
+    /// pushed from the surface (a hook load below zero) or stopped on their way; `None`
+    /// where none is (static runs; set by the ensemble).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub past_weight_lock_up: Option<super::stats::Proportion>,
 }
 
 /// The report of a run: `inputs` (key, value per sample), `qois`, and which samples failed.
@@ -212,6 +222,8 @@ pub fn analyse(
         inputs: names.clone(),
         failed: failed.iter().filter(|f| **f).count(),
         base_samples: base,
+        stops: None,
+        past_weight_lock_up: None,
         qois: qois
             .iter()
             .map(|q| {
@@ -362,6 +374,45 @@ pub fn plot(
             )?;
             files.push(file);
         }
+    }
+    Ok(files)
+}
+
+/// Where runs stop on their way ([`UncertaintyReport::stops`]): how far each run's loads
+/// get (`reached`: 1 where it reaches them, its stopped load factor where it stops, NaN
+/// where its outcome is unknown) against each input, `scatter_loads_reached_vs_<key>.png`.
+pub fn plot_reached(
+    report: &UncertaintyReport,
+    inputs: &[(Key, Vec<f64>)],
+    reached: &[f64],
+    dir: &Path,
+    title: &str,
+) -> std::io::Result<Vec<String>> {
+    let Some(stops) = &report.stops else {
+        return Ok(Vec::new());
+    };
+    let base = report.base_samples;
+    let mut files = Vec::new();
+    for (key, x) in inputs {
+        let (xs, xu) = Unit::of_key(key).display();
+        let points: Vec<(f64, f64)> = x[..base]
+            .iter()
+            .zip(&reached[..base])
+            .filter(|(_, y)| y.is_finite())
+            .map(|(a, y)| (a * xs, *y))
+            .collect();
+        let file = format!("scatter_loads_reached_vs_{}.png", key.name);
+        crate::plots::scatter(
+            &dir.join(&file),
+            &format!(
+                "{title}: {} of {} runs stop on their way (P {:.2}, 95 %: {:.2}–{:.2}), against {}",
+                stops.count, stops.of, stops.probability, stops.ci95.0, stops.ci95.1, key.name
+            ),
+            &format!("{} ({xu})", key.name),
+            "fraction of the friction and bit loads with an equilibrium",
+            &points,
+        )?;
+        files.push(file);
     }
     Ok(files)
 }

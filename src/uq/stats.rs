@@ -65,6 +65,31 @@ pub struct Exceedance {
     pub ci95: (f64, f64),
 }
 
+/// A proportion of samples (`count` of `of`), with its Wilson 95 % interval.
+#[derive(Clone, Debug, Serialize, PartialEq)]
+pub struct Proportion {
+    /// Samples counted.
+    pub count: usize,
+    /// Of these samples.
+    pub of: usize,
+    /// `count / of` (NaN where `of` is 0).
+    pub probability: f64,
+    /// Wilson 95 % interval of that probability.
+    pub ci95: (f64, f64),
+}
+
+impl Proportion {
+    /// `count` of `of`.
+    pub fn of(count: usize, of: usize) -> Self {
+        Proportion {
+            count,
+            of,
+            probability: count as f64 / of as f64,
+            ci95: wilson(count, of),
+        }
+    }
+}
+
 /// Wilson's 95 % interval of a proportion `k/n`.
 pub fn wilson(k: usize, n: usize) -> (f64, f64) {
     if n == 0 {
