@@ -389,7 +389,7 @@ fn an_ensemble_names_the_variants_the_surface_pushes() {
 /// and the loads reached are drawn against the friction. About 5 s.
 #[test]
 fn a_monte_carlo_run_gives_the_chance_the_string_stops() {
-    use holewall::backend::{BackendChoice, Precision};
+    use holewall::backend::BackendChoice;
     let path = lock_up_case_with("monte-carlo", "15 m", "3 m", "0.368");
     let mut text = std::fs::read_to_string(&path).unwrap();
     text.push_str(
@@ -411,16 +411,7 @@ fn a_monte_carlo_run_gives_the_chance_the_string_stops() {
         monte_carlo: mc,
         ..Default::default()
     };
-    let s = holewall::ensemble::job::run(
-        &path,
-        None,
-        BackendChoice::Cpu,
-        Precision::F64,
-        &out,
-        false,
-        &options,
-    )
-    .unwrap();
+    let s = common::ensemble_with(&path, None, BackendChoice::Cpu, &out, &options);
     let u = s.uncertainty.as_ref().expect("a Monte Carlo report");
     let stopped = common::variants_column(&out, "stopped_load_factor");
     let hook = common::variants_column(&out, "hook_load_n");

@@ -340,6 +340,17 @@ pub fn ensemble_on(
     backend: holewall::backend::BackendChoice,
     out: &std::path::Path,
 ) -> holewall::ensemble::report::EnsembleSummary {
+    ensemble_with(case, variants, backend, out, &Default::default())
+}
+
+/// [`ensemble_on`] with `options` (a Monte Carlo run's, say).
+pub fn ensemble_with(
+    case: &std::path::Path,
+    variants: Option<&std::path::Path>,
+    backend: holewall::backend::BackendChoice,
+    out: &std::path::Path,
+    options: &holewall::ensemble::store::EnsembleOptions,
+) -> holewall::ensemble::report::EnsembleSummary {
     holewall::ensemble::job::run(
         case,
         variants,
@@ -347,7 +358,7 @@ pub fn ensemble_on(
         holewall::backend::Precision::F64,
         out,
         false,
-        &Default::default(),
+        options,
     )
     .unwrap()
 }
