@@ -384,9 +384,7 @@ pub fn run(
             .count(),
         pushed: results
             .iter()
-            .filter(|r| {
-                !dynamic && r.status != Status::Failed && r.hook_load_n.is_some_and(|h| h < 0.0)
-            })
+            .filter(|r| !dynamic && super::report::pushed(r))
             .count(),
         stopped_pushed: results
             .iter()

@@ -218,6 +218,12 @@ impl EnsembleSummary {
     }
 }
 
+/// A solved static variant the surface pushes (hook load below zero: past the weight
+/// indicator's lock-up; [`EnsembleSummary::pushed`]).
+pub(crate) fn pushed(r: &VariantResult) -> bool {
+    r.status != Status::Failed && r.hook_load_n.is_some_and(|h| h < 0.0)
+}
+
 /// How far a variant's loads get: 1 where it reaches them, its stopped load factor where it
 /// stops on its way (a lock-up), NaN where it failed otherwise.
 pub(crate) fn loads_reached(r: &VariantResult) -> f64 {
@@ -451,7 +457,7 @@ pub(crate) fn uncertainty_report(
     let stopped = sample.iter().filter(|&&x| x < 1.0).count();
     let pushed = results[..report.base_samples]
         .iter()
-        .filter(|r| r.status != Status::Failed && r.hook_load_n.is_some_and(|h| h < 0.0))
+        .filter(|r| pushed(r))
         .count();
     if !dynamic && stopped + pushed > 0 {
         report.past_weight_lock_up =
