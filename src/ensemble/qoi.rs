@@ -201,19 +201,18 @@ pub(crate) fn failed(name: &str, reason: String, stabs: usize) -> VariantResult 
 /// its load path bracketed where the string stops (a lock-up), `at` is the largest load
 /// factor at which it found an equilibrium (`variants.csv`'s `stopped_load_factor`; the
 /// CPU solve's [`crate::solve::statics::StaticError::stopped`], the engine's
-/// [`crate::engine::EngineResult::stops`]) and `stands` the string there, if kept
+/// [`crate::engine::EngineResult::stops`]), with the string there where one was kept
 /// ([`StringQoi::stands`]).
 pub(crate) fn failed_stopping(
     case: &Case,
     name: &str,
     reason: String,
     stabs: usize,
-    at: Option<f64>,
-    stands: Option<&crate::solve::statics::Stopped>,
+    stops: Option<(f64, Option<&crate::solve::statics::Stopped>)>,
 ) -> VariantResult {
     let mut r = failed(name, reason, stabs);
-    r.string.stopped_load_factor = at;
-    if let Some(st) = stands.filter(|st| Some(st.lambda) == at) {
+    r.string.stopped_load_factor = stops.map(|(at, _)| at);
+    if let Some(st) = stops.and_then(|(at, st)| st.filter(|st| st.lambda == at)) {
         let sol = crate::solve::statics::stopped_solution(st);
         let there = static_result(case, name, &st.model, &sol);
         r.string.stands = Some(Stands {
@@ -364,8 +363,7 @@ fn solve_held(
             name,
             e.to_string(),
             model.stabilizer_sites().len(),
-            e.stopped().map(|s| s.lambda),
-            e.stopped(),
+            e.stopped().map(|s| (s.lambda, Some(s))),
         ),
     }
 }
@@ -506,12 +504,9 @@ fn dynamic_held(
     let start = match solved {
         Ok(s) => s,
         Err(e) => {
-            let at = e.stopped().map(|s| s.lambda);
             let why = format!("{STATIC_START}{e}");
-            return (
-                failed_stopping(case, name, why, stabs.len(), at, e.stopped()),
-                None,
-            );
+            let stops = e.stopped().map(|s| (s.lambda, Some(s)));
+            return (failed_stopping(case, name, why, stabs.len(), stops), None);
         }
     };
     let relaxed_start = crate::solve::continuation::relaxed(&start.log);

@@ -126,7 +126,7 @@ fn after_engine_failure(
                 again.reason
             );
             let stabs = model.stabilizer_sites().len();
-            let mut r = failed_stopping(case, name, why, stabs, Some(at), stands);
+            let mut r = failed_stopping(case, name, why, stabs, Some((at, stands)));
             r.solved_by = SolvedBy::Engine;
             r
         }
