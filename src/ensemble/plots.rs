@@ -62,21 +62,13 @@ fn lines_over(
 ) -> Vec<(String, Vec<(f64, f64)>)> {
     let mut lines: Vec<(String, Vec<(f64, f64)>)> = Vec::new();
     for (v, r) in variants.iter().zip(results) {
-        let Some((xk, xv)) = v.overrides.get(x) else {
+        let Some((label, at)) = line_place(v, x) else {
             continue;
         };
-        let label = v
-            .overrides
-            .iter()
-            .enumerate()
-            .filter(|(i, _)| *i != x)
-            .map(|(_, (k, val))| key_value_text(k, *val))
-            .collect::<Vec<_>>()
-            .join(", ");
         let Some(y) = pick(r).filter(|h| h.is_finite()) else {
             continue;
         };
-        let point = (xv.si() * key_axis(xk).1, y * scale);
+        let point = (at, y * scale);
         match lines.iter_mut().find(|(l, _)| *l == label) {
             Some((_, pts)) => pts.push(point),
             None => lines.push((label, vec![point])),
@@ -86,6 +78,89 @@ fn lines_over(
         pts.sort_by(|a, b| a.0.total_cmp(&b.0));
     }
     lines
+}
+
+/// A variant's line in [`lines_over`] (named by its keys other than `x`) and its place
+/// along x in the key's plot unit; `None` where it lacks key `x`.
+fn line_place(v: &Variant, x: usize) -> Option<(String, f64)> {
+    let (xk, xv) = v.overrides.get(x)?;
+    let label = v
+        .overrides
+        .iter()
+        .enumerate()
+        .filter(|(i, _)| *i != x)
+        .map(|(_, (k, val))| key_value_text(k, *val))
+        .collect::<Vec<_>>()
+        .join(", ");
+    Some((label, xv.si() * key_axis(xk).1))
+}
+
+/// Where [`lines_over`]'s lines end because their string stops on its way (a lock-up: the
+/// variant's `stopped_load_factor`, no equilibrium at its full friction and bit loads): a
+/// point per such variant at its place along x, at the height of its line's nearest point
+/// (the reading before the string stops, or after it where the line has none before).
+/// Nothing for a variant whose line has no point at all.
+fn stop_marks(
+    variants: &[Variant],
+    results: &[VariantResult],
+    x: usize,
+    lines: &[(String, Vec<(f64, f64)>)],
+) -> Vec<(f64, f64)> {
+    let mut marks = Vec::new();
+    for (v, r) in variants.iter().zip(results) {
+        if r.string.stopped_load_factor.is_none() {
+            continue;
+        }
+        let Some((label, at)) = line_place(v, x) else {
+            continue;
+        };
+        let Some((_, pts)) = lines.iter().find(|(l, _)| *l == label) else {
+            continue;
+        };
+        // The nearest point, one before `at` on a tie.
+        let nearest = pts.iter().min_by(|a, b| {
+            let (da, db) = ((a.0 - at).abs(), (b.0 - at).abs());
+            da.total_cmp(&db).then(a.0.total_cmp(&b.0))
+        });
+        if let Some(p) = nearest {
+            marks.push((at, p.1));
+        }
+    }
+    marks
+}
+
+/// Where each of [`lines_over`]'s `loads` lines (the string's hook load, any scale) first
+/// falls from above zero to zero or below — the weight indicator's lock-up: past it the
+/// surface must push the string in — interpolated linearly along x; a point per such line at
+/// that x and at the height of the line of the same name in `drawn` (what the plot draws:
+/// the indicator's reading where the case has a rig), interpolated the same way.
+fn zero_crossings(
+    loads: &[(String, Vec<(f64, f64)>)],
+    drawn: &[(String, Vec<(f64, f64)>)],
+) -> Vec<(f64, f64)> {
+    let at = |pts: &[(f64, f64)], x: f64| -> Option<f64> {
+        let w = pts.windows(2).find(|w| w[0].0 <= x && x <= w[1].0)?;
+        let t = if w[1].0 > w[0].0 {
+            (x - w[0].0) / (w[1].0 - w[0].0)
+        } else {
+            0.0
+        };
+        Some(w[0].1 + t * (w[1].1 - w[0].1))
+    };
+    let mut marks = Vec::new();
+    for (label, pts) in loads {
+        let Some(w) = pts.windows(2).find(|w| w[0].1 > 0.0 && w[1].1 <= 0.0) else {
+            continue;
+        };
+        let x = w[0].0 + (w[1].0 - w[0].0) * w[0].1 / (w[0].1 - w[1].1);
+        let Some((_, line)) = drawn.iter().find(|(l, _)| l == label) else {
+            continue;
+        };
+        if let Some(y) = at(line, x) {
+            marks.push((x, y));
+        }
+    }
+    marks
 }
 
 /// The numeric keys the variants vary (positions in each variant's overrides; not `mode` or
@@ -307,6 +382,13 @@ pub(crate) fn over_the_inputs(
 /// with its distance, not drawn: the loads stay readable.
 const OFF_SCALE: f64 = 3.0;
 
+/// The legend of [`stop_marks`] on the broomstick.
+const STOP_MARK: &str = "lock-up: the string stops at this depth (no equilibrium found)";
+
+/// The legend of [`zero_crossings`] on the broomstick.
+const PUSHED_MARK: &str =
+    "the hook load falls to zero (weight-indicator lock-up): deeper, the surface must push";
+
 /// A quantity of a variant's result.
 type Pick = dyn Fn(&VariantResult) -> Option<f64>;
 
@@ -426,13 +508,31 @@ pub(crate) fn broomstick(
             )
         }
     };
+    // Where a line ends because its string stops on the way, a mark of its own.
+    let mut hook_points = measured_of(|m| m.hook_load);
+    let pushed = zero_crossings(&lines_of(&|r| r.hook_load_n), &hook_lines);
+    if !pushed.is_empty() {
+        hook_points.push(Series {
+            name: PUSHED_MARK,
+            points: pushed,
+            wide: false,
+        });
+    }
+    let stops = stop_marks(variants, results, x, &hook_lines);
+    if !stops.is_empty() {
+        hook_points.push(Series {
+            name: STOP_MARK,
+            points: stops,
+            wide: false,
+        });
+    }
     let mut files = Vec::new();
     draw(
         "broomstick.png",
         "hook load",
         &crate::rig::hook_load_axis(case.rig),
         &series,
-        &measured_of(|m| m.hook_load),
+        &hook_points,
     )?;
     files.push("broomstick.png".to_string());
     // Surface torque of the lines that rotate (a sliding or tripping line reads 0).
@@ -537,5 +637,64 @@ mod tests {
             key_value_text(&variants[0].overrides[1].0, Value::Number(44_482.0)),
             "wob 44.48 kN"
         );
+    }
+
+    #[test]
+    fn a_line_that_stops_is_marked_at_the_depth_it_stops() {
+        // Hook loads at 1,000–4,000 m for two friction factors; with 0.4 the string stops
+        // at 3,000 and 4,000 m, with 0.2 at none.
+        let (depth, mu) = (Key::parse("depth").unwrap(), Key::parse("mu").unwrap());
+        let mut variants = Vec::new();
+        let mut results = Vec::new();
+        for m in [0.2, 0.4] {
+            for d in [1000.0, 2000.0, 3000.0, 4000.0] {
+                variants.push(Variant {
+                    name: format!("{}", variants.len()),
+                    overrides: vec![
+                        (mu.clone(), Value::Number(m)),
+                        (depth.clone(), Value::Number(d)),
+                    ],
+                });
+                let mut r = crate::ensemble::qoi::failed("v", String::new(), 0);
+                if m > 0.3 && d > 2500.0 {
+                    r.string.stopped_load_factor = Some(0.875);
+                } else {
+                    r.hook_load_n = Some(1e6 - 100.0 * d - 1e5 * m);
+                }
+                results.push(r);
+            }
+        }
+        let pick = |r: &VariantResult| r.hook_load_n;
+        let lines = lines_over(&variants, &results, 1, 1e-3, &pick);
+        assert_eq!(lines.len(), 2);
+        assert_eq!(lines[1].1.len(), 2, "the 0.4 line ends at 2,000 m");
+        // Each stopped depth is marked at the 0.4 line's last reading (2,000 m).
+        let marks = stop_marks(&variants, &results, 1, &lines);
+        assert_eq!(marks, vec![(3000.0, 760.0), (4000.0, 760.0)]);
+        // No stop, no mark.
+        let solved: Vec<VariantResult> = results
+            .iter()
+            .map(|r| {
+                let mut r = r.clone();
+                r.string.stopped_load_factor = None;
+                r
+            })
+            .collect();
+        assert!(stop_marks(&variants, &solved, 1, &lines).is_empty());
+        // The weight indicator's lock-up: the 0.2 line's 760 → 660 → … never crosses zero;
+        // one falling from 200 to −200 between 1,000 and 2,000 m crosses at 1,500 m, and its
+        // drawn twin (a rig's reading, 50 more) is read there.
+        let loads = vec![
+            (
+                "a".to_string(),
+                vec![(1000.0, 200.0), (2000.0, -200.0), (3000.0, -600.0)],
+            ),
+            ("b".to_string(), vec![(1000.0, 760.0), (2000.0, 660.0)]),
+        ];
+        let drawn = vec![(
+            "a".to_string(),
+            vec![(1000.0, 250.0), (2000.0, -150.0), (3000.0, -550.0)],
+        )];
+        assert_eq!(zero_crossings(&loads, &drawn), vec![(1500.0, 50.0)]);
     }
 }
